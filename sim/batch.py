@@ -1,0 +1,173 @@
+"""``simulate_batch``: validate, pack constants, allocate, run the kernel, return the recorded signals."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from sim import kernels
+from sim.aircraft import FlightCondition, GroundLoad, load_model
+from sim.checks import InputError, array_in_range, finite_array, in_range
+from sim.effects import EffectSet
+from sim.params import ActuatorParams, HealthParams
+
+DEFAULT_SAMPLE_RATE_HZ = 10_000.0
+SAMPLE_RATE_RANGE_HZ = (1_000.0, 100_000.0)
+LANES = 64  # simulations advanced in lock-step; fewer lanes pay more per-step loop overhead
+MAX_INITIAL_SPEED_RADPS = 700.0
+MAX_INITIAL_CURRENT_A = 30.0
+
+SIGNAL_NAMES = ("position_deg", "motor_speed_radps", "current_a", "hinge_moment_nm", "command_deg")
+TRUTH_NAME = "loss_torque_nm"
+
+
+@dataclass(frozen=True)
+class InitialState:
+    """Where every simulation of a batch starts (the first sample of a window)."""
+
+    position_deg: float = 0.0  # elevator deflection θ_u [deg]
+    motor_speed_radps: float = 0.0  # ω_m [rad/s]
+    current_a: float = 0.0  # phase current I [A]
+
+
+@dataclass(frozen=True)
+class BatchResult:
+    """Recorded signals, each (n_simulations, n_samples) of interval means at ``sample_rate_hz``.
+
+    ``signals`` holds the five window signals; ``loss_torque_nm`` is the true transmission loss
+    (dry + viscous + cogging friction at the motor shaft), what the residual torque reconstructs.
+    """
+
+    sample_rate_hz: float
+    signals: dict[str, np.ndarray]
+    loss_torque_nm: np.ndarray
+    health: HealthParams
+    effects: EffectSet = field(default_factory=EffectSet)
+
+    @property
+    def n_samples(self) -> int:
+        return self.loss_torque_nm.shape[1]
+
+    def simulation(self, index: int) -> dict[str, np.ndarray]:
+        """One simulation's signals, as a window would hold them."""
+        return {name: values[index] for name, values in self.signals.items()}
+
+
+def kernel_constants(actuator: ActuatorParams, effects: EffectSet, steps_per_sample: int) -> kernels.KernelConstants:
+    """The step's constants with the effects folded in (derived once per batch)."""
+    gain = effects.get("torque_constant", "gain")
+    stribeck_speed = effects.get("stribeck", "speed_radps")
+    return kernels.KernelConstants(
+        step_s=actuator.step_s,
+        steps_per_sample=steps_per_sample,
+        position_gain=actuator.position_gain_per_s,
+        max_speed_ref=actuator.max_motor_speed_radps,
+        speed_gain_over_kt=actuator.speed_gain_nms / actuator.torque_constant_nm_per_a,
+        max_current=actuator.max_current_a,
+        supply_voltage=actuator.supply_voltage_v,
+        resistance=actuator.resistance_ohm,
+        step_over_inductance=actuator.step_s / actuator.inductance_h,
+        back_emf=gain * actuator.torque_constant_nm_per_a,
+        torque_constant=gain * actuator.torque_constant_nm_per_a,
+        max_torque=actuator.max_motor_torque_nm,
+        inverse_gear=1.0 / actuator.gear_ratio,
+        step_over_inertia=actuator.step_s / actuator.inertia_kgm2,
+        viscous=actuator.viscous_nms + effects.get("viscous", "coefficient_nms"),
+        half_backlash=0.5 * (actuator.backlash_rad + effects.get("backlash", "extra_rad")),
+        end_stop=float(np.radians(actuator.end_stop_deg)),
+        current_sensor_gain=effects.get("current_sensor_gain", "gain"),
+        hinge_sensor_bias=effects.get("hinge_moment_bias", "bias_nm"),
+        stribeck_amplitude=effects.get("stribeck", "amplitude_nm"),
+        stribeck_inverse_speed=1.0 / stribeck_speed,
+        position_friction=effects.get("position_friction", "amplitude_nm") / np.radians(actuator.end_stop_deg),
+        cogging_amplitude=effects.get("cogging", "amplitude_nm"),
+        cogging_wavenumber=effects.get("cogging", "periods_per_rev") * actuator.gear_ratio,
+        with_stribeck=effects.get("stribeck", "amplitude_nm") != 0.0,
+        with_cogging=effects.get("cogging", "amplitude_nm") != 0.0,
+    )
+
+
+def steps_per_sample(sample_rate_hz: float, actuator: ActuatorParams) -> int:
+    """Integration steps per log interval; the log interval must be a whole number of steps."""
+    rate = in_range("sample_rate_hz", sample_rate_hz, *SAMPLE_RATE_RANGE_HZ, "Hz")
+    steps = round(1.0 / (rate * actuator.step_s))
+    if abs(steps * rate * actuator.step_s - 1.0) > 1e-9:
+        raise InputError("sample_rate_hz", f"1/{rate:g} s is not a whole number of {actuator.step_s:g} s steps")
+    return steps
+
+
+def _checked_knots(command_knots_deg: np.ndarray, n_health: int, end_stop_deg: float) -> np.ndarray:
+    knots = np.atleast_2d(finite_array("command_knots_deg", command_knots_deg))
+    if knots.ndim != 2 or knots.shape[1] < 2:
+        raise InputError("command_knots_deg", f"must be (n_samples + 1,) or (n, n_samples + 1), got {knots.shape}")
+    if knots.shape[0] not in (1, n_health):
+        raise InputError(
+            "command_knots_deg", f"needs 1 command or one per simulation ({n_health}), got {knots.shape[0]}"
+        )
+    array_in_range("command_knots_deg", knots, -end_stop_deg - 10.0, end_stop_deg + 10.0, "deg")
+    return knots
+
+
+def _checked_initial(initial: InitialState, end_stop_deg: float) -> InitialState:
+    in_range("initial.position_deg", initial.position_deg, -end_stop_deg, end_stop_deg, "deg")
+    in_range("initial.motor_speed_radps", initial.motor_speed_radps, -MAX_INITIAL_SPEED_RADPS, MAX_INITIAL_SPEED_RADPS)
+    in_range("initial.current_a", initial.current_a, -MAX_INITIAL_CURRENT_A, MAX_INITIAL_CURRENT_A, "A")
+    return initial
+
+
+def _padded(values: np.ndarray, multiple: int) -> np.ndarray:
+    """Repeat the last column so the simulation axis (last) is a multiple of ``multiple``."""
+    missing = -values.shape[-1] % multiple
+    if missing == 0:
+        return np.ascontiguousarray(values)
+    return np.concatenate([values, np.repeat(values[..., -1:], missing, axis=-1)], axis=-1)
+
+
+def simulate_batch(
+    command_knots_deg: np.ndarray,
+    health: HealthParams,
+    load: FlightCondition | GroundLoad = FlightCondition(),
+    initial: InitialState = InitialState(),
+    sample_rate_hz: float = DEFAULT_SAMPLE_RATE_HZ,
+    effects: EffectSet = EffectSet(),
+    actuator: ActuatorParams = ActuatorParams(),
+    lanes: int = LANES,
+) -> BatchResult:
+    """Simulate one simulation per entry of ``health`` and record interval means at ``sample_rate_hz``.
+
+    ``command_knots_deg`` is the command at the log-interval boundaries (see ``sim.commands``):
+    (n_samples + 1,) shared by the batch (Case 1) or (n_simulations, n_samples + 1) (Case 2).
+    The 1 µs trajectory is never stored. Deterministic: the same inputs give the same output.
+    """
+    if not isinstance(health, HealthParams):
+        raise InputError("health", f"must be HealthParams, got {type(health).__name__}")
+    n_sims = len(health)
+    knots = _checked_knots(command_knots_deg, n_sims, actuator.end_stop_deg)
+    _checked_initial(initial, actuator.end_stop_deg)
+    if not isinstance(effects, EffectSet):
+        raise InputError("effects", f"must be an EffectSet, got {type(effects).__name__}")
+    if not 1 <= lanes <= 64:
+        raise InputError("lanes", f"must be in [1, 64], got {lanes}")
+    steps = steps_per_sample(sample_rate_hz, actuator)
+    n_samples = knots.shape[1] - 1
+    constants = kernel_constants(actuator, effects, steps)
+    loads = load_model(load, interval_s=steps * actuator.step_s)
+
+    eta_a = health.eta_a(actuator.gear_ratio)
+    per_sim = _padded(np.stack([health.fdj_nm, health.fsj_nm, 1.0 - eta_a, 1.0 / health.eta_o - 1.0]), lanes)
+    start = [np.radians(initial.position_deg), initial.motor_speed_radps, initial.current_a]
+    initial_rows = np.repeat(np.array(start)[:, None], per_sim.shape[1], axis=1)
+    out = np.empty((kernels.N_RECORDED, per_sim.shape[1], n_samples))
+    kernels.simulate_groups(
+        constants, loads, per_sim, np.ascontiguousarray(np.radians(knots)), initial_rows, lanes, out
+    )
+    out = out[:, :n_sims]
+    signals = {
+        "position_deg": np.degrees(out[kernels.POSITION]),
+        "motor_speed_radps": out[kernels.SPEED],
+        "current_a": out[kernels.CURRENT],
+        "hinge_moment_nm": out[kernels.HINGE],
+        "command_deg": np.degrees(out[kernels.COMMAND]),
+    }
+    return BatchResult(sample_rate_hz, signals, out[kernels.LOSS], health, effects)

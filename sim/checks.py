@@ -1,0 +1,49 @@
+"""Input validation shared by every layer: one error type that names the offending field."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+
+class InputError(ValueError):
+    """Bad input; ``field`` names the argument or window field at fault."""
+
+    def __init__(self, field: str, message: str) -> None:
+        super().__init__(f"{field}: {message}")
+        self.field = field
+        self.message = message
+
+
+def finite_array(field: str, values: object, ndim: int | None = None) -> np.ndarray:
+    """Return ``values`` as a float64 array, refusing NaN/inf and the wrong number of dimensions."""
+    try:
+        array = np.asarray(values, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise InputError(field, f"must be numeric ({exc})") from None
+    if ndim is not None and array.ndim != ndim:
+        raise InputError(field, f"must have {ndim} dimension(s), got shape {array.shape}")
+    if not np.all(np.isfinite(array)):
+        bad = int(np.flatnonzero(~np.isfinite(array.ravel()))[0])
+        raise InputError(field, f"contains NaN or inf (first at flat index {bad})")
+    return array
+
+
+def in_range(field: str, value: float, low: float, high: float, unit: str = "") -> float:
+    """Return ``value`` as a float if it lies in [low, high], else raise naming the field."""
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        raise InputError(field, f"must be a number, got {value!r}") from None
+    if not math.isfinite(number) or not low <= number <= high:
+        raise InputError(field, f"{number:g} is outside [{low:g}, {high:g}] {unit}".rstrip())
+    return number
+
+
+def array_in_range(field: str, values: np.ndarray, low: float, high: float, unit: str = "") -> None:
+    """Raise naming the field if any element lies outside [low, high]."""
+    outside = (values < low) | (values > high)
+    if np.any(outside):
+        first = float(values.ravel()[np.flatnonzero(outside.ravel())[0]])
+        raise InputError(field, f"value {first:g} is outside [{low:g}, {high:g}] {unit}".rstrip())

@@ -1,0 +1,73 @@
+"""Elevator commands: the thesis §5.6 random command and the knots the kernel interpolates.
+
+The kernel takes a command as *knots*: its values at the boundaries of the log intervals
+(n_samples + 1 of them), interpolated linearly at every 1 µs step. A synthetic command is
+evaluated there exactly; a logged command (interval means) is turned into knots by
+:func:`knots_from_samples`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from sim.checks import InputError, finite_array
+
+COMMAND_AMPLITUDE_DEG = 25.0
+COMMAND_POINTS = 5
+# A 5th-order polynomial through ±25° points overshoots: about one command in three leaves ±28°
+# between its nodes, one in ten ±42°. A flight-control computer never commands past the travel,
+# so such draws are rejected (and redrawn) rather than driven into the 30° end stops.
+COMMAND_LIMIT_DEG = 28.0
+
+
+def random_command_coefficients(duration_s: float, rng: np.random.Generator) -> np.ndarray:
+    """Power-series coefficients (highest first, t in s) of one §5.6 command.
+
+    Five values uniform in ±25° placed with a leading 0° at 6 equally spaced instants over
+    [0, duration]; the 5th-order polynomial through the 6 points is unique.
+    """
+    times = np.linspace(0.0, duration_s, COMMAND_POINTS + 1)
+    values = np.concatenate([[0.0], rng.uniform(-COMMAND_AMPLITUDE_DEG, COMMAND_AMPLITUDE_DEG, COMMAND_POINTS)])
+    # Solving the Vandermonde system in normalized time keeps it well conditioned.
+    coefficients_unit = np.linalg.solve(np.vander(times / duration_s), values)
+    return coefficients_unit / duration_s ** np.arange(COMMAND_POINTS, -1, -1)
+
+
+def random_command_knots(
+    n_samples: int, sample_rate_hz: float, rng: np.random.Generator, n_commands: int = 1
+) -> np.ndarray:
+    """(n_commands, n_samples + 1) knots [deg] of independent §5.6 commands (Case 2 uses one per simulation)."""
+    duration_s = n_samples / sample_rate_hz
+    times = np.arange(n_samples + 1) / sample_rate_hz
+    dense = np.linspace(0.0, duration_s, 2001)  # fine enough to see any overshoot between knots
+    commands = []
+    while len(commands) < n_commands:
+        coefficients = random_command_coefficients(duration_s, rng)
+        if np.max(np.abs(np.polyval(coefficients, dense))) <= COMMAND_LIMIT_DEG:
+            commands.append(np.polyval(coefficients, times))
+    return np.stack(commands)
+
+
+def knots_from_samples(command_deg: np.ndarray) -> np.ndarray:
+    """Knots at interval boundaries from interval-mean samples.
+
+    Inside, the fourth-order boundary value of cell means, (7·(c₋₁ + c₀) − (c₋₂ + c₁)) / 12, so a
+    smooth command's means are reproduced to O(Δt⁴); the two knots at each end use the one-sided
+    third-order formulas from the three nearest means.
+    Accepts (n_samples,) or (n_commands, n_samples); returns one more column.
+    """
+    samples = np.atleast_2d(finite_array("command_deg", command_deg))
+    if samples.shape[-1] < 4:
+        raise InputError("command_deg", "needs at least 4 samples")
+    knots = np.empty((samples.shape[0], samples.shape[1] + 1))
+    knots[:, 2:-2] = (7 * (samples[:, 1:-2] + samples[:, 2:-1]) - (samples[:, :-3] + samples[:, 3:])) / 12
+    first, last = samples[:, :3], samples[:, :-4:-1]  # the three means nearest each end, outward first
+    for edge, near in ((0, first), (-1, last)):
+        knots[:, edge] = (11 * near[:, 0] - 7 * near[:, 1] + 2 * near[:, 2]) / 6
+        knots[:, 1 if edge == 0 else -2] = (2 * near[:, 0] + 5 * near[:, 1] - near[:, 2]) / 6
+    return knots
+
+
+def interval_means(knots: np.ndarray) -> np.ndarray:
+    """The mean of the linearly interpolated command over each interval (inverse of knots_from_samples)."""
+    return 0.5 * (knots[..., 1:] + knots[..., :-1])

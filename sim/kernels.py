@@ -1,0 +1,213 @@
+"""The Numba kernels: one 1 µs step of the EMA, and the lock-step loop over groups of simulations.
+
+Pure functions of their arguments: ``sim.batch`` validates, packs the constants, allocates
+``out`` and calls :func:`simulate_groups`. The step is written once (:func:`advance`) and every
+loop uses it, so the vectorized lock-step path and the one-lane path run the same arithmetic.
+The branches in :func:`advance` are simple enough for LLVM to turn into selects; that is what
+lets the lane loop in :func:`_run_group` vectorize across simulations.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+from numba import njit, prange
+
+# Rows of ``out``: recorded signals, each the mean over a log interval.
+POSITION, SPEED, CURRENT, HINGE, COMMAND, LOSS = range(6)
+N_RECORDED = 6
+# Rows of ``initial``: the state every simulation starts from.
+INIT_POSITION, INIT_SPEED, INIT_CURRENT = range(3)
+# Rows of ``per_sim``: health parameters in the form the friction model uses.
+FDJ, FSJ, K_AID, K_OPP = range(4)
+# Rows of a group's ``lane`` array. Everything the lane loop touches lives in this one array so
+# that LLVM sees a single base pointer and vectorizes without runtime overlap checks.
+CURRENT_NOW, SPEED_NOW, ANGLE_NOW, POSITION_NOW = range(4)  # state
+HINGE_SLOW, COMMAND0, COMMAND_STEP, COGGING = range(4, 8)  # inputs, fixed over a step or interval
+LANE_FDJ, LANE_FSJ, LANE_K_AID, LANE_K_OPP = range(8, 12)  # health, copied from per_sim
+SUM_POSITION, SUM_SPEED, SUM_CURRENT, SUM_LOSS = range(12, 16)  # running sums over the interval
+N_LANE_ROWS = 16
+
+
+class KernelConstants(NamedTuple):
+    """Everything constant over a batch, in the form the step uses (derived once, in sim.batch)."""
+
+    step_s: float  # h [s]
+    steps_per_sample: int  # 1 µs steps per log interval
+    position_gain: float  # G_P [1/s]
+    max_speed_ref: float  # ω_max [rad/s]
+    speed_gain_over_kt: float  # GAP / k_T nominal [A·s/rad]
+    max_current: float  # I_max [A]
+    supply_voltage: float  # V_max [V]
+    resistance: float  # R [Ω]
+    step_over_inductance: float  # h / L [s/H]
+    back_emf: float  # k_e, true [V·s/rad]
+    torque_constant: float  # k_T, true [N·m/A]
+    max_torque: float  # T_M,max [N·m]
+    inverse_gear: float  # 1 / n [-]
+    step_over_inertia: float  # h / J_M [s/(kg·m²)]
+    viscous: float  # C_M, true [N·m·s/rad]
+    half_backlash: float  # BLK / 2 [rad], elevator side
+    end_stop: float  # θ_stop [rad]
+    current_sensor_gain: float  # measured / true current [-]
+    hinge_sensor_bias: float  # measured − true hinge moment [N·m]
+    stribeck_amplitude: float  # extra dry friction at zero speed [N·m]
+    stribeck_inverse_speed: float  # 1 / ω_s [s/rad]
+    position_friction: float  # extra dry friction per rad of |θ_u| [N·m/rad]
+    cogging_amplitude: float  # [N·m]
+    cogging_wavenumber: float  # cogging periods per rad of θ_m / n [1/rad]
+    with_stribeck: bool  # skip the division when the effect is off
+    with_cogging: bool  # skip the sine when the effect is off
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def advance(c, hinge_delta, command_rad, hinge_slow, cogging, fdj, fsj, k_aid, k_opp, current, speed, angle, position):
+    """One step h of controller, RL phase, shaft with Borello friction, end stops and backlash.
+
+    ``angle`` is θ_m / n (the motor angle seen on the elevator side), ``position`` the elevator
+    deflection θ_u after the backlash; ``cogging`` the cogging torque at ``angle`` (0 when off).
+    Returns the new (current, speed, angle, position) and the step's
+    transmission loss torque [N·m] (dry + viscous + cogging).
+    Written branch-free (selects, min/max) so that a loop over simulations vectorizes.
+    """
+    # Controller: P position loop -> speed reference, P speed loop -> current reference.
+    speed_ref = min(max(c.position_gain * (command_rad - position), -c.max_speed_ref), c.max_speed_ref)
+    current_ref = min(max(c.speed_gain_over_kt * (speed_ref - speed), -c.max_current), c.max_current)
+    # PWM-like bang-bang on the measured current; explicit Euler on L·dI/dt = V − R·I − k_e·ω.
+    measured = c.current_sensor_gain * current
+    voltage = c.supply_voltage if current_ref > measured else (-c.supply_voltage if current_ref < measured else 0.0)
+    current = current + c.step_over_inductance * (voltage - c.resistance * current - c.back_emf * speed)
+    motor_torque = min(max(c.torque_constant * current, -c.max_torque), c.max_torque)
+
+    hinge = hinge_slow + hinge_delta * position
+    load = hinge * c.inverse_gear  # T_ext at the motor shaft
+    drive = motor_torque + load - c.viscous * speed - cogging
+
+    # Borello friction: aiding when the load acts along the motion (of the drive when stuck).
+    moving = speed != 0.0
+    direction_of = speed if moving else drive
+    direction = 1.0 if direction_of > 0.0 else (-1.0 if direction_of < 0.0 else 0.0)
+    k_load = k_aid if load * direction > 0.0 else k_opp
+    load_part = k_load * abs(load) + c.position_friction * abs(position)
+    dynamic = fdj + load_part
+    if c.with_stribeck:
+        ratio = speed * c.stribeck_inverse_speed
+        dynamic += c.stribeck_amplitude / (1.0 + ratio * ratio)
+    stuck = (not moving) & (abs(drive) <= fsj + load_part)
+    friction = drive if stuck else dynamic * direction
+    new_speed = speed + c.step_over_inertia * (drive - friction)
+    # Slipping through zero stops the shaft; the next step decides stick or slip.
+    new_speed = 0.0 if new_speed * speed < 0.0 else new_speed
+    loss = friction + c.viscous * speed + cogging
+
+    # Kinematics: semi-implicit Euler, end stops on the shaft, dead band on the elevator side.
+    free_angle = angle + c.step_s * c.inverse_gear * new_speed
+    angle = min(max(free_angle, -c.end_stop), c.end_stop)
+    new_speed = min(new_speed, 0.0) if free_angle > c.end_stop else new_speed
+    new_speed = max(new_speed, 0.0) if free_angle < -c.end_stop else new_speed
+    position = min(max(position, angle - c.half_backlash), angle + c.half_backlash)
+    return current, new_speed, angle, position, loss
+
+
+@njit(cache=True)
+def _hinge_slow(load, state, time_s):
+    """The part of H_e that changes on the aircraft's time scale: trim, α_t, the ground ramp."""
+    alpha_t = load.alpha_t0_rad
+    for i in range(4):
+        alpha_t += load.alpha_t_row[i] * state[i]
+    alpha_t = min(max(alpha_t, -load.alpha_t_limit_rad), load.alpha_t_limit_rad)
+    return load.hinge_bias_nm + load.hinge_alpha_nm * alpha_t + load.hinge_ramp_nmps * time_s
+
+
+@njit(cache=True)
+def _advance_aircraft(load, state, mean_elevator_rad):
+    """x ← Ad·x + Bd·(mean δe − δe_trim): exact ZOH over one log interval."""
+    du = mean_elevator_rad - load.trim_elevator_rad
+    new = np.empty(4)
+    for i in range(4):
+        acc = load.bd[i] * du
+        for j in range(4):
+            acc += load.ad[i, j] * state[j]
+        new[i] = acc
+    state[:] = new
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _advance_lanes(c, hinge_delta, j, lane):
+    """Advance every lane (simulation) of a group by one step h: the loop LLVM vectorizes."""
+    n_lanes = lane.shape[1]
+    if c.with_cogging:  # a call to sin would keep the main loop scalar: evaluate it apart
+        for s in range(n_lanes):
+            lane[COGGING, s] = c.cogging_amplitude * np.sin(c.cogging_wavenumber * lane[ANGLE_NOW, s])
+    for s in range(n_lanes):
+        command = lane[COMMAND0, s] + lane[COMMAND_STEP, s] * j
+        current, speed, angle, position, loss = advance(
+            c, hinge_delta, command, lane[HINGE_SLOW, s], lane[COGGING, s],
+            lane[LANE_FDJ, s], lane[LANE_FSJ, s], lane[LANE_K_AID, s], lane[LANE_K_OPP, s],
+            lane[CURRENT_NOW, s], lane[SPEED_NOW, s], lane[ANGLE_NOW, s], lane[POSITION_NOW, s],
+        )  # fmt: skip
+        lane[CURRENT_NOW, s] = current
+        lane[SPEED_NOW, s] = speed
+        lane[ANGLE_NOW, s] = angle
+        lane[POSITION_NOW, s] = position
+        lane[SUM_POSITION, s] += position
+        lane[SUM_SPEED, s] += speed
+        lane[SUM_CURRENT, s] += current
+        lane[SUM_LOSS, s] += loss
+
+
+@njit(cache=True, error_model="numpy")
+def _run_group(c, load, per_sim, knots_rad, initial, first, lanes, out):
+    """Simulate sims [first, first + lanes) in lock-step and write their interval means into out."""
+    n_samples = out.shape[2]
+    per_sim_command = knots_rad.shape[0] > 1
+    steps = c.steps_per_sample
+    interval_s = steps * c.step_s
+    lane = np.zeros((N_LANE_ROWS, lanes))
+    group = slice(first, first + lanes)
+    lane[CURRENT_NOW] = initial[INIT_CURRENT, group]
+    lane[SPEED_NOW] = initial[INIT_SPEED, group]
+    lane[POSITION_NOW] = initial[INIT_POSITION, group]
+    lane[ANGLE_NOW] = initial[INIT_POSITION, group]  # the shaft starts centred in the dead band
+    lane[LANE_FDJ] = per_sim[FDJ, group]
+    lane[LANE_FSJ] = per_sim[FSJ, group]
+    lane[LANE_K_AID] = per_sim[K_AID, group]
+    lane[LANE_K_OPP] = per_sim[K_OPP, group]
+    aircraft = np.zeros((lanes, 4))  # Δx: every simulation starts at trim
+    for s in range(lanes):
+        lane[HINGE_SLOW, s] = _hinge_slow(load, aircraft[s], 0.0)
+
+    for k in range(n_samples):
+        for s in range(lanes):
+            row = first + s if per_sim_command else 0
+            lane[COMMAND0, s] = knots_rad[row, k]
+            lane[COMMAND_STEP, s] = (knots_rad[row, k + 1] - knots_rad[row, k]) / steps
+        lane[SUM_POSITION:] = 0.0
+        for j in range(steps):
+            _advance_lanes(c, load.hinge_delta_nm, j, lane)
+        for s in range(lanes):
+            mean_position = lane[SUM_POSITION, s] / steps
+            out[POSITION, first + s, k] = mean_position
+            out[SPEED, first + s, k] = lane[SUM_SPEED, s] / steps
+            out[CURRENT, first + s, k] = c.current_sensor_gain * lane[SUM_CURRENT, s] / steps
+            out[LOSS, first + s, k] = lane[SUM_LOSS, s] / steps
+            # H_e is affine in θ_u within an interval, so its mean follows from the mean position.
+            hinge = lane[HINGE_SLOW, s] + load.hinge_delta_nm * mean_position
+            out[HINGE, first + s, k] = hinge + c.hinge_sensor_bias
+            out[COMMAND, first + s, k] = lane[COMMAND0, s] + lane[COMMAND_STEP, s] * (steps - 1) / 2
+            _advance_aircraft(load, aircraft[s], mean_position)
+            lane[HINGE_SLOW, s] = _hinge_slow(load, aircraft[s], (k + 1) * interval_s)
+
+
+@njit(cache=True, parallel=True)
+def simulate_groups(c, load, per_sim, knots_rad, initial, lanes, out):
+    """Run every group of ``lanes`` simulations, groups in parallel over the cores.
+
+    ``per_sim`` is (4, N): FDJ, FSJ, 1 − η_A, 1/η_O − 1, padded by the caller to a multiple of
+    ``lanes``. ``knots_rad`` is (1, K+1) for one command shared by the batch or (N, K+1) for one
+    per simulation; ``out`` is (6, N, K).
+    """
+    n_groups = per_sim.shape[1] // lanes
+    for g in prange(n_groups):
+        _run_group(c, load, per_sim, knots_rad, initial, g * lanes, lanes, out)

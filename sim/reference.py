@@ -1,0 +1,85 @@
+"""The same model written as plain NumPy, vectorized across simulations: the baseline the kernel is
+measured against, and an independent check of its arithmetic (tests compare the two).
+
+Slow by design of NumPy, not by neglect: every 1 µs step is some forty array operations, each a
+pass over the batch, so it is only timed on short horizons.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from sim.aircraft import LoadModel
+from sim.kernels import KernelConstants
+
+
+def _hinge_slow(load: LoadModel, aircraft: np.ndarray, time_s: float) -> np.ndarray:
+    alpha_t = np.clip(load.alpha_t0_rad + aircraft @ load.alpha_t_row, -load.alpha_t_limit_rad, load.alpha_t_limit_rad)
+    return load.hinge_bias_nm + load.hinge_alpha_nm * alpha_t + load.hinge_ramp_nmps * time_s
+
+
+def simulate_numpy(
+    c: KernelConstants,
+    load: LoadModel,
+    per_sim: np.ndarray,
+    knots_rad: np.ndarray,
+    initial: np.ndarray,
+    n_samples: int,
+) -> np.ndarray:
+    """(6, N, n_samples) interval means, rows as ``sim.kernels`` (position, speed, current, hinge, command, loss).
+
+    Base model only (effects off but for the sensor gain and bias, which are folded into ``c``).
+    """
+    fdj, fsj, k_aid, k_opp = per_sim
+    n_sims = per_sim.shape[1]
+    current, speed, position = initial[2].copy(), initial[1].copy(), initial[0].copy()
+    angle = position.copy()
+    aircraft = np.zeros((n_sims, 4))
+    hinge_slow = _hinge_slow(load, aircraft, 0.0)
+    steps = c.steps_per_sample
+    rows = np.arange(n_sims) if knots_rad.shape[0] > 1 else np.zeros(n_sims, dtype=int)
+    out = np.empty((6, n_sims, n_samples))
+    for k in range(n_samples):
+        command0 = knots_rad[rows, k]
+        command_step = (knots_rad[rows, k + 1] - knots_rad[rows, k]) / steps
+        sums = np.zeros((4, n_sims))
+        for j in range(steps):
+            command = command0 + command_step * j
+            speed_ref = np.minimum(
+                np.maximum(c.position_gain * (command - position), -c.max_speed_ref), c.max_speed_ref
+            )
+            current_ref = np.minimum(
+                np.maximum(c.speed_gain_over_kt * (speed_ref - speed), -c.max_current), c.max_current
+            )
+            measured = c.current_sensor_gain * current
+            voltage = np.where(
+                current_ref > measured, c.supply_voltage, np.where(current_ref < measured, -c.supply_voltage, 0.0)
+            )
+            current = current + c.step_over_inductance * (voltage - c.resistance * current - c.back_emf * speed)
+            motor_torque = np.minimum(np.maximum(c.torque_constant * current, -c.max_torque), c.max_torque)
+            load_torque = (hinge_slow + load.hinge_delta_nm * position) * c.inverse_gear
+            drive = motor_torque + load_torque - c.viscous * speed - 0.0
+            direction = np.sign(np.where(speed != 0.0, speed, drive))
+            k_load = np.where(load_torque * direction > 0.0, k_aid, k_opp)
+            load_part = k_load * np.abs(load_torque) + c.position_friction * np.abs(position)
+            stuck = (speed == 0.0) & (np.abs(drive) <= fsj + load_part)
+            friction = np.where(stuck, drive, (fdj + load_part) * direction)
+            new_speed = speed + c.step_over_inertia * (drive - friction)
+            new_speed = np.where(new_speed * speed < 0.0, 0.0, new_speed)
+            loss = friction + c.viscous * speed + 0.0
+            free_angle = angle + c.step_s * c.inverse_gear * new_speed
+            angle = np.minimum(np.maximum(free_angle, -c.end_stop), c.end_stop)
+            new_speed = np.where(free_angle > c.end_stop, np.minimum(new_speed, 0.0), new_speed)
+            new_speed = np.where(free_angle < -c.end_stop, np.maximum(new_speed, 0.0), new_speed)
+            speed = new_speed
+            position = np.minimum(np.maximum(position, angle - c.half_backlash), angle + c.half_backlash)
+            sums += (position, speed, current, loss)
+        mean_position = sums[0] / steps
+        out[0, :, k], out[1, :, k] = mean_position, sums[1] / steps
+        out[2, :, k] = c.current_sensor_gain * sums[2] / steps
+        out[5, :, k] = sums[3] / steps
+        out[3, :, k] = hinge_slow + load.hinge_delta_nm * mean_position + c.hinge_sensor_bias
+        out[4, :, k] = command0 + command_step * (steps - 1) / 2
+        aircraft = aircraft @ load.ad.T + np.outer(mean_position - load.trim_elevator_rad, load.bd)
+        hinge_slow = _hinge_slow(load, aircraft, (k + 1) * steps * c.step_s)
+    return out

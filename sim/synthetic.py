@@ -1,0 +1,42 @@
+"""Synthetic windows: the model standing in for an actuator's log (for demos, tests and calibration)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from sim.aircraft import FlightCondition
+from sim.batch import InitialState, simulate_batch
+from sim.commands import random_command_knots
+from sim.effects import EffectSet
+from sim.noise import SensorNoise, add_sensor_noise
+from sim.params import HealthParams
+from sim.window import Window
+
+
+def synthetic_window(
+    health: HealthParams,
+    condition: FlightCondition = FlightCondition(),
+    seed: int = 0,
+    duration_s: float = 0.5,
+    sample_rate_hz: float = 10_000.0,
+    noise: SensorNoise = SensorNoise(),
+    effects: EffectSet = EffectSet(),
+    actuator_id: str = "synthetic/elevator",
+    window_id: str | None = None,
+) -> Window:
+    """One window logged from the model: a §5.6 command, the actuator at rest at 0°, sensor noise.
+
+    ``seed`` fixes the command and the noise; ``health`` must hold one simulation.
+    """
+    rng = np.random.default_rng(seed)
+    n_samples = round(duration_s * sample_rate_hz)
+    knots = random_command_knots(n_samples, sample_rate_hz, rng)[0]
+    result = simulate_batch(knots, health, condition, InitialState(), sample_rate_hz, effects)
+    signals = add_sensor_noise(result.simulation(0), noise, rng)
+    return Window(
+        signals=signals,
+        sample_rate_hz=sample_rate_hz,
+        flight_condition=condition,
+        actuator_id=actuator_id,
+        window_id=window_id or f"synthetic-seed{seed}",
+    )

@@ -1,0 +1,147 @@
+"""The batch simulator end to end: closed-form answers, invariants, equivalences, bad input."""
+
+import numpy as np
+import pytest
+
+from sim.aircraft import FlightCondition, GroundLoad, load_model
+from sim.batch import InitialState, kernel_constants, simulate_batch
+from sim.checks import InputError
+from sim.commands import random_command_knots
+from sim.effects import EffectSet
+from sim.params import DEFAULT_RANGES, ActuatorParams, HealthParams, eta_a_from_eta_o
+from sim.reference import simulate_numpy
+from sim.residual import residual_torque_nm
+from tests.sim.conftest import ramp_knots
+
+RATE = 10_000.0
+
+
+def test_stuck_below_the_break_away_load_and_slips_above_it(nominal):
+    # Command = position = 0: the controller asks for nothing, so only the load drives the shaft.
+    # Stuck, the load aids the drive, so it breaks away when η_A·|T_ext| > FSJ.
+    threshold_nm = 0.10 / float(eta_a_from_eta_o(0.85)) * 500.0
+    below = simulate_batch(np.zeros(301), nominal, GroundLoad(0.8 * threshold_nm))
+    above = simulate_batch(np.zeros(301), nominal, GroundLoad(1.25 * threshold_nm))
+    assert np.all(below.signals["motor_speed_radps"] == 0.0)
+    assert np.all(below.signals["position_deg"] == 0.0)
+    assert np.abs(above.signals["motor_speed_radps"]).max() > 1.0
+
+
+@pytest.mark.parametrize(("load_nm", "kind"), [(-100.0, "opposing"), (100.0, "aiding")])
+def test_steady_sliding_loss_is_fdj_plus_load_part_plus_viscous(load_nm, kind):
+    health = HealthParams.single(fdj_nm=0.045, eta_o=0.8)
+    result = simulate_batch(ramp_knots(0.0, 10.0, 3000), health, GroundLoad(load_nm))
+    steady = slice(1000, 3000)
+    speed = result.signals["motor_speed_radps"][0, steady]
+    assert speed.mean() == pytest.approx(np.radians(10.0) * 500, rel=0.01)
+    t_ext = abs(load_nm) / 500
+    k_load = 1 / 0.8 - 1 if kind == "opposing" else 1 - float(eta_a_from_eta_o(0.8))
+    expected = 0.045 + k_load * t_ext + ActuatorParams().viscous_nms * speed
+    np.testing.assert_allclose(result.loss_torque_nm[0, steady], expected, rtol=1e-3)
+    # Eq. 5.3 from the recorded signals alone gives the same torque.
+    residual = residual_torque_nm(
+        result.signals["current_a"], result.signals["motor_speed_radps"], result.signals["hinge_moment_nm"], RATE
+    )[0, steady]
+    assert residual.mean() == pytest.approx(expected.mean(), rel=0.02)
+
+
+def test_elevator_follows_a_slow_command(nominal):
+    t = np.arange(5001) / RATE
+    command = 5.0 * np.sin(2 * np.pi * 1.0 * t)
+    result = simulate_batch(command, nominal, FlightCondition())
+    error = result.signals["position_deg"][0, 200:] - result.signals["command_deg"][0, 200:]
+    assert np.abs(error).max() < 0.5  # P-loop lag + half the 0.29° dead band
+    assert np.abs(result.signals["command_deg"][0] - 0.5 * (command[1:] + command[:-1])).max() < 1e-3
+
+
+def test_end_stops_hold(nominal):
+    result = simulate_batch(np.full(2001, 35.0), nominal, FlightCondition(), InitialState(position_deg=28.0))
+    position = result.signals["position_deg"][0]
+    assert position.max() <= 30.0
+    assert position[-500:].min() > 29.5
+    assert np.all(result.signals["motor_speed_radps"][0, -500:] == 0.0)
+
+
+def test_batch_equals_single_simulations_and_lanes_do_not_change_results():
+    rng = np.random.default_rng(7)
+    health = HealthParams.uniform(5, DEFAULT_RANGES, rng)
+    knots = random_command_knots(400, RATE, rng)[0]
+    batch = simulate_batch(knots, health)
+    plain = simulate_batch(knots, health, lanes=1)  # one lane: the scalar path
+    for name in batch.signals:
+        np.testing.assert_array_equal(batch.signals[name], plain.signals[name])
+    for i in (0, 3):
+        single = simulate_batch(knots, HealthParams.single(health.fsj_nm[i], health.fdj_nm[i], health.eta_o[i]))
+        for name in batch.signals:
+            np.testing.assert_array_equal(batch.signals[name][i], single.signals[name][0])
+
+
+def test_one_command_per_simulation_case_2():
+    rng = np.random.default_rng(8)
+    health = HealthParams.uniform(3, DEFAULT_RANGES, rng)
+    knots = random_command_knots(300, RATE, rng, n_commands=3)
+    batch = simulate_batch(knots, health)
+    for i in range(3):
+        single = simulate_batch(knots[i], HealthParams.single(health.fsj_nm[i], health.fdj_nm[i], health.eta_o[i]))
+        np.testing.assert_array_equal(batch.signals["position_deg"][i], single.signals["position_deg"][0])
+
+
+def test_kernel_matches_the_plain_numpy_model():
+    rng = np.random.default_rng(9)
+    health = HealthParams.uniform(4, DEFAULT_RANGES, rng)
+    knots = random_command_knots(30, RATE, rng)[0]
+    initial = InitialState(position_deg=0.3, motor_speed_radps=50.0, current_a=2.0)
+    fast = simulate_batch(knots, health, initial=initial)
+    c = kernel_constants(ActuatorParams(), EffectSet(), 100)
+    eta_a = health.eta_a()
+    per_sim = np.stack([health.fdj_nm, health.fsj_nm, 1 - eta_a, 1 / health.eta_o - 1])
+    start = np.repeat(np.array([[np.radians(0.3)], [50.0], [2.0]]), 4, axis=1)
+    slow = simulate_numpy(c, load_model(FlightCondition(), 1e-4), per_sim, np.radians(knots)[None], start, 30)
+    np.testing.assert_allclose(np.radians(fast.signals["position_deg"]), slow[0], atol=1e-12)
+    np.testing.assert_allclose(fast.signals["motor_speed_radps"], slow[1], atol=1e-9)
+    np.testing.assert_allclose(fast.signals["current_a"], slow[2], atol=1e-9)
+    np.testing.assert_allclose(fast.signals["hinge_moment_nm"], slow[3], atol=1e-9)
+    np.testing.assert_allclose(fast.loss_torque_nm, slow[5], atol=1e-9)
+
+
+def test_simulation_is_deterministic(nominal):
+    knots = random_command_knots(200, RATE, np.random.default_rng(3))[0]
+    a, b = simulate_batch(knots, nominal), simulate_batch(knots, nominal)
+    np.testing.assert_array_equal(a.signals["current_a"], b.signals["current_a"])
+
+
+def test_aircraft_on_the_log_step_is_indistinguishable_from_a_finer_one(nominal):
+    # The aircraft advances once per log interval; halving that interval must not move the outputs.
+    knots = random_command_knots(1000, RATE, np.random.default_rng(4))[0]
+    coarse = simulate_batch(knots, nominal, sample_rate_hz=RATE)
+    fine_knots = np.interp(np.arange(2001) / 2, np.arange(1001), knots)
+    fine = simulate_batch(fine_knots, nominal, sample_rate_hz=2 * RATE)
+    fine_hinge = fine.signals["hinge_moment_nm"][0].reshape(-1, 2).mean(axis=1)
+    assert np.abs(fine_hinge - coarse.signals["hinge_moment_nm"][0]).max() < 0.5  # of ~100 N·m
+    fine_position = fine.signals["position_deg"][0].reshape(-1, 2).mean(axis=1)
+    assert np.abs(fine_position - coarse.signals["position_deg"][0]).max() < 0.02
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "field"),
+    [
+        ({"command_knots_deg": np.array([0.0, np.nan, 1.0])}, "command_knots_deg"),
+        ({"command_knots_deg": np.zeros((2, 11))}, "command_knots_deg"),
+        ({"command_knots_deg": np.full(11, 80.0)}, "command_knots_deg"),
+        ({"sample_rate_hz": 3333.0}, "sample_rate_hz"),
+        ({"sample_rate_hz": 10.0}, "sample_rate_hz"),
+        ({"initial": InitialState(position_deg=40.0)}, "initial.position_deg"),
+        ({"initial": InitialState(motor_speed_radps=float("inf"))}, "initial.motor_speed_radps"),
+        ({"health": "nominal"}, "health"),
+        ({"effects": {"cogging": {}}}, "effects"),
+    ],
+)
+def test_bad_input_names_the_argument(kwargs, field):
+    arguments = {
+        "command_knots_deg": np.zeros(11),
+        "health": HealthParams.uniform(3, DEFAULT_RANGES, np.random.default_rng(0)),
+    }
+    arguments.update(kwargs)
+    with pytest.raises(InputError) as error:
+        simulate_batch(**arguments)
+    assert error.value.field == field
