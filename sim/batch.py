@@ -60,6 +60,7 @@ def kernel_constants(actuator: ActuatorParams, effects: EffectSet, steps_per_sam
     stribeck_speed = effects.get("stribeck", "speed_radps")
     return kernels.KernelConstants(
         step_s=actuator.step_s,
+        step_over_gear=actuator.step_s / actuator.gear_ratio,
         steps_per_sample=steps_per_sample,
         position_gain=actuator.position_gain_per_s,
         max_speed_ref=actuator.max_motor_speed_radps,

@@ -40,7 +40,7 @@ def random_command_knots(
     duration_s = n_samples / sample_rate_hz
     times = np.arange(n_samples + 1) / sample_rate_hz
     dense = np.linspace(0.0, duration_s, 2001)  # fine enough to see any overshoot between knots
-    commands = []
+    commands: list[np.ndarray] = []
     while len(commands) < n_commands:
         coefficients = random_command_coefficients(duration_s, rng)
         if np.max(np.abs(np.polyval(coefficients, dense))) <= COMMAND_LIMIT_DEG:

@@ -24,16 +24,18 @@ FDJ, FSJ, K_AID, K_OPP = range(4)
 # Rows of a group's ``lane`` array. Everything the lane loop touches lives in this one array so
 # that LLVM sees a single base pointer and vectorizes without runtime overlap checks.
 CURRENT_NOW, SPEED_NOW, ANGLE_NOW, POSITION_NOW = range(4)  # state
-HINGE_SLOW, COMMAND0, COMMAND_STEP, COGGING = range(4, 8)  # inputs, fixed over a step or interval
-LANE_FDJ, LANE_FSJ, LANE_K_AID, LANE_K_OPP = range(8, 12)  # health, copied from per_sim
-SUM_POSITION, SUM_SPEED, SUM_CURRENT, SUM_LOSS = range(12, 16)  # running sums over the interval
-N_LANE_ROWS = 16
+HINGE_SLOW, COMMAND0, COMMAND_STEP = range(4, 7)  # inputs, fixed over an interval
+COGGING, STRIBECK = range(7, 9)  # effect torques, evaluated before each step (0 when off)
+LANE_FDJ, LANE_FSJ, LANE_K_AID, LANE_K_OPP = range(9, 13)  # health, copied from per_sim
+SUM_POSITION, SUM_SPEED, SUM_CURRENT, SUM_LOSS = range(13, 17)  # running sums over the interval
+N_LANE_ROWS = 17
 
 
 class KernelConstants(NamedTuple):
     """Everything constant over a batch, in the form the step uses (derived once, in sim.batch)."""
 
     step_s: float  # h [s]
+    step_over_gear: float  # h / n [s]
     steps_per_sample: int  # 1 µs steps per log interval
     position_gain: float  # G_P [1/s]
     max_speed_ref: float  # ω_max [rad/s]
@@ -62,11 +64,14 @@ class KernelConstants(NamedTuple):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def advance(c, hinge_delta, command_rad, hinge_slow, cogging, fdj, fsj, k_aid, k_opp, current, speed, angle, position):
+def advance(
+    c, hinge_delta, command_rad, hinge_slow, cogging, stribeck, fdj, fsj, k_aid, k_opp, current, speed, angle, position
+):
     """One step h of controller, RL phase, shaft with Borello friction, end stops and backlash.
 
     ``angle`` is θ_m / n (the motor angle seen on the elevator side), ``position`` the elevator
-    deflection θ_u after the backlash; ``cogging`` the cogging torque at ``angle`` (0 when off).
+    deflection θ_u after the backlash; ``cogging`` the cogging torque at ``angle`` and ``stribeck``
+    the extra dynamic friction at ``speed`` (both 0 when their effect is off).
     Returns the new (current, speed, angle, position) and the step's
     transmission loss torque [N·m] (dry + viscous + cogging).
     Written branch-free (selects, min/max) so that a loop over simulations vectorizes.
@@ -90,10 +95,7 @@ def advance(c, hinge_delta, command_rad, hinge_slow, cogging, fdj, fsj, k_aid, k
     direction = 1.0 if direction_of > 0.0 else (-1.0 if direction_of < 0.0 else 0.0)
     k_load = k_aid if load * direction > 0.0 else k_opp
     load_part = k_load * abs(load) + c.position_friction * abs(position)
-    dynamic = fdj + load_part
-    if c.with_stribeck:
-        ratio = speed * c.stribeck_inverse_speed
-        dynamic += c.stribeck_amplitude / (1.0 + ratio * ratio)
+    dynamic = fdj + load_part + stribeck
     stuck = (not moving) & (abs(drive) <= fsj + load_part)
     friction = drive if stuck else dynamic * direction
     new_speed = speed + c.step_over_inertia * (drive - friction)
@@ -102,7 +104,7 @@ def advance(c, hinge_delta, command_rad, hinge_slow, cogging, fdj, fsj, k_aid, k
     loss = friction + c.viscous * speed + cogging
 
     # Kinematics: semi-implicit Euler, end stops on the shaft, dead band on the elevator side.
-    free_angle = angle + c.step_s * c.inverse_gear * new_speed
+    free_angle = angle + c.step_over_gear * new_speed
     angle = min(max(free_angle, -c.end_stop), c.end_stop)
     new_speed = min(new_speed, 0.0) if free_angle > c.end_stop else new_speed
     new_speed = max(new_speed, 0.0) if free_angle < -c.end_stop else new_speed
@@ -137,13 +139,19 @@ def _advance_aircraft(load, state, mean_elevator_rad):
 def _advance_lanes(c, hinge_delta, j, lane):
     """Advance every lane (simulation) of a group by one step h: the loop LLVM vectorizes."""
     n_lanes = lane.shape[1]
-    if c.with_cogging:  # a call to sin would keep the main loop scalar: evaluate it apart
+    # Effects with a call or a division are evaluated apart, only when on: inside the main loop a
+    # call would keep it scalar, and a division would cost every simulation-step of the base model.
+    if c.with_cogging:
         for s in range(n_lanes):
             lane[COGGING, s] = c.cogging_amplitude * np.sin(c.cogging_wavenumber * lane[ANGLE_NOW, s])
+    if c.with_stribeck:
+        for s in range(n_lanes):
+            ratio = lane[SPEED_NOW, s] * c.stribeck_inverse_speed
+            lane[STRIBECK, s] = c.stribeck_amplitude / (1.0 + ratio * ratio)
     for s in range(n_lanes):
         command = lane[COMMAND0, s] + lane[COMMAND_STEP, s] * j
         current, speed, angle, position, loss = advance(
-            c, hinge_delta, command, lane[HINGE_SLOW, s], lane[COGGING, s],
+            c, hinge_delta, command, lane[HINGE_SLOW, s], lane[COGGING, s], lane[STRIBECK, s],
             lane[LANE_FDJ, s], lane[LANE_FSJ, s], lane[LANE_K_AID, s], lane[LANE_K_OPP, s],
             lane[CURRENT_NOW, s], lane[SPEED_NOW, s], lane[ANGLE_NOW, s], lane[POSITION_NOW, s],
         )  # fmt: skip

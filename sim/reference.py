@@ -67,7 +67,7 @@ def simulate_numpy(
             new_speed = speed + c.step_over_inertia * (drive - friction)
             new_speed = np.where(new_speed * speed < 0.0, 0.0, new_speed)
             loss = friction + c.viscous * speed + 0.0
-            free_angle = angle + c.step_s * c.inverse_gear * new_speed
+            free_angle = angle + c.step_over_gear * new_speed
             angle = np.minimum(np.maximum(free_angle, -c.end_stop), c.end_stop)
             new_speed = np.where(free_angle > c.end_stop, np.minimum(new_speed, 0.0), new_speed)
             new_speed = np.where(free_angle < -c.end_stop, np.maximum(new_speed, 0.0), new_speed)

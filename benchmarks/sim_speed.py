@@ -1,0 +1,93 @@
+"""Simulator speed: ns per simulation-step and wall time for 500 simulations x 0.5 s.
+
+Beside it, in the same run: the plain NumPy model vectorized across the same 500 simulations
+(timed on a short horizon and scaled: it is linear in the horizon), the one-lane scalar path of the
+same kernel, and the thesis's Simulink figure (100-150 ms per 0.5 s simulation).
+
+    python benchmarks/sim_speed.py [--sims 500] [--repeats 3]
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+
+from benchmarks.report import write_section
+from sim.aircraft import FlightCondition, load_model
+from sim.batch import kernel_constants, simulate_batch
+from sim.commands import random_command_knots
+from sim.effects import EffectSet
+from sim.params import DEFAULT_RANGES, ActuatorParams, HealthParams
+from sim.reference import simulate_numpy
+
+RATE_HZ = 10_000.0
+STEPS_PER_SAMPLE = 100
+THESIS_MS_PER_SIM = (100.0, 150.0)  # Simulink Accelerator, one 0.5 s simulation (thesis ch. 3)
+
+
+def best_of(repeats: int, run) -> float:
+    times = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        run()
+        times.append(time.perf_counter() - start)
+    return min(times)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--sims", type=int, default=500)
+    parser.add_argument("--samples", type=int, default=5000, help="log samples per simulation (5000 = 0.5 s)")
+    parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--numpy-samples", type=int, default=5, help="horizon of the NumPy timing")
+    args = parser.parse_args()
+
+    rng = np.random.default_rng(0)
+    health = HealthParams.uniform(args.sims, DEFAULT_RANGES, rng)
+    knots = random_command_knots(args.samples, RATE_HZ, rng)[0]
+    simulate_batch(knots[:11], health)  # JIT (or cache load) outside the timing
+    simulate_batch(knots[:11], health, lanes=1)
+    steps = args.sims * args.samples * STEPS_PER_SAMPLE
+
+    fast_s = best_of(args.repeats, lambda: simulate_batch(knots, health))
+    short = args.samples // 10
+    scalar_s = best_of(1, lambda: simulate_batch(knots[: short + 1], health, lanes=1)) * args.samples / short
+
+    c = kernel_constants(ActuatorParams(), EffectSet(), STEPS_PER_SAMPLE)
+    load = load_model(FlightCondition(), STEPS_PER_SAMPLE * 1e-6)
+    eta_a = health.eta_a()
+    per_sim = np.stack([health.fdj_nm, health.fsj_nm, 1 - eta_a, 1 / health.eta_o - 1])
+    initial = np.zeros((3, args.sims))
+    knots_rad = np.radians(knots[: args.numpy_samples + 1])[None]
+    numpy_s = best_of(1, lambda: simulate_numpy(c, load, per_sim, knots_rad, initial, args.numpy_samples))
+    numpy_s *= args.samples / args.numpy_samples
+
+    thesis_s = tuple(ms / 1000 * args.sims for ms in THESIS_MS_PER_SIM)
+    rows = [
+        ("lock-step kernel, 64 lanes, all cores", fast_s, "measured"),
+        ("same kernel, 1 lane (scalar path), all cores", scalar_s, f"measured on {short} samples, scaled"),
+        ("NumPy, vectorized across simulations", numpy_s, f"measured on {args.numpy_samples} samples, scaled"),
+        ("thesis, Simulink Accelerator", thesis_s[0], f"{THESIS_MS_PER_SIM[0]:g}-{THESIS_MS_PER_SIM[1]:g} ms per sim"),
+    ]
+    lines = [
+        f"{args.sims} simulations x {args.samples / RATE_HZ:g} s at h = 1 µs ({steps:.3g} simulation-steps).",
+        "Target: ≤ 3 ns per simulation-step amortized, i.e. ≤ 0.75 s for 500 x 0.5 s.",
+        "",
+        "| implementation | wall time [s] | ns / sim-step | speed-up of the kernel | note |",
+        "|---|---:|---:|---:|---|",
+    ]
+    for name, seconds, note in rows:
+        lines.append(f"| {name} | {seconds:.3g} | {seconds / steps * 1e9:.3g} | {seconds / fast_s:.3g}x | {note} |")
+    body = "\n".join(lines)
+    print(body)
+    write_section("Simulator speed", "python benchmarks/sim_speed.py", body)
+
+
+if __name__ == "__main__":
+    main()

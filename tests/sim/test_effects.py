@@ -1,0 +1,94 @@
+"""Each optional effect leaves the trace its signature promises, and off means exactly off."""
+
+import numpy as np
+import pytest
+
+from sim.aircraft import GroundLoad
+from sim.batch import simulate_batch
+from sim.checks import InputError
+from sim.effects import EFFECTS, EffectSet
+from sim.params import HealthParams
+from tests.sim.conftest import ramp_knots
+
+STEADY = slice(1000, 3000)
+NOMINAL = HealthParams.single()
+KNOTS = ramp_knots(0.0, 10.0, 3000)  # 10°/s: the motor slides at ≈ 87 rad/s
+LOAD = GroundLoad(-100.0)
+
+
+def run(effects: EffectSet = EffectSet()):
+    return simulate_batch(KNOTS, NOMINAL, LOAD, effects=effects)
+
+
+@pytest.fixture(scope="module")
+def base():
+    return run()
+
+
+def test_neutral_parameters_reproduce_the_base_model_exactly(base):
+    neutral = EffectSet({name: {key: spec[0] for key, spec in e.parameters.items()} for name, e in EFFECTS.items()})
+    result = run(neutral)
+    for name in base.signals:
+        np.testing.assert_array_equal(result.signals[name], base.signals[name])
+
+
+def test_hinge_moment_bias_shifts_only_the_measured_hinge_moment(base):
+    result = run(EffectSet({"hinge_moment_bias": {"bias_nm": 15.0}}))
+    np.testing.assert_allclose(result.signals["hinge_moment_nm"], base.signals["hinge_moment_nm"] + 15.0, atol=1e-9)
+    np.testing.assert_array_equal(result.signals["position_deg"], base.signals["position_deg"])
+
+
+def test_viscous_adds_coefficient_times_speed(base):
+    result = run(EffectSet({"viscous": {"coefficient_nms": 2e-4}}))
+    speed = result.signals["motor_speed_radps"][0, STEADY]
+    extra = result.loss_torque_nm[0, STEADY] - base.loss_torque_nm[0, STEADY]
+    np.testing.assert_allclose(extra, 2e-4 * speed, rtol=0.02)
+
+
+def test_stribeck_adds_friction_that_fades_with_speed(base):
+    result = run(EffectSet({"stribeck": {"amplitude_nm": 0.03, "speed_radps": 50.0}}))
+    speed = result.signals["motor_speed_radps"][0, STEADY]
+    extra = result.loss_torque_nm[0, STEADY] - base.loss_torque_nm[0, STEADY]
+    np.testing.assert_allclose(extra, 0.03 / (1 + (speed / 50.0) ** 2), rtol=0.05)
+
+
+def test_position_friction_grows_with_deflection(base):
+    result = run(EffectSet({"position_friction": {"amplitude_nm": 0.02}}))
+    position_rad = np.radians(result.signals["position_deg"][0, STEADY])
+    extra = result.loss_torque_nm[0, STEADY] - base.loss_torque_nm[0, STEADY]
+    np.testing.assert_allclose(extra, 0.02 * np.abs(position_rad) / np.radians(30.0), atol=2e-4)
+
+
+def test_cogging_ripples_with_motor_angle():
+    result = run(EffectSet({"cogging": {"amplitude_nm": 0.02, "periods_per_rev": 6.0}}))
+    ripple = result.loss_torque_nm[0, STEADY] - result.loss_torque_nm[0, STEADY].mean()
+    assert ripple.std() == pytest.approx(0.02 / np.sqrt(2), rel=0.1)  # a sine of amplitude 0.02
+
+
+@pytest.mark.parametrize("effect", ["torque_constant", "current_sensor_gain"])
+def test_current_scale_effects_scale_the_logged_current(base, effect):
+    result = run(EffectSet({effect: {"gain": 1.1}}))
+    ratio = result.signals["current_a"][0, STEADY].mean() / base.signals["current_a"][0, STEADY].mean()
+    # Sliding needs the same torque: a 10 % stronger motor draws 1/1.1 of the current; a sensor
+    # reading 10 % high logs 1.1x the (unchanged) true current, whatever the loop then does.
+    expected = 1 / 1.1 if effect == "torque_constant" else 1.1
+    assert ratio == pytest.approx(expected, rel=0.01)
+
+
+def test_backlash_delays_the_elevator_at_a_reversal():
+    knots = np.concatenate([ramp_knots(0.0, 10.0, 1500), ramp_knots(1.5, -10.0, 1500)[1:]])
+    base = simulate_batch(knots, NOMINAL, LOAD)
+    wide = simulate_batch(knots, NOMINAL, LOAD, effects=EffectSet({"backlash": {"extra_rad": 0.01}}))
+    lag = np.abs(wide.signals["position_deg"][0] - base.signals["position_deg"][0]).max()
+    assert lag > np.degrees(0.01) / 4
+
+
+def test_unknown_effects_and_parameters_are_named():
+    with pytest.raises(InputError, match="unknown effect 'friction'"):
+        EffectSet({"friction": {}})
+    with pytest.raises(InputError) as error:
+        EffectSet({"cogging": {"amplitude": 0.1}})
+    assert error.value.field == "effects.cogging"
+    with pytest.raises(InputError) as error:
+        EffectSet({"viscous": {"coefficient_nms": 1.0}})
+    assert error.value.field == "effects.viscous.coefficient_nms"

@@ -1,0 +1,65 @@
+import numpy as np
+import pytest
+
+from sim.aircraft import GroundLoad
+from sim.batch import simulate_batch
+from sim.checks import InputError
+from sim.commands import random_command_knots
+from sim.noise import SensorNoise, add_sensor_noise
+from sim.params import HealthParams
+from sim.residual import residual_torque_nm, smooth_derivative, smoothed
+
+RATE = 10_000.0
+
+
+def test_derivative_is_exact_for_a_parabola_inside_and_for_a_line_everywhere():
+    t = np.arange(400) / RATE
+    parabola = smooth_derivative(3.0 + 2.0 * t + 50.0 * t**2, RATE)
+    np.testing.assert_allclose(parabola[10:-10], (2.0 + 100.0 * t)[10:-10], rtol=1e-9)
+    np.testing.assert_allclose(parabola, 2.0 + 100.0 * t, atol=0.05)  # ends: curvature leaks into the reflection
+    np.testing.assert_allclose(smooth_derivative(1.0 - 7.0 * t, RATE), -7.0, rtol=1e-9)
+
+
+def test_smoothing_keeps_a_line_and_a_constant():
+    t = np.arange(300) / RATE
+    np.testing.assert_allclose(smoothed(1.5 + 4.0 * t, RATE)[30:-30], 1.5 + 4.0 * t[30:-30], atol=1e-12)
+
+
+def test_residual_torque_reconstructs_the_true_loss_on_clean_data():
+    knots = random_command_knots(3000, RATE, np.random.default_rng(11))[0]
+    result = simulate_batch(knots, HealthParams.single(), GroundLoad(-60.0, 100.0))
+    signals = result.simulation(0)
+    residual = residual_torque_nm(signals["current_a"], signals["motor_speed_radps"], signals["hinge_moment_nm"], RATE)
+    truth = smoothed(result.loss_torque_nm[0], RATE)  # the same kernel: T_R is the true loss seen through it
+    moving = np.abs(signals["motor_speed_radps"]) > 20
+    error = residual[moving] - truth[moving]
+    assert np.sqrt(np.mean(error**2)) < 0.01  # N·m, against FDJ ≈ 0.05 and a total of ≈ 0.1
+
+
+def test_filter_cuts_speed_noise_below_fdj():
+    rng = np.random.default_rng(1)
+    knots = random_command_knots(5000, RATE, rng)[0]
+    clean = simulate_batch(knots, HealthParams.single()).simulation(0)
+    noisy = add_sensor_noise(clean, SensorNoise(), rng)
+
+    def reconstruct(signals):
+        return residual_torque_nm(signals["current_a"], signals["motor_speed_radps"], signals["hinge_moment_nm"], RATE)
+
+    difference = reconstruct(noisy) - reconstruct(clean)
+    assert difference.std() < 0.01  # a plain 10 kHz difference would give ≈ 0.09 N·m
+
+
+def test_batch_and_single_reconstruction_agree():
+    rng = np.random.default_rng(2)
+    current, speed, hinge = rng.normal(size=(3, 4, 500))
+    batch = residual_torque_nm(current, speed, hinge, RATE)
+    np.testing.assert_allclose(batch[2], residual_torque_nm(current[2], speed[2], hinge[2], RATE))
+
+
+def test_bad_inputs_are_named():
+    with pytest.raises(InputError, match="motor_speed_radps"):
+        residual_torque_nm(np.zeros(100), np.full(100, np.nan), np.zeros(100), RATE)
+    with pytest.raises(InputError, match="shapes differ"):
+        residual_torque_nm(np.zeros(100), np.zeros(99), np.zeros(100), RATE)
+    with pytest.raises(InputError, match="need more than"):
+        residual_torque_nm(np.zeros(10), np.zeros(10), np.zeros(10), RATE)
