@@ -57,34 +57,37 @@ class BatchResult:
 def kernel_constants(actuator: ActuatorParams, effects: EffectSet, steps_per_sample: int) -> kernels.KernelConstants:
     """The step's constants with the effects folded in (derived once per batch)."""
     gain = effects.get("torque_constant", "gain")
+    sensor_gain = effects.get("current_sensor_gain", "gain")
     stribeck_speed = effects.get("stribeck", "speed_radps")
+    h_over_l = actuator.step_s / actuator.inductance_h
     return kernels.KernelConstants(
         step_s=actuator.step_s,
         step_over_gear=actuator.step_s / actuator.gear_ratio,
         steps_per_sample=steps_per_sample,
         position_gain=actuator.position_gain_per_s,
         max_speed_ref=actuator.max_motor_speed_radps,
-        speed_gain_over_kt=actuator.speed_gain_nms / actuator.torque_constant_nm_per_a,
-        max_current=actuator.max_current_a,
-        supply_voltage=actuator.supply_voltage_v,
-        resistance=actuator.resistance_ohm,
-        step_over_inductance=actuator.step_s / actuator.inductance_h,
-        back_emf=gain * actuator.torque_constant_nm_per_a,
+        speed_gain_over_kt=actuator.speed_gain_nms / actuator.torque_constant_nm_per_a / sensor_gain,
+        max_current=actuator.max_current_a / sensor_gain,
+        voltage_step=h_over_l * actuator.supply_voltage_v,
+        current_decay=1.0 - h_over_l * actuator.resistance_ohm,
+        back_emf_step=h_over_l * gain * actuator.torque_constant_nm_per_a,
         torque_constant=gain * actuator.torque_constant_nm_per_a,
         max_torque=actuator.max_motor_torque_nm,
         inverse_gear=1.0 / actuator.gear_ratio,
+        gear=actuator.gear_ratio,
         step_over_inertia=actuator.step_s / actuator.inertia_kgm2,
         viscous=actuator.viscous_nms + effects.get("viscous", "coefficient_nms"),
         half_backlash=0.5 * (actuator.backlash_rad + effects.get("backlash", "extra_rad")),
         end_stop=float(np.radians(actuator.end_stop_deg)),
-        current_sensor_gain=effects.get("current_sensor_gain", "gain"),
+        current_sensor_gain=sensor_gain,
         hinge_sensor_bias=effects.get("hinge_moment_bias", "bias_nm"),
         stribeck_amplitude=effects.get("stribeck", "amplitude_nm"),
         stribeck_inverse_speed=1.0 / stribeck_speed,
         position_friction=effects.get("position_friction", "amplitude_nm") / np.radians(actuator.end_stop_deg),
         cogging_amplitude=effects.get("cogging", "amplitude_nm"),
         cogging_wavenumber=effects.get("cogging", "periods_per_rev") * actuator.gear_ratio,
-        with_stribeck=effects.get("stribeck", "amplitude_nm") != 0.0,
+        with_friction_effects=effects.get("stribeck", "amplitude_nm") != 0.0
+        or effects.get("position_friction", "amplitude_nm") != 0.0,
         with_cogging=effects.get("cogging", "amplitude_nm") != 0.0,
     )
 
@@ -148,8 +151,8 @@ def simulate_batch(
     _checked_initial(initial, actuator.end_stop_deg)
     if not isinstance(effects, EffectSet):
         raise InputError("effects", f"must be an EffectSet, got {type(effects).__name__}")
-    if not 1 <= lanes <= 64:
-        raise InputError("lanes", f"must be in [1, 64], got {lanes}")
+    if not 1 <= lanes <= 512:
+        raise InputError("lanes", f"must be in [1, 512], got {lanes}")
     steps = steps_per_sample(sample_rate_hz, actuator)
     n_samples = knots.shape[1] - 1
     constants = kernel_constants(actuator, effects, steps)

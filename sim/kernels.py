@@ -24,11 +24,11 @@ FDJ, FSJ, K_AID, K_OPP = range(4)
 # Rows of a group's ``lane`` array. Everything the lane loop touches lives in this one array so
 # that LLVM sees a single base pointer and vectorizes without runtime overlap checks.
 CURRENT_NOW, SPEED_NOW, ANGLE_NOW, POSITION_NOW = range(4)  # state
-HINGE_SLOW, COMMAND0, COMMAND_STEP = range(4, 7)  # inputs, fixed over an interval
-COGGING, STRIBECK = range(7, 9)  # effect torques, evaluated before each step (0 when off)
-LANE_FDJ, LANE_FSJ, LANE_K_AID, LANE_K_OPP = range(9, 13)  # health, copied from per_sim
-SUM_POSITION, SUM_SPEED, SUM_CURRENT, SUM_LOSS = range(13, 17)  # running sums over the interval
-N_LANE_ROWS = 17
+LOAD_SLOW, COMMAND0, COMMAND_STEP = range(4, 7)  # inputs, fixed over an interval
+COGGING, DRY_DYNAMIC, DRY_STATIC = range(7, 10)  # cogging torque, FDJ / FSJ plus friction effects
+LANE_FDJ, LANE_FSJ, LANE_K_AID, LANE_K_OPP = range(10, 14)  # health, copied from per_sim
+SUM_POSITION, SUM_SPEED, SUM_CURRENT, SUM_LOSS = range(14, 18)  # running sums over the interval
+N_LANE_ROWS = 18
 
 
 class KernelConstants(NamedTuple):
@@ -39,15 +39,15 @@ class KernelConstants(NamedTuple):
     steps_per_sample: int  # 1 µs steps per log interval
     position_gain: float  # G_P [1/s]
     max_speed_ref: float  # ω_max [rad/s]
-    speed_gain_over_kt: float  # GAP / k_T nominal [A·s/rad]
-    max_current: float  # I_max [A]
-    supply_voltage: float  # V_max [V]
-    resistance: float  # R [Ω]
-    step_over_inductance: float  # h / L [s/H]
-    back_emf: float  # k_e, true [V·s/rad]
+    speed_gain_over_kt: float  # GAP / (k_T nominal · current sensor gain) [A·s/rad], in true amperes
+    max_current: float  # I_max / current sensor gain [A], in true amperes
+    voltage_step: float  # h·V_max / L [A]
+    current_decay: float  # 1 − h·R / L [-]
+    back_emf_step: float  # h·k_e / L [A·s/rad], k_e true
     torque_constant: float  # k_T, true [N·m/A]
     max_torque: float  # T_M,max [N·m]
     inverse_gear: float  # 1 / n [-]
+    gear: float  # n [-]
     step_over_inertia: float  # h / J_M [s/(kg·m²)]
     viscous: float  # C_M, true [N·m·s/rad]
     half_backlash: float  # BLK / 2 [rad], elevator side
@@ -59,55 +59,65 @@ class KernelConstants(NamedTuple):
     position_friction: float  # extra dry friction per rad of |θ_u| [N·m/rad]
     cogging_amplitude: float  # [N·m]
     cogging_wavenumber: float  # cogging periods per rad of θ_m / n [1/rad]
-    with_stribeck: bool  # skip the division when the effect is off
+    with_friction_effects: bool  # Stribeck or position friction on: update the dry levels every step
     with_cogging: bool  # skip the sine when the effect is off
 
 
 @njit(cache=True, inline="always", error_model="numpy")
 def advance(
-    c, hinge_delta, command_rad, hinge_slow, cogging, stribeck, fdj, fsj, k_aid, k_opp, current, speed, angle, position
+    c,
+    load_delta,
+    command_rad,
+    load_slow,
+    cogging,
+    dry_dynamic,
+    dry_static,
+    k_aid,
+    k_opp,
+    current,
+    speed,
+    angle,
+    position,
 ):
     """One step h of controller, RL phase, shaft with Borello friction, end stops and backlash.
 
     ``angle`` is θ_m / n (the motor angle seen on the elevator side), ``position`` the elevator
-    deflection θ_u after the backlash; ``cogging`` the cogging torque at ``angle`` and ``stribeck``
-    the extra dynamic friction at ``speed`` (both 0 when their effect is off).
-    Returns the new (current, speed, angle, position) and the step's
-    transmission loss torque [N·m] (dry + viscous + cogging).
-    Written branch-free (selects, min/max) so that a loop over simulations vectorizes.
+    deflection θ_u after the backlash. The load torque at the motor shaft is
+    ``load_slow + load_delta·position``; ``dry_dynamic`` / ``dry_static`` are the load-independent
+    friction levels (FDJ / FSJ plus any friction effect) and ``cogging`` the cogging torque (0 when off).
+    Returns the new (current, speed, angle, position) and the step's transmission loss torque
+    [N·m] (dry + viscous + cogging). Written branch-free (selects, min/max) so that a loop over
+    simulations vectorizes; constants are pre-folded in ``KernelConstants`` to save operations.
     """
     # Controller: P position loop -> speed reference, P speed loop -> current reference.
     speed_ref = min(max(c.position_gain * (command_rad - position), -c.max_speed_ref), c.max_speed_ref)
     current_ref = min(max(c.speed_gain_over_kt * (speed_ref - speed), -c.max_current), c.max_current)
     # PWM-like bang-bang on the measured current; explicit Euler on L·dI/dt = V − R·I − k_e·ω.
-    measured = c.current_sensor_gain * current
-    voltage = c.supply_voltage if current_ref > measured else (-c.supply_voltage if current_ref < measured else 0.0)
-    current = current + c.step_over_inductance * (voltage - c.resistance * current - c.back_emf * speed)
+    voltage_step = c.voltage_step if current_ref > current else (-c.voltage_step if current_ref < current else 0.0)
+    current = c.current_decay * current + voltage_step - c.back_emf_step * speed
     motor_torque = min(max(c.torque_constant * current, -c.max_torque), c.max_torque)
 
-    hinge = hinge_slow + hinge_delta * position
-    load = hinge * c.inverse_gear  # T_ext at the motor shaft
-    drive = motor_torque + load - c.viscous * speed - cogging
+    load = load_slow + load_delta * position  # T_ext = H_e / n
+    viscous = c.viscous * speed
+    drive = motor_torque + load - viscous - cogging
 
     # Borello friction: aiding when the load acts along the motion (of the drive when stuck).
     moving = speed != 0.0
     direction_of = speed if moving else drive
     direction = 1.0 if direction_of > 0.0 else (-1.0 if direction_of < 0.0 else 0.0)
     k_load = k_aid if load * direction > 0.0 else k_opp
-    load_part = k_load * abs(load) + c.position_friction * abs(position)
-    dynamic = fdj + load_part + stribeck
-    stuck = (not moving) & (abs(drive) <= fsj + load_part)
-    friction = drive if stuck else dynamic * direction
+    load_part = k_load * abs(load)
+    stuck = (not moving) & (abs(drive) <= dry_static + load_part)
+    friction = drive if stuck else (dry_dynamic + load_part) * direction
     new_speed = speed + c.step_over_inertia * (drive - friction)
     # Slipping through zero stops the shaft; the next step decides stick or slip.
     new_speed = 0.0 if new_speed * speed < 0.0 else new_speed
-    loss = friction + c.viscous * speed + cogging
+    loss = friction + viscous + cogging
 
     # Kinematics: semi-implicit Euler, end stops on the shaft, dead band on the elevator side.
     free_angle = angle + c.step_over_gear * new_speed
     angle = min(max(free_angle, -c.end_stop), c.end_stop)
-    new_speed = min(new_speed, 0.0) if free_angle > c.end_stop else new_speed
-    new_speed = max(new_speed, 0.0) if free_angle < -c.end_stop else new_speed
+    new_speed = 0.0 if abs(free_angle) > c.end_stop else new_speed  # only outward motion gets there
     position = min(max(position, angle - c.half_backlash), angle + c.half_backlash)
     return current, new_speed, angle, position, loss
 
@@ -136,23 +146,25 @@ def _advance_aircraft(load, state, mean_elevator_rad):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _advance_lanes(c, hinge_delta, j, lane):
+def _advance_lanes(c, load_delta, j, lane):
     """Advance every lane (simulation) of a group by one step h: the loop LLVM vectorizes."""
     n_lanes = lane.shape[1]
-    # Effects with a call or a division are evaluated apart, only when on: inside the main loop a
-    # call would keep it scalar, and a division would cost every simulation-step of the base model.
+    # Effects are evaluated apart, and only when on: inside the main loop a call (sin) would keep
+    # it scalar, and any extra operation would cost every simulation-step of the base model.
     if c.with_cogging:
         for s in range(n_lanes):
             lane[COGGING, s] = c.cogging_amplitude * np.sin(c.cogging_wavenumber * lane[ANGLE_NOW, s])
-    if c.with_stribeck:
+    if c.with_friction_effects:
         for s in range(n_lanes):
             ratio = lane[SPEED_NOW, s] * c.stribeck_inverse_speed
-            lane[STRIBECK, s] = c.stribeck_amplitude / (1.0 + ratio * ratio)
+            extra_dry = c.position_friction * abs(lane[POSITION_NOW, s])
+            lane[DRY_DYNAMIC, s] = lane[LANE_FDJ, s] + extra_dry + c.stribeck_amplitude / (1.0 + ratio * ratio)
+            lane[DRY_STATIC, s] = lane[LANE_FSJ, s] + extra_dry
     for s in range(n_lanes):
         command = lane[COMMAND0, s] + lane[COMMAND_STEP, s] * j
         current, speed, angle, position, loss = advance(
-            c, hinge_delta, command, lane[HINGE_SLOW, s], lane[COGGING, s], lane[STRIBECK, s],
-            lane[LANE_FDJ, s], lane[LANE_FSJ, s], lane[LANE_K_AID, s], lane[LANE_K_OPP, s],
+            c, load_delta, command, lane[LOAD_SLOW, s], lane[COGGING, s], lane[DRY_DYNAMIC, s], lane[DRY_STATIC, s],
+            lane[LANE_K_AID, s], lane[LANE_K_OPP, s],
             lane[CURRENT_NOW, s], lane[SPEED_NOW, s], lane[ANGLE_NOW, s], lane[POSITION_NOW, s],
         )  # fmt: skip
         lane[CURRENT_NOW, s] = current
@@ -172,6 +184,7 @@ def _run_group(c, load, per_sim, knots_rad, initial, first, lanes, out):
     per_sim_command = knots_rad.shape[0] > 1
     steps = c.steps_per_sample
     interval_s = steps * c.step_s
+    load_delta = load.hinge_delta_nm * c.inverse_gear  # d(T_ext)/dθ_u [N·m/rad]
     lane = np.zeros((N_LANE_ROWS, lanes))
     group = slice(first, first + lanes)
     lane[CURRENT_NOW] = initial[INIT_CURRENT, group]
@@ -182,9 +195,11 @@ def _run_group(c, load, per_sim, knots_rad, initial, first, lanes, out):
     lane[LANE_FSJ] = per_sim[FSJ, group]
     lane[LANE_K_AID] = per_sim[K_AID, group]
     lane[LANE_K_OPP] = per_sim[K_OPP, group]
+    lane[DRY_DYNAMIC] = per_sim[FDJ, group]  # friction effects, when on, add to these every step
+    lane[DRY_STATIC] = per_sim[FSJ, group]
     aircraft = np.zeros((lanes, 4))  # Δx: every simulation starts at trim
     for s in range(lanes):
-        lane[HINGE_SLOW, s] = _hinge_slow(load, aircraft[s], 0.0)
+        lane[LOAD_SLOW, s] = _hinge_slow(load, aircraft[s], 0.0) * c.inverse_gear
 
     for k in range(n_samples):
         for s in range(lanes):
@@ -193,7 +208,7 @@ def _run_group(c, load, per_sim, knots_rad, initial, first, lanes, out):
             lane[COMMAND_STEP, s] = (knots_rad[row, k + 1] - knots_rad[row, k]) / steps
         lane[SUM_POSITION:] = 0.0
         for j in range(steps):
-            _advance_lanes(c, load.hinge_delta_nm, j, lane)
+            _advance_lanes(c, load_delta, j, lane)
         for s in range(lanes):
             mean_position = lane[SUM_POSITION, s] / steps
             out[POSITION, first + s, k] = mean_position
@@ -201,11 +216,11 @@ def _run_group(c, load, per_sim, knots_rad, initial, first, lanes, out):
             out[CURRENT, first + s, k] = c.current_sensor_gain * lane[SUM_CURRENT, s] / steps
             out[LOSS, first + s, k] = lane[SUM_LOSS, s] / steps
             # H_e is affine in θ_u within an interval, so its mean follows from the mean position.
-            hinge = lane[HINGE_SLOW, s] + load.hinge_delta_nm * mean_position
+            hinge = lane[LOAD_SLOW, s] * c.gear + load.hinge_delta_nm * mean_position
             out[HINGE, first + s, k] = hinge + c.hinge_sensor_bias
             out[COMMAND, first + s, k] = lane[COMMAND0, s] + lane[COMMAND_STEP, s] * (steps - 1) / 2
             _advance_aircraft(load, aircraft[s], mean_position)
-            lane[HINGE_SLOW, s] = _hinge_slow(load, aircraft[s], (k + 1) * interval_s)
+            lane[LOAD_SLOW, s] = _hinge_slow(load, aircraft[s], (k + 1) * interval_s) * c.inverse_gear
 
 
 @njit(cache=True, parallel=True)

@@ -28,14 +28,16 @@ def simulate_numpy(
 ) -> np.ndarray:
     """(6, N, n_samples) interval means, rows as ``sim.kernels`` (position, speed, current, hinge, command, loss).
 
-    Base model only (effects off but for the sensor gain and bias, which are folded into ``c``).
+    Base model only: the effects that act inside the step (cogging, Stribeck, position friction)
+    are not modelled here; those folded into ``c`` (viscous, gains, sensor bias, backlash) are.
     """
     fdj, fsj, k_aid, k_opp = per_sim
     n_sims = per_sim.shape[1]
     current, speed, position = initial[2].copy(), initial[1].copy(), initial[0].copy()
     angle = position.copy()
     aircraft = np.zeros((n_sims, 4))
-    hinge_slow = _hinge_slow(load, aircraft, 0.0)
+    load_delta = load.hinge_delta_nm * c.inverse_gear
+    load_slow = _hinge_slow(load, aircraft, 0.0) * c.inverse_gear
     steps = c.steps_per_sample
     rows = np.arange(n_sims) if knots_rad.shape[0] > 1 else np.zeros(n_sims, dtype=int)
     out = np.empty((6, n_sims, n_samples))
@@ -51,26 +53,25 @@ def simulate_numpy(
             current_ref = np.minimum(
                 np.maximum(c.speed_gain_over_kt * (speed_ref - speed), -c.max_current), c.max_current
             )
-            measured = c.current_sensor_gain * current
-            voltage = np.where(
-                current_ref > measured, c.supply_voltage, np.where(current_ref < measured, -c.supply_voltage, 0.0)
+            voltage_step = np.where(
+                current_ref > current, c.voltage_step, np.where(current_ref < current, -c.voltage_step, 0.0)
             )
-            current = current + c.step_over_inductance * (voltage - c.resistance * current - c.back_emf * speed)
+            current = c.current_decay * current + voltage_step - c.back_emf_step * speed
             motor_torque = np.minimum(np.maximum(c.torque_constant * current, -c.max_torque), c.max_torque)
-            load_torque = (hinge_slow + load.hinge_delta_nm * position) * c.inverse_gear
-            drive = motor_torque + load_torque - c.viscous * speed - 0.0
+            load_torque = load_slow + load_delta * position
+            viscous = c.viscous * speed
+            drive = motor_torque + load_torque - viscous - 0.0
             direction = np.sign(np.where(speed != 0.0, speed, drive))
             k_load = np.where(load_torque * direction > 0.0, k_aid, k_opp)
-            load_part = k_load * np.abs(load_torque) + c.position_friction * np.abs(position)
+            load_part = k_load * np.abs(load_torque)
             stuck = (speed == 0.0) & (np.abs(drive) <= fsj + load_part)
             friction = np.where(stuck, drive, (fdj + load_part) * direction)
             new_speed = speed + c.step_over_inertia * (drive - friction)
             new_speed = np.where(new_speed * speed < 0.0, 0.0, new_speed)
-            loss = friction + c.viscous * speed + 0.0
+            loss = friction + viscous + 0.0
             free_angle = angle + c.step_over_gear * new_speed
             angle = np.minimum(np.maximum(free_angle, -c.end_stop), c.end_stop)
-            new_speed = np.where(free_angle > c.end_stop, np.minimum(new_speed, 0.0), new_speed)
-            new_speed = np.where(free_angle < -c.end_stop, np.maximum(new_speed, 0.0), new_speed)
+            new_speed = np.where(np.abs(free_angle) > c.end_stop, 0.0, new_speed)
             speed = new_speed
             position = np.minimum(np.maximum(position, angle - c.half_backlash), angle + c.half_backlash)
             sums += (position, speed, current, loss)
@@ -78,8 +79,8 @@ def simulate_numpy(
         out[0, :, k], out[1, :, k] = mean_position, sums[1] / steps
         out[2, :, k] = c.current_sensor_gain * sums[2] / steps
         out[5, :, k] = sums[3] / steps
-        out[3, :, k] = hinge_slow + load.hinge_delta_nm * mean_position + c.hinge_sensor_bias
+        out[3, :, k] = load_slow * c.gear + load.hinge_delta_nm * mean_position + c.hinge_sensor_bias
         out[4, :, k] = command0 + command_step * (steps - 1) / 2
         aircraft = aircraft @ load.ad.T + np.outer(mean_position - load.trim_elevator_rad, load.bd)
-        hinge_slow = _hinge_slow(load, aircraft, (k + 1) * steps * c.step_s)
+        load_slow = _hinge_slow(load, aircraft, (k + 1) * steps * c.step_s) * c.inverse_gear
     return out
