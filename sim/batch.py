@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+import numba
 import numpy as np
 
 from sim import kernels
@@ -14,7 +15,8 @@ from sim.params import ActuatorParams, HealthParams
 
 DEFAULT_SAMPLE_RATE_HZ = 10_000.0
 SAMPLE_RATE_RANGE_HZ = (1_000.0, 100_000.0)
-LANES = 64  # simulations advanced in lock-step; fewer lanes pay more per-step loop overhead
+MAX_LANES = 64  # simulations advanced in lock-step; fewer lanes pay more per-step loop overhead
+LANE_MULTIPLE = 8  # one AVX-512 register of float64
 MAX_INITIAL_SPEED_RADPS = 700.0
 MAX_INITIAL_CURRENT_A = 30.0
 
@@ -120,6 +122,12 @@ def _checked_initial(initial: InitialState, end_stop_deg: float) -> InitialState
     return initial
 
 
+def default_lanes(n_sims: int) -> int:
+    """Lanes per group: every core gets a group, groups are whole registers, at most MAX_LANES."""
+    per_core = -(-n_sims // numba.get_num_threads())
+    return min(MAX_LANES, -(-per_core // LANE_MULTIPLE) * LANE_MULTIPLE)
+
+
 def _padded(values: np.ndarray, multiple: int) -> np.ndarray:
     """Repeat the last column so the simulation axis (last) is a multiple of ``multiple``."""
     missing = -values.shape[-1] % multiple
@@ -136,13 +144,15 @@ def simulate_batch(
     sample_rate_hz: float = DEFAULT_SAMPLE_RATE_HZ,
     effects: EffectSet = EffectSet(),
     actuator: ActuatorParams = ActuatorParams(),
-    lanes: int = LANES,
+    lanes: int | None = None,
 ) -> BatchResult:
     """Simulate one simulation per entry of ``health`` and record interval means at ``sample_rate_hz``.
 
     ``command_knots_deg`` is the command at the log-interval boundaries (see ``sim.commands``):
     (n_samples + 1,) shared by the batch (Case 1) or (n_simulations, n_samples + 1) (Case 2).
-    The 1 µs trajectory is never stored. Deterministic: the same inputs give the same output.
+    The 1 µs trajectory is never stored. Deterministic: the same inputs give the same output,
+    whatever ``lanes`` (simulations per lock-step group; by default as many as keep every core
+    busy, up to 64).
     """
     if not isinstance(health, HealthParams):
         raise InputError("health", f"must be HealthParams, got {type(health).__name__}")
@@ -151,6 +161,7 @@ def simulate_batch(
     _checked_initial(initial, actuator.end_stop_deg)
     if not isinstance(effects, EffectSet):
         raise InputError("effects", f"must be an EffectSet, got {type(effects).__name__}")
+    lanes = default_lanes(n_sims) if lanes is None else lanes
     if not 1 <= lanes <= 512:
         raise InputError("lanes", f"must be in [1, 512], got {lanes}")
     steps = steps_per_sample(sample_rate_hz, actuator)

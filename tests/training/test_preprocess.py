@@ -1,0 +1,33 @@
+import numpy as np
+import pytest
+
+from sim.checks import InputError
+from sim.params import HealthParams
+from sim.synthetic import synthetic_window
+from training.preprocess import bin_means, features
+
+
+def test_bin_means_cover_every_sample():
+    values = np.arange(10.0)
+    np.testing.assert_allclose(bin_means(values, 5), [0.5, 2.5, 4.5, 6.5, 8.5])
+    uneven = bin_means(values, 3)  # bins of 3, 4, 3 samples
+    assert len(uneven) == 3
+    assert uneven.sum() == pytest.approx((0 + 1 + 2) / 3 + (3 + 4 + 5 + 6) / 4 + (7 + 8 + 9) / 3)
+    with pytest.raises(InputError, match="n_timesteps"):
+        bin_means(values, 11)
+
+
+def test_the_same_features_for_a_batch_row_and_a_single_window():
+    windows = [synthetic_window(HealthParams.single(fdj_nm=f), seed=2, duration_s=0.05) for f in (0.045, 0.055)]
+    batch = {name: np.stack([w.signals[name] for w in windows]) for name in windows[0].signals}
+    together = features(batch, 10_000.0, 100, "input_map")
+    assert together.shape == (2, 300)
+    for i, window in enumerate(windows):
+        np.testing.assert_array_equal(features(window.signals, 10_000.0, 100, "input_map")[0], together[i])
+
+
+def test_unknown_input_set_is_named():
+    window = synthetic_window(HealthParams.single(), seed=2, duration_s=0.05)
+    with pytest.raises(InputError) as error:
+        features(window.signals, 10_000.0, 100, "torque")
+    assert error.value.field == "inputs"

@@ -1,0 +1,1 @@
+"""From simulations to estimates: preprocessing, datasets, the shallow network, estimators."""

@@ -1,0 +1,60 @@
+"""One preprocessing for simulated and measured windows alike: residual torque, then resampling.
+
+Measured and simulated data must go through the very same function (thesis §5.7); this module
+is that function. Resampling to K timesteps takes the mean over K equal bins rather than
+interpolating: with sensor noise, a bin mean keeps every sample's information and averages its
+noise down, where point interpolation would throw 4 of 5 samples away.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import numpy as np
+
+from sim.checks import InputError
+from sim.params import ActuatorParams
+from sim.residual import residual_torque_nm
+
+INPUT_SETS = {
+    # the thesis's two input sets (§5.5): residual torque alone, and its "input map"
+    "residual_torque": ("residual_torque",),
+    "input_map": ("residual_torque", "motor_speed", "hinge_moment"),
+}
+
+
+def bin_means(values: np.ndarray, n_bins: int) -> np.ndarray:
+    """Mean over ``n_bins`` contiguous bins along the last axis, covering every sample.
+
+    Bin edges are the rounded multiples of n / n_bins, so bins differ by at most one sample
+    when n_bins does not divide the window.
+    """
+    n = values.shape[-1]
+    if not 1 <= n_bins <= n:
+        raise InputError("n_timesteps", f"must be in [1, {n}] for a window of {n} samples, got {n_bins}")
+    edges = np.round(np.linspace(0, n, n_bins + 1)).astype(np.int64)
+    return np.add.reduceat(values, edges[:-1], axis=-1) / np.diff(edges)
+
+
+def features(
+    signals: Mapping[str, np.ndarray],
+    sample_rate_hz: float,
+    n_timesteps: int,
+    input_set: str = "residual_torque",
+    actuator: ActuatorParams = ActuatorParams(),
+) -> np.ndarray:
+    """Network inputs from window signals: (n_windows, n_channels · n_timesteps), channels side by side.
+
+    ``signals`` holds (n_samples,) arrays for one window or (n_windows, n_samples) for a batch.
+    """
+    if input_set not in INPUT_SETS:
+        raise InputError("inputs", f"unknown input set {input_set!r}; known: {', '.join(INPUT_SETS)}")
+    current = np.atleast_2d(signals["current_a"])
+    speed = np.atleast_2d(signals["motor_speed_radps"])
+    hinge = np.atleast_2d(signals["hinge_moment_nm"])
+    channels = {
+        "residual_torque": lambda: residual_torque_nm(current, speed, hinge, sample_rate_hz, actuator),
+        "motor_speed": lambda: speed,
+        "hinge_moment": lambda: hinge,
+    }
+    return np.concatenate([bin_means(channels[name](), n_timesteps) for name in INPUT_SETS[input_set]], axis=-1)
