@@ -11,6 +11,7 @@ from typing import Any
 
 import numpy as np
 
+from clients.replay import ServiceError, command_replay, print_replay
 from sim.aircraft import FlightCondition
 from sim.checks import InputError
 from sim.effects import EffectSet
@@ -18,7 +19,8 @@ from sim.noise import NO_NOISE, SensorNoise
 from sim.params import HealthParams, eta_a_from_eta_o
 from sim.residual import residual_torque_nm
 from sim.synthetic import synthetic_window
-from sim.window import Window, write_window
+from sim.window import Window, read_window, write_window
+from training.pipeline import PipelineConfig, estimate_window
 
 EXIT_OK, EXIT_INTERNAL, EXIT_BAD_INPUT = 0, 1, 2
 
@@ -99,9 +101,79 @@ def print_simulate(result: dict[str, Any]) -> None:
     print(f"moving {summary['moving_fraction']:.0%} of the window")
 
 
+def command_estimate(args: argparse.Namespace) -> dict[str, Any]:
+    window = read_window(args.window)
+    config = PipelineConfig(
+        n_simulations=args.sims,
+        n_timesteps=args.timesteps,
+        hidden_units=args.hidden,
+        members=args.members,
+        input_set=args.inputs,
+        seed=args.seed,
+    )
+    return estimate_window(window, config, on_stage=lambda text: print(f"ema estimate: {text}…", file=sys.stderr))
+
+
+def print_estimate(result: dict[str, Any]) -> None:
+    print(f"{result['actuator_id']}  window {result['window_id']}")
+    print(f"{'parameter':<10}{'value':>12}{'std':>12}{'nominal':>12}{'drift':>10}")
+    for name, entry in result["estimates"].items():
+        if name == "FSD" or entry is None:
+            continue
+        std = "—" if entry["std"] is None else f"{entry['std']:.2g}"
+        print(f"{name:<10}{entry['value']:>12.5g}{std:>12}{entry['nominal']:>12.4g}{entry['drift_pct']:>9.2f}%")
+    if result["estimates"]["FSJ"] is None:
+        print(f"FSJ: not estimated: {result['fsj_note']}")
+    timings = result["timings_s"]
+    print("time: " + "  ".join(f"{stage} {seconds:.2f} s" for stage, seconds in timings.items()))
+
+
+def command_serve(args: argparse.Namespace) -> dict[str, Any]:
+    import uvicorn
+
+    from service.config import Settings
+    from service.main import create_app
+
+    overrides = {"host": args.host, "port": args.port}
+    if args.database:
+        overrides["database"] = args.database
+    settings = Settings(**{k: v for k, v in overrides.items() if v is not None})
+    uvicorn.run(create_app(settings), host=settings.host, port=settings.port, log_level="info")
+    return {"stopped": True}
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="ema", description="Onboard health monitor for an elevator EMA.")
     commands = parser.add_subparsers(dest="command", required=True)
+    estimate = commands.add_parser("estimate", help="estimate FDJ, η_O, η_A (FSJ where it can) of one window")
+    estimate.add_argument("window", type=Path, help="an ema-window/1 JSON file")
+    estimate.add_argument("--sims", type=int, default=500, help="simulations in the training set (500)")
+    estimate.add_argument("--timesteps", type=int, default=1000, help="network input timesteps (1000)")
+    estimate.add_argument("--hidden", type=int, default=100, help="hidden neurons (100)")
+    estimate.add_argument("--members", type=int, default=1, help="networks in the ensemble (1)")
+    estimate.add_argument("--inputs", default="residual_torque", help="residual_torque or input_map")
+    estimate.add_argument("--seed", type=int, default=0, help="seed of the dataset and the training")
+    estimate.add_argument("--json", action="store_true", help="print one JSON document")
+    estimate.set_defaults(run=command_estimate, show=print_estimate)
+    serve = commands.add_parser("serve", help="run the HTTP service (settings: EMA_* environment variables)")
+    serve.add_argument("--host", default=None, help="bind address (default 127.0.0.1, or EMA_HOST)")
+    serve.add_argument("--port", type=int, default=None, help="port (default 8000, or EMA_PORT)")
+    serve.add_argument("--database", type=Path, default=None, help="SQLite history file (or EMA_DATABASE)")
+    serve.set_defaults(run=command_serve, show=lambda _: None, json=False)
+
+    replay = commands.add_parser("replay", help="post a recorded log to the service window by window")
+    replay.add_argument("log", type=Path, help="a JSON window / list / long recording, a CSV, an NPZ, or a folder")
+    replay.add_argument("--url", default="http://127.0.0.1:8000", help="the service (default http://127.0.0.1:8000)")
+    replay.add_argument("--out", type=Path, default=Path("estimates.csv"), help="CSV to append answers to")
+    replay.add_argument("--window-s", dest="window_s", type=float, default=0.5, help="cut recordings into windows [s]")
+    replay.add_argument("--api-key", dest="api_key", default=None, help="X-API-Key, if the service wants one")
+    replay.add_argument("--actuator-id", dest="actuator_id", default="unknown", help="for CSV/NPZ without one")
+    replay.add_argument("--rate", type=float, default=10_000.0, help="sample rate [Hz] for CSV/NPZ without one")
+    replay.add_argument("--airspeed", type=float, default=153.01, help="[m/s] for CSV/NPZ without one")
+    replay.add_argument("--altitude", type=float, default=0.0, help="[m] for CSV/NPZ without one")
+    replay.add_argument("--json", action="store_true", help="print one JSON document")
+    replay.set_defaults(run=command_replay, show=print_replay)
+
     simulate = commands.add_parser("simulate", help="write a synthetic ema-window/1 file from the model")
     simulate.add_argument("--out", required=True, type=Path, help="window JSON to write")
     simulate.add_argument("--fdj", type=float, default=0.05, help="dynamic friction FDJ [N·m] (default 0.05)")
@@ -134,6 +206,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     except OSError as exc:
         print(f"ema {args.command}: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT
+    except ServiceError as exc:
+        print(f"ema {args.command}: {exc}", file=sys.stderr)
+        return EXIT_INTERNAL
     except Exception as exc:
         print(f"ema {args.command}: internal error: {type(exc).__name__}: {exc}", file=sys.stderr)
         return EXIT_INTERNAL

@@ -223,9 +223,12 @@ def _run_group(c, load, per_sim, knots_rad, initial, first, lanes, out):
             lane[LOAD_SLOW, s] = _hinge_slow(load, aircraft[s], (k + 1) * interval_s) * c.inverse_gear
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, parallel=True, nogil=True)
 def simulate_groups(c, load, per_sim, knots_rad, initial, lanes, out):
     """Run every group of ``lanes`` simulations, groups in parallel over the cores.
+
+    Releases the GIL (``nogil``): a service runs this in a worker thread while its event loop
+    keeps answering.
 
     ``per_sim`` is (4, N): FDJ, FSJ, 1 − η_A, 1/η_O − 1, padded by the caller to a multiple of
     ``lanes``. ``knots_rad`` is (1, K+1) for one command shared by the batch or (N, K+1) for one

@@ -9,6 +9,7 @@ windows to blend them per parameter (``training.combine``).
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -42,6 +43,14 @@ class PipelineConfig:
     train: TrainConfig = field(default_factory=TrainConfig)
 
     def __post_init__(self) -> None:
+        if not 20 <= self.n_simulations <= 20_000:
+            raise InputError("n_simulations", f"must be in [20, 20000], got {self.n_simulations}")
+        if not 10 <= self.n_timesteps <= 10_000:
+            raise InputError("n_timesteps", f"must be in [10, 10000], got {self.n_timesteps}")
+        if not 1 <= self.hidden_units <= 2000:
+            raise InputError("hidden_units", f"must be in [1, 2000], got {self.hidden_units}")
+        if not 1 <= self.members <= 20:
+            raise InputError("members", f"must be in [1, 20], got {self.members}")
         if not 8 <= self.check_windows <= 1000:
             raise InputError("check_windows", f"must be in [8, 1000], got {self.check_windows}")
 
@@ -127,9 +136,13 @@ def static_friction(window: Window) -> tuple[float | None, str]:
     return fitted.fsj_, fitted.fsj_reason_
 
 
-def estimate_window(window: Window, config: PipelineConfig = PipelineConfig()) -> dict[str, Any]:
-    """The ``ema-estimate/1`` result for one window."""
+def estimate_window(
+    window: Window, config: PipelineConfig = PipelineConfig(), on_stage: Callable[[str], None] | None = None
+) -> dict[str, Any]:
+    """The ``ema-estimate/1`` result for one window; ``on_stage`` hears each stage as it starts."""
+    stage = on_stage or (lambda _: None)
     started = time.perf_counter()
+    stage(f"simulating {config.n_simulations} + {config.check_windows} windows")
     scenario = scenario_from_window(window)
     noise = window_noise(window, scenario)
     dataset_config = DatasetConfig(config.n_simulations, config.n_timesteps, config.input_set, seed=config.seed)
@@ -137,10 +150,12 @@ def estimate_window(window: Window, config: PipelineConfig = PipelineConfig()) -
     check_health, checks = check_windows(scenario, window, noise, config.check_windows, config.seed + 10_000)
     simulated = time.perf_counter()
 
+    stage(f"training {config.members} network(s) of {config.hidden_units} neurons")
     train = replace(config.train, hidden=config.hidden_units, seed=config.seed)
     network = NetworkEstimator(train, config.members).fit(dataset)
     trained = time.perf_counter()
 
+    stage("estimating")
     estimates, methods = blended_estimates(
         network={k: float(v[0]) for k, v in network_values(network, [window], config).items()},
         baseline=baseline_values(window),

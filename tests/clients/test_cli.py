@@ -31,3 +31,30 @@ def test_bad_input_exits_2_naming_the_field(tmp_path, capsys):
     assert main(["simulate", "--out", str(tmp_path / "w.json"), "--effect", "cogging:amplitude_nm=x"]) == EXIT_BAD_INPUT
     assert "cogging.amplitude_nm" in capsys.readouterr().err
     assert main(["simulate", "--out", str(tmp_path / "missing" / "w.json"), "--duration", "0.05"]) == EXIT_BAD_INPUT
+
+
+def test_estimate_prints_one_json_document_and_progress_on_stderr(tmp_path, capsys):
+    window = tmp_path / "w.json"
+    assert main(["simulate", "--out", str(window), "--duration", "0.1", "--fdj", "0.056"]) == EXIT_OK
+    capsys.readouterr()
+    code = main(["estimate", str(window), "--sims", "40", "--timesteps", "100", "--hidden", "10", "--json"])
+    assert code == EXIT_OK
+    captured = capsys.readouterr()
+    result = json.loads(captured.out)
+    assert result["schema"] == "ema-estimate/1"
+    assert result["estimates"]["FDJ"]["value"] > 0
+    assert "training" in captured.err
+
+
+def test_estimate_table_and_bad_inputs(tmp_path, capsys):
+    window = tmp_path / "w.json"
+    main(["simulate", "--out", str(window), "--duration", "0.1"])
+    capsys.readouterr()
+    assert main(["estimate", str(window), "--sims", "40", "--timesteps", "100", "--hidden", "10"]) == EXIT_OK
+    assert "eta_O" in capsys.readouterr().out
+    assert main(["estimate", str(window), "--sims", "5"]) == EXIT_BAD_INPUT
+    assert "n_simulations" in capsys.readouterr().err
+    (tmp_path / "broken.json").write_text('{"schema": "ema-window/1"}')
+    assert main(["estimate", str(tmp_path / "broken.json")]) == EXIT_BAD_INPUT
+    assert "flight_condition" in capsys.readouterr().err
+    assert main(["estimate", str(tmp_path / "missing.json")]) == EXIT_BAD_INPUT

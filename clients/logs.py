@@ -1,0 +1,137 @@
+"""Recorded logs -> windows: JSON windows (one, a list, or a long recording), CSV, NPZ, or a folder of them.
+
+A recording longer than the window length is cut into consecutive windows of that length,
+``window_id`` = ``<recording id>#<index>``; a tail shorter than a window is dropped and said so.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from sim.aircraft import FlightCondition
+from sim.checks import InputError
+from sim.window import SIGNALS, Window, window_from_dict
+
+SUFFIXES = (".json", ".csv", ".npz")
+
+
+@dataclass(frozen=True)
+class Defaults:
+    """Metadata for formats that may lack it (CSV, NPZ): flags of ``ema replay``."""
+
+    actuator_id: str = "unknown"
+    sample_rate_hz: float = 10_000.0
+    airspeed_mps: float = 153.01
+    altitude_m: float = 0.0
+
+
+def cut(window: Window, window_s: float) -> tuple[list[Window], int]:
+    """Consecutive windows of ``window_s`` seconds; returns them and the number of samples dropped."""
+    n = round(window_s * window.sample_rate_hz)
+    if window.n_samples <= n:
+        return [window], 0
+    count = window.n_samples // n
+    pieces = [
+        Window(
+            {name: values[i * n : (i + 1) * n] for name, values in window.signals.items()},
+            window.sample_rate_hz,
+            window.flight_condition,
+            window.actuator_id,
+            f"{window.window_id}#{i}",
+        )
+        for i in range(count)
+    ]
+    return pieces, window.n_samples - count * n
+
+
+def _from_json(path: Path) -> list[Window]:
+    document = json.loads(path.read_text())
+    documents = document if isinstance(document, list) else [document]
+    return [window_from_dict(d) for d in documents]
+
+
+def _from_csv(path: Path, defaults: Defaults) -> list[Window]:
+    """Columns named as the window's signals (others ignored); ``# key: value`` lines on top give metadata."""
+    meta: dict[str, str] = {}
+    lines = path.read_text().splitlines()
+    body = [line for line in lines if not line.startswith("#")]
+    for line in lines:
+        if line.startswith("#") and ":" in line:
+            key, value = line[1:].split(":", 1)
+            meta[key.strip()] = value.strip()
+    rows = list(csv.DictReader(body))
+    if not rows:
+        raise InputError(str(path), "has no data rows")
+    missing = [name for name in SIGNALS if name not in rows[0]]
+    if missing:
+        raise InputError(str(path), f"lacks the column(s) {', '.join(missing)}")
+    try:
+        signals = {name: np.array([float(row[name]) for row in rows]) for name in SIGNALS}
+    except (TypeError, ValueError) as exc:
+        raise InputError(str(path), f"has a non-numeric value ({exc})") from None
+    return [_window(signals, meta, defaults, path)]
+
+
+def _from_npz(path: Path, defaults: Defaults) -> list[Window]:
+    with np.load(path, allow_pickle=False) as archive:
+        missing = [name for name in SIGNALS if name not in archive]
+        if missing:
+            raise InputError(str(path), f"lacks the array(s) {', '.join(missing)}")
+        signals = {name: np.asarray(archive[name], dtype=np.float64) for name in SIGNALS}
+        meta = {key: str(archive[key]) for key in archive.files if key not in SIGNALS}
+    return [_window(signals, meta, defaults, path)]
+
+
+def _window(signals: dict[str, np.ndarray], meta: dict[str, Any], defaults: Defaults, path: Path) -> Window:
+    try:
+        return Window(
+            signals,
+            float(meta.get("sample_rate_hz", defaults.sample_rate_hz)),
+            FlightCondition(
+                float(meta.get("airspeed_mps", defaults.airspeed_mps)),
+                float(meta.get("altitude_m", defaults.altitude_m)),
+            ),
+            str(meta.get("actuator_id", defaults.actuator_id)),
+            str(meta.get("window_id", path.stem)),
+        )
+    except ValueError as exc:
+        raise InputError(str(path), str(exc)) from None
+
+
+def read_log(path: Path, defaults: Defaults = Defaults()) -> list[Window]:
+    """Every window in ``path`` (a file or a folder, files in name order); errors name the file."""
+    path = Path(path)
+    if path.is_dir():
+        files = sorted(p for p in path.iterdir() if p.suffix.lower() in SUFFIXES)
+        if not files:
+            raise InputError(str(path), f"holds no {'/'.join(SUFFIXES)} file")
+        return [window for file in files for window in read_log(file, defaults)]
+    if not path.exists():
+        raise InputError(str(path), "does not exist")
+    readers = {".json": lambda: _from_json(path), ".csv": lambda: _from_csv(path, defaults)}
+    readers[".npz"] = lambda: _from_npz(path, defaults)
+    if path.suffix.lower() not in readers:
+        raise InputError(str(path), f"is not a {'/'.join(SUFFIXES)} file")
+    try:
+        return readers[path.suffix.lower()]()
+    except InputError as exc:
+        if exc.field == str(path):
+            raise
+        raise InputError(str(path), f"{exc.field}: {exc.message}") from None
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError, ValueError) as exc:
+        raise InputError(str(path), f"cannot be read ({exc})") from None
+
+
+def windows_of(path: Path, window_s: float, defaults: Defaults = Defaults()) -> Iterator[tuple[Window, int]]:
+    """The windows of a log, long recordings cut to ``window_s``; with each, the samples its cut dropped."""
+    for recording in read_log(path, defaults):
+        pieces, dropped = cut(recording, window_s)
+        for i, piece in enumerate(pieces):
+            yield piece, dropped if i == len(pieces) - 1 else 0

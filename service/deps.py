@@ -1,0 +1,43 @@
+"""Shared request dependencies: settings, the store, the job runner, the API key check."""
+
+from __future__ import annotations
+
+import secrets
+from typing import Annotated
+
+from fastapi import Depends, Header, HTTPException, Request, status
+
+from service.config import Settings
+from service.jobs import JobRunner
+from service.store import EstimateStore
+
+
+def get_settings(request: Request) -> Settings:
+    settings: Settings = request.app.state.settings
+    return settings
+
+
+def get_store(request: Request) -> EstimateStore:
+    store: EstimateStore = request.app.state.store
+    return store
+
+
+def get_runner(request: Request) -> JobRunner:
+    runner: JobRunner = request.app.state.runner
+    return runner
+
+
+def require_api_key(
+    settings: Annotated[Settings, Depends(get_settings)],
+    x_api_key: Annotated[str | None, Header()] = None,
+) -> None:
+    """With ``EMA_API_KEY`` set, every /v1 request must carry it in X-API-Key."""
+    if settings.api_key is None:
+        return
+    if x_api_key is None or not secrets.compare_digest(x_api_key, settings.api_key):
+        raise HTTPException(status.HTTP_401_UNAUTHORIZED, "missing or wrong X-API-Key")
+
+
+SettingsDep = Annotated[Settings, Depends(get_settings)]
+StoreDep = Annotated[EstimateStore, Depends(get_store)]
+RunnerDep = Annotated[JobRunner, Depends(get_runner)]

@@ -1,0 +1,34 @@
+import copy
+
+import pytest
+from fastapi.testclient import TestClient
+
+from service.config import Settings
+from service.main import create_app
+from sim.params import HealthParams
+from sim.synthetic import synthetic_window
+from sim.window import window_to_dict
+
+SMALL = {"n_simulations": 40, "n_timesteps": 100, "hidden_units": 10, "check_windows": 8, "warm_up": False}
+
+
+@pytest.fixture(scope="session")
+def window_document() -> dict:
+    window = synthetic_window(HealthParams.single(0.1, 0.055, 0.8), seed=3, duration_s=0.1, actuator_id="ac-1/elev")
+    return window_to_dict(window)
+
+
+@pytest.fixture
+def document(window_document) -> dict:
+    return copy.deepcopy(window_document)
+
+
+@pytest.fixture
+def settings(tmp_path) -> Settings:
+    return Settings(database=tmp_path / "history.sqlite3", **SMALL)
+
+
+@pytest.fixture
+def client(settings):
+    with TestClient(create_app(settings)) as test_client:
+        yield test_client
