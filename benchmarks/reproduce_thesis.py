@@ -8,7 +8,6 @@ go to docs/figures/. Run: python benchmarks/reproduce_thesis.py [--quick]
 from __future__ import annotations
 
 import argparse
-import sys
 import time
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -19,9 +18,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
-
-from benchmarks.report import machine
+from clients.report import machine
 from sim.aircraft import FlightCondition, GroundLoad
 from sim.commands import random_command_knots
 from sim.noise import NO_NOISE, SensorNoise

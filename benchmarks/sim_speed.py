@@ -10,15 +10,11 @@ same kernel, and the thesis's Simulink figure (100-150 ms per 0.5 s simulation).
 from __future__ import annotations
 
 import argparse
-import sys
 import time
-from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
-
-from benchmarks.report import write_section
+from clients.report import write_section
 from sim.aircraft import FlightCondition, load_model
 from sim.batch import kernel_constants, simulate_batch
 from sim.commands import random_command_knots

@@ -11,7 +11,9 @@ from typing import Any
 
 import numpy as np
 
+from clients.bench import command_bench
 from clients.replay import ServiceError, command_replay, print_replay
+from clients.report import BENCHMARKS_MD
 from sim.aircraft import FlightCondition
 from sim.checks import InputError
 from sim.effects import EffectSet
@@ -160,6 +162,14 @@ def build_parser() -> argparse.ArgumentParser:
     serve.add_argument("--port", type=int, default=None, help="port (default 8000, or EMA_PORT)")
     serve.add_argument("--database", type=Path, default=None, help="SQLite history file (or EMA_DATABASE)")
     serve.set_defaults(run=command_serve, show=lambda _: None, json=False)
+
+    bench = commands.add_parser("bench", help="latency benchmark of the whole pipeline over a grid of sizes")
+    bench.add_argument("--out", type=Path, default=Path("bench-out"), help="folder for bench.json and bench.png")
+    bench.add_argument("--repeats", type=int, default=5, help="windows per size (5)")
+    bench.add_argument("--quick", action="store_true", help="one small size, no docs update (a smoke run)")
+    bench.add_argument("--docs", type=Path, default=BENCHMARKS_MD, help="markdown file to update (docs/benchmarks.md)")
+    bench.add_argument("--json", action="store_true", help="print one JSON document")
+    bench.set_defaults(run=command_bench, show=lambda result: print(result["table"]))
 
     replay = commands.add_parser("replay", help="post a recorded log to the service window by window")
     replay.add_argument("log", type=Path, help="a JSON window / list / long recording, a CSV, an NPZ, or a folder")

@@ -80,9 +80,16 @@ class ShallowNet(nn.Module):
             self.output.weight.mul_(0.1)
             self.output.bias.copy_(targets.mean(dim=0))
 
+    def project(self, x: torch.Tensor) -> torch.Tensor:
+        """(B, F) raw inputs -> (B, P) standardized, projected: fixed, so training does it once."""
+        return ((x - self.mean) / self.std) @ self.projection
+
+    def head(self, z: torch.Tensor) -> torch.Tensor:
+        """(B, P) -> tanh (B, H) -> linear (B, T): the trained part."""
+        return self.output(torch.tanh(self.hidden(z)))
+
     def forward(self, x: torch.Tensor) -> torch.Tensor:
-        z = ((x - self.mean) / self.std) @ self.projection  # (B, P)
-        return self.output(torch.tanh(self.hidden(z)))  # (B, T)
+        return self.head(self.project(x))
 
 
 def input_transform(x_train: torch.Tensor, components: int | None) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
@@ -126,9 +133,9 @@ def split_indices(n: int, fractions: tuple[float, float, float], rng: np.random.
     return {"train": order[:n_train], "val": order[n_train : n_train + n_val], "test": order[n_train + n_val :]}
 
 
-def _mse(model: nn.Module, x: torch.Tensor, y: torch.Tensor) -> float:
+def _mse(model: ShallowNet, z: torch.Tensor, y: torch.Tensor) -> float:
     with torch.no_grad():
-        return float(torch.mean((model(x) - y) ** 2))
+        return float(torch.mean((model.head(z) - y) ** 2))
 
 
 def fit(inputs: np.ndarray, targets: np.ndarray, config: TrainConfig) -> FitResult:
@@ -140,6 +147,9 @@ def fit(inputs: np.ndarray, targets: np.ndarray, config: TrainConfig) -> FitResu
     y = torch.as_tensor(targets, dtype=torch.float64)  # (N, T)
     x_train, y_train = x[parts["train"]], y[parts["train"]]
     model = ShallowNet(*input_transform(x_train, config.components), config.hidden, y_train).double()
+    with torch.no_grad():
+        z = model.project(x)  # (N, P): projected once, not in every line-search evaluation
+    z_train = z[parts["train"]]
     loss_fn = nn.MSELoss()
     if config.optimizer == "lbfgs":
         optimizer: torch.optim.Optimizer = torch.optim.LBFGS(
@@ -157,7 +167,7 @@ def fit(inputs: np.ndarray, targets: np.ndarray, config: TrainConfig) -> FitResu
 
     def closure() -> torch.Tensor:
         optimizer.zero_grad()
-        loss = loss_fn(model(x_train), y_train)
+        loss = loss_fn(model.head(z_train), y_train)
         loss.backward()
         return loss
 
@@ -165,8 +175,8 @@ def fit(inputs: np.ndarray, targets: np.ndarray, config: TrainConfig) -> FitResu
     history: list[tuple[float, float]] = []
     for _ in range(config.max_epochs):
         optimizer.step(closure)  # type: ignore[arg-type]  # torch types the closure as returning float
-        train_mse = _mse(model, x_train, y_train)
-        val_mse = _mse(model, x[parts["val"]], y[parts["val"]])
+        train_mse = _mse(model, z_train, y_train)
+        val_mse = _mse(model, z[parts["val"]], y[parts["val"]])
         history.append((train_mse, val_mse))
         if val_mse < best_val:
             best_val, best_state, failures = val_mse, copy.deepcopy(model.state_dict()), 0
@@ -183,9 +193,9 @@ def fit(inputs: np.ndarray, targets: np.ndarray, config: TrainConfig) -> FitResu
         model=model,
         epochs=len(history),
         stop_reason=stop_reason,
-        train_mse=_mse(model, x_train, y_train),
+        train_mse=_mse(model, z_train, y_train),
         val_mse=best_val,
-        test_mse=_mse(model, x[parts["test"]], y[parts["test"]]),
+        test_mse=_mse(model, z[parts["test"]], y[parts["test"]]),
         test_mse_per_target=np.mean((predict(model, inputs[parts["test"]]) - targets[parts["test"]]) ** 2, axis=0),
         seconds=time.perf_counter() - start,
         split=parts,

@@ -21,6 +21,7 @@ INPUT_SETS = {
     "residual_torque": ("residual_torque",),
     "input_map": ("residual_torque", "motor_speed", "hinge_moment"),
 }
+SIGNALS_READ = ("current_a", "motor_speed_radps", "hinge_moment_nm")  # all that ``features`` reads
 
 
 def bin_means(values: np.ndarray, n_bins: int) -> np.ndarray:

@@ -8,7 +8,7 @@ import platform
 import re
 from pathlib import Path
 
-BENCHMARKS_MD = Path(__file__).resolve().parent.parent / "docs" / "benchmarks.md"
+BENCHMARKS_MD = Path("docs/benchmarks.md")  # relative to the checkout the benchmark runs in
 HEADER = (
     "# Benchmarks\n\nEach section is rewritten by the command it names; figures from one run are compared as ratios.\n"
 )
