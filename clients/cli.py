@@ -144,6 +144,53 @@ def command_serve(args: argparse.Namespace) -> dict[str, Any]:
     return {"stopped": True}
 
 
+def read_truth(path: Path | None) -> dict[str, float] | None:
+    """``{"FDJ": 0.05, "eta_O": 0.85, "FSJ": 0.1}`` (FSJ optional); errors name the file."""
+    if path is None:
+        return None
+    try:
+        truth = json.loads(Path(path).read_text())
+        return {key: float(truth[key]) for key in ("FDJ", "eta_O")}
+    except (OSError, ValueError, KeyError, TypeError) as exc:
+        raise InputError(str(path), f"is not a truth file with FDJ and eta_O ({exc!r})") from None
+
+
+def command_calibrate(args: argparse.Namespace) -> dict[str, Any]:
+    from training.calibration.calibrate import Calibrator
+    from training.calibration.figure import residual_figure
+
+    windows = [read_window(path) for path in args.windows]
+    config = PipelineConfig(n_simulations=args.sims, n_timesteps=args.timesteps, hidden_units=args.hidden)
+    print(f"ema calibrate: {len(windows)} window(s), 3 pipeline runs each…", file=sys.stderr)
+    calibrator = Calibrator(config, seed=args.seed).fit(windows, read_truth(args.truth))
+    report = calibrator.report_
+    selected = report["selected_effect"]
+    variable = (report["unexplained_structure"] or {}).get("variable")
+    figure = residual_figure(calibrator.residuals_before_, calibrator.residuals_after_, selected, variable, args.figure)
+    return {**report, "figure": str(figure)}
+
+
+def print_calibrate(report: dict[str, Any]) -> None:
+    print(f"{'candidate':<22}{'BIC gain':>10}{'RMS cut':>9}  parameters")
+    for c in sorted(report["candidates"], key=lambda c: -c["score"]):
+        parameters = ", ".join(f"{k}={v:.4g}" for k, v in c["parameters"].items())
+        flag = "" if c["plausible"] else "  (implausible)"
+        print(f"{c['effect']:<22}{c['score']:>10.1f}{c['rms_reduction']:>8.0%}  {parameters}{flag}")
+    print(f"selected: {report['selected_effect']} — {report['selection']['reason']}")
+    if report["selected_parameters"]:
+        print("  parameters: " + ", ".join(f"{k}={v:.4g}" for k, v in report["selected_parameters"].items()))
+    if report["unexplained_structure"]:
+        print(f"  unexplained: {report['unexplained_structure']['description']}")
+    before, after = report["residual_rms_before"], report["residual_rms_after"]
+    print("residual RMS: " + "  ".join(f"{k} {before[k]:.3g} -> {after[k]:.3g}" for k in before))
+    for name in ("FDJ", "eta_O"):
+        line = f"{name}: {report['estimates_before'][name]:.5g} -> {report['estimates_after'][name]:.5g}"
+        if "error_pct_before" in report:
+            line += f"   error {report['error_pct_before'][name]:.2f} % -> {report['error_pct_after'][name]:.2f} %"
+        print(line)
+    print(f"figure: {report['figure']}")
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="ema", description="Onboard health monitor for an elevator EMA.")
     commands = parser.add_subparsers(dest="command", required=True)
@@ -162,6 +209,17 @@ def build_parser() -> argparse.ArgumentParser:
     serve.add_argument("--port", type=int, default=None, help="port (default 8000, or EMA_PORT)")
     serve.add_argument("--database", type=Path, default=None, help="SQLite history file (or EMA_DATABASE)")
     serve.set_defaults(run=command_serve, show=lambda _: None, json=False)
+
+    calibrate = commands.add_parser("calibrate", help="trace model discrepancy to a missing effect, add it")
+    calibrate.add_argument("windows", type=Path, nargs="+", help="ema-window/1 JSON files of one actuator")
+    calibrate.add_argument("--truth", type=Path, help="JSON with the true FDJ and eta_O (synthetic windows)")
+    calibrate.add_argument("--figure", type=Path, default=Path("calibration.png"), help="PNG of the residuals")
+    calibrate.add_argument("--sims", type=int, default=500, help="simulations per estimate (500)")
+    calibrate.add_argument("--timesteps", type=int, default=1000, help="network input timesteps (1000)")
+    calibrate.add_argument("--hidden", type=int, default=100, help="hidden neurons (100)")
+    calibrate.add_argument("--seed", type=int, default=0, help="seed of the bootstrap")
+    calibrate.add_argument("--json", action="store_true", help="print one JSON document")
+    calibrate.set_defaults(run=command_calibrate, show=print_calibrate)
 
     bench = commands.add_parser("bench", help="latency benchmark of the whole pipeline over a grid of sizes")
     bench.add_argument("--out", type=Path, default=Path("bench-out"), help="folder for bench.json and bench.png")

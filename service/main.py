@@ -16,7 +16,7 @@ from service.body_limit import BodyLimit
 from service.config import Settings, get_settings
 from service.deps import require_api_key
 from service.jobs import JobRunner
-from service.routes import actuators, estimate, health
+from service.routes import actuators, calibrate, estimate, health
 from service.store import EstimateStore
 from service.warmup import warm_up
 
@@ -54,6 +54,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     protected = [Depends(require_api_key)]
     app.include_router(estimate.router, dependencies=protected)
     app.include_router(actuators.router, dependencies=protected)
+    app.include_router(calibrate.router, dependencies=protected)
     return app
 
 

@@ -35,6 +35,21 @@ class WindowIn(BaseModel):
     signals: SignalsIn
 
 
+class TruthIn(BaseModel):
+    """The true parameters of synthetic windows, to report the estimation error."""
+
+    model_config = ConfigDict(extra="forbid")
+    FDJ: FiniteFloat = Field(gt=0)
+    eta_O: FiniteFloat = Field(gt=0, le=1)
+    FSJ: FiniteFloat | None = Field(None, gt=0)
+
+
+class CalibrateIn(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+    windows: list[WindowIn] = Field(min_length=1, max_length=8)
+    truth: TruthIn | None = None
+
+
 class ParameterEstimate(BaseModel):
     value: float
     std: float | None

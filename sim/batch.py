@@ -88,6 +88,7 @@ def kernel_constants(actuator: ActuatorParams, effects: EffectSet, steps_per_sam
         position_friction=effects.get("position_friction", "amplitude_nm") / np.radians(actuator.end_stop_deg),
         cogging_amplitude=effects.get("cogging", "amplitude_nm"),
         cogging_wavenumber=effects.get("cogging", "periods_per_rev") * actuator.gear_ratio,
+        cogging_phase=effects.get("cogging", "phase_rad"),
         with_friction_effects=effects.get("stribeck", "amplitude_nm") != 0.0
         or effects.get("position_friction", "amplitude_nm") != 0.0,
         with_cogging=effects.get("cogging", "amplitude_nm") != 0.0,

@@ -66,6 +66,7 @@ EFFECTS: Mapping[str, Effect] = MappingProxyType(
                 {
                     "amplitude_nm": (0.0, 0.0, 0.2),  # cogging torque amplitude [N·m]
                     "periods_per_rev": (6.0, 1.0, 48.0),  # ripple periods per motor revolution [-]
+                    "phase_rad": (0.0, -4.0, 4.0),  # A·sin(p·θ_m + φ), θ_m from n·θ_u at the window's start
                 },
                 "residual torque periodic in motor angle",
             ),

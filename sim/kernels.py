@@ -59,6 +59,7 @@ class KernelConstants(NamedTuple):
     position_friction: float  # extra dry friction per rad of |θ_u| [N·m/rad]
     cogging_amplitude: float  # [N·m]
     cogging_wavenumber: float  # cogging periods per rad of θ_m / n [1/rad]
+    cogging_phase: float  # [rad]
     with_friction_effects: bool  # Stribeck or position friction on: update the dry levels every step
     with_cogging: bool  # skip the sine when the effect is off
 
@@ -153,7 +154,7 @@ def _advance_lanes(c, load_delta, j, lane):
     # it scalar, and any extra operation would cost every simulation-step of the base model.
     if c.with_cogging:
         for s in range(n_lanes):
-            lane[COGGING, s] = c.cogging_amplitude * np.sin(c.cogging_wavenumber * lane[ANGLE_NOW, s])
+            lane[COGGING, s] = c.cogging_amplitude * np.sin(c.cogging_wavenumber * lane[ANGLE_NOW, s] + c.cogging_phase)
     if c.with_friction_effects:
         for s in range(n_lanes):
             ratio = lane[SPEED_NOW, s] * c.stribeck_inverse_speed

@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 
 from sim.checks import InputError
+from sim.effects import EffectSet
 from sim.noise import SensorNoise, add_sensor_noise
 from sim.params import DEFAULT_RANGES, HealthParams, eta_a_from_eta_o
 from sim.window import Window
@@ -137,13 +138,19 @@ def static_friction(window: Window) -> tuple[float | None, str]:
 
 
 def estimate_window(
-    window: Window, config: PipelineConfig = PipelineConfig(), on_stage: Callable[[str], None] | None = None
+    window: Window,
+    config: PipelineConfig = PipelineConfig(),
+    on_stage: Callable[[str], None] | None = None,
+    effects: EffectSet = EffectSet(),
 ) -> dict[str, Any]:
-    """The ``ema-estimate/1`` result for one window; ``on_stage`` hears each stage as it starts."""
+    """The ``ema-estimate/1`` result for one window; ``on_stage`` hears each stage as it starts.
+
+    ``effects`` extends the model the dataset is simulated with (the calibration loop's output).
+    """
     stage = on_stage or (lambda _: None)
     started = time.perf_counter()
     stage(f"simulating {config.n_simulations} + {config.check_windows} windows")
-    scenario = scenario_from_window(window)
+    scenario = scenario_from_window(window, effects)
     noise = window_noise(window, scenario)
     dataset_config = DatasetConfig(config.n_simulations, config.n_timesteps, config.input_set, seed=config.seed)
     dataset = build_dataset(scenario, dataset_config, noise)

@@ -58,3 +58,17 @@ def test_estimate_table_and_bad_inputs(tmp_path, capsys):
     assert main(["estimate", str(tmp_path / "broken.json")]) == EXIT_BAD_INPUT
     assert "flight_condition" in capsys.readouterr().err
     assert main(["estimate", str(tmp_path / "missing.json")]) == EXIT_BAD_INPUT
+
+
+def test_calibrate_writes_a_figure_and_names_a_bad_truth_file(tmp_path, capsys):
+    window, truth = tmp_path / "w.json", tmp_path / "t.json"
+    main(["simulate", "--out", str(window), "--duration", "0.15", "--truth-out", str(truth)])
+    capsys.readouterr()
+    sizes = ["--sims", "40", "--timesteps", "100", "--hidden", "10"]
+    figure = tmp_path / "cal.png"
+    assert main(["calibrate", str(window), "--truth", str(truth), "--figure", str(figure), "--json", *sizes]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert report["schema"] == "ema-calibration/1" and figure.stat().st_size > 1000
+    (tmp_path / "bad.json").write_text("{}")
+    assert main(["calibrate", str(window), "--truth", str(tmp_path / "bad.json"), *sizes]) == EXIT_BAD_INPUT
+    assert "bad.json" in capsys.readouterr().err

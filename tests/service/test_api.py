@@ -149,3 +149,18 @@ def test_history_survives_a_restart(tmp_path, document):
         history = client.get("/v1/actuators/ac-1/elev/estimates").json()
     assert [h["id"] for h in history["estimates"]] == [first["id"], second["id"]]  # oldest first
     assert history["trend"]["eta_O"]["n"] == 2
+
+
+def test_calibrate_answers_the_report(client, document):
+    response = client.post("/v1/calibrate", json={"windows": [document], "truth": {"FDJ": 0.055, "eta_O": 0.8}})
+    assert response.status_code == 200, response.text
+    report = response.json()
+    assert report["schema"] == "ema-calibration/1"
+    assert {"residual_rms_before", "candidates", "selected_effect", "error_before"} <= set(report)
+
+
+def test_calibrate_bad_input_is_named(client, document):
+    assert client.post("/v1/calibrate", json={"windows": []}).json()["detail"][0]["loc"] == ["body", "windows"]
+    response = client.post("/v1/calibrate", json={"windows": [document], "truth": {"FDJ": -1, "eta_O": 0.8}})
+    assert response.status_code == 422
+    assert response.json()["detail"][0]["loc"] == ["body", "truth", "FDJ"]
