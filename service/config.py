@@ -23,7 +23,7 @@ class Settings(BaseSettings):
     n_timesteps: int = Field(1000, ge=10, le=10_000)
     hidden_units: int = Field(100, ge=1, le=2000)
     members: int = Field(1, ge=1, le=20)
-    check_windows: int = Field(32, ge=8, le=1000)
+    check_windows: int = Field(16, ge=8, le=1000)
     seed: int = 0
     max_simulations: int = Field(2000, ge=20, le=20_000)
     max_timesteps: int = Field(5000, ge=10, le=10_000)

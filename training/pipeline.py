@@ -39,7 +39,9 @@ class PipelineConfig:
     hidden_units: int = 100
     members: int = 1  # networks in the ensemble
     input_set: str = "residual_torque"
-    check_windows: int = 32  # held-out simulated windows that score network and baseline
+    # Held-out simulated windows that score network and baseline. 16 instead of 32: 0.2 s faster,
+    # errors within the spread of 5 bench windows (0.29 % / 0.07 % against 0.23 % / 0.09 %).
+    check_windows: int = 16
     seed: int = 0
     train: TrainConfig = field(default_factory=TrainConfig)
 
