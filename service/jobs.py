@@ -51,12 +51,16 @@ class JobRunner:
             self.queued -= 1
         self.running += 1
         started = time.perf_counter()
-        try:
-            return await asyncio.get_running_loop().run_in_executor(self._executor, job, *args)
-        finally:
-            self._mean_job_s = 0.7 * self._mean_job_s + 0.3 * (time.perf_counter() - started)
-            self.running -= 1
-            self._slot.release()
+        future = asyncio.get_running_loop().run_in_executor(self._executor, job, *args)
+        # The slot is freed when the job ends, not when its request goes away: a client that hangs up
+        # cannot stop a thread, and the next job must not start beside it.
+        future.add_done_callback(lambda _: self._finished(started))
+        return await asyncio.shield(future)
+
+    def _finished(self, started: float) -> None:
+        self._mean_job_s = 0.7 * self._mean_job_s + 0.3 * (time.perf_counter() - started)
+        self.running -= 1
+        self._slot.release()
 
     def shutdown(self) -> None:
         self._executor.shutdown(wait=True, cancel_futures=True)

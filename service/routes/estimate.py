@@ -9,6 +9,7 @@ from service.deps import RunnerDep, SettingsDep, StoreDep
 from service.errors import bounded
 from service.schemas import EstimateOut, WindowIn
 from service.windows import to_window
+from sim.checks import InputError
 from training.pipeline import PipelineConfig, estimate_window
 
 router = APIRouter(prefix="/v1", tags=["estimate"])
@@ -36,6 +37,6 @@ async def estimate(
         seed=settings.seed if seed is None else seed,
     )
     if config.n_timesteps > window.n_samples:
-        bounded("n_timesteps", config.n_timesteps, 0, window.n_samples)
+        raise InputError("query.n_timesteps", f"{config.n_timesteps} exceeds the window's {window.n_samples} samples")
     result = await runner.run(estimate_window, window, config)
     return await run_in_threadpool(store.add, result)  # committed (fsync) before the answer leaves

@@ -36,6 +36,8 @@ def test_sizes_are_overridable_within_bounds(client, document):
     too_big = client.post("/v1/estimate?n_simulations=100000", json=document)
     assert too_big.status_code == 422
     assert too_big.json()["detail"][0]["loc"] == ["query", "n_simulations"]
+    longer_than_window = client.post("/v1/estimate?n_timesteps=4000", json=document)  # 1000 samples
+    assert longer_than_window.json()["detail"][0]["loc"] == ["query", "n_timesteps"]
 
 
 def _set(document, path, value):
@@ -92,7 +94,9 @@ def test_api_key_protects_v1_but_not_healthz(tmp_path, document):
         assert client.get("/v1/actuators/x/estimates", headers={"x-api-key": "s3cret"}).status_code == 200
 
 
-def test_a_full_queue_answers_503_with_retry_after(tmp_path, document, monkeypatch):
+@pytest.fixture
+def blocked(monkeypatch):
+    """The pipeline holds its slot until ``release`` is set; ``started`` says it holds it."""
     release, started = threading.Event(), threading.Event()
     real = estimate_route.estimate_window
 
@@ -102,42 +106,41 @@ def test_a_full_queue_answers_503_with_retry_after(tmp_path, document, monkeypat
         return real(window, config)
 
     monkeypatch.setattr(estimate_route, "estimate_window", slow_pipeline)
-    settings = Settings(database=tmp_path / "h.sqlite3", max_queue=0, **SMALL)
+    return release, started
+
+
+def _second_while_first_runs(settings, document, blocked, during=lambda client: None):
+    """Post once in a thread, and once more while the first holds the slot; both responses."""
+    release, started = blocked
     with TestClient(create_app(settings)) as client:
         first: dict = {}
         worker = threading.Thread(target=lambda: first.update(r=client.post("/v1/estimate", json=document)))
         worker.start()
         assert started.wait(timeout=30)
-        busy = client.post("/v1/estimate", json=document)
-        assert client.get("/healthz").json()["running"] == 1  # the loop still answers while a job runs
+        second = client.post("/v1/estimate", json=document)
+        during(client)
         release.set()
         worker.join(timeout=60)
+    return first["r"], second
+
+
+def test_a_full_queue_answers_503_with_retry_after(tmp_path, document, blocked):
+    settings = Settings(database=tmp_path / "h.sqlite3", max_queue=0, **SMALL)
+
+    def loop_still_answers(client):
+        assert client.get("/healthz").json()["running"] == 1
+
+    first, busy = _second_while_first_runs(settings, document, blocked, loop_still_answers)
     assert busy.status_code == 503
     assert int(busy.headers["Retry-After"]) >= 1
-    assert first["r"].status_code == 200
+    assert first.status_code == 200
 
 
-def test_a_queued_request_that_cannot_start_in_time_gets_503(tmp_path, document, monkeypatch):
-    release, started = threading.Event(), threading.Event()
-    real = estimate_route.estimate_window
-
-    def slow_pipeline(window, config):
-        started.set()
-        release.wait(timeout=30)
-        return real(window, config)
-
-    monkeypatch.setattr(estimate_route, "estimate_window", slow_pipeline)
+def test_a_queued_request_that_cannot_start_in_time_gets_503(tmp_path, document, blocked):
     settings = Settings(database=tmp_path / "h.sqlite3", max_queue=5, queue_timeout_s=0.5, **SMALL)
-    with TestClient(create_app(settings)) as client:
-        first: dict = {}
-        worker = threading.Thread(target=lambda: first.update(r=client.post("/v1/estimate", json=document)))
-        worker.start()
-        assert started.wait(timeout=30)
-        waited = client.post("/v1/estimate", json=document)  # queued behind it, gives up after 0.5 s
-        release.set()
-        worker.join(timeout=60)
+    first, waited = _second_while_first_runs(settings, document, blocked)  # queued, gives up after 0.5 s
     assert waited.status_code == 503
-    assert first["r"].status_code == 200
+    assert first.status_code == 200
 
 
 def test_history_survives_a_restart(tmp_path, document):
