@@ -117,7 +117,6 @@ class FitResult:
     train_mse: float
     val_mse: float
     test_mse: float
-    test_mse_per_target: np.ndarray  # (T,) on the test split: the error a prediction carries
     seconds: float
     split: dict[str, np.ndarray] = field(repr=False)  # indices of each part
     history: list[tuple[float, float]] = field(default_factory=list, repr=False)  # (train, val) per epoch
@@ -196,7 +195,6 @@ def fit(inputs: np.ndarray, targets: np.ndarray, config: TrainConfig) -> FitResu
         train_mse=_mse(model, z_train, y_train),
         val_mse=best_val,
         test_mse=_mse(model, z[parts["test"]], y[parts["test"]]),
-        test_mse_per_target=np.mean((predict(model, inputs[parts["test"]]) - targets[parts["test"]]) ** 2, axis=0),
         seconds=time.perf_counter() - start,
         split=parts,
         history=history,

@@ -85,10 +85,7 @@ def network_values(network: NetworkEstimator, windows: list[Window], config: Pip
     """The network's FDJ and η_O for each window."""
     stacked = {name: np.stack([w.signals[name] for w in windows]) for name in windows[0].signals}
     inputs = features(stacked, windows[0].sample_rate_hz, config.n_timesteps, config.input_set)
-    mean, _ = network.predict_normalized(inputs)
-    fdj_low, fdj_high = DEFAULT_RANGES.fdj_nm
-    eta_low, eta_high = DEFAULT_RANGES.eta_o
-    return {"FDJ": fdj_low + mean[:, 0] * (fdj_high - fdj_low), "eta_O": eta_low + mean[:, 1] * (eta_high - eta_low)}
+    return network.predict(inputs)
 
 
 def _entry(value: float, std: float | None, nominal: float) -> dict[str, Any]:
