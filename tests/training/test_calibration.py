@@ -85,3 +85,12 @@ def test_refinements_correct_in_each_effects_algebra():
         "stribeck", {"amplitude_nm": 0.02, "speed_radps": 40.0}, {"amplitude_nm": 0.01, "speed_radps": 40.0}
     )
     assert stribeck == pytest.approx({"amplitude_nm": 0.03, "speed_radps": 40.0})
+
+
+def test_two_undeclared_effects_are_both_found():
+    report = calibrate({"hinge_moment_bias": {"bias_nm": 12.0}, "viscous": {"coefficient_nms": 5e-5}}, seeds=(11, 12))
+    assert set(report["selected_effects"]) == {"hinge_moment_bias", "viscous"}
+    assert report["effects"]["hinge_moment_bias"]["bias_nm"] == pytest.approx(12.0, rel=0.05)
+    assert report["effects"]["viscous"]["coefficient_nms"] == pytest.approx(5e-5, rel=0.2)
+    assert report["error_pct_after"]["FDJ"] < 0.2 * report["error_pct_before"]["FDJ"]
+    assert len(report["selection_steps"]) == 2

@@ -18,7 +18,8 @@ from sim.params import DEFAULT_RANGES, ActuatorParams, HealthParams
 from sim.residual import DEFAULT_DERIVATIVE_WINDOW_S
 from sim.window import Window
 from training.calibration.channels import Residuals, residuals
-from training.calibration.library import BY_NAME, FOLLOWS, PRIMARY, refined, within_bounds
+from training.calibration.library import BY_NAME, PRIMARY, refined, within_bounds
+from training.calibration.report import calibration_report
 from training.calibration.selection import (
     HELD_OUT_GAIN,
     MIN_BIC_GAIN,
@@ -38,7 +39,6 @@ from training.calibration.selection import (
 from training.dataset import scenario_from_window
 from training.pipeline import PipelineConfig, estimate_window
 
-SCHEMA = "ema-calibration/1"
 TARGETS = ("FDJ", "eta_O")
 SAME_SIGNATURE_BIC = 0.5  # closer than this, two candidates leave the same trace: either may be named
 # Between that and MIN_BIC_GAIN the windows favour one only weakly: no name is forced.
@@ -67,12 +67,16 @@ class Calibrator:
         pipeline: PipelineConfig = PipelineConfig(),
         actuator: ActuatorParams = ActuatorParams(),
         refinements: int = 2,
+        max_effects: int = 2,
         seed: int = 0,
     ) -> None:
         if not isinstance(pipeline, PipelineConfig):
             raise InputError("pipeline", f"must be a PipelineConfig, got {type(pipeline).__name__}")
         if not 0 <= refinements <= 5:
             raise InputError("refinements", f"must be in [0, 5], got {refinements}")
+        if not 1 <= max_effects <= 4:
+            raise InputError("max_effects", f"must be in [1, 4], got {max_effects}")
+        self.max_effects = max_effects
         self.pipeline = pipeline
         self.actuator = actuator
         self.refinements = refinements
@@ -109,45 +113,58 @@ class Calibrator:
         null = fit_model(blocks, [])
         ranked = scores(blocks, [], self.actuator)
         candidates = [self._describe(choice, result, null) for choice, result in ranked]
-        selected, checks = self._select(blocks, ranked, null, windows, before)
-        effects = EffectSet()
-        structure = structure_left(blocks, [] if selected is None else [selected])
-        after, found_after = before, found
-        if selected is not None:
-            effects, after, found_after = self._add_effect(windows, selected, _parameters(selected, ranked), length)
-        self.report_ = self._report(
-            windows, before, after, found, found_after, candidates, selected, checks, structure, blocks, truth
+        chosen, steps = self._forward(blocks, ranked, null, windows, before)
+        structure = structure_left(blocks, chosen)
+        effects, after, found_after = EffectSet(), before, found
+        if chosen:
+            effects, after, found_after = self._add_effects(windows, chosen, blocks)
+        self.report_ = calibration_report(
+            windows, (before, after), (found, found_after), candidates, chosen, steps, structure, blocks, truth
         )
-        self.report_["effects"] = effects.as_dict()
+        self.report_["effects"] = effects.as_dict()  # every effect added, refined parameters
+        self.report_["selected_parameters"] = effects.as_dict()[chosen[0].candidate.effect] if chosen else None
         self.report_["timings_s"] = {"total": time.perf_counter() - started}
         self.residuals_before_, self.residuals_after_ = found, found_after
         return self
 
-    def _add_effect(
-        self, windows: Sequence[Window], selected: Choice, parameters: dict[str, float], length: int
-    ) -> tuple[EffectSet, dict[str, float], list[Residuals]]:
-        """Switch the effect on, re-estimate, and refine its parameters on what is still left.
+    def _forward(
+        self, blocks: Blocks, ranked, null, windows: Sequence[Window], estimates: Mapping[str, float]
+    ) -> tuple[list[Choice], list[dict[str, Any]]]:
+        """Forward selection of effect groups: add the best candidate while one passes every bar."""
+        chosen: list[Choice] = []
+        steps: list[dict[str, Any]] = []
+        current = null
+        while len(chosen) < self.max_effects:
+            choice, checks = self._select(blocks, ranked, current, chosen, windows, estimates)
+            steps.append({**checks, "selected": None if choice is None else choice.candidate.effect})
+            if choice is None:
+                break
+            chosen.append(choice)
+            current = fit_model(blocks, chosen)
+            ranked = scores(blocks, chosen, self.actuator)
+        return chosen, steps
 
-        The first fit was made against estimates the missing effect had biased; each round refits
-        the same signature to the new residual and corrects the parameters by it.
+    def _add_effects(
+        self, windows: Sequence[Window], chosen: Sequence[Choice], blocks: Blocks
+    ) -> tuple[EffectSet, dict[str, float], list[Residuals]]:
+        """Switch the effects on, re-estimate, and refine their parameters on what is still left.
+
+        The first fit was made against estimates the missing effects had biased; each round refits
+        the same signatures to the new residual and corrects the parameters by them.
         """
-        name = selected.candidate.effect
+        parameters = _parameters_of(chosen, fit_model(blocks, chosen))
         for round_ in range(self.refinements + 1):
-            effects = EffectSet({name: parameters})
+            effects = EffectSet(parameters)
             after = combined_estimates([estimate_window(w, self.pipeline, effects=effects) for w in windows])
             found_after = self._residuals(windows, after, effects)
             if round_ == self.refinements:
                 break
-            blocks = make_blocks(found_after, length, self.actuator)
-            choice = Choice(
-                selected.candidate,
-                selected.grid,
-                candidate_columns(blocks, selected.candidate, selected.grid, self.actuator),
-            )
-            increment = selected.candidate.parameters(fit_model(blocks, [choice]).coefficients[name], selected.grid)
-            update = refined(name, parameters, increment)
-            if not within_bounds(name, update):
-                break  # a correction past the effect's bounds is not trusted: keep the last good model
+            left = make_blocks(found_after, blocks.length, self.actuator)
+            again = [_rebuild(c, left, self.actuator) for c in chosen]
+            increments = _parameters_of(again, fit_model(left, again))
+            update = {name: refined(name, parameters[name], increments[name]) for name in parameters}
+            if not all(within_bounds(name, values) for name, values in update.items()):
+                break  # a correction past an effect's bounds is not trusted: keep the last good model
             parameters = update
         self.refined_parameters_ = parameters
         return effects, after, found_after
@@ -165,72 +182,68 @@ class Calibrator:
         }
 
     def _tie_break(
-        self, windows: Sequence[Window], estimates: Mapping[str, float], options: list[tuple[Choice, Any]]
+        self,
+        windows: Sequence[Window],
+        estimates: Mapping[str, float],
+        chosen: Sequence[Choice],
+        options: list[tuple[Choice, Any]],
     ) -> tuple[Choice, dict[str, float]]:
         """Candidates with one trace in the residuals: simulate each and keep the one whose motor speed
         matches the windows best (a torque constant also changes the back-EMF, hence the top speed;
         a current-sensor gain does not)."""
         speed_rms = {}
         for choice, result in options:
-            effect = choice.candidate.effect
-            effects = EffectSet({effect: choice.candidate.parameters(result.coefficients[effect], choice.grid)})
+            effects = EffectSet(_parameters_of([*chosen, choice], result))
             found = self._residuals(windows, estimates, effects)
-            speed_rms[effect] = float(np.sqrt(np.mean([r.rms_report["motor_speed"] ** 2 for r in found])))
+            speed_rms[choice.candidate.effect] = float(
+                np.sqrt(np.mean([r.rms_report["motor_speed"] ** 2 for r in found]))
+            )
         best = min(options, key=lambda option: speed_rms[option[0].candidate.effect])
         return best[0], speed_rms
 
     def _select(
-        self, blocks: Blocks, ranked, null, windows: Sequence[Window], estimates: Mapping[str, float]
+        self,
+        blocks: Blocks,
+        ranked,
+        current,
+        chosen: Sequence[Choice],
+        windows: Sequence[Window],
+        estimates: Mapping[str, float],
     ) -> tuple[Choice | None, dict[str, Any]]:
-        """The best candidate if it passes all three bars; the checks either way."""
+        """The best candidate beyond ``chosen`` if it passes every bar; the checks either way."""
         checks: dict[str, Any] = {"indistinguishable_from": []}
+        none_left = "no further candidate" if chosen else "no candidate"
         for choice, result in ranked:
-            parameters = choice.candidate.parameters(result.coefficients[choice.candidate.effect], choice.grid)
-            if null.bic - result.bic <= MIN_BIC_GAIN:
-                checks["reason"] = "no candidate lowers the BIC by more than 10: the residual is noise"
+            if current.bic - result.bic <= MIN_BIC_GAIN:
+                checks["reason"] = f"{none_left} lowers the BIC by more than {MIN_BIC_GAIN:g}: the rest is noise"
                 return None, checks
-            if not within_bounds(choice.candidate.effect, parameters):
+            if not _plausible(choice, result):
                 continue  # a fit the effect cannot physically have: try the next
-            checks["held_out_gain"] = held_out_gain(blocks, [], choice)
-            checks["stability"] = stability(blocks, [], choice.candidate.effect, self.actuator, self.seed)
-            checks["indistinguishable_from"] = [
-                c.candidate.effect for c, r in ranked if c is not choice and r.bic - result.bic < SAME_SIGNATURE_BIC
-            ]
-            rivals = [
-                (c.candidate.effect, r.bic - result.bic)
-                for c, r in ranked
-                if c is not choice
-                and SAME_SIGNATURE_BIC <= r.bic - result.bic < MIN_BIC_GAIN
-                and within_bounds(
-                    c.candidate.effect, c.candidate.parameters(r.coefficients[c.candidate.effect], c.grid)
-                )
-            ]
+            effect = choice.candidate.effect
+            checks["held_out_gain"] = held_out_gain(blocks, chosen, choice)
+            checks["stability"] = stability(blocks, chosen, effect, self.actuator, self.seed)
+            gaps = [(c, r, r.bic - result.bic) for c, r in ranked if c is not choice and _plausible(c, r)]
+            twins = [(c, r) for c, r, gap in gaps if gap < SAME_SIGNATURE_BIC]
+            rivals = [(c.candidate.effect, gap) for c, r, gap in gaps if SAME_SIGNATURE_BIC <= gap < MIN_BIC_GAIN]
+            checks["indistinguishable_from"] = [c.candidate.effect for c, _ in twins]
             if rivals:
                 rival, gap = rivals[0]
-                checks["contenders"] = [choice.candidate.effect, rival]
+                checks["contenders"] = [effect, rival]
                 checks["reason"] = (
-                    f"{choice.candidate.effect} and {rival} explain the residual about equally (BIC gap {gap:.1f} < "
-                    f"{MIN_BIC_GAIN:g}): neither is named"
+                    f"{effect} and {rival} explain the residual about equally "
+                    f"(BIC gap {gap:.1f} < {MIN_BIC_GAIN:g}): neither is named"
                 )
                 return None, checks
             if checks["held_out_gain"] < HELD_OUT_GAIN:
-                checks["reason"] = f"{choice.candidate.effect} does not predict held-out blocks"
+                checks["reason"] = f"{effect} does not predict held-out blocks"
                 return None, checks
             if checks["stability"] < MIN_STABILITY:
-                checks["reason"] = f"{choice.candidate.effect} is chosen in only {checks['stability']:.0%} of resamples"
+                checks["reason"] = f"{effect} is chosen in only {checks['stability']:.0%} of resamples"
                 return None, checks
             checks["reason"] = "strong evidence, predicts held-out blocks, stable under resampling"
-            twins = [
-                (c, r)
-                for c, r in ranked
-                if c.candidate.effect in checks["indistinguishable_from"]
-                and within_bounds(
-                    c.candidate.effect, c.candidate.parameters(r.coefficients[c.candidate.effect], c.grid)
-                )
-            ]
             if twins:
-                group = {choice.candidate.effect, *checks["indistinguishable_from"]}
-                choice, speed_rms = self._tie_break(windows, estimates, [(choice, result), *twins])
+                group = {effect, *checks["indistinguishable_from"]}
+                choice, speed_rms = self._tie_break(windows, estimates, chosen, [(choice, result), *twins])
                 checks["tie_break_speed_rms"] = speed_rms
                 checks["indistinguishable_from"] = sorted(group - {choice.candidate.effect})
                 checks["reason"] += f"; told from its twin by the motor speed it predicts ({choice.candidate.effect})"
@@ -238,46 +251,19 @@ class Calibrator:
         checks["reason"] = "every candidate that fits needs implausible parameters"
         return None, checks
 
-    def _report(
-        self, windows, before, after, found, found_after, candidates, selected, checks, structure, blocks, truth
-    ):
-        def rms(found_list: Sequence[Residuals]) -> dict[str, float]:
-            keys = found_list[0].rms_report
-            return {k: float(np.sqrt(np.mean([r.rms_report[k] ** 2 for r in found_list]))) for k in keys}
 
-        strongest = max(structure, key=lambda name: structure[name])
-        unexplained = None
-        contenders = checks.get("contenders")
-        if contenders:
-            variable = FOLLOWS[contenders[0]]
-            described = (
-                f"the residual follows {variable}; {' and '.join(contenders)} both fit it, "
-                "and these windows cannot tell which"
-            )
-            unexplained = {"variable": variable, "bic_gain": structure.get(variable), "description": described}
-        elif structure[strongest] > MIN_BIC_GAIN:
-            described = f"the residual torque varies systematically with {strongest}, and no candidate explains it"
-            unexplained = {"variable": strongest, "bic_gain": structure[strongest], "description": described}
-        report: dict[str, Any] = {
-            "schema": SCHEMA,
-            "n_windows": len(windows),
-            "residual_rms_before": rms(found),
-            "residual_rms_after": rms(found_after),
-            "candidates": candidates,
-            "selected_effect": None if selected is None else selected.candidate.effect,
-            "selected_parameters": None if selected is None else self.refined_parameters_,
-            "selection": {**checks, "block_length_samples": blocks.length, "effective_samples": blocks.n},
-            "unexplained_structure": unexplained,
-            "estimates_before": before,
-            "estimates_after": after,
-        }
-        if truth is not None:
-            for when, values in (("before", before), ("after", after)):
-                report[f"error_{when}"] = {k: abs(values[k] - float(truth[k])) for k in TARGETS}
-                report[f"error_pct_{when}"] = {k: 100 * abs(values[k] / float(truth[k]) - 1) for k in TARGETS}
-        return report
+def _plausible(choice: Choice, fitted) -> bool:
+    effect = choice.candidate.effect
+    return within_bounds(effect, choice.candidate.parameters(fitted.coefficients[effect], choice.grid))
 
 
-def _parameters(selected: Choice, ranked) -> dict[str, float]:
-    result = next(r for c, r in ranked if c is selected)
-    return selected.candidate.parameters(result.coefficients[selected.candidate.effect], selected.grid)
+def _parameters_of(choices: Sequence[Choice], fitted) -> dict[str, dict[str, float]]:
+    """Each chosen effect's parameters from a joint fit."""
+    return {
+        c.candidate.effect: c.candidate.parameters(fitted.coefficients[c.candidate.effect], c.grid) for c in choices
+    }
+
+
+def _rebuild(choice: Choice, blocks: Blocks, actuator: ActuatorParams) -> Choice:
+    """The same candidate and grid value, its columns recomputed on other blocks."""
+    return Choice(choice.candidate, choice.grid, candidate_columns(blocks, choice.candidate, choice.grid, actuator))
