@@ -72,11 +72,17 @@ def check_windows(
     return health, windows
 
 
-def baseline_values(window: Window) -> dict[str, float] | None:
-    """The least-squares FDJ and η_O of a window, or None where it has too little sliding to fit."""
+def baseline_fit(window: Window) -> FrictionLeastSquares | InputError:
+    """The least-squares fit of a window, or the reason it cannot fit (too little sliding motion)."""
     try:
-        fitted = FrictionLeastSquares().fit(window)
-    except InputError:
+        return FrictionLeastSquares().fit(window)
+    except InputError as exc:
+        return exc
+
+
+def baseline_values(fitted: FrictionLeastSquares | InputError) -> dict[str, float] | None:
+    """FDJ and η_O of a baseline fit, or None where it abstained."""
+    if isinstance(fitted, InputError):
         return None
     return {"FDJ": fitted.fdj_, "eta_O": fitted.eta_o_}
 
@@ -127,12 +133,10 @@ def blended_estimates(
     return estimates, methods
 
 
-def static_friction(window: Window) -> tuple[float | None, str]:
+def static_friction(fitted: FrictionLeastSquares | InputError) -> tuple[float | None, str]:
     """FSJ from the window's break-aways, or None with the reason it cannot be estimated."""
-    try:
-        fitted = FrictionLeastSquares().fit(window)
-    except InputError as exc:
-        return None, str(exc)
+    if isinstance(fitted, InputError):
+        return None, str(fitted)
     return fitted.fsj_, fitted.fsj_reason_
 
 
@@ -164,12 +168,12 @@ def estimate_window(
     stage("estimating")
     estimates, methods = blended_estimates(
         network={k: float(v[0]) for k, v in network_values(network, [window], config).items()},
-        baseline=baseline_values(window),
+        baseline=baseline_values(window_fit := baseline_fit(window)),
         check_truth={"FDJ": check_health.fdj_nm, "eta_O": check_health.eta_o},
         check_network=network_values(network, checks, config),
-        check_baseline=[baseline_values(w) for w in checks],
+        check_baseline=[baseline_values(baseline_fit(w)) for w in checks],
     )
-    fsj, fsj_note = static_friction(window)
+    fsj, fsj_note = static_friction(window_fit)  # the same fit: dynamic levels first, then break-aways
     estimates["FSJ"] = None if fsj is None else _entry(fsj, None, DEFAULT_RANGES.nominal_fsj_nm)
     if fsj is not None:
         estimates["FSD"] = {"value": fsj / estimates["FDJ"]["value"]}

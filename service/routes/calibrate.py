@@ -4,11 +4,10 @@ from typing import Any
 
 from fastapi import APIRouter
 
-from service.deps import RunnerDep, SettingsDep
+from service.deps import RunnerDep, SettingsDep, pipeline_config
 from service.schemas import CalibrateIn
 from service.windows import to_window
 from training.calibration.calibrate import Calibrator
-from training.pipeline import PipelineConfig
 
 router = APIRouter(prefix="/v1", tags=["calibrate"])
 
@@ -17,13 +16,7 @@ router = APIRouter(prefix="/v1", tags=["calibrate"])
 async def calibrate(body: CalibrateIn, settings: SettingsDep, runner: RunnerDep) -> dict[str, Any]:
     """Compare the model with the windows, trace the residual to a missing effect, add it: ema-calibration/1."""
     windows = [to_window(window) for window in body.windows]
-    config = PipelineConfig(
-        n_simulations=settings.n_simulations,
-        n_timesteps=settings.n_timesteps,
-        hidden_units=settings.hidden_units,
-        check_windows=settings.check_windows,
-        seed=settings.seed,
-    )
+    config = pipeline_config(settings)
     truth = None if body.truth is None else body.truth.model_dump(exclude_none=True)
 
     def run() -> dict[str, Any]:

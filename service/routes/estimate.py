@@ -5,12 +5,12 @@ from typing import Annotated, Any
 from fastapi import APIRouter, Query
 from starlette.concurrency import run_in_threadpool
 
-from service.deps import RunnerDep, SettingsDep, StoreDep
+from service.deps import RunnerDep, SettingsDep, StoreDep, pipeline_config
 from service.errors import bounded
 from service.schemas import EstimateOut, WindowIn
 from service.windows import to_window
 from sim.checks import InputError
-from training.pipeline import PipelineConfig, estimate_window
+from training.pipeline import estimate_window
 
 router = APIRouter(prefix="/v1", tags=["estimate"])
 
@@ -28,12 +28,11 @@ async def estimate(
 ) -> dict[str, Any]:
     """Simulate a Case-1B dataset for the window's own command, train, estimate; store and answer."""
     window = to_window(body)
-    config = PipelineConfig(
+    config = pipeline_config(
+        settings,
         n_simulations=bounded("n_simulations", n_simulations, settings.n_simulations, settings.max_simulations),
         n_timesteps=bounded("n_timesteps", n_timesteps, settings.n_timesteps, settings.max_timesteps),
         hidden_units=bounded("hidden_units", hidden_units, settings.hidden_units, settings.max_hidden_units),
-        members=settings.members,
-        check_windows=settings.check_windows,
         seed=settings.seed if seed is None else seed,
     )
     if config.n_timesteps > window.n_samples:
