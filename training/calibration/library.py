@@ -27,10 +27,6 @@ class Candidate:
     columns: Callable[[Mapping[str, np.ndarray], float, ActuatorParams], Columns]
     parameters: Callable[[dict[str, np.ndarray], float], dict[str, float]]
 
-    @property
-    def n_parameters(self) -> int:
-        return (0 if np.isnan(self.grid[0]) else 1) + sum(1 for _ in EFFECTS[self.effect].parameters)
-
 
 def _sign(v: Mapping[str, np.ndarray]) -> np.ndarray:
     return np.sign(v["speed_radps"])
