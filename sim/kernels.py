@@ -21,8 +21,9 @@ N_RECORDED = 6
 INIT_POSITION, INIT_SPEED, INIT_CURRENT = range(3)
 # Rows of ``per_sim``: health parameters in the form the friction model uses.
 FDJ, FSJ, K_AID, K_OPP = range(4)
-# Rows of a group's ``lane`` array. Everything the lane loop touches lives in this one array so
-# that LLVM sees a single base pointer and vectorizes without runtime overlap checks.
+# Rows of a group's ``lane`` array. Everything the lane loop touches lives in this one array: with
+# separate arrays LLVM needed too many runtime overlap checks and left the loop scalar; with one
+# base pointer it vectorizes, and its remaining checks are hoisted out of the step loop.
 CURRENT_NOW, SPEED_NOW, ANGLE_NOW, POSITION_NOW = range(4)  # state
 LOAD_SLOW, COMMAND0, COMMAND_STEP = range(4, 7)  # inputs, fixed over an interval
 COGGING, DRY_DYNAMIC, DRY_STATIC = range(7, 10)  # cogging torque, FDJ / FSJ plus friction effects
