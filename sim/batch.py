@@ -20,9 +20,6 @@ LANE_MULTIPLE = 8  # one AVX-512 register of float64
 MAX_INITIAL_SPEED_RADPS = 700.0
 MAX_INITIAL_CURRENT_A = 30.0
 
-SIGNAL_NAMES = ("position_deg", "motor_speed_radps", "current_a", "hinge_moment_nm", "command_deg")
-TRUTH_NAME = "loss_torque_nm"
-
 
 @dataclass(frozen=True)
 class InitialState:

@@ -66,8 +66,3 @@ def knots_from_samples(command_deg: np.ndarray) -> np.ndarray:
         knots[:, edge] = (11 * near[:, 0] - 7 * near[:, 1] + 2 * near[:, 2]) / 6
         knots[:, 1 if edge == 0 else -2] = (2 * near[:, 0] + 5 * near[:, 1] - near[:, 2]) / 6
     return knots
-
-
-def interval_means(knots: np.ndarray) -> np.ndarray:
-    """The mean of the linearly interpolated command over each interval (inverse of knots_from_samples)."""
-    return 0.5 * (knots[..., 1:] + knots[..., :-1])

@@ -17,7 +17,6 @@ from sim.window import Window
 from training.noise_level import excess_noise
 from training.preprocess import INPUT_SETS, SIGNALS_READ, features
 
-TARGETS = ("FDJ", "eta_O")
 INITIAL_FIT_SAMPLES = 8
 
 
