@@ -220,8 +220,6 @@ class Calibrator:
             if not _plausible(choice, result):
                 continue  # a fit the effect cannot physically have: try the next
             effect = choice.candidate.effect
-            checks["held_out_gain"] = held_out_gain(blocks, chosen, choice)
-            checks["stability"] = stability(blocks, chosen, effect, self.actuator, self.seed)
             gaps = [(c, r, r.bic - result.bic) for c, r in ranked if c is not choice and _plausible(c, r)]
             twins = [(c, r) for c, r, gap in gaps if gap < SAME_SIGNATURE_BIC]
             rivals = [(c.candidate.effect, gap) for c, r, gap in gaps if SAME_SIGNATURE_BIC <= gap < MIN_BIC_GAIN]
@@ -234,6 +232,10 @@ class Calibrator:
                     f"(BIC gap {gap:.1f} < {MIN_BIC_GAIN:g}): neither is named"
                 )
                 return None, checks
+            # Only now the costly checks (the bootstrap refits every candidate 40 times): a close rival
+            # already rules the name out.
+            checks["held_out_gain"] = held_out_gain(blocks, chosen, choice)
+            checks["stability"] = stability(blocks, chosen, effect, self.actuator, self.seed)
             if checks["held_out_gain"] < HELD_OUT_GAIN:
                 checks["reason"] = f"{effect} does not predict held-out blocks"
                 return None, checks
