@@ -1,0 +1,83 @@
+"""Foreign windows: the independent physics, a command family, sensor noise of its own kind.
+
+``draw`` returns an ``ema-window/1`` *document* (what a client sends) and the truth, never one of
+our own objects: tests parse it through the public contract like any user's data.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from tests.foreign import commands
+from tests.foreign.physics import Effects, Flight, Health, Setup, simulate
+
+NOISE = {"position_deg": 0.01, "motor_speed_radps": 0.5, "current_a": 0.05, "hinge_moment_nm": 2.0}
+QUANTUM = {"position_deg": 0.0025, "current_a": 0.005}  # resolver and ADC resolution
+
+
+@dataclass(frozen=True)
+class Draw:
+    document: dict
+    truth: dict[str, float]  # FDJ, eta_O, eta_A, FSJ
+    family: str
+    setup: Setup = field(repr=False)
+
+
+def noisy(signals: dict[str, np.ndarray], rng: np.random.Generator, level: float) -> dict[str, np.ndarray]:
+    """Gaussian noise at ``level`` × NOISE (each signal ±30 % around it), then sensor quantization."""
+    out = {}
+    for name, values in signals.items():
+        sigma = NOISE.get(name, 0.0) * level * rng.uniform(0.7, 1.3)
+        noisy_values = values + sigma * rng.standard_normal(len(values))
+        if name in QUANTUM:
+            noisy_values = QUANTUM[name] * np.round(noisy_values / QUANTUM[name])
+        out[name] = noisy_values
+    return out
+
+
+def draw(
+    seed: int,
+    family: str = "thesis",
+    health: Health | None = None,
+    effects: Effects = Effects(),
+    flight: Flight | None = None,
+    duration_s: float = 0.5,
+    sample_rate_hz: float = 10_000.0,
+    noise_level: float = 1.0,
+    preroll_s: float | None = None,
+) -> Draw:
+    """One window. Unset health and flight are drawn (health inside the thesis's ranges); windows of
+    the flight families start mid-motion (a pre-roll of 20–100 ms), the thesis family from rest."""
+    rng = np.random.default_rng(seed)
+    if health is None:
+        health = Health(fdj_nm=rng.uniform(0.04, 0.06), fsj_nm=rng.uniform(0.08, 0.12), eta_o=rng.uniform(0.68, 0.98))
+    if flight is None:
+        flight = Flight(airspeed_mps=rng.uniform(100.0, 210.0), altitude_m=rng.uniform(0.0, 9000.0))
+    if preroll_s is None:
+        preroll_s = 0.0 if family == "thesis" else float(rng.uniform(0.02, 0.1))
+    command = commands.BY_NAME[family](rng, duration_s)
+    setup = Setup(health, effects, flight, sample_rate_hz)
+    signals = noisy(simulate(setup, command, duration_s, preroll_s), rng, noise_level)
+    document = {
+        "schema": "ema-window/1",
+        "actuator_id": f"foreign/{family}",
+        "window_id": f"{family}-{seed}",
+        "sample_rate_hz": sample_rate_hz,
+        "flight_condition": {"airspeed_mps": flight.airspeed_mps, "altitude_m": flight.altitude_m},
+        "signals": {name: values.tolist() for name, values in signals.items()},
+    }
+    truth = {"FDJ": health.fdj_nm, "eta_O": health.eta_o, "eta_A": health.eta_a, "FSJ": health.fsj_nm}
+    return Draw(document, truth, family, setup)
+
+
+def worn(seed: int, **kwargs) -> Draw:
+    """A worn actuator (FDJ 1.3–2.5× nominal, η_O 0.45–0.66: Case 1C's irreversible range included)."""
+    rng = np.random.default_rng(10_000 + seed)
+    fdj = 0.05 * rng.uniform(1.3, 2.5)
+    health = Health(fdj_nm=fdj, fsj_nm=fdj * rng.uniform(1.6, 2.2), eta_o=rng.uniform(0.45, 0.66))
+    return draw(seed, health=health, **kwargs)
+
+
+__all__ = ["Draw", "Effects", "Flight", "Health", "draw", "replace", "worn"]
