@@ -2,8 +2,8 @@
 
 Numbers and scaling rules: ``shared/spec/aircraft.md`` (Stevens & Lewis Example 4.4-1, SI).
 The kernel sees the aircraft only through a :class:`LoadModel`: a discrete linear system advanced
-once per log interval plus the hinge-moment output, so the on-ground case (a prescribed load) is
-the same structure with the dynamics switched off.
+once per log interval plus the hinge-moment output, so the on-ground case (a prescribed load) and
+a load taken from a log are the same structure with the dynamics switched off.
 """
 
 from __future__ import annotations
@@ -110,6 +110,7 @@ class LoadModel(NamedTuple):
     hinge_alpha_nm: float  # q̄·S·c·C_hα [N·m/rad]
     hinge_delta_nm: float  # q̄·S·c·C_hδ [N·m/rad]
     hinge_ramp_nmps: float  # ground ramp [N·m/s]
+    slow_table_nm: np.ndarray  # (K,) the slow part per log interval, from a log; empty: from the model
 
 
 def state_space(condition: FlightCondition) -> tuple[np.ndarray, np.ndarray]:
@@ -187,6 +188,7 @@ def flight_load_model(
         hinge_alpha_nm=scale * hinge.ch_alpha_per_rad,
         hinge_delta_nm=scale * hinge.ch_delta_per_rad,
         hinge_ramp_nmps=0.0,
+        slow_table_nm=np.zeros(0),
     )
 
 
@@ -203,13 +205,57 @@ def ground_load_model(load: GroundLoad) -> LoadModel:
         hinge_alpha_nm=0.0,
         hinge_delta_nm=0.0,
         hinge_ramp_nmps=load.ramp_nmps,
+        slow_table_nm=np.zeros(0),
     )
 
 
-def load_model(load: FlightCondition | GroundLoad, interval_s: float) -> LoadModel:
-    """Dispatch on the kind of load: in flight or on ground."""
+@dataclass(frozen=True)
+class LoggedLoad:
+    """The hinge moment a window logged, driving its simulations in place of the aircraft model.
+
+    Per log interval the simulated moment is H_logged + q̄·S·c·C_hδ·(θ_sim − θ_logged): what the
+    aircraft really did, corrected to first order for the simulation's own deflection. Nothing is
+    assumed about the aircraft's state when the window starts (a window cut from a flight is
+    rarely at trim), and a flight condition enters only through q̄. Arrays are (K,), one value
+    per log interval, already smoothed of sensor noise by the caller.
+    """
+
+    condition: FlightCondition
+    hinge_moment_nm: np.ndarray  # H_e logged [N·m]
+    position_deg: np.ndarray  # θ_u logged [deg]
+
+    def __post_init__(self) -> None:
+        if self.hinge_moment_nm.shape != self.position_deg.shape or self.hinge_moment_nm.ndim != 1:
+            raise InputError("load", "hinge_moment_nm and position_deg must be (K,) arrays of one length")
+
+
+def logged_load_model(load: LoggedLoad, hinge: HingeGeometry = HingeGeometry()) -> LoadModel:
+    """The slow part of the moment, per interval, from the log; the δ term from the condition."""
+    delta_nm = load.condition.dynamic_pressure_pa * hinge.area_m2 * hinge.chord_m * hinge.ch_delta_per_rad
+    return LoadModel(
+        ad=np.eye(4),
+        bd=np.zeros(4),
+        trim_elevator_rad=0.0,
+        alpha_t0_rad=0.0,
+        alpha_t_row=np.zeros(4),
+        alpha_t_limit_rad=1.0,
+        hinge_bias_nm=0.0,
+        hinge_alpha_nm=0.0,
+        hinge_delta_nm=delta_nm,
+        hinge_ramp_nmps=0.0,
+        slow_table_nm=np.ascontiguousarray(load.hinge_moment_nm - delta_nm * np.radians(load.position_deg)),
+    )
+
+
+Load = FlightCondition | GroundLoad | LoggedLoad
+
+
+def load_model(load: Load, interval_s: float) -> LoadModel:
+    """Dispatch on the kind of load: in flight, on ground, or as logged."""
     if isinstance(load, FlightCondition):
         return flight_load_model(load, interval_s)
     if isinstance(load, GroundLoad):
         return ground_load_model(load)
-    raise InputError("load", f"must be a FlightCondition or a GroundLoad, got {type(load).__name__}")
+    if isinstance(load, LoggedLoad):
+        return logged_load_model(load)
+    raise InputError("load", f"must be a FlightCondition, GroundLoad or LoggedLoad, got {type(load).__name__}")

@@ -4,12 +4,11 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-import numba
 import numpy as np
 
-from sim import kernels
-from sim.aircraft import FlightCondition, GroundLoad, load_model
-from sim.checks import InputError, array_in_range, finite_array, in_range
+from sim import kernels, runtime
+from sim.aircraft import FlightCondition, Load, load_model
+from sim.checks import InputError, finite_array, in_range
 from sim.effects import EffectSet
 from sim.params import ActuatorParams, HealthParams
 
@@ -17,6 +16,9 @@ DEFAULT_SAMPLE_RATE_HZ = 10_000.0
 SAMPLE_RATE_RANGE_HZ = (1_000.0, 100_000.0)
 MAX_LANES = 64  # simulations advanced in lock-step; fewer lanes pay more per-step loop overhead
 LANE_MULTIPLE = 8  # one AVX-512 register of float64
+# Past the end stops a command only saturates the speed reference: ω_ref = sat(G_P·(θ_cmd − θ_u)) is
+# already ±ω_max once θ_cmd is ω_max/G_P ≈ 0.37° beyond them, so clipping there changes nothing.
+COMMAND_MARGIN_DEG = 1.0
 MAX_INITIAL_SPEED_RADPS = 700.0
 MAX_INITIAL_CURRENT_A = 30.0
 
@@ -53,7 +55,7 @@ class BatchResult:
         return {name: values[index] for name, values in self.signals.items()}
 
 
-def kernel_constants(actuator: ActuatorParams, effects: EffectSet, steps_per_sample: int) -> kernels.KernelConstants:
+def kernel_constants(actuator: ActuatorParams, effects: EffectSet) -> kernels.KernelConstants:
     """The step's constants with the effects folded in (derived once per batch)."""
     gain = effects.get("torque_constant", "gain")
     sensor_gain = effects.get("current_sensor_gain", "gain")
@@ -62,7 +64,6 @@ def kernel_constants(actuator: ActuatorParams, effects: EffectSet, steps_per_sam
     return kernels.KernelConstants(
         step_s=actuator.step_s,
         step_over_gear=actuator.step_s / actuator.gear_ratio,
-        steps_per_sample=steps_per_sample,
         position_gain=actuator.position_gain_per_s,
         max_speed_ref=actuator.max_motor_speed_radps,
         speed_gain_over_kt=actuator.speed_gain_nms / actuator.torque_constant_nm_per_a / sensor_gain,
@@ -92,16 +93,18 @@ def kernel_constants(actuator: ActuatorParams, effects: EffectSet, steps_per_sam
     )
 
 
-def steps_per_sample(sample_rate_hz: float, actuator: ActuatorParams) -> int:
-    """Integration steps per log interval; the log interval must be a whole number of steps."""
+def interval_steps(n_samples: int, sample_rate_hz: float, actuator: ActuatorParams = ActuatorParams()) -> np.ndarray:
+    """(n_samples,) steps of h in each log interval: interval k spans steps round(k/(f·h)) to round((k+1)/(f·h)).
+
+    Any rate is exact: at 3 kHz the intervals hold 333 or 334 steps, as a logger's clock would.
+    """
     rate = in_range("sample_rate_hz", sample_rate_hz, *SAMPLE_RATE_RANGE_HZ, "Hz")
-    steps = round(1.0 / (rate * actuator.step_s))
-    if abs(steps * rate * actuator.step_s - 1.0) > 1e-9:
-        raise InputError("sample_rate_hz", f"1/{rate:g} s is not a whole number of {actuator.step_s:g} s steps")
-    return steps
+    edges = np.round(np.arange(n_samples + 1) / (rate * actuator.step_s)).astype(np.int64)
+    return np.diff(edges)
 
 
-def _checked_knots(command_knots_deg: np.ndarray, n_health: int, end_stop_deg: float) -> np.ndarray:
+def clipped_knots(command_knots_deg: np.ndarray, n_health: int, end_stop_deg: float) -> np.ndarray:
+    """Knots checked for shape and finiteness, clipped where the controller saturates anyway."""
     knots = np.atleast_2d(finite_array("command_knots_deg", command_knots_deg))
     if knots.ndim != 2 or knots.shape[1] < 2:
         raise InputError("command_knots_deg", f"must be (n_samples + 1,) or (n, n_samples + 1), got {knots.shape}")
@@ -109,8 +112,8 @@ def _checked_knots(command_knots_deg: np.ndarray, n_health: int, end_stop_deg: f
         raise InputError(
             "command_knots_deg", f"needs 1 command or one per simulation ({n_health}), got {knots.shape[0]}"
         )
-    array_in_range("command_knots_deg", knots, -end_stop_deg - 10.0, end_stop_deg + 10.0, "deg")
-    return knots
+    limit = end_stop_deg + COMMAND_MARGIN_DEG
+    return np.clip(knots, -limit, limit)
 
 
 def _checked_initial(initial: InitialState, end_stop_deg: float) -> InitialState:
@@ -121,9 +124,25 @@ def _checked_initial(initial: InitialState, end_stop_deg: float) -> InitialState
 
 
 def default_lanes(n_sims: int) -> int:
-    """Lanes per group: every core gets a group, groups are whole registers, at most MAX_LANES."""
-    per_core = -(-n_sims // numba.get_num_threads())
-    return min(MAX_LANES, -(-per_core // LANE_MULTIPLE) * LANE_MULTIPLE)
+    """Lanes per group: every thread gets a group, groups are whole registers, at most MAX_LANES."""
+    per_thread = -(-n_sims // runtime.threads())
+    return min(MAX_LANES, -(-per_thread // LANE_MULTIPLE) * LANE_MULTIPLE)
+
+
+def run_groups(inputs: tuple, out: np.ndarray, lanes: int) -> None:
+    """``kernels.run_group`` for every group of ``lanes`` simulations, on the simulator's thread pool
+    (inline with one thread). ``inputs`` are the kernel's arguments before ``first``."""
+    firsts = range(0, out.shape[1], lanes)
+
+    def run(first: int) -> None:
+        kernels.run_group(*inputs, first, lanes, out)
+
+    if runtime.threads() == 1 or len(firsts) == 1:
+        for first in firsts:
+            run(first)
+        return
+    for future in [runtime.pool().submit(run, first) for first in firsts]:
+        future.result()
 
 
 def _padded(values: np.ndarray, multiple: int) -> np.ndarray:
@@ -137,7 +156,7 @@ def _padded(values: np.ndarray, multiple: int) -> np.ndarray:
 def simulate_batch(
     command_knots_deg: np.ndarray,
     health: HealthParams,
-    load: FlightCondition | GroundLoad = FlightCondition(),
+    load: Load = FlightCondition(),
     initial: InitialState = InitialState(),
     sample_rate_hz: float = DEFAULT_SAMPLE_RATE_HZ,
     effects: EffectSet = EffectSet(),
@@ -149,32 +168,33 @@ def simulate_batch(
     ``command_knots_deg`` is the command at the log-interval boundaries (see ``sim.commands``):
     (n_samples + 1,) shared by the batch (Case 1) or (n_simulations, n_samples + 1) (Case 2).
     The 1 µs trajectory is never stored. Deterministic: the same inputs give the same output,
-    whatever ``lanes`` (simulations per lock-step group; by default as many as keep every core
-    busy, up to 64).
+    whatever ``lanes`` (simulations per lock-step group; by default as many as keep every
+    thread busy, up to 64) and whatever the thread budget.
     """
     if not isinstance(health, HealthParams):
         raise InputError("health", f"must be HealthParams, got {type(health).__name__}")
     n_sims = len(health)
-    knots = _checked_knots(command_knots_deg, n_sims, actuator.end_stop_deg)
+    knots = clipped_knots(command_knots_deg, n_sims, actuator.end_stop_deg)
     _checked_initial(initial, actuator.end_stop_deg)
     if not isinstance(effects, EffectSet):
         raise InputError("effects", f"must be an EffectSet, got {type(effects).__name__}")
     lanes = default_lanes(n_sims) if lanes is None else lanes
     if not 1 <= lanes <= 512:
         raise InputError("lanes", f"must be in [1, 512], got {lanes}")
-    steps = steps_per_sample(sample_rate_hz, actuator)
     n_samples = knots.shape[1] - 1
-    constants = kernel_constants(actuator, effects, steps)
-    loads = load_model(load, interval_s=steps * actuator.step_s)
+    steps = interval_steps(n_samples, sample_rate_hz, actuator)
+    loads = load_model(load, interval_s=1.0 / sample_rate_hz)
+    if len(loads.slow_table_nm) not in (0, n_samples):
+        raise InputError("load", f"a logged load needs {n_samples} values, got {len(loads.slow_table_nm)}")
 
     eta_a = health.eta_a(actuator.gear_ratio)
     per_sim = _padded(np.stack([health.fdj_nm, health.fsj_nm, 1.0 - eta_a, 1.0 / health.eta_o - 1.0]), lanes)
     start = [np.radians(initial.position_deg), initial.motor_speed_radps, initial.current_a]
     initial_rows = np.repeat(np.array(start)[:, None], per_sim.shape[1], axis=1)
     out = np.empty((kernels.N_RECORDED, per_sim.shape[1], n_samples))
-    kernels.simulate_groups(
-        constants, loads, per_sim, np.ascontiguousarray(np.radians(knots)), initial_rows, lanes, out
-    )
+    constants = kernel_constants(actuator, effects)
+    knots_rad = np.ascontiguousarray(np.radians(knots))
+    run_groups((constants, loads, per_sim, knots_rad, steps, initial_rows), out, lanes)
     out = out[:, :n_sims]
     signals = {
         "position_deg": np.degrees(out[kernels.POSITION]),

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 
@@ -47,3 +48,13 @@ def array_in_range(field: str, values: np.ndarray, low: float, high: float, unit
     if np.any(outside):
         first = float(values.ravel()[np.flatnonzero(outside.ravel())[0]])
         raise InputError(field, f"value {first:g} is outside [{low:g}, {high:g}] {unit}".rstrip())
+
+
+def from_validation(exc: Any, prefix: str = "") -> InputError:
+    """A pydantic ValidationError's first error as an InputError naming the field (list indices go
+    into the message: ``signals.current_a``, "sample 17: Input should be a finite number")."""
+    first = exc.errors()[0]
+    names = [str(part) for part in first["loc"] if not isinstance(part, int)]
+    indices = [part for part in first["loc"] if isinstance(part, int)]
+    message = first["msg"] if not indices else f"sample {indices[0]}: {first['msg']}"
+    return InputError(prefix + (".".join(names) or "document"), message)

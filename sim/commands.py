@@ -53,7 +53,10 @@ def knots_from_samples(command_deg: np.ndarray) -> np.ndarray:
 
     Inside, the fourth-order boundary value of cell means, (7·(c₋₁ + c₀) − (c₋₂ + c₁)) / 12, so a
     smooth command's means are reproduced to O(Δt⁴); the two knots at each end use the one-sided
-    third-order formulas from the three nearest means.
+    third-order formulas from the three nearest means. Each inner knot is then held between its
+    two neighbouring means (the monotonicity limiter of PPM, Colella & Woodward 1984): a pilot's
+    step would otherwise ring, 1/12 of the step past it on either side. At a smooth extremum the
+    limiter costs at most |f''|·Δt²/6.
     Accepts (n_samples,) or (n_commands, n_samples); returns one more column.
     """
     samples = np.atleast_2d(finite_array("command_deg", command_deg))
@@ -65,4 +68,6 @@ def knots_from_samples(command_deg: np.ndarray) -> np.ndarray:
     for edge, near in ((0, first), (-1, last)):
         knots[:, edge] = (11 * near[:, 0] - 7 * near[:, 1] + 2 * near[:, 2]) / 6
         knots[:, 1 if edge == 0 else -2] = (2 * near[:, 0] + 5 * near[:, 1] - near[:, 2]) / 6
+    left, right = samples[:, :-1], samples[:, 1:]
+    knots[:, 1:-1] = np.clip(knots[:, 1:-1], np.minimum(left, right), np.maximum(left, right))
     return knots

@@ -1,10 +1,11 @@
 """The Numba kernels: one 1 µs step of the EMA, and the lock-step loop over groups of simulations.
 
 Pure functions of their arguments: ``sim.batch`` validates, packs the constants, allocates
-``out`` and calls :func:`simulate_groups`. The step is written once (:func:`advance`) and every
-loop uses it, so the vectorized lock-step path and the one-lane path run the same arithmetic.
-The branches in :func:`advance` are simple enough for LLVM to turn into selects; that is what
-lets the lane loop in :func:`_run_group` vectorize across simulations.
+``out`` and runs :func:`run_group` for each group of simulations on its own threads. The step is
+written once (:func:`advance`) and every loop uses it, so the vectorized lock-step path and the
+one-lane path run the same arithmetic. The branches in :func:`advance` are simple enough for
+LLVM to turn into selects; that is what lets the lane loop in :func:`_advance_lanes` vectorize
+across simulations.
 """
 
 from __future__ import annotations
@@ -12,7 +13,7 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
 # Rows of ``out``: recorded signals, each the mean over a log interval.
 POSITION, SPEED, CURRENT, HINGE, COMMAND, LOSS = range(6)
@@ -37,7 +38,6 @@ class KernelConstants(NamedTuple):
 
     step_s: float  # h [s]
     step_over_gear: float  # h / n [s]
-    steps_per_sample: int  # 1 µs steps per log interval
     position_gain: float  # G_P [1/s]
     max_speed_ref: float  # ω_max [rad/s]
     speed_gain_over_kt: float  # GAP / (k_T nominal · current sensor gain) [A·s/rad], in true amperes
@@ -179,13 +179,31 @@ def _advance_lanes(c, load_delta, j, lane):
         lane[SUM_LOSS, s] += loss
 
 
-@njit(cache=True, error_model="numpy")
-def _run_group(c, load, per_sim, knots_rad, initial, first, lanes, out):
-    """Simulate sims [first, first + lanes) in lock-step and write their interval means into out."""
+@njit(cache=True, nogil=True, error_model="numpy")
+def run_group(c, load, per_sim, knots_rad, interval_steps, initial, first, lanes, out):
+    """Simulate sims [first, first + lanes) in lock-step and write their interval means into ``out``.
+
+    Over log interval k (``interval_steps[k]`` steps of h, so logs of any rate are exact), each
+    simulation's command runs linearly from ``knots_rad[row, k]`` to ``knots_rad[row, k + 1]`` and
+    every recorded signal is the mean over the interval's steps:
+
+        out[r, first + s, k] = (1 / m_k) Σ_{j < m_k} x_r(t_k + (j + 1)·h),  m_k = interval_steps[k].
+
+    The load's slow part is constant over an interval: from the aircraft (advanced by exact ZOH
+    on the interval's mean deflection) or, when ``load.slow_table_nm`` is not empty, from that
+    table (a logged hinge moment). Releases the GIL: the caller runs groups on its own threads.
+
+    Parameters
+    ----------
+    per_sim : (4, N) FDJ, FSJ, 1 − η_A, 1/η_O − 1, N a multiple of ``lanes``
+    knots_rad : (1, K + 1) one command for the batch, or (N, K + 1) one per simulation
+    interval_steps : (K,) int64, steps of h in each log interval
+    initial : (3, N) position [rad], motor speed [rad/s], current [A] at t = 0
+    out : (6, N, K) written for columns [first, first + lanes)
+    """
     n_samples = out.shape[2]
     per_sim_command = knots_rad.shape[0] > 1
-    steps = c.steps_per_sample
-    interval_s = steps * c.step_s
+    use_table = load.slow_table_nm.shape[0] > 0
     load_delta = load.hinge_delta_nm * c.inverse_gear  # d(T_ext)/dθ_u [N·m/rad]
     lane = np.zeros((N_LANE_ROWS, lanes))
     group = slice(first, first + lanes)
@@ -201,9 +219,12 @@ def _run_group(c, load, per_sim, knots_rad, initial, first, lanes, out):
     lane[DRY_STATIC] = per_sim[FSJ, group]
     aircraft = np.zeros((lanes, 4))  # Δx: every simulation starts at trim
     for s in range(lanes):
-        lane[LOAD_SLOW, s] = _hinge_slow(load, aircraft[s], 0.0) * c.inverse_gear
+        slow = load.slow_table_nm[0] if use_table else _hinge_slow(load, aircraft[s], 0.0)
+        lane[LOAD_SLOW, s] = slow * c.inverse_gear
 
+    elapsed_steps = 0
     for k in range(n_samples):
+        steps = interval_steps[k]
         for s in range(lanes):
             row = first + s if per_sim_command else 0
             lane[COMMAND0, s] = knots_rad[row, k]
@@ -211,31 +232,26 @@ def _run_group(c, load, per_sim, knots_rad, initial, first, lanes, out):
         lane[SUM_POSITION:] = 0.0
         for j in range(steps):
             _advance_lanes(c, load_delta, j, lane)
+        elapsed_steps += steps
+        _record(c, load, lane, first, k, steps, out)
         for s in range(lanes):
-            mean_position = lane[SUM_POSITION, s] / steps
-            out[POSITION, first + s, k] = mean_position
-            out[SPEED, first + s, k] = lane[SUM_SPEED, s] / steps
-            out[CURRENT, first + s, k] = c.current_sensor_gain * lane[SUM_CURRENT, s] / steps
-            out[LOSS, first + s, k] = lane[SUM_LOSS, s] / steps
-            # H_e is affine in θ_u within an interval, so its mean follows from the mean position.
-            hinge = lane[LOAD_SLOW, s] * c.gear + load.hinge_delta_nm * mean_position
-            out[HINGE, first + s, k] = hinge + c.hinge_sensor_bias
-            out[COMMAND, first + s, k] = lane[COMMAND0, s] + lane[COMMAND_STEP, s] * (steps - 1) / 2
-            _advance_aircraft(load, aircraft[s], mean_position)
-            lane[LOAD_SLOW, s] = _hinge_slow(load, aircraft[s], (k + 1) * interval_s) * c.inverse_gear
+            if use_table:
+                lane[LOAD_SLOW, s] = load.slow_table_nm[min(k + 1, n_samples - 1)] * c.inverse_gear
+            else:
+                _advance_aircraft(load, aircraft[s], out[POSITION, first + s, k])
+                lane[LOAD_SLOW, s] = _hinge_slow(load, aircraft[s], elapsed_steps * c.step_s) * c.inverse_gear
 
 
-@njit(cache=True, parallel=True, nogil=True)
-def simulate_groups(c, load, per_sim, knots_rad, initial, lanes, out):
-    """Run every group of ``lanes`` simulations, groups in parallel over the cores.
-
-    Releases the GIL (``nogil``): a service runs this in a worker thread while its event loop
-    keeps answering.
-
-    ``per_sim`` is (4, N): FDJ, FSJ, 1 − η_A, 1/η_O − 1, padded by the caller to a multiple of
-    ``lanes``. ``knots_rad`` is (1, K+1) for one command shared by the batch or (N, K+1) for one
-    per simulation; ``out`` is (6, N, K).
-    """
-    n_groups = per_sim.shape[1] // lanes
-    for g in prange(n_groups):
-        _run_group(c, load, per_sim, knots_rad, initial, g * lanes, lanes, out)
+@njit(cache=True, inline="always", error_model="numpy")
+def _record(c, load, lane, first, k, steps, out):
+    """Interval means of lane sums into column k of ``out``."""
+    for s in range(lane.shape[1]):
+        mean_position = lane[SUM_POSITION, s] / steps
+        out[POSITION, first + s, k] = mean_position
+        out[SPEED, first + s, k] = lane[SUM_SPEED, s] / steps
+        out[CURRENT, first + s, k] = c.current_sensor_gain * lane[SUM_CURRENT, s] / steps
+        out[LOSS, first + s, k] = lane[SUM_LOSS, s] / steps
+        # H_e is affine in θ_u within an interval, so its mean follows from the mean position.
+        hinge = lane[LOAD_SLOW, s] * c.gear + load.hinge_delta_nm * mean_position
+        out[HINGE, first + s, k] = hinge + c.hinge_sensor_bias
+        out[COMMAND, first + s, k] = lane[COMMAND0, s] + lane[COMMAND_STEP, s] * (steps - 1) / 2

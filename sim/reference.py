@@ -24,7 +24,7 @@ def simulate_numpy(
     per_sim: np.ndarray,
     knots_rad: np.ndarray,
     initial: np.ndarray,
-    n_samples: int,
+    interval_steps: np.ndarray,
 ) -> np.ndarray:
     """(6, N, n_samples) interval means, rows as ``sim.kernels`` (position, speed, current, hinge, command, loss).
 
@@ -38,10 +38,11 @@ def simulate_numpy(
     aircraft = np.zeros((n_sims, 4))
     load_delta = load.hinge_delta_nm * c.inverse_gear
     load_slow = _hinge_slow(load, aircraft, 0.0) * c.inverse_gear
-    steps = c.steps_per_sample
+    n_samples, elapsed = len(interval_steps), 0
     rows = np.arange(n_sims) if knots_rad.shape[0] > 1 else np.zeros(n_sims, dtype=int)
     out = np.empty((6, n_sims, n_samples))
     for k in range(n_samples):
+        steps = int(interval_steps[k])
         command0 = knots_rad[rows, k]
         command_step = (knots_rad[rows, k + 1] - knots_rad[rows, k]) / steps
         sums = np.zeros((4, n_sims))
@@ -82,5 +83,6 @@ def simulate_numpy(
         out[3, :, k] = load_slow * c.gear + load.hinge_delta_nm * mean_position + c.hinge_sensor_bias
         out[4, :, k] = command0 + command_step * (steps - 1) / 2
         aircraft = aircraft @ load.ad.T + np.outer(mean_position - load.trim_elevator_rad, load.bd)
-        load_slow = _hinge_slow(load, aircraft, (k + 1) * steps * c.step_s) * c.inverse_gear
+        elapsed += steps
+        load_slow = _hinge_slow(load, aircraft, elapsed * c.step_s) * c.inverse_gear
     return out

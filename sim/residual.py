@@ -15,11 +15,14 @@ where a fast transient meets a filter on one term only.
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 
 from sim.checks import InputError, finite_array, in_range
 from sim.params import ActuatorParams
 
 DEFAULT_DERIVATIVE_WINDOW_S = 2e-3
+# Within this of the end stops the shaft may rest against them: T_R there is not friction.
+END_STOP_MARGIN_DEG = 1.0
 
 
 def derivative_weights(half_width: int, sample_rate_hz: float) -> np.ndarray:
@@ -54,9 +57,23 @@ def _correlate(values: np.ndarray, weights: np.ndarray, odd_extension: bool) -> 
     tail = values[..., -2 : -half - 2 : -1]
     if odd_extension:  # 2·x₀ − x keeps the end slope, so a derivative has no edge transient
         head, tail = 2 * values[..., :1] - head, 2 * values[..., -1:] - tail
-    padded = np.concatenate([head, values, tail], axis=-1)
-    views = np.lib.stride_tricks.sliding_window_view(padded, len(weights), axis=-1)
-    return views @ weights
+    padded = np.ascontiguousarray(np.concatenate([head, values, tail], axis=-1))
+    rows = padded.reshape(-1, padded.shape[-1])
+    out = np.empty((rows.shape[0], values.shape[-1]))
+    _correlate_rows(rows, np.ascontiguousarray(weights, dtype=np.float64), out)
+    return out.reshape(values.shape)
+
+
+@njit(cache=True, nogil=True)
+def _correlate_rows(padded, weights, out):
+    """out[r, i] = Σ_j weights[j] · padded[r, i + j]; padded (R, n + w − 1), weights (w,), out (R, n)."""
+    n = out.shape[1]
+    for r in range(out.shape[0]):
+        out[r, :] = 0.0
+        for j in range(weights.shape[0]):  # tap-outer: the inner loop runs along the row and vectorizes
+            w = weights[j]
+            for i in range(n):
+                out[r, i] += w * padded[r, i + j]
 
 
 def smoothed(values: np.ndarray, sample_rate_hz: float, window_s: float = DEFAULT_DERIVATIVE_WINDOW_S) -> np.ndarray:
@@ -74,6 +91,19 @@ def smooth_derivative(
     """
     half = _half_width(values, sample_rate_hz, window_s)
     return _correlate(values, derivative_weights(half, sample_rate_hz), odd_extension=True)
+
+
+def above_throughout(values: np.ndarray, threshold: float, width: int) -> np.ndarray:
+    """Whether every sample of a centred window of ``width`` samples exceeds ``threshold`` (last axis;
+    the edges look at the part of the window that exists), by a running count: O(n)."""
+    half = width // 2
+    low = (values <= threshold).astype(np.int64)
+    counts = np.cumsum(np.pad(low, [(0, 0)] * (values.ndim - 1) + [(1, 0)]), axis=-1)
+    n = values.shape[-1]
+    index = np.arange(n)
+    upper = np.minimum(index + half + 1, n)
+    lower = np.maximum(index - half, 0)
+    return (counts[..., upper] - counts[..., lower]) == 0
 
 
 def residual_torque_nm(

@@ -1,16 +1,24 @@
-"""The ``ema-window/1`` flight-log window: read, write and validate (used by every layer)."""
+"""``ema-window/1``, the flight-log window every layer reads: one definition, one validation.
+
+:class:`WindowDocument` is the JSON contract (shared/spec/ema-model.md §5): the service takes it
+as its request body, the CLI and the replay client read files through it, and its JSON Schema
+is exported to docs/schemas/. Types are strict (a boolean or a string is not a number), every
+number finite, every bound stated in the schema. :class:`Window` is what the layers below
+compute with: numpy arrays, built from a validated document or by our own code.
+"""
 
 from __future__ import annotations
 
 import json
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Annotated, Any, Literal
 
 import numpy as np
+from pydantic import AllowInfNan, BaseModel, ConfigDict, Field, Strict, ValidationError, field_validator
 
-from sim.aircraft import FlightCondition
-from sim.checks import InputError, finite_array, in_range
+from sim.aircraft import AIRSPEED_RANGE_MPS, ALTITUDE_RANGE_M, FlightCondition
+from sim.checks import InputError, from_validation
 
 SCHEMA = "ema-window/1"
 SIGNALS = ("command_deg", "position_deg", "motor_speed_radps", "current_a", "hinge_moment_nm")
@@ -19,17 +27,72 @@ MAX_SAMPLES = 1_000_000
 WINDOW_RATE_RANGE_HZ = (1_000.0, 100_000.0)
 # Physical plausibility: beyond these a sample is a sensor fault or a unit error, not a state.
 SIGNAL_LIMITS = {
-    "command_deg": (-40.0, 40.0),
+    "command_deg": (-90.0, 90.0),  # a reference, not a measurement: only a unit error is refused
     "position_deg": (-35.0, 35.0),
     "motor_speed_radps": (-2_000.0, 2_000.0),
     "current_a": (-60.0, 60.0),
     "hinge_moment_nm": (-5_000.0, 5_000.0),
 }
+IDENTIFIER = r"^[!-~](?:[ -~]{0,198}[!-~])?$"  # printable ASCII, no surrounding blanks: safe in a URL and a CSV
+
+Number = Annotated[float, Strict(), AllowInfNan(False)]
+Samples = Annotated[list[Number], Field(min_length=MIN_SAMPLES, max_length=MAX_SAMPLES)]
+
+
+class _Contract(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True, populate_by_name=True)
+
+
+class FlightConditionDocument(_Contract):
+    airspeed_mps: Number = Field(ge=AIRSPEED_RANGE_MPS[0], le=AIRSPEED_RANGE_MPS[1], description="true airspeed")
+    altitude_m: Number = Field(ge=ALTITUDE_RANGE_M[0], le=ALTITUDE_RANGE_M[1], description="pressure altitude, ISA")
+
+
+class SignalsDocument(_Contract):
+    """Five signals of one length, uniformly sampled from t = 0, each sample the mean over its interval."""
+
+    command_deg: Samples = Field(description=f"elevator command; any value within {SIGNAL_LIMITS['command_deg']}")
+    position_deg: Samples = Field(description=f"elevator deflection θ_u, within {SIGNAL_LIMITS['position_deg']}")
+    motor_speed_radps: Samples = Field(description=f"motor speed ω_m, within {SIGNAL_LIMITS['motor_speed_radps']}")
+    current_a: Samples = Field(description=f"phase current I, within {SIGNAL_LIMITS['current_a']}")
+    hinge_moment_nm: Samples = Field(description=f"hinge moment H_e, within {SIGNAL_LIMITS['hinge_moment_nm']}")
+
+    @field_validator(*SIGNALS)
+    @classmethod
+    def _plausible(cls, values: list[float], info: Any) -> list[float]:
+        low, high = SIGNAL_LIMITS[info.field_name]
+        array = np.asarray(values)
+        outside = np.flatnonzero((array < low) | (array > high))
+        if len(outside):
+            index = int(outside[0])
+            raise ValueError(f"sample {index} = {array[index]:g} is outside [{low:g}, {high:g}]")
+        return values
+
+
+class WindowDocument(_Contract):
+    """``ema-window/1``."""
+
+    schema_: Literal["ema-window/1"] = Field(alias="schema")
+    actuator_id: str = Field(min_length=1, max_length=200, pattern=IDENTIFIER, examples=["tail-123/elevator-left"])
+    window_id: str = Field(min_length=1, max_length=200, pattern=IDENTIFIER, examples=["2026-11-21T10:00:00Z#17"])
+    sample_rate_hz: Number = Field(ge=WINDOW_RATE_RANGE_HZ[0], le=WINDOW_RATE_RANGE_HZ[1])
+    flight_condition: FlightConditionDocument
+    signals: SignalsDocument
+
+    def to_window(self) -> Window:
+        """The arrays; signals of unequal lengths are refused naming the first one that differs."""
+        arrays = {name: np.asarray(getattr(self.signals, name), dtype=np.float64) for name in SIGNALS}
+        length = len(arrays["command_deg"])
+        for name, array in arrays.items():
+            if len(array) != length:
+                raise InputError(f"signals.{name}", f"has {len(array)} samples, command_deg has {length}")
+        condition = FlightCondition(self.flight_condition.airspeed_mps, self.flight_condition.altitude_m)
+        return Window(arrays, self.sample_rate_hz, condition, self.actuator_id, self.window_id)
 
 
 @dataclass(frozen=True)
 class Window:
-    """A logged window: five uniformly sampled signals from t = 0 and where the aircraft flew."""
+    """A logged window as arrays: five uniformly sampled signals from t = 0 and where the aircraft flew."""
 
     signals: dict[str, np.ndarray]
     sample_rate_hz: float = 10_000.0
@@ -38,27 +101,9 @@ class Window:
     window_id: str = "unknown"
 
     def __post_init__(self) -> None:
-        in_range("sample_rate_hz", self.sample_rate_hz, *WINDOW_RATE_RANGE_HZ, "Hz")
-        missing = [name for name in SIGNALS if name not in self.signals]
-        if missing:
-            raise InputError(f"signals.{missing[0]}", "is missing")
-        unknown = sorted(set(self.signals) - set(SIGNALS))
-        if unknown:
-            raise InputError(f"signals.{unknown[0]}", f"is not a known signal; expected {', '.join(SIGNALS)}")
-        arrays = {name: finite_array(f"signals.{name}", self.signals[name], ndim=1) for name in SIGNALS}
-        length = len(arrays["command_deg"])
-        for name, array in arrays.items():
-            if len(array) != length:
-                raise InputError(f"signals.{name}", f"has {len(array)} samples, command_deg has {length}")
-            low, high = SIGNAL_LIMITS[name]
-            outside = np.flatnonzero((array < low) | (array > high))
-            if len(outside):
-                raise InputError(
-                    f"signals.{name}", f"sample {outside[0]} = {array[outside[0]]:g} is outside [{low:g}, {high:g}]"
-                )
-        if not MIN_SAMPLES <= length <= MAX_SAMPLES:
-            raise InputError("signals", f"need {MIN_SAMPLES}..{MAX_SAMPLES} samples per signal, got {length}")
-        object.__setattr__(self, "signals", arrays)
+        lengths = {name: len(self.signals[name]) for name in SIGNALS}
+        if len(set(lengths.values())) != 1:
+            raise InputError("signals", f"signals differ in length: {lengths}")
 
     @property
     def n_samples(self) -> int:
@@ -69,34 +114,14 @@ class Window:
         return self.n_samples / self.sample_rate_hz
 
 
-def _require(document: dict[str, Any], key: str, kind: type | tuple[type, ...], prefix: str = "") -> Any:
-    if key not in document:
-        raise InputError(prefix + key, "is missing")
-    value = document[key]
-    if not isinstance(value, kind) or isinstance(value, bool):
-        raise InputError(prefix + key, f"has the wrong type {type(value).__name__}")
-    return value
-
-
 def window_from_dict(document: Any) -> Window:
-    """Parse and validate an ``ema-window/1`` document; errors name the field."""
+    """Parse and validate an ``ema-window/1`` document (a dict); errors name the field."""
     if not isinstance(document, dict):
         raise InputError("window", f"must be a JSON object, got {type(document).__name__}")
-    schema = _require(document, "schema", str)
-    if schema != SCHEMA:
-        raise InputError("schema", f"unknown schema {schema!r}; expected {SCHEMA!r}")
-    condition = _require(document, "flight_condition", dict)
-    signals = _require(document, "signals", dict)
-    return Window(
-        signals={name: np.asarray(values) if isinstance(values, list) else values for name, values in signals.items()},
-        sample_rate_hz=_require(document, "sample_rate_hz", (int, float)),
-        flight_condition=FlightCondition(
-            airspeed_mps=_require(condition, "airspeed_mps", (int, float), "flight_condition."),
-            altitude_m=_require(condition, "altitude_m", (int, float), "flight_condition."),
-        ),
-        actuator_id=str(_require(document, "actuator_id", str)),
-        window_id=str(_require(document, "window_id", str)),
-    )
+    try:
+        return WindowDocument.model_validate(document).to_window()
+    except ValidationError as exc:
+        raise from_validation(exc) from None
 
 
 def window_to_dict(window: Window) -> dict[str, Any]:
@@ -105,23 +130,26 @@ def window_to_dict(window: Window) -> dict[str, Any]:
         "schema": SCHEMA,
         "actuator_id": window.actuator_id,
         "window_id": window.window_id,
-        "sample_rate_hz": window.sample_rate_hz,
+        "sample_rate_hz": float(window.sample_rate_hz),
         "flight_condition": {
-            "airspeed_mps": window.flight_condition.airspeed_mps,
-            "altitude_m": window.flight_condition.altitude_m,
+            "airspeed_mps": float(window.flight_condition.airspeed_mps),
+            "altitude_m": float(window.flight_condition.altitude_m),
         },
         "signals": {name: window.signals[name].tolist() for name in SIGNALS},
     }
 
 
 def read_window(path: str | Path) -> Window:
-    """Read one window from a JSON file; a bad file raises InputError naming it."""
+    """Read one window from a JSON file; a bad file raises InputError naming it (and the field)."""
     path = Path(path)
     try:
-        document = json.loads(path.read_text())
+        document = json.loads(path.read_bytes())
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
         raise InputError(str(path), f"cannot be read as JSON ({exc})") from None
-    return window_from_dict(document)
+    try:
+        return window_from_dict(document)
+    except InputError as exc:
+        raise InputError(f"{path}: {exc.field}", exc.message) from None
 
 
 def write_window(window: Window, path: str | Path) -> None:

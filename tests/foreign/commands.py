@@ -29,7 +29,8 @@ def cruise(rng: np.random.Generator, duration_s: float) -> Command:
     frequency = rng.uniform(0.5, 6.0, count)
     phase = rng.uniform(0, 2 * np.pi, count)
     offset = rng.uniform(-3.0, 1.0)
-    return lambda t: offset + np.sum(amplitude[:, None] * np.sin(2 * np.pi * frequency[:, None] * t + phase[:, None]), 0)
+    a, f, p = amplitude[:, None], frequency[:, None], phase[:, None]
+    return lambda t: offset + np.sum(a * np.sin(2 * np.pi * f * t + p), axis=0)
 
 
 def gust(rng: np.random.Generator, duration_s: float) -> Command:

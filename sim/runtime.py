@@ -1,0 +1,83 @@
+"""Process-wide choices for the simulator, made by the program that starts, never at import.
+
+- **Threads.** Groups of simulations run on a pool of ``threads()`` threads (the kernel releases
+  the GIL). Numba's own threading layer is not used: with torch's OpenMP runtime in the same
+  process its idle workers spun while the other computed (a 0.7 s training took 21 s), and a
+  static split of the batch waits for its slowest thread, which on a shared computer is the one
+  the OS has parked. A pool of our own takes groups from one queue: a parked thread delays only
+  its group. The budget is shared with torch (``training.runtime``), which trains on one thread.
+- **Vector width.** LLVM tunes AVX-512 CPUs to prefer 256-bit vectors; the lane loop is
+  instruction-bound and measured ~1.5x faster with 512-bit ones (docs/benchmarks.md). Numba reads
+  this when it first compiles or loads a kernel, so :func:`configure` must run before that; a
+  user's own NUMBA_CPU_FEATURES wins.
+"""
+
+from __future__ import annotations
+
+import os
+import threading
+from concurrent.futures import ThreadPoolExecutor
+
+from sim.checks import InputError
+
+MAX_THREADS = 256
+
+
+def available_cores() -> int:
+    """Cores this process may run on (its affinity mask, not the machine's count)."""
+    if hasattr(os, "sched_getaffinity"):
+        return len(os.sched_getaffinity(0))
+    return os.cpu_count() or 1
+
+
+class _Budget:
+    def __init__(self) -> None:
+        self.lock = threading.Lock()
+        self.threads = available_cores()
+        self.pool: ThreadPoolExecutor | None = None
+
+
+_BUDGET = _Budget()
+
+
+def threads() -> int:
+    """Threads the simulator may use."""
+    return _BUDGET.threads
+
+
+def set_threads(count: int) -> None:
+    """Resize the simulator's thread pool (the next batch uses the new size)."""
+    if not 1 <= count <= MAX_THREADS:
+        raise InputError("threads", f"must be in [1, {MAX_THREADS}], got {count}")
+    with _BUDGET.lock:
+        if count != _BUDGET.threads and _BUDGET.pool is not None:
+            _BUDGET.pool.shutdown(wait=True)
+            _BUDGET.pool = None
+        _BUDGET.threads = count
+
+
+def pool() -> ThreadPoolExecutor:
+    """The shared pool, created on first use."""
+    with _BUDGET.lock:
+        if _BUDGET.pool is None:
+            _BUDGET.pool = ThreadPoolExecutor(_BUDGET.threads, thread_name_prefix="ema-sim")
+        return _BUDGET.pool
+
+
+def prefer_wide_vectors() -> None:
+    """Let LLVM use 512-bit vectors where the CPU has them (see the module docstring)."""
+    if "NUMBA_CPU_FEATURES" in os.environ:
+        return
+    import llvmlite.binding as llvm
+    from numba.core import config
+
+    features = llvm.get_host_cpu_features()
+    if features.get("avx512f"):
+        config.CPU_FEATURES = features.flatten() + ",-prefer-256-bit"  # type: ignore[attr-defined]
+
+
+def configure(threads: int | None = None) -> int:
+    """The entry points' one call: vector width, then the thread budget (default: the usable cores)."""
+    prefer_wide_vectors()
+    set_threads(threads or available_cores())
+    return _BUDGET.threads
