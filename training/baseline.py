@@ -1,134 +1,209 @@
-"""A physics baseline with no simulation and no network: Eq. 5.1 fitted by least squares.
+"""A physics estimator with no simulation and no network: Eq. 5.1 fitted by least squares.
 
 While sliding, the residual torque is T_R = sgn(ω)·(FDJ + k·|T_ext|) + C·ω with k = 1 − η_A when
 the load aids the motion and 1/η_O − 1 when it opposes it (T_ext = H_e / n). Both sides go
 through the same smoothing kernel as the reconstruction (``sim.residual``), which keeps the
-model linear in FDJ and k. η_A is tied to η_O by Eq. 3.4, as everywhere in the product, so the
-fit is a one-dimensional search over η_O with FDJ solved in closed form at each point.
+model linear in FDJ and k: with t = sgn(ω)·(T_R − C·ω), a and o the smoothed aiding and opposing
+|T_ext|, t = FDJ + k_aid·a + k_opp·o. η_A is tied to η_O by Eq. 3.4, so the fit is a search over
+η_O with FDJ in closed form at each point.
 
-FSJ is read at break-away: while the shaft is stuck, dω/dt = 0 and T_R = k_T·I + H_e/n is
-exactly the friction, which the drive raises until it reaches FSJ + k·|T_ext| and slips.
+Everything the search needs is ten sums per window (m, Σt, Σa, Σo and their products), so a
+batch of simulated windows is fitted at the cost of one pass over its samples, and a block
+jackknife (the sums of B contiguous time blocks, each left out in turn) gives a standard error
+from the window itself: one that grows when the residual holds structure the model lacks.
 """
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+from dataclasses import dataclass
+
 import numpy as np
+from numba import njit
 
 from sim.checks import InputError
 from sim.params import ActuatorParams, eta_a_from_eta_o
-from sim.residual import DEFAULT_DERIVATIVE_WINDOW_S, residual_torque_nm, smoothed
-from sim.window import Window
+from sim.residual import (
+    DEFAULT_DERIVATIVE_WINDOW_S,
+    END_STOP_MARGIN_DEG,
+    above_throughout,
+    residual_torque_nm,
+    smoothed,
+)
 
-ETA_O_RANGE = (0.30, 0.999)  # the search interval of η_O
-GRID_POINTS = 41  # per refinement: 3 passes resolve η_O to ~1e-5
-END_STOP_MARGIN_DEG = 1.0
+ETA_O_SEARCH = (0.20, 0.999)  # η_O searched over; Case 1C reaches 0.44
+GRID_POINTS = 41
+REFINEMENTS = 3  # coarse-to-fine passes: η_O to ~1e-5 (the SSE is smooth and unimodal in η_O)
+JACKKNIFE_BLOCKS = 10
+MIN_SLIDING_KERNELS = 10  # fewer sliding samples than 10 kernel widths: too little motion to fit
+T, A, OPP, TT, AA, OO, TA, TO, AO, M = range(10)  # the sufficient statistics, in this order
 
 
-def _sliding_min(values: np.ndarray, width: int) -> np.ndarray:
-    """Minimum over a centred window of ``width`` samples (edges use the part that exists)."""
-    half = width // 2
-    padded = np.pad(values, half, mode="edge")
-    return np.lib.stride_tricks.sliding_window_view(padded, 2 * half + 1).min(axis=1)
+@dataclass(frozen=True)
+class FitSettings:
+    min_speed_radps: float = 30.0  # sliding: |ω| above this over a whole kernel, one sign throughout
+    derivative_window_s: float = DEFAULT_DERIVATIVE_WINDOW_S
+    blocks: int = JACKKNIFE_BLOCKS
+
+    def __post_init__(self) -> None:
+        if self.min_speed_radps <= 0:
+            raise InputError("min_speed_radps", f"must be positive, got {self.min_speed_radps}")
+        if not 2 <= self.blocks <= 100:
+            raise InputError("blocks", f"must be in [2, 100], got {self.blocks}")
 
 
-class FrictionLeastSquares:
-    """scikit-learn shape: settings checked here, ``fit(window)`` returns self, results end in ``_``."""
+@dataclass(frozen=True)
+class FrictionFit:
+    """Per window (arrays of one length): the estimates, their jackknife std, the fit's quality."""
 
-    def __init__(
-        self,
-        actuator: ActuatorParams = ActuatorParams(),
-        min_speed_radps: float = 30.0,
-        derivative_window_s: float = DEFAULT_DERIVATIVE_WINDOW_S,
-        stuck_speed_radps: float = 0.5,
-        min_stick_events: int = 1,
-    ) -> None:
-        if min_speed_radps <= 0:
-            raise InputError("min_speed_radps", f"must be positive, got {min_speed_radps}")
-        if not 0 < stuck_speed_radps < min_speed_radps:
-            raise InputError("stuck_speed_radps", f"must be in (0, {min_speed_radps}), got {stuck_speed_radps}")
-        if min_stick_events < 1:
-            raise InputError("min_stick_events", f"must be at least 1, got {min_stick_events}")
-        self.actuator = actuator
-        self.min_speed_radps = min_speed_radps
-        self.derivative_window_s = derivative_window_s
-        self.stuck_speed_radps = stuck_speed_radps
-        self.min_stick_events = min_stick_events
+    fdj_nm: np.ndarray
+    eta_o: np.ndarray
+    fdj_std_nm: np.ndarray
+    eta_o_std: np.ndarray
+    residual_rms_nm: np.ndarray  # RMS equation error over the sliding samples
+    n_sliding: np.ndarray  # samples used
+    at_search_edge: np.ndarray  # η_O at an end of ETA_O_SEARCH: a bound, not an estimate
 
-    def fit(self, window: Window) -> FrictionLeastSquares:
-        rate, a = window.sample_rate_hz, self.actuator
-        s = window.signals
-        residual = residual_torque_nm(s["current_a"], s["motor_speed_radps"], s["hinge_moment_nm"], rate, a)
-        speed = s["motor_speed_radps"]
-        load = smoothed(s["hinge_moment_nm"] / a.gear_ratio, rate, self.derivative_window_s)
-        width = 2 * round(self.derivative_window_s * rate / 2) + 1
-        sliding = _sliding_min(np.abs(speed), width) > self.min_speed_radps  # one sign over the whole kernel
-        sliding &= np.abs(s["position_deg"]) < a.end_stop_deg - END_STOP_MARGIN_DEG
-        if sliding.sum() < 10 * width:
-            raise InputError("signals", f"too little sliding motion to fit ({int(sliding.sum())} samples)")
-        direction = np.sign(speed)
-        aiding = load * direction > 0
-        aid_part = smoothed(np.abs(load) * aiding, rate, self.derivative_window_s)[sliding]
-        opp_part = smoothed(np.abs(load) * ~aiding, rate, self.derivative_window_s)[sliding]
-        viscous = a.viscous_nms * smoothed(speed, rate, self.derivative_window_s)
-        target = (direction * (residual - viscous))[sliding]  # = FDJ + k_aid·aid + k_opp·opp
+    @property
+    def eta_a(self) -> np.ndarray:
+        return eta_a_from_eta_o(self.eta_o)
 
-        low, high = ETA_O_RANGE
-        for _ in range(3):  # coarse-to-fine grid: the SSE is smooth and unimodal in η_O here
-            grid = np.linspace(low, high, GRID_POINTS)
-            fdj, sse = self._profile(grid, target, aid_part, opp_part)
-            best = int(np.argmin(sse))
-            step = grid[1] - grid[0]
-            low, high = max(grid[best] - step, ETA_O_RANGE[0]), min(grid[best] + step, ETA_O_RANGE[1])
-        self.fdj_ = float(fdj[best])
-        self.eta_o_ = float(grid[best])
-        self.eta_a_ = float(eta_a_from_eta_o(self.eta_o_, a.gear_ratio))
-        self.n_sliding_samples_ = int(sliding.sum())
-        self.residual_rms_ = float(np.sqrt(sse[best] / len(target)))
-        self._fit_static(window, load, direction)
-        return self
 
-    def _profile(
-        self, eta_o: np.ndarray, target: np.ndarray, aid: np.ndarray, opp: np.ndarray
-    ) -> tuple[np.ndarray, np.ndarray]:
-        """For each η_O: the best FDJ (closed form) and the sum of squared residuals."""
-        k_opp = 1.0 / eta_o - 1.0
-        k_aid = 1.0 - eta_a_from_eta_o(eta_o, self.actuator.gear_ratio)
-        explained = k_aid[:, None] * aid + k_opp[:, None] * opp  # (grid, samples)
-        fdj = (target - explained).mean(axis=1)
-        return fdj, ((target - explained - fdj[:, None]) ** 2).sum(axis=1)
+def regressors(
+    signals: Mapping[str, np.ndarray],
+    rate: float,
+    actuator: ActuatorParams,
+    settings: FitSettings,
+    residual_nm: np.ndarray | None = None,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """(t, a, o, sliding mask), each (N, n): the linear model's target, aiding and opposing columns.
 
-    def _fit_static(self, window: Window, load: np.ndarray, direction: np.ndarray) -> None:
-        """FSJ from the end of each rest: ≥ 1 ms at rest, then motion for ≥ 1 ms.
+    ``residual_nm`` is T_R of these signals when the caller has reconstructed it already.
+    """
+    window_s = settings.derivative_window_s
+    speed = np.atleast_2d(signals["motor_speed_radps"])
+    if residual_nm is None:
+        current, hinge = np.atleast_2d(signals["current_a"]), np.atleast_2d(signals["hinge_moment_nm"])
+        residual_nm = residual_torque_nm(current, speed, hinge, rate, actuator, window_s)
+    residual = np.atleast_2d(residual_nm)
+    load = smoothed(np.atleast_2d(signals["hinge_moment_nm"]) / actuator.gear_ratio, rate, window_s)
+    width = 2 * round(window_s * rate / 2) + 1
+    sliding = above_throughout(np.abs(speed), settings.min_speed_radps, width)  # one sign over the whole kernel
+    sliding &= np.abs(np.atleast_2d(signals["position_deg"])) < actuator.end_stop_deg - END_STOP_MARGIN_DEG
+    direction = np.sign(speed)
+    aiding = load * direction > 0
+    aid = smoothed(np.abs(load) * aiding, rate, window_s)
+    opp = smoothed(np.abs(load) * ~aiding, rate, window_s)
+    target = direction * (residual - actuator.viscous_nms * smoothed(speed, rate, window_s))
+    return target, aid, opp, sliding
 
-        Rest is judged on the smoothed speed (the sensor noise alone exceeds a creep of 1 rad/s),
-        which lags the break-away by up to a millisecond. At rest the friction equals the drive
-        k_T·I + H_e/n, which peaks at the static level FSJ + k·|T_ext| when the shaft breaks away:
-        the peak of the drive (over 3 samples, against noise) in the last 1 ms is that level.
-        """
-        a, s = self.actuator, window.signals
-        rate = window.sample_rate_hz
-        speed = np.abs(smoothed(s["motor_speed_radps"], rate, self.derivative_window_s))
-        run = max(2, round(1e-3 * rate))
-        rest = speed < self.stuck_speed_radps
-        drive = a.torque_constant_nm_per_a * s["current_a"] + s["hinge_moment_nm"] / a.gear_ratio
-        drive = np.abs(np.convolve(drive, np.ones(3) / 3, mode="same"))
-        events = []
-        for end in np.flatnonzero(rest[:-1] & ~rest[1:]):
-            if end + 1 < run or not rest[end + 1 - run : end + 1].all() or rest[end + 1 : end + 1 + run].any():
-                continue  # too short a rest or too short a motion: hunting in passing, not a stick
-            if end + 1 + run > len(rest):
-                continue
-            moving = direction[end + run // 2]
-            k = 1.0 - self.eta_a_ if load[end] * moving > 0 else 1.0 / self.eta_o_ - 1.0
-            peak = end + 1 - run + int(np.argmax(drive[end + 1 - run : end + 2]))
-            events.append(drive[peak] - k * abs(load[peak]))
-        self.n_stick_events_ = len(events)
-        if len(events) >= self.min_stick_events:
-            self.fsj_: float | None = float(np.median(events))
-            self.fsj_reason_ = f"median of {len(events)} break-away(s)"
-        else:
-            self.fsj_ = None
-            self.fsj_reason_ = (
-                f"{len(events)} break-away(s) in the window, {self.min_stick_events} needed: the shaft never "
-                "rests for 1 ms then moves (in flight the position loop keeps it hunting in the backlash)"
-            )
+
+def block_statistics(t: np.ndarray, a: np.ndarray, o: np.ndarray, mask: np.ndarray, blocks: int) -> np.ndarray:
+    """(N, blocks, 10) sums over the masked samples of each of ``blocks`` contiguous time blocks."""
+    edges = np.linspace(0, t.shape[-1], blocks + 1).astype(np.int64)
+    out = np.zeros((t.shape[0], blocks, 10))
+    _block_sums(t, a, o, mask, edges, out)
+    return out
+
+
+@njit(cache=True, nogil=True)
+def _block_sums(t, a, o, mask, edges, out):
+    """out[r, b] = Σ over masked samples of block b of (t, a, o, t², a², o², ta, to, ao, 1)."""
+    for r in range(t.shape[0]):
+        for b in range(edges.shape[0] - 1):
+            for i in range(edges[b], edges[b + 1]):
+                if mask[r, i]:
+                    x, y, z = t[r, i], a[r, i], o[r, i]
+                    out[r, b, T] += x
+                    out[r, b, A] += y
+                    out[r, b, OPP] += z
+                    out[r, b, TT] += x * x
+                    out[r, b, AA] += y * y
+                    out[r, b, OO] += z * z
+                    out[r, b, TA] += x * y
+                    out[r, b, TO] += x * z
+                    out[r, b, AO] += y * z
+                    out[r, b, M] += 1.0
+
+
+def _profile(stats: np.ndarray, eta_o: np.ndarray, gear: float) -> tuple[np.ndarray, np.ndarray]:
+    """For stats (R, 10) and a grid per row (R, G): FDJ (R, G) in closed form and the SSE (R, G)."""
+    k_opp = 1.0 / eta_o - 1.0
+    k_aid = 1.0 - eta_a_from_eta_o(eta_o, gear)
+    s = stats[:, :, None]
+    m = np.maximum(s[:, M], 1.0)
+    fdj = (s[:, T] - k_aid * s[:, A] - k_opp * s[:, OPP]) / m
+    sse = (
+        s[:, TT] + k_aid**2 * s[:, AA] + k_opp**2 * s[:, OO]
+        - 2 * k_aid * s[:, TA] - 2 * k_opp * s[:, TO] + 2 * k_aid * k_opp * s[:, AO]
+        - m * fdj**2
+    )  # fmt: skip
+    return fdj, sse
+
+
+def solve(stats: np.ndarray, gear: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(FDJ, η_O, SSE) per row of ``stats`` (R, 10): a coarse-to-fine grid over η_O, vectorized."""
+    rows = np.arange(len(stats))
+    low = np.full(len(stats), ETA_O_SEARCH[0])
+    high = np.full(len(stats), ETA_O_SEARCH[1])
+    for _ in range(REFINEMENTS):
+        grid = low[:, None] + (high - low)[:, None] * np.linspace(0.0, 1.0, GRID_POINTS)
+        fdj, sse = _profile(stats, grid, gear)
+        best = np.argmin(sse, axis=1)
+        step = grid[:, 1] - grid[:, 0]
+        centre = grid[rows, best]
+        low = np.maximum(centre - step, ETA_O_SEARCH[0])
+        high = np.minimum(centre + step, ETA_O_SEARCH[1])
+    return fdj[rows, best], centre, sse[rows, best]
+
+
+def _jackknife_std(estimates: np.ndarray) -> np.ndarray:
+    """Std of the full-sample estimate from (N, B) leave-one-block-out estimates."""
+    b = estimates.shape[1]
+    return np.sqrt((b - 1) / b * np.sum((estimates - estimates.mean(axis=1, keepdims=True)) ** 2, axis=1))
+
+
+def fit_friction(
+    signals: Mapping[str, np.ndarray],
+    rate: float,
+    actuator: ActuatorParams = ActuatorParams(),
+    settings: FitSettings = FitSettings(),
+    residual_nm: np.ndarray | None = None,
+) -> FrictionFit:
+    """Fit every window of a batch (signals (N, n), or (n,) for one); windows with too little
+    sliding motion get NaN (``fit_window`` turns that into an error naming the signals)."""
+    t, a, o, mask = regressors(signals, rate, actuator, settings, residual_nm)
+    blocks = block_statistics(t, a, o, mask, settings.blocks)  # (N, B, 10)
+    total = blocks.sum(axis=1)
+    fdj, eta_o, sse = solve(total, actuator.gear_ratio)
+    left_out = (total[:, None, :] - blocks).reshape(-1, 10)
+    fdj_b, eta_b, _ = solve(left_out, actuator.gear_ratio)
+    n_rows = len(total)
+    width = 2 * round(settings.derivative_window_s * rate / 2) + 1
+    enough = total[:, M] >= MIN_SLIDING_KERNELS * width
+    nan = np.where(enough, 1.0, np.nan)
+    edge = (eta_o <= ETA_O_SEARCH[0] + 1e-4) | (eta_o >= ETA_O_SEARCH[1] - 1e-4)
+    return FrictionFit(
+        fdj_nm=fdj * nan,
+        eta_o=eta_o * nan,
+        fdj_std_nm=_jackknife_std(fdj_b.reshape(n_rows, -1)) * nan,
+        eta_o_std=_jackknife_std(eta_b.reshape(n_rows, -1)) * nan,
+        residual_rms_nm=np.sqrt(np.maximum(sse, 0.0) / np.maximum(total[:, M], 1.0)) * nan,
+        n_sliding=total[:, M].astype(np.int64),
+        at_search_edge=edge & enough,
+    )
+
+
+def fit_window(
+    signals: Mapping[str, np.ndarray], rate: float, actuator: ActuatorParams = ActuatorParams()
+) -> FrictionFit:
+    """One window's fit; a window that never slides long enough is bad input naming its signals."""
+    fitted = fit_friction(signals, rate, actuator)
+    if np.isnan(fitted.fdj_nm[0]):
+        raise InputError(
+            "signals",
+            f"too little sliding motion to estimate friction: {int(fitted.n_sliding[0])} samples with "
+            f"|motor speed| > {FitSettings().min_speed_radps:g} rad/s away from the end stops "
+            "(a held or barely moving elevator carries no friction information)",
+        )
+    return fitted

@@ -6,18 +6,18 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from sim.aircraft import FlightCondition, GroundLoad
+from sim.aircraft import FlightCondition, Load, LoggedLoad
 from sim.batch import BatchResult, InitialState, simulate_batch
-from sim.checks import InputError
 from sim.commands import knots_from_samples
 from sim.effects import EffectSet
-from sim.noise import NO_NOISE, SensorNoise, add_sensor_noise
-from sim.params import DEFAULT_RANGES, HealthParams, HealthRanges, eta_a_from_eta_o
+from sim.noise import SensorNoise, add_sensor_noise
+from sim.params import HealthParams
+from sim.residual import residual_torque_nm, smoothed
 from sim.window import Window
 from training.noise_level import excess_noise
-from training.preprocess import INPUT_SETS, SIGNALS_READ, features
 
 INITIAL_FIT_SAMPLES = 8
+SIGNALS_READ = ("current_a", "motor_speed_radps", "hinge_moment_nm", "position_deg")  # all the estimators read
 
 
 @dataclass(frozen=True)
@@ -25,7 +25,7 @@ class Scenario:
     """What every simulation of a dataset shares: the command, the load, the start, the rate."""
 
     command_knots_deg: np.ndarray  # (n_samples + 1,) one command (Case 1) or (n_sims, n_samples + 1) (Case 2)
-    load: FlightCondition | GroundLoad = field(default_factory=FlightCondition)
+    load: Load = field(default_factory=FlightCondition)
     initial: InitialState = field(default_factory=InitialState)
     sample_rate_hz: float = 10_000.0
     effects: EffectSet = field(default_factory=EffectSet)
@@ -34,9 +34,9 @@ class Scenario:
     def n_samples(self) -> int:
         return self.command_knots_deg.shape[-1] - 1
 
-    def simulate(self, health: HealthParams) -> BatchResult:
+    def simulate(self, health: HealthParams, lanes: int | None = None) -> BatchResult:
         return simulate_batch(
-            self.command_knots_deg, health, self.load, self.initial, self.sample_rate_hz, self.effects
+            self.command_knots_deg, health, self.load, self.initial, self.sample_rate_hz, self.effects, lanes=lanes
         )
 
 
@@ -54,77 +54,56 @@ def initial_state(window: Window) -> InitialState:
 
     return InitialState(
         position_deg=float(np.clip(at_zero(window.signals["position_deg"]), -30.0, 30.0)),
-        motor_speed_radps=at_zero(window.signals["motor_speed_radps"]),
-        current_a=at_zero(window.signals["current_a"]),
+        motor_speed_radps=float(np.clip(at_zero(window.signals["motor_speed_radps"]), -700.0, 700.0)),
+        current_a=float(np.clip(at_zero(window.signals["current_a"]), -30.0, 30.0)),
+    )
+
+
+def logged_load(window: Window) -> LoggedLoad:
+    """The window's own hinge moment (smoothed of sensor noise) as the load its simulations feel."""
+    rate = window.sample_rate_hz
+    return LoggedLoad(
+        window.flight_condition,
+        smoothed(window.signals["hinge_moment_nm"], rate),
+        smoothed(window.signals["position_deg"], rate),
     )
 
 
 def scenario_from_window(window: Window, effects: EffectSet = EffectSet()) -> Scenario:
-    """Case 1B for a logged window: its command, its flight condition, its first state."""
+    """Case 1B for a logged window: its command, its logged load, its first state."""
     return Scenario(
         command_knots_deg=knots_from_samples(window.signals["command_deg"])[0],
-        load=window.flight_condition,
+        load=logged_load(window),
         initial=initial_state(window),
         sample_rate_hz=window.sample_rate_hz,
         effects=effects,
     )
 
 
-def normalize_targets(health: HealthParams, ranges: HealthRanges) -> np.ndarray:
-    """(n, 2): FDJ and η_O mapped to [0, 1] over their ranges."""
-    fdj = (health.fdj_nm - ranges.fdj_nm[0]) / (ranges.fdj_nm[1] - ranges.fdj_nm[0])
-    eta_o = (health.eta_o - ranges.eta_o[0]) / (ranges.eta_o[1] - ranges.eta_o[0])
-    return np.stack([fdj, eta_o], axis=1)
-
-
-def denormalize_targets(normalized: np.ndarray, ranges: HealthRanges) -> dict[str, np.ndarray]:
-    """Parameter values from normalized predictions (n, 2), with η_A by Eq. 3.4."""
-    fdj = ranges.fdj_nm[0] + normalized[:, 0] * (ranges.fdj_nm[1] - ranges.fdj_nm[0])
-    eta_o = ranges.eta_o[0] + normalized[:, 1] * (ranges.eta_o[1] - ranges.eta_o[0])
-    return {"FDJ": fdj, "eta_O": eta_o, "eta_A": eta_a_from_eta_o(eta_o)}
-
-
 @dataclass(frozen=True)
-class DatasetConfig:
-    """Sizes of a training set (thesis Table 6.4 explores these)."""
+class Simulated:
+    """A batch of noisy simulated windows and what the estimators read of them."""
 
-    n_simulations: int = 500
-    n_timesteps: int = 1000
-    input_set: str = "residual_torque"
-    ranges: HealthRanges = field(default_factory=lambda: DEFAULT_RANGES)
-    seed: int = 0
-
-    def __post_init__(self) -> None:
-        if not 20 <= self.n_simulations <= 20_000:
-            raise InputError("n_simulations", f"must be in [20, 20000], got {self.n_simulations}")
-        if not 10 <= self.n_timesteps <= 10_000:
-            raise InputError("n_timesteps", f"must be in [10, 10000], got {self.n_timesteps}")
-        if self.input_set not in INPUT_SETS:
-            raise InputError("inputs", f"unknown input set {self.input_set!r}; known: {', '.join(INPUT_SETS)}")
-
-
-@dataclass(frozen=True)
-class Dataset:
-    inputs: np.ndarray  # (n_simulations, n_channels · n_timesteps), preprocessed
-    targets: np.ndarray  # (n_simulations, 2): FDJ, η_O normalized to [0, 1]
     health: HealthParams  # the truth of every simulation (FSJ included)
-    noise: SensorNoise  # the sensor noise added to every simulation
-    config: DatasetConfig
+    signals: dict[str, np.ndarray]  # SIGNALS_READ, (n, n_samples), sensor noise added
+    residual_nm: np.ndarray  # (n, n_samples) T_R of the noisy signals
+    clean_residual_nm: np.ndarray  # (n, n_samples) T_R without sensor noise: the noise floor's reference
 
 
-def build_dataset(scenario: Scenario, config: DatasetConfig, noise: SensorNoise = NO_NOISE) -> Dataset:
-    """Simulate ``config.n_simulations`` health draws of ``scenario``, add ``noise``, preprocess."""
-    rng = np.random.default_rng(config.seed)
-    health = HealthParams.uniform(config.n_simulations, config.ranges, rng)
+def simulate_noisy(scenario: Scenario, health: HealthParams, noise: SensorNoise, seed: int) -> Simulated:
+    """Simulate ``health``, add ``noise`` where the estimators read, reconstruct T_R with and without it."""
     result = scenario.simulate(health)
-    # Noise only where the features read: drawing it for the other signals would cost time, not change them.
-    signals = add_sensor_noise({name: result.signals[name] for name in SIGNALS_READ}, noise, rng)
-    inputs = features(signals, scenario.sample_rate_hz, config.n_timesteps, config.input_set)
-    return Dataset(inputs, normalize_targets(health, config.ranges), health, noise, config)
+    clean = {name: result.signals[name] for name in SIGNALS_READ}
+    noisy = add_sensor_noise(clean, noise, np.random.default_rng(seed))
+    rate = scenario.sample_rate_hz
+
+    def residual(s: dict[str, np.ndarray]) -> np.ndarray:
+        return residual_torque_nm(s["current_a"], s["motor_speed_radps"], s["hinge_moment_nm"], rate)
+
+    return Simulated(health, noisy, residual(noisy), residual(clean))
 
 
-def window_noise(window: Window, scenario: Scenario, ranges: HealthRanges = DEFAULT_RANGES) -> SensorNoise:
-    """The window's sensor noise, measured against a clean simulation of its own command."""
-    nominal = HealthParams.single(ranges.nominal_fsj_nm, ranges.nominal_fdj_nm, ranges.nominal_eta_o)
-    clean = scenario.simulate(nominal).simulation(0)
+def window_noise(window: Window, scenario: Scenario, health: HealthParams) -> SensorNoise:
+    """The window's sensor noise, measured against a clean simulation of its own command at ``health``."""
+    clean = scenario.simulate(health, lanes=1).simulation(0)
     return excess_noise(window.signals, clean)

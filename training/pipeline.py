@@ -1,211 +1,257 @@
-"""Window -> health estimates with uncertainty and timings: what ``ema estimate`` and the service call.
+"""Window -> ``ema-estimate/1``: what ``ema estimate``, the service and the fleet call.
 
-The thesis's §6.3 proposal: simulate a fresh Case-1B dataset for the window's own command, flight
-condition and first state, with the window's own sensor noise; train; predict. A physics
-least-squares fit of the same window runs beside it, and both are scored on held-out simulated
-windows to blend them per parameter (``training.combine``).
+The thesis's §6.3 proposal, made to hold on data our simulator did not draw:
+
+1. **prepare**: average the window to a bounded number of samples (``training.conditioning``);
+2. **physics**: fit Eq. 5.1 by least squares (``training.baseline``), a block-jackknife std beside;
+3. **simulate**: a Case-1B dataset of the window's own command, logged load and first state, its
+   health drawn in a box around the physics estimate (``training.design``: no fixed range, so no
+   cap on a worn actuator), with the window's own sensor noise;
+4. **train**: the shallow network on the residual torque of the sliding samples;
+5. **assess**: both estimators scored on held-out simulations, blended per parameter, checked
+   against the window itself (``training.assess``) and by simulating it at the answer
+   (``training.reproduction``);
+6. **FSJ** where the window shows a quasi-static break-away (``training.static_friction``).
 """
 
 from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field, replace
-from typing import Any
+from dataclasses import dataclass
 
 import numpy as np
 
-from sim.checks import InputError
 from sim.effects import EffectSet
-from sim.noise import SensorNoise, add_sensor_noise
-from sim.params import DEFAULT_RANGES, HealthParams, eta_a_from_eta_o
+from sim.noise import SensorNoise
+from sim.params import DEFAULT_RANGES, ActuatorParams, HealthParams, eta_a_from_eta_o
+from sim.residual import residual_torque_nm
 from sim.window import Window
-from training.baseline import FrictionLeastSquares
-from training.combine import fit_blend
-from training.dataset import DatasetConfig, Scenario, build_dataset, scenario_from_window, window_noise
+from training import design
+from training.assess import Assessed, Candidates, assess, physics_values
+from training.baseline import FitSettings, FrictionFit, fit_friction, fit_window, regressors
+from training.conditioning import Prepared, prepare
+from training.config import PipelineConfig
+from training.dataset import Scenario, Simulated, scenario_from_window, simulate_noisy, window_noise
+from training.documents import (
+    DatasetInfo,
+    Estimate,
+    Estimates,
+    FitCheck,
+    RatioEstimate,
+    Timings,
+    TrainingInfo,
+    WindowInfo,
+    parameter,
+)
 from training.estimator import NetworkEstimator
 from training.network import TrainConfig
-from training.preprocess import INPUT_SETS, features
+from training.preprocess import sliding_features
+from training.reproduction import MAX_RATIO, output_error_ratios
+from training.static_friction import StaticFriction, read_static_friction
 
-SCHEMA = "ema-estimate/1"
-TARGETS = ("FDJ", "eta_O")
 NOMINAL = {"FDJ": DEFAULT_RANGES.nominal_fdj_nm, "eta_O": DEFAULT_RANGES.nominal_eta_o}
+NOMINAL_ETA_A = float(eta_a_from_eta_o(DEFAULT_RANGES.nominal_eta_o))
 
 
 @dataclass(frozen=True)
-class PipelineConfig:
-    n_simulations: int = 500
-    n_timesteps: int = 1000
-    hidden_units: int = 100
-    members: int = 1  # networks in the ensemble
-    input_set: str = "residual_torque"
-    # Held-out simulated windows that score network and baseline. 16 instead of 32: 0.2 s faster,
-    # errors within the spread of 5 bench windows (0.29 % / 0.07 % against 0.23 % / 0.09 %).
-    check_windows: int = 16
-    seed: int = 0
-    train: TrainConfig = field(default_factory=TrainConfig)
+class Data:
+    """Everything simulated for one window."""
 
-    def __post_init__(self) -> None:
-        if not 20 <= self.n_simulations <= 20_000:
-            raise InputError("n_simulations", f"must be in [20, 20000], got {self.n_simulations}")
-        if not 10 <= self.n_timesteps <= 10_000:
-            raise InputError("n_timesteps", f"must be in [10, 10000], got {self.n_timesteps}")
-        if not 1 <= self.hidden_units <= 2000:
-            raise InputError("hidden_units", f"must be in [1, 2000], got {self.hidden_units}")
-        if not 1 <= self.members <= 20:
-            raise InputError("members", f"must be in [1, 20], got {self.members}")
-        if not 8 <= self.check_windows <= 1000:
-            raise InputError("check_windows", f"must be in [8, 1000], got {self.check_windows}")
+    scenario: Scenario
+    box: design.Box
+    noise: SensorNoise
+    sims: Simulated  # n_simulations for training, then check_windows held out
+    sliding: np.ndarray  # (n_samples,) the window's Eq. 5.1 samples
+    inputs: np.ndarray  # (n_total, n_timesteps) network inputs of every simulation
+    window_inputs: np.ndarray  # (1, n_timesteps)
 
 
-def check_windows(
-    scenario: Scenario, window: Window, noise: SensorNoise, n: int, seed: int
-) -> tuple[HealthParams, list[Window]]:
-    """Fresh health draws of the window's scenario, as noisy as the window: the scoring windows."""
-    rng = np.random.default_rng(seed)
-    health = HealthParams.uniform(n, DEFAULT_RANGES, rng)
-    signals = add_sensor_noise(scenario.simulate(health).signals, noise, rng)
-    windows = [
-        Window({name: values[i] for name, values in signals.items()}, window.sample_rate_hz, window.flight_condition)
-        for i in range(n)
-    ]
-    return health, windows
+def simulate_dataset(window: Window, physics: FrictionFit, config: PipelineConfig, effects: EffectSet) -> Data:
+    """The box around the physics estimate, the window's noise, the simulations and their features."""
+    box = design.box_around(physics.fdj_nm[0], physics.fdj_std_nm[0], physics.eta_o[0], physics.eta_o_std[0])
+    scenario = scenario_from_window(window, effects)
+    centre = HealthParams.single(2.0 * physics.fdj_nm[0], physics.fdj_nm[0], physics.eta_o[0])
+    noise = window_noise(window, scenario, centre)
+    health = design.draw(box, config.total_simulations, config.seed)
+    sims = simulate_noisy(scenario, health, noise, config.seed + 1)
+    rate = window.sample_rate_hz
+    sliding = regressors(window.signals, rate, ActuatorParams(), FitSettings())[3][0]
+    residual = residual_torque_nm(
+        window.signals["current_a"], window.signals["motor_speed_radps"], window.signals["hinge_moment_nm"], rate
+    )
+    n_timesteps = min(config.n_timesteps, window.n_samples)
+    inputs = sliding_features(sims.residual_nm, sliding, n_timesteps)
+    return Data(scenario, box, noise, sims, sliding, inputs, sliding_features(residual, sliding, n_timesteps))
 
 
-def baseline_fit(window: Window) -> FrictionLeastSquares | InputError:
-    """The least-squares fit of a window, or the reason it cannot fit (too little sliding motion)."""
-    try:
-        return FrictionLeastSquares().fit(window)
-    except InputError as exc:
-        return exc
+def train_network(data: Data, config: PipelineConfig) -> NetworkEstimator:
+    n = config.n_simulations
+    train = TrainConfig(hidden=config.hidden_units, seed=config.seed)
+    health = data.sims.health
+    return NetworkEstimator(train, config.members).fit(data.inputs[:n], health.fdj_nm[:n], health.eta_o[:n], data.box)
 
 
-def baseline_values(fitted: FrictionLeastSquares | InputError) -> dict[str, float] | None:
-    """FDJ and η_O of a baseline fit, or None where it abstained."""
-    if isinstance(fitted, InputError):
-        return None
-    return {"FDJ": fitted.fdj_, "eta_O": fitted.eta_o_}
+def candidates(
+    window: Window, physics: FrictionFit, data: Data, network: NetworkEstimator, n: int
+) -> tuple[Candidates, FrictionFit]:
+    """Physics and network on the window and on the held-out simulations (and the physics fit of those)."""
+    held = {name: values[n:] for name, values in data.sims.signals.items()}
+    check_physics = fit_friction(held, window.sample_rate_hz, residual_nm=data.sims.residual_nm[n:])
+    unit = network.predict_unit(np.vstack([data.inputs[n:], data.window_inputs]))
+    fdj, eta_o = data.box.denormalize(unit)
+    health = data.sims.health
+    return Candidates(
+        physics={k: float(v) for k, v in physics_values(physics).items()},
+        physics_std={"FDJ": float(physics.fdj_std_nm[0]), "eta_O": float(physics.eta_o_std[0])},
+        network={"FDJ": float(fdj[-1]), "eta_O": float(eta_o[-1])},
+        network_unit=unit[-1],
+        check_truth={"FDJ": health.fdj_nm[n:], "eta_O": health.eta_o[n:]},
+        check_physics=physics_values(check_physics, slice(None)),
+        check_network={"FDJ": fdj[:-1], "eta_O": eta_o[:-1]},
+    ), check_physics
 
 
-def network_values(network: NetworkEstimator, windows: list[Window], config: PipelineConfig) -> dict[str, np.ndarray]:
-    """The network's FDJ and η_O for each window."""
-    stacked = {name: np.stack([w.signals[name] for w in windows]) for name in windows[0].signals}
-    inputs = features(stacked, windows[0].sample_rate_hz, config.n_timesteps, config.input_set)
-    return network.predict(inputs)
-
-
-def _entry(value: float, std: float | None, nominal: float) -> dict[str, Any]:
-    return {"value": value, "std": std, "nominal": nominal, "drift_pct": 100.0 * (value - nominal) / nominal}
-
-
-def blended_estimates(
-    network: dict[str, float],
-    baseline: dict[str, float] | None,
-    check_truth: dict[str, np.ndarray],
-    check_network: dict[str, np.ndarray],
-    check_baseline: list[dict[str, float] | None],
-) -> tuple[dict[str, Any], dict[str, Any]]:
-    """Per parameter: the blend of both estimators scored on the check windows (network alone if
-    the baseline cannot fit the window or most check windows). Returns (estimates, methods)."""
-    usable = [i for i, b in enumerate(check_baseline) if b is not None]
-    estimates: dict[str, Any] = {}
-    methods: dict[str, Any] = {}
-    for name in TARGETS:
-        if baseline is None or len(usable) < len(check_baseline) // 2:
-            rms = float(np.sqrt(np.mean((check_network[name] - check_truth[name]) ** 2)))
-            value, std = network[name], rms
-            methods[name] = {"weight_network": 1.0, "rms_error_network": rms, "rms_error_baseline": None}
-        else:
-            base = np.array([check_baseline[i][name] for i in usable])  # type: ignore[index]
-            blend = fit_blend(check_truth[name][usable], check_network[name][usable], base)
-            value, std = blend.apply(network[name], baseline[name]), blend.rms_error
-            methods[name] = {
-                "weight_network": blend.weight_network,
-                "rms_error_network": blend.rms_error_network,
-                "rms_error_baseline": blend.rms_error_baseline,
-            }
-        methods[name].update(network=network[name], baseline=None if baseline is None else baseline[name])
-        estimates[name] = _entry(value, std, NOMINAL[name])
-    eta_o, eta_o_std = estimates["eta_O"]["value"], estimates["eta_O"]["std"]
-    slope = float((eta_a_from_eta_o(eta_o + 1e-6) - eta_a_from_eta_o(eta_o - 1e-6)) / 2e-6)
-    nominal_eta_a = float(eta_a_from_eta_o(NOMINAL["eta_O"]))
-    estimates["eta_A"] = _entry(float(eta_a_from_eta_o(eta_o)), abs(slope) * eta_o_std, nominal_eta_a)
-    return estimates, methods
-
-
-def static_friction(fitted: FrictionLeastSquares | InputError) -> tuple[float | None, str]:
-    """FSJ from the window's break-aways, or None with the reason it cannot be estimated."""
-    if isinstance(fitted, InputError):
-        return None, str(fitted)
-    return fitted.fsj_, fitted.fsj_reason_
+def fit_check(window: Window, data: Data, answer: Assessed, equation_ratio: float, n: int) -> FitCheck:
+    """Simulate the window at the answer and compare (``training.reproduction``)."""
+    health = HealthParams.single(2.0 * answer.values["FDJ"], answer.values["FDJ"], answer.values["eta_O"])
+    floor = float(np.sqrt(np.mean((data.sims.residual_nm[n:] - data.sims.clean_residual_nm[n:])[:, data.sliding] ** 2)))
+    ratios = output_error_ratios(window, data.scenario, health, data.noise, floor, data.sliding)
+    reproduced = ratios["residual_torque"] <= MAX_RATIO
+    notes = list(answer.notes)
+    if not reproduced:
+        notes.append(
+            f"simulated at these estimates, the window's residual torque differs by {ratios['residual_torque']:.1f}x "
+            "its noise floor: the model does not reproduce this window"
+        )
+    return FitCheck(
+        reproduced=reproduced,
+        equation_error_ratio=equation_ratio,
+        output_error_ratio=ratios,
+        uncertainty_inflation=answer.inflation,
+        notes=notes,
+    )
 
 
 def estimate_window(
     window: Window,
     config: PipelineConfig = PipelineConfig(),
-    on_stage: Callable[[str], None] | None = None,
     effects: EffectSet = EffectSet(),
-) -> dict[str, Any]:
+    on_stage: Callable[[str], None] | None = None,
+) -> Estimate:
     """The ``ema-estimate/1`` result for one window; ``on_stage`` hears each stage as it starts.
 
     ``effects`` extends the model the dataset is simulated with (the calibration loop's output).
+    Raises InputError (field ``signals``) for a window with too little sliding motion to read.
     """
     stage = on_stage or (lambda _: None)
-    started = time.perf_counter()
-    stage(f"simulating {config.n_simulations} + {config.check_windows} windows")
-    scenario = scenario_from_window(window, effects)
-    noise = window_noise(window, scenario)
-    dataset_config = DatasetConfig(config.n_simulations, config.n_timesteps, config.input_set, seed=config.seed)
-    dataset = build_dataset(scenario, dataset_config, noise)
-    check_health, checks = check_windows(scenario, window, noise, config.check_windows, config.seed + 10_000)
-    simulated = time.perf_counter()
-
+    clock = [time.perf_counter()]
+    prepared = prepare(window)
+    w, n = prepared.window, config.n_simulations
+    physics = fit_window(w.signals, w.sample_rate_hz)
+    stage(f"simulating {config.total_simulations} windows around the physics estimate")
+    data = simulate_dataset(w, physics, config, effects)
+    clock.append(time.perf_counter())
     stage(f"training {config.members} network(s) of {config.hidden_units} neurons")
-    train = replace(config.train, hidden=config.hidden_units, seed=config.seed)
-    network = NetworkEstimator(train, config.members).fit(dataset)
-    trained = time.perf_counter()
-
+    network = train_network(data, config)
+    clock.append(time.perf_counter())
     stage("estimating")
-    estimates, methods = blended_estimates(
-        network={k: float(v[0]) for k, v in network_values(network, [window], config).items()},
-        baseline=baseline_values(window_fit := baseline_fit(window)),
-        check_truth={"FDJ": check_health.fdj_nm, "eta_O": check_health.eta_o},
-        check_network=network_values(network, checks, config),
-        check_baseline=[baseline_values(baseline_fit(w)) for w in checks],
-    )
-    fsj, fsj_note = static_friction(window_fit)  # the same fit: dynamic levels first, then break-aways
-    estimates["FSJ"] = None if fsj is None else _entry(fsj, None, DEFAULT_RANGES.nominal_fsj_nm)
-    if fsj is not None:
-        estimates["FSD"] = {"value": fsj / estimates["FDJ"]["value"]}
-    predicted = time.perf_counter()
+    found, check_physics = candidates(w, physics, data, network, n)
+    equation_ratio = float(physics.residual_rms_nm[0] / np.median(check_physics.residual_rms_nm))
+    answer = assess(found, equation_ratio)
+    clock.append(time.perf_counter())
+    stage("checking the answer against the window")
+    check = fit_check(w, data, answer, equation_ratio, n)
+    fsj = read_static_friction(w.signals, w.sample_rate_hz, answer.values["FDJ"], answer.values["eta_O"])
+    clock.append(time.perf_counter())
+    return _document(prepared, physics, data, network, answer, check, fsj, config, clock)
 
+
+def _estimates(answer: Assessed, fsj: StaticFriction) -> Estimates:
+    """FDJ and η_O as assessed, η_A by Eq. 3.4 (its std through the derivative), FSJ and FSD if read."""
+    eta_o, eta_o_std = answer.values["eta_O"], answer.stds["eta_O"]
+    slope = float((eta_a_from_eta_o(eta_o + 1e-6) - eta_a_from_eta_o(eta_o - 1e-6)) / 2e-6)
+    fdj = answer.values["FDJ"]
+    ratio = None
+    if fsj.value_nm is not None and fsj.std_nm is not None:
+        relative = np.hypot(fsj.std_nm / fsj.value_nm, answer.stds["FDJ"] / fdj)
+        ratio = RatioEstimate(value=fsj.value_nm / fdj, std=fsj.value_nm / fdj * relative)
+    return Estimates(
+        FDJ=parameter(fdj, answer.stds["FDJ"], NOMINAL["FDJ"]),
+        eta_O=parameter(eta_o, eta_o_std, NOMINAL["eta_O"]),
+        eta_A=parameter(float(eta_a_from_eta_o(eta_o)), abs(slope) * eta_o_std, NOMINAL_ETA_A),
+        FSJ=None if fsj.value_nm is None else parameter(fsj.value_nm, fsj.std_nm, DEFAULT_RANGES.nominal_fsj_nm),
+        FSD=ratio,
+    )
+
+
+def _notes(prepared: Prepared, physics: FrictionFit, estimates: Estimates, check: FitCheck) -> list[str]:
+    notes = list(check.notes)
+    if prepared.command_clipped_fraction > 0:
+        notes.append(
+            f"{100 * prepared.command_clipped_fraction:.1f} % of the command lies past the end stops: "
+            "the actuator saturates there, and so do its simulations"
+        )
+    if physics.at_search_edge[0]:
+        notes.append("η_O lies at an end of the physical search range: read it as a bound, not a value")
+    if estimates.eta_A.value < 0:
+        notes.append("η_A < 0: the transmission is irreversible (the load cannot back-drive it; thesis Case 1C)")
+    return notes
+
+
+def _document(
+    prepared: Prepared,
+    physics: FrictionFit,
+    data: Data,
+    network: NetworkEstimator,
+    answer: Assessed,
+    check: FitCheck,
+    fsj: StaticFriction,
+    config: PipelineConfig,
+    clock: list[float],
+) -> Estimate:
+    w = prepared.window
+    estimates = _estimates(answer, fsj)
     first = network.fits_[0]
-    return {
-        "schema": SCHEMA,
-        "actuator_id": window.actuator_id,
-        "window_id": window.window_id,
-        "estimates": estimates,
-        "fsj_note": fsj_note,
-        "timings_s": {
-            "simulate": simulated - started,
-            "train": trained - simulated,
-            "predict": predicted - trained,
-            "total": predicted - started,
-        },
-        "dataset": {
-            "n_simulations": config.n_simulations,
-            "n_timesteps": config.n_timesteps,
-            "inputs": list(INPUT_SETS[config.input_set]),
-            "check_windows": config.check_windows,
-            "noise_estimated": noise.as_dict(),
-        },
-        "training": {
-            "epochs": first.epochs,
-            "stop_reason": first.stop_reason,
-            "val_mse": first.val_mse,
-            "test_mse": first.test_mse,
-            "members": config.members,
-            "hidden_units": config.hidden_units,
-        },
-        "methods": methods,
-    }
+    return Estimate(
+        actuator_id=w.actuator_id,
+        window_id=w.window_id,
+        estimates=estimates,
+        fsj_note=fsj.reason,
+        irreversible=estimates.eta_A.value < 0,
+        notes=_notes(prepared, physics, estimates, check),
+        timings_s=Timings(
+            simulate=clock[1] - clock[0],
+            train=clock[2] - clock[1],
+            predict=clock[3] - clock[2],
+            check=clock[4] - clock[3],
+            total=clock[4] - clock[0],
+        ),
+        dataset=DatasetInfo(
+            n_simulations=config.n_simulations,
+            n_timesteps=data.inputs.shape[1],
+            inputs=["residual_torque, sliding samples"],
+            check_windows=config.check_windows,
+            noise_estimated=data.noise.as_dict(),
+            box={"FDJ": data.box.fdj_nm, "eta_O": data.box.eta_o},
+        ),
+        training=TrainingInfo(
+            epochs=first.epochs,
+            stop_reason=first.stop_reason,
+            val_mse=first.val_mse,
+            test_mse=first.test_mse,
+            members=config.members,
+            hidden_units=config.hidden_units,
+        ),
+        methods=answer.methods,
+        fit_check=check,
+        window=WindowInfo(
+            n_samples=prepared.original_samples,
+            duration_s=prepared.original_samples / prepared.original_rate_hz,
+            sample_rate_hz=prepared.original_rate_hz,
+            processed_rate_hz=w.sample_rate_hz,
+            command_clipped_fraction=prepared.command_clipped_fraction,
+            sliding_fraction=float(np.mean(data.sliding)),
+        ),
+        config=config,
+    )

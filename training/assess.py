@@ -1,0 +1,137 @@
+"""Which estimator to believe, and how much: held-out simulations first, then the window itself.
+
+Both estimators run on held-out simulations of the window's own scenario (its command, load,
+first state and noise; health drawn in the same box). The physics fit's mean error there is its
+bias on this scenario (the 2 ms reconstruction blurs the reversals, the motor saturates) and is
+subtracted; the errors then give each parameter's MSE-optimal blend (``training.combine``) and
+an in-distribution std. Those simulations cannot
+see a mismatch between the model and the measured window, so two checks on the window follow:
+
+- **Consistency.** The network reads the window's residual torque, the physics fit reads it
+  too, through Eq. 5.1. On held-out simulations their difference has a known spread; on the
+  window it must fall inside it (|z| ≤ ``MAX_DISAGREEMENT_Z``), and the network's answer must
+  lie in the box it was trained on. Otherwise the network is extrapolating from a trace the
+  simulator does not produce, and only the physics fit is kept (a doublet's network answer was
+  17 % off with a 0.3 % std that way).
+- **Equation error.** The window's Eq. 5.1 residual RMS over the simulations' (the same noise,
+  no missing physics): ≈ 1 when the model explains the window. Above, the stds are scaled by it
+  (the Birge ratio): structure the model lacks widens the uncertainty instead of hiding in it.
+
+The std is never below the physics fit's block-jackknife std on the window itself.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from training.baseline import FrictionFit
+from training.combine import fit_blend
+from training.documents import TARGETS, MethodReport
+
+MAX_DISAGREEMENT_Z = 3.0
+BOX_TOLERANCE = 0.1  # the network may answer this far outside its box (in box units) before it extrapolates
+STUDENT_95 = {8: 2.31, 16: 2.12, 32: 2.04}  # t quantiles: a std read from K simulations is itself uncertain
+
+
+@dataclass(frozen=True)
+class Candidates:
+    """Each estimator's answer for the window and for the K held-out simulations, per target."""
+
+    physics: dict[str, float]
+    physics_std: dict[str, float]
+    network: dict[str, float] | None
+    network_unit: np.ndarray | None  # (2,) the window's network answer in box units
+    check_truth: dict[str, np.ndarray]
+    check_physics: dict[str, np.ndarray]
+    check_network: dict[str, np.ndarray] | None
+
+
+@dataclass(frozen=True)
+class Assessed:
+    values: dict[str, float]
+    stds: dict[str, float]
+    methods: dict[str, MethodReport]
+    inflation: float
+    notes: list[str]
+
+
+def physics_values(fit: FrictionFit, row: int | slice = 0) -> dict[str, np.ndarray]:
+    return {"FDJ": fit.fdj_nm[row], "eta_O": fit.eta_o[row]}
+
+
+def _rms(errors: np.ndarray) -> float:
+    return float(np.sqrt(np.mean(errors**2)))
+
+
+def _t_factor(k: int) -> float:
+    """The 95 % Student quantile for K check windows, relative to the normal's 1.96."""
+    nearest = min(STUDENT_95, key=lambda n: abs(n - k))
+    return max(1.0, STUDENT_95[nearest] / 1.96) if k < 60 else 1.0
+
+
+def bias_corrected(physics: np.ndarray, truth: np.ndarray) -> tuple[float, np.ndarray]:
+    """The physics fit's mean error on the held-out simulations (its bias on this scenario), and each
+    simulation's estimate corrected by the mean of the *others'* errors (leave-one-out: honest errors)."""
+    errors = physics - truth
+    k = len(errors)
+    left_out = (errors.sum() - errors) / (k - 1)
+    return float(errors.mean()), physics - left_out
+
+
+def network_note(c: Candidates, name: str) -> str | None:
+    """Why the network's answer for ``name`` cannot be used on this window, or None."""
+    if c.network is None or c.check_network is None or c.network_unit is None:
+        return "no network"
+    index = TARGETS.index(name)
+    if not -BOX_TOLERANCE <= c.network_unit[index] <= 1 + BOX_TOLERANCE:
+        return f"the network answered {c.network_unit[index]:.2f} box units: outside the box it was trained in"
+    spread = c.check_network[name] - c.check_physics[name]
+    centre, scale = float(np.mean(spread)), max(float(np.std(spread)), 1e-12)
+    z = (c.network[name] - c.physics[name] - centre) / scale
+    if abs(z) > MAX_DISAGREEMENT_Z:
+        return (
+            f"network and physics disagree by {z:.1f} times their spread on simulations: the network reads "
+            "a residual-torque trace the simulator does not produce"
+        )
+    return None
+
+
+def assess(c: Candidates, equation_error_ratio: float) -> Assessed:
+    """Blend per target, then widen by the equation-error ratio; never below the window's jackknife std."""
+    inflation = max(1.0, equation_error_ratio)
+    values, stds, methods, notes = {}, {}, {}, []
+    k = len(c.check_truth["FDJ"])
+    for name in TARGETS:
+        truth = c.check_truth[name]
+        bias, phys = bias_corrected(c.check_physics[name], truth)
+        physics = c.physics[name] - bias
+        note = network_note(c, name)
+        if note is None and c.network is not None and c.check_network is not None:
+            blend = fit_blend(truth, c.check_network[name], phys)
+            weight, rms, rms_net = blend.weight_network, blend.rms_error, blend.rms_error_network
+            value = blend.apply(c.network[name], physics)
+        else:
+            weight, rms, rms_net, value = 0.0, _rms(phys - truth), None, physics
+            if c.network is not None:
+                notes.append(f"{name}: physics fit only; {note}")
+        values[name] = value
+        stds[name] = inflation * max(_t_factor(k) * rms, c.physics_std[name])
+        methods[name] = MethodReport(
+            physics=c.physics[name],
+            physics_bias=bias,
+            physics_std=c.physics_std[name],
+            network=None if c.network is None else c.network[name],
+            weight_network=weight,
+            rms_error_physics=_rms(phys - truth),
+            rms_error_network=rms_net,
+            rms_error_blend=rms,
+            network_note=note,
+        )
+    if inflation > 1.0:
+        notes.append(
+            f"the window's Eq. 5.1 residual is {equation_error_ratio:.2f}x what noise alone leaves: "
+            "the model lacks something this window holds (stds widened by that factor; `ema calibrate` traces it)"
+        )
+    return Assessed(values, stds, methods, inflation, notes)

@@ -1,0 +1,129 @@
+"""``ema-estimate/1``: the one definition of an estimate result (shared/spec/interfaces.md).
+
+The pipeline returns it, the service declares it as its response model, the CLI prints it, the
+history stores it and the tests construct it; ``docs/schemas/ema-estimate-1.json`` is exported
+from it. Fields may be added; those of interfaces.md are never renamed or removed.
+"""
+
+from __future__ import annotations
+
+from typing import Literal
+
+from pydantic import BaseModel, ConfigDict, Field
+
+from training.config import PipelineConfig
+
+TARGETS = ("FDJ", "eta_O")  # what the estimators fit; η_A follows by Eq. 3.4, FSD from FSJ
+
+
+class Document(BaseModel):
+    """A public document: immutable, strict about unknown fields."""
+
+    model_config = ConfigDict(frozen=True, extra="forbid", populate_by_name=True)
+
+
+class ParameterEstimate(Document):
+    value: float
+    std: float | None = Field(description="one standard deviation, in the parameter's unit; null: not assessed")
+    nominal: float
+    drift_pct: float = Field(description="100 · (value − nominal) / nominal")
+
+
+class RatioEstimate(Document):
+    value: float
+    std: float | None = None
+
+
+class Estimates(Document):
+    FDJ: ParameterEstimate
+    eta_O: ParameterEstimate
+    eta_A: ParameterEstimate
+    FSJ: ParameterEstimate | None
+    FSD: RatioEstimate | None = None
+
+
+class Timings(Document):
+    simulate: float
+    train: float
+    predict: float
+    check: float = 0.0
+    total: float
+
+
+class MethodReport(Document):
+    """How one parameter's value was reached: each estimator, its error on held-out simulations, the blend."""
+
+    physics: float = Field(description="Eq. 5.1 least squares on the window")
+    physics_bias: float = Field(description="its mean error on held-out simulations, subtracted before the blend")
+    physics_std: float = Field(description="its block-jackknife std on the window")
+    network: float | None = Field(description="the window's own network; null if it was not used")
+    weight_network: float
+    rms_error_physics: float = Field(description="on held-out simulations of this window")
+    rms_error_network: float | None
+    rms_error_blend: float
+    network_note: str | None = None
+
+
+class FitCheck(Document):
+    """The answer checked against the measured window itself."""
+
+    reproduced: bool = Field(description="the model at these estimates reproduces the window within its noise")
+    equation_error_ratio: float = Field(
+        description="RMS of the window's Eq. 5.1 residual over what sensor noise alone leaves in simulations (≈ 1)"
+    )
+    output_error_ratio: dict[str, float] = Field(
+        description="per signal: RMS(measured − simulated at the estimates) over the noise-only floor"
+    )
+    uncertainty_inflation: float = Field(description="factor applied to the stds for what the model did not reproduce")
+    notes: list[str] = Field(default_factory=list)
+
+
+class WindowInfo(Document):
+    n_samples: int
+    duration_s: float
+    sample_rate_hz: float
+    processed_rate_hz: float = Field(description="after averaging adjacent samples (exact for interval means)")
+    command_clipped_fraction: float = Field(description="share of command samples past the end stops, saturating")
+    sliding_fraction: float = Field(description="share of samples the friction fit could use")
+
+
+class DatasetInfo(Document):
+    n_simulations: int
+    n_timesteps: int
+    inputs: list[str]
+    check_windows: int
+    noise_estimated: dict[str, float]
+    box: dict[str, tuple[float, float]] = Field(description="the FDJ and η_O intervals the simulations were drawn in")
+    redrawn: bool = Field(False, description="the box was moved once because an estimate fell on its edge")
+
+
+class TrainingInfo(Document):
+    epochs: int
+    stop_reason: str
+    val_mse: float
+    test_mse: float
+    members: int
+    hidden_units: int
+
+
+class Estimate(Document):
+    """``ema-estimate/1``."""
+
+    schema_: Literal["ema-estimate/1"] = Field("ema-estimate/1", alias="schema")
+    actuator_id: str
+    window_id: str
+    estimates: Estimates
+    fsj_note: str
+    irreversible: bool = Field(description="η_A < 0: the load can never back-drive the transmission (thesis Case 1C)")
+    notes: list[str] = Field(default_factory=list, description="what a reader of this answer should know")
+    timings_s: Timings
+    dataset: DatasetInfo
+    training: TrainingInfo
+    methods: dict[str, MethodReport]
+    fit_check: FitCheck
+    window: WindowInfo
+    config: PipelineConfig
+
+
+def parameter(value: float, std: float | None, nominal: float) -> ParameterEstimate:
+    return ParameterEstimate(value=value, std=std, nominal=nominal, drift_pct=100.0 * (value - nominal) / nominal)

@@ -1,0 +1,60 @@
+"""Does the model, at the estimates, reproduce the measured window? The output-error check.
+
+The window is simulated once more, clean, at the final estimates, from its own command, logged
+load and first state; each signal's RMS difference to the measurement (after the first
+``SETTLE_S``, while the simulation settles from an estimated state) is divided by the floor that
+sensor noise alone would leave: the estimated noise of that signal, and for the residual torque
+the RMS difference between noisy and clean reconstructions of the held-out simulations. A ratio
+near 1 means the model reproduces the window; a ratio of several means it does not, and the
+result says so. Position, speed and current also carry timing differences a model may have
+without any bias in friction (they are reported, and only the residual torque decides).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import numpy as np
+
+from sim.noise import SensorNoise
+from sim.params import HealthParams
+from sim.residual import residual_torque_nm
+from sim.window import Window
+from training.dataset import Scenario
+
+SETTLE_S = 0.02
+MAX_RATIO = 2.0  # residual torque within twice its noise floor: reproduced
+
+
+def output_error_ratios(
+    window: Window,
+    scenario: Scenario,
+    health: HealthParams,
+    noise: SensorNoise,
+    residual_floor_nm: float,
+    sliding: np.ndarray,
+) -> dict[str, float]:
+    """Per signal, RMS(measured − simulated at ``health``) over its noise-only floor."""
+    simulated = scenario.simulate(health, lanes=1).simulation(0)
+    rate = window.sample_rate_hz
+    measured = window.signals
+    keep = np.arange(window.n_samples) >= round(SETTLE_S * rate)
+    floors = {
+        "position_deg": noise.position_deg,
+        "motor_speed_radps": noise.motor_speed_radps,
+        "current_a": noise.current_a,
+    }
+    ratios = {
+        name: _rms(measured[name][keep] - simulated[name][keep]) / max(floor, 1e-12) for name, floor in floors.items()
+    }
+    torque = _residual(measured, rate) - _residual(simulated, rate)
+    ratios["residual_torque"] = _rms(torque[keep & sliding]) / max(residual_floor_nm, 1e-12)
+    return ratios
+
+
+def _residual(signals: Mapping[str, np.ndarray], rate: float) -> np.ndarray:
+    return residual_torque_nm(signals["current_a"], signals["motor_speed_radps"], signals["hinge_moment_nm"], rate)
+
+
+def _rms(values: np.ndarray) -> float:
+    return float(np.sqrt(np.mean(values**2))) if len(values) else 0.0
