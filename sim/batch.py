@@ -9,7 +9,7 @@ import numpy as np
 from sim import kernels, runtime
 from sim.aircraft import FlightCondition, Load, load_model
 from sim.checks import InputError, finite_array, in_range
-from sim.effects import EffectSet
+from sim.effects import TABLE_VARIABLES, EffectSet
 from sim.params import ActuatorParams, HealthParams
 
 DEFAULT_SAMPLE_RATE_HZ = 10_000.0
@@ -60,6 +60,7 @@ def kernel_constants(actuator: ActuatorParams, effects: EffectSet) -> kernels.Ke
     gain = effects.get("torque_constant", "gain")
     sensor_gain = effects.get("current_sensor_gain", "gain")
     stribeck_speed = effects.get("stribeck", "speed_radps")
+    table = effects.table
     h_over_l = actuator.step_s / actuator.inductance_h
     return kernels.KernelConstants(
         step_s=actuator.step_s,
@@ -87,8 +88,12 @@ def kernel_constants(actuator: ActuatorParams, effects: EffectSet) -> kernels.Ke
         cogging_amplitude=effects.get("cogging", "amplitude_nm"),
         cogging_wavenumber=effects.get("cogging", "periods_per_rev") * actuator.gear_ratio,
         cogging_phase=effects.get("cogging", "phase_rad"),
+        table_variable=0 if table is None else TABLE_VARIABLES[table.variable],
+        table_start=0.0 if table is None else table.start,
+        table_step=1.0 if table is None else table.step,
         with_friction_effects=effects.get("stribeck", "amplitude_nm") != 0.0
-        or effects.get("position_friction", "amplitude_nm") != 0.0,
+        or effects.get("position_friction", "amplitude_nm") != 0.0
+        or table is not None,
         with_cogging=effects.get("cogging", "amplitude_nm") != 0.0,
     )
 
@@ -194,7 +199,8 @@ def simulate_batch(
     out = np.empty((kernels.N_RECORDED, per_sim.shape[1], n_samples))
     constants = kernel_constants(actuator, effects)
     knots_rad = np.ascontiguousarray(np.radians(knots))
-    run_groups((constants, loads, per_sim, knots_rad, steps, initial_rows), out, lanes)
+    table_nm = np.zeros(2) if effects.table is None else np.array(effects.table.values_nm)
+    run_groups((constants, table_nm, loads, per_sim, knots_rad, steps, initial_rows), out, lanes)
     out = out[:, :n_sims]
     signals = {
         "position_deg": np.degrees(out[kernels.POSITION]),

@@ -2,8 +2,9 @@
 
 Each effect is a few named parameters whose neutral values leave the base model exactly as it
 is; the kernel reads them from its constants (see ``sim.kernels.advance``), so switching an
-effect on is a parameter change, never a fork of the kernel. The calibration loop reads
-``signature`` to know which variable an effect leaves its trace in.
+effect on is a parameter change, never a fork of the kernel. Beside the named effects, a
+:class:`FrictionTable` adds dry friction of any shape against motor speed, elevator position or
+time: the data-driven term the calibration loop offers when no named effect fits.
 """
 
 from __future__ import annotations
@@ -17,11 +18,10 @@ from sim.checks import InputError, in_range
 
 @dataclass(frozen=True)
 class Effect:
-    """One optional effect: its parameters with neutral value and bounds, and the trace it leaves."""
+    """One optional effect: its parameters with neutral value and bounds."""
 
     name: str
     parameters: Mapping[str, tuple[float, float, float]]  # name -> (neutral, low, high)
-    signature: str  # which variable the residual it leaves follows
 
 
 EFFECTS: Mapping[str, Effect] = MappingProxyType(
@@ -30,61 +30,78 @@ EFFECTS: Mapping[str, Effect] = MappingProxyType(
         for effect in (
             Effect(
                 "viscous",
-                {"coefficient_nms": (0.0, -5e-5, 2e-3)},  # extra viscous coefficient [N·m·s/rad], motor shaft
-                "residual torque proportional to motor speed",
+                {"coefficient_nms": (0.0, -5e-5, 5e-3)},  # extra viscous coefficient [N·m·s/rad], motor shaft
             ),
             Effect(
                 "stribeck",
                 {
-                    "amplitude_nm": (0.0, -0.1, 0.2),  # extra dry friction at zero speed [N·m]
+                    "amplitude_nm": (0.0, -0.1, 1.0),  # extra dry friction at zero speed [N·m]
                     "speed_radps": (20.0, 0.5, 300.0),  # speed where half of it is left [rad/s]
                 },
-                "residual torque peaked at low |motor speed|, sign of speed (A / (1 + (ω/ω_s)²))",
             ),
             Effect(
                 "torque_constant",
                 {"gain": (1.0, 0.7, 1.3)},  # true k_T = k_e over the nominal [-]
-                "residual torque proportional to current",
             ),
             Effect(
                 "hinge_moment_bias",
-                {"bias_nm": (0.0, -100.0, 100.0)},  # offset of the hinge-moment sensor [N·m]
-                "constant offset in hinge moment, bias/n in residual torque",
+                {"bias_nm": (0.0, -500.0, 500.0)},  # offset of the hinge-moment sensor [N·m]
             ),
             Effect(
                 "current_sensor_gain",
                 {"gain": (1.0, 0.7, 1.3)},  # measured current over true current [-] (the loop sees it)
-                "residual torque proportional to current",
             ),
             Effect(
                 "position_friction",
-                {"amplitude_nm": (0.0, -0.05, 0.1)},  # extra dry friction at full deflection [N·m], ∝ |θ_u|
-                "residual torque proportional to |position|, sign of speed",
+                {"amplitude_nm": (0.0, -0.05, 1.0)},  # extra dry friction at full deflection [N·m], ∝ |θ_u|
             ),
             Effect(
                 "cogging",
                 {
-                    "amplitude_nm": (0.0, 0.0, 0.2),  # cogging torque amplitude [N·m]
+                    "amplitude_nm": (0.0, 0.0, 0.5),  # cogging torque amplitude [N·m]
                     "periods_per_rev": (6.0, 1.0, 48.0),  # ripple periods per motor revolution [-]
                     "phase_rad": (0.0, -4.0, 4.0),  # A·sin(p·θ_m + φ), θ_m from n·θ_u at the window's start
                 },
-                "residual torque periodic in motor angle",
             ),
             Effect(
                 "backlash",
-                {"extra_rad": (0.0, -5e-3, 0.02)},  # backlash beyond the nominal BLK [rad], elevator side
-                "position error at speed reversals",
+                {"extra_rad": (0.0, -5e-3, 0.1)},  # backlash beyond the nominal BLK [rad], elevator side
             ),
         )
     }
 )
 
 
+TABLE_VARIABLES = {"speed": 1, "position": 2, "time": 3}  # |ω_m| [rad/s], θ_u [rad], t [s]; kernel codes
+MAX_TABLE_NM = 0.5
+
+
+@dataclass(frozen=True)
+class FrictionTable:
+    """Extra dry friction [N·m] (dynamic and static alike) tabulated on a uniform grid of one variable."""
+
+    variable: str  # "speed" (|ω_m| [rad/s]), "position" (θ_u [rad]) or "time" (from the window's start [s])
+    start: float  # first grid point, in the variable's unit
+    step: float  # grid spacing, > 0
+    values_nm: tuple[float, ...]  # friction at the grid points; linear between, held past the ends
+
+    def __post_init__(self) -> None:
+        if self.variable not in TABLE_VARIABLES:
+            raise InputError("table.variable", f"must be one of {', '.join(TABLE_VARIABLES)}, got {self.variable!r}")
+        in_range("table.step", self.step, 1e-9, 1e6)
+        in_range("table.start", self.start, -1e6, 1e6)
+        if not 2 <= len(self.values_nm) <= 1000:
+            raise InputError("table.values_nm", f"needs 2..1000 values, got {len(self.values_nm)}")
+        values = tuple(in_range("table.values_nm", v, -MAX_TABLE_NM, MAX_TABLE_NM, "N·m") for v in self.values_nm)
+        object.__setattr__(self, "values_nm", values)
+
+
 @dataclass(frozen=True)
 class EffectSet:
-    """The effects switched on, with their parameters; empty means the base model."""
+    """The effects switched on, with their parameters, and a friction table; empty means the base model."""
 
     values: Mapping[str, Mapping[str, float]] = field(default_factory=dict)
+    table: FrictionTable | None = None
 
     def __post_init__(self) -> None:
         checked: dict[str, dict[str, float]] = {}
@@ -109,7 +126,10 @@ class EffectSet:
 
     def with_effect(self, effect: str, **parameters: float) -> EffectSet:
         """A copy with ``effect`` switched on (or replaced)."""
-        return EffectSet({**self.values, effect: parameters})
+        return EffectSet({**self.values, effect: parameters}, self.table)
+
+    def with_table(self, table: FrictionTable | None) -> EffectSet:
+        return EffectSet(self.values, table)
 
     def as_dict(self) -> dict[str, dict[str, float]]:
         return {name: dict(parameters) for name, parameters in self.values.items()}

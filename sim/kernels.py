@@ -61,7 +61,11 @@ class KernelConstants(NamedTuple):
     cogging_amplitude: float  # [N·m]
     cogging_wavenumber: float  # cogging periods per rad of θ_m / n [1/rad]
     cogging_phase: float  # [rad]
-    with_friction_effects: bool  # Stribeck or position friction on: update the dry levels every step
+    table_variable: int  # extra dry friction tabulated against: 0 none, 1 |ω| [rad/s], 2 θ_u [rad], 3 t [s]
+    table_start: float  # first grid point of the table, in its variable's unit
+    table_step: float  # grid spacing (the values come apart, as ``table_nm``: an array in here kept LLVM
+    # from hoisting the scalars out of the lane loop, and the base model ran 2.7x slower)
+    with_friction_effects: bool  # Stribeck, position friction or a table on: update the dry levels every step
     with_cogging: bool  # skip the sine when the effect is off
 
 
@@ -148,7 +152,32 @@ def _advance_aircraft(load, state, mean_elevator_rad):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _advance_lanes(c, load_delta, j, lane):
+def _tabulated(c, table_nm, x):
+    """The friction table at x: linear between grid points, held past the ends."""
+    u = min(max((x - c.table_start) / c.table_step, 0.0), table_nm.shape[0] - 1.0)
+    i = min(int(u), table_nm.shape[0] - 2)
+    f = u - i
+    return table_nm[i] * (1.0 - f) + table_nm[i + 1] * f
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _friction_effects(c, table_nm, time_s, lane):
+    """Dry levels with Stribeck, position friction and the friction table added (when any is on)."""
+    for s in range(lane.shape[1]):
+        ratio = lane[SPEED_NOW, s] * c.stribeck_inverse_speed
+        extra_dry = c.position_friction * abs(lane[POSITION_NOW, s])
+        if c.table_variable == 1:
+            extra_dry += _tabulated(c, table_nm, abs(lane[SPEED_NOW, s]))
+        elif c.table_variable == 2:
+            extra_dry += _tabulated(c, table_nm, lane[POSITION_NOW, s])
+        elif c.table_variable == 3:
+            extra_dry += _tabulated(c, table_nm, time_s)
+        lane[DRY_DYNAMIC, s] = lane[LANE_FDJ, s] + extra_dry + c.stribeck_amplitude / (1.0 + ratio * ratio)
+        lane[DRY_STATIC, s] = lane[LANE_FSJ, s] + extra_dry
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _advance_lanes(c, table_nm, load_delta, j, time_s, lane):
     """Advance every lane (simulation) of a group by one step h: the loop LLVM vectorizes."""
     n_lanes = lane.shape[1]
     # Effects are evaluated apart, and only when on: inside the main loop a call (sin) would keep
@@ -157,11 +186,7 @@ def _advance_lanes(c, load_delta, j, lane):
         for s in range(n_lanes):
             lane[COGGING, s] = c.cogging_amplitude * np.sin(c.cogging_wavenumber * lane[ANGLE_NOW, s] + c.cogging_phase)
     if c.with_friction_effects:
-        for s in range(n_lanes):
-            ratio = lane[SPEED_NOW, s] * c.stribeck_inverse_speed
-            extra_dry = c.position_friction * abs(lane[POSITION_NOW, s])
-            lane[DRY_DYNAMIC, s] = lane[LANE_FDJ, s] + extra_dry + c.stribeck_amplitude / (1.0 + ratio * ratio)
-            lane[DRY_STATIC, s] = lane[LANE_FSJ, s] + extra_dry
+        _friction_effects(c, table_nm, time_s, lane)
     for s in range(n_lanes):
         command = lane[COMMAND0, s] + lane[COMMAND_STEP, s] * j
         current, speed, angle, position, loss = advance(
@@ -180,7 +205,7 @@ def _advance_lanes(c, load_delta, j, lane):
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
-def run_group(c, load, per_sim, knots_rad, interval_steps, initial, first, lanes, out):
+def run_group(c, table_nm, load, per_sim, knots_rad, interval_steps, initial, first, lanes, out):
     """Simulate sims [first, first + lanes) in lock-step and write their interval means into ``out``.
 
     Over log interval k (``interval_steps[k]`` steps of h, so logs of any rate are exact), each
@@ -195,6 +220,7 @@ def run_group(c, load, per_sim, knots_rad, interval_steps, initial, first, lanes
 
     Parameters
     ----------
+    table_nm : (K,) the friction table's values (``c.table_variable`` says against what; 0: unused)
     per_sim : (4, N) FDJ, FSJ, 1 − η_A, 1/η_O − 1, N a multiple of ``lanes``
     knots_rad : (1, K + 1) one command for the batch, or (N, K + 1) one per simulation
     interval_steps : (K,) int64, steps of h in each log interval
@@ -231,7 +257,7 @@ def run_group(c, load, per_sim, knots_rad, interval_steps, initial, first, lanes
             lane[COMMAND_STEP, s] = (knots_rad[row, k + 1] - knots_rad[row, k]) / steps
         lane[SUM_POSITION:] = 0.0
         for j in range(steps):
-            _advance_lanes(c, load_delta, j, lane)
+            _advance_lanes(c, table_nm, load_delta, j, (elapsed_steps + j) * c.step_s, lane)
         elapsed_steps += steps
         _record(c, load, lane, first, k, steps, out)
         for s in range(lanes):

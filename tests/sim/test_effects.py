@@ -6,7 +6,7 @@ import pytest
 from sim.aircraft import GroundLoad
 from sim.batch import simulate_batch
 from sim.checks import InputError
-from sim.effects import EFFECTS, EffectSet
+from sim.effects import EFFECTS, EffectSet, FrictionTable
 from sim.params import HealthParams
 from tests.sim.conftest import ramp_knots
 
@@ -92,3 +92,26 @@ def test_unknown_effects_and_parameters_are_named():
     with pytest.raises(InputError) as error:
         EffectSet({"viscous": {"coefficient_nms": 1.0}})
     assert error.value.field == "effects.viscous.coefficient_nms"
+
+
+@pytest.mark.parametrize(
+    ("variable", "start", "step", "values"),
+    [("position", 0.0, np.radians(0.5), (0.0, 0.01, 0.03, 0.01, 0.0)), ("time", 0.0, 0.1, (0.0, 0.02, 0.04, 0.06))],
+)
+def test_a_friction_table_adds_its_interpolated_value(base, variable, start, step, values):
+    table = FrictionTable(variable, start, step, values)
+    result = run(EffectSet().with_table(table))
+    if variable == "position":
+        x = np.radians(result.signals["position_deg"][0, STEADY])
+    else:
+        x = (np.arange(3000)[STEADY] + 0.5) * 1e-4
+    expected = np.interp(x, start + step * np.arange(len(values)), values)
+    extra = result.loss_torque_nm[0, STEADY] - base.loss_torque_nm[0, STEADY]
+    np.testing.assert_allclose(extra, expected, atol=3e-4)
+
+
+def test_a_bad_table_is_named():
+    with pytest.raises(InputError, match="table.variable"):
+        FrictionTable("load", 0.0, 1.0, (0.0, 0.1))
+    with pytest.raises(InputError, match="table.values_nm"):
+        FrictionTable("time", 0.0, 1.0, (0.0, 2.0))
