@@ -140,7 +140,7 @@ def run_groups(inputs: tuple, out: np.ndarray, lanes: int) -> None:
     firsts = range(0, out.shape[1], lanes)
 
     def run(first: int) -> None:
-        kernels.run_group(*inputs, first, lanes, out)
+        kernels.run_group(*inputs, first, lanes, out)  # type: ignore[call-arg]  # numba's Dispatcher
 
     if runtime.threads() == 1 or len(firsts) == 1:
         for first in firsts:

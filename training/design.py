@@ -74,12 +74,26 @@ def box_around(fdj_nm: float, fdj_std_nm: float, eta_o: float, eta_o_std: float)
     for name, value in (("fdj_nm", fdj_nm), ("eta_o", eta_o), ("fdj_std_nm", fdj_std_nm), ("eta_o_std", eta_o_std)):
         if not np.isfinite(value):
             raise InputError(name, f"must be finite to centre a dataset on, got {value}")
+    fdj_nm = float(np.clip(fdj_nm, *PHYSICAL.fdj_nm))
+    eta_o = float(np.clip(eta_o, *PHYSICAL.eta_o))
     fdj_half = max(SPAN_SIGMAS * fdj_std_nm, MIN_HALF_SPAN["fdj_nm"] * fdj_nm)
     eta_half = max(SPAN_SIGMAS * eta_o_std, MIN_HALF_SPAN["eta_o"])
     return Box(
         fdj_nm=_interval(fdj_nm, fdj_half, PHYSICAL.fdj_nm),
         eta_o=_interval(eta_o, eta_half, PHYSICAL.eta_o),
     )
+
+
+def inside(fdj_nm: float, eta_o: float, fsd: float = 2.0) -> HealthParams:
+    """One health point at (FDJ, η_O), held inside the physical limits (a window the model cannot
+    explain may be fitted with a negative FDJ: it is still simulated, at the limit)."""
+    fdj = float(np.clip(fdj_nm, *PHYSICAL.fdj_nm))
+    return HealthParams.single(fsd * fdj, fdj, float(np.clip(eta_o, *PHYSICAL.eta_o)))
+
+
+def centre(box: Box) -> HealthParams:
+    """The box's centre, FSJ at twice FDJ."""
+    return inside(float(np.mean(box.fdj_nm)), float(np.mean(box.eta_o)))
 
 
 def halton(n: int, seed: int) -> np.ndarray:

@@ -71,7 +71,7 @@ def simulate_dataset(window: Window, physics: FrictionFit, config: PipelineConfi
     """The box around the physics estimate, the window's noise, the simulations and their features."""
     box = design.box_around(physics.fdj_nm[0], physics.fdj_std_nm[0], physics.eta_o[0], physics.eta_o_std[0])
     scenario = scenario_from_window(window, effects)
-    centre = HealthParams.single(2.0 * physics.fdj_nm[0], physics.fdj_nm[0], physics.eta_o[0])
+    centre = design.centre(box)
     noise = window_noise(window, scenario, centre)
     health = design.draw(box, config.total_simulations, config.seed)
     sims = simulate_noisy(scenario, health, noise, config.seed + 1)
@@ -114,7 +114,7 @@ def candidates(
 
 def fit_check(window: Window, data: Data, answer: Assessed, equation_ratio: float, n: int) -> FitCheck:
     """Simulate the window at the answer and compare (``training.reproduction``)."""
-    health = HealthParams.single(2.0 * answer.values["FDJ"], answer.values["FDJ"], answer.values["eta_O"])
+    health = design.inside(answer.values["FDJ"], answer.values["eta_O"])
     floor = float(np.sqrt(np.mean((data.sims.residual_nm[n:] - data.sims.clean_residual_nm[n:])[:, data.sliding] ** 2)))
     ratios = output_error_ratios(window, data.scenario, health, data.noise, floor, data.sliding)
     reproduced = ratios["residual_torque"] <= MAX_RATIO

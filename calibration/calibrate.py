@@ -1,0 +1,182 @@
+"""The calibration loop as one estimator: residuals -> noise floor -> candidates -> selection -> report.
+
+``Calibrator`` has the scikit-learn shape: ``__init__`` stores settings, ``fit(windows, truth)``
+checks them and runs the stages once each, in order, and leaves ``report_`` (the
+``ema-calibration/1`` document) and the residuals a figure needs:
+
+1. ``training.pipeline`` estimates each window with the base model (the answer before);
+2. ``calibration.equations`` turns the windows into their equation-error problem;
+3. ``calibration.noise_floor`` builds the same problem on noise-only copies;
+4. ``calibration.families`` and ``calibration.selection`` find what explains held-out samples
+   beyond the floor, name it or describe it (``calibration.twins`` for look-alikes,
+   ``calibration.backlash`` for the dead band);
+5. ``calibration.refit`` re-estimates with the effect in, checks it holds on held-out folds;
+6. ``calibration.report`` assembles the document.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Mapping, Sequence
+
+import numpy as np
+
+from calibration import report as reporting
+from calibration.backlash import read_backlash
+from calibration.documents import CalibrationReport, Step
+from calibration.equations import Equations, equations
+from calibration.families import COGGING_ORDERS, Family, generic_families, named_families
+from calibration.noise_floor import COPIES, clean_replicas, noise_copies
+from calibration.refit import corrected, fit_with, held_out_rss
+from calibration.selection import MAX_EFFECTS, Chosen, Decision, Evidence, decide, evidence
+from calibration.twins import TWINS, tell_apart
+from sim.checks import InputError
+from sim.noise import SensorNoise
+from sim.params import ActuatorParams
+from sim.window import Window
+from training.conditioning import prepare
+from training.config import PipelineConfig
+from training.documents import TARGETS, Estimate
+from training.pipeline import estimate_window
+
+MIN_HELD_OUT_GAIN = 0.01  # the model with the effect must cut the held-out residual by at least 1 %
+
+
+def combined(results: Sequence[Estimate]) -> dict[str, float]:
+    """Inverse-variance mean of FDJ and η_O over windows (one actuator, one health)."""
+    out = {}
+    for name in TARGETS:
+        values = np.array([getattr(r.estimates, name).value for r in results])
+        weights = 1.0 / np.maximum([getattr(r.estimates, name).std or 1.0 for r in results], 1e-12) ** 2
+        out[name] = float(values @ weights / weights.sum())
+    return out
+
+
+class Calibrator:
+    def __init__(
+        self,
+        pipeline: PipelineConfig = PipelineConfig(),
+        max_effects: int = MAX_EFFECTS,
+        copies: int = COPIES,
+        seed: int = 0,
+    ) -> None:
+        self.pipeline = pipeline
+        self.max_effects = max_effects
+        self.copies = copies
+        self.seed = seed
+
+    def _check(self, windows: Sequence[Window]) -> list[Window]:
+        if not 1 <= self.max_effects <= 4:
+            raise InputError("max_effects", f"must be in [1, 4], got {self.max_effects}")
+        if not 8 <= self.copies <= 500:
+            raise InputError("copies", f"must be in [8, 500], got {self.copies}")
+        if not windows:
+            raise InputError("windows", "at least one window is needed")
+        prepared = [prepare(w).window for w in windows]
+        if len({w.sample_rate_hz for w in prepared}) > 1:
+            raise InputError("windows", "must share one sample rate (after averaging to at most 10 kHz)")
+        return prepared
+
+    def fit(
+        self,
+        windows: Sequence[Window],
+        truth: Mapping[str, float] | None = None,
+        on_stage: Callable[[str], None] | None = None,
+    ) -> Calibrator:
+        stage = on_stage or (lambda _: None)
+        started = time.perf_counter()
+        prepared = self._check(windows)
+        stage(f"estimating {len(prepared)} window(s) with the base model")
+        base = [estimate_window(w, self.pipeline) for w in prepared]
+        before = combined(base)
+        bias = {n: float(np.mean([r.methods[n].physics_bias for r in base])) for n in TARGETS}
+        noise = [SensorNoise(**r.dataset.noise_estimated) for r in base]
+        rate = prepared[0].sample_rate_hz
+        measured = equations([w.signals for w in prepared], rate, COGGING_ORDERS)
+        stage(f"simulating {self.copies} noise-only copies")
+        copies = noise_copies(clean_replicas(prepared, before), noise, rate, COGGING_ORDERS, self.seed, self.copies)
+        families = named_families(measured, ActuatorParams()) + generic_families(measured)
+        stage(f"scoring {len(families)} candidate families against the noise floor")
+        chosen, steps, first_round, unnamed = self._select(measured, copies, families, prepared, before, noise)
+        held, chosen = self._held_out(measured, chosen)
+        after = corrected(fit_with(measured, chosen).values, bias) if chosen else before
+        self.measured_, self.chosen_ = measured, chosen
+        self.report_: CalibrationReport = reporting.assemble(
+            reporting.Found(measured, copies, first_round, chosen, steps, unnamed, read_backlash(measured, copies)),
+            before, after, bias, held, truth, time.perf_counter() - started,
+        )  # fmt: skip
+        return self
+
+    def _select(
+        self,
+        measured: Equations,
+        copies: Sequence[Equations],
+        families: Sequence[Family],
+        windows: Sequence[Window],
+        before: Mapping[str, float],
+        noise: Sequence[SensorNoise],
+    ) -> tuple[list[Chosen], list[Step], list[Evidence], list[Evidence]]:
+        """Forward selection; returns the chosen families, each step, the first round's evidence, and the
+        curves that describe what no name fits."""
+        chosen: list[Chosen] = []
+        steps: list[Step] = []
+        first_round: list[Evidence] = []
+        while len(chosen) < self.max_effects:
+            taken = {c.family.name for c in chosen} | {TWINS.get(c.family.name) for c in chosen}
+            found = [evidence(measured, copies, chosen, f) for f in families if f.name not in taken]
+            first_round = first_round or found
+            decision = decide(found, measured, copies, chosen)
+            if decision.chosen is None:
+                steps.append(Step(selected=None, reason=decision.reason))
+                return chosen, steps, first_round, decision.unnamed
+            pick, step = self._name(decision, found, windows, before, noise)
+            chosen.append(Chosen(pick.family, pick.grid))
+            steps.append(step)
+        return chosen, steps, first_round, []
+
+    def _name(
+        self,
+        decision: Decision,
+        found: Sequence[Evidence],
+        windows: Sequence[Window],
+        before: Mapping[str, float],
+        noise: Sequence[SensorNoise],
+    ) -> tuple[Evidence, Step]:
+        """The decided family, or its twin if the simulation says so."""
+        pick = decision.chosen
+        assert pick is not None
+        twin = next((e for e in found if e.family.name == TWINS.get(pick.family.name)), None)
+        if twin is None:
+            return pick, Step(selected=pick.family.name, reason=decision.reason)
+        pick, errors, clear = tell_apart(windows, before, [pick, twin], noise)
+        other = twin.family.name if pick is not twin else decision.chosen.family.name  # type: ignore[union-attr]
+        reason = f"{decision.reason}; told from {other} by the motor speed and current it predicts"
+        return pick, Step(
+            selected=pick.family.name,
+            reason=reason if clear else reason + " (narrowly: the two leave nearly the same trace)",
+            indistinguishable_from=[] if clear else [other],
+            tie_break_output_error=errors,
+        )
+
+    def _held_out(self, measured: Equations, chosen: list[Chosen]) -> tuple[reporting.HeldOutCheck, list[Chosen]]:
+        """Keep each effect, in the order chosen, only if re-estimated with it the model predicts
+        held-out folds better than without it."""
+        before = held_out_rss(measured, [])
+        kept: list[Chosen] = []
+        current, dropped = before, []
+        for c in chosen:
+            trial = held_out_rss(measured, [*kept, c])
+            if trial < (1.0 - MIN_HELD_OUT_GAIN) * current:
+                kept.append(c)
+                current = trial
+            else:
+                dropped.append(c.family.name)
+        if not chosen:
+            note = "no effect to adopt"
+        elif not kept:
+            note = "re-estimated with the effects, the model does not predict held-out folds better: base model kept"
+        else:
+            note = f"re-estimated with {', '.join(c.family.name for c in kept)}, the model predicts held-out folds "
+            note += f"{100 * (1 - current / before):.0f} % better"
+            note += f"; {', '.join(dropped)} did not help on held-out folds and was left out" if dropped else ""
+        return reporting.HeldOutCheck(before, current, bool(kept), note), kept

@@ -1,0 +1,226 @@
+"""Stage 3, candidates: each effect as a flexible family of equation-error columns, and what it adds.
+
+A named effect is not one rigid shape: friction against position is a piecewise-linear curve
+over the visited deflections (a localized spall as well as a linear rise), Stribeck friction a
+decay of any speed scale, cogging a ripple of any order with the log's interval-mean
+attenuation modelled (``calibration.equations.cogging_columns``). Beside the vocabulary, generic
+families (piecewise-linear curves over time, speed, load and current) say what the residual
+follows when no name fits; over time, speed or position they are also a term the simulator
+can add (``sim.effects.FrictionTable``).
+
+Coefficients map back to the simulator's parameters: in t = sgn(ω)(T_R − C_M·ω) a torque
+constant g leaves (1 − g)·k_T·I, a current-sensor gain s leaves (1 − 1/s)·k_T·I_logged (the
+same trace: twins, told apart by simulation in ``calibration.twins``), a hinge-moment bias b
+leaves sgn(ω)·b/n.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from calibration.equations import Equations
+from calibration.fitting import hats, uniform_knots
+from sim.effects import EffectSet, FrictionTable
+from sim.params import ActuatorParams
+
+KNOTS = 9  # piecewise-linear curves: 8 segments over the visited range
+STRIBECK_SPEEDS_RADPS = (10.0, 20.0, 40.0, 80.0, 160.0, 320.0)
+COGGING_ORDERS = tuple(float(p) for p in range(1, 49))
+BUMP_WIDTHS_DEG = (0.75, 1.5, 3.0, 6.0)  # a spall's half-width, as a Gaussian's std
+BUMP_SPACING_DEG = 0.5  # centres every half degree over the visited deflections
+SPEED_TABLE = np.arange(0.0, 710.0, 10.0)  # |ω| grid [rad/s] a speed curve is tabulated on for the simulator
+POSITION_TABLE = np.radians(np.arange(-30.0, 30.05, 0.1))  # θ_u grid a position curve is tabulated on
+
+Grid = Any  # a family's nonlinear parameter: a float (ω_s, order p), a (centre, width) pair, or nan
+Columns = Callable[[Equations, Grid], np.ndarray]
+Parameters = Callable[[np.ndarray, Grid], dict[str, float]]
+Term = Callable[[np.ndarray, Grid], EffectSet | None]
+
+
+@dataclass(frozen=True)
+class Family:
+    name: str  # an effect of the vocabulary, or "friction vs <variable>" for a generic curve
+    follows: str  # the variable its trace follows
+    named: bool
+    columns: Columns  # (m, k) design columns, given the grid value
+    parameters: Parameters  # from its coefficients: what the report states
+    term: Term  # what the simulator adds, or None where it cannot
+    grid: tuple[Grid, ...] = (float("nan"),)  # its one nonlinear parameter, if any
+    # Whether its variable is imposed on the transmission rather than a response of it: the current
+    # answers the friction itself, so a curve over it mimics any large effect and may not block a name.
+    exogenous: bool = True
+    stacked: Callable[[Equations], np.ndarray] | None = None  # (m, G, c): every grid value's columns at once
+    # For the tied refit (``calibration.refit``): columns of the base replaced (a hinge-moment bias
+    # moves the load a and o are built from, and their coefficients stay k_aid and k_opp), and how
+    # many of ``columns`` are left as free terms (the others are that replacement's first order).
+    base_shift: Callable[[Equations, Grid], np.ndarray] | None = None
+    free_columns: int | None = None
+
+    def grid_columns(self, e: Equations) -> np.ndarray:
+        """(m, G, c) columns for every grid value."""
+        if self.stacked is not None:
+            return self.stacked(e)
+        return np.stack([self.columns(e, g) for g in self.grid], axis=1)
+
+
+def _table(variable: str, knots: np.ndarray, beta: np.ndarray) -> EffectSet:
+    values = np.clip(np.concatenate([[0.0], beta]), -0.5, 0.5)
+    return EffectSet(table=FrictionTable(variable, float(knots[0]), float(knots[1] - knots[0]), tuple(values)))
+
+
+def _curve(knots: np.ndarray, unit: str) -> Parameters:
+    def parameters(beta: np.ndarray, _: float) -> dict[str, float]:
+        values = np.concatenate([[0.0], beta])
+        return {f"{x:.4g} {unit}": float(v) for x, v in zip(knots, values, strict=True)}
+
+    return parameters
+
+
+def _stribeck_stacked(e: Equations) -> np.ndarray:
+    return np.exp(-e.variables["speed_radps"][:, None] / np.array(STRIBECK_SPEEDS_RADPS))[..., None]
+
+
+def _stribeck_term(beta: np.ndarray, speed: float) -> EffectSet:
+    values = np.clip(beta[0] * np.exp(-SPEED_TABLE / speed), -0.5, 0.5)
+    return EffectSet(table=FrictionTable("speed", 0.0, float(SPEED_TABLE[1]), tuple(values)))
+
+
+def _bump(x: np.ndarray, where: tuple[float, float]) -> np.ndarray:
+    centre, width = where
+    return np.exp(-0.5 * ((x - centre) / width) ** 2)
+
+
+def _bump_stacked(e: Equations, grid: tuple[tuple[float, float], ...]) -> np.ndarray:
+    centres, widths = (np.array(v)[None, :] for v in zip(*grid, strict=True))
+    x = e.variables["position_rad"][:, None]
+    return np.exp(-0.5 * ((x - centres) / widths) ** 2)[:, :, None]
+
+
+def _bump_term(beta: np.ndarray, where: tuple[float, float]) -> EffectSet:
+    values = np.clip(beta[0] * _bump(POSITION_TABLE, where), -0.5, 0.5)
+    step = float(POSITION_TABLE[1] - POSITION_TABLE[0])
+    return EffectSet(table=FrictionTable("position", float(POSITION_TABLE[0]), step, tuple(values)))
+
+
+def bump_grid(position_rad: np.ndarray) -> tuple[tuple[float, float], ...]:
+    """(centre, width) pairs: centres every BUMP_SPACING_DEG over the visited deflections."""
+    low, high = np.degrees(np.quantile(position_rad, [0.01, 0.99]))
+    centres = np.radians(np.arange(low, high + BUMP_SPACING_DEG, BUMP_SPACING_DEG))
+    return tuple((float(c), float(np.radians(w))) for c in centres for w in BUMP_WIDTHS_DEG)
+
+
+def _gain_term(effect: str, gain: float) -> EffectSet | None:
+    return EffectSet({effect: {"gain": gain}}) if 0.7 <= gain <= 1.3 else None
+
+
+HINGE_BIASES_NM = tuple(float(b) for b in np.arange(-150.0, 152.5, 2.5))
+
+
+def _hinge_columns(e: Equations, bias_nm: float, gear: float) -> np.ndarray:
+    """A hinge-moment sensor reading b too high leaves sgn(ω)·b/n in t, and moves the load the aiding
+    and opposing columns are built from: with the load corrected by b, (a, o) change, and where the
+    corrected load changes sign a sample even swaps columns. So for each b of a grid the columns
+    are sgn(ω) and the change of a and o (their coefficients then come out near b/n, k_aid, k_opp)."""
+    direction = e.variables["direction"]
+    load = e.variables["load_nm"] * direction  # smoothed T_ext as logged
+    corrected = load - bias_nm / gear
+
+    def split(t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        aiding = t * direction > 0
+        return np.abs(t) * aiding, np.abs(t) * ~aiding
+
+    (a0, o0), (a1, o1) = split(load), split(corrected)
+    return np.stack([direction, a1 - a0, o1 - o0], axis=1)
+
+
+def _hinge_shift(e: Equations, bias_nm: float, gear: float) -> np.ndarray:
+    """(m, 2): the change of (a, o) when the load is corrected by the bias."""
+    return _hinge_columns(e, bias_nm, gear)[:, 1:]
+
+
+def _hinge_stacked(e: Equations, gear: float) -> np.ndarray:
+    """_hinge_columns for every bias of the grid: (m, G, 3)."""
+    direction = e.variables["direction"][:, None]
+    load = (e.variables["load_nm"] * e.variables["direction"])[:, None]
+    corrected = load - np.array(HINGE_BIASES_NM)[None, :] / gear
+    aiding0, aiding1 = load * direction > 0, corrected * direction > 0
+    a = np.abs(corrected) * aiding1 - np.abs(load) * aiding0
+    o = np.abs(corrected) * ~aiding1 - np.abs(load) * ~aiding0
+    return np.stack([np.broadcast_to(direction, a.shape), a, o], axis=2)
+
+
+def _cogging_parameters(b: np.ndarray, order: float) -> dict[str, float]:
+    return {"amplitude_nm": float(np.hypot(b[0], b[1])), "periods_per_rev": order,
+            "phase_rad": float(np.arctan2(b[1], b[0]))}  # fmt: skip
+
+
+def named_families(measured: Equations, actuator: ActuatorParams) -> list[Family]:
+    """The vocabulary, shaped on the measured window (a bump's centres span what it visited)."""
+    k_t, n = actuator.torque_constant_nm_per_a, actuator.gear_ratio
+    bumps = bump_grid(measured.variables["position_rad"])
+    return [
+        Family("viscous", "speed_radps", True, lambda e, g: e.variables["speed_radps"][:, None],
+               lambda b, g: {"coefficient_nms": float(b[0])},
+               lambda b, g: EffectSet({"viscous": {"coefficient_nms": float(np.clip(b[0], -5e-5, 5e-3))}})),
+        Family("stribeck", "speed_radps", True, lambda e, g: np.exp(-e.variables["speed_radps"] / g)[:, None],
+               lambda b, g: {"amplitude_nm": float(b[0]), "decay_speed_radps": g}, _stribeck_term,
+               STRIBECK_SPEEDS_RADPS,
+               stacked=_stribeck_stacked),
+        Family("torque_constant", "current_a", True, lambda e, g: k_t * e.variables["current_a"][:, None],
+               lambda b, g: {"gain": 1.0 - float(b[0])}, lambda b, g: _gain_term("torque_constant", 1.0 - b[0])),
+        Family("current_sensor_gain", "current_a", True, lambda e, g: k_t * e.variables["current_a"][:, None],
+               lambda b, g: {"gain": 1.0 / (1.0 - float(b[0]))},
+               lambda b, g: _gain_term("current_sensor_gain", 1.0 / (1.0 - b[0]))),
+        Family("hinge_moment_bias", "direction", True, lambda e, g: _hinge_columns(e, g, n),
+               lambda b, g: {"bias_nm": float(b[0]) * n, "grid_bias_nm": g},
+               lambda b, g: EffectSet({"hinge_moment_bias": {"bias_nm": float(np.clip(b[0] * n, -500, 500))}}),
+               HINGE_BIASES_NM, stacked=lambda e: _hinge_stacked(e, n),
+               base_shift=lambda e, g: _hinge_shift(e, g, n), free_columns=1),
+        Family("position_friction", "position_rad", True, lambda e, g: _bump(e.variables["position_rad"], g)[:, None],
+               lambda b, g: {"amplitude_nm": float(b[0]), "centre_deg": float(np.degrees(g[0])),
+                             "width_deg": float(np.degrees(g[1]))},
+               _bump_term, bumps, stacked=lambda e: _bump_stacked(e, bumps)),
+        Family("cogging", "motor_angle_rad", True, lambda e, g: e.cogging[g], _cogging_parameters,
+               lambda b, g: EffectSet({"cogging": {**_cogging_parameters(b, g),
+                                                   "amplitude_nm": float(min(np.hypot(b[0], b[1]), 0.5))}}),
+               COGGING_ORDERS, stacked=lambda e: np.stack([e.cogging[p] for p in COGGING_ORDERS], axis=1)),
+    ]  # fmt: skip
+
+
+GENERIC = {
+    "time_s": ("time", "s"),
+    "position_rad": ("position", "rad"),
+    "speed_radps": ("speed", "rad/s"),
+    "load_nm": (None, "N·m"),
+    "current_a": (None, "A"),
+}
+
+
+def generic_families(measured: Equations) -> list[Family]:
+    """Piecewise-linear friction against each variable no name covers as such."""
+    families = []
+    for variable, (table, unit) in GENERIC.items():
+        knots = uniform_knots(measured.variables[variable], KNOTS)
+
+        def term(b: np.ndarray, g: Grid, table: str | None = table, knots: np.ndarray = knots) -> EffectSet | None:
+            return None if table is None else _table(table, knots, b)
+
+        def columns(e: Equations, g: Grid, variable: str = variable, knots: np.ndarray = knots) -> np.ndarray:
+            return hats(e.variables[variable], knots)
+
+        families.append(
+            Family(
+                f"friction vs {variable}",
+                variable,
+                False,
+                columns,
+                _curve(knots, unit),
+                term,
+                exogenous=variable != "current_a",
+            )
+        )
+    return families

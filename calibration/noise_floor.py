@@ -1,0 +1,47 @@
+"""Stage 2, noise floor: what the equation error of *these* windows looks like when nothing is missing.
+
+Each window is simulated once, clean, with its own command, logged load and first state at the
+estimates the base model gives it; then ``COPIES`` independent draws of the window's own
+estimated sensor noise are added. Every statistic the selection computes on the measured
+windows is computed on each copy too: the copies carry the same trajectory, the same 2 ms
+reconstruction and its approximation error, the same correlated noise, and none of the missing
+physics. A candidate is evidence only where the measured statistic stands far outside their
+spread (no effective-sample-size guess, no BIC on correlated samples).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+
+from calibration.equations import Equations, equations
+from sim.noise import SensorNoise, add_sensor_noise
+from sim.window import Window
+from training.dataset import scenario_from_window
+from training.design import inside
+
+COPIES = 30
+
+
+def clean_replicas(windows: Sequence[Window], estimates: Mapping[str, float]) -> list[dict[str, np.ndarray]]:
+    """Each window simulated at ``estimates`` (FSJ at twice FDJ), without noise."""
+    health = inside(estimates["FDJ"], estimates["eta_O"])
+    return [scenario_from_window(w).simulate(health, lanes=1).simulation(0) for w in windows]
+
+
+def noise_copies(
+    clean: Sequence[dict[str, np.ndarray]],
+    noise: Sequence[SensorNoise],
+    rate: float,
+    orders: Sequence[float],
+    seed: int,
+    copies: int = COPIES,
+) -> list[Equations]:
+    """``copies`` noisy versions of the clean replicas, each as the selection sees a window set."""
+    rng = np.random.default_rng(seed)
+    out = []
+    for _ in range(copies):
+        noisy = [add_sensor_noise(signals, level, rng) for signals, level in zip(clean, noise, strict=True)]
+        out.append(equations(noisy, rate, orders))
+    return out

@@ -1,0 +1,89 @@
+"""Stage 5, the estimates once the effect is in: Eq. 5.1 with its columns, η_A tied by Eq. 3.4.
+
+The same profile search over η_O as ``training.baseline``, with FDJ and the effect's
+coefficients solved in closed form at each point. The physics fit's bias on this window's
+scenario, measured by the base pipeline on its held-out simulations, is subtracted as it is
+there, so that before and after differ only by the effect. "Never worse" is judged the same
+way: the model with the effect, fitted on four folds, must predict the fifth better than the
+base model does, over every fold (``held_out_rss``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from calibration.equations import FOLDS, Equations
+from calibration.selection import Chosen
+from sim.params import eta_a_from_eta_o
+from training.baseline import ETA_O_SEARCH, GRID_POINTS, REFINEMENTS
+
+
+@dataclass(frozen=True)
+class TiedFit:
+    fdj_nm: float
+    eta_o: float
+    beta: np.ndarray  # FDJ, then the effect columns' coefficients
+
+    @property
+    def values(self) -> dict[str, float]:
+        return {"FDJ": self.fdj_nm, "eta_O": self.eta_o}
+
+
+def _extra(e: Equations, chosen: Sequence[Chosen]) -> np.ndarray:
+    """FDJ's column and each effect's free columns."""
+    columns = [e.base[:, :1]]
+    for c in chosen:
+        width = c.family.free_columns
+        columns.append(c.family.columns(e, c.grid)[:, :width])
+    return np.concatenate(columns, axis=1)
+
+
+def _loads(e: Equations, chosen: Sequence[Chosen]) -> np.ndarray:
+    """(m, 2): the aiding and opposing load columns, as the chosen effects correct them."""
+    loads = e.base[:, 1:3].copy()
+    for c in chosen:
+        if c.family.base_shift is not None:
+            loads += c.family.base_shift(e, c.grid)
+    return loads
+
+
+def _target(e: Equations, eta_o: float, loads: np.ndarray) -> np.ndarray:
+    """t minus the load-dependent friction at η_O (η_A by Eq. 3.4): what FDJ and the effect must explain."""
+    k_aid, k_opp = 1.0 - float(eta_a_from_eta_o(eta_o)), 1.0 / eta_o - 1.0
+    return e.y - k_aid * loads[:, 0] - k_opp * loads[:, 1]
+
+
+def fit_with(e: Equations, chosen: Sequence[Chosen], rows: np.ndarray | None = None) -> TiedFit:
+    """The base model plus ``chosen``'s columns, η_O searched coarse to fine, on ``rows`` (all by default)."""
+    rows = np.arange(e.m) if rows is None else rows
+    design, loads = _extra(e, chosen)[rows], _loads(e, chosen)[rows]
+    sub = Equations(e.y[rows], e.base[rows], {}, {}, e.kinematic[rows], e.folds[rows], e.window[rows])
+    low, high = ETA_O_SEARCH
+    for _ in range(REFINEMENTS):
+        grid = np.linspace(low, high, GRID_POINTS)
+        targets = [_target(sub, eta, loads) for eta in grid]
+        betas = [np.linalg.lstsq(design, t, rcond=None)[0] for t in targets]
+        sse = [float(np.sum((t - design @ b) ** 2)) for t, b in zip(targets, betas, strict=True)]
+        best = int(np.argmin(sse))
+        step = grid[1] - grid[0]
+        low, high = max(grid[best] - step, ETA_O_SEARCH[0]), min(grid[best] + step, ETA_O_SEARCH[1])
+    return TiedFit(float(betas[best][0]), float(grid[best]), betas[best])
+
+
+def held_out_rss(e: Equations, chosen: Sequence[Chosen]) -> float:
+    """Σ over folds of the squared error on the fold of the model fitted on the other four."""
+    design, loads = _extra(e, chosen), _loads(e, chosen)
+    total = 0.0
+    for f in range(FOLDS):
+        fitted = fit_with(e, chosen, np.flatnonzero(e.folds != f))
+        held = e.folds == f
+        error = _target(e, fitted.eta_o, loads)[held] - design[held] @ fitted.beta
+        total += float(error @ error)
+    return total
+
+
+def corrected(values: Mapping[str, float], bias: Mapping[str, float]) -> dict[str, float]:
+    return {name: values[name] - bias[name] for name in values}

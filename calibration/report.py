@@ -1,0 +1,145 @@
+"""Stage 6, the report: the ``ema-calibration/1`` document from what the stages found."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from calibration.backlash import BacklashReading
+from calibration.documents import CalibrationReport, Candidate, HeldOut, NoiseFloor, Step, Unexplained
+from calibration.equations import Equations
+from calibration.fitting import score
+from calibration.refit import corrected, fit_with
+from calibration.selection import Chosen, Evidence, design
+from sim.effects import EffectSet
+from training.documents import TARGETS
+
+
+@dataclass(frozen=True)
+class Found:
+    measured: Equations
+    copies: Sequence[Equations]
+    evidence: Sequence[Evidence]  # every family, first round
+    chosen: Sequence[Chosen]
+    steps: Sequence[Step]
+    unnamed: Sequence[Evidence]
+    backlash: BacklashReading
+
+
+@dataclass(frozen=True)
+class HeldOutCheck:
+    rss_before: float  # held-out residual of the base model re-estimated on each four folds [N·m²]
+    rss_after: float  # ...and with the effects
+    adopted: bool
+    note: str
+
+
+def residual_rms(e: Equations, chosen: Sequence[Chosen]) -> float:
+    """RMS of the equation error [N·m] with the base columns and ``chosen``'s."""
+    return float(np.sqrt(score(design(e, chosen), e.y, e.folds).rss / e.m))
+
+
+def _candidate(e: Evidence) -> Candidate:
+    return Candidate(
+        effect=e.family.name,
+        follows=e.family.follows,
+        named=e.family.named,
+        parameters=e.family.parameters(e.beta, e.grid),
+        rms_reduction=e.rms_reduction,
+        held_out_drop=e.improvement,
+        score=e.z,
+        plausible=e.family.term(e.beta, e.grid) is not None,
+    )
+
+
+def _backlash_candidate(reading: BacklashReading) -> Candidate:
+    return Candidate(
+        effect="backlash", follows="direction", named=True, parameters={"extra_rad": reading.extra_rad},
+        rms_reduction=0.0, held_out_drop=0.0, score=reading.z, plausible=-5e-3 <= reading.extra_rad <= 0.1,
+    )  # fmt: skip
+
+
+def adopted_effects(found: Found) -> EffectSet:
+    """The simulator's terms for everything adopted (one friction table at most: the first)."""
+    values: dict[str, dict[str, float]] = {}
+    table = None
+    evidence = {e.family.name: e for e in found.evidence}
+    for c in found.chosen:
+        e = evidence[c.family.name]
+        term = c.family.term(e.beta, c.grid)
+        if term is not None:
+            values.update({name: dict(p) for name, p in term.values.items()})
+            table = table or term.table
+    if found.backlash.significant:
+        values["backlash"] = {"extra_rad": float(np.clip(found.backlash.extra_rad, -5e-3, 0.1))}
+    return EffectSet(values, table)
+
+
+def _errors(values: Mapping[str, float], truth: Mapping[str, float] | None) -> tuple[dict, dict] | tuple[None, None]:
+    if truth is None:
+        return None, None
+    absolute = {k: abs(values[k] - float(truth[k])) for k in TARGETS}
+    return absolute, {k: 100 * absolute[k] / abs(float(truth[k])) for k in TARGETS}
+
+
+def unexplained(found: Found, bias: Mapping[str, float], truth: Mapping[str, float] | None) -> Unexplained | None:
+    if not found.unnamed:
+        return None
+    lead = found.unnamed[0]
+    variables = list(dict.fromkeys(e.family.follows for e in found.unnamed))
+    term = lead.family.term(lead.beta, lead.grid)
+    with_it = [*found.chosen, Chosen(lead.family, lead.grid)]
+    estimates = corrected(fit_with(found.measured, with_it).values, bias)
+    if len(variables) == 1:
+        described = f"the residual torque follows {variables[0]} in a shape no named effect has (table below)"
+    else:
+        described = f"the residual torque follows {' or '.join(variables)}: these windows cannot tell which"
+    return Unexplained(
+        variables=variables,
+        description=described,
+        shape=lead.family.parameters(lead.beta, lead.grid),
+        simulator_term=None if term is None or term.table is None else asdict(term.table),
+        estimates_if_added=estimates,
+        residual_rms_if_added=residual_rms(found.measured, with_it),
+        error_if_added=_errors(estimates, truth)[0],
+    )
+
+
+def assemble(
+    found: Found,
+    before: Mapping[str, float],
+    after: Mapping[str, float],
+    bias: Mapping[str, float],
+    held: HeldOutCheck,
+    truth: Mapping[str, float] | None,
+    seconds: float,
+) -> CalibrationReport:
+    floor = np.mean([residual_rms(c, []) for c in found.copies])
+    effects = adopted_effects(found)
+    names = [c.family.name for c in found.chosen] + (["backlash"] if found.backlash.significant else [])
+    first = next((e for e in found.evidence if found.chosen and e.family.name == found.chosen[0].family.name), None)
+    errors_before, pct_before = _errors(before, truth)
+    errors_after, pct_after = _errors(after, truth)
+    return CalibrationReport(
+        n_windows=int(found.measured.window.max()) + 1,
+        noise_floor=NoiseFloor(copies=len(found.copies), equation_error_ratio=residual_rms(found.measured, []) / floor),
+        residual_rms_before={"residual_torque": residual_rms(found.measured, [])},
+        residual_rms_after={"residual_torque": residual_rms(found.measured, found.chosen)},
+        candidates=[*(_candidate(e) for e in found.evidence), _backlash_candidate(found.backlash)],
+        selected_effect=names[0] if names else None,
+        selected_effects=names,
+        selected_parameters=None if first is None else first.family.parameters(first.beta, first.grid),
+        effects={**effects.as_dict(), **({"table": asdict(effects.table)} if effects.table else {})},
+        selection_steps=list(found.steps),
+        unexplained=unexplained(found, bias, truth),
+        held_out=HeldOut(rss_before=held.rss_before, rss_after=held.rss_after, adopted=held.adopted, note=held.note),
+        estimates_before=dict(before),
+        estimates_after=dict(after),
+        error_before=errors_before,
+        error_after=errors_after,
+        error_pct_before=pct_before,
+        error_pct_after=pct_after,
+        timings_s={"total": seconds},
+    )

@@ -1,0 +1,141 @@
+"""Stage 4, selection: which family explains held-out samples beyond the noise floor, and may it be named.
+
+For each family (``calibration.families``) the statistic is the drop of held-out residual
+(``calibration.fitting``), as a fraction of the base model's: on the measured windows, and on
+every noise copy (``calibration.noise_floor``), where a family with a grid takes its best grid
+value on each copy as it does on the data (the look-elsewhere freedom is in the floor). Its
+evidence is z = (measured − mean of copies) / std of copies.
+
+A family enters when z ≥ ``MIN_Z``. The one that explains held-out samples best is named only if
+no curve over *another* variable explains nearly as much (``NAME_MARGIN``): a friction drifting
+in time is not a position effect because the elevator happened to move while it drifted. When a
+generic curve wins and a named family over the same variable comes within the margin, the name
+is kept (the simpler shape); when none does, the report describes the curve instead of forcing
+a name. Up to ``MAX_EFFECTS`` families enter, one at a time, each judged given the ones before.
+The backlash lives in its own channel (``backlash``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from calibration.equations import Equations
+from calibration.families import Family, Grid
+from calibration.fitting import Scored, score, score_grid
+
+MIN_Z = 6.0  # the measured drop stands this many noise-floor stds above the copies' mean
+NAME_MARGIN = 0.15  # a rival curve explaining ≥ 85 % as much leaves the name undecided
+MAX_EFFECTS = 2
+
+
+@dataclass(frozen=True)
+class Chosen:
+    family: Family
+    grid: Grid
+
+
+@dataclass(frozen=True)
+class Evidence:
+    family: Family
+    grid: Grid
+    improvement: float  # fractional drop of held-out residual on the measured windows
+    null_mean: float
+    null_std: float
+    rms_reduction: float  # 1 − √(in-sample RSS with it / without)
+    beta: np.ndarray  # its coefficients on the measured windows
+
+    @property
+    def z(self) -> float:
+        return (self.improvement - self.null_mean) / max(self.null_std, 1e-12)
+
+
+def design(e: Equations, chosen: Sequence[Chosen]) -> np.ndarray:
+    """Base columns (1, a, o) and the chosen families' columns at their grid values."""
+    return np.concatenate([e.base, *(c.family.columns(e, c.grid) for c in chosen)], axis=1)
+
+
+def _drops(e: Equations, chosen: Sequence[Chosen], family: Family) -> tuple[np.ndarray, Scored, np.ndarray, np.ndarray]:
+    """Per grid value, the fractional held-out drop of ``family`` added to the base and ``chosen``;
+    with the base's own score, and each grid value's in-sample RSS and coefficients."""
+    base_design = design(e, chosen)
+    base = score(base_design, e.y, e.folds)
+    candidates = family.grid_columns(e)  # (m, G, c)
+    cv, rss, beta = score_grid(base_design, candidates, e.y, e.folds)
+    return 1.0 - cv / base.cv_rss, base, rss, beta[:, base_design.shape[1] :]
+
+
+def evidence(measured: Equations, copies: Sequence[Equations], chosen: Sequence[Chosen], family: Family) -> Evidence:
+    """The family's drop on the data, at its best grid value, against the copies' best drops."""
+    drops, base, rss, beta = _drops(measured, chosen, family)
+    best = int(np.argmax(drops))
+    null = [float(np.max(_drops(copy, chosen, family)[0])) for copy in copies]
+    return Evidence(
+        family=family,
+        grid=family.grid[best],
+        improvement=float(drops[best]),
+        null_mean=float(np.mean(null)),
+        null_std=float(np.std(null, ddof=1)),
+        rms_reduction=1.0 - float(np.sqrt(rss[best] / max(base.rss, 1e-300))),
+        beta=beta[best],
+    )
+
+
+@dataclass(frozen=True)
+class Decision:
+    chosen: Evidence | None  # the family to adopt now, or None
+    unnamed: list[Evidence]  # curves that explain the residual when no name may be given (best first)
+    reason: str
+
+
+def _width(e: Evidence) -> int:
+    return len(e.beta)
+
+
+def settle(
+    named: Evidence, rival: Evidence, measured: Equations, copies: Sequence[Equations], chosen: Sequence[Chosen]
+) -> str:
+    """Between a named family and a curve over another variable that explains about as much: does
+    either still explain held-out samples once the other is in? Returns "named", "rival" or "tie"."""
+    rival_beyond = evidence(measured, copies, [*chosen, Chosen(named.family, named.grid)], rival.family).z >= MIN_Z
+    named_beyond = evidence(measured, copies, [*chosen, Chosen(rival.family, rival.grid)], named.family).z >= MIN_Z
+    if rival_beyond and not named_beyond:
+        return "rival"
+    if named_beyond or not rival_beyond:
+        # Both carry something of their own (the named one enters now, the curve may later), or
+        # neither does: then the fewer columns decide, and a curve against a curve stays open.
+        return "named" if named_beyond or _width(named) < _width(rival) else "tie"
+    return "tie"
+
+
+def decide(
+    found: Sequence[Evidence], measured: Equations, copies: Sequence[Equations], chosen: Sequence[Chosen]
+) -> Decision:
+    """One forward step: adopt the best significant family if a name is earned; else describe."""
+    significant = sorted((e for e in found if e.z >= MIN_Z), key=lambda e: -e.improvement)
+    if not significant:
+        return Decision(None, [], f"no candidate lowers the held-out residual beyond {MIN_Z:g} noise-floor stds")
+    best = significant[0]
+    close = [e for e in significant[1:] if e.improvement >= (1 - NAME_MARGIN) * best.improvement]
+    named = best if best.family.named else next(
+        (e for e in close if e.family.named and e.family.follows == best.family.follows), None
+    )  # fmt: skip
+    if named is None:
+        return Decision(None, [best], f"the residual follows {best.family.follows} in a way no named effect describes")
+    rivals = [e for e in [best, *close] if not e.family.named and e.family.exogenous]
+    rivals = [e for e in rivals if e.family.follows != named.family.follows]
+    for rival in rivals:
+        verdict = settle(named, rival, measured, copies, chosen)
+        if verdict == "rival":
+            return Decision(None, [rival], f"the residual follows {rival.family.follows}, beyond what "
+                                           f"{named.family.name} explains: no named effect describes it")  # fmt: skip
+        if verdict == "tie":
+            return Decision(None, [rival, named], _ambiguous(named, [rival]))
+    return Decision(named, [], f"{named.family.name} explains held-out samples best (z = {named.z:.0f})")
+
+
+def _ambiguous(best: Evidence, rivals: Sequence[Evidence]) -> str:
+    names = ", ".join(sorted({best.family.follows, *(r.family.follows for r in rivals)}))
+    return f"curves over {names} explain the residual about equally: these windows cannot tell which it follows"

@@ -1,0 +1,86 @@
+"""Round trips of the calibration loop on windows drawn by tests/foreign, with effects in its own forms."""
+
+import numpy as np
+import pytest
+
+from calibration.calibrate import Calibrator
+from calibration.documents import CalibrationReport
+from sim.checks import InputError
+from sim.window import window_from_dict
+from tests.foreign.effects import CASES
+from tests.foreign.windows import draw
+from training.config import PipelineConfig
+
+SMALL = PipelineConfig(n_simulations=32, check_windows=16, n_timesteps=100, hidden_units=20)
+
+
+def calibrate(case: str, seed: int, scale: float = 1.0) -> tuple[CalibrationReport, dict]:
+    effects = CASES[case](np.random.default_rng(seed), scale)
+    drawn = draw(seed, "thesis", effects=effects)
+    report = Calibrator(SMALL, copies=16).fit([window_from_dict(drawn.document)], drawn.truth).report_
+    return report, drawn.truth
+
+
+def combined_error(report: CalibrationReport, when: str) -> float:
+    """|FDJ| + |η_O| relative error, as the issue counts it."""
+    errors = getattr(report, f"error_pct_{when}")
+    return (errors["FDJ"] + errors["eta_O"]) / 100
+
+
+@pytest.mark.parametrize("seed", [901, pytest.param(902, marks=pytest.mark.slow)])
+def test_clean_windows_select_nothing(seed):
+    report, _ = calibrate("clean", seed)
+    assert report.selected_effect is None and report.unexplained is None
+    assert report.estimates_after == report.estimates_before
+    assert report.noise_floor.equation_error_ratio < 1.3
+
+
+@pytest.mark.parametrize(
+    ("case", "seed"),
+    [
+        ("viscous", 911),
+        ("hinge_moment_bias", 914),
+        ("backlash", 916),
+        pytest.param("torque_constant", 912, marks=pytest.mark.slow),
+        pytest.param("cogging", 917, marks=pytest.mark.slow),
+    ],
+)
+def test_the_undeclared_effect_is_named_and_the_estimates_recover(case, seed):
+    report, _ = calibrate(case, seed)
+    assert report.selected_effect == case, report.selection_steps[0].reason
+    before, after = combined_error(report, "before"), combined_error(report, "after")
+    assert after <= max(0.5 * before, 0.01)
+    assert report.held_out.adopted or case == "backlash"  # the dead band does not move FDJ or η_O
+
+
+def test_a_current_scale_names_one_twin_and_reports_the_other():
+    report, _ = calibrate("current_sensor_gain", 913)
+    assert report.selected_effect in ("current_sensor_gain", "torque_constant")
+    step = report.selection_steps[0]
+    assert step.tie_break_output_error is not None and set(step.tie_break_output_error) == {
+        "current_sensor_gain", "torque_constant"
+    }  # fmt: skip
+    assert combined_error(report, "after") <= 0.5 * combined_error(report, "before")
+
+
+@pytest.mark.slow
+def test_a_spall_is_found_where_it_is():
+    report, _ = calibrate("position_friction", 925)
+    assert report.selected_effect == "position_friction"
+    assert combined_error(report, "after") <= max(0.5 * combined_error(report, "before"), 0.01)
+
+
+def test_friction_drifting_in_time_is_described_never_named():
+    report, truth = calibrate("drift", 919)
+    assert report.selected_effect is None
+    assert report.unexplained is not None and report.unexplained.variables[0] == "time_s"
+    assert report.unexplained.simulator_term is not None and report.unexplained.simulator_term["variable"] == "time"
+    added = report.unexplained.estimates_if_added
+    assert abs(added["FDJ"] / truth["FDJ"] - 1) < 0.5 * report.error_pct_before["FDJ"] / 100
+
+
+def test_settings_and_windows_are_checked():
+    with pytest.raises(InputError, match="windows"):
+        Calibrator().fit([])
+    with pytest.raises(InputError, match="copies"):
+        Calibrator(copies=2).fit([window_from_dict(draw(1, "thesis").document)])

@@ -1,0 +1,36 @@
+"""The equation-error problem: closed forms of its columns."""
+
+import numpy as np
+import pytest
+
+from calibration.backlash import width_rad
+from calibration.equations import cogging_columns, equations, motor_angle_rad
+from sim.noise import NO_NOISE
+from sim.params import HealthParams
+from sim.synthetic import synthetic_window
+
+
+def test_motor_angle_integrates_the_interval_mean_speed():
+    angle = motor_angle_rad(np.full(10, 100.0), np.zeros(10), 1000.0, 500.0)
+    np.testing.assert_allclose(np.diff(angle), 0.1)
+
+
+def test_a_cogging_column_carries_the_logs_interval_mean_attenuation():
+    rate, speed, order = 10_000.0, 300.0, 12.0
+    t = (np.arange(4000) + 0.5) / rate
+    angle = speed * t
+    columns = cogging_columns(angle, np.full(4000, speed), rate, [order])[order]
+    # The interval mean of sin(pθ) over an interval where θ advances by ω/f is sinc(pω/2f) times the centre value.
+    exact = np.array([np.mean(np.sin(order * speed * (k / rate + np.arange(1000) / 1000 / rate))) for k in range(4000)])
+    middle = slice(100, 3900)  # the 2 ms smoothing attenuates further; compare after it, away from the ends
+    from sim.residual import smoothed
+
+    np.testing.assert_allclose(columns[middle, 0], smoothed(exact, rate)[middle], atol=2e-3)
+
+
+def test_the_dead_band_width_is_read_from_the_windows_own_angles():
+    window = synthetic_window(HealthParams.single(), seed=3, noise=NO_NOISE)
+    problem = equations([window.signals], window.sample_rate_hz, [])
+    # BLK of Table 3.1, within the few % that smoothing over the reversals takes (the noise floor's
+    # copies carry the same, so calibration.backlash reads extra width against them, not against BLK)
+    assert width_rad(problem) == pytest.approx(5e-3, rel=0.1)
