@@ -1,42 +1,85 @@
-"""The service's one settings object, read from the environment (prefix ``EMA_``)."""
+"""The service's one settings object, read from the environment (``EMA_*``) and the CLI's flags.
+
+Pipeline sizes come from ``training.config.PipelineConfig`` (nested: ``EMA_PIPELINE__N_SIMULATIONS``),
+their per-request ceilings and the request budget are here; nothing restates either.
+"""
 
 from __future__ import annotations
 
-import os
-from functools import lru_cache
+import ipaddress
 from pathlib import Path
+from typing import Literal
 
-from pydantic import Field
+from pydantic import Field, SecretStr, field_validator, model_validator
 from pydantic_settings import BaseSettings, SettingsConfigDict
+
+from prognosis.prognose import Thresholds
+from training.config import PipelineConfig
+
+LOOPBACK_NAMES = ("localhost", "127.0.0.1", "::1")
+MIN_KEY_CHARACTERS = 16
+
+
+def is_loopback(host: str) -> bool:
+    if host in LOOPBACK_NAMES:
+        return True
+    try:
+        return ipaddress.ip_address(host).is_loopback
+    except ValueError:
+        return False
 
 
 class Settings(BaseSettings):
-    model_config = SettingsConfigDict(env_prefix="EMA_", frozen=True)
+    model_config = SettingsConfigDict(env_prefix="EMA_", env_nested_delimiter="__", frozen=True)
 
-    host: str = "127.0.0.1"  # loopback unless an operator exposes it on purpose
+    host: str = "127.0.0.1"  # loopback unless an operator exposes it on purpose (then a key is required)
     port: int = Field(8000, ge=1, le=65535)
-    api_key: str | None = None  # when set, /v1 requires the X-API-Key header
+    api_key: SecretStr | None = Field(None, description="every /v1 request must carry it in X-API-Key")
+    api_key_file: Path | None = Field(None, description="a file holding the key (kept out of the environment)")
+    api_prefix: str = Field("/v1", pattern=r"^/[a-z0-9]+$")
     database: Path = Path("ema-history.sqlite3")
+    backend: Literal["local", "ray"] = "local"  # ray: a ground station's service fans out to a cluster
+    ray_address: str | None = None
 
-    # pipeline sizes: defaults, and the bounds a request may override them within
-    n_simulations: int = Field(500, ge=20, le=20_000)
-    n_timesteps: int = Field(1000, ge=10, le=10_000)
-    hidden_units: int = Field(100, ge=1, le=2000)
-    members: int = Field(1, ge=1, le=20)
-    check_windows: int = Field(16, ge=8, le=1000)
-    seed: int = 0
-    max_simulations: int = Field(2000, ge=20, le=20_000)
-    max_timesteps: int = Field(5000, ge=10, le=10_000)
-    max_hidden_units: int = Field(400, ge=1, le=2000)
+    pipeline: PipelineConfig = PipelineConfig()
+    max_simulations: int = Field(512, ge=16, le=4000, description="ceiling of a request's n_simulations")
+    max_timesteps: int = Field(2000, ge=10, le=10_000, description="ceiling of a request's n_timesteps")
+    max_hidden_units: int = Field(400, ge=1, le=2000, description="ceiling of a request's hidden_units")
+    # The request budget: a window's duration, and its simulation work (simulations × seconds of window).
+    max_window_s: float = Field(10.0, gt=0, le=60.0)
+    max_simulated_s: float = Field(1500.0, gt=0, description="simulations × window seconds per request")
+    max_calibrate_windows: int = Field(4, ge=1, le=16)
 
-    # load: pipelines run one at a time on all cores; a few may wait, the rest get 503
-    max_queue: int = Field(4, ge=0, le=1000)
-    queue_timeout_s: float = Field(60.0, gt=0)  # a queued request not started by then gets 503
-    max_body_bytes: int = Field(50_000_000, ge=1000)
-    threads: int = Field(default_factory=lambda: os.cpu_count() or 1, ge=1)
-    warm_up: bool = True  # compile (or load) the kernels at start-up, not in the first request
+    max_queue: int = Field(4, ge=0, le=1000, description="requests that may wait while one runs")
+    queue_timeout_s: float = Field(60.0, gt=0)
+    max_body_bytes: int = Field(128_000_000, ge=1000)
+    threads: int | None = Field(None, ge=1, le=256, description="the thread budget; default: the usable cores")
+    warm_up: bool = True
+    thresholds: Thresholds = Thresholds()
 
+    @field_validator("api_key")
+    @classmethod
+    def _key_is_a_key(cls, key: SecretStr | None) -> SecretStr | None:
+        if key is not None:
+            text = key.get_secret_value()
+            if len(text.strip()) < MIN_KEY_CHARACTERS or not text.isascii() or not text.isprintable():
+                raise ValueError(f"must be at least {MIN_KEY_CHARACTERS} printable ASCII characters")
+        return key
 
-@lru_cache
-def get_settings() -> Settings:
-    return Settings()
+    @model_validator(mode="after")
+    def _key_from_file(self) -> Settings:
+        if self.api_key_file is not None and self.api_key is None:
+            try:
+                text = self.api_key_file.read_text().strip()
+            except OSError as exc:
+                raise ValueError(f"api_key_file {self.api_key_file} cannot be read: {exc.strerror}") from None
+            object.__setattr__(self, "api_key", self._key_is_a_key(SecretStr(text)))
+        if self.api_key is None and not is_loopback(self.host):
+            raise ValueError(
+                f"host {self.host} is reachable beyond this machine: set EMA_API_KEY or EMA_API_KEY_FILE "
+                "(or bind 127.0.0.1)"
+            )
+        return self
+
+    def key_bytes(self) -> bytes | None:
+        return None if self.api_key is None else self.api_key.get_secret_value().encode()

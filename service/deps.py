@@ -1,17 +1,18 @@
-"""Shared request dependencies: settings, the store, the job runner, the API key check."""
+"""Shared request dependencies: settings, the store, the job runner, a request's pipeline sizes."""
 
 from __future__ import annotations
 
-import secrets
-from dataclasses import replace
-from typing import Annotated, Any
+import threading
+from collections.abc import Callable
+from typing import Annotated
 
-from fastapi import Depends, Header, HTTPException, Request, status
+from fastapi import Depends, Request
 
 from service.config import Settings
-from service.jobs import JobRunner
+from service.jobs import CancelledError, JobRunner
 from service.store import EstimateStore
-from training.pipeline import PipelineConfig
+from sim.checks import InputError
+from training.config import PipelineConfig, validated
 
 
 def get_settings(request: Request) -> Settings:
@@ -29,30 +30,28 @@ def get_runner(request: Request) -> JobRunner:
     return runner
 
 
-def require_api_key(
-    settings: Annotated[Settings, Depends(get_settings)],
-    x_api_key: Annotated[str | None, Header()] = None,
-) -> None:
-    """With ``EMA_API_KEY`` set, every /v1 request must carry it in X-API-Key."""
-    if settings.api_key is None:
-        return
-    if x_api_key is None or not secrets.compare_digest(x_api_key, settings.api_key):
-        raise HTTPException(status.HTTP_401_UNAUTHORIZED, "missing or wrong X-API-Key")
-
-
-def pipeline_config(settings: Settings, **overrides: Any) -> PipelineConfig:
-    """The pipeline sizes of this service, with a request's overrides (already bounds-checked)."""
-    default = PipelineConfig(
-        n_simulations=settings.n_simulations,
-        n_timesteps=settings.n_timesteps,
-        hidden_units=settings.hidden_units,
-        members=settings.members,
-        check_windows=settings.check_windows,
-        seed=settings.seed,
-    )
-    return replace(default, **overrides)
-
-
 SettingsDep = Annotated[Settings, Depends(get_settings)]
 StoreDep = Annotated[EstimateStore, Depends(get_store)]
 RunnerDep = Annotated[JobRunner, Depends(get_runner)]
+
+CEILINGS = {"n_simulations": "max_simulations", "n_timesteps": "max_timesteps", "hidden_units": "max_hidden_units"}
+
+
+def request_config(settings: Settings, **overrides: int | None) -> PipelineConfig:
+    """The service's pipeline sizes with a request's overrides, each within the service's ceiling."""
+    given = {name: value for name, value in overrides.items() if value is not None}
+    for name, value in given.items():
+        ceiling = getattr(settings, CEILINGS.get(name, ""), None)
+        if ceiling is not None and value > ceiling:
+            raise InputError(f"query.{name}", f"{value} exceeds this service's limit of {ceiling}")
+    return validated(PipelineConfig, {**settings.pipeline.model_dump(), **given}, prefix="query.")
+
+
+def stopper(cancel: threading.Event) -> Callable[[str], None]:
+    """An ``on_stage`` callback that stops the job at its next stage once ``cancel`` is set."""
+
+    def on_stage(_: str) -> None:
+        if cancel.is_set():
+            raise CancelledError("the client left; stopped before the next stage")
+
+    return on_stage

@@ -1,4 +1,4 @@
-"""Errors as HTTP answers: bad input is 422 naming the field, overload is 503 with Retry-After."""
+"""Errors as HTTP answers: bad input 422 naming the field, overload 503 with Retry-After."""
 
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ from fastapi import FastAPI, Request, status
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse
 
-from service.jobs import OverloadedError
+from service.jobs import CancelledError, OverloadedError
 from sim.checks import InputError
 
 
@@ -14,16 +14,9 @@ def _location(field: str) -> list[str]:
     """``signals.current_a`` -> ["body", "signals", "current_a"]; query parameters keep "query"."""
     if field.startswith("query."):
         return ["query", *field.split(".")[1:]]
+    if field == "body":
+        return ["body"]
     return ["body", *field.split(".")]
-
-
-def bounded(name: str, value: int | None, default: int, maximum: int) -> int:
-    """A per-request override of a size, or the default; above ``maximum`` is bad input."""
-    if value is None:
-        return default
-    if value > maximum:
-        raise InputError(f"query.{name}", f"{value} exceeds this service's limit of {maximum}")
-    return value
 
 
 async def input_error(request: Request, exc: Exception) -> JSONResponse:
@@ -41,6 +34,11 @@ async def overloaded(request: Request, exc: Exception) -> JSONResponse:
     )
 
 
+async def cancelled(request: Request, exc: Exception) -> JSONResponse:
+    """The client is gone; nobody reads this, but the log shows why the request ended."""
+    return JSONResponse({"detail": str(exc)}, status_code=499)
+
+
 async def request_validation_error(request: Request, exc: Exception) -> JSONResponse:
     """Pydantic's errors without the offending input echoed back: it may be huge, or a NaN that
     JSON cannot even carry (the default handler then fails with 500)."""
@@ -53,3 +51,4 @@ def install(app: FastAPI) -> None:
     app.add_exception_handler(RequestValidationError, request_validation_error)
     app.add_exception_handler(InputError, input_error)
     app.add_exception_handler(OverloadedError, overloaded)
+    app.add_exception_handler(CancelledError, cancelled)

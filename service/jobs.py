@@ -1,20 +1,25 @@
-"""The bounded job queue: CPU-bound pipelines run off the event loop, one at a time on all cores.
+"""Admission and the job queue: one pipeline at a time, at most ``max_queue`` waiting, whatever the timing.
 
-One pipeline already uses every core (Numba's prange, torch's intra-op threads), so running two
-side by side would only slow both. Up to ``max_queue`` requests wait their turn; one more, or
-one that waits longer than ``queue_timeout_s``, gets 503 with Retry-After instead of a hang.
+One pipeline already uses the whole thread budget (the simulator's pool; torch on one thread),
+so running two side by side would only slow both. A request is *admitted* the moment it arrives,
+before its body is read: at most 1 + ``max_queue`` hold a place, the next gets 503 at once with a
+Retry-After from measured job times. A waiting request whose client hangs up leaves the queue;
+a running one is told to stop at its next stage (``Cancelled``), and its slot is freed when its
+thread returns, not when the client leaves: the next job never starts beside it.
 """
 
 from __future__ import annotations
 
 import asyncio
 import math
+import threading
 import time
-from collections.abc import Callable
+from collections.abc import Awaitable, Callable
 from concurrent.futures import ThreadPoolExecutor
 from typing import Any, TypeVar
 
 T = TypeVar("T")
+POLL_S = 0.2  # how often a waiting or running request looks at its client
 
 
 class OverloadedError(Exception):
@@ -25,37 +30,74 @@ class OverloadedError(Exception):
         self.retry_after_s = retry_after_s
 
 
+class CancelledError(Exception):
+    """The client went away; the job stopped at a stage boundary."""
+
+
+class Ticket:
+    """A place in the service: taken at arrival, given back when the request ends, however it ends."""
+
+    def __init__(self, runner: JobRunner) -> None:
+        self.runner = runner
+        self.cancel = threading.Event()
+
+    def __enter__(self) -> Ticket:
+        return self
+
+    def __exit__(self, *_: object) -> None:
+        self.runner.admitted -= 1
+
+
 class JobRunner:
     def __init__(self, max_queue: int, queue_timeout_s: float, initializer: Callable[[], None] | None = None) -> None:
         self.max_queue = max_queue
         self.queue_timeout_s = queue_timeout_s
         self._executor = ThreadPoolExecutor(max_workers=1, thread_name_prefix="ema-pipeline", initializer=initializer)
         self._slot = asyncio.Semaphore(1)
+        self.admitted = 0  # running + waiting
         self.running = 0
-        self.queued = 0
-        self._mean_job_s = 2.0  # until measured
+        self._mean_job_s = 1.0  # until measured
+
+    @property
+    def queued(self) -> int:
+        return self.admitted - self.running
 
     def retry_after_s(self) -> int:
-        return max(1, math.ceil(self._mean_job_s * (self.queued + self.running)))
+        return max(1, math.ceil(self._mean_job_s * max(self.admitted, 1)))
 
-    async def run(self, job: Callable[..., T], *args: Any) -> T:
-        """Run ``job(*args)`` in the worker thread once the slot is free; raise OverloadedError if it cannot be soon."""
-        if self.running and self.queued >= self.max_queue:
-            raise OverloadedError(f"queue full ({self.queued} waiting)", self.retry_after_s())
-        self.queued += 1
-        try:
-            await asyncio.wait_for(self._slot.acquire(), timeout=self.queue_timeout_s)
-        except TimeoutError:
-            raise OverloadedError(f"not started within {self.queue_timeout_s:g} s", self.retry_after_s()) from None
-        finally:
-            self.queued -= 1
+    def admit(self) -> Ticket:
+        """A place, or OverloadedError at once when 1 + max_queue requests hold one."""
+        if self.admitted >= 1 + self.max_queue:
+            raise OverloadedError(f"{self.running} running, {self.queued} waiting (max {self.max_queue})",
+                                  self.retry_after_s())  # fmt: skip
+        self.admitted += 1
+        return Ticket(self)
+
+    async def _acquire(self, gone: Callable[[], Awaitable[bool]]) -> None:
+        deadline = time.monotonic() + self.queue_timeout_s
+        while True:
+            try:
+                await asyncio.wait_for(self._slot.acquire(), timeout=min(POLL_S, max(deadline - time.monotonic(), 0)))
+                return
+            except TimeoutError:
+                if await gone():
+                    raise CancelledError("the client left while waiting") from None
+                if time.monotonic() >= deadline:
+                    raise OverloadedError(f"not started within {self.queue_timeout_s:g} s",
+                                          self.retry_after_s()) from None  # fmt: skip
+
+    async def run(self, ticket: Ticket, gone: Callable[[], Awaitable[bool]], job: Callable[..., T], *args: Any) -> T:
+        """Run ``job(*args)`` in the worker thread once the slot is free; ``gone`` says the client left."""
+        await self._acquire(gone)
         self.running += 1
         started = time.perf_counter()
         future = asyncio.get_running_loop().run_in_executor(self._executor, job, *args)
-        # The slot is freed when the job ends, not when its request goes away: a client that hangs up
-        # cannot stop a thread, and the next job must not start beside it.
         future.add_done_callback(lambda _: self._finished(started))
-        return await asyncio.shield(future)
+        while not future.done():
+            await asyncio.wait([future], timeout=POLL_S)
+            if not future.done() and await gone():
+                ticket.cancel.set()  # the job stops at its next stage; the slot frees when it does
+        return future.result()
 
     def _finished(self, started: float) -> None:
         self._mean_job_s = 0.7 * self._mean_job_s + 0.3 * (time.perf_counter() - started)

@@ -1,61 +1,75 @@
-"""Assemble the app: settings, store, job runner, warm-up, routers, error handlers."""
+"""Assemble the app: settings, store, job runner, warm-up, the guard, routers under the settings' prefix."""
 
 from __future__ import annotations
 
+import asyncio
 import logging
 import threading
 from collections.abc import AsyncIterator
 from contextlib import asynccontextmanager
+from importlib.metadata import version
+from typing import Any
 
-import numba
-import torch
-from fastapi import Depends, FastAPI
+from fastapi import FastAPI
+from fastapi_offline import FastAPIOffline
 
 from service import errors
-from service.body_limit import BodyLimit
-from service.config import Settings, get_settings
-from service.deps import require_api_key
+from service.config import Settings
+from service.guard import Guard
 from service.jobs import JobRunner
 from service.routes import actuators, calibrate, estimate, health
+from service.schemas import CalibrateIn
 from service.store import EstimateStore
 from service.warmup import warm_up
+from sim.window import WindowDocument
+from training import runtime
 
 log = logging.getLogger("ema.service")
+DESCRIPTION = """Onboard health monitor for an elevator EMA: one logged window in, FDJ, η_O, η_A out.
+
+Budget per request (defaults; the operator's EMA_* settings may change them): a window of at most
+10 s (EMA_MAX_WINDOW_S), simulations × window seconds at most 1500 (EMA_MAX_SIMULATED_S), a body
+of at most 128 MB (EMA_MAX_BODY_BYTES). Over it: 422 (413 for the body) naming the limit, at once.
+One job runs at a time; at most EMA_MAX_QUEUE wait; the rest get 503 with Retry-After."""
 
 
-def create_app(settings: Settings | None = None) -> FastAPI:
-    settings = settings or get_settings()
+def _openapi(app: FastAPI) -> dict[str, Any]:
+    """FastAPI's document, plus the schemas of the bodies the routes parse themselves."""
+    if app.openapi_schema is None:
+        from fastapi.openapi.utils import get_openapi
 
+        schema = get_openapi(title=app.title, version=app.version, description=app.description, routes=app.routes)
+        components = schema.setdefault("components", {}).setdefault("schemas", {})
+        for model in (WindowDocument, CalibrateIn):
+            document = model.model_json_schema(ref_template="#/components/schemas/{model}", by_alias=True)
+            components.update(document.pop("$defs", {}))
+            components[model.__name__] = document
+        app.openapi_schema = schema
+    return app.openapi_schema
+
+
+def create_app(settings: Settings) -> FastAPI:
     @asynccontextmanager
     async def lifespan(app: FastAPI) -> AsyncIterator[None]:
-        # One pipeline at a time uses every core: Numba's and torch's pools each get them all,
-        # and never run at once (the runner has one slot), so they do not oversubscribe.
-        # Numba's thread count is per calling thread, so it is set in the worker thread itself.
-        threads = min(settings.threads, numba.config.NUMBA_NUM_THREADS)  # type: ignore[attr-defined]
-        torch.set_num_threads(threads)
+        runtime.configure(settings.threads)
         app.state.store = EstimateStore(settings.database)
-        app.state.runner = JobRunner(
-            settings.max_queue, settings.queue_timeout_s, initializer=lambda: numba.set_num_threads(threads)
-        )
+        app.state.runner = JobRunner(settings.max_queue, settings.queue_timeout_s)
         if settings.warm_up:
-            await app.state.runner.run(warm_up)
+            await asyncio.get_running_loop().run_in_executor(app.state.runner._executor, warm_up)
             log.info("kernels warm")
         app.state.warm.set()
         yield
         app.state.runner.shutdown()
         app.state.store.close()
 
-    app = FastAPI(title="ema", version="0.1.0", lifespan=lifespan)
+    app = FastAPIOffline(title="ema", version=version("ema"), description=DESCRIPTION, lifespan=lifespan)
     app.state.settings = settings
     app.state.warm = threading.Event()
+    app.openapi = lambda: _openapi(app)  # type: ignore[method-assign]
     errors.install(app)
-    app.add_middleware(BodyLimit, max_bytes=settings.max_body_bytes)
+    app.add_middleware(Guard, key=settings.key_bytes(), prefix=settings.api_prefix,
+                       max_body_bytes=settings.max_body_bytes)  # fmt: skip
     app.include_router(health.router)
-    protected = [Depends(require_api_key)]
-    app.include_router(estimate.router, dependencies=protected)
-    app.include_router(actuators.router, dependencies=protected)
-    app.include_router(calibrate.router, dependencies=protected)
+    for router in (estimate.router, actuators.router, calibrate.router):
+        app.include_router(router, prefix=settings.api_prefix)
     return app
-
-
-__all__ = ["create_app"]

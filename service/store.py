@@ -1,20 +1,30 @@
-"""The history of every answered estimate: SQLite in WAL mode, committed before the answer leaves.
+"""The history of every answered estimate: SQLite, one row per (actuator_id, window_id).
 
-``synchronous=FULL`` makes a commit durable across a kill -9 of the server (and a power loss),
-so an estimate a client has received is never lost. Rows are only ever inserted: re-posting a
-window adds a row rather than overwriting what was answered before.
+- Committed (``synchronous=FULL``, WAL) before the answer leaves: an estimate a client has
+  received survives a kill -9 of the server or a power loss.
+- Idempotent: the same window posted again returns the stored answer; the trend counts it once.
+- Private: the file is created 0600 (SQLite gives its WAL and shared-memory files the same mode).
+- Checked at start: a file that is not an intact SQLite database is refused with the reason,
+  never silently replaced (nothing a user stored is lost); ``healthy()`` answers /healthz.
+- A history written by an earlier version (rows without the key) is migrated: its table is kept
+  as ``estimates_v1`` and its rows copied once each, oldest first; rows in the old result format
+  are returned as ``legacy``, as stored.
 """
 
 from __future__ import annotations
 
 import datetime as dt
 import json
+import os
 import sqlite3
 import threading
 from pathlib import Path
 from typing import Any
 
-import numpy as np
+from pydantic import ValidationError
+
+from prognosis.documents import Stored
+from training.documents import Estimate
 
 SCHEMA_SQL = """
 CREATE TABLE IF NOT EXISTS estimates (
@@ -22,66 +32,117 @@ CREATE TABLE IF NOT EXISTS estimates (
     actuator_id TEXT NOT NULL,
     window_id TEXT NOT NULL,
     stored_at TEXT NOT NULL,
-    result TEXT NOT NULL
+    result TEXT NOT NULL,
+    UNIQUE (actuator_id, window_id)
 );
 CREATE INDEX IF NOT EXISTS estimates_by_actuator ON estimates (actuator_id, id);
-CREATE INDEX IF NOT EXISTS estimates_by_window ON estimates (actuator_id, window_id);
 """
-TRENDED = ("FDJ", "eta_O", "eta_A")
+
+
+class StorageError(Exception):
+    """The history file cannot be used; ``path`` names it."""
+
+    def __init__(self, path: Path, reason: str) -> None:
+        super().__init__(f"{path}: {reason}")
+        self.path = path
+        self.reason = reason
+
+
+def _private_file(path: Path) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    if not path.exists():
+        os.close(os.open(path, os.O_CREAT | os.O_WRONLY, 0o600))
 
 
 class EstimateStore:
     def __init__(self, path: Path) -> None:
         self.path = Path(path)
-        self.path.parent.mkdir(parents=True, exist_ok=True)
         self._lock = threading.Lock()  # one writer at a time; WAL lets readers proceed
-        self._connection = sqlite3.connect(self.path, check_same_thread=False, isolation_level=None)
-        self._connection.execute("PRAGMA journal_mode=WAL")
-        self._connection.execute("PRAGMA synchronous=FULL")
-        self._connection.executescript(SCHEMA_SQL)
+        try:
+            _private_file(self.path)
+            self._connection = sqlite3.connect(self.path, check_same_thread=False, isolation_level=None)
+            verdict = self._connection.execute("PRAGMA quick_check").fetchone()[0]
+            if verdict != "ok":
+                raise StorageError(self.path, f"fails SQLite's integrity check ({verdict})")
+            self._connection.execute("PRAGMA journal_mode=WAL")
+            self._connection.execute("PRAGMA synchronous=FULL")
+            self._migrate()
+        except sqlite3.DatabaseError as exc:
+            raise StorageError(self.path, f"is not a usable SQLite database ({exc})") from None
+        except OSError as exc:
+            raise StorageError(self.path, f"cannot be opened ({exc.strerror})") from None
+
+    def _migrate(self) -> None:
+        tables = {r[0] for r in self._connection.execute("SELECT name FROM sqlite_master WHERE type = 'table'")}
+        keyed = "estimates" in tables and any(
+            "UNIQUE" in (sql or "") for (sql,) in self._connection.execute(
+                "SELECT sql FROM sqlite_master WHERE type = 'table' AND name = 'estimates'"
+            )
+        )  # fmt: skip
+        with self._lock:
+            self._connection.execute("BEGIN IMMEDIATE")
+            if "estimates" in tables and not keyed:
+                self._connection.execute("ALTER TABLE estimates RENAME TO estimates_v1")
+                self._connection.execute("DROP INDEX IF EXISTS estimates_by_actuator")
+                self._connection.execute("DROP INDEX IF EXISTS estimates_by_window")
+            for statement in filter(str.strip, SCHEMA_SQL.split(";")):
+                self._connection.execute(statement)
+            if "estimates" in tables and not keyed:
+                self._connection.execute(
+                    "INSERT OR IGNORE INTO estimates (actuator_id, window_id, stored_at, result) "
+                    "SELECT actuator_id, window_id, stored_at, result FROM estimates_v1 ORDER BY id"
+                )
+            self._connection.execute("COMMIT")
 
     def close(self) -> None:
         with self._lock:
             self._connection.close()
 
-    def add(self, result: dict[str, Any]) -> dict[str, Any]:
-        """Store one ``ema-estimate/1`` result; returns it with its ``id`` and ``stored_at``."""
+    def healthy(self) -> tuple[bool, str]:
+        try:
+            with self._lock:
+                self._connection.execute("SELECT count(*) FROM estimates").fetchone()
+            return True, "ok"
+        except sqlite3.Error as exc:
+            return False, f"{self.path}: {exc}"
+
+    def add(self, result: Estimate) -> Stored:
+        """Store one result; if its (actuator_id, window_id) is stored already, that row, marked as a replay."""
         stored_at = dt.datetime.now(dt.UTC).isoformat(timespec="milliseconds")
+        document = result.model_dump_json(by_alias=True)
         with self._lock:
             cursor = self._connection.execute(
-                "INSERT INTO estimates (actuator_id, window_id, stored_at, result) VALUES (?, ?, ?, ?)",
-                (result["actuator_id"], result["window_id"], stored_at, json.dumps(result)),
+                "INSERT OR IGNORE INTO estimates (actuator_id, window_id, stored_at, result) VALUES (?, ?, ?, ?)",
+                (result.actuator_id, result.window_id, stored_at, document),
             )
-        return {**result, "id": cursor.lastrowid, "stored_at": stored_at}
+        if cursor.rowcount == 0:
+            found = self.get(result.actuator_id, result.window_id)
+            assert found is not None
+            return found
+        return Stored(**json.loads(document), id=cursor.lastrowid, stored_at=stored_at)
 
-    def history(self, actuator_id: str) -> list[dict[str, Any]]:
-        """Every stored result of one actuator, oldest first."""
+    def get(self, actuator_id: str, window_id: str) -> Stored | None:
+        """The stored answer for this window, marked as a replay, or None."""
+        with self._lock:
+            row = self._connection.execute(
+                "SELECT id, stored_at, result FROM estimates WHERE actuator_id = ? AND window_id = ?",
+                (actuator_id, window_id),
+            ).fetchone()
+        if row is None:
+            return None
+        return Stored(**json.loads(row[2]), id=row[0], stored_at=row[1], replay=True)
+
+    def history(self, actuator_id: str) -> tuple[list[Stored], list[dict[str, Any]]]:
+        """Every stored result of one actuator, oldest first; rows of an earlier format apart, as stored."""
         with self._lock:
             rows = self._connection.execute(
                 "SELECT id, stored_at, result FROM estimates WHERE actuator_id = ? ORDER BY id", (actuator_id,)
             ).fetchall()
-        return [{**json.loads(result), "id": row_id, "stored_at": stored_at} for row_id, stored_at, result in rows]
-
-
-def trend(history: list[dict[str, Any]]) -> dict[str, dict[str, Any]]:
-    """Per parameter: first, last, and the least-squares slope per day over the stored time.
-
-    The slope is what a remaining-useful-life estimate extrapolates; it needs two points.
-    """
-    if not history:
-        return {}
-    times = np.array([dt.datetime.fromisoformat(h["stored_at"]).timestamp() for h in history]) / 86_400.0
-    out = {}
-    for name in TRENDED:
-        values = np.array([h["estimates"][name]["value"] for h in history])
-        slope = None
-        if len(values) >= 2 and np.ptp(times) > 0:
-            slope = float(np.polyfit(times - times[0], values, 1)[0])
-        out[name] = {
-            "n": len(values),
-            "first": float(values[0]),
-            "last": float(values[-1]),
-            "slope_per_day": slope,
-            "drift_pct_last": float(history[-1]["estimates"][name]["drift_pct"]),
-        }
-    return out
+        current, legacy = [], []
+        for row_id, stored_at, result in rows:
+            document = json.loads(result)
+            try:
+                current.append(Stored(**document, id=row_id, stored_at=stored_at))
+            except ValidationError:
+                legacy.append({**document, "id": row_id, "stored_at": stored_at})
+        return current, legacy

@@ -4,10 +4,12 @@ from __future__ import annotations
 
 from sim.params import HealthParams
 from sim.synthetic import synthetic_window
-from training.pipeline import PipelineConfig, estimate_window
+from training.config import PipelineConfig
+from training.pipeline import estimate_window
+
+WARM_UP = PipelineConfig(n_simulations=16, check_windows=8, n_timesteps=20, hidden_units=4)
 
 
 def warm_up() -> None:
-    """A tiny pipeline run: simulation kernels, residual, network and baseline all exercised once."""
-    window = synthetic_window(HealthParams.single(), seed=0, duration_s=0.02)
-    estimate_window(window, PipelineConfig(n_simulations=20, n_timesteps=20, hidden_units=4, check_windows=8))
+    """A tiny pipeline run: simulation kernels, residual, network and the physics fit all exercised once."""
+    estimate_window(synthetic_window(HealthParams.single(), seed=0, duration_s=0.05), WARM_UP)

@@ -15,7 +15,7 @@ from pathlib import Path
 from typing import Annotated, Any, Literal
 
 import numpy as np
-from pydantic import AllowInfNan, BaseModel, ConfigDict, Field, Strict, ValidationError, field_validator
+from pydantic import AllowInfNan, AwareDatetime, BaseModel, ConfigDict, Field, Strict, ValidationError, field_validator
 
 from sim.aircraft import AIRSPEED_RANGE_MPS, ALTITUDE_RANGE_M, FlightCondition
 from sim.checks import InputError, from_validation
@@ -78,6 +78,8 @@ class WindowDocument(_Contract):
     sample_rate_hz: Number = Field(ge=WINDOW_RATE_RANGE_HZ[0], le=WINDOW_RATE_RANGE_HZ[1])
     flight_condition: FlightConditionDocument
     signals: SignalsDocument
+    recorded_at: AwareDatetime | None = Field(None, description="when the window began (for trends)")
+    flight_hours: Number | None = Field(None, ge=0, description="the airframe's flight hours then (for trends)")
 
     def to_window(self) -> Window:
         """The arrays; signals of unequal lengths are refused naming the first one that differs."""
@@ -87,7 +89,8 @@ class WindowDocument(_Contract):
             if len(array) != length:
                 raise InputError(f"signals.{name}", f"has {len(array)} samples, command_deg has {length}")
         condition = FlightCondition(self.flight_condition.airspeed_mps, self.flight_condition.altitude_m)
-        return Window(arrays, self.sample_rate_hz, condition, self.actuator_id, self.window_id)
+        recorded = None if self.recorded_at is None else self.recorded_at.isoformat()
+        return Window(arrays, self.sample_rate_hz, condition, self.actuator_id, self.window_id, recorded, self.flight_hours)
 
 
 @dataclass(frozen=True)
@@ -99,6 +102,8 @@ class Window:
     flight_condition: FlightCondition = field(default_factory=FlightCondition)
     actuator_id: str = "unknown"
     window_id: str = "unknown"
+    recorded_at: str | None = None  # ISO 8601 with a time zone
+    flight_hours: float | None = None
 
     def __post_init__(self) -> None:
         lengths = {name: len(self.signals[name]) for name in SIGNALS}
@@ -136,6 +141,8 @@ def window_to_dict(window: Window) -> dict[str, Any]:
             "altitude_m": float(window.flight_condition.altitude_m),
         },
         "signals": {name: window.signals[name].tolist() for name in SIGNALS},
+        **({"recorded_at": window.recorded_at} if window.recorded_at is not None else {}),
+        **({"flight_hours": window.flight_hours} if window.flight_hours is not None else {}),
     }
 
 

@@ -6,14 +6,14 @@ batch of simulations records every sample of every simulation. So the window is 
 f adjacent samples first: interval means of interval means are the interval means of the longer
 intervals, exactly, which is also what the simulations record at the lower rate. ``f`` keeps the
 rate at or below ``MAX_RATE_HZ`` (the 2 ms reconstruction needs no more) and the samples at or
-below ``MAX_SAMPLES`` (a 10 s window is processed at 2 kHz): memory and time grow at most
+below ``MAX_SAMPLES`` (a 10 s window is processed at 1 kHz): memory and time grow at most
 linearly with the duration, and are bounded.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -22,7 +22,7 @@ from sim.params import ActuatorParams
 from sim.window import Window
 
 MAX_RATE_HZ = 10_000.0
-MAX_SAMPLES = 20_000
+MAX_SAMPLES = 10_000
 
 
 @dataclass(frozen=True)
@@ -47,7 +47,5 @@ def prepare(window: Window, actuator: ActuatorParams = ActuatorParams()) -> Prep
     if factor > 1:
         n = window.n_samples // factor * factor
         signals = {name: values[:n].reshape(-1, factor).mean(axis=1) for name, values in window.signals.items()}
-        window = Window(
-            signals, window.sample_rate_hz / factor, window.flight_condition, window.actuator_id, window.window_id
-        )
+        window = replace(window, signals=signals, sample_rate_hz=window.sample_rate_hz / factor)
     return Prepared(window, factor, len(command), window.sample_rate_hz * factor, clipped)

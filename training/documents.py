@@ -85,6 +85,8 @@ class WindowInfo(Document):
     processed_rate_hz: float = Field(description="after averaging adjacent samples (exact for interval means)")
     command_clipped_fraction: float = Field(description="share of command samples past the end stops, saturating")
     sliding_fraction: float = Field(description="share of samples the friction fit could use")
+    recorded_at: str | None = None
+    flight_hours: float | None = None
 
 
 class DatasetInfo(Document):

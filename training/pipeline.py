@@ -22,9 +22,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from sim.effects import EffectSet
 from sim.noise import SensorNoise
-from sim.params import DEFAULT_RANGES, ActuatorParams, HealthParams, eta_a_from_eta_o
+from sim.params import DEFAULT_RANGES, ActuatorParams, eta_a_from_eta_o
 from sim.residual import residual_torque_nm
 from sim.window import Window
 from training import design
@@ -67,10 +66,10 @@ class Data:
     window_inputs: np.ndarray  # (1, n_timesteps)
 
 
-def simulate_dataset(window: Window, physics: FrictionFit, config: PipelineConfig, effects: EffectSet) -> Data:
+def simulate_dataset(window: Window, physics: FrictionFit, config: PipelineConfig) -> Data:
     """The box around the physics estimate, the window's noise, the simulations and their features."""
     box = design.box_around(physics.fdj_nm[0], physics.fdj_std_nm[0], physics.eta_o[0], physics.eta_o_std[0])
-    scenario = scenario_from_window(window, effects)
+    scenario = scenario_from_window(window)
     centre = design.centre(box)
     noise = window_noise(window, scenario, centre)
     health = design.draw(box, config.total_simulations, config.seed)
@@ -134,15 +133,11 @@ def fit_check(window: Window, data: Data, answer: Assessed, equation_ratio: floa
 
 
 def estimate_window(
-    window: Window,
-    config: PipelineConfig = PipelineConfig(),
-    effects: EffectSet = EffectSet(),
-    on_stage: Callable[[str], None] | None = None,
+    window: Window, config: PipelineConfig = PipelineConfig(), on_stage: Callable[[str], None] | None = None
 ) -> Estimate:
-    """The ``ema-estimate/1`` result for one window; ``on_stage`` hears each stage as it starts.
-
-    ``effects`` extends the model the dataset is simulated with (the calibration loop's output).
-    Raises InputError (field ``signals``) for a window with too little sliding motion to read.
+    """The ``ema-estimate/1`` result for one window; ``on_stage`` hears each stage as it starts (and may
+    raise to stop the job there). Raises InputError (field ``signals``) for a window with too little
+    sliding motion to read.
     """
     stage = on_stage or (lambda _: None)
     clock = [time.perf_counter()]
@@ -150,7 +145,7 @@ def estimate_window(
     w, n = prepared.window, config.n_simulations
     physics = fit_window(w.signals, w.sample_rate_hz)
     stage(f"simulating {config.total_simulations} windows around the physics estimate")
-    data = simulate_dataset(w, physics, config, effects)
+    data = simulate_dataset(w, physics, config)
     clock.append(time.perf_counter())
     stage(f"training {config.members} network(s) of {config.hidden_units} neurons")
     network = train_network(data, config)
@@ -252,6 +247,8 @@ def _document(
             processed_rate_hz=w.sample_rate_hz,
             command_clipped_fraction=prepared.command_clipped_fraction,
             sliding_fraction=float(np.mean(data.sliding)),
+            recorded_at=w.recorded_at,
+            flight_hours=w.flight_hours,
         ),
         config=config,
     )

@@ -1,19 +1,25 @@
 from __future__ import annotations
 
-from typing import Any
-
 from fastapi import APIRouter
 from starlette.concurrency import run_in_threadpool
 
-from service.deps import StoreDep
-from service.schemas import HistoryOut
-from service.store import trend
+from prognosis.documents import History, Prognosis
+from prognosis.prognose import prognose
+from service.deps import SettingsDep, StoreDep
+from service.schemas import responses
 
-router = APIRouter(prefix="/v1/actuators", tags=["actuators"])
+router = APIRouter(prefix="/actuators", tags=["actuators"])
 
 
-@router.get("/{actuator_id:path}/estimates", response_model=HistoryOut, response_model_by_alias=True)
-async def history(actuator_id: str, store: StoreDep) -> dict[str, Any]:
-    """Every stored estimate of the actuator, oldest first, and each parameter's drift trend."""
-    estimates = await run_in_threadpool(store.history, actuator_id)
-    return {"actuator_id": actuator_id, "estimates": estimates, "trend": trend(estimates)}
+@router.get("/{actuator_id:path}/estimates", response_model=History, responses=responses(401))
+async def history(actuator_id: str, store: StoreDep) -> History:
+    """Every stored estimate of the actuator, oldest first, one per window."""
+    current, legacy = await run_in_threadpool(store.history, actuator_id)
+    return History(actuator_id=actuator_id, estimates=current, legacy=legacy)
+
+
+@router.get("/{actuator_id:path}/prognosis", response_model=Prognosis, responses=responses(401))
+async def prognosis(actuator_id: str, store: StoreDep, settings: SettingsDep) -> Prognosis:
+    """Trend of FDJ, η_O and η_A and the remaining useful life to the service's thresholds (EMA_THRESHOLDS__*)."""
+    current, _ = await run_in_threadpool(store.history, actuator_id)
+    return await run_in_threadpool(prognose, actuator_id, current, settings.thresholds)

@@ -1,41 +1,57 @@
 from __future__ import annotations
 
-from typing import Annotated, Any
+from typing import Annotated
 
-from fastapi import APIRouter, Query
+from fastapi import APIRouter, Query, Request
 from starlette.concurrency import run_in_threadpool
 
-from service.deps import RunnerDep, SettingsDep, StoreDep, pipeline_config
-from service.errors import bounded
-from service.schemas import EstimateOut, WindowIn
-from service.windows import to_window
-from sim.checks import InputError
+from prognosis.documents import Stored
+from service.deps import RunnerDep, SettingsDep, StoreDep, request_config, stopper
+from service.parsing import check_budget, parse
+from service.schemas import json_body, responses
+from sim.window import WindowDocument
+from training.config import PipelineConfig, bounds
 from training.pipeline import estimate_window
 
-router = APIRouter(prefix="/v1", tags=["estimate"])
+router = APIRouter(tags=["estimate"])
 
 
-@router.post("/estimate", response_model=EstimateOut, response_model_by_alias=True)
+def _query(name: str, what: str) -> object:
+    low, high = bounds(PipelineConfig, name)
+    return Query(ge=low, le=high, description=f"{what} (default and ceiling: the service's settings)")
+
+
+@router.post(
+    "/estimate",
+    response_model=Stored,
+    response_model_by_alias=True,
+    responses=responses(401, 413, 422, 503),
+    openapi_extra=json_body(WindowDocument, "one ema-window/1 window"),
+)
 async def estimate(
-    body: WindowIn,
+    request: Request,
     settings: SettingsDep,
     store: StoreDep,
     runner: RunnerDep,
-    n_simulations: Annotated[int | None, Query(ge=20)] = None,
-    n_timesteps: Annotated[int | None, Query(ge=10)] = None,
-    hidden_units: Annotated[int | None, Query(ge=1)] = None,
-    seed: Annotated[int | None, Query(ge=0)] = None,
-) -> dict[str, Any]:
-    """Simulate a Case-1B dataset for the window's own command, train, estimate; store and answer."""
-    window = to_window(body)
-    config = pipeline_config(
-        settings,
-        n_simulations=bounded("n_simulations", n_simulations, settings.n_simulations, settings.max_simulations),
-        n_timesteps=bounded("n_timesteps", n_timesteps, settings.n_timesteps, settings.max_timesteps),
-        hidden_units=bounded("hidden_units", hidden_units, settings.hidden_units, settings.max_hidden_units),
-        seed=settings.seed if seed is None else seed,
-    )
-    if config.n_timesteps > window.n_samples:
-        raise InputError("query.n_timesteps", f"{config.n_timesteps} exceeds the window's {window.n_samples} samples")
-    result = await runner.run(estimate_window, window, config)
-    return await run_in_threadpool(store.add, result)  # committed (fsync) before the answer leaves
+    n_simulations: Annotated[int | None, _query("n_simulations", "simulations to train on")] = None,
+    n_timesteps: Annotated[int | None, _query("n_timesteps", "network input timesteps")] = None,
+    hidden_units: Annotated[int | None, _query("hidden_units", "hidden neurons")] = None,
+    seed: Annotated[int | None, _query("seed", "seed of the dataset and the training")] = None,
+) -> Stored:
+    """Estimate FDJ, η_O, η_A (FSJ where the window shows it) of one window; store and answer.
+
+    A window already stored for its (actuator_id, window_id) is answered from the history
+    (``replay: true``) without recomputing. Budget: the window's duration and its simulation work
+    (simulations × seconds) are limited by the service's settings; over it, 422 naming the limit.
+    """
+    with runner.admit() as ticket:
+        window = (await parse(WindowDocument, await request.body())).to_window()
+        stored = await run_in_threadpool(store.get, window.actuator_id, window.window_id)
+        if stored is not None:
+            return stored
+        sizes = {"n_simulations": n_simulations, "n_timesteps": n_timesteps, "hidden_units": hidden_units}
+        config = request_config(settings, **sizes, seed=seed)
+        check_budget(window, config, settings)
+        result = await runner.run(ticket, request.is_disconnected, estimate_window, window, config,
+                                  stopper(ticket.cancel))  # fmt: skip
+        return await run_in_threadpool(store.add, result)  # committed (fsync) before the answer leaves

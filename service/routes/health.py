@@ -9,12 +9,14 @@ router = APIRouter(tags=["health"])
 
 @router.get("/healthz", response_model=HealthOut)
 def healthz(request: Request) -> HealthOut:
-    """Up; ``warm`` once the kernels are compiled (or loaded from cache) and a pipeline has run."""
-    runner = request.app.state.runner
+    """Up; ``warm`` once the kernels are compiled (or loaded) and a pipeline has run; storage checked."""
+    runner, store = request.app.state.runner, request.app.state.store
+    storage_ok, storage = store.healthy()
     return HealthOut(
-        status="ok",
+        status="ok" if storage_ok else "degraded",
         warm=request.app.state.warm.is_set(),
         running=runner.running,
         queued=runner.queued,
         max_queue=runner.max_queue,
+        storage=storage,
     )

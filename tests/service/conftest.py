@@ -8,8 +8,15 @@ from service.main import create_app
 from sim.params import HealthParams
 from sim.synthetic import synthetic_window
 from sim.window import window_to_dict
+from training.config import PipelineConfig
 
-SMALL = {"n_simulations": 40, "n_timesteps": 100, "hidden_units": 10, "check_windows": 8, "warm_up": False}
+SMALL = PipelineConfig(n_simulations=16, check_windows=8, n_timesteps=50, hidden_units=8)
+KEY = "a-key-of-sixteen-characters"
+LOCAL = "http://127.0.0.1"  # without a key the service answers loopback hosts only
+
+
+def settings_for(tmp_path, **overrides) -> Settings:
+    return Settings(database=tmp_path / "history.sqlite3", pipeline=SMALL, warm_up=False, **overrides)
 
 
 @pytest.fixture(scope="session")
@@ -25,10 +32,10 @@ def document(window_document) -> dict:
 
 @pytest.fixture
 def settings(tmp_path) -> Settings:
-    return Settings(database=tmp_path / "history.sqlite3", **SMALL)
+    return settings_for(tmp_path)
 
 
 @pytest.fixture
 def client(settings):
-    with TestClient(create_app(settings)) as test_client:
+    with TestClient(create_app(settings), base_url=LOCAL) as test_client:
         yield test_client

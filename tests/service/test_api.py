@@ -1,43 +1,44 @@
-"""The HTTP contract through TestClient: answers, stored history, errors naming fields, overload."""
-
-import threading
+"""The HTTP contract through TestClient: answers, stored history, errors naming fields."""
 
 import pytest
 from fastapi.testclient import TestClient
 
-from service.config import Settings
 from service.main import create_app
-from service.routes import estimate as estimate_route
-from tests.service.conftest import SMALL
+from tests.service.conftest import KEY, LOCAL, SMALL, settings_for
 
 
-def test_healthz_says_warm(client):
+def test_healthz_says_warm_and_storage_ok(client):
     health = client.get("/healthz").json()
-    assert health["status"] == "ok" and health["warm"] is True
+    assert health["status"] == "ok" and health["warm"] is True and health["storage"] == "ok"
 
 
 def test_estimate_answers_the_contract_and_is_stored(client, document):
     response = client.post("/v1/estimate", json=document)
     assert response.status_code == 200, response.text
     result = response.json()
-    assert result["schema"] == "ema-estimate/1"
+    assert result["schema"] == "ema-estimate/1" and result["replay"] is False
     assert set(result["estimates"]) >= {"FDJ", "eta_O", "eta_A", "FSJ"}
     assert result["estimates"]["FDJ"]["std"] > 0
-    assert set(result["timings_s"]) == {"simulate", "train", "predict", "total"}
-    assert result["dataset"]["n_simulations"] == SMALL["n_simulations"]
+    assert set(result["timings_s"]) >= {"simulate", "train", "predict", "total"}
+    assert result["dataset"]["n_simulations"] == SMALL.n_simulations
     history = client.get("/v1/actuators/ac-1/elev/estimates").json()
     assert [h["id"] for h in history["estimates"]] == [result["id"]]
-    assert history["trend"]["FDJ"]["n"] == 1 and history["trend"]["FDJ"]["slope_per_day"] is None
 
 
-def test_sizes_are_overridable_within_bounds(client, document):
-    ok = client.post("/v1/estimate?n_simulations=30&hidden_units=5", json=document)
-    assert ok.status_code == 200 and ok.json()["dataset"]["n_simulations"] == 30
-    too_big = client.post("/v1/estimate?n_simulations=100000", json=document)
+def test_a_window_posted_twice_is_stored_once_and_answered_from_the_history(client, document):
+    first = client.post("/v1/estimate", json=document).json()
+    again = client.post("/v1/estimate", json=document).json()
+    assert again["replay"] is True and again["id"] == first["id"]
+    assert again["estimates"] == first["estimates"]
+    assert len(client.get("/v1/actuators/ac-1/elev/estimates").json()["estimates"]) == 1
+
+
+def test_sizes_are_overridable_within_the_services_ceilings(client, document):
+    ok = client.post("/v1/estimate?n_simulations=24&hidden_units=5", json=document)
+    assert ok.status_code == 200 and ok.json()["dataset"]["n_simulations"] == 24
+    too_big = client.post("/v1/estimate?n_simulations=4000", json={**document, "window_id": "w2"})
     assert too_big.status_code == 422
     assert too_big.json()["detail"][0]["loc"] == ["query", "n_simulations"]
-    longer_than_window = client.post("/v1/estimate?n_timesteps=4000", json=document)  # 1000 samples
-    assert longer_than_window.json()["detail"][0]["loc"] == ["query", "n_timesteps"]
 
 
 def _set(document, path, value):
@@ -53,105 +54,76 @@ def _set(document, path, value):
     [
         (("signals", "current_a"), [0.0] * 10, ["body", "signals", "current_a"]),
         (("signals", "position_deg"), [50.0] * 1000, ["body", "signals", "position_deg"]),
+        (("signals", "current_a"), [True] * 1000, ["body", "signals", "current_a"]),
+        (("signals", "current_a"), ["1.5"] * 1000, ["body", "signals", "current_a"]),
+        (("sample_rate_hz",), "10000", ["body", "sample_rate_hz"]),
         (("sample_rate_hz",), 50.0, ["body", "sample_rate_hz"]),
         (("flight_condition", "altitude_m"), 20_000.0, ["body", "flight_condition", "altitude_m"]),
         (("schema",), "ema-window/9", ["body", "schema"]),
         (("signals", "torque"), [0.0], ["body", "signals", "torque"]),
+        (("actuator_id",), "tail\\n1", ["body", "actuator_id"]),
     ],
 )
 def test_bad_windows_get_422_naming_the_field(client, document, path, value, loc):
+    if path == ("actuator_id",):
+        value = "tail\n1"
     response = client.post("/v1/estimate", json=_set(document, path, value))
     assert response.status_code == 422
-    assert loc in [error["loc"] for error in response.json()["detail"]]
+    assert response.json()["detail"][0]["loc"] == loc
 
 
-def test_too_short_and_nan_and_not_json(client, document):
-    short = {**document, "signals": {name: values[:50] for name, values in document["signals"].items()}}
-    response = client.post("/v1/estimate", json=short)
-    assert response.status_code == 422 and response.json()["detail"][0]["loc"] == ["body", "signals"]
+def test_unequal_lengths_nan_not_json_and_empty(client, document):
+    document["signals"]["current_a"] = document["signals"]["current_a"][:-1]
+    response = client.post("/v1/estimate", json=document)
+    assert response.json()["detail"][0]["loc"] == ["body", "signals", "current_a"]
     raw = '{"schema": "ema-window/1", "actuator_id": "a", "window_id": "w", "sample_rate_hz": NaN}'
     response = client.post("/v1/estimate", content=raw, headers={"content-type": "application/json"})
     assert response.status_code == 422
-    assert ["body", "sample_rate_hz"] in [e["loc"] for e in response.json()["detail"]]
-    response = client.post("/v1/estimate", content="{not json", headers={"content-type": "application/json"})
+    for body in ("{not json", "", b"\xff\xfe"):
+        response = client.post("/v1/estimate", content=body, headers={"content-type": "application/json"})
+        assert response.status_code == 422 and response.json()["detail"][0]["loc"] == ["body"]
+
+
+def test_a_window_longer_than_the_budget_is_refused_at_once(tmp_path, document):
+    with TestClient(create_app(settings_for(tmp_path, max_window_s=0.05)), base_url=LOCAL) as client:
+        response = client.post("/v1/estimate", json=document)  # 0.1 s
     assert response.status_code == 422
+    assert response.json()["detail"][0]["loc"] == ["body", "signals"]
+    assert "EMA_MAX_WINDOW_S" in response.json()["detail"][0]["msg"]
 
 
-def test_oversize_body_is_refused(tmp_path, document):
-    settings = Settings(database=tmp_path / "h.sqlite3", max_body_bytes=10_000, **SMALL)
-    with TestClient(create_app(settings)) as client:
+def test_oversize_body_is_413_naming_the_body(tmp_path, document):
+    with TestClient(create_app(settings_for(tmp_path, max_body_bytes=10_000)), base_url=LOCAL) as client:
         response = client.post("/v1/estimate", json=document)
-    assert response.status_code == 422
+    assert response.status_code == 413
     assert response.json()["detail"][0]["loc"] == ["body"]
 
 
-def test_api_key_protects_v1_but_not_healthz(tmp_path, document):
-    settings = Settings(database=tmp_path / "h.sqlite3", api_key="s3cret", **SMALL)
-    with TestClient(create_app(settings)) as client:
+def test_api_key_protects_v1_but_not_healthz(tmp_path):
+    with TestClient(create_app(settings_for(tmp_path, api_key=KEY)), base_url="http://ema.example") as client:
         assert client.get("/healthz").status_code == 200
         assert client.get("/v1/actuators/x/estimates").status_code == 401
         assert client.get("/v1/actuators/x/estimates", headers={"x-api-key": "wrong"}).status_code == 401
-        assert client.get("/v1/actuators/x/estimates", headers={"x-api-key": "s3cret"}).status_code == 200
+        assert client.get("/v1/actuators/x/estimates", headers={"x-api-key": KEY}).status_code == 200
 
 
-@pytest.fixture
-def blocked(monkeypatch):
-    """The pipeline holds its slot until ``release`` is set; ``started`` says it holds it."""
-    release, started = threading.Event(), threading.Event()
-    real = estimate_route.estimate_window
-
-    def slow_pipeline(window, config):
-        started.set()
-        release.wait(timeout=30)
-        return real(window, config)
-
-    monkeypatch.setattr(estimate_route, "estimate_window", slow_pipeline)
-    return release, started
-
-
-def _second_while_first_runs(settings, document, blocked, during=lambda client: None):
-    """Post once in a thread, and once more while the first holds the slot; both responses."""
-    release, started = blocked
-    with TestClient(create_app(settings)) as client:
-        first: dict = {}
-        worker = threading.Thread(target=lambda: first.update(r=client.post("/v1/estimate", json=document)))
-        worker.start()
-        assert started.wait(timeout=30)
-        second = client.post("/v1/estimate", json=document)
-        during(client)
-        release.set()
-        worker.join(timeout=60)
-    return first["r"], second
-
-
-def test_a_full_queue_answers_503_with_retry_after(tmp_path, document, blocked):
-    settings = Settings(database=tmp_path / "h.sqlite3", max_queue=0, **SMALL)
-
-    def loop_still_answers(client):
-        assert client.get("/healthz").json()["running"] == 1
-
-    first, busy = _second_while_first_runs(settings, document, blocked, loop_still_answers)
-    assert busy.status_code == 503
-    assert int(busy.headers["Retry-After"]) >= 1
-    assert first.status_code == 200
-
-
-def test_a_queued_request_that_cannot_start_in_time_gets_503(tmp_path, document, blocked):
-    settings = Settings(database=tmp_path / "h.sqlite3", max_queue=5, queue_timeout_s=0.5, **SMALL)
-    first, waited = _second_while_first_runs(settings, document, blocked)  # queued, gives up after 0.5 s
-    assert waited.status_code == 503
-    assert first.status_code == 200
+def test_without_a_key_only_loopback_hosts_are_answered(tmp_path):
+    with TestClient(create_app(settings_for(tmp_path)), base_url="http://evil.example") as client:
+        response = client.get("/v1/actuators/x/estimates")
+    assert response.status_code == 400 and response.json()["detail"][0]["loc"] == ["header", "host"]
 
 
 def test_history_survives_a_restart(tmp_path, document):
-    settings = Settings(database=tmp_path / "h.sqlite3", **SMALL)
-    with TestClient(create_app(settings)) as client:
+    settings = settings_for(tmp_path)
+    with TestClient(create_app(settings), base_url=LOCAL) as client:
         first = client.post("/v1/estimate", json=document).json()
         second = client.post("/v1/estimate", json={**document, "window_id": "w2"}).json()
-    with TestClient(create_app(settings)) as client:
+    with TestClient(create_app(settings), base_url=LOCAL) as client:
         history = client.get("/v1/actuators/ac-1/elev/estimates").json()
+        prognosis = client.get("/v1/actuators/ac-1/elev/prognosis").json()
     assert [h["id"] for h in history["estimates"]] == [first["id"], second["id"]]  # oldest first
-    assert history["trend"]["eta_O"]["n"] == 2
+    assert prognosis["trends"]["FDJ"]["n"] == 2
+    assert prognosis["remaining_life"]["FDJ"]["status"] == "too few windows"
 
 
 def test_calibrate_answers_the_report(client, document):
@@ -167,3 +139,15 @@ def test_calibrate_bad_input_is_named(client, document):
     response = client.post("/v1/calibrate", json={"windows": [document], "truth": {"FDJ": -1, "eta_O": 0.8}})
     assert response.status_code == 422
     assert response.json()["detail"][0]["loc"] == ["body", "truth", "FDJ"]
+
+
+def test_the_openapi_document_states_bodies_errors_and_bounds(client):
+    spec = client.get("/openapi.json").json()
+    post = spec["paths"]["/v1/estimate"]["post"]
+    assert post["requestBody"]["content"]["application/json"]["schema"]["$ref"].endswith("/WindowDocument")
+    assert {"401", "413", "422", "503"} <= set(post["responses"])
+    rate = spec["components"]["schemas"]["WindowDocument"]["properties"]["sample_rate_hz"]
+    assert rate["minimum"] == 1000.0 and rate["maximum"] == 100000.0
+    seed = next(p for p in post["parameters"] if p["name"] == "seed")
+    assert seed["schema"]["anyOf"][0]["maximum"] == 2**32 - 1
+    assert client.get("/docs").status_code == 200 and "cdn" not in client.get("/docs").text

@@ -1,0 +1,74 @@
+"""The history and prognosis documents (shared/spec/interfaces.md): one definition each.
+
+``GET /v1/actuators/{id}/estimates`` answers :class:`History`, ``.../prognosis`` answers
+:class:`Prognosis`, ``ema history`` prints and plots them, and docs/schemas/ holds their JSON
+Schemas.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Literal
+
+from pydantic import Field
+
+from training.documents import Document, Estimate
+
+PARAMETERS = ("FDJ", "eta_O", "eta_A")
+
+
+class Stored(Estimate):
+    """An ``ema-estimate/1`` result as the history keeps it."""
+
+    id: int
+    stored_at: str = Field(description="when the service stored it (UTC, ISO 8601)")
+    replay: bool = Field(False, description="this window was posted before: the stored answer, not recomputed")
+
+
+class Point(Document):
+    """One window's estimate of one parameter, at its time."""
+
+    window_id: str
+    time: float = Field(description="in the prognosis's time unit")
+    value: float
+    std: float | None
+    outlier: bool = False
+
+
+class Trend(Document):
+    """value(t) = level + slope·(t − t_last), weighted by each window's std, robust to outliers."""
+
+    parameter: str
+    n: int
+    level: float = Field(description="the trend's value at the last window")
+    level_std: float
+    slope_per_unit: float
+    slope_std: float
+    excess_std: float = Field(description="scatter beyond the stated stds, added to every point's (0: none)")
+    points: list[Point]
+
+
+class RemainingLife(Document):
+    parameter: str
+    threshold: float
+    direction: Literal["above", "below"]
+    status: Literal["crossing predicted", "already crossed", "no degradation detected", "too few windows"]
+    rul: float | None = Field(description="time from the last window to the crossing, in the time unit")
+    rul_low: float | None = Field(description="5 % quantile")
+    rul_high: float | None = Field(description="95 % quantile (null: beyond any horizon the data support)")
+    probability_degrading: float | None = Field(description="probability that the trend moves towards the threshold")
+
+
+class Prognosis(Document):
+    actuator_id: str
+    time_unit: Literal["flight_hours", "days"]
+    trends: dict[str, Trend]
+    remaining_life: dict[str, RemainingLife]
+    notes: list[str] = Field(default_factory=list)
+
+
+class History(Document):
+    actuator_id: str
+    estimates: list[Stored] = Field(description="oldest first; one per (actuator_id, window_id)")
+    legacy: list[dict[str, Any]] = Field(
+        default_factory=list, description="results an earlier version stored, in their own format, as stored"
+    )

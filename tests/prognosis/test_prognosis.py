@@ -1,0 +1,66 @@
+"""Trend and remaining life on synthetic actuator histories with a known truth."""
+
+import numpy as np
+import pytest
+
+from prognosis.rul import remaining_life
+from prognosis.trend import fit_trend
+
+THRESHOLD = 0.075  # FDJ +50 % of nominal
+
+
+def degrading(seed: int, n: int = 200, slope: float = 1e-4, stated: float = 4e-4, actual: float = 4e-4, outliers=0):
+    """FDJ rising linearly over n windows, one per flight hour, with realistic noise (and wild outliers)."""
+    rng = np.random.default_rng(seed)
+    hours = np.sort(rng.uniform(0, 200, n))
+    values = 0.05 + slope * hours + actual * rng.normal(size=n)
+    values[rng.choice(n, outliers, replace=False)] += 0.02
+    return hours, values, np.full(n, stated)
+
+
+def truth_rul(hours: np.ndarray, slope: float = 1e-4) -> float:
+    return (THRESHOLD - 0.05) / slope - hours.max()
+
+
+def rul_of(hours, values, stds):
+    trend = fit_trend("FDJ", hours, values, stds, [str(i) for i in range(len(hours))])
+    return trend, remaining_life(trend, THRESHOLD, "above")
+
+
+def test_the_rul_interval_contains_the_truth_in_most_histories():
+    hits = 0
+    for seed in range(20):
+        hours, values, stds = degrading(seed)
+        _, life = rul_of(hours, values, stds)
+        assert life.status == "crossing predicted"
+        hits += life.rul_low <= truth_rul(hours) <= life.rul_high
+    assert hits >= 17  # a 90 % interval: 18 of 20 expected
+
+
+def test_outliers_do_not_move_the_trend_and_are_flagged():
+    hours, values, stds = degrading(1, outliers=8)
+    trend, life = rul_of(hours, values, stds)
+    assert trend.slope_per_unit == pytest.approx(1e-4, rel=0.1)
+    assert sum(p.outlier for p in trend.points) >= 6
+    assert life.rul_low <= truth_rul(hours) <= life.rul_high
+
+
+def test_stds_that_claim_too_much_widen_the_trend_instead_of_narrowing_it():
+    hours, values, stds = degrading(2, stated=1e-4, actual=8e-4)
+    trend, life = rul_of(hours, values, stds)
+    assert trend.excess_std == pytest.approx(8e-4, rel=0.2)
+    assert life.rul_low <= truth_rul(hours) <= life.rul_high
+
+
+def test_a_healthy_actuator_shows_no_degradation():
+    hours, values, stds = degrading(3, slope=0.0)
+    _, life = rul_of(hours, values, stds)
+    assert life.status == "no degradation detected" and life.rul is None
+
+
+def test_too_few_windows_and_a_crossed_threshold():
+    _, few = rul_of(np.array([0.0, 1.0]), np.array([0.05, 0.051]), np.array([1e-4, 1e-4]))
+    assert few.status == "too few windows"
+    hours, values, stds = degrading(4)
+    _, crossed = rul_of(hours, values + 0.03, stds)
+    assert crossed.status == "already crossed" and crossed.rul == 0.0

@@ -1,0 +1,112 @@
+"""A live server (uvicorn in its own process) probed as a careless or hostile client would."""
+
+import concurrent.futures
+import json
+import os
+import socket
+import subprocess
+import sys
+import time
+
+import httpx
+import pytest
+
+from tests.service.conftest import KEY
+
+SERVER = """
+import uvicorn
+from service.config import Settings
+from service.main import create_app
+uvicorn.run(create_app(Settings()), host="127.0.0.1", port={port}, log_level="warning")
+"""
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+@pytest.fixture(scope="module")
+def live(tmp_path_factory):
+    port = _free_port()
+    env = {
+        **os.environ,
+        "EMA_API_KEY": KEY,
+        "EMA_DATABASE": str(tmp_path_factory.mktemp("live") / "history.sqlite3"),
+        "EMA_MAX_QUEUE": "2",
+        "EMA_WARM_UP": "false",
+        "EMA_PIPELINE__N_SIMULATIONS": "16",
+        "EMA_PIPELINE__CHECK_WINDOWS": "8",
+        "EMA_PIPELINE__N_TIMESTEPS": "50",
+        "EMA_PIPELINE__HIDDEN_UNITS": "8",
+    }
+    process = subprocess.Popen([sys.executable, "-c", SERVER.format(port=port)], env=env)
+    url = f"http://127.0.0.1:{port}"
+    for _ in range(300):
+        try:
+            if httpx.get(f"{url}/healthz", timeout=1).status_code == 200:
+                break
+        except httpx.HTTPError:
+            time.sleep(0.1)
+    yield url
+    process.terminate()
+    process.wait(timeout=30)
+
+
+def _post(url: str, body, key: str = KEY, path: str = "/v1/estimate", timeout: float = 120) -> httpx.Response:
+    content = body if isinstance(body, bytes) else json.dumps(body).encode()
+    headers = {"content-type": "application/json", "x-api-key": key}
+    return httpx.post(url + path, content=content, headers=headers, timeout=timeout)
+
+
+def test_a_burst_on_an_idle_server_admits_one_plus_the_queue_and_refuses_the_rest_at_once(live, window_document):
+    windows = [{**window_document, "window_id": f"burst-{i}"} for i in range(20)]
+    started = time.perf_counter()
+    with concurrent.futures.ThreadPoolExecutor(20) as pool:
+        futures = [pool.submit(lambda w: (_post(live, w), time.perf_counter() - started), w) for w in windows]
+        answers = [f.result() for f in futures]
+    accepted = [r for r, _ in answers if r.status_code == 200]
+    refused = [(r, t) for r, t in answers if r.status_code == 503]
+    assert len(accepted) + len(refused) == 20
+    assert 1 <= len(accepted) <= 1 + 2
+    assert all(int(r.headers["Retry-After"]) >= 1 for r, _ in refused)
+    assert max(t for _, t in refused) < 2.0
+
+
+def test_wrong_keys_are_refused_before_the_body_is_read(live):
+    big = b'{"schema": "ema-window/1", "pad": "' + b"x" * 48_000_000 + b'"}'
+    started = time.perf_counter()
+    assert _post(live, big, key="wrong").status_code == 401
+    assert time.perf_counter() - started < 3.0
+    non_ascii = httpx.post(f"{live}/v1/estimate", content=b"{}", headers=[(b"x-api-key", "clé".encode())], timeout=10)
+    assert non_ascii.status_code == 401
+    assert httpx.post(f"{live}/v1/estimate", content=b"{not json", timeout=10).status_code == 401
+
+
+def test_an_oversized_window_is_refused_at_once_and_healthz_stays_quick(live, window_document):
+    long = {**window_document, "window_id": "long", "sample_rate_hz": 1000.0}  # 1000 samples at 1 kHz: 1 s...
+    long["signals"] = {k: v * 12 for k, v in window_document["signals"].items()}  # ... times 12: 12 s > 10 s
+    with concurrent.futures.ThreadPoolExecutor(2) as pool:
+        refused = pool.submit(_post, live, long)
+        time.sleep(0.05)
+        started = time.perf_counter()
+        assert httpx.get(f"{live}/healthz", timeout=5).status_code == 200
+        assert time.perf_counter() - started < 1.0
+        response = refused.result()
+    assert response.status_code == 422
+    assert response.json()["detail"][0]["loc"] == ["body", "signals"]
+
+
+def test_a_huge_seed_is_a_422_not_a_500(live, window_document):
+    response = _post(live, {**window_document, "window_id": "seed"}, path="/v1/estimate?seed=18446744073709551616")
+    assert response.status_code == 422 and response.json()["detail"][0]["loc"] == ["query", "seed"]
+
+
+def test_a_window_posted_twice_is_stored_once(live, window_document):
+    window = {**window_document, "window_id": "twice"}
+    first, second = _post(live, window), _post(live, window)
+    assert first.status_code == second.status_code == 200
+    assert second.json()["replay"] is True and second.json()["id"] == first.json()["id"]
+    history = httpx.get(f"{live}/v1/actuators/ac-1/elev/estimates", headers={"x-api-key": KEY}, timeout=10).json()
+    assert [h["window_id"] for h in history["estimates"]].count("twice") == 1

@@ -1,0 +1,59 @@
+"""The history file: idempotent, private, checked at start, migrated from the earlier format."""
+
+import json
+import sqlite3
+import stat
+
+import pytest
+
+from service.store import EstimateStore, StorageError
+from sim.params import HealthParams
+from sim.synthetic import synthetic_window
+from tests.service.conftest import SMALL
+from training.pipeline import estimate_window
+
+
+@pytest.fixture(scope="module")
+def result():
+    return estimate_window(synthetic_window(HealthParams.single(), seed=1, duration_s=0.1), SMALL)
+
+
+def test_one_row_per_window_and_the_repeat_is_a_replay(tmp_path, result):
+    store = EstimateStore(tmp_path / "h.sqlite3")
+    first, again = store.add(result), store.add(result)
+    assert not first.replay and again.replay and again.id == first.id
+    current, legacy = store.history(result.actuator_id)
+    assert [s.id for s in current] == [first.id] and legacy == []
+
+
+def test_the_file_is_private(tmp_path, result):
+    EstimateStore(tmp_path / "h.sqlite3").add(result)
+    assert stat.S_IMODE((tmp_path / "h.sqlite3").stat().st_mode) == 0o600
+
+
+def test_a_file_that_is_not_a_database_is_refused_naming_it(tmp_path):
+    broken = tmp_path / "broken.sqlite3"
+    broken.write_bytes(b"this is not sqlite" * 100)
+    with pytest.raises(StorageError) as error:
+        EstimateStore(broken)
+    assert error.value.path == broken
+    assert broken.read_bytes().startswith(b"this is not sqlite")  # refused, never replaced
+
+
+def test_a_round_one_history_is_migrated_and_nothing_is_lost(tmp_path, result):
+    path = tmp_path / "old.sqlite3"
+    old = sqlite3.connect(path)
+    old.executescript(
+        "CREATE TABLE estimates (id INTEGER PRIMARY KEY AUTOINCREMENT, actuator_id TEXT NOT NULL, "
+        "window_id TEXT NOT NULL, stored_at TEXT NOT NULL, result TEXT NOT NULL);"
+    )
+    legacy = {"schema": "ema-estimate/1", "estimates": {"FDJ": {"value": 0.05}}, "window_id": "w"}
+    rows = [("a", "w", "2026-11-01T00:00:00+00:00", json.dumps(legacy))] * 2  # round 1 stored duplicates
+    rows.append(("a", "w2", "2026-11-02T00:00:00+00:00", result.model_dump_json(by_alias=True)))
+    old.executemany("INSERT INTO estimates (actuator_id, window_id, stored_at, result) VALUES (?, ?, ?, ?)", rows)
+    old.commit()
+    old.close()
+    store = EstimateStore(path)
+    current, kept = store.history("a")
+    assert len(current) == 1 and len(kept) == 1  # one row per window, the old format returned as stored
+    assert sqlite3.connect(path).execute("SELECT count(*) FROM estimates_v1").fetchone()[0] == 3
