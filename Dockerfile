@@ -1,4 +1,8 @@
-# ema: the retraining service. Build: docker build -t ema . ; run: docker run -p 8000:8000 ema
+# ema: the retraining service.
+# Build: docker build -t ema .
+# Run:   docker run -p 8000:8000 -e EMA_API_KEY=<16+ characters> -v ema-data:/data ema
+#        (or mount a key file and set EMA_API_KEY_FILE): bound beyond loopback, the service refuses to
+#        start without a key.
 FROM python:3.11-slim
 
 ENV PYTHONDONTWRITEBYTECODE=1 \
@@ -6,28 +10,32 @@ ENV PYTHONDONTWRITEBYTECODE=1 \
     PIP_NO_CACHE_DIR=1 \
     EMA_HOST=0.0.0.0 \
     EMA_DATABASE=/data/ema-history.sqlite3 \
-    NUMBA_CACHE_DIR=/home/ema/.cache/numba
+    NUMBA_CACHE_DIR=/opt/ema/numba-cache
 
-RUN useradd --create-home --uid 10001 ema && mkdir /data && chown ema /data
-WORKDIR /app
+RUN useradd --create-home --uid 10001 ema && mkdir -p /data /opt/ema/numba-cache && chown ema /data /opt/ema/numba-cache
 
 # Dependencies first, from pyproject.toml alone, so code edits do not reinstall them.
 # The CPU wheel of torch: the default index would pull a multi-GB CUDA build.
-COPY pyproject.toml ./
+COPY pyproject.toml /tmp/ema/
 RUN pip install --index-url https://download.pytorch.org/whl/cpu "torch==2.13.0" \
-    && python -c "import tomllib; d = tomllib.load(open('pyproject.toml', 'rb'))['project']['dependencies']; \
+    && python -c "import tomllib; d = tomllib.load(open('/tmp/ema/pyproject.toml', 'rb'))['project']['dependencies']; \
 print('\n'.join(x for x in d if not x.startswith('torch')))" > /tmp/requirements.txt \
     && pip install -r /tmp/requirements.txt
 
-COPY sim ./sim
-COPY training ./training
-COPY service ./service
-COPY clients ./clients
-RUN pip install --no-deps .
+# The code, installed into site-packages; the sources are not kept beside it.
+COPY sim /tmp/ema/sim
+COPY training /tmp/ema/training
+COPY calibration /tmp/ema/calibration
+COPY prognosis /tmp/ema/prognosis
+COPY service /tmp/ema/service
+COPY clients /tmp/ema/clients
+RUN pip install --no-deps /tmp/ema && rm -rf /tmp/ema
 
 USER ema
-# Compile the kernels into the cache at build time, so the first start only loads them.
-RUN python -c "from service.warmup import warm_up; warm_up()"
+WORKDIR /data
+# Compile the kernels at build time, from the installed package (Numba keys its cache on the source
+# path: a warm-up of another copy would leave the service to compile at every start).
+RUN python -c "from training import runtime; runtime.configure(); from service.warmup import warm_up; warm_up()"
 
 VOLUME ["/data"]
 EXPOSE 8000

@@ -10,12 +10,13 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
+from training.calibration.calibrate import Calibrator
+from training.calibration.figure import residual_figure
+
 from clients.report import machine
 from sim.effects import EffectSet
 from sim.params import HealthParams
 from sim.synthetic import synthetic_window
-from training.calibration.calibrate import Calibrator
-from training.calibration.figure import residual_figure
 
 DOCS = Path(__file__).resolve().parent.parent / "docs"
 TRUTH = {"FDJ": 0.053, "eta_O": 0.80}

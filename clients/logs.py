@@ -9,13 +9,12 @@ from __future__ import annotations
 import csv
 import json
 from collections.abc import Iterator
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from sim.aircraft import FlightCondition
 from sim.checks import InputError
 from sim.window import SIGNALS, Window, window_from_dict
 
@@ -39,12 +38,10 @@ def cut(window: Window, window_s: float) -> tuple[list[Window], int]:
         return [window], 0
     count = window.n_samples // n
     pieces = [
-        Window(
-            {name: values[i * n : (i + 1) * n] for name, values in window.signals.items()},
-            window.sample_rate_hz,
-            window.flight_condition,
-            window.actuator_id,
-            f"{window.window_id}#{i}",
+        replace(
+            window,
+            signals={name: values[i * n : (i + 1) * n] for name, values in window.signals.items()},
+            window_id=f"{window.window_id}#{i}",
         )
         for i in range(count)
     ]
@@ -90,19 +87,22 @@ def _from_npz(path: Path, defaults: Defaults) -> list[Window]:
 
 
 def _window(signals: dict[str, np.ndarray], meta: dict[str, Any], defaults: Defaults, path: Path) -> Window:
+    """Arrays and metadata through the ema-window/1 contract, as a JSON window would go."""
     try:
-        return Window(
-            signals,
-            float(meta.get("sample_rate_hz", defaults.sample_rate_hz)),
-            FlightCondition(
-                float(meta.get("airspeed_mps", defaults.airspeed_mps)),
-                float(meta.get("altitude_m", defaults.altitude_m)),
-            ),
-            str(meta.get("actuator_id", defaults.actuator_id)),
-            str(meta.get("window_id", path.stem)),
-        )
+        document = {
+            "schema": "ema-window/1",
+            "actuator_id": str(meta.get("actuator_id", defaults.actuator_id)),
+            "window_id": str(meta.get("window_id", path.stem)),
+            "sample_rate_hz": float(meta.get("sample_rate_hz", defaults.sample_rate_hz)),
+            "flight_condition": {
+                "airspeed_mps": float(meta.get("airspeed_mps", defaults.airspeed_mps)),
+                "altitude_m": float(meta.get("altitude_m", defaults.altitude_m)),
+            },
+            "signals": {name: values.tolist() for name, values in signals.items()},
+        }
     except ValueError as exc:
-        raise InputError(str(path), str(exc)) from None
+        raise InputError(str(path), f"has metadata that is not a number ({exc})") from None
+    return window_from_dict(document)
 
 
 def read_log(path: Path, defaults: Defaults = Defaults()) -> list[Window]:

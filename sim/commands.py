@@ -48,6 +48,56 @@ def random_command_knots(
     return np.stack(commands)
 
 
+def _sines(times: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+    """Autopilot corrections: two sines of 1–4° at 0.3–3 Hz around an offset of up to ±2°."""
+    amplitude, frequency = rng.uniform(1.0, 4.0, 2) / np.sqrt(2), rng.uniform(0.3, 3.0, 2)
+    phase = rng.uniform(0.0, 2 * np.pi, 2)
+    return rng.uniform(-2.0, 2.0) + np.sin(2 * np.pi * np.outer(times, frequency) + phase) @ amplitude
+
+
+def _gust(times: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+    """Gust rejection: white noise through a 50 ms first-order lag, scaled to 2–5° RMS."""
+    step = times[1] - times[0]
+    noise = rng.normal(size=len(times))
+    smooth = np.empty_like(noise)
+    decay, level = np.exp(-step / 0.05), 0.0
+    for i, value in enumerate(noise):
+        level = decay * level + (1 - decay) * value
+        smooth[i] = level
+    return rng.uniform(2.0, 5.0) * smooth / max(float(np.std(smooth)), 1e-12)
+
+
+def _doublet(times: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+    """A pilot's doublet: +A for a fifth of the window, −A for the next fifth (A 2–8°), then back to 0."""
+    duration = times[-1]
+    start, half = rng.uniform(0.1, 0.3) * duration, 0.2 * duration
+    amplitude = rng.uniform(2.0, 8.0) * rng.choice([-1.0, 1.0])
+    return amplitude * ((times >= start) & (times < start + half)) - amplitude * (
+        (times >= start + half) & (times < start + 2 * half)
+    )
+
+
+def _steps(times: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+    """Step and hold: levels uniform in ±10°, each held 50–250 ms."""
+    edges = np.cumsum(rng.uniform(0.05, 0.25, size=int(times[-1] / 0.05) + 2))
+    levels = rng.uniform(-10.0, 10.0, size=len(edges) + 1)
+    return levels[np.searchsorted(edges, times)]
+
+
+FAMILIES = ("thesis", "cruise", "gust", "doublet", "steps")
+
+
+def family_knots(family: str, n_samples: int, sample_rate_hz: float, rng: np.random.Generator) -> np.ndarray:
+    """(n_samples + 1,) knots [deg] of one command of a family: the §5.6 polynomial, or what real
+    flights mostly hold (cruise corrections, gust rejection, a pilot's doublet, steps and holds)."""
+    if family == "thesis":
+        return random_command_knots(n_samples, sample_rate_hz, rng)[0]
+    makers = {"cruise": _sines, "gust": _gust, "doublet": _doublet, "steps": _steps}
+    if family not in makers:
+        raise InputError("command", f"unknown command family {family!r}; known: {', '.join(FAMILIES)}")
+    return makers[family](np.arange(n_samples + 1) / sample_rate_hz, rng)
+
+
 def knots_from_samples(command_deg: np.ndarray) -> np.ndarray:
     """Knots at interval boundaries from interval-mean samples.
 

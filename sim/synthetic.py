@@ -6,7 +6,7 @@ import numpy as np
 
 from sim.aircraft import FlightCondition
 from sim.batch import InitialState, simulate_batch
-from sim.commands import random_command_knots
+from sim.commands import family_knots
 from sim.effects import EffectSet
 from sim.noise import SensorNoise, add_sensor_noise
 from sim.params import HealthParams
@@ -23,15 +23,18 @@ def synthetic_window(
     effects: EffectSet = EffectSet(),
     actuator_id: str = "synthetic/elevator",
     window_id: str | None = None,
+    command: str = "thesis",
 ) -> Window:
-    """One window logged from the model: a §5.6 command, the actuator at rest at 0°, sensor noise.
+    """One window logged from the model: a command of ``command``'s family (``sim.commands.FAMILIES``),
+    the actuator at rest where the command starts, sensor noise.
 
     ``seed`` fixes the command and the noise; ``health`` must hold one simulation.
     """
     rng = np.random.default_rng(seed)
     n_samples = round(duration_s * sample_rate_hz)
-    knots = random_command_knots(n_samples, sample_rate_hz, rng)[0]
-    result = simulate_batch(knots, health, condition, InitialState(), sample_rate_hz, effects)
+    knots = family_knots(command, n_samples, sample_rate_hz, rng)
+    start = InitialState(position_deg=float(np.clip(knots[0], -29.0, 29.0)))
+    result = simulate_batch(knots, health, condition, start, sample_rate_hz, effects)
     signals = add_sensor_noise(result.simulation(0), noise, rng)
     return Window(
         signals=signals,

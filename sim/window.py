@@ -90,7 +90,9 @@ class WindowDocument(_Contract):
                 raise InputError(f"signals.{name}", f"has {len(array)} samples, command_deg has {length}")
         condition = FlightCondition(self.flight_condition.airspeed_mps, self.flight_condition.altitude_m)
         recorded = None if self.recorded_at is None else self.recorded_at.isoformat()
-        return Window(arrays, self.sample_rate_hz, condition, self.actuator_id, self.window_id, recorded, self.flight_hours)
+        return Window(
+            arrays, self.sample_rate_hz, condition, self.actuator_id, self.window_id, recorded, self.flight_hours
+        )
 
 
 @dataclass(frozen=True)

@@ -1,4 +1,4 @@
-"""The pipeline's one configuration: sizes, their defaults and their bounds, defined here only.
+"""The pipeline's one configuration object, built from ``training.sizes`` (the defaults and bounds).
 
 The service's settings, the CLI's flags and their help, and every result (which carries the
 config it ran with) read this model; nothing restates a default or a bound.
@@ -10,22 +10,27 @@ from typing import Any, TypeVar
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
-from sim.checks import from_validation
+from training.sizes import SIZES
 
 Model = TypeVar("Model", bound=BaseModel)
 
 
+def _field(name: str) -> Any:
+    size = SIZES[name]
+    return Field(size.default, ge=size.low, le=size.high, description=size.description)
+
+
 class PipelineConfig(BaseModel):
-    """One window -> estimates: how much to simulate and train."""
+    """One window -> estimates: how much to simulate and train (``training.sizes`` holds the numbers)."""
 
     model_config = ConfigDict(frozen=True, extra="forbid")
 
-    n_simulations: int = Field(96, ge=16, le=4000, description="simulations the network trains on")
-    check_windows: int = Field(32, ge=8, le=1000, description="held-out simulations that score the estimators")
-    n_timesteps: int = Field(500, ge=10, le=10_000, description="network input timesteps (bins of the window)")
-    hidden_units: int = Field(100, ge=1, le=2000, description="hidden neurons")
-    members: int = Field(1, ge=1, le=20, description="networks in the ensemble")
-    seed: int = Field(0, ge=0, le=2**32 - 1, description="seed of the dataset and the training")
+    n_simulations: int = _field("n_simulations")
+    check_windows: int = _field("check_windows")
+    n_timesteps: int = _field("n_timesteps")
+    hidden_units: int = _field("hidden_units")
+    members: int = _field("members")
+    seed: int = _field("seed")
 
     @property
     def total_simulations(self) -> int:
@@ -34,16 +39,14 @@ class PipelineConfig(BaseModel):
 
 def validated(model: type[Model], values: dict[str, Any], prefix: str = "") -> Model:
     """``model(**values)``, its first error as an InputError naming the field (``prefix`` + name)."""
+    from sim.checks import from_validation  # numpy: kept out of this module's import (the CLI's help reads it)
+
     try:
         return model(**values)
     except ValidationError as exc:
         raise from_validation(exc, prefix) from None
 
 
-def bounds(model: type[BaseModel], name: str) -> tuple[float | None, float | None]:
-    """(ge, le) of a field, for help texts and the service's per-request limits."""
-    low = high = None
-    for item in model.model_fields[name].metadata:
-        low = getattr(item, "ge", low)
-        high = getattr(item, "le", high)
-    return low, high
+def bounds(name: str) -> tuple[int, int]:
+    """(low, high) of a pipeline size, for the service's query parameters."""
+    return SIZES[name].low, SIZES[name].high

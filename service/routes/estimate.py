@@ -10,14 +10,14 @@ from service.deps import RunnerDep, SettingsDep, StoreDep, request_config, stopp
 from service.parsing import check_budget, parse
 from service.schemas import json_body, responses
 from sim.window import WindowDocument
-from training.config import PipelineConfig, bounds
+from training.config import bounds
 from training.pipeline import estimate_window
 
 router = APIRouter(tags=["estimate"])
 
 
 def _query(name: str, what: str) -> object:
-    low, high = bounds(PipelineConfig, name)
+    low, high = bounds(name)
     return Query(ge=low, le=high, description=f"{what} (default and ceiling: the service's settings)")
 
 

@@ -21,7 +21,12 @@ from sim.params import HealthParams
 from sim.synthetic import synthetic_window
 from sim.window import SIGNALS, window_to_dict
 
-SMALL_ENV = {"EMA_N_SIMULATIONS": "40", "EMA_N_TIMESTEPS": "100", "EMA_HIDDEN_UNITS": "10", "EMA_CHECK_WINDOWS": "8"}
+SMALL_ENV = {
+    "EMA_PIPELINE__N_SIMULATIONS": "16",
+    "EMA_PIPELINE__CHECK_WINDOWS": "8",
+    "EMA_PIPELINE__N_TIMESTEPS": "50",
+    "EMA_PIPELINE__HIDDEN_UNITS": "8",
+}
 
 
 def _free_port() -> int:
@@ -81,6 +86,17 @@ def test_replay_end_to_end_resume_and_kill_9(tmp_path, log_folder, capsys):
         assert len(out.read_text().strip().splitlines()) == 1 + 5
         assert main(["replay", str(log_folder), "--url", url, "--out", str(out), "--window-s", "0.1", "--json"]) == 0
         assert json.loads(capsys.readouterr().out)["posted"] == 0  # resumed: nothing sent twice
+        # The window in flight when a client died: stored by the server, missing from the CSV.
+        in_flight = synthetic_window(HealthParams.single(), seed=4, duration_s=0.1, actuator_id="ac-7")
+        first = post_window(url, in_flight, None)
+        lines = out.read_text().splitlines()
+        folder = tmp_path / "again"
+        folder.mkdir()
+        (folder / "w.json").write_text(json.dumps(window_to_dict(in_flight)))
+        assert main(["replay", str(folder), "--url", url, "--out", str(out), "--json"]) == 0
+        row = json.loads(capsys.readouterr().out)["rows"][0]
+        assert row["replay"] is True and len(out.read_text().splitlines()) == len(lines) + 1
+        assert first["replay"] is False
     finally:
         server.send_signal(signal.SIGKILL)
         server.wait()
@@ -97,7 +113,20 @@ def test_replay_end_to_end_resume_and_kill_9(tmp_path, log_folder, capsys):
         "flight-1#2",
         "csv-1",
         "npz-1",
+        "synthetic-seed4",
     ]
+
+
+def test_a_refused_window_is_not_posted_again_on_a_rerun(tmp_path, monkeypatch):
+    from clients import replay as replaying
+
+    posted = []
+    monkeypatch.setattr(replaying, "post_window", lambda url, w, key: posted.append(w.window_id) or {"error": "422"})
+    window = synthetic_window(HealthParams.single(), seed=5, duration_s=0.02)
+    out = tmp_path / "estimates.csv"
+    replaying.replay([window], "http://127.0.0.1:9", out)
+    replaying.replay([window], "http://127.0.0.1:9", out)
+    assert posted == [window.window_id]
 
 
 def test_a_bad_file_exits_2_naming_it(tmp_path, capsys):

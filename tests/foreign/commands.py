@@ -47,8 +47,8 @@ def doublet(rng: np.random.Generator, duration_s: float) -> Command:
     amplitude = rng.uniform(3.0, 8.0) * rng.choice([-1.0, 1.0])
     start = rng.uniform(0.05, 0.2) * duration_s
     half = rng.uniform(0.15, 0.3) * duration_s
-    return lambda t: amplitude * ((t >= start) & (t < start + half)) - amplitude * (
-        (t >= start + half) & (t < start + 2 * half)
+    return lambda t: (
+        amplitude * ((t >= start) & (t < start + half)) - amplitude * ((t >= start + half) & (t < start + 2 * half))
     )
 
 

@@ -28,12 +28,16 @@ CASES: dict[str, Case] = {
     ),
     "hinge_moment_bias": lambda rng, k: Effects(hinge_bias_nm=k * rng.choice([-1, 1]) * rng.uniform(20.0, 35.0)),
     "position_friction": lambda rng, k: Effects(
-        bump_nm=k * rng.uniform(0.03, 0.05), bump_centre_deg=rng.uniform(-8.0, 8.0), bump_width_deg=rng.uniform(1.5, 2.0)
+        bump_nm=k * rng.uniform(0.03, 0.05),
+        bump_centre_deg=rng.uniform(-8.0, 8.0),
+        bump_width_deg=rng.uniform(1.5, 2.0),
     ),
     "backlash": lambda rng, k: Effects(backlash_factor=_scaled(1.0, rng.uniform(3.0, 6.0), k)),
     "cogging": lambda rng, k: Effects(
         cogging_nm=k * rng.uniform(0.015, 0.03), cogging_periods=12.0, cogging_phase_rad=rng.uniform(-np.pi, np.pi)
     ),
-    "stribeck": lambda rng, k: Effects(stribeck_nm=k * rng.uniform(0.02, 0.04), stribeck_speed_radps=rng.uniform(80, 250)),
+    "stribeck": lambda rng, k: Effects(
+        stribeck_nm=k * rng.uniform(0.02, 0.04), stribeck_speed_radps=rng.uniform(80, 250)
+    ),
     "drift": lambda rng, k: Effects(drift_per_s=k * rng.uniform(0.3, 0.6)),  # FDJ +15-30 % over a 0.5 s window
 }

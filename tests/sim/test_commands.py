@@ -1,7 +1,11 @@
 import numpy as np
+import pytest
 
+from sim.checks import InputError
 from sim.commands import (
     COMMAND_LIMIT_DEG,
+    FAMILIES,
+    family_knots,
     knots_from_samples,
     random_command_coefficients,
     random_command_knots,
@@ -46,3 +50,17 @@ def test_knots_from_samples_do_not_ring_at_a_step():
     assert knots.min() >= 0.0 and knots.max() <= 10.0
     np.testing.assert_array_equal(knots[:10], 0.0)
     np.testing.assert_array_equal(knots[12:], 10.0)
+
+
+@pytest.mark.parametrize("family", FAMILIES)
+def test_every_family_is_seeded_finite_and_within_a_flights_deflections(family):
+    a = family_knots(family, 5000, 10_000.0, np.random.default_rng(1))
+    b = family_knots(family, 5000, 10_000.0, np.random.default_rng(1))
+    np.testing.assert_array_equal(a, b)
+    assert a.shape == (5001,) and np.all(np.isfinite(a)) and np.abs(a).max() <= 28.0
+    assert np.ptp(a) > 1.0  # it moves
+
+
+def test_an_unknown_family_is_named():
+    with pytest.raises(InputError, match="command"):
+        family_knots("barrel-roll", 100, 10_000.0, np.random.default_rng(0))

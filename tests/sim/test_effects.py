@@ -111,7 +111,7 @@ def test_a_friction_table_adds_its_interpolated_value(base, variable, start, ste
 
 
 def test_a_bad_table_is_named():
-    with pytest.raises(InputError, match="table.variable"):
+    with pytest.raises(InputError, match=r"table\.variable"):
         FrictionTable("load", 0.0, 1.0, (0.0, 0.1))
-    with pytest.raises(InputError, match="table.values_nm"):
+    with pytest.raises(InputError, match=r"table\.values_nm"):
         FrictionTable("time", 0.0, 1.0, (0.0, 2.0))

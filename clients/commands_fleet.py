@@ -1,0 +1,69 @@
+"""Commands for the ground and the bench: an archive across Ray workers, and the latency benchmark."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import click
+
+from clients.options import as_json, emit, pipeline_config, sizes
+
+ARCHIVE = click.Path(exists=True, path_type=Path)
+
+
+@click.command()
+@click.argument("archive", type=ARCHIVE)
+@click.option("--out", required=True, type=click.Path(dir_okay=False, path_type=Path),
+              help="results CSV, one row per window (a rerun resumes from it)")  # fmt: skip
+@click.option("--workers", type=click.IntRange(1, 4096), default=2, help="Ray workers (tasks at a time)")
+@click.option("--ray-address", default=None, help="'auto' or HOST:PORT of a cluster [default: a local Ray]")
+@click.option("--cores", type=click.IntRange(1, 65536), default=None,
+              help="cores the workers share [default: this machine's, or 1 per worker on a cluster]")  # fmt: skip
+@click.option("--window-s", type=click.FloatRange(0.1, 10.0), default=0.5, help="cut recordings into windows [s]")
+@click.option("--database", type=click.Path(dir_okay=False, path_type=Path), default=None,
+              help="also store every answer in this SQLite history (the service's)")  # fmt: skip
+@sizes
+@as_json
+def fleet(archive: Path, out: Path, workers: int, ray_address: str | None, cores: int | None, window_s: float,
+          database: Path | None, as_json: bool, **size_values: int) -> None:  # fmt: skip
+    """Reprocess an archive (folder, NPZ, CSV or JSON logs) on Ray workers; one CSV row per window."""
+    from clients.fleet import run_fleet
+    from clients.logs import windows_of
+    from sim.runtime import available_cores
+
+    config = pipeline_config(size_values)
+    windows = [window for window, _ in windows_of(archive, window_s)]
+    print(f"ema fleet: {len(windows)} window(s) from {archive}, {workers} worker(s)", file=sys.stderr)
+    default_cores = available_cores() if ray_address is None else workers
+    result = run_fleet(windows, out, config, workers, ray_address, cores or default_cores, database)
+    emit(result, as_json, lambda r: click.echo(
+        f"{r['answered']} answered, {r['refused']} refused, {r['skipped']} already in {r['csv']}; "
+        f"{r['windows_per_s']:.2f} windows/s on {r['workers']} worker(s) ({r['engine']})"))  # fmt: skip
+
+
+@click.command()
+@click.option("--out", type=click.Path(file_okay=False, path_type=Path), default=Path("bench-out"),
+              help="folder for bench.json and bench.png")  # fmt: skip
+@click.option("--repeats", type=click.IntRange(1, 1000), default=10, help="windows per duration")
+@click.option("--durations", default="0.5,2", help="window durations [s], comma-separated")
+@click.option("--under-load", type=click.IntRange(0, 64), default=0,
+              help="also time with this many CPU-bound processes running beside")  # fmt: skip
+@click.option("--docs", is_flag=True, help="rewrite the section of docs/benchmarks.md")
+@sizes
+@as_json
+def bench(out: Path, repeats: int, durations: str, under_load: int, docs: bool, as_json: bool,
+          **size_values: int) -> None:  # fmt: skip
+    """Latency of one window -> estimates: p50/p95 per stage, real-time factor, accuracy (idle, and under load)."""
+    from clients.bench import run_bench
+    from sim.checks import InputError
+
+    try:
+        seconds = [float(d) for d in durations.split(",")]
+    except ValueError:
+        raise InputError("--durations", f"must be numbers separated by commas, got {durations!r}") from None
+    result = run_bench(pipeline_config(size_values), seconds, repeats, under_load, out, docs)
+    emit(result, as_json, lambda r: click.echo(r["table"]))
+
+
+COMMANDS = (fleet, bench)

@@ -1,0 +1,138 @@
+"""Commands that run in this process: estimate, simulate, calibrate, serve, schemas."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import click
+
+from clients.options import as_json, emit, flags_named, pipeline_config, progress, sizes, threads
+
+FAMILIES = ("thesis", "cruise", "gust", "doublet", "steps")  # sim.commands.FAMILIES, without importing numpy here
+EXISTING = click.Path(exists=True, dir_okay=False, path_type=Path)
+SIMULATE_FLAGS = {
+    "flight_condition.airspeed_mps": "--airspeed",
+    "flight_condition.altitude_m": "--altitude",
+    "fsj_nm": "--fsj",
+    "fdj_nm": "--fdj",
+    "eta_o": "--eta-o",
+    "sample_rate_hz": "--rate",
+    "command": "--command",
+    "effects": "--effect",
+}
+
+
+@click.command()
+@click.argument("window", type=EXISTING)
+@sizes
+@threads
+@as_json
+def estimate(window: Path, threads: int | None, as_json: bool, **size_values: int) -> None:
+    """Estimate FDJ, η_O, η_A (FSJ where it shows) of one ema-window/1 JSON file, in-process."""
+    from clients.printing import print_estimate
+    from sim.window import read_window
+    from training import runtime
+    from training.pipeline import estimate_window
+
+    config = pipeline_config(size_values)
+    runtime.configure(threads)
+    result = estimate_window(read_window(window), config, on_stage=progress)
+    emit(result, as_json, print_estimate)
+
+
+@click.command()
+@click.option("--out", required=True, type=click.Path(dir_okay=False, path_type=Path), help="window JSON to write")
+@click.option("--fdj", type=float, default=0.05, help="dynamic friction FDJ [N·m]")
+@click.option("--eta-o", "eta_o", type=float, default=0.85, help="opposing efficiency η_O")
+@click.option("--fsj", type=float, default=0.10, help="static friction FSJ [N·m]")
+@click.option("--airspeed", type=float, default=153.01, help="true airspeed [m/s], 90–215")
+@click.option("--altitude", type=float, default=0.0, help="altitude [m], 0–10000")
+@click.option("--command", type=click.Choice(FAMILIES), default="thesis", help="the command's family")
+@click.option("--seed", type=int, default=0, help="seed of the command and the noise")
+@click.option("--duration", type=click.FloatRange(0.01, 60.0), default=0.5, help="window length [s]")
+@click.option("--rate", type=float, default=10_000.0, help="log rate [Hz], 1000–100000")
+@click.option("--clean", is_flag=True, help="no sensor noise")
+@click.option("--effect", "effect", multiple=True, metavar="NAME[:KEY=VALUE,...]",
+              help="an effect the base model lacks, e.g. cogging:amplitude_nm=0.02 (repeatable)")  # fmt: skip
+@click.option("--actuator-id", default="synthetic/elevator", help="actuator_id written to the window")
+@click.option("--truth-out", type=click.Path(dir_okay=False, path_type=Path), help="also write the truth as JSON")
+@as_json
+def simulate(as_json: bool, **options: Any) -> None:
+    """Write a synthetic ema-window/1 file from the model (sensor noise unless --clean)."""
+    from clients.printing import print_simulate
+    from clients.synthesis import synthesize
+
+    with flags_named(SIMULATE_FLAGS):
+        result = synthesize(**options)
+    emit(result, as_json, print_simulate)
+
+
+@click.command()
+@click.argument("windows", type=EXISTING, nargs=-1, required=True)
+@click.option("--truth", type=EXISTING, help='JSON {"FDJ": ..., "eta_O": ...} of synthetic windows')
+@click.option("--figure", type=click.Path(dir_okay=False, path_type=Path), default=Path("calibration.png"),
+              help="PNG of the residual before and after")  # fmt: skip
+@click.option("--copies", type=click.IntRange(8, 500), default=30, help="noise-only copies behind the noise floor")
+@sizes
+@threads
+@as_json
+def calibrate(windows: tuple[Path, ...], truth: Path | None, figure: Path, copies: int, threads: int | None,
+              as_json: bool, **size_values: int) -> None:  # fmt: skip
+    """Trace what the model misses in windows of one actuator to an effect, add it, re-estimate."""
+    from calibration.calibrate import Calibrator
+    from clients.figures import calibration_figure
+    from clients.printing import print_calibration, read_truth
+    from sim.window import read_window
+    from training import runtime
+
+    config = pipeline_config(size_values)
+    runtime.configure(threads)
+    loaded = [read_window(path) for path in windows]
+    calibrator = Calibrator(config, copies=copies, seed=config.seed).fit(loaded, read_truth(truth), on_stage=progress)
+    written = calibration_figure(calibrator, figure)
+    emit({**calibrator.report_.model_dump(mode="json", by_alias=True), "figure": str(written)}, as_json,
+         print_calibration)  # fmt: skip
+
+
+@click.command()
+@click.option("--host", default=None, help="bind address [default: EMA_HOST, else 127.0.0.1]")
+@click.option("--port", type=click.IntRange(1, 65535), default=None, help="port [default: EMA_PORT, else 8000]")
+@click.option("--database", type=click.Path(dir_okay=False, path_type=Path), default=None,
+              help="SQLite history file [default: EMA_DATABASE, else ./ema-history.sqlite3]")  # fmt: skip
+@click.option("--api-key-file", type=EXISTING, default=None, help="a file holding the API key (or EMA_API_KEY)")
+def serve(**flags: Any) -> None:
+    """Run the HTTP service (all settings: EMA_* environment variables; the flags win)."""
+    import uvicorn
+    from pydantic import ValidationError
+
+    from service.config import Settings
+    from service.main import create_app
+    from service.store import EstimateStore
+    from sim.checks import InputError, from_validation
+
+    try:
+        settings = Settings(**{k: v for k, v in flags.items() if v is not None})
+    except ValidationError as exc:
+        error = from_validation(exc)
+        raise InputError(f"--{error.field.replace('_', '-')} / EMA_{error.field.upper()}", error.message) from None
+    EstimateStore(settings.database).close()  # refused here, naming the file, before the server starts
+    uvicorn.run(create_app(settings), host=settings.host, port=settings.port, log_level="info")
+
+
+@click.command()
+@click.option("--out", type=click.Path(file_okay=False, path_type=Path), default=Path("docs/schemas"),
+              help="folder for the JSON Schemas")  # fmt: skip
+@click.option("--check", is_flag=True, help="exit 1 if the files there differ from the code")
+def schemas(out: Path, check: bool) -> None:
+    """Export the JSON Schema of every public document (or check the exported ones)."""
+    from clients.schemas import export
+
+    stale = export(out, check=check)
+    if check and stale:
+        raise click.ClickException(f"stale or missing in {out}: {', '.join(stale)} (run: ema schemas --out {out})")
+    click.echo(json.dumps({"folder": str(out), "checked" if check else "written": "all"}))
+
+
+COMMANDS = (estimate, simulate, calibrate, serve, schemas)

@@ -1,0 +1,91 @@
+"""ema fleet on a small archive: every window answered once, resumable; and ema history's prognosis plot."""
+
+import csv
+import json
+
+import pytest
+
+from clients.cli import EXIT_OK, main
+from sim.params import HealthParams
+from sim.synthetic import synthetic_window
+from sim.window import window_to_dict
+
+SIZES = ["--sims", "16", "--checks", "8", "--timesteps", "50", "--hidden", "8"]
+
+
+@pytest.fixture
+def archive(tmp_path):
+    folder = tmp_path / "archive"
+    folder.mkdir()
+    for a in range(2):
+        for w in range(3):
+            window = synthetic_window(HealthParams.single(), seed=10 * a + w, duration_s=0.1, actuator_id=f"tail-{a}")
+            (folder / f"{a}-{w}.json").write_text(json.dumps({**window_to_dict(window), "window_id": f"w{w}"}))
+    (folder / "9-hold.json").write_text(json.dumps({**window_to_dict(window), "window_id": "hold",
+        "signals": {k: [0.0] * 1000 for k in window.signals}}))  # fmt: skip
+    return folder
+
+
+def _rows(path):
+    with path.open() as handle:
+        return list(csv.DictReader(handle))
+
+
+@pytest.mark.slow
+def test_a_local_ray_run_answers_every_window_once_and_resumes(archive, tmp_path, capsys):
+    out, database = tmp_path / "results.csv", tmp_path / "history.sqlite3"
+    arguments = ["fleet", str(archive), "--out", str(out), "--workers", "2", "--database", str(database), *SIZES]
+    assert main([*arguments, "--json"]) == EXIT_OK
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["engine"] == "ray" and summary["answered"] == 6 and summary["refused"] == 1
+    rows = _rows(out)
+    assert len(rows) == 7 and len({(r["actuator_id"], r["window_id"]) for r in rows}) == 7
+    assert main([*arguments, "--json"]) == EXIT_OK  # rerun: nothing twice
+    assert json.loads(capsys.readouterr().out)["skipped"] == 7 and len(_rows(out)) == 7
+
+
+def test_one_worker_without_ray_runs_in_process(archive, tmp_path, capsys, monkeypatch):
+    from clients import fleet
+
+    monkeypatch.setattr(fleet, "ray_installed", lambda: False)
+    out = tmp_path / "results.csv"
+    assert main(["fleet", str(archive), "--out", str(out), "--workers", "1", "--json", *SIZES]) == EXIT_OK
+    captured = capsys.readouterr()
+    summary = json.loads(captured.out)
+    assert summary["engine"] == "in-process" and summary["answered"] == 6
+    assert "[7/7]" in captured.err and "windows/s" in captured.err  # progress: done, rate, time left
+
+
+def test_history_plots_a_prognosis_whose_interval_holds_the_truth(tmp_path, capsys):
+    import numpy as np
+
+    from service.store import EstimateStore
+    from tests.clients.test_replay import _free_port, _start_server
+    from training.config import PipelineConfig
+    from training.documents import parameter
+    from training.pipeline import estimate_window
+
+    small = PipelineConfig(n_simulations=16, check_windows=8, n_timesteps=50, hidden_units=8)
+    base = estimate_window(synthetic_window(HealthParams.single(), seed=1, duration_s=0.1), small)
+    rng, store = np.random.default_rng(0), EstimateStore(tmp_path / "history.sqlite3")
+    hours = np.sort(rng.uniform(0, 200, 200))
+    for i, h in enumerate(hours):  # FDJ rising 1e-4 N·m per flight hour: crosses 0.075 at 250 h
+        fdj = 0.05 + 1e-4 * h + 4e-4 * rng.normal()
+        estimates = base.estimates.model_copy(update={"FDJ": parameter(fdj, 4e-4, 0.05)})
+        window = base.window.model_copy(update={"flight_hours": float(h)})
+        store.add(base.model_copy(update={"estimates": estimates, "window": window, "actuator_id": "tail-9",
+                                          "window_id": f"w{i}"}))  # fmt: skip
+    store.close()
+    port = _free_port()
+    server = _start_server(port, tmp_path / "history.sqlite3")
+    try:
+        plot = tmp_path / "fdj.png"
+        arguments = ["history", "tail-9", "--url", f"http://127.0.0.1:{port}", "--plot", str(plot), "--json"]
+        assert main(arguments) == EXIT_OK
+    finally:
+        server.terminate()
+        server.wait(timeout=30)
+    life = json.loads(capsys.readouterr().out)["prognosis"]["remaining_life"]["FDJ"]
+    assert life["status"] == "crossing predicted"
+    assert life["rul_low"] <= 250 - hours.max() <= life["rul_high"]
+    assert plot.stat().st_size > 10_000

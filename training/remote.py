@@ -1,0 +1,46 @@
+"""One window as a self-contained task: what a Ray worker (or any other process) runs.
+
+The task carries the window as its ``ema-window/1`` JSON and the config as a dict, pins its own
+thread budget (``training.runtime``) before it computes, and returns the ``ema-estimate/1``
+document as JSON-able data, or the reason a window was refused. Ray is imported only here, and
+only when asked for: it is an optional extra (``pip install -e '.[fleet]'``).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from sim.checks import InputError
+from sim.window import window_from_dict
+from training import runtime
+from training.config import PipelineConfig
+from training.pipeline import estimate_window
+
+
+def estimate_document(window: dict[str, Any], config: dict[str, Any], threads: int) -> dict[str, Any]:
+    """The estimate of one window as a JSON-able dict, or {"error": ...} for a window refused as bad input."""
+    runtime.configure(threads)
+    try:
+        result = estimate_window(window_from_dict(window), PipelineConfig(**config))
+    except InputError as exc:
+        return {"error": str(exc)}
+    return result.model_dump(mode="json", by_alias=True)
+
+
+def ray_task(threads: int) -> Any:
+    """``estimate_document`` as a Ray remote function that reserves ``threads`` CPUs per task."""
+    import ray
+
+    return ray.remote(num_cpus=threads, max_retries=2)(estimate_document)
+
+
+def connect(address: str | None, cpus: int) -> None:
+    """Join the cluster at ``address`` ("auto" or host:port), or start a local Ray with ``cpus`` CPUs."""
+    import ray
+
+    if ray.is_initialized():
+        return
+    if address is None:
+        ray.init(num_cpus=cpus, include_dashboard=False, log_to_driver=False, configure_logging=False)
+    else:
+        ray.init(address=address, log_to_driver=False, configure_logging=False)
