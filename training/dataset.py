@@ -18,6 +18,8 @@ from training.noise_level import excess_noise
 
 INITIAL_FIT_SAMPLES = 8
 SIGNALS_READ = ("current_a", "motor_speed_radps", "hinge_moment_nm", "position_deg")  # all the estimators read
+# Position enters the estimators only through the end-stop margin, 1° wide: its 0.01° noise is not drawn.
+NOISY = ("current_a", "motor_speed_radps", "hinge_moment_nm")
 
 
 @dataclass(frozen=True)
@@ -85,22 +87,36 @@ class Simulated:
     """A batch of noisy simulated windows and what the estimators read of them."""
 
     health: HealthParams  # the truth of every simulation (FSJ included)
+    noise: SensorNoise  # the window's own sensor noise, added to every simulation
     signals: dict[str, np.ndarray]  # SIGNALS_READ, (n, n_samples), sensor noise added
     residual_nm: np.ndarray  # (n, n_samples) T_R of the noisy signals
-    clean_residual_nm: np.ndarray  # (n, n_samples) T_R without sensor noise: the noise floor's reference
+    clean_residual_nm: np.ndarray  # (k, n_samples) T_R without sensor noise, of the last k: the noise floor's reference
 
 
-def simulate_noisy(scenario: Scenario, health: HealthParams, noise: SensorNoise, seed: int) -> Simulated:
-    """Simulate ``health``, add ``noise`` where the estimators read, reconstruct T_R with and without it."""
-    result = scenario.simulate(health)
-    clean = {name: result.signals[name] for name in SIGNALS_READ}
-    noisy = add_sensor_noise(clean, noise, np.random.default_rng(seed))
+def simulate_noisy(
+    scenario: Scenario, health: HealthParams, window: Window, reference: HealthParams, seed: int, clean_last: int
+) -> Simulated:
+    """Simulate ``health``, add the window's own noise where the estimators read, reconstruct T_R with it
+    (and without it for the last ``clean_last`` simulations).
+
+    The noise is measured against a clean simulation of the window at ``reference`` (one point),
+    run in the same batch: it takes a lane the batch would have padded anyway.
+    """
+    together = HealthParams(
+        *(np.concatenate([getattr(health, name), getattr(reference, name)]) for name in ("fsj_nm", "fdj_nm", "eta_o"))
+    )
+    result = scenario.simulate(together)
+    noise = excess_noise(window.signals, {name: values[-1] for name, values in result.signals.items()})
+    clean = {name: result.signals[name][:-1] for name in SIGNALS_READ}
+    rng = np.random.default_rng(seed)
+    noisy = {**clean, **add_sensor_noise({name: clean[name] for name in NOISY}, noise, rng)}
     rate = scenario.sample_rate_hz
 
     def residual(s: dict[str, np.ndarray]) -> np.ndarray:
         return residual_torque_nm(s["current_a"], s["motor_speed_radps"], s["hinge_moment_nm"], rate)
 
-    return Simulated(health, noisy, residual(noisy), residual(clean))
+    tail = {name: values[len(health) - clean_last :] for name, values in clean.items()}
+    return Simulated(health, noise, noisy, residual(noisy), residual(tail))
 
 
 def window_noise(window: Window, scenario: Scenario, health: HealthParams) -> SensorNoise:

@@ -41,7 +41,9 @@ def test_noisy_simulations_are_seeded_and_keep_their_clean_residual():
     window = synthetic_window(HealthParams.single(), seed=7, duration_s=0.05)
     scenario = scenario_from_window(window)
     health = HealthParams(np.full(8, 0.1), np.linspace(0.04, 0.06, 8), np.full(8, 0.85))
-    a, b = simulate_noisy(scenario, health, SensorNoise(), 3), simulate_noisy(scenario, health, SensorNoise(), 3)
-    assert a.residual_nm.shape == (8, 500)
+    a = simulate_noisy(scenario, health, window, HealthParams.single(), 3, 2)
+    b = simulate_noisy(scenario, health, window, HealthParams.single(), 3, 2)
+    assert a.residual_nm.shape == (8, 500) and a.clean_residual_nm.shape == (2, 500)
+    assert a.noise.current_a == pytest.approx(SensorNoise().current_a, rel=0.3)  # the window's own, measured
     np.testing.assert_array_equal(a.residual_nm, b.residual_nm)
-    assert not np.array_equal(a.residual_nm, a.clean_residual_nm)
+    assert not np.array_equal(a.residual_nm[-2:], a.clean_residual_nm)
