@@ -39,7 +39,8 @@ class Settings(BaseSettings):
     api_prefix: str = Field("/v1", pattern=r"^/[a-z0-9]+$")
     database: Path = Path("ema-history.sqlite3")
     backend: Literal["local", "ray"] = "local"  # ray: a ground station's service fans out to a cluster
-    ray_address: str | None = None
+    ray_address: str | None = Field(None, description="'auto' or host:port; none: a local Ray")
+    ray_jobs: int = Field(4, ge=1, le=4096, description="with the ray backend: estimates in flight at once")
 
     pipeline: PipelineConfig = PipelineConfig()
     max_simulations: int = Field(512, ge=16, le=4000, description="ceiling of a request's n_simulations")

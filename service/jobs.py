@@ -1,9 +1,10 @@
 """Admission and the job queue: one pipeline at a time, at most ``max_queue`` waiting, whatever the timing.
 
 One pipeline already uses the whole thread budget (the simulator's pool; torch on one thread),
-so running two side by side would only slow both. A request is *admitted* the moment it arrives,
-before its body is read: at most 1 + ``max_queue`` hold a place, the next gets 503 at once with a
-Retry-After from measured job times. A waiting request whose client hangs up leaves the queue;
+so running two side by side would only slow both (with the Ray backend, ``slots`` run at once on
+the cluster). A request is *admitted* the moment it arrives, before its body is read: at most
+``slots`` + ``max_queue`` hold a place, the next gets 503 at once with a Retry-After from
+measured job times. A waiting request whose client hangs up leaves the queue;
 a running one is told to stop at its next stage (``Cancelled``), and its slot is freed when its
 thread returns, not when the client leaves: the next job never starts beside it.
 """
@@ -49,11 +50,14 @@ class Ticket:
 
 
 class JobRunner:
-    def __init__(self, max_queue: int, queue_timeout_s: float, initializer: Callable[[], None] | None = None) -> None:
+    """``slots`` jobs at a time: one on this computer (it uses every core), more when Ray runs them elsewhere."""
+
+    def __init__(self, max_queue: int, queue_timeout_s: float, slots: int = 1) -> None:
         self.max_queue = max_queue
         self.queue_timeout_s = queue_timeout_s
-        self._executor = ThreadPoolExecutor(max_workers=1, thread_name_prefix="ema-pipeline", initializer=initializer)
-        self._slot = asyncio.Semaphore(1)
+        self.slots = slots
+        self._executor = ThreadPoolExecutor(max_workers=slots, thread_name_prefix="ema-pipeline")
+        self._slot = asyncio.Semaphore(slots)
         self.admitted = 0  # running + waiting
         self.running = 0
         self._mean_job_s = 1.0  # until measured
@@ -63,11 +67,11 @@ class JobRunner:
         return self.admitted - self.running
 
     def retry_after_s(self) -> int:
-        return max(1, math.ceil(self._mean_job_s * max(self.admitted, 1)))
+        return max(1, math.ceil(self._mean_job_s * max(self.admitted, 1) / self.slots))
 
     def admit(self) -> Ticket:
         """A place, or OverloadedError at once when 1 + max_queue requests hold one."""
-        if self.admitted >= 1 + self.max_queue:
+        if self.admitted >= self.slots + self.max_queue:
             raise OverloadedError(f"{self.running} running, {self.queued} waiting (max {self.max_queue})",
                                   self.retry_after_s())  # fmt: skip
         self.admitted += 1

@@ -51,9 +51,14 @@ def _openapi(app: FastAPI) -> dict[str, Any]:
 def create_app(settings: Settings) -> FastAPI:
     @asynccontextmanager
     async def lifespan(app: FastAPI) -> AsyncIterator[None]:
-        runtime.configure(settings.threads)
+        threads = runtime.configure(settings.threads)
         app.state.store = EstimateStore(settings.database)
-        app.state.runner = JobRunner(settings.max_queue, settings.queue_timeout_s)
+        slots = settings.ray_jobs if settings.backend == "ray" else 1
+        app.state.runner = JobRunner(settings.max_queue, settings.queue_timeout_s, slots)
+        if settings.backend == "ray":
+            from training.remote import connect
+
+            connect(settings.ray_address, threads)
         if settings.warm_up:
             await asyncio.get_running_loop().run_in_executor(app.state.runner._executor, warm_up)
             log.info("kernels warm")

@@ -231,23 +231,8 @@ def run_group(c, table_nm, load, per_sim, knots_rad, interval_steps, initial, fi
     per_sim_command = knots_rad.shape[0] > 1
     use_table = load.slow_table_nm.shape[0] > 0
     load_delta = load.hinge_delta_nm * c.inverse_gear  # d(T_ext)/dθ_u [N·m/rad]
-    lane = np.zeros((N_LANE_ROWS, lanes))
-    group = slice(first, first + lanes)
-    lane[CURRENT_NOW] = initial[INIT_CURRENT, group]
-    lane[SPEED_NOW] = initial[INIT_SPEED, group]
-    lane[POSITION_NOW] = initial[INIT_POSITION, group]
-    lane[ANGLE_NOW] = initial[INIT_POSITION, group]  # the shaft starts centred in the dead band
-    lane[LANE_FDJ] = per_sim[FDJ, group]
-    lane[LANE_FSJ] = per_sim[FSJ, group]
-    lane[LANE_K_AID] = per_sim[K_AID, group]
-    lane[LANE_K_OPP] = per_sim[K_OPP, group]
-    lane[DRY_DYNAMIC] = per_sim[FDJ, group]  # friction effects, when on, add to these every step
-    lane[DRY_STATIC] = per_sim[FSJ, group]
+    lane = _start_lanes(c, load, per_sim, initial, first, lanes)
     aircraft = np.zeros((lanes, 4))  # Δx: every simulation starts at trim
-    for s in range(lanes):
-        slow = load.slow_table_nm[0] if use_table else _hinge_slow(load, aircraft[s], 0.0)
-        lane[LOAD_SLOW, s] = slow * c.inverse_gear
-
     elapsed_steps = 0
     for k in range(n_samples):
         steps = interval_steps[k]
@@ -266,6 +251,28 @@ def run_group(c, table_nm, load, per_sim, knots_rad, interval_steps, initial, fi
             else:
                 _advance_aircraft(load, aircraft[s], out[POSITION, first + s, k])
                 lane[LOAD_SLOW, s] = _hinge_slow(load, aircraft[s], elapsed_steps * c.step_s) * c.inverse_gear
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _start_lanes(c, load, per_sim, initial, first, lanes):
+    """(N_LANE_ROWS, lanes): the group's state at t = 0, its health, and the load at trim."""
+    lane = np.zeros((N_LANE_ROWS, lanes))
+    group = slice(first, first + lanes)
+    lane[CURRENT_NOW] = initial[INIT_CURRENT, group]
+    lane[SPEED_NOW] = initial[INIT_SPEED, group]
+    lane[POSITION_NOW] = initial[INIT_POSITION, group]
+    lane[ANGLE_NOW] = initial[INIT_POSITION, group]  # the shaft starts centred in the dead band
+    lane[LANE_FDJ] = per_sim[FDJ, group]
+    lane[LANE_FSJ] = per_sim[FSJ, group]
+    lane[LANE_K_AID] = per_sim[K_AID, group]
+    lane[LANE_K_OPP] = per_sim[K_OPP, group]
+    lane[DRY_DYNAMIC] = per_sim[FDJ, group]  # friction effects, when on, add to these every step
+    lane[DRY_STATIC] = per_sim[FSJ, group]
+    trim = np.zeros(4)
+    for s in range(lanes):
+        slow = load.slow_table_nm[0] if load.slow_table_nm.shape[0] > 0 else _hinge_slow(load, trim, 0.0)
+        lane[LOAD_SLOW, s] = slow * c.inverse_gear
+    return lane
 
 
 @njit(cache=True, inline="always", error_model="numpy")

@@ -137,6 +137,21 @@ def _mse(model: ShallowNet, z: torch.Tensor, y: torch.Tensor) -> float:
         return float(torch.mean((model.head(z) - y) ** 2))
 
 
+def _optimizer(model: ShallowNet, config: TrainConfig) -> torch.optim.Optimizer:
+    if config.optimizer == "adam":
+        return torch.optim.Adam(model.parameters(), lr=config.learning_rate)
+    return torch.optim.LBFGS(
+        model.parameters(),
+        lr=config.learning_rate,
+        max_iter=1,  # one iteration per epoch, so early stopping sees every step
+        max_eval=25,  # the default, 1.25 x max_iter = 1, leaves the line search no evaluation
+        history_size=50,
+        line_search_fn="strong_wolfe",
+        tolerance_grad=0.0,  # its own stopping rules (on tiny gradients) would end training silently;
+        tolerance_change=0.0,  # the epoch loop's validation check decides instead
+    )
+
+
 def fit(inputs: np.ndarray, targets: np.ndarray, config: TrainConfig) -> FitResult:
     """Train one network on (N, F) inputs and (N, T) targets in [0, 1]; seeded end to end."""
     start = time.perf_counter()
@@ -150,19 +165,7 @@ def fit(inputs: np.ndarray, targets: np.ndarray, config: TrainConfig) -> FitResu
         z = model.project(x)  # (N, P): projected once, not in every line-search evaluation
     z_train = z[parts["train"]]
     loss_fn = nn.MSELoss()
-    if config.optimizer == "lbfgs":
-        optimizer: torch.optim.Optimizer = torch.optim.LBFGS(
-            model.parameters(),
-            lr=config.learning_rate,
-            max_iter=1,  # one iteration per epoch, so early stopping sees every step
-            max_eval=25,  # the default, 1.25 x max_iter = 1, leaves the line search no evaluation
-            history_size=50,
-            line_search_fn="strong_wolfe",
-            tolerance_grad=0.0,  # its own stopping rules (on tiny gradients) would end training silently;
-            tolerance_change=0.0,  # the epoch loop's validation check decides instead
-        )
-    else:
-        optimizer = torch.optim.Adam(model.parameters(), lr=config.learning_rate)
+    optimizer = _optimizer(model, config)
 
     def closure() -> torch.Tensor:
         optimizer.zero_grad()

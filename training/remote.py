@@ -11,9 +11,10 @@ from __future__ import annotations
 from typing import Any
 
 from sim.checks import InputError
-from sim.window import window_from_dict
+from sim.window import Window, window_from_dict, window_to_dict
 from training import runtime
 from training.config import PipelineConfig
+from training.documents import Estimate
 from training.pipeline import estimate_window
 
 
@@ -44,3 +45,14 @@ def connect(address: str | None, cpus: int) -> None:
         ray.init(num_cpus=cpus, include_dashboard=False, log_to_driver=False, configure_logging=False)
     else:
         ray.init(address=address, log_to_driver=False, configure_logging=False)
+
+
+def estimate_on_ray(window: Window, config: PipelineConfig, threads: int) -> Estimate:
+    """``estimate_window`` run as a Ray task (the service's EMA_BACKEND=ray); blocks this thread until done."""
+    import ray
+
+    answer = ray.get(ray_task(threads).remote(window_to_dict(window), config.model_dump(), threads))
+    if "error" in answer:
+        field, _, message = answer["error"].partition(": ")
+        raise InputError(field, message)
+    return Estimate.model_validate(answer)

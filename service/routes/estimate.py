@@ -52,6 +52,11 @@ async def estimate(
         sizes = {"n_simulations": n_simulations, "n_timesteps": n_timesteps, "hidden_units": hidden_units}
         config = request_config(settings, **sizes, seed=seed)
         check_budget(window, config, settings)
-        result = await runner.run(ticket, request.is_disconnected, estimate_window, window, config,
-                                  stopper(ticket.cancel))  # fmt: skip
+        if settings.backend == "ray":
+            from training.remote import estimate_on_ray
+
+            result = await runner.run(ticket, request.is_disconnected, estimate_on_ray, window, config, 1)
+        else:
+            result = await runner.run(ticket, request.is_disconnected, estimate_window, window, config,
+                                      stopper(ticket.cancel))  # fmt: skip
         return await run_in_threadpool(store.add, result)  # committed (fsync) before the answer leaves

@@ -151,3 +151,15 @@ def test_the_openapi_document_states_bodies_errors_and_bounds(client):
     seed = next(p for p in post["parameters"] if p["name"] == "seed")
     assert seed["schema"]["anyOf"][0]["maximum"] == 2**32 - 1
     assert client.get("/docs").status_code == 200 and "cdn" not in client.get("/docs").text
+
+
+@pytest.mark.slow
+def test_a_ground_station_fans_out_to_ray(tmp_path, document):
+    settings = settings_for(tmp_path, backend="ray", ray_jobs=2)
+    with TestClient(create_app(settings), base_url=LOCAL) as client:
+        first = client.post("/v1/estimate", json=document)
+        second = client.post("/v1/estimate", json={**document, "window_id": "w2"})
+        hold = {**document, "window_id": "hold", "signals": {k: [0.0] * 1000 for k in document["signals"]}}
+        refused = client.post("/v1/estimate", json=hold)
+    assert first.status_code == second.status_code == 200
+    assert refused.status_code == 422 and refused.json()["detail"][0]["loc"] == ["body", "signals"]
