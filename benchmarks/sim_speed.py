@@ -4,7 +4,7 @@ Beside it, in the same run: the plain NumPy model vectorized across the same 500
 (timed on a short horizon and scaled: it is linear in the horizon), the one-lane scalar path of the
 same kernel, and the thesis's Simulink figure (100-150 ms per 0.5 s simulation).
 
-    python benchmarks/sim_speed.py [--sims 500] [--repeats 3]
+    python benchmarks/sim_speed.py [--sims 500] [--repeats 3] [--docs]
 """
 
 from __future__ import annotations
@@ -15,6 +15,7 @@ import time
 import numpy as np
 
 from clients.report import write_section
+from sim import runtime
 from sim.aircraft import FlightCondition, load_model
 from sim.batch import kernel_constants, simulate_batch
 from sim.commands import random_command_knots
@@ -42,7 +43,9 @@ def main() -> None:
     parser.add_argument("--samples", type=int, default=5000, help="log samples per simulation (5000 = 0.5 s)")
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--numpy-samples", type=int, default=5, help="horizon of the NumPy timing")
+    parser.add_argument("--docs", action="store_true", help="rewrite the section of docs/benchmarks.md")
     args = parser.parse_args()
+    threads = runtime.configure()
 
     rng = np.random.default_rng(0)
     health = HealthParams.uniform(args.sims, DEFAULT_RANGES, rng)
@@ -55,19 +58,20 @@ def main() -> None:
     short = args.samples // 10
     scalar_s = best_of(1, lambda: simulate_batch(knots[: short + 1], health, lanes=1)) * args.samples / short
 
-    c = kernel_constants(ActuatorParams(), EffectSet(), STEPS_PER_SAMPLE)
+    c = kernel_constants(ActuatorParams(), EffectSet())
     load = load_model(FlightCondition(), STEPS_PER_SAMPLE * 1e-6)
     eta_a = health.eta_a()
     per_sim = np.stack([health.fdj_nm, health.fsj_nm, 1 - eta_a, 1 / health.eta_o - 1])
     initial = np.zeros((3, args.sims))
     knots_rad = np.radians(knots[: args.numpy_samples + 1])[None]
-    numpy_s = best_of(1, lambda: simulate_numpy(c, load, per_sim, knots_rad, initial, args.numpy_samples))
+    steps_each = np.full(args.numpy_samples, STEPS_PER_SAMPLE)
+    numpy_s = best_of(1, lambda: simulate_numpy(c, load, per_sim, knots_rad, initial, steps_each))
     numpy_s *= args.samples / args.numpy_samples
 
     thesis_s = tuple(ms / 1000 * args.sims for ms in THESIS_MS_PER_SIM)
     rows = [
-        ("lock-step kernel, 64 lanes, all cores", fast_s, "measured"),
-        ("same kernel, 1 lane (scalar path), all cores", scalar_s, f"measured on {short} samples, scaled"),
+        (f"lock-step kernel, 64 lanes, {threads} threads", fast_s, "measured"),
+        (f"same kernel, 1 lane (scalar path), {threads} threads", scalar_s, f"measured on {short} samples, scaled"),
         ("NumPy, vectorized across simulations", numpy_s, f"measured on {args.numpy_samples} samples, scaled"),
         ("thesis, Simulink Accelerator", thesis_s[0], f"{THESIS_MS_PER_SIM[0]:g}-{THESIS_MS_PER_SIM[1]:g} ms per sim"),
     ]
@@ -82,7 +86,8 @@ def main() -> None:
         lines.append(f"| {name} | {seconds:.3g} | {seconds / steps * 1e9:.3g} | {seconds / fast_s:.3g}x | {note} |")
     body = "\n".join(lines)
     print(body)
-    write_section("Simulator speed", "python benchmarks/sim_speed.py", body)
+    if args.docs:
+        write_section("Simulator speed", "python benchmarks/sim_speed.py --docs", body)
 
 
 if __name__ == "__main__":
