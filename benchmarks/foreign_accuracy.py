@@ -7,7 +7,7 @@ answered, the mean and worst |error| (relative, and in % of the thesis's range: 
 0.30 for η_O), and the coverage: the share of answers whose ±2 std holds the truth (FSJ: of the
 answers that gave one).
 
-    python benchmarks/foreign_accuracy.py [--per-group 12] [--docs]
+    python -m benchmarks.foreign_accuracy [--per-group 12] [--docs]
 """
 
 from __future__ import annotations
@@ -61,7 +61,8 @@ def run_one(window: Draw) -> dict[str, Any]:
         if entry is None or entry["std"] is None:
             continue
         error = entry["value"] - window.truth[name]
-        row[name] = {"relative": error / window.truth[name], "z": error / entry["std"]}
+        row[name] = {"relative": error / window.truth[name], "z": error / entry["std"], "truth": window.truth[name],
+                     "value": entry["value"], "std": entry["std"]}  # fmt: skip
         if name in RANGE:
             row[name]["of_range"] = error / RANGE[name]
     return row
@@ -114,6 +115,31 @@ def pooled(rows: dict[str, list[dict[str, Any]]], worn_only: bool) -> dict:
     return summarize(chosen)
 
 
+def wear_figure(rows: dict[str, list[dict[str, Any]]], path: Path) -> None:
+    """Estimate against truth, ±2 std, over the whole wear range: what the thesis never had."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    figure, axes = plt.subplots(1, 2, figsize=(10, 4.5))
+    for axis, name, label in zip(axes, ("FDJ", "eta_O"), ("FDJ [N·m]", "η_O"), strict=True):
+        for group, colour in (("worn", "tab:red"), ("healthy", "tab:blue")):
+            found = [r[name] for g, rs in rows.items() for r in rs
+                     if name in r and g.startswith("worn") == (group == "worn")]  # fmt: skip
+            truth = np.array([f["truth"] for f in found])
+            axis.errorbar(truth, [f["value"] for f in found], yerr=2 * np.array([f["std"] for f in found]),
+                          fmt="o", ms=3, lw=0.8, color=colour, label=f"{group} ({len(found)})")  # fmt: skip
+        low, high = axis.get_xlim()
+        axis.plot([low, high], [low, high], color="grey", lw=1)
+        axis.set(xlabel=f"true {label}", ylabel=f"estimated {label} (± 2 std)")
+        axis.legend()
+    figure.suptitle("ema on foreign windows, healthy and worn (Case 1C's irreversible range included)")
+    figure.tight_layout()
+    figure.savefig(path, dpi=90)
+    plt.close(figure)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--per-group", type=int, default=12)
@@ -140,10 +166,13 @@ def main() -> None:
         f"pipeline sizes. Total {time.perf_counter() - started:.0f} s.",
         "",
         table(summaries),
+        "",
+        "![estimate against truth over the wear range](figures/wear_parity.png)",
     ])  # fmt: skip
     print(body)
+    wear_figure(rows, RESULTS_MD.parent / "figures" / "wear_parity.png")
     if args.docs:
-        write_section("Accuracy on windows our code did not draw", "python benchmarks/foreign_accuracy.py --docs",
+        write_section("Accuracy on windows our code did not draw", "python -m benchmarks.foreign_accuracy --docs",
                       body, RESULTS_MD)  # fmt: skip
 
 

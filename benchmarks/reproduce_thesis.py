@@ -2,7 +2,7 @@
 
 Every case trains on a fresh dataset from one §5.6 command (Case 2: one per simulation) and is
 scored on the test split and on 100 reserved simulations it never saw (thesis §6). Parity plots
-go to docs/figures/. Run: python benchmarks/reproduce_thesis.py [--quick]
+go to docs/figures/. Run: python -m benchmarks.reproduce_thesis [--quick]
 """
 
 from __future__ import annotations
@@ -229,7 +229,7 @@ def main() -> None:
     comparison = baseline_comparison(3 if args.quick else args.windows)
     print("\n".join(comparison))
     if args.docs:
-        write_results(results, comparison, "python benchmarks/reproduce_thesis.py --docs" + (" --quick" * args.quick))
+        write_results(results, comparison, "python -m benchmarks.reproduce_thesis --docs" + (" --quick" * args.quick))
 
 
 if __name__ == "__main__":

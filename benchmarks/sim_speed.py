@@ -4,7 +4,7 @@ Beside it, in the same run: the plain NumPy model vectorized across the same 500
 (timed on a short horizon and scaled: it is linear in the horizon), the one-lane scalar path of the
 same kernel, and the thesis's Simulink figure (100-150 ms per 0.5 s simulation).
 
-    python benchmarks/sim_speed.py [--sims 500] [--repeats 3] [--docs]
+    python -m benchmarks.sim_speed [--sims 500] [--repeats 3] [--docs]
 """
 
 from __future__ import annotations
@@ -87,7 +87,7 @@ def main() -> None:
     body = "\n".join(lines)
     print(body)
     if args.docs:
-        write_section("Simulator speed", "python benchmarks/sim_speed.py --docs", body)
+        write_section("Simulator speed", "python -m benchmarks.sim_speed --docs", body)
 
 
 if __name__ == "__main__":

@@ -1,1 +1,1 @@
-"""Entry points: the ``ema`` command line (and, as they land, the replay client and benchmarks)."""
+"""Entry points: the ``ema`` command line, the replay client, the fleet runner, the benchmark, the figures."""

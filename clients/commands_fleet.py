@@ -16,27 +16,24 @@ ARCHIVE = click.Path(exists=True, path_type=Path)
 @click.argument("archive", type=ARCHIVE)
 @click.option("--out", required=True, type=click.Path(dir_okay=False, path_type=Path),
               help="results CSV, one row per window (a rerun resumes from it)")  # fmt: skip
-@click.option("--workers", type=click.IntRange(1, 4096), default=2, help="Ray workers (tasks at a time)")
+@click.option("--workers", type=click.IntRange(1, 4096), default=2, help="Ray workers (windows at a time)")
+@click.option("--threads", type=click.IntRange(1, 256), default=1, help="threads (CPUs) each worker reserves")
 @click.option("--ray-address", default=None, help="'auto' or HOST:PORT of a cluster [default: a local Ray]")
-@click.option("--cores", type=click.IntRange(1, 65536), default=None,
-              help="cores the workers share [default: this machine's, or 1 per worker on a cluster]")  # fmt: skip
 @click.option("--window-s", type=click.FloatRange(0.1, 10.0), default=0.5, help="cut recordings into windows [s]")
 @click.option("--database", type=click.Path(dir_okay=False, path_type=Path), default=None,
               help="also store every answer in this SQLite history (the service's)")  # fmt: skip
 @sizes
 @as_json
-def fleet(archive: Path, out: Path, workers: int, ray_address: str | None, cores: int | None, window_s: float,
+def fleet(archive: Path, out: Path, workers: int, threads: int, ray_address: str | None, window_s: float,
           database: Path | None, as_json: bool, **size_values: int) -> None:  # fmt: skip
     """Reprocess an archive (folder, NPZ, CSV or JSON logs) on Ray workers; one CSV row per window."""
     from clients.fleet import run_fleet
     from clients.logs import windows_of
-    from sim.runtime import available_cores
 
     config = pipeline_config(size_values)
     windows = [window for window, _ in windows_of(archive, window_s)]
     print(f"ema fleet: {len(windows)} window(s) from {archive}, {workers} worker(s)", file=sys.stderr)
-    default_cores = available_cores() if ray_address is None else workers
-    result = run_fleet(windows, out, config, workers, ray_address, cores or default_cores, database)
+    result = run_fleet(windows, out, config, workers, ray_address, threads, database)
     emit(result, as_json, lambda r: click.echo(
         f"{r['answered']} answered, {r['refused']} refused, {r['skipped']} already in {r['csv']}; "
         f"{r['windows_per_s']:.2f} windows/s on {r['workers']} worker(s) ({r['engine']})"))  # fmt: skip

@@ -9,6 +9,7 @@ from typing import Any
 import click
 
 from clients.options import as_json, emit, flags_named, pipeline_config, progress, sizes, threads
+from sim.envelope import DEFAULT_AIRSPEED_MPS
 
 FAMILIES = ("thesis", "cruise", "gust", "doublet", "steps")  # sim.commands.FAMILIES, without importing numpy here
 EXISTING = click.Path(exists=True, dir_okay=False, path_type=Path)
@@ -47,7 +48,7 @@ def estimate(window: Path, threads: int | None, as_json: bool, **size_values: in
 @click.option("--fdj", type=float, default=0.05, help="dynamic friction FDJ [N·m]")
 @click.option("--eta-o", "eta_o", type=float, default=0.85, help="opposing efficiency η_O")
 @click.option("--fsj", type=float, default=0.10, help="static friction FSJ [N·m]")
-@click.option("--airspeed", type=float, default=153.01, help="true airspeed [m/s], 90–215")
+@click.option("--airspeed", type=float, default=DEFAULT_AIRSPEED_MPS, help="true airspeed [m/s], 90–215")
 @click.option("--altitude", type=float, default=0.0, help="altitude [m], 0–10000")
 @click.option("--command", type=click.Choice(FAMILIES), default="thesis", help="the command's family")
 @click.option("--seed", type=int, default=0, help="seed of the command and the noise")

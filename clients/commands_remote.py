@@ -11,6 +11,7 @@ from typing import Any
 import click
 
 from clients.options import as_json, emit, flags_named
+from sim.envelope import DEFAULT_AIRSPEED_MPS
 
 URL = "http://127.0.0.1:8000"
 LOG = click.Path(exists=True, path_type=Path)
@@ -33,7 +34,7 @@ def api_key(path: Path | None) -> str | None:
 @click.option("--api-key-file", type=KEY_FILE, default=None, help="file holding the API key [default: EMA_API_KEY]")
 @click.option("--actuator-id", default="unknown", help="for CSV/NPZ logs that carry none")
 @click.option("--rate", type=float, default=10_000.0, help="sample rate [Hz] for CSV/NPZ logs that carry none")
-@click.option("--airspeed", type=float, default=153.01, help="[m/s] for CSV/NPZ logs that carry none")
+@click.option("--airspeed", type=float, default=DEFAULT_AIRSPEED_MPS, help="[m/s] for CSV/NPZ logs that carry none")
 @click.option("--altitude", type=float, default=0.0, help="[m] for CSV/NPZ logs that carry none")
 @as_json
 def replay(log: Path, url: str, out: Path, window_s: float, api_key_file: Path | None, actuator_id: str,

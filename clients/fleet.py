@@ -1,7 +1,8 @@
 """``ema fleet``: an archive of windows through the pipeline on Ray workers, streamed into a results CSV.
 
 Ray schedules (no home-made scheduler): each window is a task that reserves and pins its own
-thread budget (cores / workers), results are written as they complete (``ray.wait``), the CSV is
+thread budget (one thread by default: a worker is a core, so throughput grows with workers),
+results are written as they complete (``ray.wait``), the CSV is
 the checkpoint (a rerun skips what it holds, so a crash never duplicates a window), and the same
 rows can go into a service's SQLite history (idempotent as well). Without Ray and with one
 worker the archive is processed in this process, one window after another.
@@ -66,11 +67,11 @@ def _on_ray(windows: list[Window], config: PipelineConfig, workers: int, threads
 
 
 def run_fleet(windows: list[Window], out: Path, config: PipelineConfig, workers: int, address: str | None,
-              cores: int, database: Path | None = None) -> dict[str, Any]:  # fmt: skip
-    """Every window of ``windows`` not yet in ``out``, on ``workers`` Ray workers (in-process with one and no Ray)."""
+              threads: int = 1, database: Path | None = None) -> dict[str, Any]:  # fmt: skip
+    """Every window of ``windows`` not yet in ``out``, on ``workers`` Ray workers of ``threads`` threads each
+    (in-process with one worker and no Ray)."""
     done = done_windows(out)
     todo = [w for w in windows if (w.actuator_id, w.window_id) not in done]
-    threads = max(1, cores // workers)
     progress = Progress(len(todo), started=time.perf_counter())
     in_process = workers == 1 and address is None and not ray_installed()
     results = _in_process(todo, config, threads) if in_process else _on_ray(todo, config, workers, threads, address)

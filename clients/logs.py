@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 
 from sim.checks import InputError
+from sim.envelope import DEFAULT_AIRSPEED_MPS
 from sim.window import SIGNALS, Window, window_from_dict
 
 SUFFIXES = (".json", ".csv", ".npz")
@@ -27,7 +28,7 @@ class Defaults:
 
     actuator_id: str = "unknown"
     sample_rate_hz: float = 10_000.0
-    airspeed_mps: float = 153.01
+    airspeed_mps: float = DEFAULT_AIRSPEED_MPS
     altitude_m: float = 0.0
 
 

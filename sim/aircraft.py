@@ -14,6 +14,7 @@ from typing import NamedTuple
 import numpy as np
 
 from sim.checks import InputError, in_range
+from sim.envelope import AIRSPEED_RANGE_MPS, ALTITUDE_RANGE_M, DEFAULT_AIRSPEED_MPS
 
 GRAVITY_MPS2 = 9.80665
 SEA_LEVEL_DENSITY_KGPM3 = 1.2250
@@ -28,7 +29,6 @@ A_DEFAULT = np.array(
     ]
 )
 B_DEFAULT = np.array([3.03345, -0.123180, 0.0, -10.0583])
-DEFAULT_AIRSPEED_MPS = 153.01
 FT_TO_M = 0.3048
 # Trim (V [ft/s], α [deg], δe [deg]); the 502 ft/s row is the default condition's exact trim.
 TRIM_TABLE = np.array(
@@ -41,8 +41,6 @@ TRIM_TABLE = np.array(
         [700.0, 0.382, -0.900],
     ]
 )
-AIRSPEED_RANGE_MPS = (90.0, 215.0)
-ALTITUDE_RANGE_M = (0.0, 10_000.0)
 
 
 @dataclass(frozen=True)
@@ -192,8 +190,10 @@ def flight_load_model(
     )
 
 
-def ground_load_model(load: GroundLoad) -> LoadModel:
-    """A prescribed load: no aircraft states, H_e = constant + ramp·t."""
+def _without_aircraft(
+    bias_nm: float = 0.0, delta_nm: float = 0.0, ramp_nmps: float = 0.0, table_nm: np.ndarray | None = None
+) -> LoadModel:
+    """A load with the aircraft's dynamics switched off: H_e = bias + ramp·t (+ table) + delta·δe."""
     return LoadModel(
         ad=np.eye(4),
         bd=np.zeros(4),
@@ -201,12 +201,17 @@ def ground_load_model(load: GroundLoad) -> LoadModel:
         alpha_t0_rad=0.0,
         alpha_t_row=np.zeros(4),
         alpha_t_limit_rad=1.0,
-        hinge_bias_nm=load.constant_nm,
+        hinge_bias_nm=bias_nm,
         hinge_alpha_nm=0.0,
-        hinge_delta_nm=0.0,
-        hinge_ramp_nmps=load.ramp_nmps,
-        slow_table_nm=np.zeros(0),
+        hinge_delta_nm=delta_nm,
+        hinge_ramp_nmps=ramp_nmps,
+        slow_table_nm=np.zeros(0) if table_nm is None else np.ascontiguousarray(table_nm),
     )
+
+
+def ground_load_model(load: GroundLoad) -> LoadModel:
+    """A prescribed load: no aircraft states, H_e = constant + ramp·t."""
+    return _without_aircraft(bias_nm=load.constant_nm, ramp_nmps=load.ramp_nmps)
 
 
 @dataclass(frozen=True)
@@ -232,18 +237,8 @@ class LoggedLoad:
 def logged_load_model(load: LoggedLoad, hinge: HingeGeometry = HingeGeometry()) -> LoadModel:
     """The slow part of the moment, per interval, from the log; the δ term from the condition."""
     delta_nm = load.condition.dynamic_pressure_pa * hinge.area_m2 * hinge.chord_m * hinge.ch_delta_per_rad
-    return LoadModel(
-        ad=np.eye(4),
-        bd=np.zeros(4),
-        trim_elevator_rad=0.0,
-        alpha_t0_rad=0.0,
-        alpha_t_row=np.zeros(4),
-        alpha_t_limit_rad=1.0,
-        hinge_bias_nm=0.0,
-        hinge_alpha_nm=0.0,
-        hinge_delta_nm=delta_nm,
-        hinge_ramp_nmps=0.0,
-        slow_table_nm=np.ascontiguousarray(load.hinge_moment_nm - delta_nm * np.radians(load.position_deg)),
+    return _without_aircraft(
+        delta_nm=delta_nm, table_nm=load.hinge_moment_nm - delta_nm * np.radians(load.position_deg)
     )
 
 

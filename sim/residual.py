@@ -43,6 +43,11 @@ def smoothing_weights(half_width: int) -> np.ndarray:
     return np.convolve(acceleration_weights(half_width), [0.5, 0.5])
 
 
+def kernel_samples(sample_rate_hz: float, window_s: float = DEFAULT_DERIVATIVE_WINDOW_S) -> int:
+    """Samples the reconstruction kernel spans at this rate (2·half + 1)."""
+    return 2 * max(1, round(window_s * sample_rate_hz / 2)) + 1
+
+
 def _half_width(values: np.ndarray, sample_rate_hz: float, window_s: float) -> int:
     half = max(1, round(window_s * sample_rate_hz / 2))
     if values.shape[-1] <= 2 * half:

@@ -27,6 +27,7 @@ from sim.residual import (
     DEFAULT_DERIVATIVE_WINDOW_S,
     END_STOP_MARGIN_DEG,
     above_throughout,
+    kernel_samples,
     residual_torque_nm,
     smoothed,
 )
@@ -87,7 +88,7 @@ def regressors(
         residual_nm = residual_torque_nm(current, speed, hinge, rate, actuator, window_s)
     residual = np.atleast_2d(residual_nm)
     load = smoothed(np.atleast_2d(signals["hinge_moment_nm"]) / actuator.gear_ratio, rate, window_s)
-    width = 2 * round(window_s * rate / 2) + 1
+    width = kernel_samples(rate, window_s)
     sliding = above_throughout(np.abs(speed), settings.min_speed_radps, width)  # one sign over the whole kernel
     sliding &= np.abs(np.atleast_2d(signals["position_deg"])) < actuator.end_stop_deg - END_STOP_MARGIN_DEG
     direction = np.sign(speed)
@@ -179,7 +180,7 @@ def fit_friction(
     left_out = (total[:, None, :] - blocks).reshape(-1, 10)
     fdj_b, eta_b, _ = solve(left_out, actuator.gear_ratio)
     n_rows = len(total)
-    width = 2 * round(settings.derivative_window_s * rate / 2) + 1
+    width = kernel_samples(rate, settings.derivative_window_s)
     enough = total[:, M] >= MIN_SLIDING_KERNELS * width
     nan = np.where(enough, 1.0, np.nan)
     edge = (eta_o <= ETA_O_SEARCH[0] + 1e-4) | (eta_o >= ETA_O_SEARCH[1] - 1e-4)

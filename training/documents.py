@@ -96,7 +96,6 @@ class DatasetInfo(Document):
     check_windows: int
     noise_estimated: dict[str, float]
     box: dict[str, tuple[float, float]] = Field(description="the FDJ and η_O intervals the simulations were drawn in")
-    redrawn: bool = Field(False, description="the box was moved once because an estimate fell on its edge")
 
 
 class TrainingInfo(Document):
