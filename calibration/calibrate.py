@@ -148,8 +148,9 @@ class Calibrator:
         twin = next((e for e in found if e.family.name == TWINS.get(pick.family.name)), None)
         if twin is None:
             return pick, Step(selected=pick.family.name, reason=decision.reason)
-        pick, errors, clear = tell_apart(windows, before, [pick, twin], noise)
-        other = twin.family.name if pick is not twin else decision.chosen.family.name  # type: ignore[union-attr]
+        first = pick
+        pick, errors, clear = tell_apart(windows, before, [first, twin], noise)
+        other = (twin if pick is first else first).family.name
         reason = f"{decision.reason}; told from {other} by the motor speed and current it predicts"
         return pick, Step(
             selected=pick.family.name,

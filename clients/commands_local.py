@@ -117,7 +117,8 @@ def serve(**flags: Any) -> None:
         settings = Settings(**{k: v for k, v in flags.items() if v is not None})
     except ValidationError as exc:
         error = from_validation(exc)
-        raise InputError(f"--{error.field.replace('_', '-')} / EMA_{error.field.upper()}", error.message) from None
+        field = "host" if error.field == "document" else error.field  # the one check across fields: host vs key
+        raise InputError(f"--{field.replace('_', '-')} / EMA_{field.upper()}", error.message) from None
     EstimateStore(settings.database).close()  # refused here, naming the file, before the server starts
     uvicorn.run(create_app(settings), host=settings.host, port=settings.port, log_level="info")
 

@@ -116,3 +116,28 @@ def test_schemas_in_docs_match_the_code():
     from clients.schemas import export
 
     assert export(Path(__file__).resolve().parents[2] / "docs" / "schemas", check=True) == []
+
+
+@pytest.mark.parametrize(
+    ("arguments", "environment", "named"),
+    [
+        ([], {"EMA_API_KEY": ""}, "EMA_API_KEY"),
+        (["--host", "0.0.0.0"], {}, "EMA_HOST"),
+        (["--database", "/proc/no-such-folder/h.sqlite3"], {}, "h.sqlite3"),
+    ],
+)
+def test_serve_refuses_unsafe_or_unusable_settings_naming_them(tmp_path, capsys, monkeypatch, arguments, environment,
+                                                               named):  # fmt: skip
+    monkeypatch.delenv("EMA_API_KEY", raising=False)
+    for key, value in environment.items():
+        monkeypatch.setenv(key, value)
+    assert main(["serve", "--database", str(tmp_path / "h.sqlite3"), *arguments]) == EXIT_BAD_INPUT
+    assert named in capsys.readouterr().err
+
+
+def test_serve_refuses_a_file_that_is_not_a_database(tmp_path, capsys):
+    broken = tmp_path / "broken.sqlite3"
+    broken.write_text("not a database" * 100)
+    assert main(["serve", "--database", str(broken)]) == EXIT_BAD_INPUT
+    assert "broken.sqlite3" in capsys.readouterr().err
+    assert broken.read_text().startswith("not a database")
