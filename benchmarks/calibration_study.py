@@ -4,7 +4,8 @@ Every window comes from ``tests.foreign`` (an independent implementation of the 
 commands, its own noise) with one effect in the foreign implementation's own form
 (``tests.foreign.effects``): a Gaussian friction bump, tanh Stribeck friction, friction drifting
 in time, cogging of 12 periods per revolution, and the rest, at 0.2x, 1x, 5x and 20x of the
-sizes the issue reported. One window at a time, several seeds per effect and size: how often the
+sizes the issue reported (a gain's departure held within 0.5–1.5). One window at a time,
+several seeds per effect and size: how often the
 right effect is named (for the drift: never named, described as following time), and the
 |FDJ| + |η_O| relative error before and after.
 
@@ -23,6 +24,7 @@ import numpy as np
 from calibration.calibrate import Calibrator
 from clients.figures import calibration_figure
 from clients.report import write_section
+from sim.checks import InputError
 from sim.window import window_from_dict
 from tests.foreign.effects import CASES
 from tests.foreign.windows import draw
@@ -72,8 +74,8 @@ def table(rows: dict[tuple[str, float], list[dict[str, Any]]]) -> str:
         wrong = sorted({str(r["named"]) for r in runs if not r["right"]} - {"None"})
         lines.append(
             f"| {case} | {scale:g}x | {sum(r['right'] for r in runs)}/{n} | {sum(r['better'] for r in runs)}/{n} "
-            f"| {sum(r['worse'] for r in runs)}/{n} | {np.median([r['before'] for r in runs]):.3f} → "
-            f"{np.median([r['after'] for r in runs]):.3f} | {', '.join(wrong) or '—'} |"
+            f"| {sum(r['worse'] for r in runs)}/{n} | {np.nanmedian([r['before'] for r in runs]):.3f} → "
+            f"{np.nanmedian([r['after'] for r in runs]):.3f} | {', '.join(wrong) or '—'} |"
         )
     return "\n".join(lines)
 
@@ -93,11 +95,16 @@ def main() -> None:
             rows[case, scale] = []
             for s in range(args.seeds):
                 figure = DOCS / "figures" / f"calibration_{case}.png" if (scale == 1.0 and s == 0) else None
-                rows[case, scale].append(one(case, scale, 5000 + 100 * c + s, figure))
+                try:
+                    rows[case, scale].append(one(case, scale, 5000 + 100 * c + s, figure))
+                except InputError as exc:  # a window the pipeline refuses (no sliding at all): counted as a miss
+                    rows[case, scale].append({"named": f"refused: {exc.field}", "unexplained": [], "right": False,
+                                              "before": np.nan, "after": np.nan, "better": False, "worse": False,
+                                              "seconds": np.nan})  # fmt: skip
             print(case, scale, [(r["named"], round(r["before"], 3), round(r["after"], 3)) for r in rows[case, scale]],
                   flush=True)  # fmt: skip
     at_one = [r for (case, scale), runs in rows.items() if scale == 1.0 and case != "clean" for r in runs]
-    seconds = [r["seconds"] for runs in rows.values() for r in runs]
+    seconds = [r["seconds"] for runs in rows.values() for r in runs if np.isfinite(r["seconds"])]
     body = "\n".join([
         f"{args.seeds} windows per effect and size, one window per calibration, 0.5 s at 10 kHz from",
         "`tests/foreign` (thesis commands, its own noise), effects in its own forms (`tests/foreign/effects.py`);",

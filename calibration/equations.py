@@ -87,6 +87,7 @@ def _one_window(
         "time_s": np.arange(len(speed)) / rate,
         "load_nm": smoothed(signals["hinge_moment_nm"], rate) / actuator.gear_ratio * sign,  # > 0: aiding
         "current_a": sign * smoothed(signals["current_a"], rate),
+        "current_unsigned_a": smoothed(signals["current_a"], rate),
         "direction": sign,
         "motor_angle_rad": angle,
     }

@@ -59,6 +59,9 @@ class Family:
     # many of ``columns`` are left as free terms (the others are that replacement's first order).
     base_shift: Callable[[Equations, Grid], np.ndarray] | None = None
     free_columns: int | None = None
+    # The physics fixes the size (a gain's trace, given the gain): its one column enters with
+    # coefficient 1, subtracted from t, and only the grid value is fitted.
+    offset: bool = False
 
     def grid_columns(self, e: Equations) -> np.ndarray:
         """(m, G, c) columns for every grid value."""
@@ -113,8 +116,22 @@ def bump_grid(position_rad: np.ndarray) -> tuple[tuple[float, float], ...]:
     return tuple((float(c), float(np.radians(w))) for c in centres for w in BUMP_WIDTHS_DEG)
 
 
+GAINS = tuple(float(g) for g in np.round(np.arange(0.70, 1.3025, 0.005), 3))
+
+
 def _gain_term(effect: str, gain: float) -> EffectSet | None:
     return EffectSet({effect: {"gain": gain}}) if 0.7 <= gain <= 1.3 else None
+
+
+def _torque_shift(e: Equations, true_over_logged: np.ndarray, actuator: ActuatorParams) -> np.ndarray:
+    """(m, G): what T_R takes for friction when the motor's true torque is sat(r·k_T·I) and the model
+    assumes sat(k_T·I), for each ratio r of a grid, as t sees it (times sgn ω). Linear in the
+    current until the saturation, which a current-sensor gain below 1 reaches (the loop holds the
+    *logged* current at I_max: the true one is above it)."""
+    limit, k_t = actuator.max_motor_torque_nm, actuator.torque_constant_nm_per_a
+    drive = k_t * e.variables["current_unsigned_a"][:, None]
+    shift = np.clip(drive, -limit, limit) - np.clip(drive * true_over_logged[None, :], -limit, limit)
+    return shift * e.variables["direction"][:, None]
 
 
 HINGE_BIASES_NM = tuple(float(b) for b in np.arange(-150.0, 152.5, 2.5))
@@ -160,7 +177,7 @@ def _cogging_parameters(b: np.ndarray, order: float) -> dict[str, float]:
 
 def named_families(measured: Equations, actuator: ActuatorParams) -> list[Family]:
     """The vocabulary, shaped on the measured window (a bump's centres span what it visited)."""
-    k_t, n = actuator.torque_constant_nm_per_a, actuator.gear_ratio
+    n = actuator.gear_ratio
     bumps = bump_grid(measured.variables["position_rad"])
     return [
         Family("viscous", "speed_radps", True, lambda e, g: e.variables["speed_radps"][:, None],
@@ -170,11 +187,14 @@ def named_families(measured: Equations, actuator: ActuatorParams) -> list[Family
                lambda b, g: {"amplitude_nm": float(b[0]), "decay_speed_radps": g}, _stribeck_term,
                STRIBECK_SPEEDS_RADPS,
                stacked=_stribeck_stacked),
-        Family("torque_constant", "current_a", True, lambda e, g: k_t * e.variables["current_a"][:, None],
-               lambda b, g: {"gain": 1.0 - float(b[0])}, lambda b, g: _gain_term("torque_constant", 1.0 - b[0])),
-        Family("current_sensor_gain", "current_a", True, lambda e, g: k_t * e.variables["current_a"][:, None],
-               lambda b, g: {"gain": 1.0 / (1.0 - float(b[0]))},
-               lambda b, g: _gain_term("current_sensor_gain", 1.0 / (1.0 - b[0]))),
+        Family("torque_constant", "current_a", True,
+               lambda e, g: _torque_shift(e, np.array([g]), actuator),
+               lambda b, g: {"gain": g}, lambda b, g: _gain_term("torque_constant", g),
+               GAINS, stacked=lambda e: _torque_shift(e, np.array(GAINS), actuator)[..., None], offset=True),
+        Family("current_sensor_gain", "current_a", True,
+               lambda e, g: _torque_shift(e, np.array([1.0 / g]), actuator),
+               lambda b, g: {"gain": g}, lambda b, g: _gain_term("current_sensor_gain", g),
+               GAINS, stacked=lambda e: _torque_shift(e, 1.0 / np.array(GAINS), actuator)[..., None], offset=True),
         Family("hinge_moment_bias", "direction", True, lambda e, g: _hinge_columns(e, g, n),
                lambda b, g: {"bias_nm": float(b[0]) * n, "grid_bias_nm": g},
                lambda b, g: EffectSet({"hinge_moment_bias": {"bias_nm": float(np.clip(b[0] * n, -500, 500))}}),

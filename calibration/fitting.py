@@ -104,6 +104,28 @@ def fold_slices(folds: np.ndarray) -> list[slice | np.ndarray]:
     return out
 
 
+def score_offsets(
+    base: np.ndarray, offsets: np.ndarray, y: np.ndarray, folds: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``score`` of y − offsets[:, g] on the base design (m, k), for each of G offsets (m, G) at once: a
+    candidate whose size the physics fixes (coefficient 1), only its grid value free. Returns
+    (cv_rss (G,), rss (G,), beta (G, k))."""
+    targets = y[:, None] - offsets  # (m, G)
+    k = base.shape[1]
+    gram, rhs, yy = np.zeros((FOLDS, k, k)), np.zeros((FOLDS, k, offsets.shape[1])), np.zeros((FOLDS, offsets.shape[1]))
+    for f, rows in enumerate(fold_slices(folds)):
+        x, t = base[rows], targets[rows]
+        gram[f], rhs[f], yy[f] = x.T @ x, x.T @ t, np.einsum("mg,mg->g", t, t)
+    total_g, total_r, total_y = gram.sum(0), rhs.sum(0), yy.sum(0)
+    cv = np.zeros(offsets.shape[1])
+    for f in range(FOLDS):
+        beta = _solve(total_g - gram[f], total_r - rhs[f])  # (k, G)
+        cv += yy[f] - 2 * np.sum(beta * rhs[f], axis=0) + np.sum(beta * (gram[f] @ beta), axis=0)
+    beta = _solve(total_g, total_r)
+    rss = total_y - 2 * np.sum(beta * total_r, axis=0) + np.sum(beta * (total_g @ beta), axis=0)
+    return cv, np.maximum(rss, 0.0), beta.T
+
+
 def _solve_many(gram: np.ndarray, rhs: np.ndarray) -> np.ndarray:
     scale = np.maximum(np.einsum("gkk->gk", gram), 1e-300)
     regularized = gram + RIDGE * scale[:, :, None] * np.eye(gram.shape[1])[None]

@@ -36,9 +36,14 @@ def _extra(e: Equations, chosen: Sequence[Chosen]) -> np.ndarray:
     """FDJ's column and each effect's free columns."""
     columns = [e.base[:, :1]]
     for c in chosen:
-        width = c.family.free_columns
-        columns.append(c.family.columns(e, c.grid)[:, :width])
+        if not c.family.offset:
+            columns.append(c.family.columns(e, c.grid)[:, : c.family.free_columns])
     return np.concatenate(columns, axis=1)
+
+
+def _offset(e: Equations, chosen: Sequence[Chosen]) -> np.ndarray:
+    """What the effects whose size the physics fixes take from t."""
+    return sum((c.family.columns(e, c.grid)[:, 0] for c in chosen if c.family.offset), np.zeros(e.m))
 
 
 def _loads(e: Equations, chosen: Sequence[Chosen]) -> np.ndarray:
@@ -50,21 +55,20 @@ def _loads(e: Equations, chosen: Sequence[Chosen]) -> np.ndarray:
     return loads
 
 
-def _target(e: Equations, eta_o: float, loads: np.ndarray) -> np.ndarray:
+def _target(y: np.ndarray, eta_o: float, loads: np.ndarray) -> np.ndarray:
     """t minus the load-dependent friction at η_O (η_A by Eq. 3.4): what FDJ and the effect must explain."""
     k_aid, k_opp = 1.0 - float(eta_a_from_eta_o(eta_o)), 1.0 / eta_o - 1.0
-    return e.y - k_aid * loads[:, 0] - k_opp * loads[:, 1]
+    return y - k_aid * loads[:, 0] - k_opp * loads[:, 1]
 
 
 def fit_with(e: Equations, chosen: Sequence[Chosen], rows: np.ndarray | None = None) -> TiedFit:
     """The base model plus ``chosen``'s columns, η_O searched coarse to fine, on ``rows`` (all by default)."""
     rows = np.arange(e.m) if rows is None else rows
-    design, loads = _extra(e, chosen)[rows], _loads(e, chosen)[rows]
-    sub = Equations(e.y[rows], e.base[rows], {}, {}, e.kinematic[rows], e.folds[rows], e.window[rows])
+    design, loads, y = _extra(e, chosen)[rows], _loads(e, chosen)[rows], (e.y - _offset(e, chosen))[rows]
     low, high = ETA_O_SEARCH
     for _ in range(REFINEMENTS):
         grid = np.linspace(low, high, GRID_POINTS)
-        targets = [_target(sub, eta, loads) for eta in grid]
+        targets = [_target(y, eta, loads) for eta in grid]
         betas = [np.linalg.lstsq(design, t, rcond=None)[0] for t in targets]
         sse = [float(np.sum((t - design @ b) ** 2)) for t, b in zip(targets, betas, strict=True)]
         best = int(np.argmin(sse))
@@ -75,12 +79,12 @@ def fit_with(e: Equations, chosen: Sequence[Chosen], rows: np.ndarray | None = N
 
 def held_out_rss(e: Equations, chosen: Sequence[Chosen]) -> float:
     """Σ over folds of the squared error on the fold of the model fitted on the other four."""
-    design, loads = _extra(e, chosen), _loads(e, chosen)
+    design, loads, y = _extra(e, chosen), _loads(e, chosen), e.y - _offset(e, chosen)
     total = 0.0
     for f in range(FOLDS):
         fitted = fit_with(e, chosen, np.flatnonzero(e.folds != f))
         held = e.folds == f
-        error = _target(e, fitted.eta_o, loads)[held] - design[held] @ fitted.beta
+        error = _target(y, fitted.eta_o, loads)[held] - design[held] @ fitted.beta
         total += float(error @ error)
     return total
 

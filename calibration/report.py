@@ -12,7 +12,7 @@ from calibration.documents import CalibrationReport, Candidate, HeldOut, NoiseFl
 from calibration.equations import Equations
 from calibration.fitting import score
 from calibration.refit import corrected, fit_with
-from calibration.selection import Chosen, Evidence, design
+from calibration.selection import Chosen, Evidence, problem
 from sim.effects import EffectSet
 from training.documents import TARGETS
 
@@ -38,7 +38,8 @@ class HeldOutCheck:
 
 def residual_rms(e: Equations, chosen: Sequence[Chosen]) -> float:
     """RMS of the equation error [N·m] with the base columns and ``chosen``'s."""
-    return float(np.sqrt(score(design(e, chosen), e.y, e.folds).rss / e.m))
+    design, target = problem(e, chosen)
+    return float(np.sqrt(score(design, target, e.folds).rss / e.m))
 
 
 def _candidate(e: Evidence) -> Candidate:

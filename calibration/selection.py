@@ -24,9 +24,12 @@ import numpy as np
 
 from calibration.equations import Equations
 from calibration.families import Family, Grid
-from calibration.fitting import Scored, score, score_grid
+from calibration.fitting import Scored, score, score_grid, score_offsets
 
 MIN_Z = 6.0  # the measured drop stands this many noise-floor stds above the copies' mean
+# A floor under the copies' std: a family whose grid holds "no effect" (a gain of 1) drops exactly
+# nothing on every copy, and a zero std would make any drop infinitely significant.
+MIN_NULL_STD = 1e-3
 NAME_MARGIN = 0.15  # a rival curve explaining ≥ 85 % as much leaves the name undecided
 MAX_EFFECTS = 2
 
@@ -49,21 +52,27 @@ class Evidence:
 
     @property
     def z(self) -> float:
-        return (self.improvement - self.null_mean) / max(self.null_std, 1e-12)
+        return (self.improvement - self.null_mean) / max(self.null_std, MIN_NULL_STD)
 
 
-def design(e: Equations, chosen: Sequence[Chosen]) -> np.ndarray:
-    """Base columns (1, a, o) and the chosen families' columns at their grid values."""
-    return np.concatenate([e.base, *(c.family.columns(e, c.grid) for c in chosen)], axis=1)
+def problem(e: Equations, chosen: Sequence[Chosen]) -> tuple[np.ndarray, np.ndarray]:
+    """(design, target): the base columns (1, a, o) and the chosen families' columns at their grid
+    values; t less the chosen families whose size the physics fixes."""
+    columns = [c.family.columns(e, c.grid) for c in chosen if not c.family.offset]
+    offsets = [c.family.columns(e, c.grid)[:, 0] for c in chosen if c.family.offset]
+    return np.concatenate([e.base, *columns], axis=1), e.y - sum(offsets, np.zeros(e.m))
 
 
 def _drops(e: Equations, chosen: Sequence[Chosen], family: Family) -> tuple[np.ndarray, Scored, np.ndarray, np.ndarray]:
     """Per grid value, the fractional held-out drop of ``family`` added to the base and ``chosen``;
     with the base's own score, and each grid value's in-sample RSS and coefficients."""
-    base_design = design(e, chosen)
-    base = score(base_design, e.y, e.folds)
+    base_design, target = problem(e, chosen)
+    base = score(base_design, target, e.folds)
     candidates = family.grid_columns(e)  # (m, G, c)
-    cv, rss, beta = score_grid(base_design, candidates, e.y, e.folds)
+    if family.offset:
+        cv, rss, _ = score_offsets(base_design, candidates[:, :, 0], target, e.folds)
+        return 1.0 - cv / base.cv_rss, base, rss, np.ones((len(cv), 1))
+    cv, rss, beta = score_grid(base_design, candidates, target, e.folds)
     return 1.0 - cv / base.cv_rss, base, rss, beta[:, base_design.shape[1] :]
 
 

@@ -30,7 +30,7 @@ def _pyplot() -> Any:
 def calibration_figure(calibrator: Any, path: Path) -> Path:
     """The equation-error residual before and after, against the variable that explains it."""
     from calibration.fitting import score
-    from calibration.selection import design
+    from calibration.selection import problem
 
     plt = _pyplot()
     e, report = calibrator.measured_, calibrator.report_
@@ -45,7 +45,8 @@ def calibration_figure(calibrator: Any, path: Path) -> Path:
         x = np.mod(x, 2 * np.pi)
     figure, axis = plt.subplots(figsize=(7, 4))
     for label, model, colour in (("before", [], "tab:red"), ("after", chosen, "tab:blue")):
-        residual = e.y - design(e, model) @ score(design(e, model), e.y, e.folds).beta
+        design, target = problem(e, model)
+        residual = target - design @ score(design, target, e.folds).beta
         axis.scatter(x[::4], residual[::4], s=3, alpha=0.4, color=colour, label=label)
     axis.set(xlabel=LABELS.get(variable, variable), ylabel="equation error of Eq. 5.1 [N·m]")
     axis.set_title(f"calibration: {report.selected_effect or 'no effect named'}")

@@ -127,5 +127,8 @@ def residual_torque_nm(
         raise InputError("signals", f"shapes differ: current {current.shape}, speed {speed.shape}, hinge {hinge.shape}")
     rate = in_range("sample_rate_hz", sample_rate_hz, 100.0, 1e6, "Hz")
     acceleration = smooth_derivative(speed, rate, derivative_window_s)
-    driving = actuator.torque_constant_nm_per_a * current + hinge / actuator.gear_ratio
+    motor = np.clip(
+        actuator.torque_constant_nm_per_a * current, -actuator.max_motor_torque_nm, actuator.max_motor_torque_nm
+    )
+    driving = motor + hinge / actuator.gear_ratio
     return smoothed(driving, rate, derivative_window_s) - actuator.inertia_kgm2 * acceleration

@@ -31,6 +31,7 @@ from training.combine import fit_blend
 from training.documents import TARGETS, MethodReport
 
 MAX_DISAGREEMENT_Z = 3.0
+MIN_CHECKS = 4  # held-out simulations the scoring needs (those that could not slide are left out)
 BOX_TOLERANCE = 0.1  # the network may answer this far outside its box (in box units) before it extrapolates
 STUDENT_95 = {8: 2.31, 16: 2.12, 32: 2.04}  # t quantiles: a std read from K simulations is itself uncertain
 
@@ -62,7 +63,7 @@ def physics_values(fit: FrictionFit, row: int | slice = 0) -> dict[str, np.ndarr
 
 
 def _rms(errors: np.ndarray) -> float:
-    return float(np.sqrt(np.mean(errors**2)))
+    return float(np.sqrt(np.mean(errors**2))) if len(errors) else 0.0
 
 
 def _t_factor(k: int) -> float:
@@ -76,6 +77,8 @@ def bias_corrected(physics: np.ndarray, truth: np.ndarray) -> tuple[float, np.nd
     simulation's estimate corrected by the mean of the *others'* errors (leave-one-out: honest errors)."""
     errors = physics - truth
     k = len(errors)
+    if k < MIN_CHECKS:
+        return 0.0, physics  # too few to measure a bias with
     left_out = (errors.sum() - errors) / (k - 1)
     return float(errors.mean()), physics - left_out
 
@@ -84,6 +87,8 @@ def network_note(c: Candidates, name: str) -> str | None:
     """Why the network's answer for ``name`` cannot be used on this window, or None."""
     if c.network is None or c.check_network is None or c.network_unit is None:
         return "no network"
+    if len(c.check_truth[name]) < MIN_CHECKS:
+        return "too few held-out simulations could be scored to trust the network with"
     index = TARGETS.index(name)
     if not -BOX_TOLERANCE <= c.network_unit[index] <= 1 + BOX_TOLERANCE:
         return f"the network answered {c.network_unit[index]:.2f} box units: outside the box it was trained in"

@@ -53,6 +53,9 @@ class FitSettings:
             raise InputError("blocks", f"must be in [2, 100], got {self.blocks}")
 
 
+FIT_ARRAYS = ("fdj_nm", "eta_o", "fdj_std_nm", "eta_o_std", "residual_rms_nm", "n_sliding", "at_search_edge")
+
+
 @dataclass(frozen=True)
 class FrictionFit:
     """Per window (arrays of one length): the estimates, their jackknife std, the fit's quality."""
