@@ -28,6 +28,10 @@ from sim.effects import EffectSet, FrictionTable
 from sim.params import ActuatorParams
 
 KNOTS = 9  # piecewise-linear curves: 8 segments over the visited range
+# A friction that changes in time (warming, wear-in) does so smoothly over one log: a line with one
+# bend. Eight free segments would spend their freedom on noise, and lose on held-out samples to any
+# one-column shape that merely correlates with time (the direction, when the elevator turns once).
+TIME_KNOTS = 3
 STRIBECK_SPEEDS_RADPS = (10.0, 20.0, 40.0, 80.0, 160.0, 320.0)
 COGGING_ORDERS = tuple(float(p) for p in range(1, 49))
 BUMP_WIDTHS_DEG = (0.75, 1.5, 3.0, 6.0)  # a spall's half-width, as a Gaussian's std
@@ -211,20 +215,20 @@ def named_families(measured: Equations, actuator: ActuatorParams) -> list[Family
     ]  # fmt: skip
 
 
-GENERIC = {
-    "time_s": ("time", "s"),
-    "position_rad": ("position", "rad"),
-    "speed_radps": ("speed", "rad/s"),
-    "load_nm": (None, "N·m"),
-    "current_a": (None, "A"),
+GENERIC = {  # variable: (the simulator's table for it, unit, knots)
+    "time_s": ("time", "s", TIME_KNOTS),
+    "position_rad": ("position", "rad", KNOTS),
+    "speed_radps": ("speed", "rad/s", KNOTS),
+    "load_nm": (None, "N·m", KNOTS),
+    "current_a": (None, "A", KNOTS),
 }
 
 
 def generic_families(measured: Equations) -> list[Family]:
     """Piecewise-linear friction against each variable no name covers as such."""
     families = []
-    for variable, (table, unit) in GENERIC.items():
-        knots = uniform_knots(measured.variables[variable], KNOTS)
+    for variable, (table, unit, count) in GENERIC.items():
+        knots = uniform_knots(measured.variables[variable], count)
 
         def term(b: np.ndarray, g: Grid, table: str | None = table, knots: np.ndarray = knots) -> EffectSet | None:
             return None if table is None else _table(table, knots, b)

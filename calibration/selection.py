@@ -11,7 +11,9 @@ no curve over *another* variable explains nearly as much (``NAME_MARGIN``): a fr
 in time is not a position effect because the elevator happened to move while it drifted. When a
 generic curve wins and a named family over the same variable comes within the margin, the name
 is kept (the simpler shape); when none does, the report describes the curve instead of forcing
-a name. Up to ``MAX_EFFECTS`` families enter, one at a time, each judged given the ones before.
+a name. Between two named families over the same variable that explain about as much, the one with
+fewer shapes to choose from is kept unless the other explains held-out samples beyond it. Up to
+``MAX_EFFECTS`` families enter, one at a time, each judged given the ones before.
 The backlash lives in its own channel (``backlash``).
 """
 
@@ -119,6 +121,26 @@ def settle(
     return "tie"
 
 
+def simplest(
+    named: Evidence,
+    close: Sequence[Evidence],
+    measured: Equations,
+    copies: Sequence[Equations],
+    chosen: Sequence[Chosen],
+) -> Evidence:
+    """A named family over the same variable with fewer shapes to choose from, if ``named`` explains
+    nothing beyond it: a Stribeck decay of the slowest scale is a straight line in speed over the
+    visited range, and its grid should not win a viscous friction by a hair."""
+    simpler = [
+        e for e in close
+        if e.family.named and e.family.follows == named.family.follows and len(e.family.grid) < len(named.family.grid)
+    ]  # fmt: skip
+    for rival in sorted(simpler, key=lambda e: len(e.family.grid)):
+        if evidence(measured, copies, [*chosen, Chosen(rival.family, rival.grid)], named.family).z < MIN_Z:
+            return rival
+    return named
+
+
 def decide(
     found: Sequence[Evidence], measured: Equations, copies: Sequence[Equations], chosen: Sequence[Chosen]
 ) -> Decision:
@@ -133,6 +155,7 @@ def decide(
     )  # fmt: skip
     if named is None:
         return Decision(None, [best], f"the residual follows {best.family.follows} in a way no named effect describes")
+    named = simplest(named, [best, *close], measured, copies, chosen)
     rivals = [e for e in [best, *close] if not e.family.named and e.family.exogenous]
     rivals = [e for e in rivals if e.family.follows != named.family.follows]
     for rival in rivals:

@@ -84,3 +84,21 @@ def test_settings_and_windows_are_checked():
         Calibrator().fit([])
     with pytest.raises(InputError, match="copies"):
         Calibrator(copies=2).fit([window_from_dict(draw(1, "thesis").document)])
+
+
+@pytest.mark.slow
+def test_a_drift_while_the_elevator_turns_once_is_no_hinge_bias():
+    # The window turns once (t = 0.13 s): sgn(ω), the trace a hinge-moment bias leaves, is a step in
+    # time, and a linear drift fits it as well. The report may say either variable, never the name.
+    report, _ = calibrate("drift", 5902)
+    assert report.selected_effect is None, report.selection_steps[0].reason
+    assert report.unexplained is not None and "time_s" in report.unexplained.variables
+
+
+@pytest.mark.slow
+def test_a_small_viscous_friction_is_not_won_by_a_slow_stribeck_decay():
+    # exp(−ω/320) is nearly a line over the visited speeds: the grid of decay scales must not win
+    # the one-column viscous term by a hair when it explains nothing beyond it.
+    report, _ = calibrate("viscous", 5103, scale=0.2)
+    assert report.selected_effect == "viscous", report.selection_steps[0].reason
+    assert combined_error(report, "after") <= max(0.5 * combined_error(report, "before"), 0.01)
