@@ -65,8 +65,8 @@ def one(case: str, scale: float, seed: int, figure: Path | None) -> dict[str, An
 
 def table(rows: dict[tuple[str, float], list[dict[str, Any]]]) -> str:
     lines = [
-        "| effect | size | right name | error ≤ ½ before or ≤ 0.01 | worse than before and > 0.01 | error before → after (median) "
-        "| named instead |",
+        "| effect | size | right name | error ≤ ½ before or ≤ 0.01 | worse than before and > 0.01 "
+        "| error before → after (median) | named instead |",
         "|---|---:|---:|---:|---:|---:|---|",
     ]
     for (case, scale), runs in rows.items():
