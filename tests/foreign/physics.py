@@ -145,6 +145,51 @@ def _hinge(p, x, theta_u):
 
 
 @njit(cache=True)
+def _current(p, command, theta_u, speed, current, decay):
+    """The current after one step: the speed and current loops bang the supply on the *measured* current."""
+    measured_current = p[P_ISENSE] * current
+    speed_ref = max(-p[P_VMAX] / 0.0752, min(p[P_VMAX] / 0.0752, p[P_GP] * (command - theta_u)))
+    current_ref = max(-p[P_IMAX], min(p[P_IMAX], p[P_GAP] * (speed_ref - speed) / 0.0752))
+    voltage = 0.0
+    if current_ref > measured_current:
+        voltage = p[P_VMAX]
+    elif current_ref < measured_current:
+        voltage = -p[P_VMAX]
+    steady = (voltage - p[P_KE] * speed) / p[P_R]
+    return steady + (current - steady) * decay
+
+
+@njit(cache=True)
+def _new_speed(p, t, h, theta_u, theta_m, speed, current, load):
+    """Motor speed after one explicit Euler step, with stick-slip."""
+    torque = max(-p[P_TMAX], min(p[P_TMAX], p[P_KT] * current))
+    bump = p[P_BUMP_A] * np.exp(-0.5 * ((theta_u - p[P_BUMP_C]) / p[P_BUMP_W]) ** 2)
+    dynamic = p[P_FDJ] * (1.0 + p[P_DRIFT] * max(t, 0.0)) + bump
+    dynamic += p[P_STRIB_A] * (1.0 - np.tanh(abs(speed) / p[P_STRIB_W]))
+    static = p[P_FSJ] + bump + p[P_STRIB_A]
+    cogging = p[P_COG_A] * np.cos(p[P_COG_P] * theta_m + p[P_COG_PHI])
+    drive = torque + load - p[P_C] * speed + cogging
+    sense = (1.0 if speed > 0 else -1.0) if speed != 0.0 else (1.0 if drive > 0 else -1.0)
+    k = p[P_KAID] if load * sense > 0 else p[P_KOPP]
+    accelerating = drive - (dynamic + k * abs(load)) * sense
+    if speed != 0.0:
+        new_speed = speed + h / p[P_J] * accelerating
+        return 0.0 if new_speed * speed < 0 else new_speed
+    if abs(drive) <= max(static, dynamic) + k * abs(load):
+        return 0.0
+    return h / p[P_J] * accelerating
+
+
+@njit(cache=True)
+def _rk4(a, b, x, u, dt):
+    k1 = _derivative(a, b, x, u)
+    k2 = _derivative(a, b, x + 0.5 * dt * k1, u)
+    k3 = _derivative(a, b, x + 0.5 * dt * k2, u)
+    k4 = _derivative(a, b, x + dt * k3, u)
+    return x + dt / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4)
+
+
+@njit(cache=True)
 def _run(p, a, b, command_rad, first_step, n_steps, rate_hz, theta0, out):
     """Integrate from step ``first_step`` (negative: a pre-roll before the log starts) to ``n_steps``."""
     h = 1e-6
@@ -156,46 +201,12 @@ def _run(p, a, b, command_rad, first_step, n_steps, rate_hz, theta0, out):
     sums = np.zeros(5)
     count = 0
     sample = 0
-    n_samples = out.shape[1]
     for i in range(first_step, n_steps):
-        t = i * h
         pos = (i - first_step) * h * 1e5
         j = int(pos)
-        frac = pos - j
-        command = command_rad[j] + frac * (command_rad[j + 1] - command_rad[j])
-        # controller on the measured current
-        measured_current = p[P_ISENSE] * current
-        speed_ref = max(-p[P_VMAX] / 0.0752, min(p[P_VMAX] / 0.0752, p[P_GP] * (command - theta_u)))
-        current_ref = max(-p[P_IMAX], min(p[P_IMAX], p[P_GAP] * (speed_ref - speed) / 0.0752))
-        voltage = 0.0
-        if current_ref > measured_current:
-            voltage = p[P_VMAX]
-        elif current_ref < measured_current:
-            voltage = -p[P_VMAX]
-        steady = (voltage - p[P_KE] * speed) / p[P_R]
-        current = steady + (current - steady) * decay
-        torque = max(-p[P_TMAX], min(p[P_TMAX], p[P_KT] * current))
-        hinge = _hinge(p, x, theta_u)
-        load = hinge / GEAR
-        bump = p[P_BUMP_A] * np.exp(-0.5 * ((theta_u - p[P_BUMP_C]) / p[P_BUMP_W]) ** 2)
-        dynamic = p[P_FDJ] * (1.0 + p[P_DRIFT] * max(t, 0.0)) + bump
-        dynamic += p[P_STRIB_A] * (1.0 - np.tanh(abs(speed) / p[P_STRIB_W]))
-        static = p[P_FSJ] + bump + p[P_STRIB_A]
-        cogging = p[P_COG_A] * np.cos(p[P_COG_P] * theta_m + p[P_COG_PHI])
-        drive = torque + load - p[P_C] * speed + cogging
-        if speed != 0.0:
-            sense = 1.0 if speed > 0 else -1.0
-            k = p[P_KAID] if load * sense > 0 else p[P_KOPP]
-            new_speed = speed + h / p[P_J] * (drive - (dynamic + k * abs(load)) * sense)
-            if new_speed * speed < 0:
-                new_speed = 0.0
-        else:
-            sense = 1.0 if drive > 0 else -1.0
-            k = p[P_KAID] if load * sense > 0 else p[P_KOPP]
-            if abs(drive) <= max(static, dynamic) + k * abs(load):
-                new_speed = 0.0
-            else:
-                new_speed = h / p[P_J] * (drive - (dynamic + k * abs(load)) * sense)
+        command = command_rad[j] + (pos - j) * (command_rad[j + 1] - command_rad[j])
+        current = _current(p, command, theta_u, speed, current, decay)
+        new_speed = _new_speed(p, i * h, h, theta_u, theta_m, speed, current, _hinge(p, x, theta_u) / GEAR)
         theta_m += 0.5 * h * (speed + new_speed)
         speed = new_speed
         limit = p[P_STOP] * GEAR
@@ -211,13 +222,7 @@ def _run(p, a, b, command_rad, first_step, n_steps, rate_hz, theta0, out):
         elif motor_side - theta_u < -0.5 * p[P_BLK]:
             theta_u = motor_side + 0.5 * p[P_BLK]
         if (i - first_step + 1) % AIRCRAFT_EVERY == 0:  # RK4 over 100 µs on the instantaneous deflection
-            u = theta_u - p[P_DELTA_TRIM]
-            dt = AIRCRAFT_EVERY * h
-            k1 = _derivative(a, b, x, u)
-            k2 = _derivative(a, b, x + 0.5 * dt * k1, u)
-            k3 = _derivative(a, b, x + 0.5 * dt * k2, u)
-            k4 = _derivative(a, b, x + dt * k3, u)
-            x = x + dt / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4)
+            x = _rk4(a, b, x, theta_u - p[P_DELTA_TRIM], AIRCRAFT_EVERY * h)
         if i >= 0:
             sums[0] += theta_u
             sums[1] += speed
@@ -231,7 +236,7 @@ def _run(p, a, b, command_rad, first_step, n_steps, rate_hz, theta0, out):
                     sums[r] = 0.0
                 count = 0
                 sample += 1
-                if sample == n_samples:
+                if sample == out.shape[1]:
                     return
 
 
