@@ -101,8 +101,9 @@ class Calibrator:
         held, chosen = self._held_out(measured, chosen)
         after = corrected(fit_with(measured, chosen).values, bias) if chosen else before
         self.measured_, self.chosen_ = measured, chosen
+        backlash = read_backlash(measured, copies, chosen)
         self.report_: CalibrationReport = reporting.assemble(
-            reporting.Found(measured, copies, first_round, chosen, steps, unnamed, read_backlash(measured, copies)),
+            reporting.Found(measured, copies, first_round, chosen, steps, unnamed, backlash),
             before, after, bias, held, truth, time.perf_counter() - started,
         )  # fmt: skip
         return self

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from sim.params import ActuatorParams
-from sim.residual import smoothed
+from sim.residual import smooth_derivative, smoothed
 from training.baseline import FitSettings, regressors
 
 FOLDS = 5
@@ -36,7 +36,8 @@ class Equations:
 
     y: np.ndarray  # (m,) t = sgn(ω)(T_R − C_M ω) [N·m]
     base: np.ndarray  # (m, 3): 1, a, o
-    variables: dict[str, np.ndarray]  # VARIABLES and "motor_angle_rad", each (m,), from the measured states
+    # VARIABLES, "motor_angle_rad" and "engaged" (``engaged``), each (m,), from the measured states
+    variables: dict[str, np.ndarray]
     cogging: dict[float, np.ndarray]  # order p -> (m, 2): sgn·(sin, cos)(p·θ_m), as logged and smoothed
     kinematic: np.ndarray  # (m,) d = θ_m/n − θ_u [rad]
     folds: np.ndarray  # (m,) held-out fold of each sample
@@ -73,6 +74,13 @@ def cogging_columns(
     return out
 
 
+def engaged(position_deg: np.ndarray, speed_radps: np.ndarray, rate: float, gear: float) -> np.ndarray:
+    """1 where the motor drives the elevator (it moves with the motor, at least half its speed on the
+    motor side), 0 where the motor crosses the dead band after a reversal and the elevator waits."""
+    elevator = gear * smooth_derivative(np.radians(position_deg), rate)
+    return (elevator * np.sign(speed_radps) > 0.5 * np.abs(speed_radps)).astype(float)
+
+
 def _one_window(
     signals: Mapping[str, np.ndarray], rate: float, actuator: ActuatorParams, orders: Sequence[float], index: int
 ) -> Equations:
@@ -90,6 +98,7 @@ def _one_window(
         "current_unsigned_a": smoothed(signals["current_a"], rate),
         "direction": sign,
         "motor_angle_rad": angle,
+        "engaged": engaged(signals["position_deg"], speed, rate, actuator.gear_ratio),
     }
     return Equations(
         y=t[mask],

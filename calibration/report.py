@@ -10,9 +10,8 @@ import numpy as np
 from calibration.backlash import BacklashReading
 from calibration.documents import CalibrationReport, Candidate, HeldOut, NoiseFloor, Step, Unexplained
 from calibration.equations import Equations
-from calibration.fitting import score
 from calibration.refit import corrected, fit_with
-from calibration.selection import Chosen, Evidence, problem
+from calibration.selection import Chosen, Evidence, floor_rms, residual_rms
 from sim.effects import EffectSet
 from training.documents import TARGETS
 
@@ -34,12 +33,6 @@ class HeldOutCheck:
     rss_after: float  # ...and with the effects
     adopted: bool
     note: str
-
-
-def residual_rms(e: Equations, chosen: Sequence[Chosen]) -> float:
-    """RMS of the equation error [N·m] with the base columns and ``chosen``'s."""
-    design, target = problem(e, chosen)
-    return float(np.sqrt(score(design, target, e.folds).rss / e.m))
 
 
 def _candidate(e: Evidence) -> Candidate:
@@ -117,7 +110,7 @@ def assemble(
     truth: Mapping[str, float] | None,
     seconds: float,
 ) -> CalibrationReport:
-    floor = np.mean([residual_rms(c, []) for c in found.copies])
+    floor = floor_rms(found.copies)
     effects = adopted_effects(found)
     names = [c.family.name for c in found.chosen] + (["backlash"] if found.backlash.significant else [])
     first = next((e for e in found.evidence if found.chosen and e.family.name == found.chosen[0].family.name), None)

@@ -65,6 +65,17 @@ def problem(e: Equations, chosen: Sequence[Chosen]) -> tuple[np.ndarray, np.ndar
     return np.concatenate([e.base, *columns], axis=1), e.y - sum(offsets, np.zeros(e.m))
 
 
+def residual_rms(e: Equations, chosen: Sequence[Chosen]) -> float:
+    """RMS of the equation error [N·m] with the base columns and ``chosen``'s."""
+    design, target = problem(e, chosen)
+    return float(np.sqrt(score(design, target, e.folds).rss / e.m))
+
+
+def floor_rms(copies: Sequence[Equations]) -> float:
+    """The base model's equation error on noise-only copies: what noise alone leaves [N·m]."""
+    return float(np.mean([residual_rms(c, []) for c in copies]))
+
+
 def _drops(e: Equations, chosen: Sequence[Chosen], family: Family) -> tuple[np.ndarray, Scored, np.ndarray, np.ndarray]:
     """Per grid value, the fractional held-out drop of ``family`` added to the base and ``chosen``;
     with the base's own score, and each grid value's in-sample RSS and coefficients."""

@@ -53,6 +53,24 @@ def test_the_undeclared_effect_is_named_and_the_estimates_recover(case, seed):
     assert report.held_out.adopted or case == "backlash"  # the dead band does not move FDJ or η_O
 
 
+@pytest.mark.parametrize(("scale", "seed"), [(1.0, 5701), pytest.param(5.0, 5700, marks=pytest.mark.slow)])
+def test_the_dead_band_width_is_read_where_the_motor_drives_the_elevator(scale, seed):
+    report, _ = calibrate("backlash", seed, scale)
+    drawn_extra_rad = 5e-3 * (CASES["backlash"](np.random.default_rng(seed), scale).backlash_factor - 1.0)
+    read = next(c for c in report.candidates if c.effect == "backlash").parameters["extra_rad"]
+    assert report.selected_effect == "backlash"
+    assert read == pytest.approx(drawn_extra_rad, rel=0.1)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(("case", "scale", "seed"), [("torque_constant", 5.0, 5201), ("hinge_moment_bias", 20.0, 5500)])
+def test_a_model_that_cannot_follow_the_window_is_no_worn_dead_band(case, scale, seed):
+    # The copies replicate the base model, which moves the motor unlike the window: their spread
+    # understates the reading's, and the dead band must stand out of the widened one.
+    report, _ = calibrate(case, seed, scale)
+    assert "backlash" not in report.selected_effects
+
+
 def test_a_current_scale_names_one_twin_and_reports_the_other():
     report, _ = calibrate("current_sensor_gain", 913)
     assert report.selected_effect in ("current_sensor_gain", "torque_constant")
