@@ -38,7 +38,10 @@ class Unexplained(Document):
     description: str
     shape: dict[str, float] = Field(description="extra friction [N·m] at grid points of the first variable")
     simulator_term: dict | None = Field(description="a FrictionTable the simulator can add; null where it has none")
-    estimates_if_added: dict[str, float]
+    estimates_if_added: dict[str, float] | None = Field(
+        description="FDJ and η_O re-estimated with the term; null where not identified (see estimates_withheld)"
+    )
+    estimates_withheld: str | None = Field(default=None, description="why estimates_if_added is null")
     residual_rms_if_added: float
     error_if_added: dict[str, float] | None = None
 

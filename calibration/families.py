@@ -32,7 +32,13 @@ KNOTS = 9  # piecewise-linear curves: 8 segments over the visited range
 # bend. Eight free segments would spend their freedom on noise, and lose on held-out samples to any
 # one-column shape that merely correlates with time (the direction, when the elevator turns once).
 TIME_KNOTS = 3
-STRIBECK_SPEEDS_RADPS = (10.0, 20.0, 40.0, 80.0, 160.0, 320.0)
+# A Stribeck curve exp(−(|ω|/ω_s)^δ): Tustin's δ = 1, the Gaussian δ = 2, and a slower δ = ½. With
+# only the scale free (steps of 2), a decay of another form was matched by the wrong tail, and what
+# the tail missed at speed went into FDJ; scales a quarter-octave apart and three exponents follow
+# any monotone decay closely enough that FDJ stays put.
+STRIBECK_GRID = tuple(
+    (float(w), d) for d in (0.5, 1.0, 2.0) for w in np.round(np.geomspace(10.0, 640.0, 25), 1)
+)  # (ω_s [rad/s], δ)
 COGGING_ORDERS = tuple(float(p) for p in range(1, 49))
 BUMP_WIDTHS_DEG = (0.75, 1.5, 3.0, 6.0)  # a spall's half-width, as a Gaussian's std
 BUMP_SPACING_DEG = 0.5  # centres every half degree over the visited deflections
@@ -87,12 +93,18 @@ def _curve(knots: np.ndarray, unit: str) -> Parameters:
     return parameters
 
 
+def _stribeck(speed_radps: np.ndarray, shape: tuple[float, float]) -> np.ndarray:
+    scale, exponent = shape
+    return np.exp(-((speed_radps / scale) ** exponent))
+
+
 def _stribeck_stacked(e: Equations) -> np.ndarray:
-    return np.exp(-e.variables["speed_radps"][:, None] / np.array(STRIBECK_SPEEDS_RADPS))[..., None]
+    scales, exponents = (np.array(v)[None, :] for v in zip(*STRIBECK_GRID, strict=True))
+    return np.exp(-((e.variables["speed_radps"][:, None] / scales) ** exponents))[..., None]
 
 
-def _stribeck_term(beta: np.ndarray, speed: float) -> EffectSet:
-    values = np.clip(beta[0] * np.exp(-SPEED_TABLE / speed), -0.5, 0.5)
+def _stribeck_term(beta: np.ndarray, shape: tuple[float, float]) -> EffectSet:
+    values = np.clip(beta[0] * _stribeck(SPEED_TABLE, shape), -0.5, 0.5)
     return EffectSet(table=FrictionTable("speed", 0.0, float(SPEED_TABLE[1]), tuple(values)))
 
 
@@ -187,10 +199,9 @@ def named_families(measured: Equations, actuator: ActuatorParams) -> list[Family
         Family("viscous", "speed_radps", True, lambda e, g: e.variables["speed_radps"][:, None],
                lambda b, g: {"coefficient_nms": float(b[0])},
                lambda b, g: EffectSet({"viscous": {"coefficient_nms": float(np.clip(b[0], -5e-5, 5e-3))}})),
-        Family("stribeck", "speed_radps", True, lambda e, g: np.exp(-e.variables["speed_radps"] / g)[:, None],
-               lambda b, g: {"amplitude_nm": float(b[0]), "decay_speed_radps": g}, _stribeck_term,
-               STRIBECK_SPEEDS_RADPS,
-               stacked=_stribeck_stacked),
+        Family("stribeck", "speed_radps", True, lambda e, g: _stribeck(e.variables["speed_radps"], g)[:, None],
+               lambda b, g: {"amplitude_nm": float(b[0]), "decay_speed_radps": g[0], "exponent": g[1]},
+               _stribeck_term, STRIBECK_GRID, stacked=_stribeck_stacked),
         Family("torque_constant", "current_a", True,
                lambda e, g: _torque_shift(e, np.array([g]), actuator),
                lambda b, g: {"gain": g}, lambda b, g: _gain_term("torque_constant", g),

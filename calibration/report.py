@@ -13,7 +13,12 @@ from calibration.equations import Equations
 from calibration.refit import corrected, fit_with
 from calibration.selection import Chosen, Evidence, floor_rms, residual_rms
 from sim.effects import EffectSet
+from training.baseline import ETA_O_SEARCH
 from training.documents import TARGETS
+
+# How much further noise alone may move FDJ or η_O with a described term than without it before the
+# estimates with it are withheld: a time drift inflates them 1–2.5x, a ramp over deflection 13–32x.
+MAX_TERM_INFLATION = 5.0
 
 
 @dataclass(frozen=True)
@@ -78,6 +83,29 @@ def _errors(values: Mapping[str, float], truth: Mapping[str, float] | None) -> t
     return absolute, {k: 100 * absolute[k] / abs(float(truth[k])) for k in TARGETS}
 
 
+def scatter(copies: Sequence[Equations], with_it: Sequence[Chosen]) -> np.ndarray:
+    """Relative std of FDJ and η_O, fitted with ``with_it``, over the noise-only copies."""
+    fits = np.array([[fit_with(c, with_it).values[n] for n in TARGETS] for c in copies])
+    return fits.std(axis=0) / np.abs(fits.mean(axis=0))
+
+
+def withheld(found: Found, with_it: Sequence[Chosen], estimates: Mapping[str, float], has_term: bool) -> str | None:
+    """Why the estimates with a described term are not offered, or None where they are. Where the
+    load columns mimic the term (a ramp over deflection, which the hinge moment follows; a curve
+    over current, which answers the friction itself), FDJ and η_O trade with it: noise alone then
+    moves them many times further than without it, or drives η_O to the end of its search."""
+    if not has_term:
+        return "the simulator has no term for this variable"
+    low, high = ETA_O_SEARCH
+    if not (estimates["FDJ"] > 0 and low + 1e-3 < estimates["eta_O"] < high - 1e-3):
+        return "with this term η_O goes to the end of its range: the estimates are not identified"
+    inflation = float(np.max(scatter(found.copies, with_it) / scatter(found.copies, found.chosen)))
+    if inflation > MAX_TERM_INFLATION:
+        return (f"with this term noise alone moves FDJ or η_O {inflation:.0f}x as far as without it: "
+                "the load columns mimic it, and the estimates with it are not identified")  # fmt: skip
+    return None
+
+
 def unexplained(found: Found, bias: Mapping[str, float], truth: Mapping[str, float] | None) -> Unexplained | None:
     if not found.unnamed:
         return None
@@ -85,7 +113,9 @@ def unexplained(found: Found, bias: Mapping[str, float], truth: Mapping[str, flo
     variables = list(dict.fromkeys(e.family.follows for e in found.unnamed))
     term = lead.family.term(lead.beta, lead.grid)
     with_it = [*found.chosen, Chosen(lead.family, lead.grid)]
-    estimates = corrected(fit_with(found.measured, with_it).values, bias)
+    raw = fit_with(found.measured, with_it).values
+    reason = withheld(found, with_it, raw, term is not None and term.table is not None)
+    estimates = None if reason else corrected(raw, bias)
     if len(variables) == 1:
         described = f"the residual torque follows {variables[0]} in a shape no named effect has (table below)"
     else:
@@ -96,8 +126,9 @@ def unexplained(found: Found, bias: Mapping[str, float], truth: Mapping[str, flo
         shape=lead.family.parameters(lead.beta, lead.grid),
         simulator_term=None if term is None or term.table is None else asdict(term.table),
         estimates_if_added=estimates,
+        estimates_withheld=reason,
         residual_rms_if_added=residual_rms(found.measured, with_it),
-        error_if_added=_errors(estimates, truth)[0],
+        error_if_added=None if estimates is None else _errors(estimates, truth)[0],
     )
 
 
