@@ -103,9 +103,9 @@ def run_case(case: Case, index: int) -> dict:
     result = fit(train_x, train_y, replace(case.train, hidden=case.neurons))
     reserved = predict(result.model, inputs[case.sims :])
     truth = targets[case.sims :]
-    plot_parity(case, index, reserved, truth)
     return {
         "case": case,
+        "parity": (reserved, truth),
         "simulate_s": simulate_s,
         "fit": result,
         "reserved_mse": float(np.mean((reserved - truth) ** 2)),
@@ -229,6 +229,8 @@ def main() -> None:
     comparison = baseline_comparison(3 if args.quick else args.windows)
     print("\n".join(comparison))
     if args.docs:
+        for index, result in enumerate(results):
+            plot_parity(result["case"], index, *result["parity"])
         write_results(results, comparison, "python -m benchmarks.reproduce_thesis --docs" + (" --quick" * args.quick))
 
 
