@@ -112,9 +112,10 @@ def unexplained(found: Found, bias: Mapping[str, float], truth: Mapping[str, flo
     lead = found.unnamed[0]
     variables = list(dict.fromkeys(e.family.follows for e in found.unnamed))
     term = lead.family.term(lead.beta, lead.grid)
+    table = None if term is None else term.table
     with_it = [*found.chosen, Chosen(lead.family, lead.grid)]
     raw = fit_with(found.measured, with_it).values
-    reason = withheld(found, with_it, raw, term is not None and term.table is not None)
+    reason = withheld(found, with_it, raw, table is not None)
     estimates = None if reason else corrected(raw, bias)
     if len(variables) == 1:
         described = f"the residual torque follows {variables[0]} in a shape no named effect has (table below)"
@@ -124,7 +125,7 @@ def unexplained(found: Found, bias: Mapping[str, float], truth: Mapping[str, flo
         variables=variables,
         description=described,
         shape=lead.family.parameters(lead.beta, lead.grid),
-        simulator_term=None if term is None or term.table is None else asdict(term.table),
+        simulator_term=None if table is None else asdict(table),
         estimates_if_added=estimates,
         estimates_withheld=reason,
         residual_rms_if_added=residual_rms(found.measured, with_it),
