@@ -99,8 +99,9 @@ def smooth_derivative(
 
 
 def above_throughout(values: np.ndarray, threshold: float, width: int) -> np.ndarray:
-    """Whether every sample of a centred window of ``width`` samples exceeds ``threshold`` (last axis;
-    the edges look at the part of the window that exists), by a running count: O(n)."""
+    """Whether every sample of a centred window of ``width`` samples exceeds ``threshold`` (last axis),
+    by a running count: O(n). False where the window runs past either end: the reconstruction's
+    kernel is padded there, and after a step the padded acceleration is tens of mN·m off."""
     half = width // 2
     low = (values <= threshold).astype(np.int64)
     counts = np.cumsum(np.pad(low, [(0, 0)] * (values.ndim - 1) + [(1, 0)]), axis=-1)
@@ -108,7 +109,8 @@ def above_throughout(values: np.ndarray, threshold: float, width: int) -> np.nda
     index = np.arange(n)
     upper = np.minimum(index + half + 1, n)
     lower = np.maximum(index - half, 0)
-    return (counts[..., upper] - counts[..., lower]) == 0
+    whole = (index >= half) & (index < n - half)
+    return ((counts[..., upper] - counts[..., lower]) == 0) & whole
 
 
 def residual_torque_nm(

@@ -7,7 +7,7 @@ from sim.checks import InputError
 from sim.commands import random_command_knots
 from sim.noise import SensorNoise, add_sensor_noise
 from sim.params import HealthParams
-from sim.residual import residual_torque_nm, smooth_derivative, smoothed
+from sim.residual import above_throughout, kernel_samples, residual_torque_nm, smooth_derivative, smoothed
 
 RATE = 10_000.0
 
@@ -63,3 +63,18 @@ def test_bad_inputs_are_named():
         residual_torque_nm(np.zeros(100), np.zeros(99), np.zeros(100), RATE)
     with pytest.raises(InputError, match="need more than"):
         residual_torque_nm(np.zeros(10), np.zeros(10), np.zeros(10), RATE)
+
+
+def test_sliding_mask_leaves_out_the_edges_where_the_kernel_is_padded():
+    # The padded end of the derivative leans on the last few samples: its noise grows ~4x there,
+    # and the errors of those samples move together (one window's 9 edge samples held 35 mN·m).
+    t = np.arange(400) / RATE
+    speed = 200.0 + 2e4 * t
+    noisy = speed + np.random.default_rng(3).normal(0.0, 0.5, (2000, t.size))
+    current = np.full_like(noisy, 5.0)
+    hinge = np.full_like(noisy, -40.0)
+    spread = residual_torque_nm(current, noisy, hinge, RATE).std(axis=0)
+    kept = above_throughout(speed, 30.0, kernel_samples(RATE))
+    assert not kept[: kernel_samples(RATE) // 2].any() and not kept[-(kernel_samples(RATE) // 2) :].any()
+    assert spread[kept].max() < 1.15 * np.median(spread)
+    assert spread[~kept].max() > 3 * np.median(spread)
