@@ -24,11 +24,10 @@ from sim.params import DEFAULT_RANGES, HealthParams
 from sim.synthetic import synthetic_window
 from sim.window import read_window, write_window
 from training import runtime
-from training.pipeline import estimate_window
+from training.pipeline import HEALTHY_RANGE, estimate_window, share_of_range
 
 LEGACY = "b8987e4"  # the last commit of round 1
 ROOT = Path(__file__).resolve().parent.parent
-RANGE = {"FDJ": 0.02, "eta_O": 0.30}
 LEGACY_RUN = """
 import json, sys, time
 from sim.window import read_window
@@ -81,8 +80,8 @@ def today(paths: list[Path]) -> list[dict[str, float]]:
 
 def row(name: str, runs: list[dict[str, float]], truths: list[dict[str, float]]) -> str:
     totals = np.array([r["total"] for r in runs])
-    errors = {k: 100 * np.mean([abs(r[k] - t[k]) / RANGE[k] for r, t in zip(runs, truths, strict=True)])
-              for k in RANGE}  # fmt: skip
+    errors = {k: 100 * np.mean([share_of_range(k, abs(r[k] - t[k])) for r, t in zip(runs, truths, strict=True)])
+              for k in HEALTHY_RANGE}  # fmt: skip
     return (f"| {name} | {np.median(totals):.2f} | {np.percentile(totals, 95):.2f} | {np.median(totals) / 0.5:.2f} "
             f"| {errors['FDJ']:.2f} % / {errors['eta_O']:.2f} % |")  # fmt: skip
 

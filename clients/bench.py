@@ -25,10 +25,9 @@ from sim.params import DEFAULT_RANGES, HealthParams
 from sim.synthetic import synthetic_window
 from training import runtime
 from training.config import PipelineConfig
-from training.pipeline import estimate_window
+from training.pipeline import estimate_window, share_of_range
 
 STAGES = ("simulate", "train", "predict", "check", "total")
-RANGE = {"FDJ": 0.02, "eta_O": 0.30}  # the thesis's ranges, for "% of range"
 BUSY = "import itertools\nfor _ in itertools.count(): pass"
 
 
@@ -55,8 +54,8 @@ def time_windows(config: PipelineConfig, duration_s: float, repeats: int, seed: 
         result = estimate_window(window, config)
         for stage in STAGES:
             timings[stage].append(getattr(result.timings_s, stage))
-        errors["FDJ"].append(abs(result.estimates.FDJ.value - truth.fdj_nm[0]) / RANGE["FDJ"])
-        errors["eta_O"].append(abs(result.estimates.eta_O.value - truth.eta_o[0]) / RANGE["eta_O"])
+        errors["FDJ"].append(share_of_range("FDJ", abs(result.estimates.FDJ.value - truth.fdj_nm[0])))
+        errors["eta_O"].append(share_of_range("eta_O", abs(result.estimates.eta_O.value - truth.eta_o[0])))
         print(f"  {duration_s:g} s window #{repeat + 1}: {result.timings_s.total:.2f} s", file=sys.stderr)
     return {
         "duration_s": duration_s,

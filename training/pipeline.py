@@ -33,6 +33,7 @@ from training.conditioning import Prepared, prepare
 from training.config import PipelineConfig
 from training.dataset import Scenario, Simulated, scenario_from_window, simulate_noisy
 from training.documents import (
+    TARGETS,
     DatasetInfo,
     Estimate,
     Estimates,
@@ -51,6 +52,15 @@ from training.static_friction import StaticFriction, read_static_friction
 
 NOMINAL = {"FDJ": DEFAULT_RANGES.nominal_fdj_nm, "eta_O": DEFAULT_RANGES.nominal_eta_o}
 NOMINAL_ETA_A = float(eta_a_from_eta_o(DEFAULT_RANGES.nominal_eta_o))
+HEALTHY_RANGE = {"FDJ": DEFAULT_RANGES.fdj_nm, "eta_O": DEFAULT_RANGES.eta_o}  # Table 3.1: "% of range" is of these
+# ±2 std wider than this share of the healthy range: the window is said to determine the parameter weakly.
+WEAK_SHARE_OF_RANGE = 0.10
+
+
+def share_of_range(name: str, amount: float) -> float:
+    """``amount`` (in the parameter's unit) as a share of the width of its Table 3.1 range."""
+    low, high = HEALTHY_RANGE[name]
+    return amount / (high - low)
 
 
 @dataclass(frozen=True)
@@ -198,6 +208,15 @@ def _notes(prepared: Prepared, physics: FrictionFit, estimates: Estimates, check
             f"{100 * prepared.command_clipped_fraction:.1f} % of the command lies past the end stops: "
             "the actuator saturates there, and so do its simulations"
         )
+    for name in TARGETS:
+        spread = share_of_range(name, 2 * (getattr(estimates, name).std or 0.0))
+        if spread > WEAK_SHARE_OF_RANGE:
+            low, high = HEALTHY_RANGE[name]
+            notes.append(
+                f"{name} is weakly determined by this window: ±2 std spans {100 * spread:.0f} % of the healthy "
+                f"range ({low:g}–{high:g}); a short window, a slow log or a hinge load that barely varies "
+                "holds little of it (trend it with its std)"
+            )
     if physics.at_search_edge[0]:
         notes.append("η_O lies at an end of the physical search range: read it as a bound, not a value")
     if estimates.FDJ.value <= 0:
