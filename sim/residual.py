@@ -101,7 +101,7 @@ def smooth_derivative(
 def above_throughout(values: np.ndarray, threshold: float, width: int) -> np.ndarray:
     """Whether every sample of a centred window of ``width`` samples exceeds ``threshold`` (last axis),
     by a running count: O(n). False where the window runs past either end: the reconstruction's
-    kernel is padded there, and after a step the padded acceleration is tens of mN·m off."""
+    kernel is padded there, leaning on the last few samples (noise ~4x, the samples erring together)."""
     half = width // 2
     low = (values <= threshold).astype(np.int64)
     counts = np.cumsum(np.pad(low, [(0, 0)] * (values.ndim - 1) + [(1, 0)]), axis=-1)
