@@ -148,7 +148,7 @@ class Calibrator:
         assert pick is not None
         twin = next((e for e in found if e.family.name == TWINS.get(pick.family.name)), None)
         if twin is None:
-            return pick, Step(selected=pick.family.name, reason=decision.reason)
+            return pick, Step(selected=pick.family.name, reason=decision.reason, indistinguishable_from=decision.alike)
         first = pick
         pick, errors, clear = tell_apart(windows, before, [first, twin], noise)
         other = (twin if pick is first else first).family.name

@@ -20,7 +20,7 @@ The backlash lives in its own channel (``backlash``).
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -110,6 +110,7 @@ class Decision:
     chosen: Evidence | None  # the family to adopt now, or None
     unnamed: list[Evidence]  # curves that explain the residual when no name may be given (best first)
     reason: str
+    alike: list[str] = field(default_factory=list)  # named families this window cannot tell from the chosen one
 
 
 def _width(e: Evidence) -> int:
@@ -138,18 +139,20 @@ def simplest(
     measured: Equations,
     copies: Sequence[Equations],
     chosen: Sequence[Chosen],
-) -> Evidence:
+) -> tuple[Evidence, list[str]]:
     """A named family over the same variable with fewer shapes to choose from, if ``named`` explains
     nothing beyond it: a Stribeck decay of the slowest scale is a straight line in speed over the
-    visited range, and its grid should not win a viscous friction by a hair."""
+    visited range, and its grid should not win a viscous friction by a hair. The second value names
+    the family set aside that way: the window cannot tell the two apart, and the report says so (a
+    small Stribeck decay over 120–300 rad/s is named viscous that way, with a negative coefficient)."""
     simpler = [
         e for e in close
         if e.family.named and e.family.follows == named.family.follows and len(e.family.grid) < len(named.family.grid)
     ]  # fmt: skip
     for rival in sorted(simpler, key=lambda e: len(e.family.grid)):
         if evidence(measured, copies, [*chosen, Chosen(rival.family, rival.grid)], named.family).z < MIN_Z:
-            return rival
-    return named
+            return rival, [named.family.name]
+    return named, []
 
 
 def decide(
@@ -166,7 +169,7 @@ def decide(
     )  # fmt: skip
     if named is None:
         return Decision(None, [best], f"the residual follows {best.family.follows} in a way no named effect describes")
-    named = simplest(named, [best, *close], measured, copies, chosen)
+    named, alike = simplest(named, [best, *close], measured, copies, chosen)
     rivals = [e for e in [best, *close] if not e.family.named and e.family.exogenous]
     rivals = [e for e in rivals if e.family.follows != named.family.follows]
     for rival in rivals:
@@ -176,7 +179,10 @@ def decide(
                                            f"{named.family.name} explains: no named effect describes it")  # fmt: skip
         if verdict == "tie":
             return Decision(None, [rival, named], _ambiguous(named, [rival]))
-    return Decision(named, [], f"{named.family.name} explains held-out samples best (z = {named.z:.0f})")
+    reason = f"{named.family.name} explains held-out samples best (z = {named.z:.0f})"
+    if alike:
+        reason += f"; {', '.join(alike)} explains the same samples (one trace over the range visited): simpler named"
+    return Decision(named, [], reason, alike)
 
 
 def _ambiguous(best: Evidence, rivals: Sequence[Evidence]) -> str:

@@ -132,6 +132,7 @@ def test_a_small_viscous_friction_is_not_won_by_a_slow_stribeck_decay():
     # the one-column viscous term by a hair when it explains nothing beyond it.
     report, _ = calibrate("viscous", 5103, scale=0.2)
     assert report.selected_effect == "viscous", report.selection_steps[0].reason
+    assert report.selection_steps[0].indistinguishable_from == ["stribeck"]  # and the report says it could be
     assert combined_error(report, "after") <= max(0.5 * combined_error(report, "before"), 0.01)
 
 
