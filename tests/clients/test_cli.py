@@ -1,7 +1,6 @@
 import json
 import subprocess
 import sys
-import time
 
 import pytest
 
@@ -90,10 +89,13 @@ def test_calibrate_writes_a_figure_and_names_a_bad_truth_file(tmp_path, capsys):
 
 
 def test_help_is_quick_and_version_is_printed():
-    started = time.perf_counter()
-    done = subprocess.run([sys.executable, "-m", "clients.cli", "--help"], capture_output=True, text=True)
-    assert done.returncode == 0 and "estimate" in done.stdout
-    assert time.perf_counter() - started < 2.0  # < 0.5 s measured (docs/benchmarks.md); generous for CI
+    # Quick because it loads none of the heavy libraries (a wall-clock bound flaked on a busy machine).
+    probe = "\n".join([
+        "import sys", "from clients.cli import main", "try:", "    main(['--help'])", "except SystemExit:", "    pass",
+        "print('loaded:', sorted(m for m in ('torch', 'numba', 'numpy', 'pydantic') if m in sys.modules))",
+    ])  # fmt: skip
+    done = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True)
+    assert "estimate" in done.stdout and done.stdout.rstrip().endswith("loaded: []"), done.stdout[-200:]
     version = subprocess.run([sys.executable, "-m", "clients.cli", "--version"], capture_output=True, text=True)
     assert version.stdout.startswith("ema ")
 
@@ -102,12 +104,16 @@ def test_a_closed_pipe_and_an_interrupt_end_quietly(tmp_path):
     command = f"{sys.executable} -m clients.cli simulate --out {tmp_path / 'w.json'} --duration 0.05 | head -1"
     done = subprocess.run(["bash", "-o", "pipefail", "-c", command], capture_output=True, text=True)
     assert done.returncode == 0 and "Traceback" not in done.stderr
-    process = subprocess.Popen([sys.executable, "-m", "clients.cli", "estimate", str(tmp_path / "w.json")],
-                               stderr=subprocess.PIPE, text=True)  # fmt: skip
-    time.sleep(3.0)
+    # The largest dataset, interrupted once its first stage is announced: a fixed sleep raced both the
+    # start-up (an interrupt during imports) and a job that finished first on a busy machine.
+    job = [sys.executable, "-m", "clients.cli", "estimate", str(tmp_path / "w.json"), "--sims", "4000"]
+    process = subprocess.Popen(job, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    assert process.stderr is not None
+    first = process.stderr.readline()
+    assert "simulating" in first, first
     process.send_signal(2)  # SIGINT: Ctrl-C
     _, err = process.communicate(timeout=60)
-    assert process.returncode == 130 and "Traceback" not in err
+    assert process.returncode == 130 and "Traceback" not in err, err
 
 
 def test_schemas_in_docs_match_the_code():
