@@ -93,14 +93,15 @@ def _curve(knots: np.ndarray, unit: str) -> Parameters:
     return parameters
 
 
-def _stribeck(speed_radps: np.ndarray, shape: tuple[float, float]) -> np.ndarray:
+def _stribeck(speed_radps: np.ndarray, shape: tuple[float | np.ndarray, float | np.ndarray]) -> np.ndarray:
+    """exp(−(|ω|/ω_s)^δ) for shape (ω_s, δ); arrays of shapes broadcast against the speeds."""
     scale, exponent = shape
     return np.exp(-((speed_radps / scale) ** exponent))
 
 
 def _stribeck_stacked(e: Equations) -> np.ndarray:
     scales, exponents = (np.array(v)[None, :] for v in zip(*STRIBECK_GRID, strict=True))
-    return np.exp(-((e.variables["speed_radps"][:, None] / scales) ** exponents))[..., None]
+    return _stribeck(e.variables["speed_radps"][:, None], (scales, exponents))[..., None]
 
 
 def _stribeck_term(beta: np.ndarray, shape: tuple[float, float]) -> EffectSet:
