@@ -15,11 +15,12 @@ from sim.params import HealthParams
 from sim.residual import residual_torque_nm, smoothed
 from sim.window import Window
 from training.noise_level import excess_noise
+from training.preprocess import as_read
 
 INITIAL_FIT_SAMPLES = 8
 SIGNALS_READ = ("current_a", "motor_speed_radps", "hinge_moment_nm", "position_deg")  # all the estimators read
-# Position enters the estimators only through the end-stop margin, 1° wide: its 0.01° noise is not drawn.
-NOISY = ("current_a", "motor_speed_radps", "hinge_moment_nm")
+# Position's noise is drawn too: the hinge moment is read along it (sim.hinge), b·0.01° ≈ 0.1 N·m.
+NOISY = SIGNALS_READ
 
 
 @dataclass(frozen=True)
@@ -115,8 +116,9 @@ def simulate_noisy(
     def residual(s: dict[str, np.ndarray]) -> np.ndarray:
         return residual_torque_nm(s["current_a"], s["motor_speed_radps"], s["hinge_moment_nm"], rate)
 
-    tail = {name: values[len(health) - clean_last :] for name, values in clean.items()}
-    return Simulated(health, noise, noisy, residual(noisy), residual(tail))
+    seen = as_read(noisy, rate)
+    tail = as_read({name: values[len(health) - clean_last :] for name, values in clean.items()}, rate)
+    return Simulated(health, noise, seen, residual(seen), residual(tail))
 
 
 def window_noise(window: Window, scenario: Scenario, health: HealthParams) -> SensorNoise:

@@ -46,7 +46,7 @@ from training.documents import (
 )
 from training.estimator import NetworkEstimator
 from training.network import TrainConfig
-from training.preprocess import sliding_features
+from training.preprocess import as_read, sliding_features
 from training.reproduction import MAX_RATIO, output_error_ratios
 from training.static_friction import StaticFriction, read_static_friction
 
@@ -76,16 +76,17 @@ class Data:
     window_inputs: np.ndarray  # (1, n_timesteps)
 
 
-def simulate_dataset(window: Window, physics: FrictionFit, config: PipelineConfig) -> Data:
-    """The box around the physics estimate, the window's noise, the simulations and their features."""
+def simulate_dataset(window: Window, seen: Window, physics: FrictionFit, config: PipelineConfig) -> Data:
+    """The box around the physics estimate, the window's sensor noise (measured on ``window`` as logged),
+    the simulations, and the features of both (the window read as ``seen``: through ``as_read``)."""
     box = design.box_around(physics.fdj_nm[0], physics.fdj_std_nm[0], physics.eta_o[0], physics.eta_o_std[0])
-    scenario = scenario_from_window(window)
+    scenario = scenario_from_window(seen)
     health = design.draw(box, config.total_simulations, config.seed)
     sims = simulate_noisy(scenario, health, window, design.centre(box), config.seed + 1, config.check_windows)
     rate = window.sample_rate_hz
-    sliding = regressors(window.signals, rate, ActuatorParams(), FitSettings())[3][0]
+    sliding = regressors(seen.signals, rate, ActuatorParams(), FitSettings())[3][0]
     residual = residual_torque_nm(
-        window.signals["current_a"], window.signals["motor_speed_radps"], window.signals["hinge_moment_nm"], rate
+        seen.signals["current_a"], seen.signals["motor_speed_radps"], seen.signals["hinge_moment_nm"], rate
     )
     n_timesteps = min(config.n_timesteps, window.n_samples)
     inputs = sliding_features(sims.residual_nm, sliding, n_timesteps)
@@ -163,9 +164,10 @@ def estimate_window(
     clock = [time.perf_counter()]
     prepared = prepare(window)
     w, n = prepared.window, config.n_simulations
-    physics = fit_window(w.signals, w.sample_rate_hz)
+    seen = replace(w, signals=as_read(w.signals, w.sample_rate_hz))
+    physics = fit_window(seen.signals, w.sample_rate_hz)
     stage(f"simulating {config.total_simulations} windows around the physics estimate")
-    data = simulate_dataset(w, physics, config)
+    data = simulate_dataset(w, seen, physics, config)
     clock.append(time.perf_counter())
     stage(f"training {config.members} network(s) of {config.hidden_units} neurons")
     network = train_network(data, config)
@@ -177,8 +179,8 @@ def estimate_window(
     answer = assess(found, equation_ratio)
     clock.append(time.perf_counter())
     stage("checking the answer against the window")
-    check = fit_check(w, data, answer, equation_ratio, n)
-    fsj = read_static_friction(w.signals, w.sample_rate_hz, answer.values["FDJ"], answer.values["eta_O"])
+    check = fit_check(seen, data, answer, equation_ratio, n)
+    fsj = read_static_friction(seen.signals, w.sample_rate_hz, answer.values["FDJ"], answer.values["eta_O"])
     clock.append(time.perf_counter())
     return _document(prepared, physics, data, network, answer, check, fsj, config, clock)
 

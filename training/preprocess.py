@@ -1,4 +1,5 @@
-"""One preprocessing for simulated and measured windows alike: residual torque, then resampling.
+"""One preprocessing for simulated and measured windows alike: the signals as read (the hinge moment
+denoised, ``sim.hinge``), residual torque, then resampling.
 
 Measured and simulated data must go through the very same function (thesis §5.7); this module
 is that function. Resampling to K timesteps takes the mean over K equal bins rather than
@@ -13,6 +14,7 @@ from collections.abc import Mapping
 import numpy as np
 
 from sim.checks import InputError
+from sim.hinge import denoised_hinge_nm
 from sim.params import ActuatorParams
 from sim.residual import residual_torque_nm
 
@@ -21,6 +23,14 @@ INPUT_SETS = {
     "residual_torque": ("residual_torque",),
     "input_map": ("residual_torque", "motor_speed", "hinge_moment"),
 }
+
+
+def as_read(signals: Mapping[str, np.ndarray], sample_rate_hz: float) -> dict[str, np.ndarray]:
+    """The signals as every estimator reads them: the hinge moment denoised along the deflection
+    (``sim.hinge``), the rest as logged. One window (n,) or a batch (N, n) per signal."""
+    out = dict(signals)
+    out["hinge_moment_nm"] = denoised_hinge_nm(signals["hinge_moment_nm"], signals["position_deg"], sample_rate_hz)
+    return out
 
 
 def bin_means(values: np.ndarray, n_bins: int) -> np.ndarray:

@@ -21,6 +21,7 @@ from sim.params import HealthParams
 from sim.residual import residual_torque_nm
 from sim.window import Window
 from training.dataset import Scenario
+from training.preprocess import as_read
 
 SETTLE_S = 0.02
 MAX_RATIO = 2.0  # residual torque within twice its noise floor: reproduced
@@ -35,8 +36,8 @@ def output_error_ratios(
     sliding: np.ndarray,
 ) -> dict[str, float]:
     """Per signal, RMS(measured − simulated at ``health``) over its noise-only floor."""
-    simulated = scenario.simulate(health, lanes=1).simulation(0)
     rate = window.sample_rate_hz
+    simulated = as_read(scenario.simulate(health, lanes=1).simulation(0), rate)
     measured = window.signals
     keep = np.arange(window.n_samples) >= round(SETTLE_S * rate)
     floors = {
