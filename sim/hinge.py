@@ -25,6 +25,7 @@ from __future__ import annotations
 import numpy as np
 
 from sim.checks import InputError
+from sim.residual import kernel_samples
 
 # A 3 Hz short-period swing loses 2.4 % of its amplitude to a 40 ms mean; 10 kHz noise, 20x.
 HINGE_SMOOTHING_S = 0.04
@@ -67,7 +68,7 @@ def denoised_hinge_nm(
     position = np.asarray(position_deg, dtype=np.float64)
     if hinge.shape != position.shape:
         raise InputError("signals", f"shapes differ: hinge {hinge.shape}, position {position.shape}")
-    width = 2 * max(1, round(window_s * sample_rate_hz / 2)) + 1
+    width = kernel_samples(sample_rate_hz, window_s)
     slow_hinge = local_line(hinge, width)
     fast_position = position - local_line(position, width)
     spread = np.sum(fast_position**2, axis=-1, keepdims=True)
