@@ -8,7 +8,7 @@ answered, the mean and worst |error| (relative, and in % of the thesis's range: 
 answers that gave one), and how many errors pass 10 % of the range (and of those, how many the
 answer itself said were weakly determined).
 
-    python -m benchmarks.foreign_accuracy [--per-group 30] [--seed 7000] [--docs]
+    python -m benchmarks.foreign_accuracy [--per-group 60] [--seed 7000] [--docs]
 """
 
 from __future__ import annotations
@@ -204,7 +204,7 @@ def report(rows: dict[str, list[dict[str, Any]]], per_group: int, seconds: float
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--per-group", type=int, default=30, help="windows per group (held positions: 3)")
+    parser.add_argument("--per-group", type=int, default=60, help="windows per group (held positions: 3)")
     parser.add_argument(
         "--seed", type=int, default=7000, help="first seed (the benchmark's windows are not the tests')"
     )
