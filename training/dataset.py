@@ -18,9 +18,9 @@ from training.noise_level import excess_noise
 from training.preprocess import as_read
 
 INITIAL_FIT_SAMPLES = 8
-SIGNALS_READ = ("current_a", "motor_speed_radps", "hinge_moment_nm", "position_deg")  # all the estimators read
-# Position's noise is drawn too: the hinge moment is read along it (sim.hinge), b·0.01° ≈ 0.1 N·m.
-NOISY = SIGNALS_READ
+# All the estimators read, and so all drawn with the window's noise (position too: the hinge
+# moment is read along it, sim.hinge, and b·0.01° ≈ 0.1 N·m).
+SIGNALS_READ = ("current_a", "motor_speed_radps", "hinge_moment_nm", "position_deg")
 
 
 @dataclass(frozen=True)
@@ -89,7 +89,7 @@ class Simulated:
 
     health: HealthParams  # the truth of every simulation (FSJ included)
     noise: SensorNoise  # the window's own sensor noise, added to every simulation
-    signals: dict[str, np.ndarray]  # SIGNALS_READ, (n, n_samples), sensor noise added
+    signals: dict[str, np.ndarray]  # SIGNALS_READ, (n, n_samples), sensor noise added, then as_read
     residual_nm: np.ndarray  # (n, n_samples) T_R of the noisy signals
     clean_residual_nm: np.ndarray  # (k, n_samples) T_R without sensor noise, of the last k: the noise floor's reference
 
@@ -97,8 +97,8 @@ class Simulated:
 def simulate_noisy(
     scenario: Scenario, health: HealthParams, window: Window, reference: HealthParams, seed: int, clean_last: int
 ) -> Simulated:
-    """Simulate ``health``, add the window's own noise where the estimators read, reconstruct T_R with it
-    (and without it for the last ``clean_last`` simulations).
+    """Simulate ``health``, add the window's own noise to what the estimators read, read it as the window
+    is read (``as_read``) and reconstruct T_R (and without noise for the last ``clean_last`` simulations).
 
     The noise is measured against a clean simulation of the window at ``reference`` (one point),
     run in the same batch: it takes a lane the batch would have padded anyway.
@@ -110,7 +110,7 @@ def simulate_noisy(
     noise = excess_noise(window.signals, {name: values[-1] for name, values in result.signals.items()})
     clean = {name: result.signals[name][:-1] for name in SIGNALS_READ}
     rng = np.random.default_rng(seed)
-    noisy = {**clean, **add_sensor_noise({name: clean[name] for name in NOISY}, noise, rng)}
+    noisy = add_sensor_noise(clean, noise, rng)
     rate = scenario.sample_rate_hz
 
     def residual(s: dict[str, np.ndarray]) -> np.ndarray:
