@@ -4,7 +4,8 @@ A logged hinge moment is H_e = H_slow(t) + b·δ(t) + noise: the aircraft's part
 attack: short-period motion, periods of a few tenths of a second) and the deflection's own part
 (b = q̄·S·c·C_hδ), which follows the elevator as fast as it moves. The strain gauge's noise
 (~2 N·m a sample, ~4 mN·m at the motor shaft, as much as the current sensor's) enters the residual
-torque and both load columns of Eq. 5.1; on a 0.1 s window it is most of the error.
+torque and both load columns of Eq. 5.1; on a 0.1 s window it makes as much of the error as the
+current sensor's noise does.
 
 So the moment is split along the measured deflection, whose sensor is ~15x quieter in N·m:
 b is the least-squares slope of the fast part of H_e on the fast part of δ (each minus its
@@ -16,8 +17,9 @@ b is the least-squares slope of the fast part of H_e on the fast part of δ (eac
 i.e. the slow part averaged over the window, the fast part as the deflection draws it. Where δ
 does not move fast, b·(δ − mean δ) vanishes and H_read is the plain mean. The position sensor's
 own noise passes through b (~12 N·m/deg · 0.01° ≈ 0.12 N·m a sample at 153 m/s, sea level),
-so the hinge noise drops ~10x at 10 kHz. Measured and simulated windows go
-through this one function, and simulations draw position noise for it.
+so the hinge noise drops ~10x per sample at 10 kHz. The estimates respond mostly to the noise's
+low frequencies, which no filter removes: their error falls 5–20 % (docs/pipeline.md). Measured
+and simulated windows go through this one function, and simulations draw position noise for it.
 """
 
 from __future__ import annotations

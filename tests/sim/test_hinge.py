@@ -18,7 +18,7 @@ def _plain_local_line(values: np.ndarray, width: int) -> np.ndarray:
     return out
 
 
-def test_the_running_mean_equals_its_definition_and_keeps_a_line():
+def test_the_local_line_equals_its_definition_and_keeps_a_line():
     rng = np.random.default_rng(4)
     values = rng.normal(size=257)
     np.testing.assert_allclose(local_line(values, 41), _plain_local_line(values, 41), atol=1e-10)
@@ -33,7 +33,7 @@ def test_a_fast_deflection_term_is_kept_and_its_slope_is_measured():
     slow_nm = 400.0 + 120.0 * np.sin(2 * np.pi * 1.5 * t)  # a short-period swing
     hinge = slow_nm - 12.0 * position_deg
     read = denoised_hinge_nm(hinge, position_deg, RATE_HZ)
-    inner = slice(200, -200)  # the point-reflected ends bend the sine's curvature a little
+    inner = slice(200, -200)  # near the ends a straight line stands in for the sine's curvature
     assert np.max(np.abs(read - hinge)[inner]) < 0.01 * np.ptp(hinge)
 
 
