@@ -7,7 +7,8 @@ states, sample by sample, over the sliding samples:
 
     t = sgn(ω)·(T_R − C_M·ω) = FDJ + k_aid·a + k_opp·o + Σ effect columns + noise,
 
-with a and o the smoothed aiding and opposing |T_ext|. A second channel carries the backlash:
+with a and o the smoothed aiding and opposing |T_ext|, the hinge moment read as the estimators
+read it (``training.preprocess.as_read``). A second channel carries the backlash:
 the motor angle (integrated measured speed) minus the elevator angle, d = θ_m/n − θ_u, sits at
 c ± BLK/2 depending on which side of the dead band the motor pushes. Simulated windows go
 through this very function, so the noise floor (``calibration.noise_floor``) sees what the
@@ -24,6 +25,7 @@ import numpy as np
 from sim.params import ActuatorParams
 from sim.residual import smooth_derivative, smoothed
 from training.baseline import FitSettings, regressors
+from training.preprocess import as_read
 
 FOLDS = 5
 FOLD_BLOCK_S = 0.02  # held-out folds are interleaved 20 ms blocks: each fold sees every regime of the window
@@ -84,6 +86,7 @@ def engaged(position_deg: np.ndarray, speed_radps: np.ndarray, rate: float, gear
 def _one_window(
     signals: Mapping[str, np.ndarray], rate: float, actuator: ActuatorParams, orders: Sequence[float], index: int
 ) -> Equations:
+    signals = as_read(signals, rate)  # the hinge moment as the estimators read it
     t, a, o, mask = (x[0] for x in regressors(signals, rate, actuator, FitSettings()))
     speed = smoothed(signals["motor_speed_radps"], rate)
     sign = np.sign(speed)

@@ -160,7 +160,7 @@ def _hinge_columns(e: Equations, bias_nm: float, gear: float) -> np.ndarray:
     corrected load changes sign a sample even swaps columns. So for each b of a grid the columns
     are sgn(ω) and the change of a and o (their coefficients then come out near b/n, k_aid, k_opp)."""
     direction = e.variables["direction"]
-    load = e.variables["load_nm"] * direction  # smoothed T_ext as logged
+    load = e.variables["load_nm"] * direction  # smoothed T_ext as read (a constant bias passes the reading)
     corrected = load - bias_nm / gear
 
     def split(t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
