@@ -33,20 +33,30 @@ BOUND = 0.10  # issue 9: no window's error over 10 % of the range
 FAMILIES = ("thesis", "cruise", "gust", "doublet", "steps")
 
 
-def groups() -> dict[str, Callable[[int], Draw]]:
-    """Named groups of windows, each a function of a seed."""
-    out: dict[str, Callable[[int], Draw]] = {f: (lambda s, f=f: draw(s, f)) for f in FAMILIES}
-    out["long window (2 s, cruise)"] = lambda s: draw(s, "cruise", duration_s=2.0)
-    out["short window (0.1 s, gust)"] = lambda s: draw(s, "gust", duration_s=0.1)
-    out["low log rate (1-2 kHz)"] = lambda s: draw(s, FAMILIES[s % 5], sample_rate_hz=(1_000.0, 2_000.0)[s % 2])
-    out["high log rate (50-100 kHz)"] = lambda s: draw(s, FAMILIES[s % 5], sample_rate_hz=(50_000.0, 100_000.0)[s % 2])
-    out["odd log rate (3 kHz, 12.8 kHz)"] = lambda s: draw(
-        s, FAMILIES[s % 5], sample_rate_hz=(3_000.0, 12_800.0)[s % 2]
+def groups() -> dict[str, Callable[..., Draw]]:
+    """Named groups of windows, each a function of a seed (keywords pass on to ``draw``: ``noise_level=0``
+    gives the same window without its sensor noise)."""
+    out: dict[str, Callable[..., Draw]] = {f: (lambda s, f=f, **kw: draw(s, f, **kw)) for f in FAMILIES}
+    out["long window (2 s, cruise)"] = lambda s, **kw: draw(s, "cruise", duration_s=2.0, **kw)
+    out["short window (0.1 s, gust)"] = lambda s, **kw: draw(s, "gust", duration_s=0.1, **kw)
+    out["low log rate (1-2 kHz)"] = lambda s, **kw: draw(
+        s, FAMILIES[s % 5], sample_rate_hz=(1_000.0, 2_000.0)[s % 2], **kw
+    )
+    out["high log rate (50-100 kHz)"] = lambda s, **kw: draw(
+        s, FAMILIES[s % 5], sample_rate_hz=(50_000.0, 100_000.0)[s % 2], **kw
+    )
+    out["odd log rate (3 kHz, 12.8 kHz)"] = lambda s, **kw: draw(
+        s, FAMILIES[s % 5], sample_rate_hz=(3_000.0, 12_800.0)[s % 2], **kw
     )
     for family in FAMILIES:
-        out[f"worn, {family}"] = lambda s, f=family: worn(s, family=f)
-    out["held position"] = lambda s: draw(s, "hold")
+        out[f"worn, {family}"] = lambda s, f=family, **kw: worn(s, family=f, **kw)
+    out["held position"] = lambda s, **kw: draw(s, "hold", **kw)
     return out
+
+
+def group_seed(group: str, i: int, first: int = 7000) -> int:
+    """The seed of window ``i`` of ``group``: each group its own thousand, so groups never share a window."""
+    return first + 1000 * list(groups()).index(group) + i
 
 
 def run_one(window: Draw) -> dict[str, Any]:
@@ -192,6 +202,8 @@ def report(rows: dict[str, list[dict[str, Any]]], per_group: int, seconds: float
         "a note calls the parameter weakly determined by the window. A 0.1 s window, a 1–2 kHz log or a",
         "hinge moment of a few N·m (the load term then a few tenths of a mN·m) holds little of η_O, and",
         "extrapolating the friction line to zero load from a high, steady load holds little of FDJ.",
+        "How many such errors the sensor noise alone makes unavoidable: `benchmarks.information_limit`",
+        "(next section).",
         "",
         "Against wear (every answered window, grouped by its true FDJ over the nominal 0.05 N·m; the worn",
         "windows reach η_O 0.45, Case 1C's irreversible range, where η_A < 0):",
@@ -213,9 +225,9 @@ def main() -> None:
     runtime.configure()
     started = time.perf_counter()
     rows: dict[str, list[dict[str, Any]]] = {}
-    for g, (name, make) in enumerate(groups().items()):
+    for name, make in groups().items():
         count = 3 if "held" in name else args.per_group
-        rows[name] = [run_one(make(args.seed + 1000 * g + i)) for i in range(count)]
+        rows[name] = [run_one(make(group_seed(name, i, args.seed))) for i in range(count)]
         print(f"{name}: {summarize(rows[name])}", flush=True)
     body = report(rows, args.per_group, time.perf_counter() - started)
     print(body)
