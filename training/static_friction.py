@@ -2,13 +2,24 @@
 
 While the shaft is stuck, dω/dt = 0 and the drive k_T·I + H_e/n is exactly the friction; a slowly
 rising drive lifts it until it reaches FSJ + k·|T_ext| and the shaft slips. So the drive at the
-end of a rest, minus the load part, is FSJ. Only a *quasi-static* break-away shows it: after a
-pilot's step the current reference saturates within microseconds, the drive jumps past the
-static level inside one log interval, and the logged drive says nothing about where the shaft
-let go (such a doublet read 0.037 N·m against a true 0.094). In flight the position loop keeps
-the shaft hunting in the backlash and it rarely rests at all. Hence: an event counts only if the
-drive crept up to it, and the answer is a value with a std from the spread of the events, or no
-value with the reason.
+end of a rest, minus the load part, is FSJ. Only a *quasi-static* break-away shows it, and a rest
+counts as one only if
+
+- the drive *crept* into the break-away: after a pilot's step the current reference saturates
+  within microseconds and the drive jumps past the static level inside one log interval (a
+  doublet read 0.037 N·m against a true 0.094 that way);
+- the drive did not jump *as the shaft let go* either: a shaft held still against the hinge load
+  and then stepped away shows a drive that is only a lower bound of the static level (read as
+  values, 18 of 25 FSJ readings of independently drawn windows, most of them such holds, lay
+  outside their ±2 std, up to 53 % low);
+- the shaft was stuck, not creeping: its mean speed over the rest is zero within the noise (a
+  shaft creeping at 0.3 rad/s under dynamic friction passes for resting in a noisy log);
+- it was clear of the end stops, where the drive is the stop's reaction, not friction;
+- the drive rose over the rest by more than its noise (a flat drive: no build-up).
+
+The smoothed speed leaves "rest" a little after the shaft does (its kernel, the noise), so the
+break-away is sought over the last ``LOOKBACK_RUNS`` ms of the rest. The answer is the median of
+the events with a std from their spread, or no value with the reason.
 """
 
 from __future__ import annotations
@@ -19,14 +30,15 @@ from dataclasses import dataclass
 import numpy as np
 
 from sim.params import ActuatorParams, eta_a_from_eta_o
-from sim.residual import smoothed
+from sim.residual import END_STOP_MARGIN_DEG, smoothed
 from training.noise_level import white_noise_std
 
 REST_SPEED_RADPS = 0.5  # at rest: the smoothed speed below this (the sensor noise alone exceeds a creep of 1 rad/s)
 MIN_RUN_S = 1e-3  # a rest and the motion after it must each last this long
-QUASI_STATIC = 0.05  # the drive rose less than this fraction of its level over the last 3 samples of the rest
+QUASI_STATIC = 0.05  # the drive moves less than this share of its level in the 3 samples into a break-away, or 1 ms out
 MIN_RISE_NOISE = 4.0  # ...and by more than this many noise stds over the whole rest
 MIN_EVENTS_FOR_STD = 3
+LOOKBACK_RUNS = 3  # the break-away is sought over the last 3 MIN_RUN_S of a rest
 
 
 @dataclass(frozen=True)
@@ -37,27 +49,70 @@ class StaticFriction:
     reason: str  # how it was read, or why it could not be
 
 
-def _events(signals: Mapping[str, np.ndarray], rate: float, actuator: ActuatorParams) -> list[tuple[int, float]]:
-    """(index, drive) at the end of each rest of ≥ 1 ms, followed by motion of ≥ 1 ms, during which the
-    drive was built up against the stuck shaft (it rose by more than its noise, and crept into the end)."""
-    speed = np.abs(smoothed(signals["motor_speed_radps"], rate))
-    run = max(2, round(MIN_RUN_S * rate))
-    rest = speed < REST_SPEED_RADPS
-    drive = actuator.torque_constant_nm_per_a * signals["current_a"] + signals["hinge_moment_nm"] / actuator.gear_ratio
-    noise = white_noise_std(drive)
-    drive = np.abs(np.convolve(drive, np.ones(3) / 3, mode="same"))
+def _rests(speed_radps: np.ndarray, run: int) -> list[tuple[int, int]]:
+    """(first, last) sample of each rest of ≥ ``run`` samples that is followed by ≥ ``run`` samples of motion."""
+    rest = speed_radps < REST_SPEED_RADPS
     starts = np.flatnonzero(~rest[:-1] & rest[1:]) + 1
-    events = []
+    out = []
     for end in np.flatnonzero(rest[:-1] & ~rest[1:]):
         begin = int(starts[starts <= end][-1]) if np.any(starts <= end) else 0
-        if end + 1 - begin < run or end + 1 + run > len(rest) or rest[end + 1 : end + 1 + run].any():
-            continue  # too short a rest or too short a motion: hunting in passing, not a stick
-        peak = end + 1 - run + int(np.argmax(drive[end + 1 - run : end + 2]))
-        if peak < 3 or drive[peak] - drive[peak - 3] > QUASI_STATIC * drive[peak]:
-            continue  # the drive jumped past the static level: a step, not a break-away
-        if drive[peak] - drive[begin : begin + 3].mean() < MIN_RISE_NOISE * noise:
-            continue  # a flat drive: the shaft crept (dynamic friction), it was not stuck
-        events.append((int(peak), float(drive[peak])))
+        if end + 1 - begin >= run and end + 1 + run <= len(rest) and not rest[end + 1 : end + 1 + run].any():
+            out.append((begin, int(end)))
+    return out
+
+
+@dataclass(frozen=True)
+class _Traces:
+    """What a break-away is read from: the drive |k_T·I + H_e/n| (3-sample means) and the raw speed, each
+    with its per-sample noise std, and the deflection."""
+
+    drive_nm: np.ndarray
+    drive_noise_nm: float
+    speed_radps: np.ndarray
+    speed_noise_radps: float
+    position_deg: np.ndarray
+
+
+def _break_away(t: _Traces, rest: tuple[int, int], run: int, end_stop_deg: float) -> int | None:
+    """The sample where the drive, built up against the stuck shaft, let it go; None if this rest shows no
+    quasi-static break-away (module docstring)."""
+    begin, end = rest
+    drive, noise = t.drive_nm, t.drive_noise_nm
+    back = min(LOOKBACK_RUNS * run, end + 1 - begin)
+    peak = end + 1 - back + int(np.argmax(drive[end + 1 - back : end + 2]))
+    level = drive[peak]
+    tolerance = 3 * noise * np.sqrt(2 / 3)  # 3 std of the difference of two 3-sample means
+    if peak < 3 or level - drive[peak - 3] > QUASI_STATIC * level + tolerance:
+        return None  # the drive jumped into the break-away: a step
+    if drive[end + 1 : end + 1 + run].max() > (1 + QUASI_STATIC) * level + MIN_RISE_NOISE * noise:
+        return None  # it jumped as the shaft let go: the rest's drive only bounds the static level
+    inside = t.speed_radps[begin + run // 2 : end + 1 - run]  # the rest but its ends, where the motion leaks in
+    if len(inside) < 2 or abs(inside.mean()) > MIN_RISE_NOISE * t.speed_noise_radps / np.sqrt(len(inside)):
+        return None  # the shaft crept (dynamic friction), or rested too briefly to tell
+    if np.abs(t.position_deg[begin : end + 1 + run]).max() >= end_stop_deg - END_STOP_MARGIN_DEG:
+        return None  # against an end stop the drive is the stop's reaction
+    if level - drive[begin : begin + 3].mean() < MIN_RISE_NOISE * noise:
+        return None  # a flat drive: nothing was built up
+    return peak
+
+
+def _events(signals: Mapping[str, np.ndarray], rate: float, actuator: ActuatorParams) -> list[tuple[int, float]]:
+    """(index, drive) of each quasi-static break-away: a rest of ≥ 1 ms, then motion of ≥ 1 ms."""
+    run = max(2, round(MIN_RUN_S * rate))
+    drive = actuator.torque_constant_nm_per_a * signals["current_a"] + signals["hinge_moment_nm"] / actuator.gear_ratio
+    speed = signals["motor_speed_radps"]
+    traces = _Traces(
+        drive_nm=np.abs(np.convolve(drive, np.ones(3) / 3, mode="same")),
+        drive_noise_nm=white_noise_std(drive),
+        speed_radps=speed,
+        speed_noise_radps=max(white_noise_std(speed), 0.01),  # a floor: a noiseless log still has a resolution
+        position_deg=signals["position_deg"],
+    )
+    events = []
+    for rest in _rests(np.abs(smoothed(speed, rate)), run):
+        peak = _break_away(traces, rest, run, actuator.end_stop_deg)
+        if peak is not None:
+            events.append((peak, float(traces.drive_nm[peak])))
     return events
 
 

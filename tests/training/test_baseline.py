@@ -1,4 +1,4 @@
-"""The Eq. 5.1 least-squares fit and the FSJ reading, on our windows and on foreign ones."""
+"""The Eq. 5.1 least-squares fit, on our windows and on foreign ones."""
 
 import numpy as np
 import pytest
@@ -12,7 +12,6 @@ from sim.synthetic import synthetic_window
 from sim.window import window_from_dict
 from tests.foreign.windows import draw
 from training.baseline import FitSettings, fit_friction, fit_window
-from training.static_friction import read_static_friction
 
 
 @pytest.mark.parametrize(("noise", "tolerance"), [(NO_NOISE, 0.004), (SensorNoise(), 0.015)])
@@ -59,24 +58,3 @@ def test_too_little_motion_is_refused_naming_the_signals():
 def test_settings_are_checked():
     with pytest.raises(InputError, match="min_speed_radps"):
         FitSettings(min_speed_radps=-1)
-
-
-@pytest.mark.parametrize("fsj", [0.085, 0.115])
-def test_reads_fsj_at_a_quasi_static_break_away(fsj):
-    # On ground with a rising load and the command held, the shaft rests until the load breaks it away.
-    result = simulate_batch(np.zeros(3001), HealthParams.single(fsj, 0.05, 0.85), GroundLoad(-20.0, -600.0))
-    found = read_static_friction(result.simulation(0), 10_000.0, 0.05, 0.85)
-    assert found.value_nm == pytest.approx(fsj, rel=0.02)
-    assert found.std_nm is not None and found.std_nm > 0
-
-
-@pytest.mark.parametrize("seed", range(5))
-def test_steps_and_doublets_give_no_fsj_rather_than_a_wrong_one(seed):
-    # After a pilot's step the drive jumps past the static level in one log interval: nothing to read.
-    window = draw(100 + seed, ("steps", "doublet")[seed % 2])
-    found = read_static_friction(window_from_dict(window.document).signals, 10_000.0,
-                                 window.truth["FDJ"], window.truth["eta_O"])  # fmt: skip
-    if found.value_nm is not None:
-        assert abs(found.value_nm - window.truth["FSJ"]) < 2 * found.std_nm
-    else:
-        assert "break-away" in found.reason
