@@ -54,7 +54,10 @@ class MethodReport(Document):
     """How one parameter's value was reached: each estimator, its error on held-out simulations, the blend."""
 
     physics: float = Field(description="Eq. 5.1 least squares on the window")
-    physics_bias: float = Field(description="its mean error on held-out simulations, subtracted before the blend")
+    physics_bias: float = Field(
+        description="its mean error on held-out simulations, shrunk by how well they resolve it (James–Stein); "
+        "subtracted"
+    )
     physics_std: float = Field(description="its block-jackknife std on the window")
     network: float | None = Field(description="the window's own network; null if it was not used")
     weight_network: float
