@@ -195,7 +195,7 @@ def write_results(results: list[dict], comparison: list[str], command: str) -> N
         "Mean absolute relative error (physical units) over synthetic 0.5 s in-flight windows with",
         "realistic sensor noise: the window's network, the least-squares baseline of Eq. 5.1",
         "(`training/baseline.py`, no simulation), and the answer the product reports (the baseline,",
-        "corrected by its bias on held-out simulations, blended with the network: `training/assess.py`).",
+        "less its bias on held-out simulations, blended with the network where it earns it: `training/assess.py`).",
         "",
         "| estimator | FDJ | η_O |",
         "|---|---:|---:|",
