@@ -114,7 +114,7 @@ def network_note(c: Candidates, name: str) -> str | None:
     return None
 
 
-def _one(c: Candidates, name: str, inflation: float) -> tuple[float, float, MethodReport, str | None]:
+def _assess_parameter(c: Candidates, name: str, inflation: float) -> tuple[float, float, MethodReport, str | None]:
     """(value, std, report, note for the answer) of one parameter."""
     truth = c.check_truth[name]
     bias, phys = bias_corrected(c.check_physics[name], truth)
@@ -152,7 +152,7 @@ def assess(c: Candidates, equation_error_ratio: float) -> Assessed:
     inflation = max(1.0, equation_error_ratio)
     values, stds, methods, notes = {}, {}, {}, []
     for name in TARGETS:
-        values[name], stds[name], methods[name], note = _one(c, name, inflation)
+        values[name], stds[name], methods[name], note = _assess_parameter(c, name, inflation)
         if note is not None:
             notes.append(note)
     if inflation > 1.0:

@@ -36,7 +36,7 @@ from training.noise_level import white_noise_std
 REST_SPEED_RADPS = 0.5  # at rest: the smoothed speed below this (the sensor noise alone exceeds a creep of 1 rad/s)
 MIN_RUN_S = 1e-3  # a rest and the motion after it must each last this long
 QUASI_STATIC = 0.05  # the drive moves less than this share of its level in the 3 samples into a break-away, or 1 ms out
-MIN_RISE_NOISE = 4.0  # ...and by more than this many noise stds over the whole rest
+MIN_RISE_NOISE = 4.0  # noise stds: how far the drive must rise over a rest; the allowance of the jump and creep tests
 MIN_EVENTS_FOR_STD = 3
 LOOKBACK_RUNS = 3  # the break-away is sought over the last 3 MIN_RUN_S of a rest
 
