@@ -84,10 +84,10 @@ def simulate_dataset(window: Window, seen: Window, physics: FrictionFit, config:
     health = design.draw(box, config.total_simulations, config.seed)
     sims = simulate_noisy(scenario, health, window, design.centre(box), config.seed + 1, config.check_windows)
     rate = window.sample_rate_hz
-    sliding = regressors(seen.signals, rate, ActuatorParams(), FitSettings())[3][0]
     residual = residual_torque_nm(
         seen.signals["current_a"], seen.signals["motor_speed_radps"], seen.signals["hinge_moment_nm"], rate
     )
+    sliding = regressors(seen.signals, rate, ActuatorParams(), FitSettings(), residual_nm=residual)[3][0]
     n_timesteps = min(config.n_timesteps, window.n_samples)
     inputs = sliding_features(sims.residual_nm, sliding, n_timesteps)
     return Data(scenario, box, sims.noise, sims, sliding, inputs, sliding_features(residual, sliding, n_timesteps))
