@@ -23,13 +23,14 @@ from numba import njit
 STEP_S = 1e-6
 COMMAND_TABLE_HZ = 100_000.0
 AIRCRAFT_EVERY = 100  # steps between RK4 steps of the aircraft
+LOOP_SAMPLE_STEPS = 100  # the loop's sensors are read at 10 kHz
 GEAR = 500.0
 
 # Indices of the parameter vector the loop reads.
 (P_GP, P_GAP, P_R, P_L, P_KT, P_KE, P_TMAX, P_VMAX, P_IMAX, P_J, P_C, P_BLK, P_STOP,
  P_FSJ, P_FDJ, P_KAID, P_KOPP, P_ISENSE, P_HBIAS,
  P_BUMP_A, P_BUMP_C, P_BUMP_W, P_STRIB_A, P_STRIB_W, P_DRIFT, P_COG_A, P_COG_P, P_COG_PHI,
- P_QSC, P_CHA, P_CHD, P_DWN, P_LT, P_V, P_ALPHA_TRIM, P_DELTA_TRIM, P_ALPHA_LIM, N_P) = range(38)  # fmt: skip
+ P_QSC, P_CHA, P_CHD, P_DWN, P_LT, P_V, P_ALPHA_TRIM, P_DELTA_TRIM, P_ALPHA_LIM, P_VBUS, N_P) = range(39)  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -62,6 +63,13 @@ class Effects:
     cogging_nm: float = 0.0  # A · cos(p · θ_m + φ)
     cogging_periods: float = 12.0  # per motor revolution
     cogging_phase_rad: float = 0.0
+    # A controller that departs slightly from the spec's loop (the log does not show it):
+    position_gain_factor: float = 1.0  # true G_P over the spec's
+    supply_voltage_factor: float = 1.0  # the bus voltage the PWM switches over the spec's V_max (not ω_max)
+    loop_delay_s: float = 0.0  # the loop acts on the command this much later than it is logged
+    loop_noise_deg: float = 0.0  # std of the noise on the angle the loop reads (new every LOOP_SAMPLE_STEPS)
+    loop_noise_radps: float = 0.0  # std of the noise on the speed the loop reads
+    loop_noise_seed: int = 0
 
 
 @dataclass(frozen=True)
@@ -114,7 +122,7 @@ def trim_rad(flight: Flight) -> tuple[float, float]:
 def parameters(setup: Setup) -> np.ndarray:
     h, e, f = setup.health, setup.effects, setup.flight
     p = np.zeros(N_P)
-    p[P_GP], p[P_GAP], p[P_R], p[P_L] = 1e5, 5e-2, 2.13, 7.2e-4
+    p[P_GP], p[P_GAP], p[P_R], p[P_L] = 1e5 * e.position_gain_factor, 5e-2, 2.13, 7.2e-4
     p[P_KT] = p[P_KE] = 0.0752 * e.torque_constant_gain
     p[P_TMAX], p[P_VMAX], p[P_IMAX], p[P_J] = 1.689, 48.0, 22.5, 2.5e-5
     p[P_C], p[P_BLK], p[P_STOP] = 5.172e-5 * e.viscous_factor, 5e-3 * e.backlash_factor, np.radians(30.0)
@@ -128,6 +136,7 @@ def parameters(setup: Setup) -> np.ndarray:
     p[P_CHA], p[P_CHD], p[P_DWN], p[P_LT], p[P_V] = -0.25, -0.55, 0.4, 4.6, f.airspeed_mps
     p[P_ALPHA_TRIM], p[P_DELTA_TRIM] = trim_rad(f)
     p[P_ALPHA_LIM] = np.radians(15.0)
+    p[P_VBUS] = 48.0 * e.supply_voltage_factor
     return p
 
 
@@ -152,9 +161,9 @@ def _current(p, command, theta_u, speed, current, decay):
     current_ref = max(-p[P_IMAX], min(p[P_IMAX], p[P_GAP] * (speed_ref - speed) / 0.0752))
     voltage = 0.0
     if current_ref > measured_current:
-        voltage = p[P_VMAX]
+        voltage = p[P_VBUS]
     elif current_ref < measured_current:
-        voltage = -p[P_VMAX]
+        voltage = -p[P_VBUS]
     steady = (voltage - p[P_KE] * speed) / p[P_R]
     return steady + (current - steady) * decay
 
@@ -190,8 +199,10 @@ def _rk4(a, b, x, u, dt):
 
 
 @njit(cache=True)
-def _run(p, a, b, command_rad, first_step, n_steps, rate_hz, theta0, out):
-    """Integrate from step ``first_step`` (negative: a pre-roll before the log starts) to ``n_steps``."""
+def _run(p, a, b, command_rad, logged_rad, loop_noise, first_step, n_steps, rate_hz, theta0, out):
+    """Integrate from step ``first_step`` (negative: a pre-roll before the log starts) to ``n_steps``; the
+    loop follows ``command_rad`` and reads angle and speed with ``loop_noise`` (2, blocks) added, the
+    log records ``logged_rad`` (both 100 kHz tables) and the true states."""
     h = 1e-6
     current, speed = 0.0, 0.0
     theta_u = theta0
@@ -205,7 +216,9 @@ def _run(p, a, b, command_rad, first_step, n_steps, rate_hz, theta0, out):
         pos = (i - first_step) * h * 1e5
         j = int(pos)
         command = command_rad[j] + (pos - j) * (command_rad[j + 1] - command_rad[j])
-        current = _current(p, command, theta_u, speed, current, decay)
+        logged = logged_rad[j] + (pos - j) * (logged_rad[j + 1] - logged_rad[j])
+        block = (i - first_step) // LOOP_SAMPLE_STEPS
+        current = _current(p, command, theta_u + loop_noise[0, block], speed + loop_noise[1, block], current, decay)
         new_speed = _new_speed(p, i * h, h, theta_u, theta_m, speed, current, _hinge(p, x, theta_u) / GEAR)
         theta_m += 0.5 * h * (speed + new_speed)
         speed = new_speed
@@ -228,7 +241,7 @@ def _run(p, a, b, command_rad, first_step, n_steps, rate_hz, theta0, out):
             sums[1] += speed
             sums[2] += p[P_ISENSE] * current
             sums[3] += _hinge(p, x, theta_u) + p[P_HBIAS]
-            sums[4] += command
+            sums[4] += logged
             count += 1
             if (i + 1) * h * rate_hz >= sample + 1 - 1e-9:
                 for r in range(5):
@@ -240,18 +253,26 @@ def _run(p, a, b, command_rad, first_step, n_steps, rate_hz, theta0, out):
                     return
 
 
+def _loop_noise(effects: Effects, steps: int) -> np.ndarray:
+    """(2, blocks) noise on the angle [rad] and speed [rad/s] the loop reads, one value per LOOP_SAMPLE_STEPS."""
+    draws = np.random.default_rng(effects.loop_noise_seed).standard_normal((2, steps // LOOP_SAMPLE_STEPS + 1))
+    return draws * np.array([[np.radians(effects.loop_noise_deg)], [effects.loop_noise_radps]])
+
+
 def simulate(setup: Setup, command_deg, duration_s: float, preroll_s: float = 0.0) -> dict[str, np.ndarray]:
     """Clean logged signals of one window: ``command_deg(t)`` a vectorized function of time [s]
     (t from −preroll_s), the actuator at rest where the command starts, the aircraft at trim."""
     rate = setup.sample_rate_hz
     n_samples = int(np.floor(duration_s * rate + 1e-9))
     table_t = np.arange(-preroll_s, duration_s + 2e-5, 1.0 / COMMAND_TABLE_HZ)
-    command_rad = np.radians(np.asarray(command_deg(table_t), dtype=np.float64))
+    logged_rad = np.radians(np.asarray(command_deg(table_t), dtype=np.float64))
+    command_rad = np.radians(np.asarray(command_deg(table_t - setup.effects.loop_delay_s), dtype=np.float64))
     a, b = aircraft_matrices(setup.flight)
     out = np.zeros((5, n_samples))
-    first = -round(preroll_s / STEP_S)
+    first, last = -round(preroll_s / STEP_S), round(duration_s / STEP_S) + 10
     start = float(np.clip(command_rad[0], -np.radians(30.0), np.radians(30.0)))
-    _run(parameters(setup), a, b, command_rad, first, round(duration_s / STEP_S) + 10, rate, start, out)
+    _run(parameters(setup), a, b, command_rad, logged_rad, _loop_noise(setup.effects, last - first), first, last, rate,
+         start, out)  # fmt: skip
     names = ("position_deg", "motor_speed_radps", "current_a", "hinge_moment_nm", "command_deg")
     signals = dict(zip(names, out, strict=True))
     signals["position_deg"] = np.degrees(signals["position_deg"])

@@ -11,6 +11,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from tests.foreign import commands
+from tests.foreign.commands import Command
 from tests.foreign.physics import Effects, Flight, Health, Setup, simulate
 
 NOISE = {"position_deg": 0.01, "motor_speed_radps": 0.5, "current_a": 0.05, "hinge_moment_nm": 2.0}
@@ -23,6 +24,14 @@ class Draw:
     truth: dict[str, float]  # FDJ, eta_O, eta_A, FSJ
     family: str
     setup: Setup = field(repr=False)
+    command: Command = field(repr=False)
+    duration_s: float
+    preroll_s: float
+
+    def clean_signals(self, health: Health | None = None, effects: Effects | None = None) -> dict[str, np.ndarray]:
+        """This window's signals without sensor noise, drawn again, with another health or other effects if given."""
+        setup = replace(self.setup, health=health or self.setup.health, effects=effects or self.setup.effects)
+        return simulate(setup, self.command, self.duration_s, self.preroll_s)
 
 
 def noisy(signals: dict[str, np.ndarray], rng: np.random.Generator, level: float) -> dict[str, np.ndarray]:
@@ -69,7 +78,7 @@ def draw(
         "signals": {name: values.tolist() for name, values in signals.items()},
     }
     truth = {"FDJ": health.fdj_nm, "eta_O": health.eta_o, "eta_A": health.eta_a, "FSJ": health.fsj_nm}
-    return Draw(document, truth, family, setup)
+    return Draw(document, truth, family, setup, command, duration_s, preroll_s)
 
 
 def worn(seed: int, **kwargs) -> Draw:

@@ -7,7 +7,7 @@ from sim.checks import InputError
 from sim.params import HealthParams
 from sim.synthetic import synthetic_window
 from sim.window import window_from_dict
-from tests.foreign.windows import draw, worn
+from tests.foreign.windows import NOISE, Effects, draw, worn
 from training.config import PipelineConfig
 from training.documents import Estimate
 from training.pipeline import estimate_window, share_of_range
@@ -65,6 +65,24 @@ def test_worn_actuators_are_followed_beyond_the_thesis_ranges(seed):
         assert abs(entry.value - drawn.truth[name]) < 3.5 * entry.std
     if drawn.truth["eta_A"] < 0:
         assert result.irreversible and any("irreversible" in note for note in result.notes)
+
+
+@pytest.mark.parametrize(
+    "loop",
+    [Effects(supply_voltage_factor=1.1), Effects(loop_delay_s=5e-5), Effects(position_gain_factor=0.98),
+     Effects(loop_noise_radps=0.5, loop_noise_seed=3)],
+    ids=["bus 10 % high", "50 µs lag", "G_P 2 % low", "loop reads a noisy speed"],
+)  # fmt: skip
+def test_a_controller_that_departs_from_the_spec_loop_does_not_move_the_answer(loop):
+    """Eq. 5.1 needs k_T, J and n, never the loop's gains, supply or timing: a drive unlike the spec's
+    (and unlike the simulations the pipeline trains on) is read as well as one that follows it."""
+    drawn = draw(33, "doublet", effects=loop)
+    as_spec = draw(33, "doublet").clean_signals()
+    assert np.std(drawn.clean_signals()["current_a"] - as_spec["current_a"]) > 3 * NOISE["current_a"]  # it differs
+    result = _estimate(drawn)
+    for name, (of_range, z) in _errors(result, drawn.truth).items():
+        assert of_range < 10.0, name
+        assert z < 3.5, name
 
 
 @pytest.mark.slow
