@@ -14,8 +14,8 @@ slope b included). With Σ = Σ_s σ_s² A_s A_sᵀ, generalized least squares h
 (Xᵀ Σ⁻¹ X)⁻¹ (X: ∂y/∂(FDJ, η_O)): the smallest any linear unbiased reading of these equations
 reaches, because it weighs every sample by what the noise leaves of it. *Current sensor alone*
 keeps only the current's noise (speed, hinge and position perfect): the torque no reading of the
-motor current avoids. Neither uses the controller's equations: a real controller reacts to its
-own sensors' noise, which a fit that trusts the spec's loop would mistake for friction.
+motor current avoids. Neither uses the controller's equations: what those would add, and what
+they would cost, is ``benchmarks.whole_loop``'s question.
 
 For each group: the mean |error| an unbiased estimator at that std would make (√(2/π)·std),
 the number of windows expected past 10 % of the range (Σ P(|N(0, std)| > 10 %)), and our Eq. 5.1
@@ -183,9 +183,9 @@ def report(rows: dict[str, list[dict[str, np.ndarray]]], draws: int) -> str:
         "product measures on its simulations and subtracts). *Current sensor alone* is",
         "the Cramér–Rao bound with speed, hinge and position noise-free: the model is then linear in",
         "(FDJ, k) with white noise, and least squares is efficient. Where these expect windows past 10 %",
-        "of the range, no estimator of the window alone avoids them, short of a model of how the",
-        "controller reacts to its own sensors' noise. The remedy is more window (a longer or faster log)",
-        "or the actuator's history (`ema history` weighs each window by its std).",
+        "of the range, no reading of Eq. 5.1 avoids them. A reading of the whole closed loop would hold",
+        "more, but only for a loop known to the microsecond (next section). The remedy is more window",
+        "(a longer or faster log) or the actuator's history (`ema history` weighs each window by its std).",
     ])  # fmt: skip
 
 

@@ -1,0 +1,187 @@
+"""Would reading the whole closed loop beat Eq. 5.1 on short and slow windows? Not on a real loop: docs/results.md.
+
+Eq. 5.1 reads the torque balance alone: k_T, J, n and four sensors. The spec's model says more:
+how the position and speed loops turn the command into a current reference, and how the PWM
+current loop follows it. A reading that simulates that whole loop (the window's start, command
+and flight condition known) and fits all four sensors can also use *when* things happen: the
+instant the speed reference leaves saturation depends on the angle integrated over the whole
+slew, so a friction change of a fraction of a mN·m moves a 20 A current step by microseconds.
+
+For each window of ``benchmarks.information_limit``'s groups, with ``tests.foreign``'s simulation
+and the window's realized sensor noise, by central differences at the true health (±2.5 % of the
+range), this computes:
+
+- *whole loop*: the Cramér–Rao std of that reading, F = Σ_s J_sᵀ J_s / σ_s² over the four sensors.
+  Timing events make the signals almost discontinuous in the parameters, so read it as a scale;
+  and the same with the loop's bus voltage, lag and position gain fitted as unknowns too;
+- its first-order bias b = F⁻¹ Σ_s J_sᵀ Δs / σ_s² when the model it trusts is *our* simulator of
+  the same spec (started where the window starts, fed its command and logged hinge moment: what
+  ``training.dataset`` simulates), and when the real loop departs from the spec's by less than any
+  log shows: the PWM bus 1 % high, the command reaching the loop 10 µs late, the position gain
+  0.1 % high, the loop reading a speed as noisy as the logged one (``tests.foreign.physics.Effects``);
+- how far our Eq. 5.1 fit (``training.baseline``) moves on the same departures, noise-free.
+
+    python -m benchmarks.whole_loop [--per-group 60] [--docs]
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+from dataclasses import replace
+
+import numpy as np
+
+from benchmarks.foreign_accuracy import RESULTS_MD, group_seed, groups
+from benchmarks.information_limit import GROUPS, SENSORS, expected_over
+from clients.report import write_section
+from sim import runtime
+from sim.params import HealthParams
+from sim.window import window_from_dict
+from tests.foreign.physics import Effects
+from tests.foreign.windows import Draw
+from training.baseline import fit_friction
+from training.conditioning import prepare
+from training.dataset import scenario_from_window
+from training.pipeline import HEALTHY_RANGE
+from training.preprocess import as_read
+
+WIDTH = np.array([np.ptp(HEALTHY_RANGE["FDJ"]), np.ptp(HEALTHY_RANGE["eta_O"])])  # the ranges, for shares
+STEP = 0.025  # central-difference step, share of each range
+DEPARTURES = {
+    "bus +1 %": Effects(supply_voltage_factor=1.01),
+    "10 µs late": Effects(loop_delay_s=1e-5),
+    "G_P +0.1 %": Effects(position_gain_factor=1.001),
+    "noisy speed read": Effects(loop_noise_radps=0.5),  # the loop reads the logged sensor's 0.5 rad/s noise
+}
+CONSTANTS = ("bus +1 %", "10 µs late", "G_P +0.1 %")  # departures a whole-loop reading could fit as unknowns
+
+
+def _weighted(signals: dict[str, np.ndarray], levels: dict[str, float]) -> np.ndarray:
+    """(4·n,) the four sensors' clean signals, each over its noise std."""
+    return np.concatenate([signals[s] / levels[s] for s in SENSORS])
+
+
+def sensitivities(window: Draw, levels: dict[str, float]) -> np.ndarray:
+    """(4·n, 2) ∂(weighted signals)/∂(FDJ, η_O), per share of the range."""
+    health, columns = window.setup.health, []
+    for field, width in (("fdj_nm", WIDTH[0]), ("eta_o", WIDTH[1])):
+        value = getattr(health, field)
+        up, down = (window.clean_signals(health=replace(health, **{field: value + s * STEP * width})) for s in (1, -1))
+        columns.append((_weighted(up, levels) - _weighted(down, levels)) / (2 * STEP))
+    return np.stack(columns, axis=1)
+
+
+def our_simulator_bias(window: Draw, clean: dict[str, np.ndarray], levels: dict[str, float]) -> np.ndarray:
+    """(2,) first-order bias of a whole-loop reading that simulates the window with *our* simulator
+    (``training.dataset``'s scenario of the noise-free window: its command, start and logged load)."""
+    document = {**window.document, "signals": {name: values.tolist() for name, values in clean.items()}}
+    scenario = scenario_from_window(window_from_dict(document))
+    truth, (d_fdj, d_eta) = window.truth, STEP * WIDTH
+    fdj, eta_o = truth["FDJ"] + np.array([0, d_fdj, -d_fdj, 0, 0]), truth["eta_O"] + np.array([0, 0, 0, d_eta, -d_eta])
+    signals = scenario.simulate(HealthParams(fsj_nm=np.full(5, truth["FSJ"]), fdj_nm=fdj, eta_o=eta_o)).signals
+    at, fdj_up, fdj_down, eta_up, eta_down = (_weighted({s: signals[s][j] for s in SENSORS}, levels) for j in range(5))
+    J = np.stack([fdj_up - fdj_down, eta_up - eta_down], axis=1) / (2 * STEP)
+    return np.linalg.solve(J.T @ J, J.T @ (_weighted(clean, levels) - at))
+
+
+def our_fit(window: Draw, signals: dict[str, np.ndarray]) -> np.ndarray:
+    """(2,) FDJ and η_O of the Eq. 5.1 fit on these signals, as shares of the range."""
+    document = {**window.document, "signals": {name: values.tolist() for name, values in signals.items()}}
+    prepared = prepare(window_from_dict(document)).window
+    rate = prepared.sample_rate_hz
+    fit = fit_friction(as_read({k: v[None] for k, v in prepared.signals.items()}, rate), rate)
+    return np.array([fit.fdj_nm[0], fit.eta_o[0]]) / WIDTH
+
+
+def one_window(group: str, i: int) -> dict[str, np.ndarray]:
+    """The whole-loop std (2,), the same with the loop's constants estimated too (2,), its biases
+    (departures, 2), its bias read with our simulator (2,) and our fit's shifts (departures, 2)."""
+    window = groups()[group](group_seed(group, i))
+    clean = window.clean_signals()
+    levels = {s: float(np.std(np.asarray(window.document["signals"][s]) - clean[s])) for s in SENSORS}
+    J = sensitivities(window, levels)
+    information = J.T @ J
+    base, ours = _weighted(clean, levels), our_fit(window, clean)
+    departed = {name: window.clean_signals(effects=effects) for name, effects in DEPARTURES.items()}
+    changes = np.stack([_weighted(signals, levels) - base for signals in departed.values()], axis=1)
+    constants = changes[:, [name in CONSTANTS for name in DEPARTURES]]  # ∂/∂ each constant, one-sided
+    cross = J.T @ constants
+    profiled = information - cross @ np.linalg.pinv(constants.T @ constants) @ cross.T
+    return {
+        "std": np.sqrt(np.diag(np.linalg.inv(information))),
+        "std_constants_fitted": np.sqrt(np.diag(np.linalg.inv(profiled))),
+        "bias": np.linalg.solve(information, J.T @ changes).T,
+        "our_simulator": our_simulator_bias(window, clean, levels),
+        "shift": np.array([our_fit(window, signals) - ours for signals in departed.values()]),
+    }
+
+
+def _bound(stds: np.ndarray) -> str:
+    return f"{100 * math.sqrt(2 / math.pi) * stds.mean():.2f} % / {expected_over(stds):.1f}"
+
+
+def _spread(values: np.ndarray) -> str:
+    """Median (worst) of shares of the range, in %."""
+    median, worst = (f"{x:.0f}" if x >= 10 else f"{x:.2g}" for x in (100 * np.median(values), 100 * values.max()))
+    return f"{median} ({worst})"
+
+
+def table(rows: dict[str, list[dict[str, np.ndarray]]]) -> str:
+    lines = [
+        "| windows | parameter | whole loop: mean error / expected past 10 % | the same, its constants fitted too | "
+        "its bias, read with our simulator | "
+        + " | ".join(f"its bias, {name}" for name in DEPARTURES)
+        + " | our fit moves, any of these |",
+        "|---|---|" + "---:|" * (len(DEPARTURES) + 4),
+    ]
+    for group, found in rows.items():
+        for p, name in enumerate(("FDJ", "η_O")):
+            bias = np.abs(np.array([r["bias"][:, p] for r in found]))  # (windows, departures)
+            cells = [_bound(np.array([r[k][p] for r in found])) for k in ("std", "std_constants_fitted")]
+            cells.append(_spread(np.abs(np.array([r["our_simulator"][p] for r in found]))))
+            cells += [_spread(b) for b in bias.T]
+            cells.append(_spread(np.array([np.abs(r["shift"][:, p]).max() for r in found])))
+            lines.append(f"| {group} ({len(found)}) | {name} | " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
+def report(rows: dict[str, list[dict[str, np.ndarray]]]) -> str:
+    return "\n".join([
+        "The windows of the section above, read through the whole closed loop of the spec instead of",
+        "Eq. 5.1 (module docstring): what that would buy and what it would cost. Errors and biases in",
+        "% of the range; biases as median (worst) over the windows.",
+        "",
+        table(rows),
+        "",
+        "Trusted to the microsecond, the spec's loop holds far more than Eq. 5.1 (first column), most",
+        "of it in the instants the speed loop leaves saturation or the shaft crosses the backlash, and in",
+        "the PWM ripple; fitting the loop's constants as unknowns keeps most of it (second column). But",
+        "that information belongs to one implementation. Our own simulator of the same spec, started",
+        "where the window starts and fed its command and hinge moment, differs from the independent one",
+        "by far more (third column; among the causes, the side of the backlash at the start, the command",
+        "between log samples and the ripple of an Euler against an exact current step, all legitimate",
+        "readings of the spec). A departure of the loop smaller than any log shows (a bus 1 % high,",
+        "a 10 µs lag, a gain 0.1 % off, a loop that reads the logged speed sensor's noise) moves the",
+        "reading by more than its std. Eq. 5.1 uses none of the loop's constants, and our fit moves by",
+        "the last column's amounts under the same departures (at 1 kHz the 3-sample reconstruction",
+        "feels the slightly changed motion). So the product reads Eq. 5.1 and says when a window is",
+        "weak; `benchmarks.foreign_accuracy`'s drives unlike the spec's are read as well as the others.",
+    ])  # fmt: skip
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--per-group", type=int, default=60, help="windows per group")
+    parser.add_argument("--docs", action="store_true", help="rewrite the section of docs/results.md")
+    args = parser.parse_args()
+    runtime.configure()
+    rows = {group: [one_window(group, i) for i in range(args.per_group)] for group in GROUPS}
+    body = report(rows)
+    print(body)
+    if args.docs:
+        write_section("Reading the whole loop instead", "python -m benchmarks.whole_loop --docs", body, RESULTS_MD)
+
+
+if __name__ == "__main__":
+    main()
