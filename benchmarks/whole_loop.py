@@ -37,7 +37,7 @@ from benchmarks.information_limit import GROUPS, SENSORS, expected_over
 from clients.report import write_section
 from sim import runtime
 from sim.params import HealthParams
-from sim.window import window_from_dict
+from sim.window import Window, window_from_dict
 from tests.foreign.physics import Effects
 from tests.foreign.windows import Draw
 from training.baseline import fit_friction
@@ -72,11 +72,15 @@ def sensitivities(window: Draw, levels: dict[str, float]) -> np.ndarray:
     return np.stack(columns, axis=1)
 
 
+def _as_window(window: Draw, signals: dict[str, np.ndarray]) -> Window:
+    """``window``'s document with these signals, through the public contract."""
+    return window_from_dict({**window.document, "signals": {name: values.tolist() for name, values in signals.items()}})
+
+
 def our_simulator_bias(window: Draw, clean: dict[str, np.ndarray], levels: dict[str, float]) -> np.ndarray:
     """(2,) first-order bias of a whole-loop reading that simulates the window with *our* simulator
     (``training.dataset``'s scenario of the noise-free window: its command, start and logged load)."""
-    document = {**window.document, "signals": {name: values.tolist() for name, values in clean.items()}}
-    scenario = scenario_from_window(window_from_dict(document))
+    scenario = scenario_from_window(_as_window(window, clean))
     truth, (d_fdj, d_eta) = window.truth, STEP * WIDTH
     fdj, eta_o = truth["FDJ"] + np.array([0, d_fdj, -d_fdj, 0, 0]), truth["eta_O"] + np.array([0, 0, 0, d_eta, -d_eta])
     signals = scenario.simulate(HealthParams(fsj_nm=np.full(5, truth["FSJ"]), fdj_nm=fdj, eta_o=eta_o)).signals
@@ -87,8 +91,7 @@ def our_simulator_bias(window: Draw, clean: dict[str, np.ndarray], levels: dict[
 
 def our_fit(window: Draw, signals: dict[str, np.ndarray]) -> np.ndarray:
     """(2,) FDJ and η_O of the Eq. 5.1 fit on these signals, as shares of the range."""
-    document = {**window.document, "signals": {name: values.tolist() for name, values in signals.items()}}
-    prepared = prepare(window_from_dict(document)).window
+    prepared = prepare(_as_window(window, signals)).window
     rate = prepared.sample_rate_hz
     fit = fit_friction(as_read({k: v[None] for k, v in prepared.signals.items()}, rate), rate)
     return np.array([fit.fdj_nm[0], fit.eta_o[0]]) / WIDTH
