@@ -90,7 +90,7 @@ def run_one(window: Draw) -> dict[str, Any]:
                      "value": entry["value"], "std": entry["std"]}  # fmt: skip
         if name in HEALTHY_RANGE:
             row[name]["of_range"] = share_of_range(name, error)
-            row[name]["weak"] = share_of_range(name, 2 * entry["std"]) > WEAK_SHARE_OF_RANGE
+            row[name]["weak"] = entry["weakly_determined"]
     return row
 
 

@@ -33,7 +33,9 @@ def print_estimate(result: Any) -> None:
         entry = getattr(result.estimates, name)
         if entry is None:
             continue
-        click.echo(f"{name:<10}{entry.value:>12.5g}{_std(entry.std):>12}{entry.nominal:>12.4g}{entry.drift_pct:>9.2f}%")
+        weak = "  weakly determined" if entry.weakly_determined else ""
+        click.echo(f"{name:<10}{entry.value:>12.5g}{_std(entry.std):>12}{entry.nominal:>12.4g}{entry.drift_pct:>9.2f}%"
+                   f"{weak}")  # fmt: skip
     if result.estimates.FSJ is None:
         click.echo(f"FSJ: not estimated: {result.fsj_note}")
     check = result.fit_check

@@ -27,6 +27,11 @@ class ParameterEstimate(Document):
     std: float | None = Field(description="one standard deviation, in the parameter's unit; null: not assessed")
     nominal: float
     drift_pct: float = Field(description="100 · (value − nominal) / nominal")
+    weakly_determined: bool = Field(
+        default=False,
+        description="the window holds little of this parameter: its ±2 std spans more than 10 % of the healthy "
+        "range (a short window, a slow log, a hinge load that barely varies); the notes say so in words",
+    )
 
 
 class RatioEstimate(Document):
@@ -129,5 +134,7 @@ class Estimate(Document):
     config: PipelineConfig
 
 
-def parameter(value: float, std: float | None, nominal: float) -> ParameterEstimate:
-    return ParameterEstimate(value=value, std=std, nominal=nominal, drift_pct=100.0 * (value - nominal) / nominal)
+def parameter(value: float, std: float | None, nominal: float, weak: bool = False) -> ParameterEstimate:
+    return ParameterEstimate(
+        value=value, std=std, nominal=nominal, drift_pct=100.0 * (value - nominal) / nominal, weakly_determined=weak
+    )

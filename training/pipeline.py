@@ -63,6 +63,11 @@ def share_of_range(name: str, amount: float) -> float:
     return amount / (high - low)
 
 
+def weakly_determined(name: str, std: float) -> bool:
+    """±2 std wider than ``WEAK_SHARE_OF_RANGE`` of ``name``'s healthy range."""
+    return share_of_range(name, 2 * std) > WEAK_SHARE_OF_RANGE
+
+
 @dataclass(frozen=True)
 class Data:
     """Everything simulated for one window."""
@@ -194,10 +199,11 @@ def _estimates(answer: Assessed, fsj: StaticFriction) -> Estimates:
     if fsj.value_nm is not None and fsj.std_nm is not None:
         relative = np.hypot(fsj.std_nm / fsj.value_nm, answer.stds["FDJ"] / fdj)
         ratio = RatioEstimate(value=fsj.value_nm / fdj, std=fsj.value_nm / fdj * relative)
+    weak_eta = weakly_determined("eta_O", eta_o_std)  # η_A is η_O's through Eq. 3.4, and as weak
     return Estimates(
-        FDJ=parameter(fdj, answer.stds["FDJ"], NOMINAL["FDJ"]),
-        eta_O=parameter(eta_o, eta_o_std, NOMINAL["eta_O"]),
-        eta_A=parameter(float(eta_a_from_eta_o(eta_o)), abs(slope) * eta_o_std, NOMINAL_ETA_A),
+        FDJ=parameter(fdj, answer.stds["FDJ"], NOMINAL["FDJ"], weakly_determined("FDJ", answer.stds["FDJ"])),
+        eta_O=parameter(eta_o, eta_o_std, NOMINAL["eta_O"], weak_eta),
+        eta_A=parameter(float(eta_a_from_eta_o(eta_o)), abs(slope) * eta_o_std, NOMINAL_ETA_A, weak_eta),
         FSJ=None if fsj.value_nm is None else parameter(fsj.value_nm, fsj.std_nm, DEFAULT_RANGES.nominal_fsj_nm),
         FSD=ratio,
     )
@@ -211,9 +217,10 @@ def _notes(prepared: Prepared, physics: FrictionFit, estimates: Estimates, check
             "the actuator saturates there, and so do its simulations"
         )
     for name in TARGETS:
-        spread = share_of_range(name, 2 * (getattr(estimates, name).std or 0.0))
-        if spread > WEAK_SHARE_OF_RANGE:
+        entry = getattr(estimates, name)
+        if entry.weakly_determined:
             low, high = HEALTHY_RANGE[name]
+            spread = share_of_range(name, 2 * entry.std)
             notes.append(
                 f"{name} is weakly determined by this window: ±2 std spans {100 * spread:.0f} % of the healthy "
                 f"range ({low:g}–{high:g}); a short window, a slow log or a hinge load that barely varies "

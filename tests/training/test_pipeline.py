@@ -100,7 +100,9 @@ def test_a_window_that_holds_little_of_eta_o_says_so_and_one_that_holds_it_does_
     weak = _estimate(draw(37026, "cruise", sample_rate_hz=1_000.0))
     strong = _estimate(draw(31, "thesis"))
     assert any(note.startswith("eta_O is weakly determined") for note in weak.notes)
+    assert weak.estimates.eta_O.weakly_determined and weak.estimates.eta_A.weakly_determined
     assert not any("weakly determined" in note for note in strong.notes)
+    assert not any(getattr(strong.estimates, name).weakly_determined for name in ("FDJ", "eta_O", "eta_A"))
 
 
 def test_a_held_elevator_is_refused_with_the_reason():
