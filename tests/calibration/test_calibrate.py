@@ -8,7 +8,7 @@ from calibration.documents import CalibrationReport
 from sim.checks import InputError
 from sim.window import window_from_dict
 from tests.foreign.effects import CASES
-from tests.foreign.windows import draw
+from tests.foreign.windows import Effects, draw
 from training.config import PipelineConfig
 
 SMALL = PipelineConfig(n_simulations=32, check_windows=16, n_timesteps=100, hidden_units=20)
@@ -33,6 +33,17 @@ def test_clean_windows_select_nothing(seed):
     assert report.selected_effect is None and report.unexplained is None
     assert report.estimates_after == report.estimates_before
     assert report.noise_floor.equation_error_ratio < 1.3
+
+
+def test_a_drive_whose_loop_departs_from_the_spec_is_no_effect():
+    # Bus 8 % high, G_P 1.5 % low, 30 µs of lag and a loop dithering on a noisy speed reading: the
+    # torque balance the calibration reads is untouched, so nothing may be named or described.
+    loop = Effects(supply_voltage_factor=1.08, position_gain_factor=0.985, loop_delay_s=3e-5,
+                   loop_noise_radps=0.4, loop_noise_seed=5)  # fmt: skip
+    drawn = draw(903, "doublet", effects=loop)
+    report = Calibrator(SMALL, copies=16).fit([window_from_dict(drawn.document)], drawn.truth).report_
+    assert report.selected_effect is None and report.unexplained is None
+    assert report.estimates_after == report.estimates_before
 
 
 @pytest.mark.parametrize(
