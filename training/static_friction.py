@@ -67,6 +67,15 @@ def _rests(speed_radps: np.ndarray, run: int) -> list[tuple[int, int]]:
 
 
 @dataclass(frozen=True)
+class _Event:
+    """One quasi-static break-away."""
+
+    index: int
+    drive_nm: float  # |drive| (3-sample mean) as the shaft let go
+    scatter_nm: float  # the drive samples' std about their ramp before it
+
+
+@dataclass(frozen=True)
 class _Traces:
     """What a break-away is read from: the drive |k_T·I + H_e/n| (3-sample means) and the raw speed, each
     with its per-sample noise std, and the deflection."""
@@ -78,13 +87,18 @@ class _Traces:
     position_deg: np.ndarray
 
 
+def _lookback_start(rest: tuple[int, int], run: int) -> int:
+    """The first sample of the rest's last ``LOOKBACK_RUNS`` runs, where its break-away is sought."""
+    return max(rest[0], rest[1] + 1 - LOOKBACK_RUNS * run)
+
+
 def _break_away(t: _Traces, rest: tuple[int, int], run: int, end_stop_deg: float) -> int | None:
     """The sample where the drive, built up against the stuck shaft, let it go; None if this rest shows no
     quasi-static break-away (module docstring)."""
     begin, end = rest
     drive, noise = t.drive_nm, t.drive_noise_nm
-    back = min(LOOKBACK_RUNS * run, end + 1 - begin)
-    peak = end + 1 - back + int(np.argmax(drive[end + 1 - back : end + 2]))
+    first = _lookback_start(rest, run)
+    peak = first + int(np.argmax(drive[first : end + 2]))
     level = drive[peak]
     tolerance = 3 * noise * np.sqrt(2 / 3)  # 3 std of the difference of two 3-sample means
     if peak < 3 or level - drive[peak - 3] > QUASI_STATIC * level + tolerance:
@@ -111,9 +125,8 @@ def _scatter(drive_nm: np.ndarray, begin: int, peak: int) -> float:
     return float(np.sqrt(np.sum(residual**2) / (len(t) - 3)))
 
 
-def _events(signals: Mapping[str, np.ndarray], rate: float, actuator: ActuatorParams) -> list[tuple[int, float, float]]:
-    """(index, drive, the drive's scatter before it) of each quasi-static break-away: a rest of ≥ 1 ms, then
-    motion of ≥ 1 ms."""
+def _events(signals: Mapping[str, np.ndarray], rate: float, actuator: ActuatorParams) -> list[_Event]:
+    """Each quasi-static break-away: a rest of ≥ 1 ms, then motion of ≥ 1 ms."""
     run = max(2, round(MIN_RUN_S * rate))
     drive = actuator.torque_constant_nm_per_a * signals["current_a"] + signals["hinge_moment_nm"] / actuator.gear_ratio
     speed = signals["motor_speed_radps"]
@@ -128,8 +141,8 @@ def _events(signals: Mapping[str, np.ndarray], rate: float, actuator: ActuatorPa
     for rest in _rests(np.abs(smoothed(speed, rate)), run):
         peak = _break_away(traces, rest, run, actuator.end_stop_deg)
         if peak is not None:
-            lookback = max(rest[0], rest[1] + 1 - LOOKBACK_RUNS * run)
-            events.append((peak, float(traces.drive_nm[peak]), _scatter(drive, lookback, peak)))
+            scatter = _scatter(drive, _lookback_start(rest, run), peak)
+            events.append(_Event(peak, float(traces.drive_nm[peak]), scatter))
     return events
 
 
@@ -152,21 +165,21 @@ def read_static_friction(
     direction = np.sign(smoothed(signals["motor_speed_radps"], rate))
     k_aid, k_opp = 1.0 - float(eta_a_from_eta_o(eta_o)), 1.0 / eta_o - 1.0
     levels = []
-    for peak, drive, _ in events:
-        moving = direction[min(peak + round(MIN_RUN_S * rate), len(direction) - 1)]
-        k = k_aid if load[peak] * moving > 0 else k_opp
-        levels.append(drive - k * abs(load[peak]))
+    for event in events:
+        moving = direction[min(event.index + round(MIN_RUN_S * rate), len(direction) - 1)]
+        k = k_aid if load[event.index] * moving > 0 else k_opp
+        levels.append(event.drive_nm - k * abs(load[event.index]))
     value = float(np.median(levels))
     if value < fdj_nm:
         return StaticFriction(None, None, len(levels), (
             f"{len(levels)} break-away(s) read {value:.4f} N·m, below the dynamic friction {fdj_nm:.4f} N·m: "
             "not a static level (the drive did not build up against a stuck shaft)"
         ))  # fmt: skip
-    noise = actuator.torque_constant_nm_per_a * white_noise_std(signals["current_a"]) / np.sqrt(3)
-    noise = max(noise, DITHER_STDS * float(np.median([scatter for _, _, scatter in events])))
+    sensor = actuator.torque_constant_nm_per_a * white_noise_std(signals["current_a"]) / np.sqrt(3)
+    floor = max(sensor, DITHER_STDS * float(np.median([event.scatter_nm for event in events])))
     if len(levels) >= MIN_EVENTS_FOR_STD:
         spread = 1.2533 * float(np.std(levels, ddof=1)) / np.sqrt(len(levels))  # std of a median
-        std = max(spread, noise)
+        std = max(spread, floor)
     else:
-        std = max(noise, 0.1 * value)  # one or two events: no spread to read, so a wide 10 %
+        std = max(floor, 0.1 * value)  # one or two events: no spread to read, so a wide 10 %
     return StaticFriction(value, std, len(levels), f"median of {len(levels)} quasi-static break-away(s)")
