@@ -10,7 +10,9 @@ Deliberate differences in form from ``sim.kernels`` (each one a legitimate readi
 - the command held in a 100 kHz table, linearly interpolated;
 - log intervals of any length (a 3 kHz log has 333 or 334 steps per interval);
 - effects in forms ``sim.effects`` does not have: a Gaussian friction bump over elevator position,
-  a tanh Stribeck curve, dynamic friction drifting in time, cogging as a cosine of any order.
+  a tanh Stribeck curve, dynamic friction drifting in time, cogging as a cosine of any order;
+- a loop that may depart from the spec's, unlogged: bus voltage, position gain, a lag between the
+  logged command and the one the loop follows, a noisy speed reading.
 """
 
 from __future__ import annotations
@@ -67,8 +69,7 @@ class Effects:
     position_gain_factor: float = 1.0  # true G_P over the spec's
     supply_voltage_factor: float = 1.0  # the bus voltage the PWM switches over the spec's V_max (not ω_max)
     loop_delay_s: float = 0.0  # the loop acts on the command this much later than it is logged
-    loop_noise_deg: float = 0.0  # std of the noise on the angle the loop reads (new every LOOP_SAMPLE_STEPS)
-    loop_noise_radps: float = 0.0  # std of the noise on the speed the loop reads
+    loop_noise_radps: float = 0.0  # std of the noise on the speed the loop reads (new every LOOP_SAMPLE_STEPS)
     loop_noise_seed: int = 0
 
 
@@ -199,10 +200,10 @@ def _rk4(a, b, x, u, dt):
 
 
 @njit(cache=True)
-def _run(p, a, b, command_rad, logged_rad, loop_noise, first_step, n_steps, rate_hz, theta0, out):
+def _run(p, a, b, command_rad, logged_rad, loop_noise_radps, first_step, n_steps, rate_hz, theta0, out):
     """Integrate from step ``first_step`` (negative: a pre-roll before the log starts) to ``n_steps``; the
-    loop follows ``command_rad`` and reads angle and speed with ``loop_noise`` (2, blocks) added, the
-    log records ``logged_rad`` (both 100 kHz tables) and the true states."""
+    loop follows ``command_rad`` and reads the speed with ``loop_noise_radps`` (one value per block of
+    LOOP_SAMPLE_STEPS) added, the log records ``logged_rad`` (both 100 kHz tables) and the true states."""
     h = 1e-6
     current, speed = 0.0, 0.0
     theta_u = theta0
@@ -218,7 +219,7 @@ def _run(p, a, b, command_rad, logged_rad, loop_noise, first_step, n_steps, rate
         command = command_rad[j] + (pos - j) * (command_rad[j + 1] - command_rad[j])
         logged = logged_rad[j] + (pos - j) * (logged_rad[j + 1] - logged_rad[j])
         block = (i - first_step) // LOOP_SAMPLE_STEPS
-        current = _current(p, command, theta_u + loop_noise[0, block], speed + loop_noise[1, block], current, decay)
+        current = _current(p, command, theta_u, speed + loop_noise_radps[block], current, decay)
         new_speed = _new_speed(p, i * h, h, theta_u, theta_m, speed, current, _hinge(p, x, theta_u) / GEAR)
         theta_m += 0.5 * h * (speed + new_speed)
         speed = new_speed
@@ -254,9 +255,9 @@ def _run(p, a, b, command_rad, logged_rad, loop_noise, first_step, n_steps, rate
 
 
 def _loop_noise(effects: Effects, steps: int) -> np.ndarray:
-    """(2, blocks) noise on the angle [rad] and speed [rad/s] the loop reads, one value per LOOP_SAMPLE_STEPS."""
-    draws = np.random.default_rng(effects.loop_noise_seed).standard_normal((2, steps // LOOP_SAMPLE_STEPS + 1))
-    return draws * np.array([[np.radians(effects.loop_noise_deg)], [effects.loop_noise_radps]])
+    """(blocks,) noise on the speed [rad/s] the loop reads, one value per LOOP_SAMPLE_STEPS."""
+    draws = np.random.default_rng(effects.loop_noise_seed).standard_normal(steps // LOOP_SAMPLE_STEPS + 1)
+    return effects.loop_noise_radps * draws
 
 
 def simulate(setup: Setup, command_deg, duration_s: float, preroll_s: float = 0.0) -> dict[str, np.ndarray]:
