@@ -28,6 +28,8 @@ from __future__ import annotations
 
 import argparse
 import math
+from collections.abc import Mapping
+from typing import Any
 
 import numpy as np
 
@@ -57,9 +59,9 @@ def twins(group: str, i: int) -> tuple[Window, Window, dict[str, float]]:
     return as_logged, prepare(window_from_dict(clean.document)).window, logged.truth
 
 
-def noise_levels(logged: Window, clean: Window) -> dict[str, float]:
+def noise_levels(logged: Mapping[str, Any], clean: Mapping[str, np.ndarray]) -> dict[str, float]:
     """Each sensor's realized noise std (the foreign draw scales its levels ±30 % per window)."""
-    return {name: float(np.std(logged.signals[name] - clean.signals[name])) for name in SENSORS}
+    return {name: float(np.std(np.asarray(logged[name]) - clean[name])) for name in SENSORS}
 
 
 def _k_slopes(eta_o: float, step: float = 1e-5) -> tuple[float, float]:
@@ -136,7 +138,7 @@ def our_rms(clean: Window, truth: dict[str, float], levels: dict[str, float], dr
 
 def one_window(group: str, i: int, draws: int) -> dict[str, np.ndarray]:
     logged, clean, truth = twins(group, i)
-    levels = noise_levels(logged, clean)
+    levels = noise_levels(logged.signals, clean.signals)
     X, mask, operators = linearized(clean, truth)
     return {
         "efficient": efficient_std(X, mask, operators, levels, SENSORS),

@@ -34,7 +34,7 @@ from dataclasses import replace
 import numpy as np
 
 from benchmarks.foreign_accuracy import RESULTS_MD, group_seed, groups
-from benchmarks.information_limit import GROUPS, SENSORS, expected_over
+from benchmarks.information_limit import GROUPS, SENSORS, expected_over, noise_levels
 from clients.report import write_section
 from sim import runtime
 from sim.params import HealthParams
@@ -113,7 +113,7 @@ def one_window(group: str, i: int) -> dict[str, np.ndarray]:
     (departures, 2), its bias read with our simulator (2,) and our fit's shifts (departures, 2)."""
     window = groups()[group](group_seed(group, i))
     clean = window.clean_signals()
-    levels = {s: float(np.std(np.asarray(window.document["signals"][s]) - clean[s])) for s in SENSORS}
+    levels = noise_levels(window.document["signals"], clean)
     J = sensitivities(window, levels)
     information = J.T @ J
     base, ours = _weighted(clean, levels), our_fit(window, clean)
