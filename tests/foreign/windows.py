@@ -6,6 +6,7 @@ our own objects: tests parse it through the public contract like any user's data
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -34,12 +35,36 @@ class Draw:
         return simulate(setup, self.command, self.duration_s, self.preroll_s)
 
 
-def noisy(signals: dict[str, np.ndarray], rng: np.random.Generator, level: float) -> dict[str, np.ndarray]:
-    """Gaussian noise at ``level`` × NOISE (each signal ±30 % around it), then sensor quantization."""
+def filtered(white: np.ndarray, width: int) -> np.ndarray:
+    """Unit-variance noise behind a ``width``-sample moving average (an averaging ADC, a FIR anti-aliasing
+    filter): correlated over ``width`` samples, then not at all (``sim.noise`` draws AR(1) instead)."""
+    if width <= 1:
+        return white
+    return np.convolve(white, np.ones(width) / np.sqrt(width), mode="valid")
+
+
+def filter_widths(seed: int) -> dict[str, int]:
+    """Sensors behind moving-average filters, as a log might hold them: current 2–6 samples, speed and
+    position 2–8, the hinge moment's strain-gauge amplifier 10–40 (1–4 ms at 10 kHz)."""
+    rng = np.random.default_rng(30_000 + seed)
+    return {
+        "current_a": int(rng.integers(2, 7)),
+        "motor_speed_radps": int(rng.integers(2, 9)),
+        "position_deg": int(rng.integers(2, 9)),
+        "hinge_moment_nm": int(rng.integers(10, 41)),
+    }
+
+
+def noisy(
+    signals: dict[str, np.ndarray], rng: np.random.Generator, level: float, filter_samples: Mapping[str, int] = {}
+) -> dict[str, np.ndarray]:
+    """Gaussian noise at ``level`` × NOISE (each signal ±30 % around it), each sensor's behind its
+    ``filter_samples`` moving average if given, then sensor quantization."""
     out = {}
     for name, values in signals.items():
         sigma = NOISE.get(name, 0.0) * level * rng.uniform(0.7, 1.3)
-        noisy_values = values + sigma * rng.standard_normal(len(values))
+        width = filter_samples.get(name, 1)
+        noisy_values = values + sigma * filtered(rng.standard_normal(len(values) + width - 1), width)
         if name in QUANTUM:
             noisy_values = QUANTUM[name] * np.round(noisy_values / QUANTUM[name])
         out[name] = noisy_values
@@ -56,6 +81,7 @@ def draw(
     sample_rate_hz: float = 10_000.0,
     noise_level: float = 1.0,
     preroll_s: float | None = None,
+    filter_samples: Mapping[str, int] = {},
 ) -> Draw:
     """One window. Unset health and flight are drawn (health inside the thesis's ranges); windows of
     the flight families start mid-motion (a pre-roll of 20–100 ms), the thesis family from rest."""
@@ -68,7 +94,7 @@ def draw(
         preroll_s = 0.0 if family == "thesis" else float(rng.uniform(0.02, 0.1))
     command = commands.BY_NAME[family](rng, duration_s)
     setup = Setup(health, effects, flight, sample_rate_hz)
-    signals = noisy(simulate(setup, command, duration_s, preroll_s), rng, noise_level)
+    signals = noisy(simulate(setup, command, duration_s, preroll_s), rng, noise_level, filter_samples)
     document = {
         "schema": "ema-window/1",
         "actuator_id": f"foreign/{family}",
@@ -89,4 +115,4 @@ def worn(seed: int, **kwargs) -> Draw:
     return draw(seed, health=health, **kwargs)
 
 
-__all__ = ["Draw", "Effects", "Flight", "Health", "draw", "replace", "worn"]
+__all__ = ["Draw", "Effects", "Flight", "Health", "draw", "filter_widths", "replace", "worn"]
