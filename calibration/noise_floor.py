@@ -42,6 +42,6 @@ def noise_copies(
     rng = np.random.default_rng(seed)
     out = []
     for _ in range(copies):
-        noisy = [add_sensor_noise(signals, level, rng) for signals, level in zip(clean, noise, strict=True)]
+        noisy = [add_sensor_noise(signals, level, rng, rate) for signals, level in zip(clean, noise, strict=True)]
         out.append(equations(noisy, rate, orders))
     return out

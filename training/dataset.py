@@ -107,11 +107,11 @@ def simulate_noisy(
         *(np.concatenate([getattr(health, name), getattr(reference, name)]) for name in ("fsj_nm", "fdj_nm", "eta_o"))
     )
     result = scenario.simulate(together)
-    noise = excess_noise(window.signals, {name: values[-1] for name, values in result.signals.items()})
+    rate = scenario.sample_rate_hz
+    noise = excess_noise(window.signals, {name: values[-1] for name, values in result.signals.items()}, rate)
     clean = {name: result.signals[name][:-1] for name in SIGNALS_READ}
     rng = np.random.default_rng(seed)
-    noisy = add_sensor_noise(clean, noise, rng)
-    rate = scenario.sample_rate_hz
+    noisy = add_sensor_noise(clean, noise, rng, rate)
 
     def residual(s: dict[str, np.ndarray]) -> np.ndarray:
         return residual_torque_nm(s["current_a"], s["motor_speed_radps"], s["hinge_moment_nm"], rate)
@@ -124,4 +124,4 @@ def simulate_noisy(
 def window_noise(window: Window, scenario: Scenario, health: HealthParams) -> SensorNoise:
     """The window's sensor noise, measured against a clean simulation of its own command at ``health``."""
     clean = scenario.simulate(health, lanes=1).simulation(0)
-    return excess_noise(window.signals, clean)
+    return excess_noise(window.signals, clean, window.sample_rate_hz)
