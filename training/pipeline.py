@@ -185,7 +185,7 @@ def estimate_window(
     clock.append(time.perf_counter())
     stage("checking the answer against the window")
     check = fit_check(seen, data, answer, equation_ratio, n)
-    fsj = read_static_friction(seen.signals, w.sample_rate_hz, answer.values["FDJ"], answer.values["eta_O"])
+    fsj = read_static_friction(seen.signals, w.sample_rate_hz, answer.values["FDJ"], answer.values["eta_O"], data.noise)
     clock.append(time.perf_counter())
     return _document(prepared, physics, data, network, answer, check, fsj, config, clock)
 
