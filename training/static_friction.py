@@ -79,13 +79,14 @@ class _Event:
 @dataclass(frozen=True)
 class _Traces:
     """What a break-away is read from: the drive |k_T·I + H_e/n| (3-sample means) and the raw speed, each
-    with its per-sample noise std, and the deflection."""
+    with its per-sample noise std, the deflection, and the signed drive per sample (its scatter)."""
 
     drive_nm: np.ndarray
     drive_noise_nm: float
     speed_radps: np.ndarray
     speed_noise_radps: float
     position_deg: np.ndarray
+    signed_drive_nm: np.ndarray
 
 
 def _lookback_start(rest: tuple[int, int], run: int) -> int:
@@ -142,6 +143,7 @@ def _traces(signals: Mapping[str, np.ndarray], rate: float, actuator: ActuatorPa
         speed_radps=speed,
         speed_noise_radps=speed_noise * float(np.sqrt((1 + rho_speed) / (1 - rho_speed))),  # of long means
         position_deg=signals["position_deg"],
+        signed_drive_nm=drive,
     )
 
 
@@ -151,12 +153,11 @@ def _events(
     """Each quasi-static break-away: a rest of ≥ 1 ms, then motion of ≥ 1 ms."""
     run = max(2, round(MIN_RUN_S * rate))
     traces = _traces(signals, rate, actuator, noise)
-    drive = actuator.torque_constant_nm_per_a * signals["current_a"] + signals["hinge_moment_nm"] / actuator.gear_ratio
     events = []
     for rest in _rests(np.abs(smoothed(traces.speed_radps, rate)), run):
         peak = _break_away(traces, rest, run, actuator.end_stop_deg)
         if peak is not None:
-            scatter = _scatter(drive, _lookback_start(rest, run), peak)
+            scatter = _scatter(traces.signed_drive_nm, _lookback_start(rest, run), peak)
             events.append(_Event(peak, float(traces.drive_nm[peak]), scatter))
     return events
 
