@@ -15,7 +15,8 @@ are used; a robust (MAD) variance ignores the few samples where the motion turns
 What the estimates feel is the noise's low-frequency density, R(0)·T with T = 1 + 2·Σ R(k)/R(0)
 (1 when white). The area between the plateau and S is Σ (6R(0) − S(L)) = 8·ΣR(k) − 2·ΣR(2k),
 between 7 and 8 times ΣR(k) for any correlation shape, so T is read from it without assuming one
-(summed over the lags before S first reaches ``1 − DIP`` of its plateau).
+(summed over the lags before S first reaches ``1 − DIP`` of its plateau), on the fewest lags over
+which S levels off (``noise_span``).
 The simulations then draw AR(1) noise of the same per-sample std and the same T:
 ρ = (T − 1) / (T + 1): a W-sample moving average's noise (T = W) is read with T within 25 %
 (tests/training/test_noise_level.py). Fitting an AR(1)'s shape to S instead read the hinge noise
@@ -40,6 +41,12 @@ AREA_PER_COVARIANCE = 7.5  # Σ(6R(0) − S(L)) / ΣR(k): 8 for a lag-1 correlat
 # A correlation shows as a dip of S below its plateau; the mismatch's shallow rise over many lags (5–25 %
 # by 16 samples on white foreign windows) does not, and counted as area it read white noise as T ≈ 2.
 DIP = 0.1
+# Noise's S is flat past its correlation; the mismatch's grows as L⁴. A span of lags is the noise's when
+# S rises by at most ``RISE`` of its plateau across the span's upper half (a least-squares line: a
+# correlation longer than the span rises ~0.67 there). On 0.1 s gust windows, all 16 lags read the
+# current's white noise with a median 1.8x its √(low-frequency density); the fewest flat lags, 1.3x.
+RISE = 0.25
+MIN_SPAN = 8
 
 
 def robust_variance(values: np.ndarray) -> float:
@@ -63,15 +70,37 @@ def second_difference_structure(values: np.ndarray, max_lag: int) -> np.ndarray:
     return np.array([robust_variance(values[2 * lag :] - 2 * values[lag:-lag] + values[: -2 * lag]) for lag in lags])
 
 
+def plateau_and_dip(structure: np.ndarray) -> tuple[float, int]:
+    """S's plateau (the median of its upper half: 6·R(0)) and how many of the first lags dip below
+    ``1 − DIP`` of it (0: white)."""
+    plateau = float(np.median(structure[len(structure) // 2 :]))
+    reached = np.flatnonzero(structure >= (1.0 - DIP) * plateau)
+    return plateau, int(reached[0]) if len(reached) else len(structure)
+
+
+def noise_span(structure: np.ndarray) -> int:
+    """How many of the first lags of S are the noise's: the fewest (at least ``MIN_SPAN``; the mismatch
+    grows into the longer ones) whose dip ends in their lower half and whose upper half is flat (rises
+    by at most ``RISE`` of its plateau). When no span is, all of them: the mismatch can then only widen
+    the noise read, never narrow it (a correlation too long for the window rises through every span;
+    a 1 kHz log's mismatch reaches even the first lags and is read as noise, up to 57x the speed's)."""
+    for span in range(MIN_SPAN, len(structure) + 1):
+        plateau, dip = plateau_and_dip(structure[:span])
+        upper = np.arange(span // 2, span, dtype=np.float64)
+        rise = np.polyfit(upper, structure[span // 2 : span], 1)[0] * (span - span // 2)
+        if dip <= span // 2 and rise <= RISE * plateau:
+            return span
+    return len(structure)
+
+
 def noise_of(difference: np.ndarray, sample_rate_hz: float, max_lag: int) -> tuple[float, float]:
     """(σ, τ [s]) of the AR(1) noise with the per-sample variance and the low-frequency density of the
     noise in ``difference`` (measured minus a clean reference of the same window)."""
     structure = second_difference_structure(difference, max_lag)
+    structure = structure[: noise_span(structure)]
     if len(structure) == 0:
         return 0.0, 0.0
-    plateau = float(np.median(structure[len(structure) // 2 :]))
-    reached = np.flatnonzero(structure >= (1.0 - DIP) * plateau)
-    correlated = int(reached[0]) if len(reached) else len(structure)  # the lags 1 … this one dip
+    plateau, correlated = plateau_and_dip(structure)  # the lags 1 … correlated dip
     if correlated == 0 or plateau <= 0.0:
         return float(np.sqrt(structure[0] / 6.0)), 0.0  # white
     area = float(np.sum(plateau - structure[:correlated]))

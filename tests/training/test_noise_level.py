@@ -53,3 +53,20 @@ def test_white_and_moving_average_noise_are_told_apart_by_their_structure():
         rho = np.exp(-1 / (tau_s * RATE))
         assert sigma == pytest.approx(1.0, rel=0.1)
         assert (1 + rho) / (1 - rho) == pytest.approx(width, rel=0.25)  # a moving average's T is its width
+
+
+def test_a_short_windows_mismatch_at_its_sharp_motions_is_not_read_as_correlation():
+    """A 0.1 s window's difference from its clean simulation: white noise plus a few ms-wide departures
+    where the motion turns sharply (their S grows as L⁴, unlike any noise's). Read over all 16 lags,
+    6 of 20 such windows gave T over 1.5 (up to 2.5): simulations that noisy widen the stds for nothing."""
+    t = np.arange(1000)
+    over = 0
+    for seed in range(20):
+        rng = np.random.default_rng(seed)
+        bumps = zip(rng.uniform(-8, 8, 3), rng.uniform(100, 900, 3), rng.uniform(5, 15, 3), strict=True)
+        mismatch = sum(a * np.exp(-0.5 * ((t - centre) / width) ** 2) for a, centre, width in bumps)
+        sigma, tau_s = noise_of(rng.standard_normal(1000) + mismatch, RATE, 16)
+        assert sigma == pytest.approx(1.0, rel=0.15)
+        rho = np.exp(-1 / (tau_s * RATE)) if tau_s > 0 else 0.0
+        over += (1 + rho) / (1 - rho) > 1.5
+    assert over <= 2
