@@ -25,7 +25,7 @@ from clients.report import write_section
 from sim import runtime
 from sim.checks import InputError
 from sim.window import window_from_dict
-from tests.foreign.windows import Draw, Effects, draw, worn
+from tests.foreign.windows import Draw, Effects, draw, filter_widths, worn
 from training.pipeline import HEALTHY_RANGE, WEAK_SHARE_OF_RANGE, estimate_window, share_of_range
 
 RESULTS_MD = Path(__file__).resolve().parent.parent / "docs" / "results.md"
@@ -51,6 +51,7 @@ def groups() -> dict[str, Callable[..., Draw]]:
     for family in FAMILIES:
         out[f"worn, {family}"] = lambda s, f=family, **kw: worn(s, family=f, **kw)
     out["drive unlike the spec's"] = lambda s, **kw: draw(s, FAMILIES[s % 5], effects=unlike_the_spec(s), **kw)
+    out["sensors behind filters"] = lambda s, **kw: draw(s, FAMILIES[s % 5], filter_samples=filter_widths(s), **kw)
     out["held position"] = lambda s, **kw: draw(s, "hold", **kw)
     return out
 
@@ -208,7 +209,10 @@ def report(rows: dict[str, list[dict[str, Any]]], per_group: int, seconds: float
         "Table 3.1's ranges (worn: FDJ 1.3–2.5x nominal, η_O 0.45–0.66), random flight condition; default",
         "pipeline sizes. *Drive unlike the spec's*: the five families, with a loop that departs from the",
         "spec's and from every simulation the pipeline runs, unlogged (bus ±10 %, position gain ±2 %, up",
-        f"to 50 µs of lag, a speed read with up to 0.5 rad/s of noise: `unlike_the_spec`). Total {seconds:.0f} s.",
+        "to 50 µs of lag, a speed read with up to 0.5 rad/s of noise: `unlike_the_spec`). *Sensors behind",
+        "filters*: the five families, each sensor's noise through a moving average (current 2–6 samples,",
+        "speed and position 2–8, the hinge moment 10–40: `filter_widths`), so its low frequencies carry up",
+        f"to 40x the power of white noise of the same std. Total {seconds:.0f} s.",
         "",
         table(summaries),
         "",
