@@ -16,7 +16,7 @@ What the estimates feel is the noise's low-frequency density, R(0)·T with T = 1
 (1 when white). The area between the plateau and S is Σ (6R(0) − S(L)) = 8·ΣR(k) − 2·ΣR(2k),
 between 7 and 8 times ΣR(k) for any correlation shape, so T is read from it without assuming one
 (summed over the lags before S first reaches ``1 − DIP`` of its plateau), on the fewest lags over
-which S levels off (``noise_span``).
+which S levels off (``noise_structure``).
 The simulations then draw AR(1) noise of the same per-sample std and the same T:
 ρ = (T − 1) / (T + 1): a W-sample moving average's noise (T = W) is read with T within 25 %
 (tests/training/test_noise_level.py). Fitting an AR(1)'s shape to S instead read the hinge noise
@@ -64,10 +64,9 @@ def white_noise_std(values: np.ndarray) -> float:
     return float(np.sqrt(robust_variance(np.diff(values, n=2)) / 6.0))
 
 
-def second_difference_structure(values: np.ndarray, max_lag: int) -> np.ndarray:
-    """S(L) for L = 1 … ``max_lag`` (fewer where the window leaves under 8 differences)."""
-    lags = range(1, min(max_lag, (len(values) - 8) // 2) + 1)
-    return np.array([robust_variance(values[2 * lag :] - 2 * values[lag:-lag] + values[: -2 * lag]) for lag in lags])
+def second_difference_variance(values: np.ndarray, lag: int) -> float:
+    """S(L): the robust variance of x[k+L] − 2·x[k] + x[k−L]."""
+    return robust_variance(values[2 * lag :] - 2 * values[lag:-lag] + values[: -2 * lag])
 
 
 def plateau_and_dip(structure: np.ndarray) -> tuple[float, int]:
@@ -78,26 +77,34 @@ def plateau_and_dip(structure: np.ndarray) -> tuple[float, int]:
     return plateau, int(reached[0]) if len(reached) else len(structure)
 
 
-def noise_span(structure: np.ndarray) -> int:
-    """How many of the first lags of S are the noise's: the fewest (at least ``MIN_SPAN``; the mismatch
-    grows into the longer ones) whose dip ends in their lower half and whose upper half is flat (rises
-    by at most ``RISE`` of its plateau). When no span is, all of them: the mismatch can then only widen
+def levels_off(structure: np.ndarray) -> bool:
+    """Whether S over these lags is the noise's: its dip ends in their lower half, and its upper half
+    is flat (a least-squares line through it rises by at most ``RISE`` of the plateau)."""
+    span, half = len(structure), len(structure) // 2
+    plateau, dip = plateau_and_dip(structure)
+    lags = np.arange(half, span, dtype=np.float64)
+    upper = structure[half:]
+    slope = np.sum((lags - lags.mean()) * (upper - upper.mean())) / np.sum((lags - lags.mean()) ** 2)
+    return dip <= half and slope * (span - half) <= RISE * plateau
+
+
+def noise_structure(values: np.ndarray, max_lag: int) -> np.ndarray:
+    """S(L) for L = 1 … the fewest lags (at least ``MIN_SPAN``: the mismatch grows into the longer
+    ones) over which it ``levels_off``, computed lag by lag (white noise's settles at 8). When it never
+    does within ``max_lag`` (or the window's half, less 4), all of them: the mismatch can then only widen
     the noise read, never narrow it (a correlation too long for the window rises through every span;
     a 1 kHz log's mismatch reaches even the first lags and is read as noise, up to 57x the speed's)."""
-    for span in range(MIN_SPAN, len(structure) + 1):
-        plateau, dip = plateau_and_dip(structure[:span])
-        upper = np.arange(span // 2, span, dtype=np.float64)
-        rise = np.polyfit(upper, structure[span // 2 : span], 1)[0] * (span - span // 2)
-        if dip <= span // 2 and rise <= RISE * plateau:
-            return span
-    return len(structure)
+    available = min(max_lag, (len(values) - 8) // 2)
+    structure = [second_difference_variance(values, lag) for lag in range(1, min(MIN_SPAN, available) + 1)]
+    while len(structure) < available and not levels_off(np.array(structure)):
+        structure.append(second_difference_variance(values, len(structure) + 1))
+    return np.array(structure)
 
 
 def noise_of(difference: np.ndarray, sample_rate_hz: float, max_lag: int) -> tuple[float, float]:
     """(σ, τ [s]) of the AR(1) noise with the per-sample variance and the low-frequency density of the
     noise in ``difference`` (measured minus a clean reference of the same window)."""
-    structure = second_difference_structure(difference, max_lag)
-    structure = structure[: noise_span(structure)]
+    structure = noise_structure(difference, max_lag)
     if len(structure) == 0:
         return 0.0, 0.0
     plateau, correlated = plateau_and_dip(structure)  # the lags 1 … correlated dip
