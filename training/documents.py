@@ -11,6 +11,7 @@ from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
+from training.conditioning import GLITCH_STDS
 from training.config import PipelineConfig
 
 TARGETS = ("FDJ", "eta_O")  # what the estimators fit; η_A follows by Eq. 3.4, FSD from FSJ
@@ -92,6 +93,11 @@ class WindowInfo(Document):
     sample_rate_hz: float
     processed_rate_hz: float = Field(description="after averaging adjacent samples (exact for interval means)")
     command_clipped_fraction: float = Field(description="share of command samples past the end stops, saturating")
+    glitches_repaired: dict[str, int] = Field(
+        default_factory=dict,
+        description=f"per sensor, isolated samples off both neighbours by > {GLITCH_STDS:g} noise stds, replaced "
+        "by their mean",
+    )
     sliding_fraction: float = Field(description="share of samples the friction fit could use")
     recorded_at: str | None = None
     flight_hours: float | None = None

@@ -29,7 +29,7 @@ from sim.window import Window
 from training import design
 from training.assess import Assessed, Candidates, assess, physics_values
 from training.baseline import FIT_ARRAYS, FitSettings, FrictionFit, fit_friction, fit_window, regressors
-from training.conditioning import Prepared, prepare
+from training.conditioning import GLITCH_STDS, Prepared, prepare
 from training.config import PipelineConfig
 from training.dataset import Scenario, Simulated, scenario_from_window, simulate_noisy
 from training.documents import (
@@ -216,6 +216,12 @@ def _notes(prepared: Prepared, physics: FrictionFit, estimates: Estimates, check
             f"{100 * prepared.command_clipped_fraction:.1f} % of the command lies past the end stops: "
             "the actuator saturates there, and so do its simulations"
         )
+    if prepared.glitches:
+        counts = ", ".join(f"{count} of {name}" for name, count in prepared.glitches.items())
+        notes.append(
+            f"isolated glitches replaced by their neighbours' mean ({counts}): samples that left both "
+            f"neighbours by over {GLITCH_STDS:g} noise stds and came straight back (EMI, bit errors)"
+        )
     for name in TARGETS:
         entry = getattr(estimates, name)
         if entry.weakly_determined:
@@ -287,6 +293,7 @@ def _document(
             sample_rate_hz=prepared.original_rate_hz,
             processed_rate_hz=w.sample_rate_hz,
             command_clipped_fraction=prepared.command_clipped_fraction,
+            glitches_repaired=prepared.glitches,
             sliding_fraction=float(np.mean(data.sliding)),
             recorded_at=w.recorded_at,
             flight_hours=w.flight_hours,

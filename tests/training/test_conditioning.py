@@ -1,9 +1,13 @@
+from dataclasses import replace
+
 import numpy as np
+import pytest
 
 from sim.params import HealthParams
 from sim.synthetic import synthetic_window
-from sim.window import Window
-from training.conditioning import MAX_RATE_HZ, MAX_SAMPLES, averaging_factor, prepare
+from sim.window import Window, window_from_dict
+from tests.foreign.windows import NOISE, draw
+from training.conditioning import GLITCH_ACTIVITY, MAX_RATE_HZ, MAX_SAMPLES, averaging_factor, prepare
 
 
 def test_averaging_keeps_rate_and_samples_bounded():
@@ -28,3 +32,41 @@ def test_a_command_past_the_end_stops_is_measured_not_refused():
     window = synthetic_window(HealthParams.single(), seed=2, duration_s=0.05)
     signals = dict(window.signals, command_deg=np.where(np.arange(500) < 100, 45.0, 0.0))
     assert prepare(Window(signals)).command_clipped_fraction == 0.2
+
+
+FAMILIES = ("thesis", "cruise", "gust", "doublet", "steps")
+
+
+def _foreign(seed: int, rate: float) -> Window:
+    return window_from_dict(draw(seed, FAMILIES[seed % 5], sample_rate_hz=rate, duration_s=0.2).document)
+
+
+@pytest.mark.parametrize("rate", [1_000.0, 10_000.0, 100_000.0])
+def test_no_sample_of_a_foreign_window_is_taken_for_a_glitch(rate):
+    """A 1 kHz log's fastest turns reach 36 noise stds from sample to sample: legitimate, and kept."""
+    for seed in range(10):
+        window = _foreign(seed, rate)
+        assert prepare(window).glitches == {}, seed
+
+
+def test_glitches_are_found_and_replaced_by_the_line_between_their_flanks():
+    """Spikes of 50–1000 noise stds (an EMI burst, a bit error; two may fall side by side), drawn here,
+    on foreign windows. One a few times the steps of a fast slew beside it may stay: it is the motion's
+    size there, not the noise's."""
+    found = planted = 0
+    for seed in range(10):
+        window, rng = _foreign(seed, 10_000.0), np.random.default_rng(seed)
+        signals = dict(window.signals)
+        for name, sigma in NOISE.items():
+            at = rng.choice(np.arange(5, window.n_samples - 5), size=3, replace=False)
+            signals[name] = signals[name].copy()
+            signals[name][at] += rng.choice([-1, 1], 3) * rng.uniform(50, 1000, 3) * sigma
+            planted += 3
+        prepared = prepare(replace(window, signals=signals))
+        found += sum(prepared.glitches.values())
+        for name, sigma in NOISE.items():  # repaired to within the noise, or a few local steps, of the log
+            left = np.abs(prepared.window.signals[name] - window.signals[name])
+            steps = np.abs(np.diff(window.signals[name]))
+            local = np.array([np.median(steps[max(0, k - 10) : k + 10]) for k in range(len(left))])
+            assert np.all(left < np.maximum(5 * sigma, 2 * GLITCH_ACTIVITY * local)), name
+    assert found >= 0.95 * planted

@@ -131,6 +131,23 @@ def test_a_command_past_the_end_stops_is_answered_and_reported():
     assert any("past the end stops" in note for note in result.notes)
 
 
+def test_glitches_are_repaired_and_reported_and_the_answer_is_the_clean_twins():
+    """Two spikes of 100–200 noise stds on each sensor (drawn here): unrepaired, such windows were
+    read 3–4 % of range off on average (up to 17 %), every answer weakly determined."""
+    drawn = draw(35, "doublet")
+    clean, rng = _estimate(drawn), np.random.default_rng(35)
+    signals = {name: list(values) for name, values in drawn.document["signals"].items()}
+    for name, sigma in NOISE.items():
+        for at in rng.choice(np.arange(100, 4900), size=2, replace=False):
+            signals[name][at] += float(rng.choice([-1, 1]) * rng.uniform(100, 200) * sigma)
+    result = estimate_window(window_from_dict({**drawn.document, "signals": signals}), SMALL)
+    assert result.window.glitches_repaired == dict.fromkeys(NOISE, 2)
+    assert any("glitches" in note for note in result.notes)
+    for name in ("FDJ", "eta_O"):
+        ours, twin = getattr(result.estimates, name), getattr(clean.estimates, name)
+        assert abs(ours.value - twin.value) < 0.5 * twin.std and ours.std < 1.5 * twin.std, name
+
+
 def test_a_network_that_disagrees_with_the_window_is_set_aside(monkeypatch):
     # A network that reads nonsense: the window's own consistency check must not trust it.
     from training import estimator
