@@ -25,7 +25,7 @@ from clients.report import write_section
 from sim import runtime
 from sim.checks import InputError
 from sim.window import window_from_dict
-from tests.foreign.windows import Draw, Effects, draw, filter_widths, worn
+from tests.foreign.windows import Draw, Effects, draw, filter_widths, with_spikes, worn
 from training.pipeline import HEALTHY_RANGE, WEAK_SHARE_OF_RANGE, estimate_window, share_of_range
 
 RESULTS_MD = Path(__file__).resolve().parent.parent / "docs" / "results.md"
@@ -52,6 +52,7 @@ def groups() -> dict[str, Callable[..., Draw]]:
         out[f"worn, {family}"] = lambda s, f=family, **kw: worn(s, family=f, **kw)
     out["drive unlike the spec's"] = lambda s, **kw: draw(s, FAMILIES[s % 5], effects=unlike_the_spec(s), **kw)
     out["sensors behind filters"] = lambda s, **kw: draw(s, FAMILIES[s % 5], filter_samples=filter_widths(s), **kw)
+    out["sensor glitches"] = lambda s, **kw: with_spikes(draw(s, FAMILIES[s % 5], **kw), s)
     out["held position"] = lambda s, **kw: draw(s, "hold", **kw)
     return out
 
@@ -212,7 +213,9 @@ def report(rows: dict[str, list[dict[str, Any]]], per_group: int, seconds: float
         "to 50 µs of lag, a speed read with up to 0.5 rad/s of noise: `unlike_the_spec`). *Sensors behind",
         "filters*: the five families, each sensor's noise through a moving average (current 2–6 samples,",
         "speed and position 2–8, the hinge moment 10–40: `filter_widths`), so its low frequencies carry up",
-        f"to 40x the power of white noise of the same std. Total {seconds:.0f} s.",
+        "to 40x the power of white noise of the same std. *Sensor glitches*: the five families with 1–5",
+        "spikes of 50–500 noise stds on each sensor, one in four two samples long (`with_spikes`).",
+        f"Total {seconds:.0f} s.",
         "",
         table(summaries),
         "",

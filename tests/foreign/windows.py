@@ -55,6 +55,20 @@ def filter_widths(seed: int) -> dict[str, int]:
     }
 
 
+def with_spikes(drawn: Draw, seed: int) -> Draw:
+    """``drawn`` with EMI spikes and bit errors as a log might hold them: 1–5 on each sensor, 50–500
+    noise stds, one in four doubled on the next sample (the product repairs runs of up to 3)."""
+    rng = np.random.default_rng(40_000 + seed)
+    signals = {name: list(values) for name, values in drawn.document["signals"].items()}
+    for name, sigma in NOISE.items():
+        n = len(signals[name])
+        for at in rng.choice(np.arange(20, n - 20), size=int(rng.integers(1, 6)), replace=False):
+            size = float(rng.choice([-1, 1]) * rng.uniform(50, 500) * sigma)
+            for k in range(at, at + (2 if rng.uniform() < 0.25 else 1)):
+                signals[name][k] += size
+    return replace(drawn, document={**drawn.document, "signals": signals})
+
+
 def noisy(
     signals: dict[str, np.ndarray], rng: np.random.Generator, level: float, filter_samples: Mapping[str, int] = {}
 ) -> dict[str, np.ndarray]:
@@ -115,4 +129,4 @@ def worn(seed: int, **kwargs) -> Draw:
     return draw(seed, health=health, **kwargs)
 
 
-__all__ = ["Draw", "Effects", "Flight", "Health", "draw", "filter_widths", "replace", "worn"]
+__all__ = ["Draw", "Effects", "Flight", "Health", "draw", "filter_widths", "replace", "with_spikes", "worn"]
