@@ -95,8 +95,8 @@ class WindowInfo(Document):
     command_clipped_fraction: float = Field(description="share of command samples past the end stops, saturating")
     glitches_repaired: dict[str, int] = Field(
         default_factory=dict,
-        description=f"per sensor, isolated samples off both neighbours by > {GLITCH_STDS:g} noise stds, replaced "
-        "by their mean",
+        description=f"per sensor, samples of glitches (runs off both flanks by > {GLITCH_STDS:g} noise stds), "
+        "replaced by the line between the flanks",
     )
     sliding_fraction: float = Field(description="share of samples the friction fit could use")
     recorded_at: str | None = None

@@ -219,8 +219,8 @@ def _notes(prepared: Prepared, physics: FrictionFit, estimates: Estimates, check
     if prepared.glitches:
         counts = ", ".join(f"{count} of {name}" for name, count in prepared.glitches.items())
         notes.append(
-            f"isolated glitches replaced by their neighbours' mean ({counts}): samples that left both "
-            f"neighbours by over {GLITCH_STDS:g} noise stds and came straight back (EMI, bit errors)"
+            f"glitches replaced by the line between their flanking samples ({counts}): a sample, or a few, "
+            f"that left both flanks by over {GLITCH_STDS:g} noise stds and came straight back (EMI, bit errors)"
         )
     for name in TARGETS:
         entry = getattr(estimates, name)
