@@ -53,7 +53,8 @@ class Prepared:
     original_samples: int
     original_rate_hz: float
     command_clipped_fraction: float  # share of command samples past the end stops (the actuator saturates)
-    glitches: dict[str, int]  # per sensor, isolated samples replaced by their neighbours' mean
+    glitches: dict[str, int]  # per sensor, samples of glitches replaced by the line between their flanks
+    current_lag_s: float = 0.0  # how late the current is logged behind the speed (training.alignment)
 
 
 def averaging_factor(n_samples: int, rate_hz: float) -> int:

@@ -98,6 +98,9 @@ class WindowInfo(Document):
         description=f"per sensor, samples of glitches (runs off both flanks by > {GLITCH_STDS:g} noise stds), "
         "replaced by the line between the flanks",
     )
+    current_lag_s: float = Field(
+        default=0.0, description="how late the current is logged behind the speed (negative: the speed), undone"
+    )
     sliding_fraction: float = Field(description="share of samples the friction fit could use")
     recorded_at: str | None = None
     flight_hours: float | None = None

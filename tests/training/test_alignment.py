@@ -1,0 +1,55 @@
+"""The current's lag behind the speed, read on foreign windows whose sensors are filtered here (the
+filter acts on the signal and its noise, as a real one does: tests/foreign filters only the noise)."""
+
+import numpy as np
+import pytest
+
+from sim.window import window_from_dict
+from tests.foreign.windows import draw, noisy
+from training.alignment import aligned
+
+FAMILIES = ("thesis", "cruise", "gust", "doublet", "steps")
+RATE = 10_000.0
+
+
+def moving_average(values: np.ndarray, width: int) -> np.ndarray:
+    """Causal: each sample the mean of itself and the width − 1 before (delay (width − 1) / 2)."""
+    padded = np.concatenate([np.full(width - 1, values[0]), values])
+    return np.convolve(padded, np.ones(width) / width, mode="valid")
+
+
+def first_order(values: np.ndarray, tau_samples: float) -> np.ndarray:
+    """y[k] = a·y[k−1] + (1 − a)·x[k]: an RC low-pass, low-frequency delay a / (1 − a) samples."""
+    a, out, state = np.exp(-1.0 / tau_samples), np.empty_like(values), values[0]
+    for k, x in enumerate(values):
+        state = a * state + (1.0 - a) * x
+        out[k] = state
+    return out
+
+
+def _window(seed: int, filters: dict):
+    drawn = draw(seed, FAMILIES[seed % 5], noise_level=0)
+    signals = noisy(drawn.clean_signals(), np.random.default_rng(seed), 1.0)
+    for name, apply in filters.items():
+        signals[name] = apply(signals[name])
+    return window_from_dict({**drawn.document, "signals": {k: v.tolist() for k, v in signals.items()}})
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_a_filtered_current_or_speed_is_read_late_by_its_filters_delay(seed):
+    width = 2 + seed  # 0.5–2.5 samples of delay
+    _, lag_s = aligned(_window(seed, {"current_a": lambda x: moving_average(x, width)}))
+    assert lag_s * RATE == pytest.approx((width - 1) / 2, abs=0.1)
+    _, lag_s = aligned(_window(seed, {"motor_speed_radps": lambda x: moving_average(x, width)}))
+    assert lag_s * RATE == pytest.approx(-(width - 1) / 2, abs=0.1)
+    tau, a = 1.0 + seed, np.exp(-1.0 / (1.0 + seed))
+    _, lag_s = aligned(_window(seed, {"current_a": lambda x: first_order(x, tau)}))
+    # an RC filter delays fast content less than slow; Eq. 5.1 reads it at the accelerations
+    assert lag_s * RATE == pytest.approx(a / (1 - a), rel=0.1)
+
+
+def test_unfiltered_sensors_are_left_as_logged():
+    for seed in range(5, 15):
+        window = _window(seed, {})
+        out, lag_s = aligned(window)
+        assert lag_s == 0.0 and out is window, seed
