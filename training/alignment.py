@@ -7,9 +7,9 @@ speed read through a filtered resolver) leaves a residual that no friction expla
 windows whose current or speed passed through a 2–8 sample moving average (0.05–0.35 ms of delay),
 FDJ and η_O were 7–19 % of the range off on average (up to 59 %), every answer weakly determined.
 
-The lag is read as the shift of the current, on a grid of ``LAG_STEP_SAMPLES`` within
-``MAX_LAG_S``, that minimizes the equation error of the physics fit: one batched fit of the window
-with the current shifted each way (the sliding samples, set by the speed, stay the same). It is
+The lag is read as the shift of the current, to half a sample within ``MAX_LAG_S``, that minimizes
+the equation error of the physics fit: batched fits of the window with the current shifted each way
+(the sliding samples, set by the speed, stay the same). It is
 sharp: on those windows the minimum fell exactly on the filter's delay, the equation error 32–88 %
 below the unshifted one, and on windows without filters exactly on zero. A lag is applied only
 where it lowers the equation error by ``MIN_GAIN``; then the later of the two signals is advanced
@@ -27,7 +27,7 @@ from training.baseline import fit_friction
 from training.preprocess import as_read
 
 MAX_LAG_S = 1e-3
-LAG_STEP_SAMPLES = 0.5
+HALF_STEP = 0.5  # samples: the finest grid searched
 MIN_GAIN = 0.05  # the least relative drop of the equation error a lag must bring
 
 
@@ -37,24 +37,34 @@ def advanced(values: np.ndarray, samples: float) -> np.ndarray:
     return np.interp(index + samples, index, values)
 
 
-def current_lag_samples(signals: dict[str, np.ndarray], sample_rate_hz: float) -> float:
-    """How many samples the logged current trails the logged speed (negative: the speed trails), 0
-    unless that lag lowers the window's equation error by ``MIN_GAIN``."""
-    reach = max(1.0, np.floor(MAX_LAG_S * sample_rate_hz / LAG_STEP_SAMPLES) * LAG_STEP_SAMPLES)
-    lags = np.arange(-reach, reach + LAG_STEP_SAMPLES / 2, LAG_STEP_SAMPLES)
+def equation_errors(signals: dict[str, np.ndarray], sample_rate_hz: float, lags: np.ndarray) -> np.ndarray:
+    """The physics fit's equation error with the current read ``lags`` samples later, one batched fit."""
     read = as_read(signals, sample_rate_hz)
     batch = {name: np.broadcast_to(values, (len(lags), len(values))) for name, values in read.items()}
     batch["current_a"] = np.stack([advanced(signals["current_a"], lag) for lag in lags])
-    error = fit_friction(batch, sample_rate_hz).residual_rms_nm
-    if not np.all(np.isfinite(error)):
+    return fit_friction(batch, sample_rate_hz).residual_rms_nm
+
+
+def current_lag_samples(signals: dict[str, np.ndarray], sample_rate_hz: float) -> float:
+    """How many samples the logged current trails the logged speed (negative: the speed trails), 0
+    unless that lag lowers the window's equation error by ``MIN_GAIN``: whole samples within
+    ``MAX_LAG_S`` first, then half a sample either side of the best, then the parabola's vertex."""
+    reach = max(1.0, np.floor(MAX_LAG_S * sample_rate_hz))
+    grid = np.arange(-reach, reach + 0.5)
+    coarse = equation_errors(signals, sample_rate_hz, grid)
+    if not np.all(np.isfinite(coarse)):
         return 0.0  # too little sliding motion: the physics fit says so next
-    best, unshifted = int(np.argmin(error)), int(np.argmin(np.abs(lags)))
-    if error[best] >= (1.0 - MIN_GAIN) * error[unshifted]:
+    near = grid[int(np.argmin(coarse))] + np.array([-HALF_STEP, HALF_STEP])
+    errors = dict(zip(grid, coarse, strict=True)) | dict(
+        zip(near, equation_errors(signals, sample_rate_hz, near), strict=True)
+    )
+    best = min(errors, key=errors.__getitem__)
+    if errors[best] >= (1.0 - MIN_GAIN) * errors[0.0]:
         return 0.0
-    if 0 < best < len(lags) - 1:  # a filter's delay falls between grid points: the parabola's vertex
-        below, at, above = error[best - 1] ** 2, error[best] ** 2, error[best + 1] ** 2
-        return float(lags[best] + 0.5 * LAG_STEP_SAMPLES * (below - above) / (below - 2 * at + above))
-    return float(lags[best])
+    if best - HALF_STEP in errors and best + HALF_STEP in errors:  # a filter's delay falls between: the vertex
+        below, at, above = (errors[best + d] ** 2 for d in (-HALF_STEP, 0.0, HALF_STEP))
+        return float(best + 0.5 * HALF_STEP * (below - above) / (below - 2 * at + above))
+    return float(best)
 
 
 def aligned(window: Window) -> tuple[Window, float]:
