@@ -55,6 +55,7 @@ class Prepared:
     command_clipped_fraction: float  # share of command samples past the end stops (the actuator saturates)
     glitches: dict[str, int]  # per sensor, samples of glitches replaced by the line between their flanks
     current_lag_s: float = 0.0  # how late the current is logged behind the speed (training.alignment)
+    hinge_lag_s: float = 0.0  # how late the hinge moment is logged (training.alignment)
 
 
 def averaging_factor(n_samples: int, rate_hz: float) -> int:

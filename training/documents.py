@@ -101,6 +101,7 @@ class WindowInfo(Document):
     current_lag_s: float = Field(
         default=0.0, description="how late the current is logged behind the speed (negative: the speed), undone"
     )
+    hinge_lag_s: float = Field(default=0.0, description="how late the hinge moment is logged (its filter), undone")
     sliding_fraction: float = Field(description="share of samples the friction fit could use")
     recorded_at: str | None = None
     flight_hours: float | None = None

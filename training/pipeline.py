@@ -169,7 +169,7 @@ def estimate_window(
     stage = on_stage or (lambda _: None)
     clock = [time.perf_counter()]
     prepared = prepare(window)
-    (w, current_lag_s), n = aligned(prepared.window), config.n_simulations
+    (w, lags), n = aligned(prepared.window), config.n_simulations
     seen = replace(w, signals=as_read(w.signals, w.sample_rate_hz))
     physics = fit_window(seen.signals, w.sample_rate_hz)
     stage(f"simulating {config.total_simulations} windows around the physics estimate")
@@ -188,8 +188,8 @@ def estimate_window(
     check = fit_check(seen, data, answer, equation_ratio, n)
     fsj = read_static_friction(seen.signals, w.sample_rate_hz, answer.values["FDJ"], answer.values["eta_O"], data.noise)
     clock.append(time.perf_counter())
-    return _document(replace(prepared, window=w, current_lag_s=current_lag_s), physics, data, network, answer, check,
-                     fsj, config, clock)  # fmt: skip
+    prepared = replace(prepared, window=w, current_lag_s=lags.current_s, hinge_lag_s=lags.hinge_s)
+    return _document(prepared, physics, data, network, answer, check, fsj, config, clock)
 
 
 def _estimates(answer: Assessed, fsj: StaticFriction) -> Estimates:
@@ -225,6 +225,11 @@ def _notes(prepared: Prepared, physics: FrictionFit, estimates: Estimates, check
         notes.append(
             f"the {late} is logged {1e6 * by:.0f} µs late (a sensor filter): advanced onto the other before Eq. 5.1, "
             "which it otherwise breaks at every acceleration"
+        )
+    if prepared.hinge_lag_s:
+        notes.append(
+            f"the hinge moment is logged {1e6 * prepared.hinge_lag_s:.0f} µs late (its filter, read from the "
+            "correlation of its noise): advanced before Eq. 5.1"
         )
     if prepared.glitches:
         counts = ", ".join(f"{count} of {name}" for name, count in prepared.glitches.items())
@@ -305,6 +310,7 @@ def _document(
             command_clipped_fraction=prepared.command_clipped_fraction,
             glitches_repaired=prepared.glitches,
             current_lag_s=prepared.current_lag_s,
+            hinge_lag_s=prepared.hinge_lag_s,
             sliding_fraction=float(np.mean(data.sliding)),
             recorded_at=w.recorded_at,
             flight_hours=w.flight_hours,

@@ -55,6 +55,20 @@ def filter_widths(seed: int) -> dict[str, int]:
     }
 
 
+def through_filters(drawn: Draw, widths: Mapping[str, int]) -> Draw:
+    """``drawn`` with each named sensor's logged signal, noise and all, through a causal moving average
+    of its width, then quantized again: a real filter delays the signal by (width − 1) / 2 samples
+    (``draw``'s ``filter_samples`` filters the noise alone)."""
+    signals = {name: list(values) for name, values in drawn.document["signals"].items()}
+    for name, width in widths.items():
+        values = np.asarray(signals[name])
+        values = np.convolve(np.concatenate([np.full(width - 1, values[0]), values]), np.ones(width) / width, "valid")
+        if name in QUANTUM:
+            values = QUANTUM[name] * np.round(values / QUANTUM[name])
+        signals[name] = values.tolist()
+    return replace(drawn, document={**drawn.document, "signals": signals})
+
+
 def with_spikes(drawn: Draw, seed: int) -> Draw:
     """``drawn`` with EMI spikes and bit errors as a log might hold them: 1–5 on each sensor, 50–500
     noise stds, one in four doubled on the next sample (the product repairs runs of up to 3)."""
@@ -129,4 +143,15 @@ def worn(seed: int, **kwargs) -> Draw:
     return draw(seed, health=health, **kwargs)
 
 
-__all__ = ["Draw", "Effects", "Flight", "Health", "draw", "filter_widths", "replace", "with_spikes", "worn"]
+__all__ = [
+    "Draw",
+    "Effects",
+    "Flight",
+    "Health",
+    "draw",
+    "filter_widths",
+    "replace",
+    "through_filters",
+    "with_spikes",
+    "worn",
+]
