@@ -125,8 +125,12 @@ def residual_torque_nm(
     current = finite_array("current_a", current_a)
     speed = finite_array("motor_speed_radps", motor_speed_radps)
     hinge = finite_array("hinge_moment_nm", hinge_moment_nm)
-    if not current.shape == speed.shape == hinge.shape:
-        raise InputError("signals", f"shapes differ: current {current.shape}, speed {speed.shape}, hinge {hinge.shape}")
+    try:  # one window, a batch, or a batch of one signal against one window of the others
+        np.broadcast_shapes(current.shape, speed.shape, hinge.shape)
+    except ValueError:
+        raise InputError(
+            "signals", f"shapes differ: current {current.shape}, speed {speed.shape}, hinge {hinge.shape}"
+        ) from None
     rate = in_range("sample_rate_hz", sample_rate_hz, 100.0, 1e6, "Hz")
     acceleration = smooth_derivative(speed, rate, derivative_window_s)
     motor = np.clip(

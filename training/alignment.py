@@ -54,9 +54,11 @@ def equation_errors(
     signals: dict[str, np.ndarray], sample_rate_hz: float, lags: np.ndarray, name: str = "current_a"
 ) -> np.ndarray:
     """The physics fit's equation error with signal ``name`` read ``lags`` samples later, one batched fit."""
-    batch = {key: np.broadcast_to(values, (len(lags), len(values))) for key, values in signals.items()}
-    batch[name] = np.stack([advanced(signals[name], lag) for lag in lags])
-    return fit_friction(as_read(batch, sample_rate_hz), sample_rate_hz).residual_rms_nm
+    batch = dict(signals, **{name: np.stack([advanced(signals[name], lag) for lag in lags])})
+    if name == "hinge_moment_nm":  # its reading leans on the deflection, row by row
+        batch["position_deg"] = np.broadcast_to(signals["position_deg"], batch[name].shape)
+    read = dict(as_read(batch, sample_rate_hz), position_deg=signals["position_deg"])
+    return fit_friction(read, sample_rate_hz).residual_rms_nm
 
 
 def current_lag_samples(signals: dict[str, np.ndarray], sample_rate_hz: float) -> float:
@@ -87,7 +89,7 @@ def hinge_lag_samples(signals: dict[str, np.ndarray], sample_rate_hz: float) -> 
     the signal (T − 1) / 2 samples, exactly for a moving average and a first-order lag."""
     hinge = signals["hinge_moment_nm"]
     difference = hinge - denoised_hinge_nm(hinge, signals["position_deg"], sample_rate_hz)
-    _, tau_s = noise_of(difference, sample_rate_hz, MAX_LAG["hinge_moment_nm"])
+    _, tau_s = noise_of(difference, sample_rate_hz, MAX_LAG["hinge_moment_nm"], rising_is_noise=True)
     if tau_s == 0.0:
         return 0.0
     rho = float(np.exp(-1.0 / (tau_s * sample_rate_hz)))

@@ -174,9 +174,13 @@ def fit_friction(
     settings: FitSettings = FitSettings(),
     residual_nm: np.ndarray | None = None,
 ) -> FrictionFit:
-    """Fit every window of a batch (signals (N, n), or (n,) for one); windows with too little
-    sliding motion get NaN (``fit_window`` turns that into an error naming the signals)."""
-    t, a, o, mask = regressors(signals, rate, actuator, settings, residual_nm)
+    """Fit every window of a batch (signals (N, n), or (n,) for one; or one signal (N, n) against the
+    others of one window, each (n,)); windows with too little sliding motion get NaN (``fit_window``
+    turns that into an error naming the signals)."""
+    t, a, o, mask = (
+        np.ascontiguousarray(c)
+        for c in np.broadcast_arrays(*regressors(signals, rate, actuator, settings, residual_nm))
+    )
     blocks = block_statistics(t, a, o, mask, settings.blocks)  # (N, B, 10)
     total = blocks.sum(axis=1)
     fdj, eta_o, sse = solve(total, actuator.gear_ratio)

@@ -88,23 +88,30 @@ def levels_off(structure: np.ndarray) -> bool:
     return dip <= half and slope * (span - half) <= RISE * plateau
 
 
-def noise_structure(values: np.ndarray, max_lag: int) -> np.ndarray:
+def noise_structure(values: np.ndarray, max_lag: int, rising_is_noise: bool) -> np.ndarray:
     """S(L) for L = 1 … the fewest lags (at least ``MIN_SPAN``: the mismatch grows into the longer
     ones) over which it ``levels_off``, computed lag by lag (white noise's settles at 8). When it never
-    does within ``max_lag`` (or the window's half, less 4), all of them: the mismatch can then only widen
-    the noise read, never narrow it (a correlation too long for the window rises through every span;
-    a 1 kHz log's mismatch reaches even the first lags and is read as noise, up to 57x the speed's)."""
+    does within ``max_lag`` (or the window's half, less 4): all of them if ``rising_is_noise`` (a
+    reading against the signal's own smoothing, where the rise is a correlation too long for the
+    window), else the first alone, read as white (against a simulation, the rise is the model's
+    mismatch: a 1 kHz log's reached the speed's first lags and read 57x its noise's density, and a
+    hinge moment 500 N·m off zero made a worn dead band of white speed noise)."""
     available = min(max_lag, (len(values) - 8) // 2)
     structure = [second_difference_variance(values, lag) for lag in range(1, min(MIN_SPAN, available) + 1)]
     while len(structure) < available and not levels_off(np.array(structure)):
         structure.append(second_difference_variance(values, len(structure) + 1))
+    if len(structure) >= MIN_SPAN and not rising_is_noise and not levels_off(np.array(structure)):
+        return np.array(structure[:1])
     return np.array(structure)
 
 
-def noise_of(difference: np.ndarray, sample_rate_hz: float, max_lag: int) -> tuple[float, float]:
+def noise_of(
+    difference: np.ndarray, sample_rate_hz: float, max_lag: int, rising_is_noise: bool = False
+) -> tuple[float, float]:
     """(σ, τ [s]) of the AR(1) noise with the per-sample variance and the low-frequency density of the
-    noise in ``difference`` (measured minus a clean reference of the same window)."""
-    structure = noise_structure(difference, max_lag)
+    noise in ``difference`` (measured minus a clean reference of the same window; ``noise_structure``
+    says what a difference that never levels off is read as)."""
+    structure = noise_structure(difference, max_lag, rising_is_noise)
     if len(structure) == 0:
         return 0.0, 0.0
     plateau, correlated = plateau_and_dip(structure)  # the lags 1 … correlated dip
@@ -132,5 +139,7 @@ def excess_noise(
     levels = {}
     for name in NOISY_SIGNALS:
         difference = np.asarray(measured[name]) - np.asarray(reference[name])
-        levels[name], levels[f"{name}_corr_s"] = noise_of(difference, sample_rate_hz, MAX_LAG[name])
+        levels[name], levels[f"{name}_corr_s"] = noise_of(
+            difference, sample_rate_hz, MAX_LAG[name], rising_is_noise=name == "hinge_moment_nm"
+        )
     return SensorNoise(**levels)
