@@ -70,3 +70,16 @@ def test_a_short_windows_mismatch_at_its_sharp_motions_is_not_read_as_correlatio
         rho = np.exp(-1 / (tau_s * RATE)) if tau_s > 0 else 0.0
         over += (1 + rho) / (1 - rho) > 1.5
     assert over <= 2
+
+
+def test_a_difference_from_a_simulation_that_never_levels_off_is_read_white():
+    """A smooth mismatch large enough to grow through all 16 lags (S rising as L⁴): against a
+    simulation it is the model's, and the noise is read from the first lag; against the signal's own
+    smoothing (the hinge moment), a rise through every lag is a long correlation and is kept."""
+    t = np.arange(5000)
+    for amplitude, period in ((300, 300), (1000, 500)):
+        rng = np.random.default_rng(amplitude)
+        difference = rng.standard_normal(5000) + amplitude * np.sin(2 * np.pi * t / period)
+        assert noise_of(difference, RATE, 16) == (pytest.approx(1.0, rel=0.1), 0.0)
+        sigma, tau_s = noise_of(difference, RATE, 16, rising_is_noise=True)
+        assert sigma > 3.0 and tau_s > 0.0
