@@ -34,7 +34,6 @@ from sim.checks import InputError
 from sim.noise import SensorNoise
 from sim.params import ActuatorParams
 from sim.window import Window
-from training.alignment import aligned
 from training.conditioning import prepare
 from training.config import PipelineConfig
 from training.documents import TARGETS, Estimate
@@ -73,7 +72,7 @@ class Calibrator:
             raise InputError("copies", f"must be in [8, 500], got {self.copies}")
         if not windows:
             raise InputError("windows", "at least one window is needed")
-        prepared = [aligned(prepare(w).window)[0] for w in windows]
+        prepared = [prepare(w).window for w in windows]
         if len({w.sample_rate_hz for w in prepared}) > 1:
             raise InputError("windows", "must share one sample rate (after averaging to at most 10 kHz)")
         return prepared

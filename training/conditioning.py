@@ -1,5 +1,5 @@
 """A logged window made ready for the pipeline: isolated glitches repaired, a bounded number of
-samples, and what was done to it.
+samples, its sensors on one clock (``training.alignment``), and what was done to it.
 
 A sensor's sample that jumps away from both neighbours and straight back (an EMI spike, a bit
 error) is no measurement, nor is a burst of a few of them (``MAX_GLITCH_RUN``, ``MAX_GLITCH_S``:
@@ -35,6 +35,7 @@ from sim.batch import COMMAND_MARGIN_DEG
 from sim.noise import NOISY_SIGNALS
 from sim.params import ActuatorParams
 from sim.window import Window
+from training.alignment import Lags, aligned
 from training.noise_level import white_noise_std
 
 MAX_RATE_HZ = 10_000.0
@@ -54,8 +55,7 @@ class Prepared:
     original_rate_hz: float
     command_clipped_fraction: float  # share of command samples past the end stops (the actuator saturates)
     glitches: dict[str, int]  # per sensor, samples of glitches replaced by the line between their flanks
-    current_lag_s: float = 0.0  # how late the current is logged behind the speed (training.alignment)
-    hinge_lag_s: float = 0.0  # how late the hinge moment is logged (training.alignment)
+    lags: Lags  # how late the current (behind the speed) and the hinge moment were logged, undone
 
 
 def averaging_factor(n_samples: int, rate_hz: float) -> int:
@@ -113,8 +113,9 @@ def repaired(window: Window) -> tuple[Window, dict[str, int]]:
 
 
 def prepare(window: Window, actuator: ActuatorParams = ActuatorParams()) -> Prepared:
-    """Repair ``window``'s glitches and average it down to the pipeline's sizes; say how many glitches
-    there were and how far its command reached past the stops."""
+    """Repair ``window``'s glitches, average it down to the pipeline's sizes and put its sensors on one
+    clock (``training.alignment``); say how many glitches there were, how late each sensor was, and
+    how far its command reached past the stops."""
     window, glitches = repaired(window)
     factor = averaging_factor(window.n_samples, window.sample_rate_hz)
     command = window.signals["command_deg"]
@@ -123,4 +124,5 @@ def prepare(window: Window, actuator: ActuatorParams = ActuatorParams()) -> Prep
         n = window.n_samples // factor * factor
         signals = {name: values[:n].reshape(-1, factor).mean(axis=1) for name, values in window.signals.items()}
         window = replace(window, signals=signals, sample_rate_hz=window.sample_rate_hz / factor)
-    return Prepared(window, factor, len(command), window.sample_rate_hz * factor, clipped, glitches)
+    window, lags = aligned(window)
+    return Prepared(window, factor, len(command), window.sample_rate_hz * factor, clipped, glitches, lags)

@@ -27,7 +27,6 @@ from sim.params import DEFAULT_RANGES, ActuatorParams, eta_a_from_eta_o
 from sim.residual import residual_torque_nm
 from sim.window import Window
 from training import design
-from training.alignment import aligned
 from training.assess import Assessed, Candidates, assess, physics_values
 from training.baseline import FIT_ARRAYS, FitSettings, FrictionFit, fit_friction, fit_window, regressors
 from training.conditioning import GLITCH_STDS, Prepared, prepare
@@ -169,7 +168,7 @@ def estimate_window(
     stage = on_stage or (lambda _: None)
     clock = [time.perf_counter()]
     prepared = prepare(window)
-    (w, lags), n = aligned(prepared.window), config.n_simulations
+    w, n = prepared.window, config.n_simulations
     seen = replace(w, signals=as_read(w.signals, w.sample_rate_hz))
     physics = fit_window(seen.signals, w.sample_rate_hz)
     stage(f"simulating {config.total_simulations} windows around the physics estimate")
@@ -188,7 +187,6 @@ def estimate_window(
     check = fit_check(seen, data, answer, equation_ratio, n)
     fsj = read_static_friction(seen.signals, w.sample_rate_hz, answer.values["FDJ"], answer.values["eta_O"], data.noise)
     clock.append(time.perf_counter())
-    prepared = replace(prepared, window=w, current_lag_s=lags.current_s, hinge_lag_s=lags.hinge_s)
     return _document(prepared, physics, data, network, answer, check, fsj, config, clock)
 
 
@@ -218,17 +216,16 @@ def _notes(prepared: Prepared, physics: FrictionFit, estimates: Estimates, check
             f"{100 * prepared.command_clipped_fraction:.1f} % of the command lies past the end stops: "
             "the actuator saturates there, and so do its simulations"
         )
-    if prepared.current_lag_s:
-        late, by = (
-            ("current", prepared.current_lag_s) if prepared.current_lag_s > 0 else ("speed", -prepared.current_lag_s)
-        )
+    lags = prepared.lags
+    if lags.current_s:
+        late, by = ("current", lags.current_s) if lags.current_s > 0 else ("speed", -lags.current_s)
         notes.append(
             f"the {late} is logged {1e6 * by:.0f} µs late (a sensor filter): advanced onto the other before Eq. 5.1, "
             "which it otherwise breaks at every acceleration"
         )
-    if prepared.hinge_lag_s:
+    if lags.hinge_s:
         notes.append(
-            f"the hinge moment is logged {1e6 * prepared.hinge_lag_s:.0f} µs late (its filter, read from the "
+            f"the hinge moment is logged {1e6 * lags.hinge_s:.0f} µs late (its filter, read from the "
             "correlation of its noise): advanced before Eq. 5.1"
         )
     if prepared.glitches:
@@ -309,8 +306,8 @@ def _document(
             processed_rate_hz=w.sample_rate_hz,
             command_clipped_fraction=prepared.command_clipped_fraction,
             glitches_repaired=prepared.glitches,
-            current_lag_s=prepared.current_lag_s,
-            hinge_lag_s=prepared.hinge_lag_s,
+            current_lag_s=prepared.lags.current_s,
+            hinge_lag_s=prepared.lags.hinge_s,
             sliding_fraction=float(np.mean(data.sliding)),
             recorded_at=w.recorded_at,
             flight_hours=w.flight_hours,
