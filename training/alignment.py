@@ -9,9 +9,9 @@ FDJ and η_O were 7–19 % of the range off on average (up to 59 %), every answe
 
 The lag is read as the shift of the current, to half a sample within ``MAX_LAG_S``, that minimizes
 the equation error of the physics fit: batched fits of the window with the current shifted each way
-(the sliding samples, set by the speed, stay the same). It is
-sharp: on those windows the minimum fell exactly on the filter's delay, the equation error 32–88 %
-below the unshifted one, and on windows without filters exactly on zero. A lag is applied only
+(the sliding samples, set by the speed, stay the same). It is sharp: on those windows the minimum
+fell exactly on the filter's delay, the equation error 32–88 % below the unshifted one, and on
+windows without filters exactly on zero. A lag is applied only
 where it lowers the equation error by ``MIN_GAIN``; then the later of the two signals is advanced
 (a filter only delays), by linear interpolation, the end held.
 
