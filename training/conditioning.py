@@ -126,3 +126,31 @@ def prepare(window: Window, actuator: ActuatorParams = ActuatorParams()) -> Prep
         window = replace(window, signals=signals, sample_rate_hz=window.sample_rate_hz / factor)
     window, lags = aligned(window)
     return Prepared(window, factor, len(command), window.sample_rate_hz * factor, clipped, glitches, lags)
+
+
+def conditioning_notes(prepared: Prepared) -> list[str]:
+    """What conditioning did to the window, in words for the result's notes."""
+    notes, lags = [], prepared.lags
+    if prepared.command_clipped_fraction > 0:
+        notes.append(
+            f"{100 * prepared.command_clipped_fraction:.1f} % of the command lies past the end stops: "
+            "the actuator saturates there, and so do its simulations"
+        )
+    if lags.current_s:
+        late, by = ("current", lags.current_s) if lags.current_s > 0 else ("speed", -lags.current_s)
+        notes.append(
+            f"the {late} is logged {1e6 * by:.0f} µs late (a sensor filter): advanced onto the other before Eq. 5.1, "
+            "which it otherwise breaks at every acceleration"
+        )
+    if lags.hinge_s:
+        notes.append(
+            f"the hinge moment is logged {1e6 * lags.hinge_s:.0f} µs late (its filter, read from the "
+            "correlation of its noise): advanced before Eq. 5.1"
+        )
+    if prepared.glitches:
+        counts = ", ".join(f"{count} of {name}" for name, count in prepared.glitches.items())
+        notes.append(
+            f"glitches replaced by the line between their flanking samples ({counts}): a sample, or a few, "
+            f"that left both flanks by over {GLITCH_STDS:g} noise stds and came straight back (EMI, bit errors)"
+        )
+    return notes

@@ -29,7 +29,7 @@ from sim.window import Window
 from training import design
 from training.assess import Assessed, Candidates, assess, physics_values
 from training.baseline import FIT_ARRAYS, FitSettings, FrictionFit, fit_friction, fit_window, regressors
-from training.conditioning import GLITCH_STDS, Prepared, prepare
+from training.conditioning import Prepared, conditioning_notes, prepare
 from training.config import PipelineConfig
 from training.dataset import Scenario, Simulated, scenario_from_window, simulate_noisy
 from training.documents import (
@@ -210,30 +210,7 @@ def _estimates(answer: Assessed, fsj: StaticFriction) -> Estimates:
 
 
 def _notes(prepared: Prepared, physics: FrictionFit, estimates: Estimates, check: FitCheck) -> list[str]:
-    notes = list(check.notes)
-    if prepared.command_clipped_fraction > 0:
-        notes.append(
-            f"{100 * prepared.command_clipped_fraction:.1f} % of the command lies past the end stops: "
-            "the actuator saturates there, and so do its simulations"
-        )
-    lags = prepared.lags
-    if lags.current_s:
-        late, by = ("current", lags.current_s) if lags.current_s > 0 else ("speed", -lags.current_s)
-        notes.append(
-            f"the {late} is logged {1e6 * by:.0f} µs late (a sensor filter): advanced onto the other before Eq. 5.1, "
-            "which it otherwise breaks at every acceleration"
-        )
-    if lags.hinge_s:
-        notes.append(
-            f"the hinge moment is logged {1e6 * lags.hinge_s:.0f} µs late (its filter, read from the "
-            "correlation of its noise): advanced before Eq. 5.1"
-        )
-    if prepared.glitches:
-        counts = ", ".join(f"{count} of {name}" for name, count in prepared.glitches.items())
-        notes.append(
-            f"glitches replaced by the line between their flanking samples ({counts}): a sample, or a few, "
-            f"that left both flanks by over {GLITCH_STDS:g} noise stds and came straight back (EMI, bit errors)"
-        )
+    notes = [*check.notes, *conditioning_notes(prepared)]
     for name in TARGETS:
         entry = getattr(estimates, name)
         if entry.weakly_determined:
@@ -251,6 +228,24 @@ def _notes(prepared: Prepared, physics: FrictionFit, estimates: Estimates, check
     if estimates.eta_A.value < 0:
         notes.append("η_A < 0: the transmission is irreversible (the load cannot back-drive it; thesis Case 1C)")
     return notes
+
+
+def _window_info(prepared: Prepared, data: Data) -> WindowInfo:
+    """The window as logged, and what conditioning did to it."""
+    w = prepared.window
+    return WindowInfo(
+        n_samples=prepared.original_samples,
+        duration_s=prepared.original_samples / prepared.original_rate_hz,
+        sample_rate_hz=prepared.original_rate_hz,
+        processed_rate_hz=w.sample_rate_hz,
+        command_clipped_fraction=prepared.command_clipped_fraction,
+        glitches_repaired=prepared.glitches,
+        current_lag_s=prepared.lags.current_s,
+        hinge_lag_s=prepared.lags.hinge_s,
+        sliding_fraction=float(np.mean(data.sliding)),
+        recorded_at=w.recorded_at,
+        flight_hours=w.flight_hours,
+    )
 
 
 def _document(
@@ -299,18 +294,6 @@ def _document(
         ),
         methods=answer.methods,
         fit_check=check,
-        window=WindowInfo(
-            n_samples=prepared.original_samples,
-            duration_s=prepared.original_samples / prepared.original_rate_hz,
-            sample_rate_hz=prepared.original_rate_hz,
-            processed_rate_hz=w.sample_rate_hz,
-            command_clipped_fraction=prepared.command_clipped_fraction,
-            glitches_repaired=prepared.glitches,
-            current_lag_s=prepared.lags.current_s,
-            hinge_lag_s=prepared.lags.hinge_s,
-            sliding_fraction=float(np.mean(data.sliding)),
-            recorded_at=w.recorded_at,
-            flight_hours=w.flight_hours,
-        ),
+        window=_window_info(prepared, data),
         config=config,
     )
