@@ -7,7 +7,7 @@ from sim.checks import InputError
 from sim.params import HealthParams
 from sim.synthetic import synthetic_window
 from sim.window import window_from_dict
-from tests.foreign.windows import NOISE, Effects, draw, filter_widths, noisy, worn
+from tests.foreign.windows import NOISE, Effects, draw, filter_widths, noisy, through_filters, worn
 from training.config import PipelineConfig
 from training.documents import Estimate
 from training.pipeline import estimate_window, share_of_range
@@ -163,6 +163,18 @@ def test_a_current_logged_behind_a_filter_is_aligned_and_read_within_its_std(see
     assert any("current is logged 2" in note and "µs late" in note for note in result.notes)
     for name, (of_range, z) in _errors(result, drawn.truth).items():
         assert of_range < 5.0 and z < 3.5, name
+
+
+@pytest.mark.parametrize(("seed", "family", "width"), [(31, "gust", 30), (33, "steps", 36)])
+def test_a_hinge_moment_logged_behind_its_filter_is_advanced_and_fdj_read_within_its_std(seed, family, width):
+    """A strain-gauge filter of 3–3.6 ms (signal and noise): unaligned, FDJ was 3.6 and 6.0 % of range
+    off at 3.7 and 4.0 std; its delay is read from the noise's correlation."""
+    drawn = through_filters(draw(seed, family), {"hinge_moment_nm": width})
+    result = _estimate(drawn)
+    assert result.window.hinge_lag_s * 10_000.0 == pytest.approx((width - 1) / 2, rel=0.2)
+    assert any("hinge moment is logged" in note for note in result.notes)
+    for name, (of_range, z) in _errors(result, drawn.truth).items():
+        assert of_range < 3.0 and z < 2.0, name
 
 
 def test_a_network_that_disagrees_with_the_window_is_set_aside(monkeypatch):
