@@ -37,7 +37,9 @@ GRID_POINTS = 41
 REFINEMENTS = 3  # coarse-to-fine passes: η_O to ~1e-5 (the SSE is smooth and unimodal in η_O)
 JACKKNIFE_BLOCKS = 10
 MIN_SLIDING_KERNELS = 10  # fewer sliding samples than 10 kernel widths: too little motion to fit
-T, A, OPP, TT, AA, OO, TA, TO, AO, M = range(10)  # the sufficient statistics, in this order
+# The sufficient statistics, in this order; S… are the direction's (s = sgn ω, s² = 1), for the offset.
+T, A, OPP, TT, AA, OO, TA, TO, AO, M, S, ST, SA, SO = range(14)
+N_STATS = 14
 
 
 @dataclass(frozen=True)
@@ -45,6 +47,7 @@ class FitSettings:
     min_speed_radps: float = 30.0  # sliding: |ω| above this over a whole kernel, one sign throughout
     derivative_window_s: float = DEFAULT_DERIVATIVE_WINDOW_S
     blocks: int = JACKKNIFE_BLOCKS
+    offset: bool = False  # also fit a constant torque at the shaft (a current or hinge sensor off zero)
 
     def __post_init__(self) -> None:
         if self.min_speed_radps <= 0:
@@ -53,7 +56,10 @@ class FitSettings:
             raise InputError("blocks", f"must be in [2, 100], got {self.blocks}")
 
 
-FIT_ARRAYS = ("fdj_nm", "eta_o", "fdj_std_nm", "eta_o_std", "residual_rms_nm", "n_sliding", "at_search_edge")
+FIT_ARRAYS = (
+    "fdj_nm", "eta_o", "fdj_std_nm", "eta_o_std", "offset_nm", "offset_std_nm", "residual_rms_nm", "n_sliding",
+    "at_search_edge",
+)  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -64,6 +70,8 @@ class FrictionFit:
     eta_o: np.ndarray
     fdj_std_nm: np.ndarray
     eta_o_std: np.ndarray
+    offset_nm: np.ndarray  # the constant torque at the shaft T_R holds beyond friction (0 unless fitted)
+    offset_std_nm: np.ndarray
     residual_rms_nm: np.ndarray  # RMS equation error over the sliding samples
     n_sliding: np.ndarray  # samples used
     at_search_edge: np.ndarray  # η_O at an end of ETA_O_SEARCH: a bound, not an estimate
@@ -102,22 +110,24 @@ def regressors(
     return target, aid, opp, sliding
 
 
-def block_statistics(t: np.ndarray, a: np.ndarray, o: np.ndarray, mask: np.ndarray, blocks: int) -> np.ndarray:
-    """(N, blocks, 10) sums over the masked samples of each of ``blocks`` contiguous time blocks."""
+def block_statistics(
+    t: np.ndarray, a: np.ndarray, o: np.ndarray, s: np.ndarray, mask: np.ndarray, blocks: int
+) -> np.ndarray:
+    """(N, blocks, N_STATS) sums over the masked samples of each of ``blocks`` contiguous time blocks."""
     edges = np.linspace(0, t.shape[-1], blocks + 1).astype(np.int64)
-    out = np.zeros((t.shape[0], blocks, 10))
-    _block_sums(t, a, o, mask, edges, out)
+    out = np.zeros((t.shape[0], blocks, N_STATS))
+    _block_sums(t, a, o, s, mask, edges, out)
     return out
 
 
 @njit(cache=True, nogil=True)
-def _block_sums(t, a, o, mask, edges, out):
-    """out[r, b] = Σ over masked samples of block b of (t, a, o, t², a², o², ta, to, ao, 1)."""
+def _block_sums(t, a, o, s, mask, edges, out):
+    """out[r, b] = Σ over masked samples of block b of (t, a, o, t², a², o², ta, to, ao, 1, s, st, sa, so)."""
     for r in range(t.shape[0]):
         for b in range(edges.shape[0] - 1):
             for i in range(edges[b], edges[b + 1]):
                 if mask[r, i]:
-                    x, y, z = t[r, i], a[r, i], o[r, i]
+                    x, y, z, d = t[r, i], a[r, i], o[r, i], s[r, i]
                     out[r, b, T] += x
                     out[r, b, A] += y
                     out[r, b, OPP] += z
@@ -128,37 +138,52 @@ def _block_sums(t, a, o, mask, edges, out):
                     out[r, b, TO] += x * z
                     out[r, b, AO] += y * z
                     out[r, b, M] += 1.0
+                    out[r, b, S] += d
+                    out[r, b, ST] += d * x
+                    out[r, b, SA] += d * y
+                    out[r, b, SO] += d * z
 
 
-def _profile(stats: np.ndarray, eta_o: np.ndarray, gear: float) -> tuple[np.ndarray, np.ndarray]:
-    """For stats (R, 10) and a grid per row (R, G): FDJ (R, G) in closed form and the SSE (R, G)."""
+# An offset needs motion both ways: with fewer than this share of the samples in the rarer direction,
+# it cannot be told from FDJ and is not fitted.
+MIN_OFFSET_BALANCE = 0.05
+
+
+def _profile(stats: np.ndarray, eta_o: np.ndarray, gear: float, offset: bool) -> tuple[np.ndarray, ...]:
+    """For stats (R, N_STATS) and a grid per row (R, G): FDJ and the offset (R, G) in closed form, and the
+    SSE (R, G). With u = t − k_aid·a − k_opp·o, FDJ + c·s is u's least-squares line in s (c = 0 unless
+    ``offset``, or the motion is too one-sided to tell c from FDJ)."""
     k_opp = 1.0 / eta_o - 1.0
     k_aid = 1.0 - eta_a_from_eta_o(eta_o, gear)
-    s = stats[:, :, None]
-    m = np.maximum(s[:, M], 1.0)
-    fdj = (s[:, T] - k_aid * s[:, A] - k_opp * s[:, OPP]) / m
-    sse = (
-        s[:, TT] + k_aid**2 * s[:, AA] + k_opp**2 * s[:, OO]
-        - 2 * k_aid * s[:, TA] - 2 * k_opp * s[:, TO] + 2 * k_aid * k_opp * s[:, AO]
-        - m * fdj**2
+    st = stats[:, :, None]
+    m = np.maximum(st[:, M], 1.0)
+    u = st[:, T] - k_aid * st[:, A] - k_opp * st[:, OPP]
+    su = st[:, ST] - k_aid * st[:, SA] - k_opp * st[:, SO]
+    uu = (
+        st[:, TT] + k_aid**2 * st[:, AA] + k_opp**2 * st[:, OO]
+        - 2 * k_aid * st[:, TA] - 2 * k_opp * st[:, TO] + 2 * k_aid * k_opp * st[:, AO]
     )  # fmt: skip
-    return fdj, sse
+    balanced = offset & (m - np.abs(st[:, S]) >= 2 * MIN_OFFSET_BALANCE * m)  # 2 × the rarer direction's count
+    det = np.where(balanced, m**2 - st[:, S] ** 2, 1.0)
+    c = np.where(balanced, (m * su - st[:, S] * u) / det, 0.0)
+    fdj = (u - c * st[:, S]) / m
+    return fdj, c, uu - fdj * u - c * su
 
 
-def solve(stats: np.ndarray, gear: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(FDJ, η_O, SSE) per row of ``stats`` (R, 10): a coarse-to-fine grid over η_O, vectorized."""
+def solve(stats: np.ndarray, gear: float, offset: bool = False) -> tuple[np.ndarray, ...]:
+    """(FDJ, η_O, offset, SSE) per row of ``stats`` (R, N_STATS): a coarse-to-fine grid over η_O, vectorized."""
     rows = np.arange(len(stats))
     low = np.full(len(stats), ETA_O_SEARCH[0])
     high = np.full(len(stats), ETA_O_SEARCH[1])
     for _ in range(REFINEMENTS):
         grid = low[:, None] + (high - low)[:, None] * np.linspace(0.0, 1.0, GRID_POINTS)
-        fdj, sse = _profile(stats, grid, gear)
+        fdj, c, sse = _profile(stats, grid, gear, offset)
         best = np.argmin(sse, axis=1)
         step = grid[:, 1] - grid[:, 0]
         centre = grid[rows, best]
         low = np.maximum(centre - step, ETA_O_SEARCH[0])
         high = np.minimum(centre + step, ETA_O_SEARCH[1])
-    return fdj[rows, best], centre, sse[rows, best]
+    return fdj[rows, best], centre, c[rows, best], sse[rows, best]
 
 
 def _jackknife_std(estimates: np.ndarray) -> np.ndarray:
@@ -177,16 +202,15 @@ def fit_friction(
     """Fit every window of a batch (signals (N, n), or (n,) for one; or one signal (N, n) against the
     others of one window, each (n,)); windows with too little sliding motion get NaN (``fit_window``
     turns that into an error naming the signals)."""
-    t, a, o, mask = (
-        np.ascontiguousarray(c)
-        for c in np.broadcast_arrays(*regressors(signals, rate, actuator, settings, residual_nm))
-    )
-    blocks = block_statistics(t, a, o, mask, settings.blocks)  # (N, B, 10)
+    t, a, o, mask = regressors(signals, rate, actuator, settings, residual_nm)
+    s = np.sign(np.atleast_2d(signals["motor_speed_radps"]))
+    t, a, o, s, mask = (np.ascontiguousarray(c) for c in np.broadcast_arrays(t, a, o, s, mask))
+    blocks = block_statistics(t, a, o, s, mask, settings.blocks)  # (N, B, N_STATS)
     total = blocks.sum(axis=1)
-    fdj, eta_o, sse = solve(total, actuator.gear_ratio)
-    left_out = (total[:, None, :] - blocks).reshape(-1, 10)
-    fdj_b, eta_b, _ = solve(left_out, actuator.gear_ratio)
+    fdj, eta_o, offset, sse = solve(total, actuator.gear_ratio, settings.offset)
+    left_out = (total[:, None, :] - blocks).reshape(-1, N_STATS)
     n_rows = len(total)
+    fdj_b, eta_b, offset_b = (x.reshape(n_rows, -1) for x in solve(left_out, actuator.gear_ratio, settings.offset)[:3])
     width = kernel_samples(rate, settings.derivative_window_s)
     enough = total[:, M] >= MIN_SLIDING_KERNELS * width
     nan = np.where(enough, 1.0, np.nan)
@@ -194,8 +218,10 @@ def fit_friction(
     return FrictionFit(
         fdj_nm=fdj * nan,
         eta_o=eta_o * nan,
-        fdj_std_nm=_jackknife_std(fdj_b.reshape(n_rows, -1)) * nan,
-        eta_o_std=_jackknife_std(eta_b.reshape(n_rows, -1)) * nan,
+        fdj_std_nm=_jackknife_std(fdj_b) * nan,
+        eta_o_std=_jackknife_std(eta_b) * nan,
+        offset_nm=offset * nan,
+        offset_std_nm=_jackknife_std(offset_b) * nan,
         residual_rms_nm=np.sqrt(np.maximum(sse, 0.0) / np.maximum(total[:, M], 1.0)) * nan,
         n_sliding=total[:, M].astype(np.int64),
         at_search_edge=edge & enough,
