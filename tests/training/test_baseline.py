@@ -58,3 +58,24 @@ def test_too_little_motion_is_refused_naming_the_signals():
 def test_settings_are_checked():
     with pytest.raises(InputError, match="min_speed_radps"):
         FitSettings(min_speed_radps=-1)
+
+
+def test_a_constant_torque_is_fitted_beside_friction_and_moves_nothing_else():
+    """A current i₀ off zero adds exactly k_T·i₀ to T_R: the offset fit reads it and FDJ, η_O stay put."""
+    window = synthetic_window(HealthParams.single(0.1, 0.052, 0.8), seed=5, noise=SensorNoise())
+    settings = FitSettings(offset=True)
+    plain = fit_friction(window.signals, 10_000.0, settings=settings)
+    shifted = dict(window.signals, current_a=window.signals["current_a"] + 0.1)
+    off = fit_friction(shifted, 10_000.0, settings=settings)
+    # exactly, but for the few samples where k_T·I is clipped at the motor's peak torque
+    assert off.offset_nm[0] - plain.offset_nm[0] == pytest.approx(0.1 * 0.0752, rel=5e-3)
+    assert off.fdj_nm[0] == pytest.approx(plain.fdj_nm[0], rel=1e-3)
+    assert off.eta_o[0] == pytest.approx(plain.eta_o[0], rel=1e-3)
+    assert abs(plain.offset_nm[0]) < 3 * plain.offset_std_nm[0]  # none there: zero within its std
+    assert fit_friction(shifted, 10_000.0).offset_nm[0] == 0.0  # not asked: not fitted
+
+
+def test_an_offset_is_not_fitted_where_the_motion_goes_one_way():
+    window = synthetic_window(HealthParams.single(0.1, 0.052, 0.8), seed=5)
+    one_way = dict(window.signals, motor_speed_radps=np.abs(window.signals["motor_speed_radps"]))
+    assert fit_friction(one_way, 10_000.0, settings=FitSettings(offset=True)).offset_nm[0] == 0.0
