@@ -30,9 +30,9 @@ GEAR = 500.0
 
 # Indices of the parameter vector the loop reads.
 (P_GP, P_GAP, P_R, P_L, P_KT, P_KE, P_TMAX, P_VMAX, P_IMAX, P_J, P_C, P_BLK, P_STOP,
- P_FSJ, P_FDJ, P_KAID, P_KOPP, P_ISENSE, P_HBIAS,
+ P_FSJ, P_FDJ, P_KAID, P_KOPP, P_ISENSE, P_IBIAS, P_HBIAS,
  P_BUMP_A, P_BUMP_C, P_BUMP_W, P_STRIB_A, P_STRIB_W, P_DRIFT, P_COG_A, P_COG_P, P_COG_PHI,
- P_QSC, P_CHA, P_CHD, P_DWN, P_LT, P_V, P_ALPHA_TRIM, P_DELTA_TRIM, P_ALPHA_LIM, P_VBUS, N_P) = range(39)  # fmt: skip
+ P_QSC, P_CHA, P_CHD, P_DWN, P_LT, P_V, P_ALPHA_TRIM, P_DELTA_TRIM, P_ALPHA_LIM, P_VBUS, N_P) = range(40)  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -54,6 +54,7 @@ class Effects:
     viscous_factor: float = 1.0  # total C = factor · C_M
     torque_constant_gain: float = 1.0  # true k_T = k_e over nominal
     current_sensor_gain: float = 1.0  # logged (and fed back) current over true current
+    current_bias_a: float = 0.0  # logged (and fed back) current minus current_sensor_gain × true
     hinge_bias_nm: float = 0.0  # logged hinge moment minus true
     bump_nm: float = 0.0  # Gaussian friction bump (spall): height [N·m] on FDJ and FSJ
     bump_centre_deg: float = 0.0
@@ -129,7 +130,7 @@ def parameters(setup: Setup) -> np.ndarray:
     p[P_C], p[P_BLK], p[P_STOP] = 5.172e-5 * e.viscous_factor, 5e-3 * e.backlash_factor, np.radians(30.0)
     p[P_FSJ], p[P_FDJ] = h.fsj_nm, h.fdj_nm
     p[P_KAID], p[P_KOPP] = 1.0 - h.eta_a, 1.0 / h.eta_o - 1.0
-    p[P_ISENSE], p[P_HBIAS] = e.current_sensor_gain, e.hinge_bias_nm
+    p[P_ISENSE], p[P_IBIAS], p[P_HBIAS] = e.current_sensor_gain, e.current_bias_a, e.hinge_bias_nm
     p[P_BUMP_A], p[P_BUMP_C], p[P_BUMP_W] = e.bump_nm, np.radians(e.bump_centre_deg), np.radians(e.bump_width_deg)
     p[P_STRIB_A], p[P_STRIB_W], p[P_DRIFT] = e.stribeck_nm, e.stribeck_speed_radps, e.drift_per_s
     p[P_COG_A], p[P_COG_P], p[P_COG_PHI] = e.cogging_nm, e.cogging_periods, e.cogging_phase_rad
@@ -157,7 +158,7 @@ def _hinge(p, x, theta_u):
 @njit(cache=True)
 def _current(p, command, theta_u, speed, current, decay):
     """The current after one step: the speed and current loops bang the supply on the *measured* current."""
-    measured_current = p[P_ISENSE] * current
+    measured_current = p[P_ISENSE] * current + p[P_IBIAS]
     speed_ref = max(-p[P_VMAX] / 0.0752, min(p[P_VMAX] / 0.0752, p[P_GP] * (command - theta_u)))
     current_ref = max(-p[P_IMAX], min(p[P_IMAX], p[P_GAP] * (speed_ref - speed) / 0.0752))
     voltage = 0.0
@@ -240,7 +241,7 @@ def _run(p, a, b, command_rad, logged_rad, loop_noise_radps, first_step, n_steps
         if i >= 0:
             sums[0] += theta_u
             sums[1] += speed
-            sums[2] += p[P_ISENSE] * current
+            sums[2] += p[P_ISENSE] * current + p[P_IBIAS]
             sums[3] += _hinge(p, x, theta_u) + p[P_HBIAS]
             sums[4] += logged
             count += 1
