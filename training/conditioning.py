@@ -1,5 +1,6 @@
 """A logged window made ready for the pipeline: isolated glitches repaired, a bounded number of
-samples, its sensors on one clock (``training.alignment``), and what was done to it.
+samples, its sensors on one clock (``training.alignment``) and on zero (``training.zero_offset``),
+and what was done to it.
 
 A sensor's sample that jumps away from both neighbours and straight back (an EMI spike, a bit
 error) is no measurement, nor is a burst of a few of them (``MAX_GLITCH_RUN``, ``MAX_GLITCH_S``:
@@ -28,6 +29,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
+from typing import Any
 
 import numpy as np
 
@@ -37,6 +39,7 @@ from sim.params import ActuatorParams
 from sim.window import Window
 from training.alignment import Lags, aligned
 from training.noise_level import white_noise_std
+from training.zero_offset import ZeroOffset, offset_note, read_zero_offset, zeroed
 
 MAX_RATE_HZ = 10_000.0
 MAX_SAMPLES = 10_000
@@ -56,6 +59,7 @@ class Prepared:
     command_clipped_fraction: float  # share of command samples past the end stops (the actuator saturates)
     glitches: dict[str, int]  # per sensor, samples of glitches replaced by the line between their flanks
     lags: Lags  # how late the current (behind the speed) and the hinge moment were logged, undone
+    offset: ZeroOffset  # a sensor off zero, taken off
 
 
 def averaging_factor(n_samples: int, rate_hz: float) -> int:
@@ -112,10 +116,11 @@ def repaired(window: Window) -> tuple[Window, dict[str, int]]:
     return (replace(window, signals=signals) if counts else window), counts
 
 
-def prepare(window: Window, actuator: ActuatorParams = ActuatorParams()) -> Prepared:
-    """Repair ``window``'s glitches, average it down to the pipeline's sizes and put its sensors on one
-    clock (``training.alignment``); say how many glitches there were, how late each sensor was, and
-    how far its command reached past the stops."""
+def prepare(window: Window, actuator: ActuatorParams = ActuatorParams(), take_off_offset: bool = True) -> Prepared:
+    """Repair ``window``'s glitches, average it down to the pipeline's sizes, put its sensors on one
+    clock (``training.alignment``) and take a sensor's offset off (``training.zero_offset``; not for
+    ``calibration``, which names it across windows); say how many glitches there were, how late each
+    sensor was, how far off zero, and how far its command reached past the stops."""
     window, glitches = repaired(window)
     factor = averaging_factor(window.n_samples, window.sample_rate_hz)
     command = window.signals["command_deg"]
@@ -125,7 +130,21 @@ def prepare(window: Window, actuator: ActuatorParams = ActuatorParams()) -> Prep
         signals = {name: values[:n].reshape(-1, factor).mean(axis=1) for name, values in window.signals.items()}
         window = replace(window, signals=signals, sample_rate_hz=window.sample_rate_hz / factor)
     window, lags = aligned(window)
-    return Prepared(window, factor, len(command), window.sample_rate_hz * factor, clipped, glitches, lags)
+    offset = read_zero_offset(window, actuator) if take_off_offset else ZeroOffset()
+    window = zeroed(window, offset)
+    return Prepared(window, factor, len(command), window.sample_rate_hz * factor, clipped, glitches, lags, offset)
+
+
+def conditioning_done(prepared: Prepared) -> dict[str, Any]:
+    """What conditioning did to the window, as the result's ``WindowInfo`` fields."""
+    return {
+        "command_clipped_fraction": prepared.command_clipped_fraction,
+        "glitches_repaired": prepared.glitches,
+        "current_lag_s": prepared.lags.current_s,
+        "hinge_lag_s": prepared.lags.hinge_s,
+        "hinge_offset_nm": prepared.offset.hinge_nm,
+        "current_offset_a": prepared.offset.current_a,
+    }
 
 
 def conditioning_notes(prepared: Prepared) -> list[str]:
@@ -147,6 +166,8 @@ def conditioning_notes(prepared: Prepared) -> list[str]:
             f"the hinge moment is logged {1e6 * lags.hinge_s:.0f} µs late (its filter, read from the "
             "correlation of its noise): advanced before Eq. 5.1"
         )
+    if (offset := offset_note(prepared.offset)) is not None:
+        notes.append(offset)
     if prepared.glitches:
         counts = ", ".join(f"{count} of {name}" for name, count in prepared.glitches.items())
         notes.append(

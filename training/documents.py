@@ -102,6 +102,8 @@ class WindowInfo(Document):
         default=0.0, description="how late the current is logged behind the speed (negative: the speed), undone"
     )
     hinge_lag_s: float = Field(default=0.0, description="how late the hinge moment is logged (its filter), undone")
+    hinge_offset_nm: float = Field(default=0.0, description="taken off the logged hinge moment (a sensor off zero)")
+    current_offset_a: float = Field(default=0.0, description="taken off the logged current (a sensor off zero)")
     sliding_fraction: float = Field(description="share of samples the friction fit could use")
     recorded_at: str | None = None
     flight_hours: float | None = None

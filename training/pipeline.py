@@ -2,7 +2,7 @@
 
 The thesis's §6.3 proposal, made to hold on data our simulator did not draw:
 
-1. **prepare**: average the window to a bounded number of samples (``training.conditioning``);
+1. **prepare**: repair, average, align and zero the window's sensors (``training.conditioning``);
 2. **physics**: fit Eq. 5.1 by least squares (``training.baseline``), a block-jackknife std beside;
 3. **simulate**: a Case-1B dataset of the window's own command, logged load and first state, its
    health drawn in a box around the physics estimate (``training.design``: no fixed range, so no
@@ -29,7 +29,7 @@ from sim.window import Window
 from training import design
 from training.assess import Assessed, Candidates, assess, physics_values
 from training.baseline import FIT_ARRAYS, FitSettings, FrictionFit, fit_friction, fit_window, regressors
-from training.conditioning import Prepared, conditioning_notes, prepare
+from training.conditioning import Prepared, conditioning_done, conditioning_notes, prepare
 from training.config import PipelineConfig
 from training.dataset import Scenario, Simulated, scenario_from_window, simulate_noisy
 from training.documents import (
@@ -49,6 +49,7 @@ from training.network import TrainConfig
 from training.preprocess import as_read, sliding_features
 from training.reproduction import MAX_RATIO, output_error_ratios
 from training.static_friction import StaticFriction, read_static_friction
+from training.zero_offset import widened
 
 NOMINAL = {"FDJ": DEFAULT_RANGES.nominal_fdj_nm, "eta_O": DEFAULT_RANGES.nominal_eta_o}
 NOMINAL_ETA_A = float(eta_a_from_eta_o(DEFAULT_RANGES.nominal_eta_o))
@@ -98,9 +99,9 @@ def simulate_dataset(window: Window, seen: Window, physics: FrictionFit, config:
     return Data(scenario, box, sims.noise, sims, sliding, inputs, sliding_features(residual, sliding, n_timesteps))
 
 
-# The window's network trains on a few dozen noisy simulations: it stops improving within a few
-# epochs, and the physics fit carries most of the answer (training.assess), so its training is
-# kept short; the thesis's 12 failures and 1000 epochs made its time the pipeline's least predictable.
+# On a few dozen noisy simulations the network stops improving within a few epochs, and the physics fit
+# carries most of the answer (training.assess): the thesis's 12 failures and 1000 epochs made its time
+# the pipeline's least predictable.
 PIPELINE_TRAINING = TrainConfig(max_epochs=60, max_validation_failures=6)
 
 
@@ -120,8 +121,7 @@ def candidates(
     unit = network.predict_unit(np.vstack([data.inputs[n:], data.window_inputs]))
     fdj, eta_o = data.box.denormalize(unit)
     health = data.sims.health
-    # A held-out simulation that never slides long enough (a window whose logged load the model
-    # cannot follow) has no physics answer: it is left out of the scoring, not allowed to poison it.
+    # A held-out simulation that never slides long enough has no physics answer: left out, not poisoning the scores.
     ok = np.isfinite(check_physics.fdj_nm) & np.isfinite(check_physics.eta_o)
     check_physics = replace(check_physics, **{k: getattr(check_physics, k)[ok] for k in FIT_ARRAYS})
     fdj_check, eta_check = fdj[:-1][ok], eta_o[:-1][ok]
@@ -159,15 +159,18 @@ def fit_check(window: Window, data: Data, answer: Assessed, equation_ratio: floa
 
 
 def estimate_window(
-    window: Window, config: PipelineConfig = PipelineConfig(), on_stage: Callable[[str], None] | None = None
+    window: Window,
+    config: PipelineConfig = PipelineConfig(),
+    on_stage: Callable[[str], None] | None = None,
+    take_off_offset: bool = True,
 ) -> Estimate:
     """The ``ema-estimate/1`` result for one window; ``on_stage`` hears each stage as it starts (and may
-    raise to stop the job there). Raises InputError (field ``signals``) for a window with too little
-    sliding motion to read.
+    raise to stop the job there); ``take_off_offset=False`` reads the window with the spec's model alone
+    (``calibration``'s base). Raises InputError (field ``signals``) for a window with too little sliding motion.
     """
     stage = on_stage or (lambda _: None)
     clock = [time.perf_counter()]
-    prepared = prepare(window)
+    prepared = prepare(window, take_off_offset=take_off_offset)
     w, n = prepared.window, config.n_simulations
     seen = replace(w, signals=as_read(w.signals, w.sample_rate_hz))
     physics = fit_window(seen.signals, w.sample_rate_hz)
@@ -182,6 +185,7 @@ def estimate_window(
     floor = np.median(check_physics.residual_rms_nm) if len(check_physics.residual_rms_nm) else np.nan
     equation_ratio = float(physics.residual_rms_nm[0] / floor) if np.isfinite(floor) else 1.0
     answer = assess(found, equation_ratio)
+    answer = replace(answer, stds=widened(answer.stds, prepared.offset))
     clock.append(time.perf_counter())
     stage("checking the answer against the window")
     check = fit_check(seen, data, answer, equation_ratio, n)
@@ -238,10 +242,7 @@ def _window_info(prepared: Prepared, data: Data) -> WindowInfo:
         duration_s=prepared.original_samples / prepared.original_rate_hz,
         sample_rate_hz=prepared.original_rate_hz,
         processed_rate_hz=w.sample_rate_hz,
-        command_clipped_fraction=prepared.command_clipped_fraction,
-        glitches_repaired=prepared.glitches,
-        current_lag_s=prepared.lags.current_s,
-        hinge_lag_s=prepared.lags.hinge_s,
+        **conditioning_done(prepared),
         sliding_fraction=float(np.mean(data.sliding)),
         recorded_at=w.recorded_at,
         flight_hours=w.flight_hours,

@@ -177,6 +177,21 @@ def test_a_hinge_moment_logged_behind_its_filter_is_advanced_and_fdj_read_within
         assert of_range < 3.0 and z < 2.0, name
 
 
+@pytest.mark.parametrize(
+    ("seed", "family", "effects", "field", "bias"),
+    [(41, "doublet", Effects(hinge_bias_nm=-8.0), "hinge_offset_nm", -8.0),
+     (43, "cruise", Effects(current_bias_a=0.2), "current_offset_a", 0.2)],
+)  # fmt: skip
+def test_a_sensor_off_zero_is_taken_off_and_the_answer_read_within_its_std(seed, family, effects, field, bias):
+    """Left in, the offsets put FDJ 6 and 19 % of range off, η_O 12 and 10 % (said weak: stds of 40–200 %)."""
+    drawn = draw(seed, family, effects=effects)
+    result = _estimate(drawn)
+    assert getattr(result.window, field) == pytest.approx(bias, rel=0.15)
+    assert any("sensor off zero" in note for note in result.notes)
+    for name, (of_range, z) in _errors(result, drawn.truth).items():
+        assert of_range < 3.0 and z < 2.5, name
+
+
 def test_a_network_that_disagrees_with_the_window_is_set_aside(monkeypatch):
     # A network that reads nonsense: the window's own consistency check must not trust it.
     from training import estimator
