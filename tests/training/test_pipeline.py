@@ -192,6 +192,15 @@ def test_a_sensor_off_zero_is_taken_off_and_the_answer_read_within_its_std(seed,
         assert of_range < 3.0 and z < 2.5, name
 
 
+@pytest.mark.parametrize("seed", [108, 131])
+def test_a_window_moving_one_way_says_fdj_rests_on_the_sensors_zero(seed):
+    """Steps that all go one way, a current 0.06 A off: no window can tell that from friction."""
+    drawn = draw(seed, "steps", effects=Effects(current_bias_a=0.06))
+    result = _estimate(drawn)
+    assert result.estimates.FDJ.weakly_determined and any("motion goes one way" in n for n in result.notes)
+    assert _errors(result, drawn.truth)["FDJ"][1] < 2.0  # within ±2 std, though 0.06 A is ~23 % of the range
+
+
 def test_a_network_that_disagrees_with_the_window_is_set_aside(monkeypatch):
     # A network that reads nonsense: the window's own consistency check must not trust it.
     from training import estimator
