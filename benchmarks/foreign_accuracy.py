@@ -56,6 +56,7 @@ def groups() -> dict[str, Callable[..., Draw]]:
         s, FAMILIES[s % 5], filter_samples=filter_widths(s), **kw
     )
     out["sensor glitches"] = lambda s, **kw: with_spikes(draw(s, FAMILIES[s % 5], **kw), s)
+    out["sensors off zero"] = lambda s, **kw: draw(s, FAMILIES[s % 5], effects=off_zero(s), **kw)
     out["held position"] = lambda s, **kw: draw(s, "hold", **kw)
     return out
 
@@ -71,6 +72,16 @@ def unlike_the_spec(seed: int) -> Effects:
         loop_noise_radps=rng.uniform(0.0, 0.5),
         loop_noise_seed=seed,
     )
+
+
+def off_zero(seed: int) -> Effects:
+    """A sensor off zero, unlogged: in turn the hinge moment by 1–10 N·m and the current by 0.04–0.25 A
+    (the same torque at the shaft; the current's offset is fed back to its loop, too)."""
+    rng = np.random.default_rng(30_000 + seed)
+    sign = float(rng.choice([-1.0, 1.0]))
+    if seed % 2:
+        return Effects(current_bias_a=sign * rng.uniform(0.04, 0.25))
+    return Effects(hinge_bias_nm=sign * rng.uniform(1.0, 10.0))
 
 
 def group_seed(group: str, i: int, first: int = 7000) -> int:
@@ -222,6 +233,8 @@ def report(rows: dict[str, list[dict[str, Any]]], per_group: int, seconds: float
         "the product tells from one that does only where the equation error shows it (`training.alignment`).",
         "*Sensor glitches*: the five families with",
         "1–5 spikes of 50–500 noise stds on each sensor, one in four two samples long (`with_spikes`).",
+        "*Sensors off zero*: the five families with the hinge moment 1–10 N·m or the current 0.04–0.25 A",
+        "off zero, in turn (`off_zero`), read and taken off per window (`training.zero_offset`).",
         f"Total {seconds:.0f} s.",
         "",
         table(summaries),

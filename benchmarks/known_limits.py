@@ -11,12 +11,10 @@ import time
 from collections.abc import Callable
 from typing import Any
 
-import numpy as np
-
 from benchmarks.foreign_accuracy import FAMILIES, RESULTS_MD, run_one, summarize, table
 from clients.report import write_section
 from sim import runtime
-from tests.foreign.windows import Draw, Effects, draw, filter_widths, through_filters
+from tests.foreign.windows import Draw, draw, filter_widths, through_filters
 
 FIRST_SEED = 60_000  # apart from foreign_accuracy's 7000–26000 and the tests'
 
@@ -31,18 +29,10 @@ def _hinge_late(scale: float) -> Callable[[int], Draw]:
     return make
 
 
-def _hinge_offset(seed: int) -> Draw:
-    """A hinge moment sensor 1–10 N·m off zero (the same at the shaft as a current 0.04–0.25 A off)."""
-    rng = np.random.default_rng(50_000 + seed)
-    offset = float(rng.choice([-1, 1]) * rng.uniform(1.0, 10.0))
-    return draw(seed, FAMILIES[seed % 5], effects=Effects(hinge_bias_nm=offset))
-
-
 GROUPS: dict[str, Callable[[int], Draw]] = {
     "hinge moment 0.5-2 ms late (10-40 sample filter)": _hinge_late(1.0),
     "hinge moment 0.05-0.45 ms late (2-10 samples)": _hinge_late(0.25),
     "hinge moment 0-0.15 ms late (1-4 samples)": _hinge_late(0.1),
-    "hinge moment 1-10 N·m off zero": _hinge_offset,
 }
 
 PROSE = """Windows of `tests/foreign` with a departure a real log can carry that the product undoes only
@@ -51,9 +41,8 @@ strain-gauge amplifier's filter delays the load the fit reads (signal and noise 
 moving average: `through_filters`). The window's equation error barely feels that lag, so it is read
 from the filter's trace in the noise (`training.alignment`), 0.70–1.15 of the true delay: what is
 left shows in the heaviest filters. The sensor chain's lag is the same in every window of an
-actuator; read across them, as a calibration term, it could be pinned. *Off zero*: every answer
-says it is weakly determined and that the model does not reproduce the window, but the values are
-useless until `ema calibrate` names the offset and refits with it (`docs/calibration.md`)."""
+actuator; read across them, as a calibration term, it could be pinned. (A sensor off zero, listed
+here until it was read per window, is now a group of the accuracy table above.)"""
 
 
 def main() -> None:
