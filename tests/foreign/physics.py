@@ -30,9 +30,9 @@ GEAR = 500.0
 
 # Indices of the parameter vector the loop reads.
 (P_GP, P_GAP, P_R, P_L, P_KT, P_KE, P_TMAX, P_VMAX, P_IMAX, P_J, P_C, P_BLK, P_STOP,
- P_FSJ, P_FDJ, P_KAID, P_KOPP, P_ISENSE, P_IBIAS, P_HBIAS,
+ P_FSJ, P_FDJ, P_ASYM, P_KAID, P_KOPP, P_ISENSE, P_IBIAS, P_HBIAS,
  P_BUMP_A, P_BUMP_C, P_BUMP_W, P_STRIB_A, P_STRIB_W, P_DRIFT, P_COG_A, P_COG_P, P_COG_PHI,
- P_QSC, P_CHA, P_CHD, P_DWN, P_LT, P_V, P_ALPHA_TRIM, P_DELTA_TRIM, P_ALPHA_LIM, P_VBUS, N_P) = range(40)  # fmt: skip
+ P_QSC, P_CHA, P_CHD, P_DWN, P_LT, P_V, P_ALPHA_TRIM, P_DELTA_TRIM, P_ALPHA_LIM, P_VBUS, N_P) = range(41)  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -56,6 +56,7 @@ class Effects:
     current_sensor_gain: float = 1.0  # logged (and fed back) current over true current
     current_bias_a: float = 0.0  # logged (and fed back) current minus current_sensor_gain × true
     hinge_bias_nm: float = 0.0  # logged hinge moment minus true
+    fdj_asymmetry: float = 0.0  # dynamic friction FDJ·(1 + a) turning one way, FDJ·(1 − a) the other
     bump_nm: float = 0.0  # Gaussian friction bump (spall): height [N·m] on FDJ and FSJ
     bump_centre_deg: float = 0.0
     bump_width_deg: float = 1.0  # standard deviation of the bump [deg]
@@ -128,7 +129,7 @@ def parameters(setup: Setup) -> np.ndarray:
     p[P_KT] = p[P_KE] = 0.0752 * e.torque_constant_gain
     p[P_TMAX], p[P_VMAX], p[P_IMAX], p[P_J] = 1.689, 48.0, 22.5, 2.5e-5
     p[P_C], p[P_BLK], p[P_STOP] = 5.172e-5 * e.viscous_factor, 5e-3 * e.backlash_factor, np.radians(30.0)
-    p[P_FSJ], p[P_FDJ] = h.fsj_nm, h.fdj_nm
+    p[P_FSJ], p[P_FDJ], p[P_ASYM] = h.fsj_nm, h.fdj_nm, e.fdj_asymmetry
     p[P_KAID], p[P_KOPP] = 1.0 - h.eta_a, 1.0 / h.eta_o - 1.0
     p[P_ISENSE], p[P_IBIAS], p[P_HBIAS] = e.current_sensor_gain, e.current_bias_a, e.hinge_bias_nm
     p[P_BUMP_A], p[P_BUMP_C], p[P_BUMP_W] = e.bump_nm, np.radians(e.bump_centre_deg), np.radians(e.bump_width_deg)
@@ -181,6 +182,7 @@ def _new_speed(p, t, h, theta_u, theta_m, speed, current, load):
     cogging = p[P_COG_A] * np.cos(p[P_COG_P] * theta_m + p[P_COG_PHI])
     drive = torque + load - p[P_C] * speed + cogging
     sense = (1.0 if speed > 0 else -1.0) if speed != 0.0 else (1.0 if drive > 0 else -1.0)
+    dynamic += p[P_FDJ] * p[P_ASYM] * sense
     k = p[P_KAID] if load * sense > 0 else p[P_KOPP]
     accelerating = drive - (dynamic + k * abs(load)) * sense
     if speed != 0.0:
