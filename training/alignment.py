@@ -24,17 +24,18 @@ and ``noise_level`` reads that correlation. The delay is read from it (``hinge_l
 after an unfiltered signal would be advanced for nothing, so the read is kept only where the
 equation error bears it out (no larger than unshifted): on 20 windows each, 19 of the filtered
 signals' reads are kept and 6 of the noise-only filters' (whose answers then err by ~5 % of range).
+What a misread lag moves FDJ and η_O by goes into their stds (``hinge_lag_spread``).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from sim.hinge import denoised_hinge_nm
 from sim.window import Window
-from training.baseline import fit_friction
+from training.baseline import FrictionFit, fit_friction
 from training.noise_level import MAX_LAG, noise_of
 from training.preprocess import as_read
 
@@ -42,6 +43,10 @@ MAX_LAG_S = 1e-3
 HALF_STEP = 0.5  # samples: the finest grid searched
 MIN_GAIN = 0.05  # the least relative drop of the equation error a lag must bring
 MAX_HINGE_LAG_S = 3e-3
+# The hinge lag as read from the noise is 0.70–1.15 of a filter's delay (RMS 12 % off on 20 windows), and
+# a lag misread moves FDJ: taken as ±15 % (one std) into its std, the physics fit's FDJ held its ±2 std in
+# 19 of 20 windows behind 10–40 sample filters, against 15 without.
+HINGE_LAG_UNCERTAINTY = 0.15
 
 
 def advanced(values: np.ndarray, samples: float) -> np.ndarray:
@@ -50,15 +55,30 @@ def advanced(values: np.ndarray, samples: float) -> np.ndarray:
     return np.interp(index + samples, index, values)
 
 
-def equation_errors(
+def shifted_fits(
     signals: dict[str, np.ndarray], sample_rate_hz: float, lags: np.ndarray, name: str = "current_a"
-) -> np.ndarray:
-    """The physics fit's equation error with signal ``name`` read ``lags`` samples later, one batched fit."""
+) -> FrictionFit:
+    """The physics fit with signal ``name`` read ``lags`` samples later, one row per lag, one batched fit."""
     batch = dict(signals, **{name: np.stack([advanced(signals[name], lag) for lag in lags])})
     if name == "hinge_moment_nm":  # its reading leans on the deflection, row by row
         batch["position_deg"] = np.broadcast_to(signals["position_deg"], batch[name].shape)
     read = dict(as_read(batch, sample_rate_hz), position_deg=signals["position_deg"])
-    return fit_friction(read, sample_rate_hz).residual_rms_nm
+    return fit_friction(read, sample_rate_hz)
+
+
+def equation_errors(
+    signals: dict[str, np.ndarray], sample_rate_hz: float, lags: np.ndarray, name: str = "current_a"
+) -> np.ndarray:
+    """The physics fit's equation error with signal ``name`` read ``lags`` samples later."""
+    return shifted_fits(signals, sample_rate_hz, lags, name).residual_rms_nm
+
+
+def hinge_lag_spread(signals: dict[str, np.ndarray], sample_rate_hz: float, lag: float) -> dict[str, float]:
+    """What the hinge lag's read uncertainty (± ``HINGE_LAG_UNCERTAINTY`` of it) leaves in FDJ and η_O: half
+    the change of the physics fit across that band, a std to add to theirs."""
+    band = lag * (1.0 + HINGE_LAG_UNCERTAINTY * np.array([-1.0, 1.0]))
+    fits = shifted_fits(signals, sample_rate_hz, band, "hinge_moment_nm")
+    return {"FDJ": float(abs(np.diff(fits.fdj_nm)[0]) / 2), "eta_O": float(abs(np.diff(fits.eta_o)[0]) / 2)}
 
 
 def current_lag_samples(signals: dict[str, np.ndarray], sample_rate_hz: float) -> float:
@@ -101,10 +121,11 @@ def hinge_lag_samples(signals: dict[str, np.ndarray], sample_rate_hz: float) -> 
 @dataclass(frozen=True)
 class Lags:
     """How late each signal was logged [s], undone: the current behind the speed (negative: the speed
-    behind the current), the hinge moment behind the load."""
+    behind the current), the hinge moment behind the load; and the std its read uncertainty adds, per target."""
 
     current_s: float = 0.0
     hinge_s: float = 0.0
+    spread: dict[str, float] = field(default_factory=dict)
 
 
 def aligned(window: Window) -> tuple[Window, Lags]:
@@ -115,9 +136,10 @@ def aligned(window: Window) -> tuple[Window, Lags]:
     if current != 0.0:
         late = "current_a" if current > 0 else "motor_speed_radps"
         signals[late] = advanced(signals[late], abs(current))
-    hinge = hinge_lag_samples(signals, rate)
+    hinge, spread = hinge_lag_samples(signals, rate), {}
     if hinge != 0.0:
+        spread = hinge_lag_spread(signals, rate, hinge)
         signals["hinge_moment_nm"] = advanced(signals["hinge_moment_nm"], hinge)
     if current == 0.0 and hinge == 0.0:
         return window, Lags()
-    return replace(window, signals=signals), Lags(current / rate, hinge / rate)
+    return replace(window, signals=signals), Lags(current / rate, hinge / rate, spread)

@@ -135,6 +135,12 @@ def prepare(window: Window, actuator: ActuatorParams = ActuatorParams(), take_of
     return Prepared(window, factor, len(command), window.sample_rate_hz * factor, clipped, glitches, lags, offset)
 
 
+def widened(stds: dict[str, float], *spreads: dict[str, float]) -> dict[str, float]:
+    """Each std with what conditioning could not settle (``Prepared.offset``'s and ``.lags``' spreads, per
+    target) added in quadrature."""
+    return {name: float(np.sqrt(std**2 + sum(s.get(name, 0.0) ** 2 for s in spreads))) for name, std in stds.items()}
+
+
 def conditioning_done(prepared: Prepared) -> dict[str, Any]:
     """What conditioning did to the window, as the result's ``WindowInfo`` fields."""
     return {
@@ -164,7 +170,7 @@ def conditioning_notes(prepared: Prepared) -> list[str]:
     if lags.hinge_s:
         notes.append(
             f"the hinge moment is logged {1e6 * lags.hinge_s:.0f} µs late (its filter, read from the "
-            "correlation of its noise): advanced before Eq. 5.1"
+            "correlation of its noise): advanced before Eq. 5.1, the stds include what a misread of it moves"
         )
     if (offset := offset_note(prepared.offset)) is not None:
         notes.append(offset)

@@ -29,7 +29,7 @@ from sim.window import Window
 from training import design
 from training.assess import Assessed, Candidates, assess, physics_values
 from training.baseline import FIT_ARRAYS, FitSettings, FrictionFit, fit_friction, fit_window, regressors
-from training.conditioning import Prepared, conditioning_done, conditioning_notes, prepare
+from training.conditioning import Prepared, conditioning_done, conditioning_notes, prepare, widened
 from training.config import PipelineConfig
 from training.dataset import Scenario, Simulated, scenario_from_window, simulate_noisy
 from training.documents import (
@@ -49,7 +49,6 @@ from training.network import TrainConfig
 from training.preprocess import as_read, sliding_features
 from training.reproduction import MAX_RATIO, output_error_ratios
 from training.static_friction import StaticFriction, read_static_friction
-from training.zero_offset import widened
 
 NOMINAL = {"FDJ": DEFAULT_RANGES.nominal_fdj_nm, "eta_O": DEFAULT_RANGES.nominal_eta_o}
 NOMINAL_ETA_A = float(eta_a_from_eta_o(DEFAULT_RANGES.nominal_eta_o))
@@ -185,7 +184,7 @@ def estimate_window(
     floor = np.median(check_physics.residual_rms_nm) if len(check_physics.residual_rms_nm) else np.nan
     equation_ratio = float(physics.residual_rms_nm[0] / floor) if np.isfinite(floor) else 1.0
     answer = assess(found, equation_ratio)
-    answer = replace(answer, stds=widened(answer.stds, prepared.offset))
+    answer = replace(answer, stds=widened(answer.stds, prepared.offset.spread, prepared.lags.spread))
     clock.append(time.perf_counter())
     stage("checking the answer against the window")
     check = fit_check(seen, data, answer, equation_ratio, n)

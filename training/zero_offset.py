@@ -16,7 +16,7 @@ value per reconstruction kernel) weigh them: on 20 foreign windows each, the tru
 the less likely one, and was favoured more than 9:1 on 11 of the hinge's and 15 of the current's.
 The window is corrected by the weighted mix (the hinge moment by w·b, the current by (1 − w)·c/k_T),
 which puts the answer between the readings, and each target's std grows by their disagreement
-(``widened``): an offset the window cannot place is an uncertainty, said as one. Where the motion goes
+(``conditioning.widened``): an offset the window cannot place is an uncertainty, said as one. Where the motion goes
 one way, no offset can be read; FDJ's std then carries one a sensor may keep unseen
 (``UNSEEN_CURRENT_OFFSET_A``), and a note says why.
 """
@@ -118,11 +118,6 @@ def zeroed(window: Window, offset: ZeroOffset) -> Window:
     if not offset.hinge_nm and not offset.current_a:
         return window
     return replace(window, signals=_shifted(dict(window.signals), offset.hinge_nm, offset.current_a))
-
-
-def widened(stds: dict[str, float], offset: ZeroOffset) -> dict[str, float]:
-    """Each std with the disagreement of the offset's two readings added in quadrature."""
-    return {name: float(np.hypot(std, offset.spread.get(name, 0.0))) for name, std in stds.items()}
 
 
 def offset_note(offset: ZeroOffset) -> str | None:

@@ -65,3 +65,10 @@ def test_unfiltered_sensors_are_left_as_logged():
         window = _window(seed, {})
         out, lags = aligned(window)
         assert lags == Lags() and out is window, seed
+
+
+def test_the_hinge_lags_read_uncertainty_is_carried_as_a_spread_only_where_one_is_read():
+    """Behind a 30-sample filter FDJ moves with the lag; its ±15 % band goes into the stds."""
+    _, lags = aligned(_window(3, {"hinge_moment_nm": lambda x: moving_average(x, 30)}))
+    assert lags.hinge_s > 0 and 0.0 < lags.spread["FDJ"] < 2e-3 and lags.spread["eta_O"] >= 0.0
+    assert aligned(_window(3, {}))[1] == Lags()

@@ -7,7 +7,7 @@ from sim.params import HealthParams
 from sim.synthetic import synthetic_window
 from sim.window import Window, window_from_dict
 from tests.foreign.windows import NOISE, draw, worn
-from training.conditioning import GLITCH_ACTIVITY, MAX_RATE_HZ, MAX_SAMPLES, averaging_factor, prepare
+from training.conditioning import GLITCH_ACTIVITY, MAX_RATE_HZ, MAX_SAMPLES, averaging_factor, prepare, widened
 
 
 def test_averaging_keeps_rate_and_samples_bounded():
@@ -84,3 +84,8 @@ def test_glitches_are_found_and_replaced_by_the_line_between_their_flanks():
             local = np.array([np.median(steps[max(0, k - 10) : k + 10]) for k in range(len(left))])
             assert np.all(left < np.maximum(5 * sigma, 2 * GLITCH_ACTIVITY * local)), name
     assert found >= 0.95 * planted
+
+
+def test_what_conditioning_could_not_settle_widens_the_stds_in_quadrature():
+    stds = widened({"FDJ": 4e-4, "eta_O": 0.01}, {"FDJ": 3e-4}, {"FDJ": 12e-4, "eta_O": 0.0})
+    assert stds == pytest.approx({"FDJ": 13e-4, "eta_O": 0.01})

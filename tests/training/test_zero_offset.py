@@ -7,7 +7,7 @@ import pytest
 from sim.window import window_from_dict
 from tests.foreign.windows import Effects, draw
 from training.conditioning import prepare
-from training.zero_offset import ZeroOffset, widened
+from training.zero_offset import ZeroOffset
 
 FAMILIES = ("thesis", "cruise", "gust", "doublet", "steps")
 GEAR, TORQUE_CONSTANT = 500.0, 0.0752
@@ -43,8 +43,3 @@ def test_a_current_off_zero_is_read_as_the_current_and_taken_off():
 def test_sensors_on_zero_are_left_alone():
     """On 1140 foreign windows of every benchmark group one offset was read (a worn doublet's)."""
     assert all(_offset(seed, Effects()) == ZeroOffset() for seed in range(60, 75))
-
-
-def test_the_readings_disagreement_widens_the_stds():
-    offset = ZeroOffset(torque_nm=1e-3, hinge_share=0.5, spread={"FDJ": 3e-4, "eta_O": 0.0})
-    assert widened({"FDJ": 4e-4, "eta_O": 0.01}, offset) == pytest.approx({"FDJ": 5e-4, "eta_O": 0.01})
