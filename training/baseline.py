@@ -37,9 +37,10 @@ GRID_POINTS = 41
 REFINEMENTS = 3  # coarse-to-fine passes: η_O to ~1e-5 (the SSE is smooth and unimodal in η_O)
 JACKKNIFE_BLOCKS = 10
 MIN_SLIDING_KERNELS = 10  # fewer sliding samples than 10 kernel widths: too little motion to fit
-# The sufficient statistics, in this order; S… are the direction's (s = sgn ω, s² = 1), for the offset.
-T, A, OPP, TT, AA, OO, TA, TO, AO, M, S, ST, SA, SO = range(14)
-N_STATS = 14
+# The sufficient statistics, in this order; S… are the direction's (s = sgn ω, s² = 1), for the offset,
+# V… the speed's (v = |ω| smoothed), for the viscous coefficient.
+T, A, OPP, TT, AA, OO, TA, TO, AO, M, S, ST, SA, SO, V, VT, VA, VO, VV, SV = range(20)
+N_STATS = 20
 
 
 @dataclass(frozen=True)
@@ -48,6 +49,7 @@ class FitSettings:
     derivative_window_s: float = DEFAULT_DERIVATIVE_WINDOW_S
     blocks: int = JACKKNIFE_BLOCKS
     offset: bool = False  # also fit a constant torque at the shaft (a current or hinge sensor off zero)
+    viscous: bool = False  # also fit a change ΔC of the viscous coefficient (C·|ω| beyond the spec's)
 
     def __post_init__(self) -> None:
         if self.min_speed_radps <= 0:
@@ -57,8 +59,8 @@ class FitSettings:
 
 
 FIT_ARRAYS = (
-    "fdj_nm", "eta_o", "fdj_std_nm", "eta_o_std", "offset_nm", "offset_std_nm", "residual_rms_nm", "n_sliding",
-    "at_search_edge",
+    "fdj_nm", "eta_o", "fdj_std_nm", "eta_o_std", "offset_nm", "offset_std_nm", "viscous_nms", "viscous_std_nms",
+    "residual_rms_nm", "n_sliding", "at_search_edge",
 )  # fmt: skip
 
 
@@ -72,6 +74,8 @@ class FrictionFit:
     eta_o_std: np.ndarray
     offset_nm: np.ndarray  # the constant torque at the shaft T_R holds beyond friction (0 unless fitted)
     offset_std_nm: np.ndarray
+    viscous_nms: np.ndarray  # ΔC [N·m·s/rad] beyond the actuator's C (0 unless fitted)
+    viscous_std_nms: np.ndarray
     residual_rms_nm: np.ndarray  # RMS equation error over the sliding samples
     n_sliding: np.ndarray  # samples used
     at_search_edge: np.ndarray  # η_O at an end of ETA_O_SEARCH: a bound, not an estimate
@@ -111,23 +115,24 @@ def regressors(
 
 
 def block_statistics(
-    t: np.ndarray, a: np.ndarray, o: np.ndarray, s: np.ndarray, mask: np.ndarray, blocks: int
+    t: np.ndarray, a: np.ndarray, o: np.ndarray, s: np.ndarray, v: np.ndarray, mask: np.ndarray, blocks: int
 ) -> np.ndarray:
     """(N, blocks, N_STATS) sums over the masked samples of each of ``blocks`` contiguous time blocks."""
     edges = np.linspace(0, t.shape[-1], blocks + 1).astype(np.int64)
     out = np.zeros((t.shape[0], blocks, N_STATS))
-    _block_sums(t, a, o, s, mask, edges, out)
+    _block_sums(t, a, o, s, v, mask, edges, out)
     return out
 
 
 @njit(cache=True, nogil=True)
-def _block_sums(t, a, o, s, mask, edges, out):
-    """out[r, b] = Σ over masked samples of block b of (t, a, o, t², a², o², ta, to, ao, 1, s, st, sa, so)."""
+def _block_sums(t, a, o, s, v, mask, edges, out):
+    """out[r, b] = Σ over masked samples of block b of (t, a, o, t², a², o², ta, to, ao, 1, s, st, sa, so,
+    v, vt, va, vo, v², sv)."""
     for r in range(t.shape[0]):
         for b in range(edges.shape[0] - 1):
             for i in range(edges[b], edges[b + 1]):
                 if mask[r, i]:
-                    x, y, z, d = t[r, i], a[r, i], o[r, i], s[r, i]
+                    x, y, z, d, w = t[r, i], a[r, i], o[r, i], s[r, i], v[r, i]
                     out[r, b, T] += x
                     out[r, b, A] += y
                     out[r, b, OPP] += z
@@ -142,48 +147,79 @@ def _block_sums(t, a, o, s, mask, edges, out):
                     out[r, b, ST] += d * x
                     out[r, b, SA] += d * y
                     out[r, b, SO] += d * z
+                    out[r, b, V] += w
+                    out[r, b, VT] += w * x
+                    out[r, b, VA] += w * y
+                    out[r, b, VO] += w * z
+                    out[r, b, VV] += w * w
+                    out[r, b, SV] += d * w
 
 
 # An offset needs motion both ways: with fewer than this share of the samples in the rarer direction,
-# it cannot be told from FDJ and is not fitted.
+# it cannot be told from FDJ and is not fitted. ΔC needs speeds that vary: a coefficient of variation below
+# this, and C·|ω| cannot be told from FDJ either.
 MIN_OFFSET_BALANCE = 0.05
+MIN_SPEED_VARIATION = 0.05
 
 
-def _profile(stats: np.ndarray, eta_o: np.ndarray, gear: float, offset: bool) -> tuple[np.ndarray, ...]:
-    """For stats (R, N_STATS) and a grid per row (R, G): FDJ and the offset (R, G) in closed form, and the
-    SSE (R, G). With u = t − k_aid·a − k_opp·o, FDJ + c·s is u's least-squares line in s (c = 0 unless
-    ``offset``, or the motion is too one-sided to tell c from FDJ)."""
+def _nuisances(
+    st: np.ndarray, m: np.ndarray, u: tuple[np.ndarray, ...], offset: bool, viscous: bool
+) -> tuple[np.ndarray, ...]:
+    """(FDJ, c, ΔC, Σ fitted·u) from the normal equations of u ≈ FDJ + c·s + ΔC·v; a term not fitted (not
+    asked, or not told from FDJ by this window) gets an identity row, so its value is 0."""
+    some = st[:, M] > 0
+    use_c = offset & some & (m - np.abs(st[:, S]) >= 2 * MIN_OFFSET_BALANCE * m)  # 2 × the rarer direction's count
+    use_d = viscous & some & (st[:, VV] * m - st[:, V] ** 2 > (MIN_SPEED_VARIATION * st[:, V]) ** 2)
+    use_c, use_d = np.broadcast_arrays(use_c, use_d, u[0])[:2]
+    ridge = 1.0 + 1e-12  # s and v both fitted yet nearly dependent (speeds set by the direction): no singular solve
+    gram = np.zeros((*u[0].shape, 3, 3))
+    gram[..., 0, 0] = m
+    gram[..., 0, 1] = gram[..., 1, 0] = np.where(use_c, st[:, S], 0.0)
+    gram[..., 0, 2] = gram[..., 2, 0] = np.where(use_d, st[:, V], 0.0)
+    gram[..., 1, 2] = gram[..., 2, 1] = np.where(use_c & use_d, st[:, SV], 0.0)
+    gram[..., 1, 1] = np.where(use_c, ridge * m, 1.0)
+    gram[..., 2, 2] = np.where(use_d, ridge * st[:, VV], 1.0)
+    rhs = np.stack([u[0], np.where(use_c, u[1], 0.0), np.where(use_d, u[2], 0.0)], axis=-1)
+    beta = np.linalg.solve(gram, rhs[..., None])[..., 0]
+    return beta[..., 0], beta[..., 1], beta[..., 2], np.sum(beta * rhs, axis=-1)
+
+
+def _profile(stats: np.ndarray, eta_o: np.ndarray, gear: float, offset: bool, viscous: bool) -> tuple[np.ndarray, ...]:
+    """For stats (R, N_STATS) and a grid per row (R, G): FDJ, the offset and ΔC (R, G) in closed form, and
+    the SSE (R, G). With u = t − k_aid·a − k_opp·o, FDJ is u's mean, or with c·s and ΔC·v its regression on
+    them where asked (``_nuisances``)."""
     k_opp = 1.0 / eta_o - 1.0
     k_aid = 1.0 - eta_a_from_eta_o(eta_o, gear)
     st = stats[:, :, None]
     m = np.maximum(st[:, M], 1.0)
     u = st[:, T] - k_aid * st[:, A] - k_opp * st[:, OPP]
-    su = st[:, ST] - k_aid * st[:, SA] - k_opp * st[:, SO]
     uu = (
         st[:, TT] + k_aid**2 * st[:, AA] + k_opp**2 * st[:, OO]
         - 2 * k_aid * st[:, TA] - 2 * k_opp * st[:, TO] + 2 * k_aid * k_opp * st[:, AO]
     )  # fmt: skip
-    balanced = offset & (m - np.abs(st[:, S]) >= 2 * MIN_OFFSET_BALANCE * m)  # 2 × the rarer direction's count
-    det = np.where(balanced, m**2 - st[:, S] ** 2, 1.0)
-    c = np.where(balanced, (m * su - st[:, S] * u) / det, 0.0)
-    fdj = (u - c * st[:, S]) / m
-    return fdj, c, uu - fdj * u - c * su
+    if not (offset or viscous):  # the batches of simulations: the plain mean, no solve
+        fdj = u / m
+        return fdj, np.zeros_like(fdj), np.zeros_like(fdj), uu - fdj * u
+    su = st[:, ST] - k_aid * st[:, SA] - k_opp * st[:, SO]
+    vu = st[:, VT] - k_aid * st[:, VA] - k_opp * st[:, VO]
+    fdj, c, d, explained = _nuisances(st, m, (u, su, vu), offset, viscous)
+    return fdj, c, d, uu - explained
 
 
-def solve(stats: np.ndarray, gear: float, offset: bool = False) -> tuple[np.ndarray, ...]:
-    """(FDJ, η_O, offset, SSE) per row of ``stats`` (R, N_STATS): a coarse-to-fine grid over η_O, vectorized."""
+def solve(stats: np.ndarray, gear: float, offset: bool = False, viscous: bool = False) -> tuple[np.ndarray, ...]:
+    """(FDJ, η_O, offset, ΔC, SSE) per row of ``stats`` (R, N_STATS): a coarse-to-fine grid over η_O, vectorized."""
     rows = np.arange(len(stats))
     low = np.full(len(stats), ETA_O_SEARCH[0])
     high = np.full(len(stats), ETA_O_SEARCH[1])
     for _ in range(REFINEMENTS):
         grid = low[:, None] + (high - low)[:, None] * np.linspace(0.0, 1.0, GRID_POINTS)
-        fdj, c, sse = _profile(stats, grid, gear, offset)
+        fdj, c, d, sse = _profile(stats, grid, gear, offset, viscous)
         best = np.argmin(sse, axis=1)
         step = grid[:, 1] - grid[:, 0]
         centre = grid[rows, best]
         low = np.maximum(centre - step, ETA_O_SEARCH[0])
         high = np.minimum(centre + step, ETA_O_SEARCH[1])
-    return fdj[rows, best], centre, c[rows, best], sse[rows, best]
+    return fdj[rows, best], centre, c[rows, best], d[rows, best], sse[rows, best]
 
 
 def _jackknife_std(estimates: np.ndarray) -> np.ndarray:
@@ -203,14 +239,17 @@ def fit_friction(
     others of one window, each (n,)); windows with too little sliding motion get NaN (``fit_window``
     turns that into an error naming the signals)."""
     t, a, o, mask = regressors(signals, rate, actuator, settings, residual_nm)
-    s = np.sign(np.atleast_2d(signals["motor_speed_radps"]))
-    t, a, o, s, mask = (np.ascontiguousarray(c) for c in np.broadcast_arrays(t, a, o, s, mask))
-    blocks = block_statistics(t, a, o, s, mask, settings.blocks)  # (N, B, N_STATS)
+    speed = np.atleast_2d(signals["motor_speed_radps"])
+    s = np.sign(speed)
+    v = s * smoothed(speed, rate, settings.derivative_window_s)  # |ω| as the target reads it, where sliding
+    t, a, o, s, v, mask = (np.ascontiguousarray(c) for c in np.broadcast_arrays(t, a, o, s, v, mask))
+    blocks = block_statistics(t, a, o, s, v, mask, settings.blocks)  # (N, B, N_STATS)
     total = blocks.sum(axis=1)
-    fdj, eta_o, offset, sse = solve(total, actuator.gear_ratio, settings.offset)
+    terms = (actuator.gear_ratio, settings.offset, settings.viscous)
+    fdj, eta_o, offset, viscous, sse = solve(total, *terms)
     left_out = (total[:, None, :] - blocks).reshape(-1, N_STATS)
     n_rows = len(total)
-    fdj_b, eta_b, offset_b = (x.reshape(n_rows, -1) for x in solve(left_out, actuator.gear_ratio, settings.offset)[:3])
+    fdj_b, eta_b, offset_b, viscous_b = (x.reshape(n_rows, -1) for x in solve(left_out, *terms)[:4])
     width = kernel_samples(rate, settings.derivative_window_s)
     enough = total[:, M] >= MIN_SLIDING_KERNELS * width
     nan = np.where(enough, 1.0, np.nan)
@@ -222,6 +261,8 @@ def fit_friction(
         eta_o_std=_jackknife_std(eta_b) * nan,
         offset_nm=offset * nan,
         offset_std_nm=_jackknife_std(offset_b) * nan,
+        viscous_nms=viscous * nan,
+        viscous_std_nms=_jackknife_std(viscous_b) * nan,
         residual_rms_nm=np.sqrt(np.maximum(sse, 0.0) / np.maximum(total[:, M], 1.0)) * nan,
         n_sliding=total[:, M].astype(np.int64),
         at_search_edge=edge & enough,

@@ -7,7 +7,7 @@ from sim.aircraft import GroundLoad
 from sim.batch import simulate_batch
 from sim.checks import InputError
 from sim.noise import NO_NOISE, SensorNoise, add_sensor_noise
-from sim.params import HealthParams
+from sim.params import ActuatorParams, HealthParams
 from sim.synthetic import synthetic_window
 from sim.window import window_from_dict
 from tests.foreign.windows import draw
@@ -79,3 +79,19 @@ def test_an_offset_is_not_fitted_where_the_motion_goes_one_way():
     window = synthetic_window(HealthParams.single(0.1, 0.052, 0.8), seed=5)
     one_way = dict(window.signals, motor_speed_radps=np.abs(window.signals["motor_speed_radps"]))
     assert fit_friction(one_way, 10_000.0, settings=FitSettings(offset=True)).offset_nm[0] == 0.0
+
+
+def test_a_viscous_coefficient_beyond_the_actuators_is_read_exactly_and_moves_nothing_else():
+    """Motor torque ΔC·ω more (the current k_T⁻¹·ΔC·ω more): the viscous fit reads ΔC, FDJ and η_O stay put."""
+    window = synthetic_window(HealthParams.single(0.1, 0.052, 0.8), seed=5, noise=SensorNoise())
+    unclipped = ActuatorParams(max_motor_torque_nm=100.0)  # the extra torque is not lost where the motor saturates
+    settings = FitSettings(offset=True, viscous=True)
+    plain = fit_friction(window.signals, 10_000.0, unclipped, settings)
+    extra = 3e-5 * window.signals["motor_speed_radps"] / 0.0752
+    more = fit_friction(
+        dict(window.signals, current_a=window.signals["current_a"] + extra), 10_000.0, unclipped, settings
+    )
+    assert more.viscous_nms[0] - plain.viscous_nms[0] == pytest.approx(3e-5, rel=1e-6)
+    assert more.fdj_nm[0] == pytest.approx(plain.fdj_nm[0], rel=1e-6)
+    assert more.eta_o[0] == pytest.approx(plain.eta_o[0], rel=1e-6)
+    assert abs(plain.viscous_nms[0]) < 4 * plain.viscous_std_nms[0]  # the spec's C: no change within its std
