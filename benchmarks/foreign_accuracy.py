@@ -26,7 +26,8 @@ from sim import runtime
 from sim.checks import InputError
 from sim.window import window_from_dict
 from tests.foreign.windows import Draw, Effects, draw, filter_widths, through_filters, with_spikes, worn
-from training.pipeline import HEALTHY_RANGE, WEAK_SHARE_OF_RANGE, estimate_window, share_of_range
+from training.pipeline import estimate_window
+from training.result import HEALTHY_RANGE, WEAK_SHARE_OF_RANGE, share_of_range
 
 RESULTS_MD = Path(__file__).resolve().parent.parent / "docs" / "results.md"
 BOUND = 0.10  # issue 9: no window's error over 10 % of the range

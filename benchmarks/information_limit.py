@@ -42,8 +42,8 @@ from sim.residual import kernel_samples
 from sim.window import Window, window_from_dict
 from training.baseline import FitSettings, fit_friction, regressors
 from training.conditioning import prepare
-from training.pipeline import HEALTHY_RANGE
 from training.preprocess import as_read
+from training.result import HEALTHY_RANGE
 
 GROUPS = ("short window (0.1 s, gust)", "low log rate (1-2 kHz)")  # the groups with errors past 10 % of range
 SENSORS = ("current_a", "motor_speed_radps", "hinge_moment_nm", "position_deg")

@@ -44,8 +44,8 @@ from tests.foreign.windows import Draw
 from training.baseline import fit_friction
 from training.conditioning import prepare
 from training.dataset import scenario_from_window
-from training.pipeline import HEALTHY_RANGE
 from training.preprocess import as_read
+from training.result import HEALTHY_RANGE
 
 WIDTH = np.array([np.ptp(HEALTHY_RANGE["FDJ"]), np.ptp(HEALTHY_RANGE["eta_O"])])  # the ranges, for shares
 STEP = 0.025  # central-difference step, share of each range

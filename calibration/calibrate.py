@@ -5,7 +5,7 @@ checks them and runs the stages once each, in order, and leaves ``report_`` (the
 ``ema-calibration/1`` document) and the residuals a figure needs:
 
 1. ``training.pipeline`` estimates each window with the base model, the spec's alone (the answer before;
-   ``ema estimate`` also takes a sensor's offset off, ``training.zero_offset``);
+   ``ema estimate`` also takes a sensor's offset off and reads the viscous coefficient);
 2. ``calibration.equations`` turns the windows into their equation-error problem;
 3. ``calibration.noise_floor`` builds the same problem on noise-only copies;
 4. ``calibration.families`` and ``calibration.selection`` find what explains held-out samples
@@ -73,7 +73,7 @@ class Calibrator:
             raise InputError("copies", f"must be in [8, 500], got {self.copies}")
         if not windows:
             raise InputError("windows", "at least one window is needed")
-        prepared = [prepare(w, take_off_offset=False).window for w in windows]  # an offset is named, not taken off
+        prepared = [prepare(w, spec_only=True).window for w in windows]  # what departs is named, not taken off
         if len({w.sample_rate_hz for w in prepared}) > 1:
             raise InputError("windows", "must share one sample rate (after averaging to at most 10 kHz)")
         return prepared
@@ -88,7 +88,7 @@ class Calibrator:
         started = time.perf_counter()
         prepared = self._check(windows)
         stage(f"estimating {len(prepared)} window(s) with the base model")
-        base = [estimate_window(w, self.pipeline, take_off_offset=False) for w in prepared]
+        base = [estimate_window(w, self.pipeline, spec_only=True) for w in prepared]
         before = combined(base)
         bias = {n: float(np.mean([r.methods[n].physics_bias for r in base])) for n in TARGETS}
         noise = [SensorNoise(**r.dataset.noise_estimated) for r in base]

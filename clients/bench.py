@@ -25,7 +25,8 @@ from sim.params import DEFAULT_RANGES, HealthParams
 from sim.synthetic import synthetic_window
 from training import runtime
 from training.config import PipelineConfig
-from training.pipeline import estimate_window, share_of_range
+from training.pipeline import estimate_window
+from training.result import share_of_range
 
 STAGES = ("simulate", "train", "predict", "check", "total")
 BUSY = "import itertools\nfor _ in itertools.count(): pass"

@@ -39,6 +39,7 @@ from sim.params import ActuatorParams
 from sim.window import Window
 from training.alignment import Lags, aligned
 from training.noise_level import white_noise_std
+from training.viscosity import Viscosity, read_viscosity, viscosity_note
 from training.zero_offset import ZeroOffset, offset_note, read_zero_offset, zeroed
 
 MAX_RATE_HZ = 10_000.0
@@ -60,6 +61,7 @@ class Prepared:
     glitches: dict[str, int]  # per sensor, samples of glitches replaced by the line between their flanks
     lags: Lags  # how late the current (behind the speed) and the hinge moment were logged, undone
     offset: ZeroOffset  # a sensor off zero, taken off
+    viscosity: Viscosity  # the viscous coefficient, where it departs from the spec's
 
 
 def averaging_factor(n_samples: int, rate_hz: float) -> int:
@@ -116,11 +118,11 @@ def repaired(window: Window) -> tuple[Window, dict[str, int]]:
     return (replace(window, signals=signals) if counts else window), counts
 
 
-def prepare(window: Window, actuator: ActuatorParams = ActuatorParams(), take_off_offset: bool = True) -> Prepared:
+def prepare(window: Window, actuator: ActuatorParams = ActuatorParams(), spec_only: bool = False) -> Prepared:
     """Repair ``window``'s glitches, average it down to the pipeline's sizes, put its sensors on one
-    clock (``training.alignment``) and take a sensor's offset off (``training.zero_offset``; not for
-    ``calibration``, which names it across windows); say how many glitches there were, how late each
-    sensor was, how far off zero, and how far its command reached past the stops."""
+    clock (``training.alignment``), take a sensor's offset off (``training.zero_offset``) and read the
+    viscous coefficient (``training.viscosity``); say what it found. ``spec_only`` skips the last two:
+    ``calibration`` reads the spec's model alone and names what departs from it."""
     window, glitches = repaired(window)
     factor = averaging_factor(window.n_samples, window.sample_rate_hz)
     command = window.signals["command_deg"]
@@ -130,14 +132,17 @@ def prepare(window: Window, actuator: ActuatorParams = ActuatorParams(), take_of
         signals = {name: values[:n].reshape(-1, factor).mean(axis=1) for name, values in window.signals.items()}
         window = replace(window, signals=signals, sample_rate_hz=window.sample_rate_hz / factor)
     window, lags = aligned(window)
-    offset = read_zero_offset(window, actuator) if take_off_offset else ZeroOffset()
+    offset = ZeroOffset() if spec_only else read_zero_offset(window, actuator)
     window = zeroed(window, offset)
-    return Prepared(window, factor, len(command), window.sample_rate_hz * factor, clipped, glitches, lags, offset)
+    viscosity = Viscosity() if spec_only else read_viscosity(window, actuator)
+    rate = window.sample_rate_hz * factor
+    return Prepared(window, factor, len(command), rate, clipped, glitches, lags, offset, viscosity)
 
 
-def widened(stds: dict[str, float], *spreads: dict[str, float]) -> dict[str, float]:
-    """Each std with what conditioning could not settle (``Prepared.offset``'s and ``.lags``' spreads, per
-    target) added in quadrature."""
+def widened(stds: dict[str, float], prepared: Prepared) -> dict[str, float]:
+    """Each std with what conditioning could not settle (an offset's readings, a lag's band, the viscous
+    coefficient's std: their spreads, per target) added in quadrature."""
+    spreads = (prepared.offset.spread, prepared.lags.spread, prepared.viscosity.spread)
     return {name: float(np.sqrt(std**2 + sum(s.get(name, 0.0) ** 2 for s in spreads))) for name, std in stds.items()}
 
 
@@ -150,6 +155,7 @@ def conditioning_done(prepared: Prepared) -> dict[str, Any]:
         "hinge_lag_s": prepared.lags.hinge_s,
         "hinge_offset_nm": prepared.offset.hinge_nm,
         "current_offset_a": prepared.offset.current_a,
+        "viscous_factor": prepared.viscosity.actuator().viscous_nms / ActuatorParams().viscous_nms,
     }
 
 
@@ -172,8 +178,7 @@ def conditioning_notes(prepared: Prepared) -> list[str]:
             f"the hinge moment is logged {1e6 * lags.hinge_s:.0f} µs late (its filter, read from the "
             "correlation of its noise): advanced before Eq. 5.1, the stds include what a misread of it moves"
         )
-    if (offset := offset_note(prepared.offset)) is not None:
-        notes.append(offset)
+    notes.extend(note for note in (offset_note(prepared.offset), viscosity_note(prepared.viscosity)) if note)
     if prepared.glitches:
         counts = ", ".join(f"{count} of {name}" for name, count in prepared.glitches.items())
         notes.append(

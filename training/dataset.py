@@ -1,4 +1,5 @@
-"""Window -> Case-1B dataset: simulations of that very command, preprocessed as the window is."""
+"""Window -> Case-1B dataset: simulations of that very command, preprocessed as the window is, in a box
+around the physics estimate (``simulate_dataset``)."""
 
 from __future__ import annotations
 
@@ -11,11 +12,15 @@ from sim.batch import BatchResult, InitialState, simulate_batch
 from sim.commands import knots_from_samples
 from sim.effects import EffectSet
 from sim.noise import SensorNoise, add_sensor_noise
-from sim.params import HealthParams
+from sim.params import ActuatorParams, HealthParams
 from sim.residual import residual_torque_nm, smoothed
 from sim.window import Window
+from training import design
+from training.baseline import FitSettings, FrictionFit, regressors
+from training.config import PipelineConfig
 from training.noise_level import excess_noise
-from training.preprocess import as_read
+from training.preprocess import as_read, sliding_features
+from training.viscosity import Viscosity
 
 INITIAL_FIT_SAMPLES = 8
 # All the estimators read, and so all drawn with the window's noise (position too: the hinge
@@ -125,3 +130,39 @@ def window_noise(window: Window, scenario: Scenario, health: HealthParams) -> Se
     """The window's sensor noise, measured against a clean simulation of its own command at ``health``."""
     clean = scenario.simulate(health, lanes=1).simulation(0)
     return excess_noise(window.signals, clean, window.sample_rate_hz)
+
+
+@dataclass(frozen=True)
+class Data:
+    """Everything simulated for one window."""
+
+    scenario: Scenario
+    box: design.Box
+    noise: SensorNoise
+    sims: Simulated  # n_simulations for training, then check_windows held out
+    sliding: np.ndarray  # (n_samples,) the window's Eq. 5.1 samples
+    inputs: np.ndarray  # (n_total, n_timesteps) network inputs of every simulation
+    window_inputs: np.ndarray  # (1, n_timesteps)
+    actuator: ActuatorParams  # as every fit reads it (the viscous coefficient the window shows)
+
+
+def simulate_dataset(
+    window: Window, seen: Window, physics: FrictionFit, config: PipelineConfig, viscosity: Viscosity
+) -> Data:
+    """The box around the physics estimate, the window's sensor noise (measured on ``window`` as logged),
+    the simulations (at the window's viscous coefficient), and the features of both (the window read as
+    ``seen``: through ``as_read``)."""
+    box = design.box_around(physics.fdj_nm[0], physics.fdj_std_nm[0], physics.eta_o[0], physics.eta_o_std[0])
+    scenario = scenario_from_window(seen, viscosity.effects())
+    health = design.draw(box, config.total_simulations, config.seed)
+    sims = simulate_noisy(scenario, health, window, design.centre(box), config.seed + 1, config.check_windows)
+    rate = window.sample_rate_hz
+    residual = residual_torque_nm(
+        seen.signals["current_a"], seen.signals["motor_speed_radps"], seen.signals["hinge_moment_nm"], rate
+    )
+    actuator = viscosity.actuator()
+    sliding = regressors(seen.signals, rate, actuator, FitSettings(), residual_nm=residual)[3][0]
+    n_timesteps = min(config.n_timesteps, window.n_samples)
+    inputs = sliding_features(sims.residual_nm, sliding, n_timesteps)
+    features = sliding_features(residual, sliding, n_timesteps)
+    return Data(scenario, box, sims.noise, sims, sliding, inputs, features, actuator)

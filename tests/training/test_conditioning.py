@@ -7,7 +7,10 @@ from sim.params import HealthParams
 from sim.synthetic import synthetic_window
 from sim.window import Window, window_from_dict
 from tests.foreign.windows import NOISE, draw, worn
+from training.alignment import Lags
 from training.conditioning import GLITCH_ACTIVITY, MAX_RATE_HZ, MAX_SAMPLES, averaging_factor, prepare, widened
+from training.viscosity import Viscosity
+from training.zero_offset import ZeroOffset
 
 
 def test_averaging_keeps_rate_and_samples_bounded():
@@ -87,5 +90,11 @@ def test_glitches_are_found_and_replaced_by_the_line_between_their_flanks():
 
 
 def test_what_conditioning_could_not_settle_widens_the_stds_in_quadrature():
-    stds = widened({"FDJ": 4e-4, "eta_O": 0.01}, {"FDJ": 3e-4}, {"FDJ": 12e-4, "eta_O": 0.0})
-    assert stds == pytest.approx({"FDJ": 13e-4, "eta_O": 0.01})
+    prepared = prepare(synthetic_window(HealthParams.single(), seed=1))
+    prepared = replace(
+        prepared,
+        offset=ZeroOffset(spread={"FDJ": 3e-4}),
+        lags=Lags(spread={"FDJ": 12e-4, "eta_O": 0.0}),
+        viscosity=Viscosity(spread={"FDJ": 0.0}),
+    )
+    assert widened({"FDJ": 4e-4, "eta_O": 0.01}, prepared) == pytest.approx({"FDJ": 13e-4, "eta_O": 0.01})

@@ -10,7 +10,8 @@ from sim.window import window_from_dict
 from tests.foreign.windows import NOISE, Effects, draw, filter_widths, noisy, through_filters, worn
 from training.config import PipelineConfig
 from training.documents import Estimate
-from training.pipeline import estimate_window, share_of_range
+from training.pipeline import estimate_window
+from training.result import share_of_range
 
 SMALL = PipelineConfig(n_simulations=48, check_windows=16, n_timesteps=100, hidden_units=20)
 
@@ -202,6 +203,17 @@ def test_friction_that_differs_by_direction_is_read_as_its_mean(seed, family):
     assert not result.estimates.FDJ.weakly_determined
     for name, (of_range, z) in _errors(result, drawn.truth).items():
         assert of_range < 6.0 and z < 2.5, name
+
+
+@pytest.mark.parametrize(("seed", "family"), [(84, "gust"), (86, "doublet")])
+def test_a_viscous_coefficient_beyond_the_specs_is_read_and_every_estimator_uses_it(seed, family):
+    """C 1.6x the spec's: read with the spec's, FDJ was 102 and 84 % of range off, 32 and 5 std (spec_only)."""
+    drawn = draw(seed, family, effects=Effects(viscous_factor=1.6))
+    result = _estimate(drawn)
+    assert result.window.viscous_factor == pytest.approx(1.6, abs=0.05)
+    assert any("viscous coefficient reads" in note for note in result.notes)
+    for name, (of_range, z) in _errors(result, drawn.truth).items():
+        assert of_range < 5.0 and z < 2.5, name
 
 
 @pytest.mark.parametrize("seed", [108, 131])
