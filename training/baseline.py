@@ -5,9 +5,12 @@ the load aids the motion and 1/η_O − 1 when it opposes it (T_ext = H_e / n). 
 through the same smoothing kernel as the reconstruction (``sim.residual``), which keeps the
 model linear in FDJ and k: with t = sgn(ω)·(T_R − C·ω), a and o the smoothed aiding and opposing
 |T_ext|, t = FDJ + k_aid·a + k_opp·o. η_A is tied to η_O by Eq. 3.4, so the fit is a search over
-η_O with FDJ in closed form at each point.
+η_O with FDJ in closed form at each point. Where asked, two nuisances join FDJ in that closed form:
+a constant torque c (t gains c·sgn ω: a sensor off zero, ``training.zero_offset``) and a change ΔC of
+the viscous coefficient (t gains ΔC·|ω|, ``training.viscosity``).
 
-Everything the search needs is ten sums per window (m, Σt, Σa, Σo and their products), so a
+Everything the search needs is ten sums per window (m, Σt, Σa, Σo and their products; twenty with
+the nuisances' columns), so a
 batch of simulated windows is fitted at the cost of one pass over its samples, and a block
 jackknife (the sums of B contiguous time blocks, each left out in turn) gives a standard error
 from the window itself: one that grows when the residual holds structure the model lacks.
