@@ -58,6 +58,7 @@ def groups() -> dict[str, Callable[..., Draw]]:
     )
     out["sensor glitches"] = lambda s, **kw: with_spikes(draw(s, FAMILIES[s % 5], **kw), s)
     out["sensors off zero"] = lambda s, **kw: draw(s, FAMILIES[s % 5], effects=off_zero(s), **kw)
+    out["viscous friction 1.2-2x the spec's"] = lambda s, **kw: draw(s, FAMILIES[s % 5], effects=viscous(s), **kw)
     out["held position"] = lambda s, **kw: draw(s, "hold", **kw)
     return out
 
@@ -83,6 +84,11 @@ def off_zero(seed: int) -> Effects:
     if seed % 2:
         return Effects(current_bias_a=sign * rng.uniform(0.04, 0.25))
     return Effects(hinge_bias_nm=sign * rng.uniform(1.0, 10.0))
+
+
+def viscous(seed: int) -> Effects:
+    """Viscous friction 1.2–2x the spec's C (a cold grease), unlogged, as a change of temperature is."""
+    return Effects(viscous_factor=float(np.random.default_rng(40_000 + seed).uniform(1.2, 2.0)))
 
 
 def group_seed(group: str, i: int, first: int = 7000) -> int:
@@ -236,6 +242,8 @@ def report(rows: dict[str, list[dict[str, Any]]], per_group: int, seconds: float
         "1–5 spikes of 50–500 noise stds on each sensor, one in four two samples long (`with_spikes`).",
         "*Sensors off zero*: the five families with the hinge moment 1–10 N·m or the current 0.04–0.25 A",
         "off zero, in turn (`off_zero`), read and taken off per window (`training.zero_offset`).",
+        "*Viscous friction 1.2–2x the spec's*: the five families with C above the spec's, as a cold grease",
+        "has it (`viscous`), read per window and used by every estimator (`training.viscosity`).",
         f"Total {seconds:.0f} s.",
         "",
         table(summaries),

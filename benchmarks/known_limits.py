@@ -39,10 +39,11 @@ PROSE = """Windows of `tests/foreign` with a departure a real log can carry that
 in part, or not at all; the accuracy table above holds none of them. *Hinge moment late*: a
 strain-gauge amplifier's filter delays the load the fit reads (signal and noise through a causal
 moving average: `through_filters`). The window's equation error barely feels that lag, so it is read
-from the filter's trace in the noise (`training.alignment`), 0.70–1.15 of the true delay: what is
-left shows in the heaviest filters. The sensor chain's lag is the same in every window of an
-actuator; read across them, as a calibration term, it could be pinned. (A sensor off zero, listed
-here until it was read per window, is now a group of the accuracy table above.)"""
+from the filter's trace in the noise (`training.alignment`), 0.70–1.15 of the true delay, and ±15 %
+of it goes into the stds: what is left shows in the heaviest filters. The sensor chain's lag is the
+same in every window of an actuator; read across them, as a calibration term, it could be pinned.
+(A sensor off zero and a viscous coefficient above the spec's, listed here until each was read
+per window, are now groups of the accuracy table above.)"""
 
 
 def main() -> None:
