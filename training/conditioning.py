@@ -155,7 +155,7 @@ def conditioning_done(prepared: Prepared) -> dict[str, Any]:
         "hinge_lag_s": prepared.lags.hinge_s,
         "hinge_offset_nm": prepared.offset.hinge_nm,
         "current_offset_a": prepared.offset.current_a,
-        "viscous_factor": prepared.viscosity.actuator().viscous_nms / ActuatorParams().viscous_nms,
+        "viscous_factor": prepared.viscosity.factor,
     }
 
 

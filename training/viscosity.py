@@ -43,6 +43,12 @@ class Viscosity:
     change_nms: float = 0.0  # ΔC [N·m·s/rad] at the motor shaft
     change_std_nms: float = 0.0
     spread: dict[str, float] = field(default_factory=dict)  # per target, the std C's uncertainty adds
+    spec_nms: float = ActuatorParams().viscous_nms  # the C_M it was read against
+
+    @property
+    def factor(self) -> float:
+        """The coefficient read over the spec's."""
+        return 1.0 + self.change_nms / self.spec_nms
 
     def actuator(self, spec: ActuatorParams = ActuatorParams()) -> ActuatorParams:
         """The actuator every fit of the window reads it with."""
@@ -70,16 +76,15 @@ def read_viscosity(window: Window, spec: ActuatorParams = ActuatorParams()) -> V
         "FDJ": abs(float(high.fdj_nm[0] - low.fdj_nm[0])) / 2,
         "eta_O": abs(float(high.eta_o[0] - low.eta_o[0])) / 2,
     }
-    return Viscosity(change, std, spread)
+    return Viscosity(change, std, spread, spec.viscous_nms)
 
 
-def viscosity_note(viscosity: Viscosity, spec: ActuatorParams = ActuatorParams()) -> str | None:
+def viscosity_note(viscosity: Viscosity) -> str | None:
     """The change in words for the result's notes, or None."""
     if not viscosity.change_nms:
         return None
-    ratio = 1.0 + viscosity.change_nms / spec.viscous_nms
     return (
-        f"the viscous coefficient reads {ratio:.2f} ± {viscosity.change_std_nms / spec.viscous_nms:.2f} times the "
-        "spec's (a cold or aged grease): every estimator of this window used it, and the stds include its "
-        "uncertainty; read with the spec's, C·|ω| would have passed for friction"
+        f"the viscous coefficient reads {viscosity.factor:.2f} ± {viscosity.change_std_nms / viscosity.spec_nms:.2f} "
+        "times the spec's (a cold or aged grease): every estimator of this window used it, and the stds include "
+        "its uncertainty; read with the spec's, C·|ω| would have passed for friction"
     )
