@@ -10,8 +10,8 @@ True)``) and read as an offset where it stands ``MIN_Z`` jackknife stds from zer
 windows of the five families none reached 4, two reached 3). Which sensor is off matters: a hinge
 moment off by b also shifts |T_ext|, whose k·|T_ext| term then moves FDJ by about k·b/n (up to 18 % of
 the range at 10 N·m). The two readings differ in the fit only where |T_ext| comes near zero or varies,
-so both are made: the current corrected by c/k_T, or the hinge moment by b (found by refitting, as
-|H − b| is not linear in b). Their likelihoods (the equation errors' RSS, over about one independent
+so both are made: the current corrected by i₀, or the hinge moment by b, each refitted until no
+constant is left (|H − b| is not linear in b, and k_T·I is cut at the motor's peak torque). Their likelihoods (the equation errors' RSS, over about one independent
 value per reconstruction kernel) weigh them: on 20 foreign windows each, the true sensor was never
 the less likely one, and was favoured more than 9:1 on 11 of the hinge's and 15 of the current's.
 The window is corrected by the weighted mix (the hinge moment by w·b, the current by (1 − w)·c/k_T),
@@ -38,7 +38,10 @@ MIN_Z = 4.0
 # being on zero, and its std carries the offset a Hall sensor keeps after its power-up zeroing (~0.2 % of
 # the drive's 22.5 A). One foreign window in fifty is so; one 0.075 A off was read 24 % of range off at 1.9 % std.
 UNSEEN_CURRENT_OFFSET_A = 0.05
-HINGE_ITERATIONS = 4  # refits of the hinge moment's offset: each cuts what is left by ~k (< 0.5)
+# Refits of a sensor's offset: the hinge moment's moves |H − b| (each refit cuts what is left by ~k), the
+# current's is lost where k_T·I meets the motor's peak torque (on worn foreign windows, which saturate more,
+# one read 7 % low, FDJ 4.7 % of range off at 2.9 std).
+ITERATIONS = 4
 OFFSET_FIT = FitSettings(offset=True)
 
 
@@ -65,15 +68,16 @@ def _shifted(signals: dict[str, np.ndarray], hinge_nm: float = 0.0, current_a: f
     )
 
 
-def hinge_offset_nm(signals: dict[str, np.ndarray], rate: float, torque_nm: float, gear_ratio: float) -> float:
-    """The hinge moment's offset b that leaves no constant in T_R: from b = n·c, refitted as |H − b| moves."""
-    bias = gear_ratio * torque_nm
-    for _ in range(HINGE_ITERATIONS):
-        left = _fit(_shifted(signals, hinge_nm=bias), rate, OFFSET_FIT).offset_nm[0]
+def sensor_offset(signals: dict[str, np.ndarray], rate: float, torque_nm: float, sensor: str, per_nm: float) -> float:
+    """The offset of ``sensor`` (``hinge_nm`` or ``current_a``, ``per_nm`` of it per N·m at the shaft) that
+    leaves no constant in T_R: from ``per_nm``·c, refitted as the reading moves (``ITERATIONS``)."""
+    offset = per_nm * torque_nm
+    for _ in range(ITERATIONS):
+        left = _fit(_shifted(signals, **{sensor: offset}), rate, OFFSET_FIT).offset_nm[0]
         if not np.isfinite(left):
             break
-        bias += gear_ratio * float(left)
-    return bias
+        offset += per_nm * float(left)
+    return offset
 
 
 def hinge_share(current: FrictionFit, hinge: FrictionFit, rate: float) -> float:
@@ -94,8 +98,8 @@ def read_zero_offset(window: Window, actuator: ActuatorParams = ActuatorParams()
         return ZeroOffset(one_way=True, spread={"FDJ": UNSEEN_CURRENT_OFFSET_A * actuator.torque_constant_nm_per_a})
     if not (np.isfinite(torque) and abs(torque) > MIN_Z * std):
         return ZeroOffset()
-    current_a = torque / actuator.torque_constant_nm_per_a
-    hinge_nm = hinge_offset_nm(signals, rate, torque, actuator.gear_ratio)
+    current_a = sensor_offset(signals, rate, torque, "current_a", 1.0 / actuator.torque_constant_nm_per_a)
+    hinge_nm = sensor_offset(signals, rate, torque, "hinge_nm", actuator.gear_ratio)
     as_current = _fit(_shifted(signals, current_a=current_a), rate)
     as_hinge = _fit(_shifted(signals, hinge_nm=hinge_nm), rate)
     share = hinge_share(as_current, as_hinge, rate)
