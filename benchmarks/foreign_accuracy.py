@@ -59,6 +59,8 @@ def groups() -> dict[str, Callable[..., Draw]]:
     out["sensor glitches"] = lambda s, **kw: with_spikes(draw(s, FAMILIES[s % 5], **kw), s)
     out["sensors off zero"] = lambda s, **kw: draw(s, FAMILIES[s % 5], effects=off_zero(s), **kw)
     out["viscous friction 1.2-2x the spec's"] = lambda s, **kw: draw(s, FAMILIES[s % 5], effects=viscous(s), **kw)
+    out["worn, sensors off zero"] = lambda s, **kw: worn(s, family=FAMILIES[s % 5], effects=off_zero(s), **kw)
+    out["worn, viscous 1.2-2x"] = lambda s, **kw: worn(s, family=FAMILIES[s % 5], effects=viscous(s), **kw)
     out["held position"] = lambda s, **kw: draw(s, "hold", **kw)
     return out
 
@@ -243,7 +245,9 @@ def report(rows: dict[str, list[dict[str, Any]]], per_group: int, seconds: float
         "*Sensors off zero*: the five families with the hinge moment 1–10 N·m or the current 0.04–0.25 A",
         "off zero, in turn (`off_zero`), read and taken off per window (`training.zero_offset`).",
         "*Viscous friction 1.2–2x the spec's*: the five families with C above the spec's, as a cold grease",
-        "has it (`viscous`), read per window and used by every estimator (`training.viscosity`).",
+        "has it (`viscous`), read per window and used by every estimator (`training.viscosity`). The",
+        "*worn* groups with these two: a worn transmission's k = 1/η_O − 1 reaches 1.2, and so does the",
+        "share of a hinge offset that passes for FDJ where the window cannot tell which sensor is off.",
         f"Total {seconds:.0f} s.",
         "",
         table(summaries),
