@@ -1,6 +1,6 @@
 """A logged window made ready for the pipeline: isolated glitches repaired, a bounded number of
 samples, its sensors on one clock (``training.alignment``) and on zero (``training.zero_offset``),
-and what was done to it.
+its viscous coefficient read (``training.viscosity``), and what was done to it.
 
 A sensor's sample that jumps away from both neighbours and straight back (an EMI spike, a bit
 error) is no measurement, nor is a burst of a few of them (``MAX_GLITCH_RUN``, ``MAX_GLITCH_S``:
