@@ -26,7 +26,7 @@ from sim.window import Window
 from training.baseline import FitSettings, fit_friction
 from training.preprocess import as_read
 
-MIN_Z = 4.0
+MIN_Z = 4.0  # jackknife stds ΔC must stand from 0 (and MIN_CHANGE of C: a change that matters)
 MIN_CHANGE = 0.1  # of the spec's C
 # On 20 foreign windows with C 1.2–2x the spec's the read erred by 2.2 % of the spec's C (RMS; up to 7 %,
 # mostly low), beyond what its jackknife std, often 0.5 %, said: the reconstruction's bias follows the speed

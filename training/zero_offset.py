@@ -37,7 +37,7 @@ from sim.window import Window
 from training.baseline import FitSettings, FrictionFit, fit_friction
 from training.preprocess import as_read
 
-MIN_Z = 4.0
+MIN_Z = 4.0  # stds by which the fit with an offset must explain the window better (``equation_z``)
 # Where the motion goes one way, an offset is FDJ's twin and cannot be read: FDJ then rests on the sensors
 # being on zero, and its std carries the offset a Hall sensor keeps after its power-up zeroing (~0.2 % of
 # the drive's 22.5 A). One foreign window in fifty is so; one 0.075 A off was read 24 % of range off at 1.9 % std.
@@ -102,8 +102,9 @@ def hinge_share(current: FrictionFit, hinge: FrictionFit, rate: float) -> float:
 
 
 def read_zero_offset(window: Window, actuator: ActuatorParams = ActuatorParams()) -> ZeroOffset:
-    """The window's constant torque beyond friction, if it stands ``MIN_Z`` stds out, and the two
-    readings of it (module docstring) weighed."""
+    """The window's constant torque beyond friction, where the fit with it explains the window ``MIN_Z``
+    stds better, and the two readings of it (module docstring) weighed; or the note that the motion goes
+    one way."""
     rate, signals = window.sample_rate_hz, dict(window.signals)
     found = _fit(signals, rate, OFFSET_FIT)
     torque, std = float(found.offset_nm[0]), float(found.offset_std_nm[0])
