@@ -244,7 +244,8 @@ def fit_friction(
     t, a, o, mask = regressors(signals, rate, actuator, settings, residual_nm)
     speed = np.atleast_2d(signals["motor_speed_radps"])
     s = np.sign(speed)
-    v = s * smoothed(speed, rate, settings.derivative_window_s)  # |ω| as the target reads it, where sliding
+    # |ω| as the target reads it, where sliding; only a viscous fit reads it (the batches of simulations do not)
+    v = s * smoothed(speed, rate, settings.derivative_window_s) if settings.viscous else np.zeros(1)
     t, a, o, s, v, mask = (np.ascontiguousarray(c) for c in np.broadcast_arrays(t, a, o, s, v, mask))
     blocks = block_statistics(t, a, o, s, v, mask, settings.blocks)  # (N, B, N_STATS)
     total = blocks.sum(axis=1)
