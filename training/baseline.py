@@ -5,15 +5,16 @@ the load aids the motion and 1/η_O − 1 when it opposes it (T_ext = H_e / n). 
 through the same smoothing kernel as the reconstruction (``sim.residual``), which keeps the
 model linear in FDJ and k: with t = sgn(ω)·(T_R − C·ω), a and o the smoothed aiding and opposing
 |T_ext|, t = FDJ + k_aid·a + k_opp·o. η_A is tied to η_O by Eq. 3.4, so the fit is a search over
-η_O with FDJ in closed form at each point. Where asked, two nuisances join FDJ in that closed form:
-a constant torque c (t gains c·sgn ω: a sensor off zero, ``training.zero_offset``) and a change ΔC of
-the viscous coefficient (t gains ΔC·|ω|, ``training.viscosity``).
+η_O with FDJ in closed form at each point. Where asked, nuisances join FDJ in that closed form
+(``nuisance_columns``): a constant torque c (t gains c·sgn ω: a sensor off zero,
+``training.zero_offset``), a change ΔC of the viscous coefficient (t gains ΔC·|ω|,
+``training.viscosity``) and a scale γ of the motor torque (t loses γ·sgn ω·k_T·I: k_T or the current
+sensor's gain off, ``training.torque_scale``).
 
-Everything the search needs is ten sums per window (m, Σt, Σa, Σo and their products; twenty with
-the nuisances' columns), so a
-batch of simulated windows is fitted at the cost of one pass over its samples, and a block
-jackknife (the sums of B contiguous time blocks, each left out in turn) gives a standard error
-from the window itself: one that grows when the residual holds structure the model lacks.
+Everything the search needs is the matrix of sums Σ z·zᵀ per window, z = (t, a, o, nuisances…, 1)
+(ten numbers without nuisances), so a batch of simulated windows is fitted at the cost of one pass
+over its samples, and a block jackknife (the sums of B contiguous time blocks, each left out in
+turn) gives a standard error from the window itself: one that grows when the residual holds structure the model lacks.
 """
 
 from __future__ import annotations
@@ -40,10 +41,7 @@ GRID_POINTS = 41
 REFINEMENTS = 3  # coarse-to-fine passes: η_O to ~1e-5 (the SSE is smooth and unimodal in η_O)
 JACKKNIFE_BLOCKS = 10
 MIN_SLIDING_KERNELS = 10  # fewer sliding samples than 10 kernel widths: too little motion to fit
-# The sufficient statistics, in this order; S… are the direction's (s = sgn ω, s² = 1), for the offset,
-# V… the speed's (v = |ω| smoothed), for the viscous coefficient.
-T, A, OPP, TT, AA, OO, TA, TO, AO, M, S, ST, SA, SO, V, VT, VA, VO, VV, SV = range(20)
-N_STATS = 20
+NUISANCES = ("offset", "viscous", "torque_scale")  # the terms a fit may carry beside FDJ, in this order
 
 
 @dataclass(frozen=True)
@@ -53,6 +51,7 @@ class FitSettings:
     blocks: int = JACKKNIFE_BLOCKS
     offset: bool = False  # also fit a constant torque at the shaft (a current or hinge sensor off zero)
     viscous: bool = False  # also fit a change ΔC of the viscous coefficient (C·|ω| beyond the spec's)
+    torque_scale: bool = False  # also fit γ, the motor torque per logged k_T·I beyond 1 (k_T or a current gain off)
 
     def __post_init__(self) -> None:
         if self.min_speed_radps <= 0:
@@ -60,10 +59,14 @@ class FitSettings:
         if not 2 <= self.blocks <= 100:
             raise InputError("blocks", f"must be in [2, 100], got {self.blocks}")
 
+    @property
+    def nuisances(self) -> tuple[str, ...]:
+        return tuple(name for name in NUISANCES if getattr(self, name))
+
 
 FIT_ARRAYS = (
     "fdj_nm", "eta_o", "fdj_std_nm", "eta_o_std", "offset_nm", "offset_std_nm", "viscous_nms", "viscous_std_nms",
-    "residual_rms_nm", "n_sliding", "at_search_edge",
+    "torque_scale", "torque_scale_std", "residual_rms_nm", "n_sliding", "at_search_edge",
 )  # fmt: skip
 
 
@@ -79,6 +82,8 @@ class FrictionFit:
     offset_std_nm: np.ndarray
     viscous_nms: np.ndarray  # ΔC [N·m·s/rad] beyond the actuator's C (0 unless fitted)
     viscous_std_nms: np.ndarray
+    torque_scale: np.ndarray  # γ: the motor's torque is (1 + γ)·k_T·I where unsaturated (0 unless fitted)
+    torque_scale_std: np.ndarray
     residual_rms_nm: np.ndarray  # RMS equation error over the sliding samples
     n_sliding: np.ndarray  # samples used
     at_search_edge: np.ndarray  # η_O at an end of ETA_O_SEARCH: a bound, not an estimate
@@ -117,116 +122,119 @@ def regressors(
     return target, aid, opp, sliding
 
 
-def block_statistics(
-    t: np.ndarray, a: np.ndarray, o: np.ndarray, s: np.ndarray, v: np.ndarray, mask: np.ndarray, blocks: int
-) -> np.ndarray:
-    """(N, blocks, N_STATS) sums over the masked samples of each of ``blocks`` contiguous time blocks."""
-    edges = np.linspace(0, t.shape[-1], blocks + 1).astype(np.int64)
-    out = np.zeros((t.shape[0], blocks, N_STATS))
-    _block_sums(t, a, o, s, v, mask, edges, out)
-    return out
+def nuisance_columns(
+    signals: Mapping[str, np.ndarray], rate: float, actuator: ActuatorParams, settings: FitSettings
+) -> list[np.ndarray]:
+    """The columns of ``settings.nuisances``, each (N, n) and, like the target, signed by the direction s:
+    s itself (a constant torque), |ω| smoothed (ΔC), −k_T·I smoothed where the motor is not saturated (γ:
+    T_R misses γ·k_T·I there; where k_T·I is cut at the peak torque, it misses nothing)."""
+    window_s = settings.derivative_window_s
+    direction = np.sign(np.atleast_2d(signals["motor_speed_radps"]))
+    columns = {"offset": lambda: direction}
+    columns["viscous"] = lambda: direction * smoothed(np.atleast_2d(signals["motor_speed_radps"]), rate, window_s)
+
+    def scale() -> np.ndarray:
+        motor = actuator.torque_constant_nm_per_a * np.atleast_2d(signals["current_a"])
+        return -direction * smoothed(motor * (np.abs(motor) < actuator.max_motor_torque_nm), rate, window_s)
+
+    columns["torque_scale"] = scale
+    return [columns[name]() for name in settings.nuisances]
+
+
+def block_statistics(columns: list[np.ndarray], mask: np.ndarray, blocks: int) -> np.ndarray:
+    """(N, blocks, P, P) with P = K + 1: per contiguous time block, Σ z·zᵀ over the masked samples, z the
+    K ``columns`` (each (N, n): t, a, o, then the nuisances') and a constant 1 last (its entry: the count)."""
+    *columns, mask = (np.ascontiguousarray(c) for c in np.broadcast_arrays(*columns, mask))
+    edges = np.linspace(0, mask.shape[-1], blocks + 1).astype(np.int64)
+    out = np.zeros((mask.shape[0], blocks, len(columns) + 1, len(columns) + 1))
+    _block_sums(tuple(np.asarray(c, dtype=np.float64) for c in columns), mask, edges, out)  # a tuple: no copy
+    return out + np.triu(out, 1).swapaxes(-1, -2)
 
 
 @njit(cache=True, nogil=True)
-def _block_sums(t, a, o, s, v, mask, edges, out):
-    """out[r, b] = Σ over masked samples of block b of (t, a, o, t², a², o², ta, to, ao, 1, s, st, sa, so,
-    v, vt, va, vo, v², sv)."""
-    for r in range(t.shape[0]):
+def _block_sums(columns, mask, edges, out):
+    """out[r, b, i, j] (i ≤ j) = Σ over masked samples k of block b of z_i·z_j, z = (columns[…][r, k], 1)."""
+    k_cols = len(columns)
+    for r in range(mask.shape[0]):
         for b in range(edges.shape[0] - 1):
-            for i in range(edges[b], edges[b + 1]):
-                if mask[r, i]:
-                    x, y, z, d, w = t[r, i], a[r, i], o[r, i], s[r, i], v[r, i]
-                    out[r, b, T] += x
-                    out[r, b, A] += y
-                    out[r, b, OPP] += z
-                    out[r, b, TT] += x * x
-                    out[r, b, AA] += y * y
-                    out[r, b, OO] += z * z
-                    out[r, b, TA] += x * y
-                    out[r, b, TO] += x * z
-                    out[r, b, AO] += y * z
-                    out[r, b, M] += 1.0
-                    out[r, b, S] += d
-                    out[r, b, ST] += d * x
-                    out[r, b, SA] += d * y
-                    out[r, b, SO] += d * z
-                    out[r, b, V] += w
-                    out[r, b, VT] += w * x
-                    out[r, b, VA] += w * y
-                    out[r, b, VO] += w * z
-                    out[r, b, VV] += w * w
-                    out[r, b, SV] += d * w
+            for k in range(edges[b], edges[b + 1]):
+                if mask[r, k]:
+                    for i in range(k_cols):
+                        x = columns[i][r, k]
+                        for j in range(i, k_cols):
+                            out[r, b, i, j] += x * columns[j][r, k]
+                        out[r, b, i, k_cols] += x
+                    out[r, b, k_cols, k_cols] += 1.0
 
 
 # An offset needs motion both ways: with fewer than this share of the samples in the rarer direction,
-# it cannot be told from FDJ and is not fitted. ΔC needs speeds that vary: a coefficient of variation below
-# this, and C·|ω| cannot be told from FDJ either.
+# it cannot be told from FDJ and is not fitted. ΔC and γ need columns that vary: a coefficient of variation
+# below this, and they cannot be told from FDJ either.
 MIN_OFFSET_BALANCE = 0.05
-MIN_SPEED_VARIATION = 0.05
+MIN_VARIATION = 0.05
 
 
-def _nuisances(
-    st: np.ndarray, m: np.ndarray, u: tuple[np.ndarray, ...], offset: bool, viscous: bool
-) -> tuple[np.ndarray, ...]:
-    """(FDJ, c, ΔC, Σ fitted·u) from the normal equations of u ≈ FDJ + c·s + ΔC·v; a term not fitted (not
-    asked, or not told from FDJ by this window) gets an identity row, so its value is 0."""
-    some = st[:, M] > 0
-    use_c = offset & some & (m - np.abs(st[:, S]) >= 2 * MIN_OFFSET_BALANCE * m)  # 2 × the rarer direction's count
-    use_d = viscous & some & (st[:, VV] * m - st[:, V] ** 2 > (MIN_SPEED_VARIATION * st[:, V]) ** 2)
-    use_c, use_d = np.broadcast_arrays(use_c, use_d, u[0])[:2]
-    ridge = 1.0 + 1e-12  # s and v both fitted yet nearly dependent (speeds set by the direction): no singular solve
-    gram = np.zeros((*u[0].shape, 3, 3))
-    gram[..., 0, 0] = m
-    gram[..., 0, 1] = gram[..., 1, 0] = np.where(use_c, st[:, S], 0.0)
-    gram[..., 0, 2] = gram[..., 2, 0] = np.where(use_d, st[:, V], 0.0)
-    gram[..., 1, 2] = gram[..., 2, 1] = np.where(use_c & use_d, st[:, SV], 0.0)
-    gram[..., 1, 1] = np.where(use_c, ridge * m, 1.0)
-    gram[..., 2, 2] = np.where(use_d, ridge * st[:, VV], 1.0)
-    rhs = np.stack([u[0], np.where(use_c, u[1], 0.0), np.where(use_d, u[2], 0.0)], axis=-1)
-    beta = np.linalg.solve(gram, rhs[..., None])[..., 0]
-    return beta[..., 0], beta[..., 1], beta[..., 2], np.sum(beta * rhs, axis=-1)
+def _fitted(stats: np.ndarray, nuisances: tuple[str, ...]) -> np.ndarray:
+    """(R, F) which of (FDJ, *nuisances) each row's window can tell apart (FDJ always; the rest by their
+    column's balance or variation; ``stats`` (R, P, P))."""
+    m = stats[:, -1, -1]
+    used = [m > 0]
+    for i, name in enumerate(nuisances, start=3):
+        total, square = stats[:, i, -1], stats[:, i, i]
+        if name == "offset":
+            used.append((m > 0) & (m - np.abs(total) >= 2 * MIN_OFFSET_BALANCE * m))  # 2 × the rarer direction's
+        else:
+            used.append((m > 0) & (square * m - total**2 > (MIN_VARIATION * total) ** 2))
+    return np.stack(used, axis=-1)
 
 
-def _profile(stats: np.ndarray, eta_o: np.ndarray, gear: float, offset: bool, viscous: bool) -> tuple[np.ndarray, ...]:
-    """For stats (R, N_STATS) and a grid per row (R, G): FDJ, the offset and ΔC (R, G) in closed form, and
-    the SSE (R, G). With u = t − k_aid·a − k_opp·o, FDJ is u's mean, or with c·s and ΔC·v its regression on
-    them where asked (``_nuisances``)."""
+def _profile(stats: np.ndarray, eta_o: np.ndarray, gear: float, nuisances: tuple[str, ...]) -> tuple[np.ndarray, ...]:
+    """For stats (R, P, P) and a grid per row (R, G): the coefficients (R, G, F) of FDJ and each nuisance
+    in closed form, and the SSE (R, G). With u = t − k_aid·a − k_opp·o, FDJ is u's mean, or with the
+    nuisances, the regression of u on (1, nuisances…); a term this window cannot tell (``_fitted``) gets
+    an identity row, so its coefficient is 0."""
     k_opp = 1.0 / eta_o - 1.0
     k_aid = 1.0 - eta_a_from_eta_o(eta_o, gear)
-    st = stats[:, :, None]
-    m = np.maximum(st[:, M], 1.0)
-    u = st[:, T] - k_aid * st[:, A] - k_opp * st[:, OPP]
+    s = stats[:, None]  # (R, 1, P, P)
     uu = (
-        st[:, TT] + k_aid**2 * st[:, AA] + k_opp**2 * st[:, OO]
-        - 2 * k_aid * st[:, TA] - 2 * k_opp * st[:, TO] + 2 * k_aid * k_opp * st[:, AO]
+        s[..., 0, 0] + k_aid**2 * s[..., 1, 1] + k_opp**2 * s[..., 2, 2]
+        - 2 * k_aid * s[..., 0, 1] - 2 * k_opp * s[..., 0, 2] + 2 * k_aid * k_opp * s[..., 1, 2]
     )  # fmt: skip
-    if not (offset or viscous):  # the batches of simulations: the plain mean, no solve
-        fdj = u / m
-        return fdj, np.zeros_like(fdj), np.zeros_like(fdj), uu - fdj * u
-    su = st[:, ST] - k_aid * st[:, SA] - k_opp * st[:, SO]
-    vu = st[:, VT] - k_aid * st[:, VA] - k_opp * st[:, VO]
-    fdj, c, d, explained = _nuisances(st, m, (u, su, vu), offset, viscous)
-    return fdj, c, d, uu - explained
+    free = [-1, *range(3, 3 + len(nuisances))]  # the constant (FDJ) first
+    cross = s[..., 0, free] - k_aid[..., None] * s[..., 1, free] - k_opp[..., None] * s[..., 2, free]
+    if not nuisances:  # the batches of simulations: the plain mean, no solve
+        fdj = cross[..., 0] / np.maximum(s[..., -1, -1], 1.0)
+        return fdj[..., None], uu - fdj * cross[..., 0]
+    used = _fitted(stats, nuisances)[:, None, :]  # (R, 1, F)
+    both = used[..., :, None] & used[..., None, :]
+    gram = np.where(both, stats[:, free][:, :, free][:, None], 0.0)
+    # Two nuisances nearly dependent (speeds set by the direction): a ridge keeps the solve regular.
+    diagonal = np.where(used, np.diagonal(gram, axis1=-2, axis2=-1) * (1.0 + 1e-12), 1.0)
+    gram = gram * ~np.eye(len(free), dtype=bool) + diagonal[..., None] * np.eye(len(free))
+    rhs = np.where(used, cross, 0.0)
+    beta = np.linalg.solve(np.broadcast_to(gram, (*rhs.shape, len(free))), rhs[..., None])[..., 0]
+    return beta, uu - np.sum(beta * rhs, axis=-1)
 
 
-def solve(stats: np.ndarray, gear: float, offset: bool = False, viscous: bool = False) -> tuple[np.ndarray, ...]:
-    """(FDJ, η_O, offset, ΔC, SSE) per row of ``stats`` (R, N_STATS): a coarse-to-fine grid over η_O, vectorized."""
+def solve(stats: np.ndarray, gear: float, nuisances: tuple[str, ...] = ()) -> tuple[np.ndarray, ...]:
+    """(coefficients (R, F): FDJ then the nuisances', η_O, SSE) per row of ``stats`` (R, P, P): a
+    coarse-to-fine grid over η_O, vectorized."""
     rows = np.arange(len(stats))
     low = np.full(len(stats), ETA_O_SEARCH[0])
     high = np.full(len(stats), ETA_O_SEARCH[1])
     for _ in range(REFINEMENTS):
         grid = low[:, None] + (high - low)[:, None] * np.linspace(0.0, 1.0, GRID_POINTS)
-        fdj, c, d, sse = _profile(stats, grid, gear, offset, viscous)
+        beta, sse = _profile(stats, grid, gear, nuisances)
         best = np.argmin(sse, axis=1)
         step = grid[:, 1] - grid[:, 0]
         centre = grid[rows, best]
         low = np.maximum(centre - step, ETA_O_SEARCH[0])
         high = np.minimum(centre + step, ETA_O_SEARCH[1])
-    return fdj[rows, best], centre, c[rows, best], d[rows, best], sse[rows, best]
+    return beta[rows, best], centre, sse[rows, best]
 
 
 def _jackknife_std(estimates: np.ndarray) -> np.ndarray:
-    """Std of the full-sample estimate from (N, B) leave-one-block-out estimates."""
+    """Std of the full-sample estimate from (N, B, …) leave-one-block-out estimates."""
     b = estimates.shape[1]
     return np.sqrt((b - 1) / b * np.sum((estimates - estimates.mean(axis=1, keepdims=True)) ** 2, axis=1))
 
@@ -242,33 +250,34 @@ def fit_friction(
     others of one window, each (n,)); windows with too little sliding motion get NaN (``fit_window``
     turns that into an error naming the signals)."""
     t, a, o, mask = regressors(signals, rate, actuator, settings, residual_nm)
-    speed = np.atleast_2d(signals["motor_speed_radps"])
-    s = np.sign(speed)
-    # |ω| as the target reads it, where sliding; only a viscous fit reads it (the batches of simulations do not)
-    v = s * smoothed(speed, rate, settings.derivative_window_s) if settings.viscous else np.zeros(1)
-    t, a, o, s, v, mask = (np.ascontiguousarray(c) for c in np.broadcast_arrays(t, a, o, s, v, mask))
-    blocks = block_statistics(t, a, o, s, v, mask, settings.blocks)  # (N, B, N_STATS)
+    columns = [t, a, o, *nuisance_columns(signals, rate, actuator, settings)]
+    blocks = block_statistics(columns, mask, settings.blocks)  # (N, B, P, P)
     total = blocks.sum(axis=1)
-    terms = (actuator.gear_ratio, settings.offset, settings.viscous)
-    fdj, eta_o, offset, viscous, sse = solve(total, *terms)
-    left_out = (total[:, None, :] - blocks).reshape(-1, N_STATS)
-    n_rows = len(total)
-    fdj_b, eta_b, offset_b, viscous_b = (x.reshape(n_rows, -1) for x in solve(left_out, *terms)[:4])
-    width = kernel_samples(rate, settings.derivative_window_s)
-    enough = total[:, M] >= MIN_SLIDING_KERNELS * width
+    terms = (actuator.gear_ratio, settings.nuisances)
+    beta, eta_o, sse = solve(total, *terms)
+    left_out = (total[:, None] - blocks).reshape(-1, *total.shape[1:])
+    beta_b, eta_b = (x.reshape(len(total), blocks.shape[1], -1) for x in solve(left_out, *terms)[:2])
+    std = _jackknife_std(beta_b)
+    eta_o_std = _jackknife_std(eta_b[..., 0])
+    enough = total[:, -1, -1] >= MIN_SLIDING_KERNELS * kernel_samples(rate, settings.derivative_window_s)
     nan = np.where(enough, 1.0, np.nan)
+    zero = np.zeros(len(total))
+    terms_of = {name: (beta[:, i] * nan, std[:, i] * nan) for i, name in enumerate(settings.nuisances, start=1)}
+    offset, viscous, scale = (terms_of.get(name, (zero, zero)) for name in NUISANCES)
     edge = (eta_o <= ETA_O_SEARCH[0] + 1e-4) | (eta_o >= ETA_O_SEARCH[1] - 1e-4)
     return FrictionFit(
-        fdj_nm=fdj * nan,
+        fdj_nm=beta[:, 0] * nan,
         eta_o=eta_o * nan,
-        fdj_std_nm=_jackknife_std(fdj_b) * nan,
-        eta_o_std=_jackknife_std(eta_b) * nan,
-        offset_nm=offset * nan,
-        offset_std_nm=_jackknife_std(offset_b) * nan,
-        viscous_nms=viscous * nan,
-        viscous_std_nms=_jackknife_std(viscous_b) * nan,
-        residual_rms_nm=np.sqrt(np.maximum(sse, 0.0) / np.maximum(total[:, M], 1.0)) * nan,
-        n_sliding=total[:, M].astype(np.int64),
+        fdj_std_nm=std[:, 0] * nan,
+        eta_o_std=eta_o_std * nan,
+        offset_nm=offset[0],
+        offset_std_nm=offset[1],
+        viscous_nms=viscous[0],
+        viscous_std_nms=viscous[1],
+        torque_scale=scale[0],
+        torque_scale_std=scale[1],
+        residual_rms_nm=np.sqrt(np.maximum(sse, 0.0) / np.maximum(total[:, -1, -1], 1.0)) * nan,
+        n_sliding=total[:, -1, -1].astype(np.int64),
         at_search_edge=edge & enough,
     )
 

@@ -95,3 +95,20 @@ def test_a_viscous_coefficient_beyond_the_actuators_is_read_exactly_and_moves_no
     assert more.fdj_nm[0] == pytest.approx(plain.fdj_nm[0], rel=1e-6)
     assert more.eta_o[0] == pytest.approx(plain.eta_o[0], rel=1e-6)
     assert abs(plain.viscous_nms[0]) < 4 * plain.viscous_std_nms[0]  # the spec's C: no change within its std
+
+
+def test_a_scaled_motor_torque_is_read_exactly_and_moves_nothing_else():
+    """A current logged 3 % low (or k_T 3 % above the spec's): the scale fit reads γ = 1/0.97 − 1, FDJ and η_O
+    stay put; without it, FDJ moves by several % of its range."""
+    window = synthetic_window(HealthParams.single(0.1, 0.052, 0.8), seed=5, noise=SensorNoise())
+    unclipped = ActuatorParams(max_motor_torque_nm=100.0)  # no sample saturated: the scale holds everywhere
+    settings = FitSettings(offset=True, torque_scale=True)
+    plain = fit_friction(window.signals, 10_000.0, unclipped, settings)
+    low = dict(window.signals, current_a=0.97 * window.signals["current_a"])
+    scaled = fit_friction(low, 10_000.0, unclipped, settings)
+    assert (1 + scaled.torque_scale[0]) / (1 + plain.torque_scale[0]) == pytest.approx(1 / 0.97, rel=1e-9)
+    assert scaled.fdj_nm[0] == pytest.approx(plain.fdj_nm[0], rel=1e-6)
+    assert scaled.eta_o[0] == pytest.approx(plain.eta_o[0], rel=1e-6)
+    assert abs(plain.torque_scale[0]) < 4 * plain.torque_scale_std[0]  # the spec's k_T: no scale within its std
+    unread = fit_friction(low, 10_000.0, unclipped)
+    assert abs(unread.fdj_nm[0] - plain.fdj_nm[0]) > 0.05 * 0.02
