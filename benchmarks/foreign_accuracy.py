@@ -62,6 +62,9 @@ def groups() -> dict[str, Callable[..., Draw]]:
     out["worn, sensors off zero"] = lambda s, **kw: worn(s, family=FAMILIES[s % 5], effects=off_zero(s), **kw)
     out["worn, viscous 1.2-2x"] = lambda s, **kw: worn(s, family=FAMILIES[s % 5], effects=viscous(s), **kw)
     out["held position"] = lambda s, **kw: draw(s, "hold", **kw)
+    # appended: a group's seeds follow its place in this list (``group_seed``)
+    out["k_T or current gain off"] = lambda s, **kw: draw(s, FAMILIES[s % 5], effects=scaled(s), **kw)
+    out["worn, k_T or current gain off"] = lambda s, **kw: worn(s, family=FAMILIES[s % 5], effects=scaled(s), **kw)
     return out
 
 
@@ -91,6 +94,15 @@ def off_zero(seed: int) -> Effects:
 def viscous(seed: int) -> Effects:
     """Viscous friction 1.2–2x the spec's C (a cold grease), unlogged, as a change of temperature is."""
     return Effects(viscous_factor=float(np.random.default_rng(40_000 + seed).uniform(1.2, 2.0)))
+
+
+def scaled(seed: int) -> Effects:
+    """The motor's torque per logged current off the spec's, unlogged: in turn k_T 0.95–1.05x (the magnets
+    warm or cold) and the current sensor's gain 0.97–1.03 (fed back to its loop, too)."""
+    rng = np.random.default_rng(50_000 + seed)
+    if seed % 2:
+        return Effects(current_sensor_gain=rng.uniform(0.97, 1.03))
+    return Effects(torque_constant_gain=rng.uniform(0.95, 1.05))
 
 
 def group_seed(group: str, i: int, first: int = 7000) -> int:
@@ -248,6 +260,9 @@ def report(rows: dict[str, list[dict[str, Any]]], per_group: int, seconds: float
         "has it (`viscous`), read per window and used by every estimator (`training.viscosity`). The",
         "*worn* groups with these two: a worn transmission's k = 1/η_O − 1 reaches 1.2, and so does the",
         "share of a hinge offset that passes for FDJ where the window cannot tell which sensor is off.",
+        "*k_T or current gain off*: the five families with, in turn, k_T 0.95–1.05x the spec's (magnets",
+        "warm or cold) and the current sensor's gain 0.97–1.03 (`scaled`), read per window and the current",
+        "rescaled (`training.torque_scale`); and on worn actuators.",
         f"Total {seconds:.0f} s.",
         "",
         table(summaries),

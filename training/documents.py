@@ -104,6 +104,11 @@ class WindowInfo(Document):
     hinge_lag_s: float = Field(default=0.0, description="how late the hinge moment is logged (its filter), undone")
     hinge_offset_nm: float = Field(default=0.0, description="taken off the logged hinge moment (a sensor off zero)")
     current_offset_a: float = Field(default=0.0, description="taken off the logged current (a sensor off zero)")
+    torque_scale: float = Field(
+        default=1.0,
+        description="the motor's torque per spec k_T·I as read (k_T warm or cold, a current sensor's gain); "
+        "the current was multiplied by it before every estimator",
+    )
     viscous_factor: float = Field(
         default=1.0,
         description="the viscous coefficient every estimator used over the spec's C_M (read where it departs)",

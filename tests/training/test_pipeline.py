@@ -253,3 +253,20 @@ def test_the_result_is_the_typed_contract_and_carries_its_config():
     assert Estimate.model_validate(document) == result
     assert result.config == SMALL
     assert result.estimates.FDJ.drift_pct == pytest.approx(100 * (result.estimates.FDJ.value / 0.05 - 1))
+
+
+@pytest.mark.parametrize(
+    ("seed", "family", "effects", "factor"),
+    [(87, "gust", Effects(torque_constant_gain=1.04), 1.04),
+     (88, "thesis", Effects(current_sensor_gain=0.985), 1 / 0.985)],
+)  # fmt: skip
+def test_a_torque_constant_or_current_gain_off_the_specs_is_read_and_the_answer_within_its_std(
+    seed, family, effects, factor
+):
+    """Read with the spec's k_T (``spec_only``), FDJ was 30 and 15 % of range off, the answers said weak."""
+    drawn = draw(seed, family, effects=effects)
+    result = _estimate(drawn)
+    assert result.window.torque_scale == pytest.approx(factor, abs=0.002)
+    assert any("times the spec's k_T·I" in note for note in result.notes)
+    for name, (of_range, z) in _errors(result, drawn.truth).items():
+        assert of_range < 3.0 and z < 2.5, name
