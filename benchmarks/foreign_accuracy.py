@@ -15,99 +15,22 @@ from __future__ import annotations
 
 import argparse
 import time
-from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from benchmarks.foreign_groups import group_seed, groups
 from clients.report import write_section
 from sim import runtime
 from sim.checks import InputError
 from sim.window import window_from_dict
-from tests.foreign.windows import Draw, Effects, draw, filter_widths, through_filters, with_spikes, worn
+from tests.foreign.windows import Draw
 from training.pipeline import estimate_window
 from training.result import HEALTHY_RANGE, WEAK_SHARE_OF_RANGE, share_of_range
 
 RESULTS_MD = Path(__file__).resolve().parent.parent / "docs" / "results.md"
 BOUND = 0.10  # issue 9: no window's error over 10 % of the range
-FAMILIES = ("thesis", "cruise", "gust", "doublet", "steps")
-
-
-def groups() -> dict[str, Callable[..., Draw]]:
-    """Named groups of windows, each a function of a seed (keywords pass on to ``draw``: ``noise_level=0``
-    gives the same window without its sensor noise)."""
-    out: dict[str, Callable[..., Draw]] = {f: (lambda s, f=f, **kw: draw(s, f, **kw)) for f in FAMILIES}
-    out["long window (2 s, cruise)"] = lambda s, **kw: draw(s, "cruise", duration_s=2.0, **kw)
-    out["short window (0.1 s, gust)"] = lambda s, **kw: draw(s, "gust", duration_s=0.1, **kw)
-    out["low log rate (1-2 kHz)"] = lambda s, **kw: draw(
-        s, FAMILIES[s % 5], sample_rate_hz=(1_000.0, 2_000.0)[s % 2], **kw
-    )
-    out["high log rate (50-100 kHz)"] = lambda s, **kw: draw(
-        s, FAMILIES[s % 5], sample_rate_hz=(50_000.0, 100_000.0)[s % 2], **kw
-    )
-    out["odd log rate (3 kHz, 12.8 kHz)"] = lambda s, **kw: draw(
-        s, FAMILIES[s % 5], sample_rate_hz=(3_000.0, 12_800.0)[s % 2], **kw
-    )
-    for family in FAMILIES:
-        out[f"worn, {family}"] = lambda s, f=family, **kw: worn(s, family=f, **kw)
-    out["drive unlike the spec's"] = lambda s, **kw: draw(s, FAMILIES[s % 5], effects=unlike_the_spec(s), **kw)
-    out["sensors behind filters"] = lambda s, **kw: through_filters(draw(s, FAMILIES[s % 5], **kw), filter_widths(s))
-    out["noise behind filters, not the signal"] = lambda s, **kw: draw(
-        s, FAMILIES[s % 5], filter_samples=filter_widths(s), **kw
-    )
-    out["sensor glitches"] = lambda s, **kw: with_spikes(draw(s, FAMILIES[s % 5], **kw), s)
-    out["sensors off zero"] = lambda s, **kw: draw(s, FAMILIES[s % 5], effects=off_zero(s), **kw)
-    out["viscous friction 1.2-2x the spec's"] = lambda s, **kw: draw(s, FAMILIES[s % 5], effects=viscous(s), **kw)
-    out["worn, sensors off zero"] = lambda s, **kw: worn(s, family=FAMILIES[s % 5], effects=off_zero(s), **kw)
-    out["worn, viscous 1.2-2x"] = lambda s, **kw: worn(s, family=FAMILIES[s % 5], effects=viscous(s), **kw)
-    out["held position"] = lambda s, **kw: draw(s, "hold", **kw)
-    # appended: a group's seeds follow its place in this list (``group_seed``)
-    out["k_T or current gain off"] = lambda s, **kw: draw(s, FAMILIES[s % 5], effects=scaled(s), **kw)
-    out["worn, k_T or current gain off"] = lambda s, **kw: worn(s, family=FAMILIES[s % 5], effects=scaled(s), **kw)
-    return out
-
-
-def unlike_the_spec(seed: int) -> Effects:
-    """A drive whose loop departs from the spec's, unlogged: bus ±10 %, position gain ±2 %, the command
-    reaching the loop up to 50 µs late, the loop reading a speed as noisy as the logged one (up to 0.5 rad/s)."""
-    rng = np.random.default_rng(20_000 + seed)
-    return Effects(
-        supply_voltage_factor=rng.uniform(0.9, 1.1),
-        position_gain_factor=rng.uniform(0.98, 1.02),
-        loop_delay_s=rng.uniform(0.0, 5e-5),
-        loop_noise_radps=rng.uniform(0.0, 0.5),
-        loop_noise_seed=seed,
-    )
-
-
-def off_zero(seed: int) -> Effects:
-    """A sensor off zero, unlogged: in turn the hinge moment by 1–10 N·m and the current by 0.04–0.25 A
-    (the same torque at the shaft; the current's offset is fed back to its loop, too)."""
-    rng = np.random.default_rng(30_000 + seed)
-    sign = float(rng.choice([-1.0, 1.0]))
-    if seed % 2:
-        return Effects(current_bias_a=sign * rng.uniform(0.04, 0.25))
-    return Effects(hinge_bias_nm=sign * rng.uniform(1.0, 10.0))
-
-
-def viscous(seed: int) -> Effects:
-    """Viscous friction 1.2–2x the spec's C (a cold grease), unlogged, as a change of temperature is."""
-    return Effects(viscous_factor=float(np.random.default_rng(40_000 + seed).uniform(1.2, 2.0)))
-
-
-def scaled(seed: int) -> Effects:
-    """The motor's torque per logged current off the spec's, unlogged: in turn k_T 0.95–1.05x (the magnets
-    warm or cold) and the current sensor's gain 0.97–1.03 (fed back to its loop, too)."""
-    rng = np.random.default_rng(50_000 + seed)
-    if seed % 2:
-        return Effects(current_sensor_gain=rng.uniform(0.97, 1.03))
-    return Effects(torque_constant_gain=rng.uniform(0.95, 1.05))
-
-
-def group_seed(group: str, i: int, first: int = 7000) -> int:
-    """The seed of window ``i`` of ``group``: each group its own thousand, so groups never share a window."""
-    return first + 1000 * list(groups()).index(group) + i
 
 
 def run_one(window: Draw) -> dict[str, Any]:
@@ -260,9 +183,9 @@ def report(rows: dict[str, list[dict[str, Any]]], per_group: int, seconds: float
         "has it (`viscous`), read per window and used by every estimator (`training.viscosity`). The",
         "*worn* groups with these two: a worn transmission's k = 1/η_O − 1 reaches 1.2, and so does the",
         "share of a hinge offset that passes for FDJ where the window cannot tell which sensor is off.",
-        "*k_T or current gain off*: the five families with, in turn, k_T 0.95–1.05x the spec's (magnets",
-        "warm or cold) and the current sensor's gain 0.97–1.03 (`scaled`), read per window and the current",
-        "rescaled (`training.torque_scale`); and on worn actuators.",
+        "*k_T, current gain or J_M off*: the five families with, in turn, k_T 0.95–1.05x the spec's (magnets",
+        "warm or cold), the current sensor's gain 0.97–1.03 and J_M 0.9–1.1x (`drive_off`), read per window",
+        "and corrected (`training.drive_constants`); and on worn actuators.",
         f"Total {seconds:.0f} s.",
         "",
         table(summaries),

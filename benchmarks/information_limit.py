@@ -33,7 +33,8 @@ from typing import Any
 
 import numpy as np
 
-from benchmarks.foreign_accuracy import BOUND, RESULTS_MD, group_seed, groups
+from benchmarks.foreign_accuracy import BOUND, RESULTS_MD
+from benchmarks.foreign_groups import group_seed, groups
 from clients.report import write_section
 from sim import runtime
 from sim.hinge import HINGE_SMOOTHING_S, local_line

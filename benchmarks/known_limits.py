@@ -11,7 +11,8 @@ import time
 from collections.abc import Callable
 from typing import Any
 
-from benchmarks.foreign_accuracy import FAMILIES, RESULTS_MD, off_zero, run_one, summarize, table, viscous
+from benchmarks.foreign_accuracy import RESULTS_MD, run_one, summarize, table
+from benchmarks.foreign_groups import FAMILIES, off_zero, viscous
 from clients.report import write_section
 from sim import runtime
 from tests.foreign.windows import Draw, draw, filter_widths, through_filters

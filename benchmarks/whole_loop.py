@@ -33,7 +33,8 @@ from dataclasses import replace
 
 import numpy as np
 
-from benchmarks.foreign_accuracy import RESULTS_MD, group_seed, groups
+from benchmarks.foreign_accuracy import RESULTS_MD
+from benchmarks.foreign_groups import group_seed, groups
 from benchmarks.information_limit import GROUPS, SENSORS, expected_over, noise_levels
 from clients.report import write_section
 from sim import runtime

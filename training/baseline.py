@@ -6,15 +6,15 @@ through the same smoothing kernel as the reconstruction (``sim.residual``), whic
 model linear in FDJ and k: with t = sgn(ω)·(T_R − C·ω), a and o the smoothed aiding and opposing
 |T_ext|, t = FDJ + k_aid·a + k_opp·o. η_A is tied to η_O by Eq. 3.4, so the fit is a search over
 η_O with FDJ in closed form at each point. Where asked, nuisances join FDJ in that closed form
-(``nuisance_columns``): a constant torque c (t gains c·sgn ω: a sensor off zero,
-``training.zero_offset``), a change ΔC of the viscous coefficient (t gains ΔC·|ω|,
-``training.viscosity``) and a scale γ of the motor torque (t loses γ·sgn ω·k_T·I: k_T or the current
-sensor's gain off, ``training.torque_scale``).
+(``nuisance_columns``): a constant torque c (a sensor off zero, ``training.zero_offset``), a change
+ΔC of the viscous coefficient (``training.viscosity``), a scale γ of the motor torque and a change
+ΔJ of the inertia (k_T, a current sensor's gain or J_M off, ``training.drive_constants``).
 
 Everything the search needs is the matrix of sums Σ z·zᵀ per window, z = (t, a, o, nuisances…, 1)
 (ten numbers without nuisances), so a batch of simulated windows is fitted at the cost of one pass
 over its samples, and a block jackknife (the sums of B contiguous time blocks, each left out in
-turn) gives a standard error from the window itself: one that grows when the residual holds structure the model lacks.
+turn) gives a standard error from the window itself, one that grows when the residual holds
+structure the model lacks.
 """
 
 from __future__ import annotations
@@ -33,6 +33,7 @@ from sim.residual import (
     above_throughout,
     kernel_samples,
     residual_torque_nm,
+    smooth_derivative,
     smoothed,
 )
 
@@ -41,7 +42,7 @@ GRID_POINTS = 41
 REFINEMENTS = 3  # coarse-to-fine passes: η_O to ~1e-5 (the SSE is smooth and unimodal in η_O)
 JACKKNIFE_BLOCKS = 10
 MIN_SLIDING_KERNELS = 10  # fewer sliding samples than 10 kernel widths: too little motion to fit
-NUISANCES = ("offset", "viscous", "torque_scale")  # the terms a fit may carry beside FDJ, in this order
+NUISANCES = ("offset", "viscous", "torque_scale", "inertia")  # the terms a fit may carry beside FDJ, in this order
 
 
 @dataclass(frozen=True)
@@ -52,6 +53,7 @@ class FitSettings:
     offset: bool = False  # also fit a constant torque at the shaft (a current or hinge sensor off zero)
     viscous: bool = False  # also fit a change ΔC of the viscous coefficient (C·|ω| beyond the spec's)
     torque_scale: bool = False  # also fit γ, the motor torque per logged k_T·I beyond 1 (k_T or a current gain off)
+    inertia: bool = False  # also fit ΔJ, the inertia at the motor shaft beyond the actuator's J_M
 
     def __post_init__(self) -> None:
         if self.min_speed_radps <= 0:
@@ -64,10 +66,8 @@ class FitSettings:
         return tuple(name for name in NUISANCES if getattr(self, name))
 
 
-FIT_ARRAYS = (
-    "fdj_nm", "eta_o", "fdj_std_nm", "eta_o_std", "offset_nm", "offset_std_nm", "viscous_nms", "viscous_std_nms",
-    "torque_scale", "torque_scale_std", "residual_rms_nm", "n_sliding", "at_search_edge",
-)  # fmt: skip
+FIT_ARRAYS = ("fdj_nm", "eta_o", "fdj_std_nm", "eta_o_std", "terms", "term_stds", "residual_rms_nm", "n_sliding",
+              "at_search_edge")  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -78,15 +78,21 @@ class FrictionFit:
     eta_o: np.ndarray
     fdj_std_nm: np.ndarray
     eta_o_std: np.ndarray
-    offset_nm: np.ndarray  # the constant torque at the shaft T_R holds beyond friction (0 unless fitted)
-    offset_std_nm: np.ndarray
-    viscous_nms: np.ndarray  # ΔC [N·m·s/rad] beyond the actuator's C (0 unless fitted)
-    viscous_std_nms: np.ndarray
-    torque_scale: np.ndarray  # γ: the motor's torque is (1 + γ)·k_T·I where unsaturated (0 unless fitted)
-    torque_scale_std: np.ndarray
+    # (N, len(NUISANCES)), 0 where not fitted: the constant torque c [N·m] at the shaft T_R holds beyond
+    # friction, ΔC [N·m·s/rad] beyond the actuator's C, γ (the motor's torque is (1 + γ)·k_T·I where
+    # unsaturated), ΔJ [kg·m²] beyond the actuator's J_M
+    terms: np.ndarray
+    term_stds: np.ndarray
     residual_rms_nm: np.ndarray  # RMS equation error over the sliding samples
     n_sliding: np.ndarray  # samples used
     at_search_edge: np.ndarray  # η_O at an end of ETA_O_SEARCH: a bound, not an estimate
+
+    def term(self, name: str) -> np.ndarray:
+        """The nuisance ``name``'s fitted value per window (its unit: ``terms``)."""
+        return self.terms[:, NUISANCES.index(name)]
+
+    def term_std(self, name: str) -> np.ndarray:
+        return self.term_stds[:, NUISANCES.index(name)]
 
     @property
     def eta_a(self) -> np.ndarray:
@@ -127,17 +133,18 @@ def nuisance_columns(
 ) -> list[np.ndarray]:
     """The columns of ``settings.nuisances``, each (N, n) and, like the target, signed by the direction s:
     s itself (a constant torque), |ω| smoothed (ΔC), −k_T·I smoothed where the motor is not saturated (γ:
-    T_R misses γ·k_T·I there; where k_T·I is cut at the peak torque, it misses nothing)."""
-    window_s = settings.derivative_window_s
-    direction = np.sign(np.atleast_2d(signals["motor_speed_radps"]))
-    columns = {"offset": lambda: direction}
-    columns["viscous"] = lambda: direction * smoothed(np.atleast_2d(signals["motor_speed_radps"]), rate, window_s)
-
-    def scale() -> np.ndarray:
-        motor = actuator.torque_constant_nm_per_a * np.atleast_2d(signals["current_a"])
-        return -direction * smoothed(motor * (np.abs(motor) < actuator.max_motor_torque_nm), rate, window_s)
-
-    columns["torque_scale"] = scale
+    T_R misses γ·k_T·I there; where k_T·I is cut at the peak torque, it misses nothing), and the
+    reconstruction's dω/dt (ΔJ: T_R holds ΔJ·dω/dt too much)."""
+    window_s, peak = settings.derivative_window_s, actuator.max_motor_torque_nm
+    speed = np.atleast_2d(signals["motor_speed_radps"])
+    direction = np.sign(speed)
+    motor = actuator.torque_constant_nm_per_a * np.atleast_2d(signals["current_a"])
+    columns = {
+        "offset": lambda: direction,
+        "viscous": lambda: direction * smoothed(speed, rate, window_s),
+        "torque_scale": lambda: -direction * smoothed(motor * (np.abs(motor) < peak), rate, window_s),
+        "inertia": lambda: direction * smooth_derivative(speed, rate, window_s),
+    }
     return [columns[name]() for name in settings.nuisances]
 
 
@@ -168,8 +175,8 @@ def _block_sums(columns, mask, edges, out):
 
 
 # An offset needs motion both ways: with fewer than this share of the samples in the rarer direction,
-# it cannot be told from FDJ and is not fitted. ΔC and γ need columns that vary: a coefficient of variation
-# below this, and they cannot be told from FDJ either.
+# it cannot be told from FDJ and is not fitted. ΔC, γ and ΔJ need columns that vary: a coefficient of
+# variation below this, and they cannot be told from FDJ either.
 MIN_OFFSET_BALANCE = 0.05
 MIN_VARIATION = 0.05
 
@@ -253,29 +260,25 @@ def fit_friction(
     columns = [t, a, o, *nuisance_columns(signals, rate, actuator, settings)]
     blocks = block_statistics(columns, mask, settings.blocks)  # (N, B, P, P)
     total = blocks.sum(axis=1)
-    terms = (actuator.gear_ratio, settings.nuisances)
-    beta, eta_o, sse = solve(total, *terms)
+    model = (actuator.gear_ratio, settings.nuisances)
+    beta, eta_o, sse = solve(total, *model)
     left_out = (total[:, None] - blocks).reshape(-1, *total.shape[1:])
-    beta_b, eta_b = (x.reshape(len(total), blocks.shape[1], -1) for x in solve(left_out, *terms)[:2])
+    beta_b, eta_b = (x.reshape(len(total), blocks.shape[1], -1) for x in solve(left_out, *model)[:2])
     std = _jackknife_std(beta_b)
     eta_o_std = _jackknife_std(eta_b[..., 0])
     enough = total[:, -1, -1] >= MIN_SLIDING_KERNELS * kernel_samples(rate, settings.derivative_window_s)
     nan = np.where(enough, 1.0, np.nan)
-    zero = np.zeros(len(total))
-    terms_of = {name: (beta[:, i] * nan, std[:, i] * nan) for i, name in enumerate(settings.nuisances, start=1)}
-    offset, viscous, scale = (terms_of.get(name, (zero, zero)) for name in NUISANCES)
+    terms, term_stds = np.zeros((2, len(total), len(NUISANCES)))
+    for i, name in enumerate(settings.nuisances, start=1):
+        terms[:, NUISANCES.index(name)], term_stds[:, NUISANCES.index(name)] = beta[:, i], std[:, i]
     edge = (eta_o <= ETA_O_SEARCH[0] + 1e-4) | (eta_o >= ETA_O_SEARCH[1] - 1e-4)
     return FrictionFit(
         fdj_nm=beta[:, 0] * nan,
         eta_o=eta_o * nan,
         fdj_std_nm=std[:, 0] * nan,
         eta_o_std=eta_o_std * nan,
-        offset_nm=offset[0],
-        offset_std_nm=offset[1],
-        viscous_nms=viscous[0],
-        viscous_std_nms=viscous[1],
-        torque_scale=scale[0],
-        torque_scale_std=scale[1],
+        terms=terms * nan[:, None],
+        term_stds=term_stds * nan[:, None],
         residual_rms_nm=np.sqrt(np.maximum(sse, 0.0) / np.maximum(total[:, -1, -1], 1.0)) * nan,
         n_sliding=total[:, -1, -1].astype(np.int64),
         at_search_edge=edge & enough,

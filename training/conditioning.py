@@ -1,6 +1,6 @@
 """A logged window made ready for the pipeline: isolated glitches repaired, a bounded number of
 samples, its sensors on one clock (``training.alignment``) and on zero (``training.zero_offset``),
-its current on the spec's k_T (``training.torque_scale``), its viscous coefficient read
+its current on the spec's k_T and J_M (``training.drive_constants``), its viscous coefficient read
 (``training.viscosity``), and what was done to it.
 
 A sensor's sample that jumps away from both neighbours and straight back (an EMI spike, a bit
@@ -39,8 +39,8 @@ from sim.noise import NOISY_SIGNALS
 from sim.params import ActuatorParams
 from sim.window import Window
 from training.alignment import Lags, aligned
+from training.drive_constants import DriveConstants, drive_constants_note, read_drive_constants
 from training.noise_level import white_noise_std
-from training.torque_scale import TorqueScale, read_torque_scale, rescaled, torque_scale_note
 from training.viscosity import Viscosity, read_viscosity, viscosity_note
 from training.zero_offset import ZeroOffset, offset_note, read_zero_offset, zeroed
 
@@ -63,8 +63,13 @@ class Prepared:
     glitches: dict[str, int]  # per sensor, samples of glitches replaced by the line between their flanks
     lags: Lags  # how late the current (behind the speed) and the hinge moment were logged, undone
     offset: ZeroOffset  # a sensor off zero, taken off
-    scale: TorqueScale  # the motor's torque per spec k_T·I, where it departs from 1: the current rescaled
+    drive: DriveConstants  # k_T and J_M where they depart from the spec's: the current carries them
     viscosity: Viscosity  # the viscous coefficient, where it departs from the spec's
+
+    @property
+    def actuator(self) -> ActuatorParams:
+        """What every reconstruction and fit of the window reads it with: the spec's, J_M and C as read."""
+        return self.viscosity.actuator(self.drive.actuator)
 
 
 def averaging_factor(n_samples: int, rate_hz: float) -> int:
@@ -124,7 +129,7 @@ def repaired(window: Window) -> tuple[Window, dict[str, int]]:
 def prepare(window: Window, actuator: ActuatorParams = ActuatorParams(), spec_only: bool = False) -> Prepared:
     """Repair ``window``'s glitches, average it down to the pipeline's sizes, put its sensors on one
     clock (``training.alignment``), take a sensor's offset off (``training.zero_offset``), put the current
-    on the spec's k_T (``training.torque_scale``) and read the viscous coefficient (``training.viscosity``);
+    on the spec's k_T and J_M (``training.drive_constants``) and read the viscous coefficient (``training.viscosity``);
     say what it found. ``spec_only`` skips the last three:
     ``calibration`` reads the spec's model alone and names what departs from it."""
     window, glitches = repaired(window)
@@ -136,34 +141,34 @@ def prepare(window: Window, actuator: ActuatorParams = ActuatorParams(), spec_on
         signals = {name: values[:n].reshape(-1, factor).mean(axis=1) for name, values in window.signals.items()}
         window = replace(window, signals=signals, sample_rate_hz=window.sample_rate_hz / factor)
     window, lags = aligned(window)
-    offset, scale, viscosity = ZeroOffset(), TorqueScale(), Viscosity()
+    offset, drive, viscosity = ZeroOffset(), DriveConstants(), Viscosity()
     if not spec_only:
-        window, offset, scale = on_zero_and_scale(window, actuator)
-        viscosity = read_viscosity(window, actuator)
+        window, offset, drive = on_zero_and_drive(window, actuator)
+        viscosity = read_viscosity(window, drive.actuator)
     rate = window.sample_rate_hz * factor
-    return Prepared(window, factor, len(command), rate, clipped, glitches, lags, offset, scale, viscosity)
+    return Prepared(window, factor, len(command), rate, clipped, glitches, lags, offset, drive, viscosity)
 
 
-def on_zero_and_scale(window: Window, actuator: ActuatorParams) -> tuple[Window, ZeroOffset, TorqueScale]:
-    """``window`` with a sensor's offset taken off and its current on the spec's k_T, and what was read.
+def on_zero_and_drive(window: Window, actuator: ActuatorParams) -> tuple[Window, ZeroOffset, DriveConstants]:
+    """``window`` with a sensor's offset taken off and its current on the spec's k_T and J_M, and what was read.
 
-    A scale of the motor torque, seen before it is read, passes in part for an offset (a thesis window's
-    current logged 1.5 % low read as 2.2 mN·m off zero, which left FDJ 11 % of range off once the scale
-    was read too), so where a scale is read the offset is read again on the rescaled window (the logged
-    current is s·I + i₀: rescaled, then zeroed)."""
+    A drive constant, seen before it is read, passes in part for an offset (a thesis window's current
+    logged 1.5 % low read as 2.2 mN·m off zero, which left FDJ 11 % of range off once the scale was read
+    too), so where one is read the offset is read again on the corrected window (the logged current is
+    s·I + i₀: corrected, then zeroed)."""
     offset = read_zero_offset(window, actuator)
-    scale = read_torque_scale(zeroed(window, offset), actuator)
-    if not scale.gain:
-        return zeroed(window, offset), offset, scale
-    window = rescaled(window, scale)
-    offset = read_zero_offset(window, actuator)
-    return zeroed(window, offset), offset, scale
+    drive = read_drive_constants(zeroed(window, offset), actuator)
+    if not drive.stds:
+        return zeroed(window, offset), offset, drive
+    window = drive.corrected(window)
+    offset = read_zero_offset(window, drive.actuator)
+    return zeroed(window, offset), offset, drive
 
 
 def widened(stds: dict[str, float], prepared: Prepared) -> dict[str, float]:
     """Each std with what conditioning could not settle (an offset's readings, a lag's band, the viscous
     coefficient's std: their spreads, per target) added in quadrature."""
-    spreads = (prepared.offset.spread, prepared.lags.spread, prepared.scale.spread, prepared.viscosity.spread)
+    spreads = (prepared.offset.spread, prepared.lags.spread, prepared.drive.spread, prepared.viscosity.spread)
     return {name: float(np.sqrt(std**2 + sum(s.get(name, 0.0) ** 2 for s in spreads))) for name, std in stds.items()}
 
 
@@ -176,7 +181,8 @@ def conditioning_done(prepared: Prepared) -> dict[str, Any]:
         "hinge_lag_s": prepared.lags.hinge_s,
         "hinge_offset_nm": prepared.offset.hinge_nm,
         "current_offset_a": prepared.offset.current_a,
-        "torque_scale": prepared.scale.factor,
+        "torque_scale": prepared.drive.torque_factor,
+        "inertia_factor": prepared.drive.inertia_factor,
         "viscous_factor": prepared.viscosity.factor,
     }
 
@@ -200,7 +206,7 @@ def conditioning_notes(prepared: Prepared) -> list[str]:
             f"the hinge moment is logged {1e6 * lags.hinge_s:.0f} µs late (its filter, read from the "
             "correlation of its noise): advanced before Eq. 5.1, the stds include what a misread of it moves"
         )
-    found = (offset_note(prepared.offset), torque_scale_note(prepared.scale), viscosity_note(prepared.viscosity))
+    found = (offset_note(prepared.offset), drive_constants_note(prepared.drive), viscosity_note(prepared.viscosity))
     notes.extend(note for note in found if note)
     if prepared.glitches:
         counts = ", ".join(f"{count} of {name}" for name, count in prepared.glitches.items())

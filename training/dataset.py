@@ -20,7 +20,6 @@ from training.baseline import FitSettings, FrictionFit, regressors
 from training.config import PipelineConfig
 from training.noise_level import excess_noise
 from training.preprocess import as_read, sliding_features
-from training.viscosity import Viscosity
 
 INITIAL_FIT_SAMPLES = 8
 # All the estimators read, and so all drawn with the window's noise (position too: the hinge
@@ -143,24 +142,28 @@ class Data:
     sliding: np.ndarray  # (n_samples,) the window's Eq. 5.1 samples
     inputs: np.ndarray  # (n_total, n_timesteps) network inputs of every simulation
     window_inputs: np.ndarray  # (1, n_timesteps)
-    actuator: ActuatorParams  # as every fit reads it (the viscous coefficient the window shows)
+    actuator: ActuatorParams  # as the window is read (``Prepared.actuator``: J_M and C as it shows them)
 
 
 def simulate_dataset(
-    window: Window, seen: Window, physics: FrictionFit, config: PipelineConfig, viscosity: Viscosity
+    window: Window,
+    seen: Window,
+    physics: FrictionFit,
+    config: PipelineConfig,
+    actuator: ActuatorParams,
+    effects: EffectSet,
 ) -> Data:
     """The box around the physics estimate, the window's sensor noise (measured on ``window`` as logged),
-    the simulations (at the window's viscous coefficient), and the features of both (the window read as
-    ``seen``: through ``as_read``)."""
+    the simulations (the spec's model with ``effects``: the window's viscous coefficient), and the features
+    of both (the window read as ``seen``: through ``as_read``, its T_R with ``actuator``)."""
     box = design.box_around(physics.fdj_nm[0], physics.fdj_std_nm[0], physics.eta_o[0], physics.eta_o_std[0])
-    scenario = scenario_from_window(seen, viscosity.effects())
+    scenario = scenario_from_window(seen, effects)
     health = design.draw(box, config.total_simulations, config.seed)
     sims = simulate_noisy(scenario, health, window, design.centre(box), config.seed + 1, config.check_windows)
     rate = window.sample_rate_hz
     residual = residual_torque_nm(
-        seen.signals["current_a"], seen.signals["motor_speed_radps"], seen.signals["hinge_moment_nm"], rate
+        seen.signals["current_a"], seen.signals["motor_speed_radps"], seen.signals["hinge_moment_nm"], rate, actuator
     )
-    actuator = viscosity.actuator()
     sliding = regressors(seen.signals, rate, actuator, FitSettings(), residual_nm=residual)[3][0]
     n_timesteps = min(config.n_timesteps, window.n_samples)
     inputs = sliding_features(sims.residual_nm, sliding, n_timesteps)

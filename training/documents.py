@@ -109,6 +109,10 @@ class WindowInfo(Document):
         description="the motor's torque per spec k_T·I as read (k_T warm or cold, a current sensor's gain); "
         "the current was multiplied by it before every estimator",
     )
+    inertia_factor: float = Field(
+        default=1.0,
+        description="the inertia at the motor shaft over the spec's J_M as read; the current carries the difference",
+    )
     viscous_factor: float = Field(
         default=1.0,
         description="the viscous coefficient every estimator used over the spec's C_M (read where it departs)",

@@ -80,7 +80,7 @@ def fit_check(window: Window, data: Data, answer: Assessed, equation_ratio: floa
     """Simulate the window at the answer and compare (``training.reproduction``)."""
     health = design.inside(answer.values["FDJ"], answer.values["eta_O"])
     floor = float(np.sqrt(np.mean((data.sims.residual_nm[n:] - data.sims.clean_residual_nm)[:, data.sliding] ** 2)))
-    ratios = output_error_ratios(window, data.scenario, health, data.noise, floor, data.sliding)
+    ratios = output_error_ratios(window, data.scenario, health, data.noise, floor, data.sliding, data.actuator)
     reproduced = ratios["residual_torque"] <= MAX_RATIO
     notes = list(answer.notes)
     if not reproduced:
@@ -112,9 +112,9 @@ def estimate_window(
     prepared = prepare(window, spec_only=spec_only)
     w, n = prepared.window, config.n_simulations
     seen = replace(w, signals=as_read(w.signals, w.sample_rate_hz))
-    physics = fit_window(seen.signals, w.sample_rate_hz, prepared.viscosity.actuator())
+    physics = fit_window(seen.signals, w.sample_rate_hz, prepared.actuator)
     stage(f"simulating {config.total_simulations} windows around the physics estimate")
-    data = simulate_dataset(w, seen, physics, config, prepared.viscosity)
+    data = simulate_dataset(w, seen, physics, config, prepared.actuator, prepared.viscosity.effects())
     clock.append(time.perf_counter())
     stage(f"training {config.members} network(s) of {config.hidden_units} neurons")
     network = train_network(data, config)
@@ -128,6 +128,8 @@ def estimate_window(
     clock.append(time.perf_counter())
     stage("checking the answer against the window")
     check = fit_check(seen, data, answer, equation_ratio, n)
-    fsj = read_static_friction(seen.signals, w.sample_rate_hz, answer.values["FDJ"], answer.values["eta_O"], data.noise)
+    fsj = read_static_friction(
+        seen.signals, w.sample_rate_hz, answer.values["FDJ"], answer.values["eta_O"], data.noise, data.actuator
+    )
     clock.append(time.perf_counter())
     return estimate_document(prepared, physics, data, network, answer, check, fsj, config, clock)

@@ -17,7 +17,7 @@ from collections.abc import Mapping
 import numpy as np
 
 from sim.noise import SensorNoise
-from sim.params import HealthParams
+from sim.params import ActuatorParams, HealthParams
 from sim.residual import residual_torque_nm
 from sim.window import Window
 from training.dataset import Scenario
@@ -34,8 +34,10 @@ def output_error_ratios(
     noise: SensorNoise,
     residual_floor_nm: float,
     sliding: np.ndarray,
+    actuator: ActuatorParams = ActuatorParams(),
 ) -> dict[str, float]:
-    """Per signal, RMS(measured − simulated at ``health``) over its noise-only floor."""
+    """Per signal, RMS(measured − simulated at ``health``) over its noise-only floor; the measured T_R
+    reconstructed with ``actuator`` (as the window is read), the simulated with the spec's it is drawn with."""
     rate = window.sample_rate_hz
     simulated = as_read(scenario.simulate(health, lanes=1).simulation(0), rate)
     measured = window.signals
@@ -48,13 +50,14 @@ def output_error_ratios(
     ratios = {
         name: _rms(measured[name][keep] - simulated[name][keep]) / max(floor, 1e-12) for name, floor in floors.items()
     }
-    torque = _residual(measured, rate) - _residual(simulated, rate)
+    torque = _residual(measured, rate, actuator) - _residual(simulated, rate, ActuatorParams())
     ratios["residual_torque"] = _rms(torque[keep & sliding]) / max(residual_floor_nm, 1e-12)
     return ratios
 
 
-def _residual(signals: Mapping[str, np.ndarray], rate: float) -> np.ndarray:
-    return residual_torque_nm(signals["current_a"], signals["motor_speed_radps"], signals["hinge_moment_nm"], rate)
+def _residual(signals: Mapping[str, np.ndarray], rate: float, actuator: ActuatorParams) -> np.ndarray:
+    current, speed, hinge = signals["current_a"], signals["motor_speed_radps"], signals["hinge_moment_nm"]
+    return residual_torque_nm(current, speed, hinge, rate, actuator)
 
 
 def _rms(values: np.ndarray) -> float:

@@ -64,7 +64,7 @@ def read_viscosity(window: Window, spec: ActuatorParams = ActuatorParams()) -> V
     rate = window.sample_rate_hz
     seen = as_read(window.signals, rate)
     fitted = fit_friction(seen, rate, spec, VISCOUS_FIT)
-    change, std = float(fitted.viscous_nms[0]), float(fitted.viscous_std_nms[0])
+    change, std = float(fitted.term("viscous")[0]), float(fitted.term_std("viscous")[0])
     if not (np.isfinite(change) and std > 0 and abs(change) > max(MIN_Z * std, MIN_CHANGE * spec.viscous_nms)):
         return Viscosity()
     change = float(np.clip(change, *CHANGE_BOUNDS_NMS))

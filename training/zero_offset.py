@@ -62,8 +62,10 @@ class ZeroOffset:
     one_way: bool = False  # the motion goes one way: no offset could be read, FDJ's std carries an unseen one
 
 
-def _fit(signals: dict[str, np.ndarray], rate: float, settings: FitSettings = FitSettings()) -> FrictionFit:
-    return fit_friction(as_read(signals, rate), rate, settings=settings)
+def _fit(
+    signals: dict[str, np.ndarray], rate: float, actuator: ActuatorParams, settings: FitSettings = FitSettings()
+) -> FrictionFit:
+    return fit_friction(as_read(signals, rate), rate, actuator, settings)
 
 
 def _shifted(signals: dict[str, np.ndarray], hinge_nm: float = 0.0, current_a: float = 0.0) -> dict[str, np.ndarray]:
@@ -72,12 +74,15 @@ def _shifted(signals: dict[str, np.ndarray], hinge_nm: float = 0.0, current_a: f
     )
 
 
-def sensor_offset(signals: dict[str, np.ndarray], rate: float, torque_nm: float, sensor: str, per_nm: float) -> float:
-    """The offset of ``sensor`` (``hinge_nm`` or ``current_a``, ``per_nm`` of it per N·m at the shaft) that
-    leaves no constant in T_R: from ``per_nm``·c, refitted as the reading moves (``ITERATIONS``)."""
+def sensor_offset(
+    signals: dict[str, np.ndarray], rate: float, torque_nm: float, sensor: str, actuator: ActuatorParams
+) -> float:
+    """The offset of ``sensor`` (``hinge_nm`` or ``current_a``) that leaves no constant in T_R: from the
+    shaft's c in the sensor's unit, refitted as the reading moves (``ITERATIONS``)."""
+    per_nm = actuator.gear_ratio if sensor == "hinge_nm" else 1.0 / actuator.torque_constant_nm_per_a
     offset = per_nm * torque_nm
     for _ in range(ITERATIONS):
-        left = _fit(_shifted(signals, **{sensor: offset}), rate, OFFSET_FIT).offset_nm[0]
+        left = _fit(_shifted(signals, **{sensor: offset}), rate, actuator, OFFSET_FIT).term("offset")[0]
         if not np.isfinite(left):
             break
         offset += per_nm * float(left)
@@ -96,9 +101,10 @@ def equation_z(plain: FrictionFit, with_offset: FrictionFit, rate: float) -> flo
     return float(np.sqrt(max(0.0, 2.0 * log_likelihood_ratio(plain, with_offset, rate))))
 
 
-def hinge_share(current: FrictionFit, hinge: FrictionFit, rate: float) -> float:
-    """The weight of the hinge reading against the current's: their likelihoods, equal odds before."""
-    return float(1.0 / (1.0 + np.exp(-np.clip(log_likelihood_ratio(current, hinge, rate), -50.0, 50.0))))
+def second_weight(first: FrictionFit, second: FrictionFit, rate: float) -> float:
+    """The weight of the second of two readings of a window against the first: their likelihoods, equal
+    odds before."""
+    return float(1.0 / (1.0 + np.exp(-np.clip(log_likelihood_ratio(first, second, rate), -50.0, 50.0))))
 
 
 def read_zero_offset(window: Window, actuator: ActuatorParams = ActuatorParams()) -> ZeroOffset:
@@ -106,17 +112,17 @@ def read_zero_offset(window: Window, actuator: ActuatorParams = ActuatorParams()
     stds better, and the two readings of it (module docstring) weighed; or the note that the motion goes
     one way."""
     rate, signals = window.sample_rate_hz, dict(window.signals)
-    found = _fit(signals, rate, OFFSET_FIT)
-    torque, std = float(found.offset_nm[0]), float(found.offset_std_nm[0])
+    found = _fit(signals, rate, actuator, OFFSET_FIT)
+    torque, std = float(found.term("offset")[0]), float(found.term_std("offset")[0])
     if std == 0.0:  # too little motion the other way to tell an offset from FDJ (``baseline.MIN_OFFSET_BALANCE``)
         return ZeroOffset(one_way=True, spread={"FDJ": UNSEEN_CURRENT_OFFSET_A * actuator.torque_constant_nm_per_a})
-    if not (np.isfinite(torque) and equation_z(_fit(signals, rate), found, rate) > MIN_Z):
+    if not (np.isfinite(torque) and equation_z(_fit(signals, rate, actuator), found, rate) > MIN_Z):
         return ZeroOffset()
-    current_a = sensor_offset(signals, rate, torque, "current_a", 1.0 / actuator.torque_constant_nm_per_a)
-    hinge_nm = sensor_offset(signals, rate, torque, "hinge_nm", actuator.gear_ratio)
-    as_current = _fit(_shifted(signals, current_a=current_a), rate)
-    as_hinge = _fit(_shifted(signals, hinge_nm=hinge_nm), rate)
-    share = hinge_share(as_current, as_hinge, rate)
+    current_a = sensor_offset(signals, rate, torque, "current_a", actuator)
+    hinge_nm = sensor_offset(signals, rate, torque, "hinge_nm", actuator)
+    as_current = _fit(_shifted(signals, current_a=current_a), rate, actuator)
+    as_hinge = _fit(_shifted(signals, hinge_nm=hinge_nm), rate, actuator)
+    share = second_weight(as_current, as_hinge, rate)
     apart = {
         "FDJ": float(as_hinge.fdj_nm[0] - as_current.fdj_nm[0]),
         "eta_O": float(as_hinge.eta_o[0] - as_current.eta_o[0]),

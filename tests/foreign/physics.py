@@ -53,6 +53,7 @@ class Effects:
 
     viscous_factor: float = 1.0  # total C = factor · C_M
     torque_constant_gain: float = 1.0  # true k_T = k_e over nominal
+    inertia_factor: float = 1.0  # true J_M over the spec's (a rotor, screw and gears reflected otherwise than it says)
     current_sensor_gain: float = 1.0  # logged (and fed back) current over true current
     current_bias_a: float = 0.0  # logged (and fed back) current minus current_sensor_gain × true
     hinge_bias_nm: float = 0.0  # logged hinge moment minus true
@@ -127,7 +128,7 @@ def parameters(setup: Setup) -> np.ndarray:
     p = np.zeros(N_P)
     p[P_GP], p[P_GAP], p[P_R], p[P_L] = 1e5 * e.position_gain_factor, 5e-2, 2.13, 7.2e-4
     p[P_KT] = p[P_KE] = 0.0752 * e.torque_constant_gain
-    p[P_TMAX], p[P_VMAX], p[P_IMAX], p[P_J] = 1.689, 48.0, 22.5, 2.5e-5
+    p[P_TMAX], p[P_VMAX], p[P_IMAX], p[P_J] = 1.689, 48.0, 22.5, 2.5e-5 * e.inertia_factor
     p[P_C], p[P_BLK], p[P_STOP] = 5.172e-5 * e.viscous_factor, 5e-3 * e.backlash_factor, np.radians(30.0)
     p[P_FSJ], p[P_FDJ], p[P_ASYM] = h.fsj_nm, h.fdj_nm, e.fdj_asymmetry
     p[P_KAID], p[P_KOPP] = 1.0 - h.eta_a, 1.0 / h.eta_o - 1.0

@@ -68,17 +68,17 @@ def test_a_constant_torque_is_fitted_beside_friction_and_moves_nothing_else():
     shifted = dict(window.signals, current_a=window.signals["current_a"] + 0.1)
     off = fit_friction(shifted, 10_000.0, settings=settings)
     # exactly, but for the few samples where k_T·I is clipped at the motor's peak torque
-    assert off.offset_nm[0] - plain.offset_nm[0] == pytest.approx(0.1 * 0.0752, rel=5e-3)
+    assert off.term("offset")[0] - plain.term("offset")[0] == pytest.approx(0.1 * 0.0752, rel=5e-3)
     assert off.fdj_nm[0] == pytest.approx(plain.fdj_nm[0], rel=1e-3)
     assert off.eta_o[0] == pytest.approx(plain.eta_o[0], rel=1e-3)
-    assert abs(plain.offset_nm[0]) < 3 * plain.offset_std_nm[0]  # none there: zero within its std
-    assert fit_friction(shifted, 10_000.0).offset_nm[0] == 0.0  # not asked: not fitted
+    assert abs(plain.term("offset")[0]) < 3 * plain.term_std("offset")[0]  # none there: zero within its std
+    assert fit_friction(shifted, 10_000.0).term("offset")[0] == 0.0  # not asked: not fitted
 
 
 def test_an_offset_is_not_fitted_where_the_motion_goes_one_way():
     window = synthetic_window(HealthParams.single(0.1, 0.052, 0.8), seed=5)
     one_way = dict(window.signals, motor_speed_radps=np.abs(window.signals["motor_speed_radps"]))
-    assert fit_friction(one_way, 10_000.0, settings=FitSettings(offset=True)).offset_nm[0] == 0.0
+    assert fit_friction(one_way, 10_000.0, settings=FitSettings(offset=True)).term("offset")[0] == 0.0
 
 
 def test_a_viscous_coefficient_beyond_the_actuators_is_read_exactly_and_moves_nothing_else():
@@ -91,10 +91,10 @@ def test_a_viscous_coefficient_beyond_the_actuators_is_read_exactly_and_moves_no
     more = fit_friction(
         dict(window.signals, current_a=window.signals["current_a"] + extra), 10_000.0, unclipped, settings
     )
-    assert more.viscous_nms[0] - plain.viscous_nms[0] == pytest.approx(3e-5, rel=1e-6)
+    assert more.term("viscous")[0] - plain.term("viscous")[0] == pytest.approx(3e-5, rel=1e-6)
     assert more.fdj_nm[0] == pytest.approx(plain.fdj_nm[0], rel=1e-6)
     assert more.eta_o[0] == pytest.approx(plain.eta_o[0], rel=1e-6)
-    assert abs(plain.viscous_nms[0]) < 4 * plain.viscous_std_nms[0]  # the spec's C: no change within its std
+    assert abs(plain.term("viscous")[0]) < 4 * plain.term_std("viscous")[0]  # the spec's C: no change within its std
 
 
 def test_a_scaled_motor_torque_is_read_exactly_and_moves_nothing_else():
@@ -106,9 +106,13 @@ def test_a_scaled_motor_torque_is_read_exactly_and_moves_nothing_else():
     plain = fit_friction(window.signals, 10_000.0, unclipped, settings)
     low = dict(window.signals, current_a=0.97 * window.signals["current_a"])
     scaled = fit_friction(low, 10_000.0, unclipped, settings)
-    assert (1 + scaled.torque_scale[0]) / (1 + plain.torque_scale[0]) == pytest.approx(1 / 0.97, rel=1e-9)
+    assert (1 + scaled.term("torque_scale")[0]) / (1 + plain.term("torque_scale")[0]) == pytest.approx(
+        1 / 0.97, rel=1e-9
+    )
     assert scaled.fdj_nm[0] == pytest.approx(plain.fdj_nm[0], rel=1e-6)
     assert scaled.eta_o[0] == pytest.approx(plain.eta_o[0], rel=1e-6)
-    assert abs(plain.torque_scale[0]) < 4 * plain.torque_scale_std[0]  # the spec's k_T: no scale within its std
+    assert (
+        abs(plain.term("torque_scale")[0]) < 4 * plain.term_std("torque_scale")[0]
+    )  # the spec's k_T: no scale within its std
     unread = fit_friction(low, 10_000.0, unclipped)
     assert abs(unread.fdj_nm[0] - plain.fdj_nm[0]) > 0.05 * 0.02

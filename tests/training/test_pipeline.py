@@ -257,16 +257,18 @@ def test_the_result_is_the_typed_contract_and_carries_its_config():
 
 @pytest.mark.parametrize(
     ("seed", "family", "effects", "factor"),
-    [(87, "gust", Effects(torque_constant_gain=1.04), 1.04),
-     (88, "thesis", Effects(current_sensor_gain=0.985), 1 / 0.985)],
+    [(87, "gust", Effects(torque_constant_gain=1.04), {"torque_scale": 1.04}),
+     (88, "thesis", Effects(current_sensor_gain=0.985), {"torque_scale": 1 / 0.985}),
+     (89, "steps", Effects(inertia_factor=0.93), {"inertia_factor": 0.93})],
 )  # fmt: skip
-def test_a_torque_constant_or_current_gain_off_the_specs_is_read_and_the_answer_within_its_std(
+def test_a_torque_constant_current_gain_or_inertia_off_the_specs_is_read_and_the_answer_within_its_std(
     seed, family, effects, factor
 ):
-    """Read with the spec's k_T (``spec_only``), FDJ was 30 and 15 % of range off, the answers said weak."""
+    """Read with the spec's constants (``spec_only``), FDJ was 30 and 15 % of range off, η_O 18, 1 and 33 %."""
     drawn = draw(seed, family, effects=effects)
     result = _estimate(drawn)
-    assert result.window.torque_scale == pytest.approx(factor, abs=0.002)
-    assert any("times the spec's k_T·I" in note for note in result.notes)
+    for field, value in factor.items():
+        assert getattr(result.window, field) == pytest.approx(value, abs=0.002)
+    assert any("spec's k_T·I" in note or "spec's J_M" in note for note in result.notes)
     for name, (of_range, z) in _errors(result, drawn.truth).items():
         assert of_range < 3.0 and z < 2.5, name

@@ -1,0 +1,59 @@
+"""The drive's k_T and J_M read per window, on foreign windows (tests/foreign's own torque constant, current
+sensor gain, fed back through its loop, and inertia)."""
+
+import pytest
+
+from sim.window import window_from_dict
+from tests.foreign.windows import Effects, draw
+from training.conditioning import prepare
+from training.drive_constants import DriveConstants
+
+FAMILIES = ("thesis", "cruise", "gust", "doublet", "steps")
+
+
+def _read(seed: int, effects: Effects) -> DriveConstants:
+    drawn = draw(seed, FAMILIES[seed % 5], effects=effects)
+    return prepare(window_from_dict(drawn.document)).drive
+
+
+@pytest.mark.parametrize("gain", [0.96, 1.02, 1.05])
+def test_a_warm_or_cold_motors_torque_constant_is_read_within_its_std(gain):
+    """k_T·gain at the shaft: the current reads gain⁻¹ of what the spec's k_T needs (above 1, the motor's
+    peak torque cuts the saturated samples, where nothing is scaled)."""
+    for seed in range(60, 65):
+        read = _read(seed, Effects(torque_constant_gain=gain))
+        assert read.torque_factor == pytest.approx(gain, abs=max(3 * read.stds["torque_scale"], 0.001)), seed
+        assert read.spread["FDJ"] > 0.0
+
+
+@pytest.mark.parametrize("gain", [0.97, 1.03])
+def test_a_current_sensors_gain_is_read_as_the_inverse_scale(gain):
+    for seed in range(65, 70):
+        read = _read(seed, Effects(current_sensor_gain=gain))
+        assert read.torque_factor == pytest.approx(1 / gain, abs=max(3 * read.stds["torque_scale"], 0.001)), seed
+
+
+def test_a_lighter_inertia_than_the_specs_is_read_on_its_own_not_as_a_scale():
+    """Fitted alone, γ took up most of a ΔJ (J_M 0.92x read as k_T 1.086x, FDJ then 27 % of range off)."""
+    for seed in range(83, 88):
+        read = _read(seed, Effects(inertia_factor=0.93))
+        assert read.inertia_factor == pytest.approx(0.93, abs=max(3 * read.stds["inertia_kgm2"] / 2.5e-5, 0.002))
+        assert read.torque_scale == 0.0, seed
+
+
+def test_a_heavier_inertia_the_window_cannot_tell_from_a_weaker_motor_widens_the_stds():
+    """J_M 1.06x: where the motor saturates as it accelerates, k_T·I 0.94x explains the window as well;
+    γ is read and FDJ's std carries what reading ΔJ instead would change (0.6 of 2–3 mN·m)."""
+    for seed in range(83, 86):
+        read = _read(seed, Effects(inertia_factor=1.06))
+        assert read.torque_factor == pytest.approx(0.94, abs=0.005) and read.inertia_kgm2 == 0.0
+        assert read.spread["FDJ"] > 1e-3
+
+
+def test_the_specs_constants_are_left_alone():
+    """On 420 clean foreign windows of every benchmark group no constant stood MIN_Z stds out; nor do a sensor
+    off zero or a viscous coefficient 1.2–2x the spec's pass for one."""
+    assert all(_read(seed, Effects()) == DriveConstants() for seed in range(70, 80))
+    assert _read(80, Effects(hinge_bias_nm=8.0)) == DriveConstants()
+    assert _read(81, Effects(current_bias_a=-0.2)) == DriveConstants()
+    assert _read(82, Effects(viscous_factor=1.8)) == DriveConstants()

@@ -1,0 +1,172 @@
+"""The drive's k_T and J_M as a window shows them, read where they depart from the spec's.
+
+T_R = k_T·I − J_M·dω/dt + H_e/n takes both constants from the spec, and a real drive has neither
+exactly. A magnet's k_T falls about 0.1 %/K as the motor warms (NdFeB; SmCo a third of that) and a
+Hall current sensor carries a gain error of about 1 %: T_R then misses γ·k_T·I, with γ the motor's
+torque per spec k_T·I less one. A rotor, screw and gear train reflect an inertia the spec rounds:
+T_R then holds ΔJ·dω/dt too much. k_T·I is mostly the hinge load and the inertia, and dω/dt reaches
+6·10⁴ rad/s²: on foreign windows, k_T 0.95–1.05x the spec's put FDJ a mean 53 % of its range off (up
+to 258 %, at up to 14 stds), J_M 0.92–1.06x a mean 21 %, 7 of 10 outside ±2 std.
+
+Friction follows the direction and |T_ext|; k_T·I follows the signed load and the acceleration, dω/dt
+the acceleration alone; so γ and ΔJ are fitted beside FDJ (``baseline.nuisance_columns``), the
+offset and ΔC free too (either might pass for them), and each is read where the fit with it explains
+the window ``MIN_Z`` stds better than the fit without it (``zero_offset.equation_z``). Fitted alone,
+γ takes up most of a ΔJ; fitted together, each is read on its own. The current then carries γ (I' =
+(1 + γ)·I: where k_T·I meets the motor's peak torque the model cuts it, the drive's too) and the
+window's actuator ΔJ (``actuator``: every reconstruction of the window's T_R uses it, the
+simulations keep the spec's, which they are drawn with); the fit is repeated on the corrected window
+until nothing is left (``ITERATIONS``). FDJ's and η_O's stds grow by what each constant's std moves
+them.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from sim.params import ActuatorParams
+from sim.window import Window
+from training.baseline import FitSettings, FrictionFit, fit_friction
+from training.preprocess import as_read
+from training.zero_offset import equation_z, log_likelihood_ratio
+
+MIN_Z = 4.0  # stds by which the fit with a constant must explain the window better
+ITERATIONS = 3  # refits of the corrected window: each settles what the peak torque's cut left
+BESIDE = FitSettings(offset=True, viscous=True)  # what each constant is fitted beside
+FIELDS = {"torque_scale": "torque_scale", "inertia": "inertia_kgm2"}  # the fit's nuisance -> the field it reads
+# Beyond these no drive runs (γ: k_T from −55 to 125 °C and a sensor's gain; ΔJ: of J_M): a read past them
+# is something else the model lacks (a 0.1 s foreign window read J_M 0.27x), which the fit check reports.
+PLAUSIBLE = {"torque_scale": 0.2, "inertia": 0.5}
+# Where both stand out, the log-likelihood ratio of the two readings that decides between them: on 30
+# foreign windows with one of them off it pointed the wrong way by up to 6 (the sensor noise sits in both
+# columns as in the target, and favours one); under this, the window cannot tell them apart.
+DECISIVE = 12.0
+# Undecided, γ is read (k_T moves with temperature from flight to flight, J_M stays with the build), and the
+# stds grow by this share of what reading ΔJ instead would change: on 7 such foreign windows with J_M off,
+# the truth lay 0.87–1.07 of that change from γ's answer.
+UNDECIDED_SHARE = 0.6
+
+
+@dataclass(frozen=True)
+class DriveConstants:
+    """γ and ΔJ read on a window (0: the spec's), and what their stds add to FDJ's and η_O's."""
+
+    torque_scale: float = 0.0  # γ: the motor's torque is (1 + γ)·k_T·I
+    inertia_kgm2: float = 0.0  # ΔJ beyond the spec's J_M
+    stds: dict[str, float] = field(default_factory=dict)  # per field read, its std
+    spread: dict[str, float] = field(default_factory=dict)  # per target, the std the constants' uncertainty adds
+    spec: ActuatorParams = ActuatorParams()
+
+    @property
+    def torque_factor(self) -> float:
+        """The motor's torque per spec k_T·I."""
+        return 1.0 + self.torque_scale
+
+    @property
+    def inertia_factor(self) -> float:
+        """The inertia at the motor shaft over the spec's J_M."""
+        return 1.0 + self.inertia_kgm2 / self.spec.inertia_kgm2
+
+    @property
+    def actuator(self) -> ActuatorParams:
+        """The actuator the window's T_R is reconstructed with: the spec's, its J_M as read."""
+        return replace(self.spec, inertia_kgm2=self.spec.inertia_kgm2 + self.inertia_kgm2)
+
+    def added(self, left: FrictionFit) -> DriveConstants:
+        """These constants with what a fit of the corrected window left of them."""
+        scale = self.torque_factor * (1.0 + float(left.term("torque_scale")[0])) - 1.0
+        return replace(self, torque_scale=scale, inertia_kgm2=self.inertia_kgm2 + float(left.term("inertia")[0]))
+
+    def corrected(self, window: Window) -> Window:
+        """``window`` with its current on the spec's k_T: I' = (1 + γ)·I."""
+        if not self.torque_scale:
+            return window
+        return replace(window, signals=dict(window.signals, current_a=self.torque_factor * window.signals["current_a"]))
+
+
+def _fit(window: Window, actuator: ActuatorParams, settings: FitSettings) -> FrictionFit:
+    rate = window.sample_rate_hz
+    return fit_friction(as_read(window.signals, rate), rate, actuator, settings)
+
+
+def read_drive_constants(window: Window, actuator: ActuatorParams = ActuatorParams()) -> DriveConstants:
+    """γ or ΔJ where it stands out (module docstring), with FDJ's and η_O's change across it ± its std. Where
+    both do, the likelier if the window decides (``DECISIVE``); else γ, the stds widened by what reading ΔJ
+    instead would change (``UNDECIDED_SHARE``)."""
+    rate = window.sample_rate_hz
+    plain = _fit(window, actuator, BESIDE)
+    alone = {name: _fit(window, actuator, replace(BESIDE, **{name: True})) for name in FIELDS}
+    found = [name for name in FIELDS if _stands_out(plain, alone[name], name, rate, actuator)]
+    readings = {name: _reading(window, actuator, name, alone[name]) for name in found}
+    if not readings:
+        return DriveConstants(spec=actuator)
+    if len(readings) == 1:
+        return next(iter(readings.values()))[0]
+    (scale, scale_fit), (inertia, inertia_fit) = readings["torque_scale"], readings["inertia"]
+    ratio = log_likelihood_ratio(scale_fit, inertia_fit, rate)  # for the inertia
+    if abs(ratio) >= DECISIVE:
+        return inertia if ratio > 0 else scale
+    gap = {target: _plain(window, scale)[target] - _plain(window, inertia)[target] for target in scale.spread}
+    spread = {target: float(np.hypot(scale.spread[target], UNDECIDED_SHARE * gap[target])) for target in gap}
+    return replace(scale, spread=spread)
+
+
+def _stands_out(plain: FrictionFit, alone: FrictionFit, name: str, rate: float, spec: ActuatorParams) -> bool:
+    """The fit with constant ``name`` explains the window ``MIN_Z`` stds better, reading it within ``PLAUSIBLE``."""
+    relative = float(alone.term(name)[0]) / (spec.inertia_kgm2 if name == "inertia" else 1.0)
+    return bool(
+        np.isfinite(relative)
+        and alone.term_std(name)[0] > 0  # else the window cannot tell it from FDJ (``baseline._fitted``)
+        and abs(relative) < PLAUSIBLE[name]
+        and equation_z(plain, alone, rate) > MIN_Z
+    )
+
+
+def _reading(
+    window: Window, actuator: ActuatorParams, name: str, first: FrictionFit
+) -> tuple[DriveConstants, FrictionFit]:
+    """Constant ``name``, refitted on the corrected window until nothing is left, with its spread; and the
+    last fit (its likelihood)."""
+    settings = replace(BESIDE, **{name: True})
+    read, left = DriveConstants(spec=actuator, stds={FIELDS[name]: float(first.term_std(name)[0])}), first
+    for _ in range(ITERATIONS + 1):
+        read = read.added(left)
+        left = _fit(read.corrected(window), read.actuator, settings)
+    return replace(read, spread=_spread(window, read)), left
+
+
+def _plain(window: Window, read: DriveConstants) -> dict[str, float]:
+    fitted = _fit(read.corrected(window), read.actuator, FitSettings())
+    return {"FDJ": float(fitted.fdj_nm[0]), "eta_O": float(fitted.eta_o[0])}
+
+
+def _spread(window: Window, read: DriveConstants) -> dict[str, float]:
+    """Per target, half the change of the plain fit across each read constant ± its std, in quadrature."""
+    spread = {"FDJ": 0.0, "eta_O": 0.0}
+    for key, std in read.stds.items():
+        low, high = (_plain(window, replace(read, **{key: getattr(read, key) + d})) for d in (-std, std))
+        spread = {target: float(np.hypot(spread[target], (high[target] - low[target]) / 2)) for target in spread}
+    return spread
+
+
+def drive_constants_note(read: DriveConstants) -> str | None:
+    """The constants in words for the result's notes, or None."""
+    found = []
+    if read.torque_scale:
+        found.append(
+            f"the motor gives {read.torque_factor:.4f} ± {read.stds['torque_scale']:.4f} times the spec's k_T·I (k_T "
+            "moves with the magnets' temperature, a current sensor has a gain error)"
+        )
+    if read.inertia_kgm2:
+        found.append(
+            f"the inertia at the motor is {read.inertia_factor:.3f} ± "
+            f"{read.stds['inertia_kgm2'] / read.spec.inertia_kgm2:.3f} times the spec's J_M"
+        )
+    if not found:
+        return None
+    return (
+        "; ".join(found) + ": the current was corrected for it before every estimator, and the stds include its "
+        "uncertainty; read with the spec's constants, the load and inertia would have passed for friction"
+    )
