@@ -1,7 +1,7 @@
 """A logged window made ready for the pipeline: isolated glitches repaired, a bounded number of
-samples, its sensors on one clock (``training.alignment``) and on zero (``training.zero_offset``),
-its current on the spec's k_T and J_M (``training.drive_constants``), its viscous coefficient read
-(``training.viscosity``), and what was done to it.
+samples, its sensors on one clock (``training.alignment``), what it shows beyond the spec's model
+read and undone (``training.departures``: a sensor off zero, the drive's k_T and J_M, the viscous
+coefficient), and what was done to it.
 
 A sensor's sample that jumps away from both neighbours and straight back (an EMI spike, a bit
 error) is no measurement, nor is a burst of a few of them (``MAX_GLITCH_RUN``, ``MAX_GLITCH_S``:
@@ -39,10 +39,11 @@ from sim.noise import NOISY_SIGNALS
 from sim.params import ActuatorParams
 from sim.window import Window
 from training.alignment import Lags, aligned
-from training.drive_constants import DriveConstants, drive_constants_note, read_drive_constants
+from training.departures import Departures, read_departures
+from training.drive_constants import DriveConstants, drive_constants_note
 from training.noise_level import white_noise_std
-from training.viscosity import Viscosity, read_viscosity, viscosity_note
-from training.zero_offset import ZeroOffset, offset_note, read_zero_offset, zeroed
+from training.viscosity import Viscosity, viscosity_note
+from training.zero_offset import ZeroOffset, offset_note
 
 MAX_RATE_HZ = 10_000.0
 MAX_SAMPLES = 10_000
@@ -128,10 +129,9 @@ def repaired(window: Window) -> tuple[Window, dict[str, int]]:
 
 def prepare(window: Window, actuator: ActuatorParams = ActuatorParams(), spec_only: bool = False) -> Prepared:
     """Repair ``window``'s glitches, average it down to the pipeline's sizes, put its sensors on one
-    clock (``training.alignment``), take a sensor's offset off (``training.zero_offset``), put the current
-    on the spec's k_T and J_M (``training.drive_constants``) and read the viscous coefficient (``training.viscosity``);
-    say what it found. ``spec_only`` skips the last three:
-    ``calibration`` reads the spec's model alone and names what departs from it."""
+    clock (``training.alignment``) and read what it shows beyond ``actuator`` (``training.departures``);
+    say what it found. ``spec_only`` skips the last: ``calibration`` reads the spec's model alone and
+    names what departs from it."""
     window, glitches = repaired(window)
     factor = averaging_factor(window.n_samples, window.sample_rate_hz)
     command = window.signals["command_deg"]
@@ -141,28 +141,11 @@ def prepare(window: Window, actuator: ActuatorParams = ActuatorParams(), spec_on
         signals = {name: values[:n].reshape(-1, factor).mean(axis=1) for name, values in window.signals.items()}
         window = replace(window, signals=signals, sample_rate_hz=window.sample_rate_hz / factor)
     window, lags = aligned(window)
-    offset, drive, viscosity = ZeroOffset(), DriveConstants(), Viscosity()
-    if not spec_only:
-        window, offset, drive = on_zero_and_drive(window, actuator)
-        viscosity = read_viscosity(window, drive.actuator)
-    rate = window.sample_rate_hz * factor
-    return Prepared(window, factor, len(command), rate, clipped, glitches, lags, offset, drive, viscosity)
-
-
-def on_zero_and_drive(window: Window, actuator: ActuatorParams) -> tuple[Window, ZeroOffset, DriveConstants]:
-    """``window`` with a sensor's offset taken off and its current on the spec's k_T and J_M, and what was read.
-
-    A drive constant, seen before it is read, passes in part for an offset (a thesis window's current
-    logged 1.5 % low read as 2.2 mN·m off zero, which left FDJ 11 % of range off once the scale was read
-    too), so where one is read the offset is read again on the corrected window (the logged current is
-    s·I + i₀: corrected, then zeroed)."""
-    offset = read_zero_offset(window, actuator)
-    drive = read_drive_constants(zeroed(window, offset), actuator)
-    if not drive.stds:
-        return zeroed(window, offset), offset, drive
-    window = drive.corrected(window)
-    offset = read_zero_offset(window, drive.actuator)
-    return zeroed(window, offset), offset, drive
+    read = Departures(window) if spec_only else read_departures(window, actuator)
+    rate = read.window.sample_rate_hz * factor
+    return Prepared(
+        read.window, factor, len(command), rate, clipped, glitches, lags, read.offset, read.drive, read.viscosity
+    )
 
 
 def widened(stds: dict[str, float], prepared: Prepared) -> dict[str, float]:

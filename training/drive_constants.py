@@ -9,14 +9,18 @@ T_R then holds ΔJ·dω/dt too much. k_T·I is mostly the hinge load and the ine
 to 258 %, at up to 14 stds), J_M 0.92–1.06x a mean 21 %, 7 of 10 outside ±2 std.
 
 Friction follows the direction and |T_ext|; k_T·I follows the signed load and the acceleration, dω/dt
-the acceleration alone; so γ and ΔJ are fitted beside FDJ (``baseline.nuisance_columns``), the
-offset and ΔC free too (either might pass for them), and each is read where the fit with it explains
-the window ``MIN_Z`` stds better than the fit without it (``zero_offset.equation_z``). Fitted alone,
-γ takes up most of a ΔJ; fitted together, each is read on its own. The current then carries γ (I' =
-(1 + γ)·I: where k_T·I meets the motor's peak torque the model cuts it, the drive's too) and the
-window's actuator ΔJ (``actuator``: every reconstruction of the window's T_R uses it, the
-simulations keep the spec's, which they are drawn with); the fit is repeated on the corrected window
-until nothing is left (``ITERATIONS``). FDJ's and η_O's stds grow by what each constant's std moves
+the acceleration alone. So each is fitted beside FDJ (``baseline.nuisance_columns``), the offset and
+ΔC free too (either might pass for them), and read where the fit with it explains the window
+``MIN_Z`` stds better than the fit without it (``zero_offset.equation_z``). Not together: γ and
+ΔJ/J_M equal make a gain of the hinge moment's term, and the sensor noise the two columns share
+with the target read one on clean foreign cruise windows (up to 12 stds). Where both stand out
+alone, the likelihood ratio of the two readings decides if it can (``DECISIVE``); where it cannot
+(mostly a heavier J_M in a window where the motor saturates as it accelerates, which a weaker motor
+explains as well), γ is read and the stds carry what ΔJ would change instead (``UNDECIDED_SHARE``).
+The current carries γ (I' = (1 + γ)·I, refitted until nothing is left, ``ITERATIONS``: where k_T·I
+meets the motor's peak torque the model cuts it, the drive's too), the window's actuator ΔJ
+(``DriveConstants.actuator``: every reconstruction of the window's T_R uses it; the simulations
+keep the spec's they are drawn with). FDJ's and η_O's stds grow by what each constant's std moves
 them.
 """
 
@@ -39,13 +43,15 @@ FIELDS = {"torque_scale": "torque_scale", "inertia": "inertia_kgm2"}  # the fit'
 # Beyond these no drive runs (γ: k_T from −55 to 125 °C and a sensor's gain; ΔJ: of J_M): a read past them
 # is something else the model lacks (a 0.1 s foreign window read J_M 0.27x), which the fit check reports.
 PLAUSIBLE = {"torque_scale": 0.2, "inertia": 0.5}
-# Where both stand out, the log-likelihood ratio of the two readings that decides between them: on 30
-# foreign windows with one of them off it pointed the wrong way by up to 6 (the sensor noise sits in both
-# columns as in the target, and favours one); under this, the window cannot tell them apart.
-DECISIVE = 12.0
+# Where both stand out, the log-likelihood ratio of the two readings that decides for each: on 110 foreign
+# windows where both did (k_T, the current gain or J_M off, healthy and worn), none with γ off read past 6
+# for ΔJ (the sensor noise sits in both columns as in the target, and favours one), but a J_M 3–10 % heavier,
+# which saturates the motor as a weaker one would, read down to −18 for γ. Short of these, the window
+# cannot tell them apart.
+DECISIVE = {"inertia": 12.0, "torque_scale": -30.0}
 # Undecided, γ is read (k_T moves with temperature from flight to flight, J_M stays with the build), and the
-# stds grow by this share of what reading ΔJ instead would change: on 7 such foreign windows with J_M off,
-# the truth lay 0.87–1.07 of that change from γ's answer.
+# stds grow by this share of what reading ΔJ instead would change (``training.departures``): on 7 such
+# foreign windows with J_M off, the truth lay 0.87–1.07 of that change from γ's answer.
 UNDECIDED_SHARE = 0.6
 
 
@@ -58,6 +64,7 @@ class DriveConstants:
     stds: dict[str, float] = field(default_factory=dict)  # per field read, its std
     spread: dict[str, float] = field(default_factory=dict)  # per target, the std the constants' uncertainty adds
     spec: ActuatorParams = ActuatorParams()
+    alternative: DriveConstants | None = None  # where the window did not tell ΔJ from this γ: the ΔJ reading
 
     @property
     def torque_factor(self) -> float:
@@ -106,11 +113,9 @@ def read_drive_constants(window: Window, actuator: ActuatorParams = ActuatorPara
         return next(iter(readings.values()))[0]
     (scale, scale_fit), (inertia, inertia_fit) = readings["torque_scale"], readings["inertia"]
     ratio = log_likelihood_ratio(scale_fit, inertia_fit, rate)  # for the inertia
-    if abs(ratio) >= DECISIVE:
+    if ratio >= DECISIVE["inertia"] or ratio <= DECISIVE["torque_scale"]:
         return inertia if ratio > 0 else scale
-    gap = {target: _plain(window, scale)[target] - _plain(window, inertia)[target] for target in scale.spread}
-    spread = {target: float(np.hypot(scale.spread[target], UNDECIDED_SHARE * gap[target])) for target in gap}
-    return replace(scale, spread=spread)
+    return replace(scale, alternative=inertia)  # ``training.departures`` widens the stds by their gap
 
 
 def _stands_out(plain: FrictionFit, alone: FrictionFit, name: str, rate: float, spec: ActuatorParams) -> bool:
@@ -166,7 +171,10 @@ def drive_constants_note(read: DriveConstants) -> str | None:
         )
     if not found:
         return None
+    if read.alternative is not None:
+        found.append("or the inertia off the spec's: the window tells them apart too little, and the stds include "
+                     "what reading that instead would change")  # fmt: skip
     return (
-        "; ".join(found) + ": the current was corrected for it before every estimator, and the stds include its "
-        "uncertainty; read with the spec's constants, the load and inertia would have passed for friction"
+        "; ".join(found) + ": every estimator read the window with it, and the stds include its uncertainty; "
+        "read with the spec's constants, the load and inertia it moves would have passed for friction"
     )
