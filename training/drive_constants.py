@@ -37,7 +37,8 @@ from training.preprocess import as_read
 from training.zero_offset import equation_z, log_likelihood_ratio
 
 MIN_Z = 4.0  # stds by which the fit with a constant must explain the window better
-ITERATIONS = 3  # refits of the corrected window: each settles what the peak torque's cut left
+ITERATIONS = 3  # refits of the corrected window at most: each settles what the peak torque's cut left
+SETTLED = 0.01  # of the constant's std: what a refit may leave
 BESIDE = FitSettings(offset=True, viscous=True)  # what each constant is fitted beside
 FIELDS = {"torque_scale": "torque_scale", "inertia": "inertia_kgm2"}  # the fit's nuisance -> the field it reads
 # Beyond these no drive runs (γ: k_T from −55 to 125 °C and a sensor's gain; ΔJ: of J_M): a read past them
@@ -134,11 +135,13 @@ def _reading(
 ) -> tuple[DriveConstants, FrictionFit]:
     """Constant ``name``, refitted on the corrected window until nothing is left, with its spread; and the
     last fit (its likelihood)."""
-    settings = replace(BESIDE, **{name: True})
-    read, left = DriveConstants(spec=actuator, stds={FIELDS[name]: float(first.term_std(name)[0])}), first
+    settings, std = replace(BESIDE, **{name: True}), float(first.term_std(name)[0])
+    read, left = DriveConstants(spec=actuator, stds={FIELDS[name]: std}), first
     for _ in range(ITERATIONS + 1):
         read = read.added(left)
         left = _fit(read.corrected(window), read.actuator, settings)
+        if abs(float(left.term(name)[0])) < SETTLED * std:  # ΔJ is linear: settled at once; γ within a few
+            break
     return replace(read, spread=_spread(window, read)), left
 
 
