@@ -175,9 +175,12 @@ def drive_constants_note(read: DriveConstants) -> str | None:
     if not found:
         return None
     if read.alternative is not None:
-        found.append("or the inertia off the spec's: the window tells them apart too little, and the stds include "
-                     "what reading that instead would change")  # fmt: skip
+        found.append(
+            f"or, about as likely, the inertia at the motor is {read.alternative.inertia_factor:.3f} times the "
+            "spec's J_M (the window tells the two apart too little: the stds include what reading that instead "
+            "would change)"
+        )
     return (
-        "; ".join(found) + ": every estimator read the window with it, and the stds include its uncertainty; "
-        "read with the spec's constants, the load and inertia it moves would have passed for friction"
+        "; ".join(found) + ". Every estimator read the window with the first, and the stds include its "
+        "uncertainty; read with the spec's constants, the load and inertia it moves would have passed for friction"
     )
