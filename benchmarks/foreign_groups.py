@@ -10,7 +10,16 @@ from collections.abc import Callable
 
 import numpy as np
 
-from tests.foreign.windows import Draw, Effects, draw, filter_widths, through_filters, with_spikes, worn
+from tests.foreign.windows import (
+    Draw,
+    Effects,
+    draw,
+    filter_widths,
+    through_filters,
+    with_hinge_gain,
+    with_spikes,
+    worn,
+)
 
 FAMILIES = ("thesis", "cruise", "gust", "doublet", "steps")
 
@@ -48,6 +57,7 @@ def groups() -> dict[str, Callable[..., Draw]]:
     out["worn, k_T, current gain or J_M off"] = lambda s, **kw: worn(
         s, family=FAMILIES[s % 5], effects=drive_off(s), **kw
     )
+    out["hinge moment gain 0.95-1.05x"] = lambda s, **kw: with_hinge_gain(draw(s, FAMILIES[s % 5], **kw), hinge_gain(s))
     return out
 
 
@@ -88,6 +98,11 @@ def drive_off(seed: int) -> Effects:
         Effects(current_sensor_gain=1.0 + 0.03 * value),
         Effects(inertia_factor=1.0 + 0.1 * value),
     )[seed % 3]
+
+
+def hinge_gain(seed: int) -> float:
+    """The hinge moment's logged over its true value, 0.95–1.05: a strain-gauge bridge calibrated off."""
+    return float(np.random.default_rng(70_000 + seed).uniform(0.95, 1.05))
 
 
 def group_seed(group: str, i: int, first: int = 7000) -> int:

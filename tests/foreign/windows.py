@@ -69,6 +69,14 @@ def through_filters(drawn: Draw, widths: Mapping[str, int]) -> Draw:
     return replace(drawn, document={**drawn.document, "signals": signals})
 
 
+def with_hinge_gain(drawn: Draw, gain: float) -> Draw:
+    """``drawn`` with its hinge moment logged ``gain`` times the true one, noise and all (a strain gauge's
+    bridge calibrated off; the loop never reads it, so the motion is the same)."""
+    signals = dict(drawn.document["signals"])
+    signals["hinge_moment_nm"] = (gain * np.asarray(signals["hinge_moment_nm"])).tolist()  # not quantized
+    return replace(drawn, document={**drawn.document, "signals": signals})
+
+
 def with_spikes(drawn: Draw, seed: int) -> Draw:
     """``drawn`` with EMI spikes and bit errors as a log might hold them: 1–5 on each sensor, 50–500
     noise stds, one in four doubled on the next sample (the product repairs runs of up to 3)."""
