@@ -30,7 +30,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from training.baseline import FrictionFit
 from training.combine import fit_blend
 from training.documents import TARGETS, MethodReport
 
@@ -61,10 +60,6 @@ class Assessed:
     methods: dict[str, MethodReport]
     inflation: float
     notes: list[str]
-
-
-def physics_values(fit: FrictionFit, row: int | slice = 0) -> dict[str, np.ndarray]:
-    return {"FDJ": fit.fdj_nm[row], "eta_O": fit.eta_o[row]}
 
 
 def _rms(errors: np.ndarray) -> float:

@@ -94,9 +94,9 @@ class FrictionFit:
     def term_std(self, name: str) -> np.ndarray:
         return self.term_stds[:, NUISANCES.index(name)]
 
-    @property
-    def eta_a(self) -> np.ndarray:
-        return eta_a_from_eta_o(self.eta_o)
+    def values(self, row: int | slice = 0) -> dict[str, np.ndarray]:
+        """FDJ and η_O of window ``row`` (or rows), keyed as the targets are."""
+        return {"FDJ": self.fdj_nm[row], "eta_O": self.eta_o[row]}
 
 
 def regressors(

@@ -42,7 +42,7 @@ class Departures:
         """FDJ and η_O of Eq. 5.1's fit of the window as read."""
         rate = self.window.sample_rate_hz
         fitted = fit_friction(as_read(self.window.signals, rate), rate, self.actuator)
-        return {"FDJ": float(fitted.fdj_nm[0]), "eta_O": float(fitted.eta_o[0])}
+        return {name: float(value) for name, value in fitted.values().items()}
 
 
 def read_departures(window: Window, actuator: ActuatorParams = ActuatorParams()) -> Departures:

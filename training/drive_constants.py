@@ -147,7 +147,7 @@ def _reading(
 
 def _plain(window: Window, read: DriveConstants) -> dict[str, float]:
     fitted = _fit(read.corrected(window), read.actuator, FitSettings())
-    return {"FDJ": float(fitted.fdj_nm[0]), "eta_O": float(fitted.eta_o[0])}
+    return {name: float(value) for name, value in fitted.values().items()}
 
 
 def _spread(window: Window, read: DriveConstants) -> dict[str, float]:

@@ -25,7 +25,7 @@ import numpy as np
 
 from sim.window import Window
 from training import design
-from training.assess import Assessed, Candidates, assess, physics_values
+from training.assess import Assessed, Candidates, assess
 from training.baseline import FIT_ARRAYS, FrictionFit, fit_friction, fit_window
 from training.conditioning import prepare, widened
 from training.config import PipelineConfig
@@ -66,12 +66,12 @@ def candidates(
     fdj_check, eta_check = fdj[:-1][ok], eta_o[:-1][ok]
     truth_fdj, truth_eta = health.fdj_nm[n:][ok], health.eta_o[n:][ok]
     return Candidates(
-        physics={k: float(v) for k, v in physics_values(physics).items()},
+        physics={k: float(v) for k, v in physics.values().items()},
         physics_std={"FDJ": float(physics.fdj_std_nm[0]), "eta_O": float(physics.eta_o_std[0])},
         network={"FDJ": float(fdj[-1]), "eta_O": float(eta_o[-1])},
         network_unit=unit[-1],
         check_truth={"FDJ": truth_fdj, "eta_O": truth_eta},
-        check_physics=physics_values(check_physics, slice(None)),
+        check_physics=check_physics.values(slice(None)),
         check_network={"FDJ": fdj_check, "eta_O": eta_check},
     ), check_physics
 
