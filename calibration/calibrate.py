@@ -144,20 +144,21 @@ class Calibrator:
         before: Mapping[str, float],
         noise: Sequence[SensorNoise],
     ) -> tuple[Evidence, Step]:
-        """The decided family, or its twin if the simulation says so."""
+        """The decided family, or one of its twins if the simulation says so."""
         pick = decision.chosen
         assert pick is not None
-        twin = next((e for e in found if e.family.name == TWINS.get(pick.family.name)), None)
-        if twin is None:
+        twins = [e for e in found if e.family.name in TWINS.get(pick.family.name, ())]
+        if not twins:
             return pick, Step(selected=pick.family.name, reason=decision.reason, indistinguishable_from=decision.alike)
-        first = pick
-        pick, errors, clear = tell_apart(windows, before, [first, twin], noise)
-        other = (twin if pick is first else first).family.name
-        reason = f"{decision.reason}; told from {other} by the motor speed and current it predicts"
+        options = [pick, *twins]
+        pick, errors, clear = tell_apart(windows, before, options, noise)
+        others = [o.family.name for o in options if o is not pick]
+        runner = min(others, key=errors.__getitem__)
+        reason = f"{decision.reason}; told from {' and '.join(others)} by the motor speed and current it predicts"
         return pick, Step(
             selected=pick.family.name,
-            reason=reason if clear else reason + " (narrowly: the two leave nearly the same trace)",
-            indistinguishable_from=[] if clear else [other],
+            reason=reason if clear else reason + f" (narrowly from {runner}: the two leave nearly the same trace)",
+            indistinguishable_from=[] if clear else [runner],
             tie_break_output_error=errors,
         )
 

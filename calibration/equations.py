@@ -38,7 +38,8 @@ class Equations:
 
     y: np.ndarray  # (m,) t = sgn(ω)(T_R − C_M ω) [N·m]
     base: np.ndarray  # (m, 3): 1, a, o
-    # VARIABLES, "motor_angle_rad" and "engaged" (``engaged``), each (m,), from the measured states
+    # VARIABLES, "current_unsigned_a", "acceleration_radps2" (signed by the direction), "motor_angle_rad" and
+    # "engaged" (``engaged``), each (m,), from the measured states
     variables: dict[str, np.ndarray]
     cogging: dict[float, np.ndarray]  # order p -> (m, 2): sgn·(sin, cos)(p·θ_m), as logged and smoothed
     kinematic: np.ndarray  # (m,) d = θ_m/n − θ_u [rad]
@@ -99,6 +100,7 @@ def _one_window(
         "load_nm": smoothed(signals["hinge_moment_nm"], rate) / actuator.gear_ratio * sign,  # > 0: aiding
         "current_a": sign * smoothed(signals["current_a"], rate),
         "current_unsigned_a": smoothed(signals["current_a"], rate),
+        "acceleration_radps2": sign * smooth_derivative(signals["motor_speed_radps"], rate),  # as T_R reads it
         "direction": sign,
         "motor_angle_rad": angle,
         "engaged": engaged(signals["position_deg"], speed, rate, actuator.gear_ratio),

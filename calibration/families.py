@@ -11,7 +11,7 @@ can add (``sim.effects.FrictionTable``).
 Coefficients map back to the simulator's parameters: in t = sgn(ω)(T_R − C_M·ω) a torque
 constant g leaves (1 − g)·k_T·I, a current-sensor gain s leaves (1 − 1/s)·k_T·I_logged (the
 same trace: twins, told apart by simulation in ``calibration.twins``), a hinge-moment bias b
-leaves sgn(ω)·b/n.
+leaves sgn(ω)·b/n, an inertia ΔJ beyond J_M leaves sgn(ω)·ΔJ·dω/dt.
 """
 
 from __future__ import annotations
@@ -211,6 +211,10 @@ def named_families(measured: Equations, actuator: ActuatorParams) -> list[Family
                lambda e, g: _torque_shift(e, np.array([1.0 / g]), actuator),
                lambda b, g: {"gain": g}, lambda b, g: _gain_term("current_sensor_gain", g),
                GAINS, stacked=lambda e: _torque_shift(e, 1.0 / np.array(GAINS), actuator)[..., None], offset=True),
+        Family("inertia", "acceleration_radps2", True, lambda e, g: e.variables["acceleration_radps2"][:, None],
+               lambda b, g: {"factor": 1.0 + float(b[0]) / actuator.inertia_kgm2},
+               lambda b, g: EffectSet({"inertia": {"factor": float(np.clip(1.0 + b[0] / actuator.inertia_kgm2,
+                                                                           0.5, 2.0))}})),
         Family("hinge_moment_bias", "direction", True, lambda e, g: _hinge_columns(e, g, n),
                lambda b, g: {"bias_nm": float(b[0]) * n, "grid_bias_nm": g},
                lambda b, g: EffectSet({"hinge_moment_bias": {"bias_nm": float(np.clip(b[0] * n, -500, 500))}}),

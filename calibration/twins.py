@@ -2,7 +2,9 @@
 
 A torque constant g and a current-sensor gain s both leave a term in k_T·I in the residual
 torque; only the first also changes the back-EMF (k_e = k_T), hence how much voltage is left to
-drive current near top speed, hence how the motor speed and current evolve. Each twin is added
+drive current near top speed, hence how the motor speed and current evolve. An inertia off the
+spec's leaves a term in dω/dt, which k_T·I mostly is, and moves how fast the speed follows the
+current. Each twin is added
 to the simulator in turn, the window simulated at the estimates, and the one whose speed and
 current stay closer to the measured ones (in units of their noise) is named; the other is
 reported as indistinguishable when the difference is small.
@@ -17,12 +19,13 @@ import numpy as np
 from calibration.selection import Evidence
 from sim.noise import SensorNoise
 from sim.window import Window
-from training.dataset import scenario_from_window
 from training.design import inside
-from training.reproduction import SETTLE_S
+from training.reproduction import CLEAR_MARGIN, following_error
 
-TWINS = {"torque_constant": "current_sensor_gain", "current_sensor_gain": "torque_constant"}
-CLEAR_MARGIN = 0.05  # the loser's output error at least 5 % above the winner's: a clear call
+# Look-alikes, each with the others of its group. An inertia ΔJ leaves ΔJ·dω/dt, which a gain of k_T·I
+# (mostly the load and J_M·dω/dt) nearly matches; only its simulation moves the speed otherwise.
+GROUP = ("torque_constant", "current_sensor_gain", "inertia")
+TWINS = {name: tuple(other for other in GROUP if other != name) for name in GROUP}
 
 
 def output_error(
@@ -33,14 +36,8 @@ def output_error(
     if effects is None:
         return float("inf")  # a gain outside what the simulator admits: not this twin
     health = inside(estimates["FDJ"], estimates["eta_O"])
-    total = 0.0
-    for window, level in zip(windows, noise, strict=True):
-        simulated = scenario_from_window(window, effects).simulate(health, lanes=1).simulation(0)
-        keep = slice(round(SETTLE_S * window.sample_rate_hz), None)
-        for name, sigma in (("motor_speed_radps", level.motor_speed_radps), ("current_a", level.current_a)):
-            error = window.signals[name][keep] - simulated[name][keep]
-            total += float(np.sqrt(np.mean(error**2))) / max(sigma, 1e-9)
-    return total / len(windows)
+    errors = [following_error(w, effects, health, level) for w, level in zip(windows, noise, strict=True)]
+    return float(np.mean(errors))
 
 
 def tell_apart(

@@ -76,7 +76,7 @@ def kernel_constants(actuator: ActuatorParams, effects: EffectSet) -> kernels.Ke
         max_torque=actuator.max_motor_torque_nm,
         inverse_gear=1.0 / actuator.gear_ratio,
         gear=actuator.gear_ratio,
-        step_over_inertia=actuator.step_s / actuator.inertia_kgm2,
+        step_over_inertia=actuator.step_s / (actuator.inertia_kgm2 * effects.get("inertia", "factor")),
         viscous=actuator.viscous_nms + effects.get("viscous", "coefficient_nms"),
         half_backlash=0.5 * (actuator.backlash_rad + effects.get("backlash", "extra_rad")),
         end_stop=float(np.radians(actuator.end_stop_deg)),

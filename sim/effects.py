@@ -64,6 +64,10 @@ EFFECTS: Mapping[str, Effect] = MappingProxyType(
                 },
             ),
             Effect(
+                "inertia",
+                {"factor": (1.0, 0.5, 2.0)},  # true J_M over the nominal [-] (a rotor, screw and gears reflected)
+            ),
+            Effect(
                 "backlash",
                 {"extra_rad": (0.0, -5e-3, 0.1)},  # backlash beyond the nominal BLK [rad], elevator side
             ),

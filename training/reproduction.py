@@ -16,15 +16,17 @@ from collections.abc import Mapping
 
 import numpy as np
 
+from sim.effects import EffectSet
 from sim.noise import SensorNoise
 from sim.params import ActuatorParams, HealthParams
 from sim.residual import residual_torque_nm
 from sim.window import Window
-from training.dataset import Scenario
+from training.dataset import Scenario, scenario_from_window
 from training.preprocess import as_read
 
 SETTLE_S = 0.02
 MAX_RATIO = 2.0  # residual torque within twice its noise floor: reproduced
+CLEAR_MARGIN = 0.05  # of two models, the loser's ``following_error`` this far above the winner's: a clear call
 
 
 def output_error_ratios(
@@ -53,6 +55,17 @@ def output_error_ratios(
     torque = _residual(measured, rate, actuator) - _residual(simulated, rate, ActuatorParams())
     ratios["residual_torque"] = _rms(torque[keep & sliding]) / max(residual_floor_nm, 1e-12)
     return ratios
+
+
+def following_error(window: Window, effects: EffectSet, health: HealthParams, noise: SensorNoise) -> float:
+    """RMS(speed)/σ_speed + RMS(current)/σ_current of ``window`` simulated clean at ``health`` with ``effects``
+    (after ``SETTLE_S``): how closely a model with those effects follows the drive itself."""
+    simulated = scenario_from_window(window, effects).simulate(health, lanes=1).simulation(0)
+    keep = slice(round(SETTLE_S * window.sample_rate_hz), None)
+    return sum(
+        _rms(window.signals[name][keep] - simulated[name][keep]) / max(sigma, 1e-9)
+        for name, sigma in (("motor_speed_radps", noise.motor_speed_radps), ("current_a", noise.current_a))
+    )
 
 
 def _residual(signals: Mapping[str, np.ndarray], rate: float, actuator: ActuatorParams) -> np.ndarray:

@@ -45,4 +45,7 @@ CASES: dict[str, Case] = {
         stribeck_nm=k * rng.uniform(0.02, 0.04), stribeck_speed_radps=rng.uniform(80, 250)
     ),
     "drift": lambda rng, k: Effects(drift_per_s=k * rng.uniform(0.3, 0.6)),  # FDJ +15-30 % over a 0.5 s window
+    "inertia": lambda rng, k: Effects(
+        inertia_factor=_gain(rng.choice([rng.uniform(0.88, 0.94), rng.uniform(1.06, 1.12)]), k)
+    ),
 }
