@@ -17,11 +17,15 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from sim.noise import SensorNoise
 from sim.params import ActuatorParams
 from sim.window import Window
 from training.baseline import fit_friction
+from training.design import inside
 from training.drive_constants import UNDECIDED_SHARE, DriveConstants, read_drive_constants
+from training.noise_level import white_noise_std
 from training.preprocess import as_read
+from training.reproduction import CLEAR_MARGIN, MAX_RATIO, following_error
 from training.viscosity import Viscosity, read_viscosity
 from training.zero_offset import ZeroOffset, read_zero_offset, zeroed
 
@@ -52,9 +56,41 @@ def read_departures(window: Window, actuator: ActuatorParams = ActuatorParams())
     read = _along(window, offset, drive)
     if drive.alternative is None:
         return read
-    mine, other = read.answer(), _along(window, offset, drive.alternative).answer()
-    spread = {name: float(np.hypot(drive.spread[name], UNDECIDED_SHARE * (mine[name] - other[name]))) for name in mine}
+    other = _along(window, offset, drive.alternative)
+    told = _told_apart(window, read, other)
+    if told is not None:
+        return replace(told, drive=replace(told.drive, alternative=None))
+    mine, theirs = read.answer(), other.answer()
+    spread = {name: float(np.hypot(drive.spread[name], UNDECIDED_SHARE * (mine[name] - theirs[name]))) for name in mine}
     return replace(read, drive=replace(drive, spread=spread))
+
+
+def _told_apart(window: Window, scale: Departures, inertia: Departures) -> Departures | None:
+    """The reading whose simulation follows the window's motor speed and current clearly better
+    (``CLEAR_MARGIN``), or None: γ as a torque constant or as a current sensor's gain, whichever
+    follows better, against ΔJ; each at its own answer, with the viscous coefficient it read. Only
+    where the better one follows within twice the noise: a replay that drifts from the drive (after a
+    pilot's step, or where the loop saturates) drifts by tens of noise stds whichever constant it
+    carries, and on foreign doublets then preferred ΔJ to a current gain that was the truth."""
+    signals = window.signals
+    noise = SensorNoise(
+        motor_speed_radps=white_noise_std(signals["motor_speed_radps"]), current_a=white_noise_std(signals["current_a"])
+    )
+
+    def error(read: Departures, effect: str, **parameters: float) -> float:
+        effects, answer = read.viscosity.effects().with_effect(effect, **parameters), read.answer()
+        return following_error(window, effects, inside(answer["FDJ"], answer["eta_O"]), noise)
+
+    factor = scale.drive.torque_factor
+    errors = (
+        min(error(scale, "torque_constant", gain=factor), error(scale, "current_sensor_gain", gain=1.0 / factor)),
+        error(inertia, "inertia", factor=inertia.drive.inertia_factor),
+    )
+    if min(errors) > 2 * MAX_RATIO:  # neither follows the drive within twice the noise on speed and current
+        return None
+    if errors[1] * (1.0 + CLEAR_MARGIN) < errors[0]:
+        return inertia
+    return scale if errors[0] * (1.0 + CLEAR_MARGIN) < errors[1] else None
 
 
 def _along(window: Window, offset: ZeroOffset, drive: DriveConstants) -> Departures:

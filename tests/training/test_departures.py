@@ -1,7 +1,9 @@
 """The departures from the spec's model read in turn, on a foreign window where the order matters."""
 
+import pytest
+
 from sim.window import window_from_dict
-from tests.foreign.windows import Effects, worn
+from tests.foreign.windows import Effects, draw, worn
 from training.baseline import fit_window
 from training.conditioning import prepare, widened
 from training.preprocess import as_read
@@ -20,3 +22,12 @@ def test_where_a_scale_and_an_inertia_cannot_be_told_apart_the_stds_reach_both_e
     assert error > 0.3 * 0.02  # the γ end is far off ...
     assert error < 2 * std  # ... and the std says so,
     assert prepared.drive.spread["FDJ"] > 0.5 * error  # by the gap between the two ends
+
+
+def test_a_heavier_inertia_is_told_from_a_weaker_motor_where_the_replay_follows_the_drive():
+    """J_M 1.09x on a thesis window: the likelihood ratio does not decide, but simulated with ΔJ the window's
+    speed and current are followed within the noise and with γ they are not (2.1 against 15 noise stds)."""
+    drawn = draw(85, "thesis", effects=Effects(inertia_factor=1.09))
+    prepared = prepare(window_from_dict(drawn.document))
+    assert prepared.drive.alternative is None and prepared.drive.torque_scale == 0.0
+    assert prepared.drive.inertia_factor == pytest.approx(1.09, abs=0.003)
