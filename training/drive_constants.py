@@ -169,8 +169,8 @@ def drive_constants_note(read: DriveConstants) -> str | None:
         )
     if read.inertia_kgm2:
         found.append(
-            f"the inertia at the motor is {read.inertia_factor:.3f} ± "
-            f"{read.stds['inertia_kgm2'] / read.spec.inertia_kgm2:.3f} times the spec's J_M"
+            f"the inertia at the motor is {read.inertia_factor:.4f} ± "
+            f"{read.stds['inertia_kgm2'] / read.spec.inertia_kgm2:.4f} times the spec's J_M"
         )
     if not found:
         return None
@@ -180,7 +180,8 @@ def drive_constants_note(read: DriveConstants) -> str | None:
             "spec's J_M (the window tells the two apart too little: the stds include what reading that instead "
             "would change)"
         )
+    used = "the first" if read.alternative is not None else "it"
     return (
-        "; ".join(found) + ". Every estimator read the window with the first, and the stds include its "
+        "; ".join(found) + f". Every estimator read the window with {used}, and the stds include its "
         "uncertainty; read with the spec's constants, the load and inertia it moves would have passed for friction"
     )
