@@ -5,10 +5,12 @@ viscous coefficient (``training.viscosity``).
 A drive constant, seen before it is read, passes in part for an offset (a thesis window's current logged
 1.5 % low read as 2.2 mN·m off zero, which left FDJ 11 % of range off once the scale was read too), so
 where one is read the offset is read again on the corrected window (the logged current is s·I + i₀:
-corrected, then zeroed). Where the window cannot tell γ from ΔJ, both are carried to the end: what is
-read after them moves with the choice (a worn gust window read γ where J_M was 0.5 % light, then its
-viscous coefficient 0.63x, FDJ 66 % of range off; read with ΔJ instead, 1.0x and right), so the stds
-grow by ``UNDECIDED_SHARE`` of how far the two ends lie apart.
+corrected, then zeroed). Where the window's equation error cannot tell γ from ΔJ, both are read to the
+end and the window simulated with each: the one whose replay follows the motor speed and current
+clearly better, and within twice the noise, is taken (``_told_apart``). Where neither does, both ends
+stand: what is read after them moves with the choice (a worn gust window read γ where J_M was 0.5 %
+light, then its viscous coefficient 0.63x, FDJ 66 % of range off; read with ΔJ instead, 1.0x and
+right), so the stds grow by ``UNDECIDED_SHARE`` of how far the two ends lie apart.
 """
 
 from __future__ import annotations
