@@ -73,9 +73,10 @@ little to begin with (a 1–2 kHz log, 0.1 s) the answers past 10 % of range are
 FDJ's ±2 std holds the truth less often than 90 %. Of the 20 short windows 8 move (almost) one way,
 where no offset can be read and FDJ's std carries only one of 0.05 A (these are up to 0.25 A); the
 offset is read in 11 and missed in 1. *J_M heavier than the spec's*: where the motor saturates as it
-accelerates, a motor k_T·I a few % weaker explains the window about as well, the likelihood ratio
-does not decide, and γ is read with FDJ's std widened by 0.6 of what reading ΔJ would change
-(`training.drive_constants`): honest, but often weak."""
+accelerates, a motor k_T·I a few % weaker explains the window about as well, and the likelihood ratio
+does not decide; a replay of the window with each tells them apart only where it follows the drive
+within the noise (thesis windows), and elsewhere γ is read with FDJ's std widened by 0.6 of what
+reading ΔJ would change (`training.departures`): honest, but often weak."""
 
 
 def main() -> None:
