@@ -16,6 +16,7 @@ right), so the stds grow by ``UNDECIDED_SHARE`` of how far the two ends lie apar
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
+from functools import cached_property
 
 import numpy as np
 
@@ -44,8 +45,9 @@ class Departures:
         """What every reconstruction and fit of the window reads it with: the spec's, J_M and C as read."""
         return self.viscosity.actuator(self.drive.actuator)
 
+    @cached_property
     def answer(self) -> dict[str, float]:
-        """FDJ and η_O of Eq. 5.1's fit of the window as read."""
+        """FDJ and η_O of Eq. 5.1's fit of the window as read (fitted once: the tie-break and the stds ask)."""
         rate = self.window.sample_rate_hz
         fitted = fit_friction(as_read(self.window.signals, rate), rate, self.actuator)
         return {name: float(value) for name, value in fitted.values().items()}
@@ -62,7 +64,7 @@ def read_departures(window: Window, actuator: ActuatorParams = ActuatorParams())
     told = _told_apart(window, read, other)
     if told is not None:
         return replace(told, drive=replace(told.drive, alternative=None))
-    mine, theirs = read.answer(), other.answer()
+    mine, theirs = read.answer, other.answer
     spread = {name: float(np.hypot(drive.spread[name], UNDECIDED_SHARE * (mine[name] - theirs[name]))) for name in mine}
     return replace(read, drive=replace(drive, spread=spread))
 
@@ -80,8 +82,8 @@ def _told_apart(window: Window, scale: Departures, inertia: Departures) -> Depar
     )
 
     def error(read: Departures, effect: str, **parameters: float) -> float:
-        effects, answer = read.viscosity.effects().with_effect(effect, **parameters), read.answer()
-        return following_error(window, effects, inside(answer["FDJ"], answer["eta_O"]), noise)
+        effects = read.viscosity.effects().with_effect(effect, **parameters)
+        return following_error(window, effects, inside(read.answer["FDJ"], read.answer["eta_O"]), noise)
 
     factor = scale.drive.torque_factor
     errors = (
