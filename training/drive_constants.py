@@ -101,8 +101,8 @@ def _fit(window: Window, actuator: ActuatorParams, settings: FitSettings) -> Fri
 
 def read_drive_constants(window: Window, actuator: ActuatorParams = ActuatorParams()) -> DriveConstants:
     """γ or ΔJ where it stands out (module docstring), with FDJ's and η_O's change across it ± its std. Where
-    both do, the likelier if the window decides (``DECISIVE``); else γ, the stds widened by what reading ΔJ
-    instead would change (``UNDECIDED_SHARE``)."""
+    both do, the likelier if the window decides (``DECISIVE``); else γ, with ΔJ beside it as the
+    ``alternative`` (``training.departures`` replays both, or widens the stds by their gap)."""
     rate = window.sample_rate_hz
     plain = _fit(window, actuator, BESIDE)
     alone = {name: _fit(window, actuator, replace(BESIDE, **{name: True})) for name in FIELDS}
@@ -111,12 +111,12 @@ def read_drive_constants(window: Window, actuator: ActuatorParams = ActuatorPara
     if not readings:
         return DriveConstants(spec=actuator)
     if len(readings) == 1:
-        return next(iter(readings.values()))[0]
+        return _with_spread(window, next(iter(readings.values()))[0])
     (scale, scale_fit), (inertia, inertia_fit) = readings["torque_scale"], readings["inertia"]
     ratio = log_likelihood_ratio(scale_fit, inertia_fit, rate)  # for the inertia
     if ratio >= DECISIVE["inertia"] or ratio <= DECISIVE["torque_scale"]:
-        return inertia if ratio > 0 else scale
-    return replace(scale, alternative=inertia)  # ``training.departures`` widens the stds by their gap
+        return _with_spread(window, inertia if ratio > 0 else scale)
+    return replace(_with_spread(window, scale), alternative=_with_spread(window, inertia))
 
 
 def _stands_out(plain: FrictionFit, alone: FrictionFit, name: str, rate: float, spec: ActuatorParams) -> bool:
@@ -133,8 +133,8 @@ def _stands_out(plain: FrictionFit, alone: FrictionFit, name: str, rate: float, 
 def _reading(
     window: Window, actuator: ActuatorParams, name: str, first: FrictionFit
 ) -> tuple[DriveConstants, FrictionFit]:
-    """Constant ``name``, refitted on the corrected window until nothing is left, with its spread; and the
-    last fit (its likelihood)."""
+    """Constant ``name``, refitted on the corrected window until nothing is left; and the last fit (its
+    likelihood)."""
     settings, std = replace(BESIDE, **{name: True}), float(first.term_std(name)[0])
     read, left = DriveConstants(spec=actuator, stds={FIELDS[name]: std}), first
     for _ in range(ITERATIONS + 1):
@@ -142,7 +142,7 @@ def _reading(
         left = _fit(read.corrected(window), read.actuator, settings)
         if abs(float(left.term(name)[0])) < SETTLED * std:  # ΔJ is linear: settled at once; γ within a few
             break
-    return replace(read, spread=_spread(window, read)), left
+    return read, left
 
 
 def _plain(window: Window, read: DriveConstants) -> dict[str, float]:
@@ -150,13 +150,14 @@ def _plain(window: Window, read: DriveConstants) -> dict[str, float]:
     return {name: float(value) for name, value in fitted.values().items()}
 
 
-def _spread(window: Window, read: DriveConstants) -> dict[str, float]:
-    """Per target, half the change of the plain fit across each read constant ± its std, in quadrature."""
+def _with_spread(window: Window, read: DriveConstants) -> DriveConstants:
+    """``read`` with, per target, half the change of the plain fit across each read constant ± its std, in
+    quadrature."""
     spread = {"FDJ": 0.0, "eta_O": 0.0}
     for key, std in read.stds.items():
         low, high = (_plain(window, replace(read, **{key: getattr(read, key) + d})) for d in (-std, std))
         spread = {target: float(np.hypot(spread[target], (high[target] - low[target]) / 2)) for target in spread}
-    return spread
+    return replace(read, spread=spread)
 
 
 def drive_constants_note(read: DriveConstants) -> str | None:
