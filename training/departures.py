@@ -23,11 +23,10 @@ import numpy as np
 from sim.noise import SensorNoise
 from sim.params import ActuatorParams
 from sim.window import Window
-from training.baseline import fit_friction
 from training.design import inside
 from training.drive_constants import UNDECIDED_SHARE, DriveConstants, read_drive_constants
 from training.noise_level import white_noise_std
-from training.preprocess import as_read
+from training.preprocess import fit_as_read
 from training.reproduction import CLEAR_MARGIN, MAX_RATIO, following_error
 from training.viscosity import Viscosity, read_viscosity
 from training.zero_offset import ZeroOffset, read_zero_offset, zeroed
@@ -48,8 +47,7 @@ class Departures:
     @cached_property
     def answer(self) -> dict[str, float]:
         """FDJ and η_O of Eq. 5.1's fit of the window as read (fitted once: the tie-break and the stds ask)."""
-        rate = self.window.sample_rate_hz
-        fitted = fit_friction(as_read(self.window.signals, rate), rate, self.actuator)
+        fitted = fit_as_read(self.window.signals, self.window.sample_rate_hz, self.actuator)
         return {name: float(value) for name, value in fitted.values().items()}
 
 

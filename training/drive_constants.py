@@ -32,8 +32,8 @@ import numpy as np
 
 from sim.params import ActuatorParams
 from sim.window import Window
-from training.baseline import FitSettings, FrictionFit, fit_friction
-from training.preprocess import as_read
+from training.baseline import FitSettings, FrictionFit
+from training.preprocess import fit_as_read
 from training.zero_offset import equation_z, log_likelihood_ratio
 
 MIN_Z = 4.0  # stds by which the fit with a constant must explain the window better
@@ -95,8 +95,7 @@ class DriveConstants:
 
 
 def _fit(window: Window, actuator: ActuatorParams, settings: FitSettings) -> FrictionFit:
-    rate = window.sample_rate_hz
-    return fit_friction(as_read(window.signals, rate), rate, actuator, settings)
+    return fit_as_read(window.signals, window.sample_rate_hz, actuator, settings)
 
 
 def read_drive_constants(window: Window, actuator: ActuatorParams = ActuatorParams()) -> DriveConstants:

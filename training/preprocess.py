@@ -17,6 +17,7 @@ from sim.checks import InputError
 from sim.hinge import denoised_hinge_nm
 from sim.params import ActuatorParams
 from sim.residual import residual_torque_nm
+from training.baseline import FitSettings, FrictionFit, fit_friction
 
 INPUT_SETS = {
     # the thesis's two input sets (§5.5): residual torque alone, and its "input map"
@@ -31,6 +32,16 @@ def as_read(signals: Mapping[str, np.ndarray], sample_rate_hz: float) -> dict[st
     out = dict(signals)
     out["hinge_moment_nm"] = denoised_hinge_nm(signals["hinge_moment_nm"], signals["position_deg"], sample_rate_hz)
     return out
+
+
+def fit_as_read(
+    signals: Mapping[str, np.ndarray],
+    sample_rate_hz: float,
+    actuator: ActuatorParams = ActuatorParams(),
+    settings: FitSettings = FitSettings(),
+) -> FrictionFit:
+    """Eq. 5.1's fit (``training.baseline``) of a window's signals read as every estimator reads them."""
+    return fit_friction(as_read(signals, sample_rate_hz), sample_rate_hz, actuator, settings)
 
 
 def bin_means(values: np.ndarray, n_bins: int) -> np.ndarray:

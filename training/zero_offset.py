@@ -34,8 +34,8 @@ import numpy as np
 from sim.params import ActuatorParams
 from sim.residual import DEFAULT_DERIVATIVE_WINDOW_S, kernel_samples
 from sim.window import Window
-from training.baseline import FitSettings, FrictionFit, fit_friction
-from training.preprocess import as_read
+from training.baseline import FitSettings, FrictionFit
+from training.preprocess import fit_as_read
 
 MIN_Z = 4.0  # stds by which the fit with an offset must explain the window better (``equation_z``)
 # Where the motion goes one way, an offset is FDJ's twin and cannot be read: FDJ then rests on the sensors
@@ -62,12 +62,6 @@ class ZeroOffset:
     one_way: bool = False  # the motion goes one way: no offset could be read, FDJ's std carries an unseen one
 
 
-def _fit(
-    signals: dict[str, np.ndarray], rate: float, actuator: ActuatorParams, settings: FitSettings = FitSettings()
-) -> FrictionFit:
-    return fit_friction(as_read(signals, rate), rate, actuator, settings)
-
-
 def _shifted(signals: dict[str, np.ndarray], hinge_nm: float = 0.0, current_a: float = 0.0) -> dict[str, np.ndarray]:
     return dict(
         signals, hinge_moment_nm=signals["hinge_moment_nm"] - hinge_nm, current_a=signals["current_a"] - current_a
@@ -82,7 +76,7 @@ def sensor_offset(
     per_nm = actuator.gear_ratio if sensor == "hinge_nm" else 1.0 / actuator.torque_constant_nm_per_a
     offset = per_nm * torque_nm
     for _ in range(ITERATIONS):
-        left = _fit(_shifted(signals, **{sensor: offset}), rate, actuator, OFFSET_FIT).term("offset")[0]
+        left = fit_as_read(_shifted(signals, **{sensor: offset}), rate, actuator, OFFSET_FIT).term("offset")[0]
         if not np.isfinite(left):
             break
         offset += per_nm * float(left)
@@ -112,16 +106,16 @@ def read_zero_offset(window: Window, actuator: ActuatorParams = ActuatorParams()
     stds better, and the two readings of it (module docstring) weighed; or the note that the motion goes
     one way."""
     rate, signals = window.sample_rate_hz, dict(window.signals)
-    found = _fit(signals, rate, actuator, OFFSET_FIT)
+    found = fit_as_read(signals, rate, actuator, OFFSET_FIT)
     torque, std = float(found.term("offset")[0]), float(found.term_std("offset")[0])
     if std == 0.0:  # too little motion the other way to tell an offset from FDJ (``baseline.MIN_OFFSET_BALANCE``)
         return ZeroOffset(one_way=True, spread={"FDJ": UNSEEN_CURRENT_OFFSET_A * actuator.torque_constant_nm_per_a})
-    if not (np.isfinite(torque) and equation_z(_fit(signals, rate, actuator), found, rate) > MIN_Z):
+    if not (np.isfinite(torque) and equation_z(fit_as_read(signals, rate, actuator), found, rate) > MIN_Z):
         return ZeroOffset()
     current_a = sensor_offset(signals, rate, torque, "current_a", actuator)
     hinge_nm = sensor_offset(signals, rate, torque, "hinge_nm", actuator)
-    as_current = _fit(_shifted(signals, current_a=current_a), rate, actuator)
-    as_hinge = _fit(_shifted(signals, hinge_nm=hinge_nm), rate, actuator)
+    as_current = fit_as_read(_shifted(signals, current_a=current_a), rate, actuator)
+    as_hinge = fit_as_read(_shifted(signals, hinge_nm=hinge_nm), rate, actuator)
     share = second_weight(as_current, as_hinge, rate)
     apart = {
         "FDJ": float(as_hinge.fdj_nm[0] - as_current.fdj_nm[0]),
