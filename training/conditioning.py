@@ -1,7 +1,9 @@
 """A logged window made ready for the pipeline: isolated glitches repaired, a bounded number of
-samples, its sensors on one clock (``training.alignment``), what it shows beyond the spec's model
-read and undone (``training.departures``: a sensor off zero, the drive's k_T and J_M, the viscous
-coefficient), and what was done to it.
+samples, its signals checked to tell one story (``training.consistency``: a sign, unit or sample
+rate the log got wrong is refused, naming the field), its sensors on one clock
+(``training.alignment``), what it shows beyond the spec's model read and undone
+(``training.departures``: a sensor off zero, the drive's k_T and J_M, the viscous coefficient), and
+what was done to it.
 
 A sensor's sample that jumps away from both neighbours and straight back (an EMI spike, a bit
 error) is no measurement, nor is a burst of a few of them (``MAX_GLITCH_RUN``, ``MAX_GLITCH_S``:
@@ -39,6 +41,7 @@ from sim.noise import NOISY_SIGNALS
 from sim.params import ActuatorParams
 from sim.window import Window
 from training.alignment import Lags, aligned
+from training.consistency import check_consistency
 from training.departures import Departures, read_departures
 from training.drive_constants import DriveConstants, drive_constants_note
 from training.noise_level import white_noise_std
@@ -128,9 +131,10 @@ def repaired(window: Window) -> tuple[Window, dict[str, int]]:
 
 
 def prepare(window: Window, actuator: ActuatorParams = ActuatorParams(), spec_only: bool = False) -> Prepared:
-    """Repair ``window``'s glitches, average it down to the pipeline's sizes, put its sensors on one
-    clock (``training.alignment``) and read what it shows beyond ``actuator`` (``training.departures``);
-    say what it found. ``spec_only`` skips the last: ``calibration`` reads the spec's model alone and
+    """Repair ``window``'s glitches, average it down to the pipeline's sizes, check its signals agree
+    (``training.consistency``: InputError naming the field), put its sensors on one clock
+    (``training.alignment``) and read what it shows beyond ``actuator`` (``training.departures``); say
+    what it found. ``spec_only`` skips the last: ``calibration`` reads the spec's model alone and
     names what departs from it."""
     window, glitches = repaired(window)
     factor = averaging_factor(window.n_samples, window.sample_rate_hz)
@@ -140,6 +144,7 @@ def prepare(window: Window, actuator: ActuatorParams = ActuatorParams(), spec_on
         n = window.n_samples // factor * factor
         signals = {name: values[:n].reshape(-1, factor).mean(axis=1) for name, values in window.signals.items()}
         window = replace(window, signals=signals, sample_rate_hz=window.sample_rate_hz / factor)
+    check_consistency(window, actuator)
     window, lags = aligned(window)
     read = Departures(window) if spec_only else read_departures(window, actuator)
     rate = read.window.sample_rate_hz * factor

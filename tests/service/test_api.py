@@ -72,6 +72,14 @@ def test_bad_windows_get_422_naming_the_field(client, document, path, value, loc
     assert response.json()["detail"][0]["loc"] == loc
 
 
+def test_a_window_whose_signals_disagree_is_a_422_naming_the_field(client, document):
+    document["signals"]["current_a"] = [-v for v in document["signals"]["current_a"]]
+    response = client.post("/v1/estimate", json=document)
+    assert response.status_code == 422
+    assert response.json()["detail"][0]["loc"] == ["body", "signals", "current_a"]
+    assert "sign" in response.json()["detail"][0]["msg"]
+
+
 def test_unequal_lengths_nan_not_json_and_empty(client, document):
     document["signals"]["current_a"] = document["signals"]["current_a"][:-1]
     response = client.post("/v1/estimate", json=document)

@@ -1,0 +1,46 @@
+"""Careless exports of a window: a sign convention, a unit or a sample rate a log got wrong (test-only).
+
+Each slip scales fields of an ``ema-window/1`` document as an export script might, and names the
+field the product should refuse it by.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class Slip:
+    factors: dict[str, float]  # signal name (or "sample_rate_hz") -> what the export multiplied it by
+    field: str  # the field a refusal should name
+
+
+SLIPS: dict[str, Slip] = {
+    "speed of the other sign": Slip({"motor_speed_radps": -1.0}, "signals.motor_speed_radps"),
+    "position of the other sign": Slip({"position_deg": -1.0}, "signals.position_deg"),
+    "both motion signals of the other sign": Slip(
+        {"position_deg": -1.0, "motor_speed_radps": -1.0}, "signals.position_deg"
+    ),
+    "position in radians": Slip({"position_deg": math.pi / 180}, "signals.position_deg"),
+    "sample rate stated twice the log's": Slip({"sample_rate_hz": 2.0}, "sample_rate_hz"),
+    "sample rate stated half the log's": Slip({"sample_rate_hz": 0.5}, "sample_rate_hz"),
+    "command in radians": Slip({"command_deg": math.pi / 180}, "signals.command_deg"),
+    "current of the other sign": Slip({"current_a": -1.0}, "signals.current_a"),
+    "hinge moment of the other sign": Slip({"hinge_moment_nm": -1.0}, "signals.hinge_moment_nm"),
+    "hinge moment in kN·m": Slip({"hinge_moment_nm": 1e-3}, "signals.hinge_moment_nm"),
+    "current and hinge moment of the other sign": Slip(
+        {"current_a": -1.0, "hinge_moment_nm": -1.0}, "signals.current_a"
+    ),
+}
+
+
+def exported(document: dict, slip: Slip) -> dict:
+    """``document`` as the careless export wrote it."""
+    factors = slip.factors
+    signals = {name: [v * factors.get(name, 1.0) for v in values] for name, values in document["signals"].items()}
+    return {
+        **document,
+        "signals": signals,
+        "sample_rate_hz": document["sample_rate_hz"] * factors.get("sample_rate_hz", 1.0),
+    }

@@ -1,0 +1,206 @@
+"""Whether a window's signals tell one story: a sign convention, a unit or a sample rate the log got
+wrong, found and named before anything is read from the window.
+
+A careless export answered with garbage before: a speed or current of the other sign, a sample rate
+twice the log's, a hinge moment in kN·m gave FDJ 2–15 ranges off (said weak, the fit check failing,
+but an answer). Three relations hold in every window of a working drive, whatever its health:
+
+1. Kinematics: the surface turns as the motor does, θ_u = θ_m / n behind the backlash's dead band.
+   The position is ``g`` times the speed's integral over n carried through a dead band
+   (``sim.dead_band``, its width fitted: a worn band as well); on 1983 foreign windows of every
+   group of ``benchmarks.foreign_accuracy`` and ``known_limits`` (60 each) g was 0.995–1.009. A speed of the
+   other sign gives g = −1, a sample rate stated twice the log's g = 2, a position in radians 1/57.3.
+   Refused outside ``TRAVEL_GAIN``: a position sensor's gain a few % off is no unit error.
+2. The closed loop: the surface moves toward the command whenever it is over ``FOLLOW_GAP_DEG`` away.
+   Over 2 ms steps, begun on the side of the command the surface has been on for ``REACTION_S`` (a
+   drive at full speed needs ~20 ms to turn), it did so in every step of the 1983 windows; for a
+   position of the other sign in 4–56 %, for a command in radians in 39–90 %. Judged over
+   ``MIN_FOLLOW_S`` of such steps.
+3. Eq. 5.1: the current drives the motion against friction and load. Read with the current's sign
+   flipped, the hinge moment's, both (which is the motion's sign flipped), or the hinge moment ×1000
+   (kN·m logged as N·m), the window's fit (a sensor offset free) is ``MIN_BETTER`` times better only
+   if that field is wrong: on 200 foreign windows of every group no flipped reading came past 1.3x,
+   on the 1983 none past 3x; with the field wrong, the right reading is 24–940x better for the
+   current, 0.8–65x for the hinge moment's sign and 0.7–33x for its unit (those it misses, the fit
+   check still flags).
+
+Which field is named follows from which relations fail together (``check_consistency``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from sim.checks import InputError
+from sim.dead_band import dead_band_paths
+from sim.params import ActuatorParams
+from sim.window import Window
+from training.baseline import fit_friction
+from training.preprocess import as_read
+from training.zero_offset import OFFSET_FIT
+
+TRAVEL_GAIN = (0.9, 1.1)  # g accepted
+BAND_GRID = 40  # dead band widths tried: 0, then geometric from 5 % of the spec's to the whole travel
+MIN_EXPLAINED = 0.9  # share of the position's variance the speed's travel must explain for g to be judged
+FOLLOW_GAP_DEG = 1.0
+FOLLOW_STEP_S = 2e-3
+FOLLOW_MIN_STEP_DEG = 0.05  # a step that moves: 5 position-noise stds
+REACTION_S = 0.025  # J_M·2ω_max / T_M,max ≈ 19 ms to turn from full speed one way to the other
+MIN_FOLLOW_S = 0.01  # of steps over the gap, to judge the loop by
+MIN_FOLLOWING = 0.8  # share of those steps toward the command, accepted
+UNIT_SLIPS = (  # a travel gain of about (factor): the field, and the slip it points to
+    (1.0 / np.degrees(1.0), "signals.position_deg", "in radians (or motor_speed_radps in deg/s)?"),
+    (np.pi / 30.0, "signals.motor_speed_radps", "in rpm?"),
+)
+UNIT_SLIP_TOLERANCE = 0.1
+MIN_BETTER = 3.0  # how many times better a reading of a field must fit Eq. 5.1 to call the field wrong
+READINGS = {  # fields read otherwise: ({signal: factor}, the field named, what it would mean)
+    "current sign": (
+        {"current_a": -1.0},
+        "current_a",
+        "its sign is the other one: it opposes the torque the motion needs",
+    ),
+    "hinge sign": (
+        {"hinge_moment_nm": -1.0},
+        "hinge_moment_nm",
+        "its sign is the other one: the load aids where it opposes",
+    ),
+    "hinge unit": ({"hinge_moment_nm": 1e3}, "hinge_moment_nm", "it is 1000x too small: kN·m logged as N·m?"),
+    # Eq. 5.1 is odd in (I, H) against (ω, θ): both torques flipped is the motion flipped, which the command tells
+    "torque signs": (
+        {"current_a": -1.0, "hinge_moment_nm": -1.0},
+        "current_a",
+        "and hinge_moment_nm both have the other sign: they oppose the motion",
+    ),
+}
+
+
+@dataclass(frozen=True)
+class Consistency:
+    """How a window's signals relate (None: too little motion to judge that relation)."""
+
+    travel_gain: float | None  # the position's travel over the speed's integral / n (1: consistent)
+    following: float | None  # share of the steps over the gap that move toward the command
+    better_reading: tuple[str, float] | None  # a field read otherwise (``READINGS``), and how many times better
+
+
+def _best_band(travel: np.ndarray, y: np.ndarray, halves: np.ndarray) -> tuple[float, float, int]:
+    """Over dead bands of ``halves`` (each begun at either face or the middle), the one whose path best
+    explains ``y`` (centred): (explained sum of squares, slope, its index in ``halves``)."""
+    starts = np.repeat([-1.0, 0.0, 1.0], len(halves))
+    paths = dead_band_paths(travel, np.tile(halves, 3), starts)
+    paths -= paths.mean(axis=1, keepdims=True)
+    spread, covariance = np.einsum("ij,ij->i", paths, paths), paths @ y
+    explained = np.divide(covariance**2, spread, out=np.zeros_like(spread), where=spread > 0.0)
+    best = int(np.argmax(explained))
+    slope = covariance[best] / spread[best] if spread[best] > 0.0 else 0.0
+    return float(explained[best]), float(slope), best % len(halves)
+
+
+def travel_gain(window: Window, actuator: ActuatorParams) -> float | None:
+    """The drive's kinematic gain g: the least-squares slope (with an intercept) of the position (rad) on
+    the speed's integral / n carried through a dead band (``sim.dead_band``) whose width (any the travel
+    shows: a worn band too; a coarse grid, then a fine one about the best) and start the least squares
+    choose; None where that explains under ``MIN_EXPLAINED`` of the position's variance (a surface that
+    hardly moves, or not with the motor)."""
+    rate, position = window.sample_rate_hz, np.radians(window.signals["position_deg"])
+    travel = np.cumsum(window.signals["motor_speed_radps"]) / rate / actuator.gear_ratio
+    y = position - position.mean()
+    widest = max(np.ptp(travel), actuator.backlash_rad)
+    coarse = np.concatenate([[0.0], np.geomspace(0.05 * actuator.backlash_rad, widest, BAND_GRID - 1)]) / 2
+    at = _best_band(travel, y, coarse)[2]
+    fine = np.linspace(coarse[max(0, at - 1)], coarse[min(len(coarse) - 1, at + 1)], BAND_GRID)
+    explained, gain, _ = _best_band(travel, y, fine)
+    return gain if explained >= MIN_EXPLAINED * (y @ y) > 0.0 else None
+
+
+def following(window: Window, actuator: ActuatorParams) -> float | None:
+    """The share of ``FOLLOW_STEP_S`` steps, begun over ``FOLLOW_GAP_DEG`` from the command (clipped to the
+    end stops) on the side it has stood for ``REACTION_S`` and moving, that move toward it; None where they
+    last under ``MIN_FOLLOW_S`` in all."""
+    position, rate = window.signals["position_deg"], window.sample_rate_hz
+    command = np.clip(window.signals["command_deg"], -actuator.end_stop_deg, actuator.end_stop_deg)
+    lag = max(1, round(FOLLOW_STEP_S * rate))
+    step, gap = position[lag:] - position[:-lag], (command - position)[:-lag]
+    side, at = np.sign(gap), np.arange(len(gap))
+    since = at - np.maximum.accumulate(np.where(np.diff(side, prepend=side[0]) != 0, at, 0))  # on this side
+    judged = (np.abs(gap) > FOLLOW_GAP_DEG) & (np.abs(step) > FOLLOW_MIN_STEP_DEG) & (since >= REACTION_S * rate)
+    if judged.sum() < MIN_FOLLOW_S * rate:
+        return None
+    return float(np.mean(np.sign(step[judged]) == side[judged]))
+
+
+def better_reading(window: Window, actuator: ActuatorParams) -> tuple[str, float] | None:
+    """The reading of ``READINGS`` that fits Eq. 5.1 best, with how many times its equation error is below
+    the window's as logged, if by ``MIN_BETTER``; one batched fit of the window and its readings."""
+    signals, rate = window.signals, window.sample_rate_hz
+    batch = {name: np.stack([signals[name]] * (1 + len(READINGS))) for name in ("current_a", "hinge_moment_nm")}
+    for row, (factors, _, _) in enumerate(READINGS.values(), start=1):
+        for name, factor in factors.items():
+            batch[name][row] = signals[name] * factor
+    batch["position_deg"] = np.broadcast_to(signals["position_deg"], batch["current_a"].shape)
+    read = dict(as_read(dict(signals, **batch), rate), position_deg=signals["position_deg"])
+    errors = fit_friction(read, rate, actuator, OFFSET_FIT).residual_rms_nm
+    gains = errors[0] / errors[1:]
+    best = int(np.nanargmax(gains)) if np.any(np.isfinite(gains)) else -1
+    if best < 0 or not gains[best] >= MIN_BETTER:
+        return None
+    return list(READINGS)[best], float(gains[best])
+
+
+def consistency(window: Window, actuator: ActuatorParams = ActuatorParams()) -> Consistency:
+    """The three relations of the module docstring, read off ``window``."""
+    return Consistency(travel_gain(window, actuator), following(window, actuator), better_reading(window, actuator))
+
+
+def _travel_error(gain: float, lost: bool, loop: str, window: Window, actuator: ActuatorParams) -> InputError:
+    """The error for a travel gain outside ``TRAVEL_GAIN``, naming the field it points to: the position if it
+    has ``lost`` the command too, else the speed (a sign), a known unit slip, or the sample rate."""
+    travel = (
+        f"the position's travel is {gain:.3g}x the speed's integral over the window / gear ratio "
+        f"{actuator.gear_ratio:g} (1 in a working drive){loop}"
+    )
+    if gain < 0 and lost:
+        return InputError("signals.position_deg", f"runs against motor_speed_radps and the command: {travel}: a sign?")
+    if gain < 0:
+        return InputError("signals.motor_speed_radps", f"runs against position_deg: {travel}: a sign convention?")
+    for factor, field, slip in UNIT_SLIPS:
+        if abs(gain / factor - 1.0) < UNIT_SLIP_TOLERANCE:
+            return InputError(field, f"{slip} {travel}")
+    rate = window.sample_rate_hz
+    return InputError(
+        "sample_rate_hz",
+        f"{travel}: at {rate * gain:.6g} Hz instead of {rate:.6g} it would be 1; or is motor_speed_radps in "
+        "other units?",
+    )
+
+
+def check_consistency(window: Window, actuator: ActuatorParams = ActuatorParams()) -> Consistency:
+    """``window``'s relations, or an InputError naming the field the failing ones point to."""
+    found = consistency(window, actuator)
+    gain, follows, reading = found.travel_gain, found.following, found.better_reading
+    lost = follows is not None and follows < MIN_FOLLOWING
+    loop = (
+        ""
+        if follows is None
+        else f"; the position moves toward the command in {100 * follows:.0f} % of the {FOLLOW_STEP_S * 1e3:g} ms "
+        f"steps begun over {FOLLOW_GAP_DEG:g}° from it (97–100 % in a working closed loop)"
+    )
+    if gain is not None and not TRAVEL_GAIN[0] <= gain <= TRAVEL_GAIN[1]:
+        raise _travel_error(gain, lost, loop, window, actuator)
+    if lost and reading is not None and reading[0] in ("current sign", "torque signs"):
+        raise InputError(
+            "signals.position_deg",
+            f"and motor_speed_radps both run against the command and the current{loop}: a sign convention?",
+        )
+    if lost:
+        raise InputError(
+            "signals.command_deg",
+            f"the position does not follow it{loop}: a command in other units, of the other sign or of another window?",
+        )
+    if reading is not None:
+        _, name, meaning = READINGS[reading[0]]
+        raise InputError(f"signals.{name}", f"{meaning}: Eq. 5.1 fits the window {reading[1]:.3g}x better so")
+    return found
