@@ -41,7 +41,7 @@ from sim.noise import NOISY_SIGNALS
 from sim.params import ActuatorParams
 from sim.window import Window
 from training.alignment import Lags, aligned
-from training.consistency import check_consistency
+from training.consistency import Consistency, check_consistency, kinematics_note
 from training.departures import Departures, read_departures
 from training.drive_constants import DriveConstants, drive_constants_note
 from training.noise_level import white_noise_std
@@ -59,21 +59,36 @@ MAX_GLITCH_S = 3e-4  # ... and so may a shorter one at a low rate: a current pul
 
 @dataclass(frozen=True)
 class Prepared:
-    window: Window  # what the pipeline processes
     factor: int  # adjacent samples averaged into one
     original_samples: int
     original_rate_hz: float
     command_clipped_fraction: float  # share of command samples past the end stops (the actuator saturates)
     glitches: dict[str, int]  # per sensor, samples of glitches replaced by the line between their flanks
+    consistency: Consistency  # how its signals relate: the kinematic gain, the loop, Eq. 5.1's readings
     lags: Lags  # how late the current (behind the speed) and the hinge moment were logged, undone
-    offset: ZeroOffset  # a sensor off zero, taken off
-    drive: DriveConstants  # k_T and J_M where they depart from the spec's: the current carries them
-    viscosity: Viscosity  # the viscous coefficient, where it departs from the spec's
+    departures: Departures  # what it shows beyond the spec's model (an offset, k_T and J_M, C), undone
+
+    @property
+    def window(self) -> Window:
+        """What the pipeline processes: averaged, aligned, corrected for its departures."""
+        return self.departures.window
 
     @property
     def actuator(self) -> ActuatorParams:
         """What every reconstruction and fit of the window reads it with: the spec's, J_M and C as read."""
-        return self.viscosity.actuator(self.drive.actuator)
+        return self.departures.actuator
+
+    @property
+    def offset(self) -> ZeroOffset:
+        return self.departures.offset
+
+    @property
+    def drive(self) -> DriveConstants:
+        return self.departures.drive
+
+    @property
+    def viscosity(self) -> Viscosity:
+        return self.departures.viscosity
 
 
 def averaging_factor(n_samples: int, rate_hz: float) -> int:
@@ -144,13 +159,11 @@ def prepare(window: Window, actuator: ActuatorParams = ActuatorParams(), spec_on
         n = window.n_samples // factor * factor
         signals = {name: values[:n].reshape(-1, factor).mean(axis=1) for name, values in window.signals.items()}
         window = replace(window, signals=signals, sample_rate_hz=window.sample_rate_hz / factor)
-    check_consistency(window, actuator)
+    consistent = check_consistency(window, actuator)
     window, lags = aligned(window)
     read = Departures(window) if spec_only else read_departures(window, actuator)
     rate = read.window.sample_rate_hz * factor
-    return Prepared(
-        read.window, factor, len(command), rate, clipped, glitches, lags, read.offset, read.drive, read.viscosity
-    )
+    return Prepared(factor, len(command), rate, clipped, glitches, consistent, lags, read)
 
 
 def widened(stds: dict[str, float], prepared: Prepared) -> dict[str, float]:
@@ -165,6 +178,7 @@ def conditioning_done(prepared: Prepared) -> dict[str, Any]:
     return {
         "command_clipped_fraction": prepared.command_clipped_fraction,
         "glitches_repaired": prepared.glitches,
+        "kinematic_gain": prepared.consistency.travel_gain,
         "current_lag_s": prepared.lags.current_s,
         "hinge_lag_s": prepared.lags.hinge_s,
         "hinge_offset_nm": prepared.offset.hinge_nm,
@@ -194,7 +208,12 @@ def conditioning_notes(prepared: Prepared) -> list[str]:
             f"the hinge moment is logged {1e6 * lags.hinge_s:.0f} µs late (its filter, read from the "
             "correlation of its noise): advanced before Eq. 5.1, the stds include what a misread of it moves"
         )
-    found = (offset_note(prepared.offset), drive_constants_note(prepared.drive), viscosity_note(prepared.viscosity))
+    found = (
+        kinematics_note(prepared.consistency),
+        offset_note(prepared.offset),
+        drive_constants_note(prepared.drive),
+        viscosity_note(prepared.viscosity),
+    )
     notes.extend(note for note in found if note)
     if prepared.glitches:
         counts = ", ".join(f"{count} of {name}" for name, count in prepared.glitches.items())

@@ -117,6 +117,11 @@ class WindowInfo(Document):
         default=1.0,
         description="the viscous coefficient every estimator used over the spec's C_M (read where it departs)",
     )
+    kinematic_gain: float | None = Field(
+        default=None,
+        description="the position's travel over the speed's integral / gear ratio through the dead band (1 in a "
+        "consistent log; 0.9-1.1 accepted; null: too little motion to tell)",
+    )
     sliding_fraction: float = Field(description="share of samples the friction fit could use")
     recorded_at: str | None = None
     flight_hours: float | None = None

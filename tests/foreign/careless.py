@@ -29,6 +29,8 @@ SLIPS: dict[str, Slip] = {
     "current of the other sign": Slip({"current_a": -1.0}, "signals.current_a"),
     "hinge moment of the other sign": Slip({"hinge_moment_nm": -1.0}, "signals.hinge_moment_nm"),
     "hinge moment in kN·m": Slip({"hinge_moment_nm": 1e-3}, "signals.hinge_moment_nm"),
+    "hinge moment in lbf·in": Slip({"hinge_moment_nm": 8.8507}, "signals.hinge_moment_nm"),
+    "hinge moment in lbf·ft": Slip({"hinge_moment_nm": 0.73756}, "signals.hinge_moment_nm"),
     "current and hinge moment of the other sign": Slip(
         {"current_a": -1.0, "hinge_moment_nm": -1.0}, "signals.current_a"
     ),

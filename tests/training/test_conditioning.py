@@ -91,10 +91,8 @@ def test_glitches_are_found_and_replaced_by_the_line_between_their_flanks():
 
 def test_what_conditioning_could_not_settle_widens_the_stds_in_quadrature():
     prepared = prepare(synthetic_window(HealthParams.single(), seed=1))
-    prepared = replace(
-        prepared,
-        offset=ZeroOffset(spread={"FDJ": 3e-4}),
-        lags=Lags(spread={"FDJ": 12e-4, "eta_O": 0.0}),
-        viscosity=Viscosity(spread={"FDJ": 0.0}),
+    departures = replace(
+        prepared.departures, offset=ZeroOffset(spread={"FDJ": 3e-4}), viscosity=Viscosity(spread={"FDJ": 0.0})
     )
+    prepared = replace(prepared, lags=Lags(spread={"FDJ": 12e-4, "eta_O": 0.0}), departures=departures)
     assert widened({"FDJ": 4e-4, "eta_O": 0.01}, prepared) == pytest.approx({"FDJ": 13e-4, "eta_O": 0.01})

@@ -8,7 +8,7 @@ from sim.checks import InputError
 from sim.window import window_from_dict
 from tests.foreign.careless import SLIPS, Slip, exported
 from tests.foreign.windows import Effects, draw, filter_widths, through_filters, worn
-from training.conditioning import prepare
+from training.conditioning import conditioning_notes, prepare
 from training.consistency import check_consistency
 
 FAMILIES = ("thesis", "cruise", "gust", "doublet", "steps")
@@ -52,6 +52,8 @@ CAUGHT = {  # of the five windows, fewer than all where the window cannot show t
     "hinge moment in kN·m": 4,
     # a gust window's surface swings about 0°, where a command in radians stays: it looks followed in 90 % of steps
     "command in radians": 4,
+    # 0.74x the load is much as η_O 0.74x as high would be (Eq. 5.1's load term): the answer then says it is weak
+    "hinge moment in lbf·ft": 1,
 }
 
 
@@ -82,3 +84,11 @@ def test_the_travel_gain_follows_a_misstated_sample_rate():
         except InputError as refused:
             gains.append(float(refused.message.split("travel is ")[1].split("x")[0]))
     assert np.allclose(np.array(gains) / gains[1], [0.8, 1.0, 1.25], rtol=1e-3)
+
+
+def test_a_time_base_a_few_percent_off_is_answered_with_a_note():
+    document = draw(4412, "cruise").document
+    slow = prepare(window_from_dict(exported(document, Slip({"sample_rate_hz": 0.95}, "sample_rate_hz"))))
+    assert slow.consistency.travel_gain == pytest.approx(0.95, abs=0.005)
+    assert any("travels 0.95" in note for note in conditioning_notes(slow))
+    assert not any("travels" in note for note in conditioning_notes(prepare(window_from_dict(document))))
