@@ -25,6 +25,11 @@ but an answer). Three relations hold in every window of a working drive, whateve
    much what η_O 0.74x as high reads (Eq. 5.1's load term), and seldom told; what is missed, the fit
    check still flags.
 
+Before these, every sensor must show that it logs: a working one shows at least ``MIN_LEVELS``
+values over a window (its noise, its quantization). A hinge moment logged as zeros (an aircraft
+without the strain gauge) or stuck at one value was answered 0.2–2.5 ranges off, η_O once at 15 of
+its stds. The command may hold still.
+
 Which field is named follows from which relations fail together (``check_consistency``).
 """
 
@@ -57,6 +62,7 @@ UNIT_SLIPS = (  # a travel gain of about (factor): the field, and the slip it po
     (np.pi / 30.0, "signals.motor_speed_radps", "in rpm?"),
 )
 UNIT_SLIP_TOLERANCE = 0.1
+MIN_LEVELS = 3  # distinct values a logged sensor shows over a window
 MIN_BETTER = 3.0  # how many times better a reading of a field must fit Eq. 5.1 to call the field wrong
 READINGS = {  # fields read otherwise: ({signal: factor}, the field named, what it would mean)
     "current sign": (
@@ -154,6 +160,19 @@ def better_reading(window: Window, actuator: ActuatorParams) -> tuple[str, float
     return list(READINGS)[best], float(gains[best])
 
 
+def check_logged(window: Window) -> None:
+    """An InputError naming the first sensor with fewer than ``MIN_LEVELS`` distinct values over ``window``."""
+    for name in ("position_deg", "motor_speed_radps", "current_a", "hinge_moment_nm"):
+        levels = np.unique(window.signals[name])
+        if len(levels) < MIN_LEVELS:
+            values = ", ".join(f"{v:g}" for v in levels)
+            raise InputError(
+                f"signals.{name}",
+                f"takes only {values} over the window: a sensor not logged or stuck (a working one shows its noise); "
+                "nothing can be read through it",
+            )
+
+
 def consistency(window: Window, actuator: ActuatorParams = ActuatorParams()) -> Consistency:
     """The three relations of the module docstring, read off ``window``."""
     return Consistency(travel_gain(window, actuator), following(window, actuator), better_reading(window, actuator))
@@ -196,6 +215,7 @@ def _travel_error(gain: float, lost: bool, loop: str, window: Window, actuator: 
 
 def check_consistency(window: Window, actuator: ActuatorParams = ActuatorParams()) -> Consistency:
     """``window``'s relations, or an InputError naming the field the failing ones point to."""
+    check_logged(window)
     found = consistency(window, actuator)
     gain, follows, reading = found.travel_gain, found.following, found.better_reading
     lost = follows is not None and follows < MIN_FOLLOWING

@@ -92,3 +92,12 @@ def test_a_time_base_a_few_percent_off_is_answered_with_a_note():
     assert slow.consistency.travel_gain == pytest.approx(0.95, abs=0.005)
     assert any("travels 0.95" in note for note in conditioning_notes(slow))
     assert not any("travels" in note for note in conditioning_notes(prepare(window_from_dict(document))))
+
+
+@pytest.mark.parametrize("name", ["position_deg", "motor_speed_radps", "current_a", "hinge_moment_nm"])
+def test_a_sensor_stuck_at_one_value_is_refused_naming_it(name):
+    document = draw(4413, "doublet").document
+    stuck = {**document, "signals": {**document["signals"], name: [document["signals"][name][100]] * 5000}}
+    with pytest.raises(InputError, match="stuck") as refused:
+        check_consistency(window_from_dict(stuck))
+    assert refused.value.field == f"signals.{name}"
