@@ -2,8 +2,8 @@
 samples, its signals checked to tell one story (``training.consistency``: a sign, unit or sample
 rate the log got wrong is refused, naming the field), its sensors on one clock
 (``training.alignment``), what it shows beyond the spec's model read and undone
-(``training.departures``: a sensor off zero, the drive's k_T and J_M, the viscous coefficient), and
-what was done to it.
+(``training.departures``: a sensor off zero, the drive's k_T and J_M, the hinge moment's gain, the
+viscous coefficient), and what was done to it.
 
 A sensor's sample that jumps away from both neighbours and straight back (an EMI spike, a bit
 error) is no measurement, nor is a burst of a few of them (``MAX_GLITCH_RUN``, ``MAX_GLITCH_S``:
@@ -44,6 +44,7 @@ from training.alignment import Lags, aligned
 from training.consistency import Consistency, check_consistency, kinematics_note
 from training.departures import Departures, read_departures
 from training.drive_constants import DriveConstants, drive_constants_note
+from training.hinge_gain import HingeGain, hinge_gain_note
 from training.noise_level import white_noise_std
 from training.viscosity import Viscosity, viscosity_note
 from training.zero_offset import ZeroOffset, offset_note
@@ -89,6 +90,10 @@ class Prepared:
     @property
     def viscosity(self) -> Viscosity:
         return self.departures.viscosity
+
+    @property
+    def hinge(self) -> HingeGain:
+        return self.departures.hinge
 
 
 def averaging_factor(n_samples: int, rate_hz: float) -> int:
@@ -169,7 +174,8 @@ def prepare(window: Window, actuator: ActuatorParams = ActuatorParams(), spec_on
 def widened(stds: dict[str, float], prepared: Prepared) -> dict[str, float]:
     """Each std with what conditioning could not settle (an offset's readings, a lag's band, the viscous
     coefficient's std: their spreads, per target) added in quadrature."""
-    spreads = (prepared.offset.spread, prepared.lags.spread, prepared.drive.spread, prepared.viscosity.spread)
+    read = prepared.departures
+    spreads = (read.offset.spread, prepared.lags.spread, read.drive.spread, read.hinge.spread, read.viscosity.spread)
     return {name: float(np.sqrt(std**2 + sum(s.get(name, 0.0) ** 2 for s in spreads))) for name, std in stds.items()}
 
 
@@ -186,6 +192,7 @@ def conditioning_done(prepared: Prepared) -> dict[str, Any]:
         "torque_scale": prepared.drive.torque_factor,
         "inertia_factor": prepared.drive.inertia_factor,
         "viscous_factor": prepared.viscosity.factor,
+        "hinge_gain": prepared.hinge.gain,
     }
 
 
@@ -212,6 +219,7 @@ def conditioning_notes(prepared: Prepared) -> list[str]:
         kinematics_note(prepared.consistency),
         offset_note(prepared.offset),
         drive_constants_note(prepared.drive),
+        hinge_gain_note(prepared.hinge),
         viscosity_note(prepared.viscosity),
     )
     notes.extend(note for note in found if note)

@@ -1,6 +1,6 @@
 """What a window shows beyond the spec's model, read in turn, each on the window the last corrected: a
 sensor off zero (``training.zero_offset``), the drive's k_T and J_M (``training.drive_constants``), the
-viscous coefficient (``training.viscosity``).
+hinge moment's gain (``training.hinge_gain``), the viscous coefficient (``training.viscosity``).
 
 A drive constant, seen before it is read, passes in part for an offset (a thesis window's current logged
 1.5 % low read as 2.2 mN·m off zero, which left FDJ 11 % of range off once the scale was read too), so
@@ -25,6 +25,7 @@ from sim.params import ActuatorParams
 from sim.window import Window
 from training.design import inside
 from training.drive_constants import UNDECIDED_SHARE, DriveConstants, read_drive_constants
+from training.hinge_gain import HingeGain, leads, read_hinge_gain
 from training.noise_level import white_noise_std
 from training.preprocess import fit_as_read
 from training.reproduction import CLEAR_MARGIN, MAX_RATIO, following_error
@@ -38,6 +39,7 @@ class Departures:
     offset: ZeroOffset = field(default_factory=ZeroOffset)
     drive: DriveConstants = field(default_factory=DriveConstants)
     viscosity: Viscosity = field(default_factory=Viscosity)
+    hinge: HingeGain = field(default_factory=HingeGain)
 
     @property
     def actuator(self) -> ActuatorParams:
@@ -53,12 +55,14 @@ class Departures:
 
 def read_departures(window: Window, actuator: ActuatorParams = ActuatorParams()) -> Departures:
     """The window corrected for what it shows beyond ``actuator``, and what that was (module docstring)."""
+    hinge = read_hinge_gain(window, actuator) if leads(window, actuator) else HingeGain()
+    window = hinge.corrected(window)
     offset = read_zero_offset(window, actuator)
     drive = read_drive_constants(zeroed(window, offset), actuator)
-    read = _along(window, offset, drive)
+    read = _along(window, offset, drive, hinge)
     if drive.alternative is None:
         return read
-    other = _along(window, offset, drive.alternative)
+    other = _along(window, offset, drive.alternative, hinge)
     told = _told_apart(window, read, other)
     if told is not None:
         return replace(told, drive=replace(told.drive, alternative=None))
@@ -95,10 +99,14 @@ def _told_apart(window: Window, scale: Departures, inertia: Departures) -> Depar
     return scale if errors[0] * (1.0 + CLEAR_MARGIN) < errors[1] else None
 
 
-def _along(window: Window, offset: ZeroOffset, drive: DriveConstants) -> Departures:
-    """The offset read first (again on the corrected window where a drive constant was read), then C."""
+def _along(window: Window, offset: ZeroOffset, drive: DriveConstants, hinge: HingeGain) -> Departures:
+    """The offset read first (again on the corrected window where a drive constant was read), then the
+    hinge moment's gain unless it led (on the zeroed moment: a logged g·H + b), then C."""
     if drive.stds:
         window = drive.corrected(window)
         offset = read_zero_offset(window, drive.actuator)
     window = zeroed(window, offset)
-    return Departures(window, offset, drive, read_viscosity(window, drive.actuator))
+    if hinge.gain == 1.0:
+        hinge = read_hinge_gain(window, drive.actuator)
+        window = hinge.corrected(window)
+    return Departures(window, offset, drive, read_viscosity(window, drive.actuator), hinge)

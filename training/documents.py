@@ -117,6 +117,11 @@ class WindowInfo(Document):
         default=1.0,
         description="the viscous coefficient every estimator used over the spec's C_M (read where it departs)",
     )
+    hinge_gain: float = Field(
+        default=1.0,
+        description="the logged hinge moment over the load it shows (a strain gauge calibrated off, other units); "
+        "the moment was divided by it before every estimator",
+    )
     kinematic_gain: float | None = Field(
         default=None,
         description="the position's travel over the speed's integral / gear ratio through the dead band (1 in a "
