@@ -55,9 +55,11 @@ class Departures:
 
 def read_departures(window: Window, actuator: ActuatorParams = ActuatorParams()) -> Departures:
     """The window corrected for what it shows beyond ``actuator``, and what that was (module docstring)."""
-    hinge = read_hinge_gain(window, actuator) if leads(window, actuator) else HingeGain()
-    window = hinge.corrected(window)
     offset = read_zero_offset(window, actuator)
+    hinge = _leading_hinge_gain(zeroed(window, offset), actuator)
+    if hinge.gain != 1.0:  # a logged g·H + b: the offset, b/g once the gain is taken off, read again
+        window = hinge.corrected(window)
+        offset = read_zero_offset(window, actuator)
     drive = read_drive_constants(zeroed(window, offset), actuator)
     read = _along(window, offset, drive, hinge)
     if drive.alternative is None:
@@ -69,6 +71,11 @@ def read_departures(window: Window, actuator: ActuatorParams = ActuatorParams())
     mine, theirs = read.answer, other.answer
     spread = {name: float(np.hypot(drive.spread[name], UNDECIDED_SHARE * (mine[name] - theirs[name]))) for name in mine}
     return replace(read, drive=replace(drive, spread=spread))
+
+
+def _leading_hinge_gain(window: Window, actuator: ActuatorParams) -> HingeGain:
+    """The hinge moment's gain where it leads the drive's constants (``hinge_gain.leads``), else none yet."""
+    return read_hinge_gain(window, actuator) if leads(window, actuator) else HingeGain()
 
 
 def _told_apart(window: Window, scale: Departures, inertia: Departures) -> Departures | None:
