@@ -22,9 +22,10 @@ windows were read as hinge gains (η_O 9 % of range off on worn ones, against 0.
 before them only where it explains the window decisively better than γ or ΔJ alone (``leads``, as
 ΔJ must beat γ), and after them otherwise: 0.8x was then read 0.795–0.806x on ten foreign windows,
 every answer as with the true moment, and 60 windows with k_T, a current gain or J_M off were
-answered as before. Every fit of g sits beside a sensor offset, and leads on the window the offset
-stage zeroed: a hinge moment off zero bends |H − b| as a gain would, and worn windows 5 N·m off
-were read as gains 0.73–1.25 (FDJ up to 69 % of range off) before.
+answered as before. Every fit of g sits beside a sensor offset and a change of C, and leads on the
+window the offset stage zeroed: a hinge moment off zero bends |H − b| as a gain would, and C·|ω|
+grows with the load's speeds; without them worn windows 5 N·m off were read as gains 0.73–1.25
+(FDJ up to 69 % of range off), and worn windows with C 1.2–2x as 0.89 and 1.08 (52 and 22 %).
 """
 
 from __future__ import annotations
@@ -38,7 +39,6 @@ from sim.residual import DEFAULT_DERIVATIVE_WINDOW_S, kernel_samples
 from sim.window import Window
 from training.baseline import JACKKNIFE_BLOCKS, MIN_SLIDING_KERNELS, FitSettings, nuisance_columns, regressors
 from training.preprocess import as_read, fit_as_read
-from training.zero_offset import OFFSET_FIT
 
 MIN_Z = 4.0  # stds by which the free load coefficients must explain the window better than g = 1
 PLAUSIBLE = (0.5, 2.0)  # a gain read outside is no sensor's: not taken
@@ -113,9 +113,9 @@ def leads(window: Window, actuator: ActuatorParams = ActuatorParams()) -> bool:
 
 def _stands_out(window: Window, actuator: ActuatorParams, free_rms: float, used: int) -> bool:
     """Whether the free fit explains the window ``MIN_Z`` stds better than Eq. 5.1's with g = 1, each beside
-    a sensor offset (which the load's terms would otherwise take for a gain)."""
+    a sensor offset and ΔC (which the load's terms would otherwise take for a gain)."""
     rate = window.sample_rate_hz
-    plain = float(fit_as_read(window.signals, rate, actuator, OFFSET_FIT).residual_rms_nm[0])
+    plain = float(fit_as_read(window.signals, rate, actuator, BESIDE).residual_rms_nm[0])
     if not (np.isfinite(plain) and free_rms > 0):
         return False
     independent = used / kernel_samples(rate, DEFAULT_DERIVATIVE_WINDOW_S)
@@ -124,7 +124,7 @@ def _stands_out(window: Window, actuator: ActuatorParams, free_rms: float, used:
 
 def read_hinge_gain(window: Window, actuator: ActuatorParams = ActuatorParams()) -> HingeGain:
     """g where it stands out and is plausible (module docstring), with FDJ's and η_O's change across g ± its std."""
-    fitted = free_load_fit(window, actuator, OFFSET_FIT)
+    fitted = free_load_fit(window, actuator, BESIDE)
     if fitted is None:
         return HingeGain()
     gain, free_rms, used = fitted
