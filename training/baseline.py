@@ -240,7 +240,7 @@ def solve(stats: np.ndarray, gear: float, nuisances: tuple[str, ...] = ()) -> tu
     return beta[rows, best], centre, sse[rows, best]
 
 
-def _jackknife_std(estimates: np.ndarray) -> np.ndarray:
+def jackknife_std(estimates: np.ndarray) -> np.ndarray:
     """Std of the full-sample estimate from (N, B, …) leave-one-block-out estimates."""
     b = estimates.shape[1]
     return np.sqrt((b - 1) / b * np.sum((estimates - estimates.mean(axis=1, keepdims=True)) ** 2, axis=1))
@@ -264,8 +264,8 @@ def fit_friction(
     beta, eta_o, sse = solve(total, *model)
     left_out = (total[:, None] - blocks).reshape(-1, *total.shape[1:])
     beta_b, eta_b = (x.reshape(len(total), blocks.shape[1], -1) for x in solve(left_out, *model)[:2])
-    std = _jackknife_std(beta_b)
-    eta_o_std = _jackknife_std(eta_b[..., 0])
+    std = jackknife_std(beta_b)
+    eta_o_std = jackknife_std(eta_b[..., 0])
     enough = total[:, -1, -1] >= MIN_SLIDING_KERNELS * kernel_samples(rate, settings.derivative_window_s)
     nan = np.where(enough, 1.0, np.nan)
     terms, term_stds = np.zeros((2, len(total), len(NUISANCES)))

@@ -37,11 +37,19 @@ import numpy as np
 from sim.params import ActuatorParams
 from sim.residual import DEFAULT_DERIVATIVE_WINDOW_S, kernel_samples
 from sim.window import Window
-from training.baseline import JACKKNIFE_BLOCKS, MIN_SLIDING_KERNELS, FitSettings, nuisance_columns, regressors
+from training.baseline import (
+    JACKKNIFE_BLOCKS,
+    MIN_SLIDING_KERNELS,
+    FitSettings,
+    jackknife_std,
+    nuisance_columns,
+    regressors,
+)
 from training.preprocess import as_read, fit_as_read
+from training.zero_offset import rms_log_likelihood_ratio
 
 MIN_Z = 4.0  # stds by which the free load coefficients must explain the window better than g = 1
-PLAUSIBLE = (0.5, 2.0)  # a gain read outside is no sensor's: not taken
+PLAUSIBLE = (0.7, 1.35)  # lbf·ft for N·m is 0.74; outside, no sensor's (a 0.1 s window read 1.47): not taken
 MIN_CHANGE = 0.01  # a gain nearer 1 than this changes nothing worth a note
 DECISIVE = 12.0  # ln LR by which g must beat γ and ΔJ to be read before them (as ΔJ must beat γ)
 BESIDE = FitSettings(offset=True, viscous=True)  # what g, γ and ΔJ are weighed beside
@@ -105,10 +113,9 @@ def leads(window: Window, actuator: ActuatorParams = ActuatorParams()) -> bool:
     if fitted is None or not fitted[1] > 0:
         return False
     rate, (_, free_rms, used) = window.sample_rate_hz, fitted
-    independent = used / kernel_samples(rate, DEFAULT_DERIVATIVE_WINDOW_S)
     others = [fit_as_read(window.signals, rate, actuator, replace(BESIDE, **{name: True})) for name in DRIVE_CONSTANTS]
     best_other = min(float(other.residual_rms_nm[0]) for other in others)
-    return bool(np.isfinite(best_other) and independent * np.log(best_other / free_rms) > DECISIVE)
+    return bool(np.isfinite(best_other) and rms_log_likelihood_ratio(best_other, free_rms, used, rate) > DECISIVE)
 
 
 def _stands_out(window: Window, actuator: ActuatorParams, free_rms: float, used: int) -> bool:
@@ -118,8 +125,7 @@ def _stands_out(window: Window, actuator: ActuatorParams, free_rms: float, used:
     plain = float(fit_as_read(window.signals, rate, actuator, BESIDE).residual_rms_nm[0])
     if not (np.isfinite(plain) and free_rms > 0):
         return False
-    independent = used / kernel_samples(rate, DEFAULT_DERIVATIVE_WINDOW_S)
-    return 2.0 * independent * np.log(plain / free_rms) > MIN_Z**2
+    return 2.0 * rms_log_likelihood_ratio(plain, free_rms, used, rate) > MIN_Z**2
 
 
 def read_hinge_gain(window: Window, actuator: ActuatorParams = ActuatorParams()) -> HingeGain:
@@ -131,8 +137,7 @@ def read_hinge_gain(window: Window, actuator: ActuatorParams = ActuatorParams())
     plausible = np.all(np.isfinite(gain)) and PLAUSIBLE[0] <= gain[0] <= PLAUSIBLE[1]
     if not (plausible and abs(gain[0] - 1.0) >= MIN_CHANGE and _stands_out(window, actuator, free_rms, used)):
         return HingeGain()
-    b = len(gain) - 1
-    std = float(np.sqrt((b - 1) / b * np.sum((gain[1:] - gain[1:].mean()) ** 2)))
+    std = float(jackknife_std(gain[None, 1:])[0])
     rate = window.sample_rate_hz
     low, high = (
         fit_as_read(HingeGain(float(gain[0]) + d).corrected(window).signals, rate, actuator) for d in (-std, std)

@@ -84,10 +84,16 @@ def sensor_offset(
 
 
 def log_likelihood_ratio(worse: FrictionFit, better: FrictionFit, rate: float) -> float:
-    """ln of the likelihood ratio of two fits of one window by their equation errors, with one independent
-    value per reconstruction kernel (the kernel smooths both sides of Eq. 5.1)."""
-    independent = float(worse.n_sliding[0]) / kernel_samples(rate, DEFAULT_DERIVATIVE_WINDOW_S)
-    return independent * float(np.log(worse.residual_rms_nm[0] / better.residual_rms_nm[0]))
+    """ln of the likelihood ratio of two fits of one window by their equation errors (``rms_log_likelihood_ratio``)."""
+    return rms_log_likelihood_ratio(
+        float(worse.residual_rms_nm[0]), float(better.residual_rms_nm[0]), float(worse.n_sliding[0]), rate
+    )
+
+
+def rms_log_likelihood_ratio(worse_rms: float, better_rms: float, n_sliding: float, rate: float) -> float:
+    """ln of the likelihood ratio of two fits of one window's ``n_sliding`` samples by their RMS equation
+    errors, with one independent value per reconstruction kernel (the kernel smooths both sides of Eq. 5.1)."""
+    return n_sliding / kernel_samples(rate, DEFAULT_DERIVATIVE_WINDOW_S) * float(np.log(worse_rms / better_rms))
 
 
 def equation_z(plain: FrictionFit, with_offset: FrictionFit, rate: float) -> float:
