@@ -34,6 +34,7 @@ SLIPS: dict[str, Slip] = {
     "current and hinge moment of the other sign": Slip(
         {"current_a": -1.0, "hinge_moment_nm": -1.0}, "signals.current_a"
     ),
+    "hinge moment not logged (zeros)": Slip({"hinge_moment_nm": 0.0}, "signals.hinge_moment_nm"),
 }
 
 
