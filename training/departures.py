@@ -25,7 +25,7 @@ from sim.params import ActuatorParams
 from sim.window import Window
 from training.design import inside
 from training.drive_constants import UNDECIDED_SHARE, DriveConstants, read_drive_constants
-from training.hinge_gain import HingeGain, leads, read_hinge_gain
+from training.hinge_gain import HingeGain, read_hinge_gain
 from training.noise_level import white_noise_std
 from training.preprocess import fit_as_read
 from training.reproduction import CLEAR_MARGIN, MAX_RATIO, following_error
@@ -56,7 +56,7 @@ class Departures:
 def read_departures(window: Window, actuator: ActuatorParams = ActuatorParams()) -> Departures:
     """The window corrected for what it shows beyond ``actuator``, and what that was (module docstring)."""
     offset = read_zero_offset(window, actuator)
-    hinge = _leading_hinge_gain(zeroed(window, offset), actuator)
+    hinge = read_hinge_gain(zeroed(window, offset), actuator, leading=True)
     if hinge.gain != 1.0:  # a logged g·H + b: the offset, b/g once the gain is taken off, read again
         window = hinge.corrected(window)
         offset = read_zero_offset(window, actuator)
@@ -71,11 +71,6 @@ def read_departures(window: Window, actuator: ActuatorParams = ActuatorParams())
     mine, theirs = read.answer, other.answer
     spread = {name: float(np.hypot(drive.spread[name], UNDECIDED_SHARE * (mine[name] - theirs[name]))) for name in mine}
     return replace(read, drive=replace(drive, spread=spread))
-
-
-def _leading_hinge_gain(window: Window, actuator: ActuatorParams) -> HingeGain:
-    """The hinge moment's gain where it leads the drive's constants (``hinge_gain.leads``), else none yet."""
-    return read_hinge_gain(window, actuator) if leads(window, actuator) else HingeGain()
 
 
 def _told_apart(window: Window, scale: Departures, inertia: Departures) -> Departures | None:

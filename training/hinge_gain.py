@@ -19,7 +19,7 @@ stds grow by what g's jackknife std moves them (``spread``).
 A k_T or J_M off (``training.drive_constants``) and g each take a part of the other: read after
 them, a moment logged 0.8x was read 0.84–1.0x (FDJ up to 54 % off); read first, k_T and J_M
 windows were read as hinge gains (η_O 9 % of range off on worn ones, against 0.3 %). So g is read
-before them only where it explains the window decisively better than γ or ΔJ alone (``leads``, as
+before them only where it explains the window decisively better than γ or ΔJ alone (``leading``, as
 ΔJ must beat γ), and after them otherwise: 0.8x was then read 0.795–0.806x on ten foreign windows,
 every answer as with the true moment, and 60 windows with k_T, a current gain or J_M off were
 answered as before. Every fit of g sits beside a sensor offset and a change of C, and leads on the
@@ -105,37 +105,31 @@ def free_load_fit(
     return 1.0 / ((1 + betas[:, 2]) * eta_o), rms, used
 
 
-def leads(window: Window, actuator: ActuatorParams = ActuatorParams()) -> bool:
-    """Whether g explains the window ``DECISIVE`` (ln LR) better than γ or ΔJ does alone, each beside an
-    offset and ΔC: then it is read before them, which would each take a part of it (a moment logged
-    0.8x was read 0.84–1.0x after them, FDJ up to 54 % off)."""
-    fitted = free_load_fit(window, actuator, BESIDE)
-    if fitted is None or not fitted[1] > 0:
-        return False
-    rate, (_, free_rms, used) = window.sample_rate_hz, fitted
-    others = [fit_as_read(window.signals, rate, actuator, replace(BESIDE, **{name: True})) for name in DRIVE_CONSTANTS]
-    best_other = min(float(other.residual_rms_nm[0]) for other in others)
-    return bool(np.isfinite(best_other) and rms_log_likelihood_ratio(best_other, free_rms, used, rate) > DECISIVE)
-
-
-def _stands_out(window: Window, actuator: ActuatorParams, free_rms: float, used: int) -> bool:
-    """Whether the free fit explains the window ``MIN_Z`` stds better than Eq. 5.1's with g = 1, each beside
-    a sensor offset and ΔC (which the load's terms would otherwise take for a gain)."""
+def _margin(window: Window, actuator: ActuatorParams, free_rms: float, used: int, rivals: list[FitSettings]) -> float:
+    """ln LR by which the free load fit explains ``window`` better than the best of Eq. 5.1's fits with
+    g = 1 and ``rivals``' terms (−inf where one cannot be compared)."""
     rate = window.sample_rate_hz
-    plain = float(fit_as_read(window.signals, rate, actuator, BESIDE).residual_rms_nm[0])
-    if not (np.isfinite(plain) and free_rms > 0):
-        return False
-    return 2.0 * rms_log_likelihood_ratio(plain, free_rms, used, rate) > MIN_Z**2
+    best = min(float(fit_as_read(window.signals, rate, actuator, rival).residual_rms_nm[0]) for rival in rivals)
+    if not (np.isfinite(best) and free_rms > 0):
+        return -np.inf
+    return rms_log_likelihood_ratio(best, free_rms, used, rate)
 
 
-def read_hinge_gain(window: Window, actuator: ActuatorParams = ActuatorParams()) -> HingeGain:
-    """g where it stands out and is plausible (module docstring), with FDJ's and η_O's change across g ± its std."""
+def read_hinge_gain(window: Window, actuator: ActuatorParams = ActuatorParams(), leading: bool = False) -> HingeGain:
+    """g where it stands out and is plausible (module docstring), with FDJ's and η_O's change across g ± its
+    std; ``leading``: only where it also explains the window ``DECISIVE`` (ln LR) better than γ or ΔJ alone,
+    each beside an offset and ΔC, to be read before them (which would each take a part of it)."""
     fitted = free_load_fit(window, actuator, BESIDE)
     if fitted is None:
         return HingeGain()
     gain, free_rms, used = fitted
     plausible = np.all(np.isfinite(gain)) and PLAUSIBLE[0] <= gain[0] <= PLAUSIBLE[1]
-    if not (plausible and abs(gain[0] - 1.0) >= MIN_CHANGE and _stands_out(window, actuator, free_rms, used)):
+    if not (plausible and abs(gain[0] - 1.0) >= MIN_CHANGE):
+        return HingeGain()
+    if not 2.0 * _margin(window, actuator, free_rms, used, [BESIDE]) > MIN_Z**2:
+        return HingeGain()
+    rivals = [replace(BESIDE, **{name: True}) for name in DRIVE_CONSTANTS]
+    if leading and not _margin(window, actuator, free_rms, used, rivals) > DECISIVE:
         return HingeGain()
     std = float(jackknife_std(gain[None, 1:])[0])
     rate = window.sample_rate_hz
