@@ -43,11 +43,11 @@ from sim.window import Window
 from training.alignment import Lags, aligned
 from training.consistency import Consistency, check_consistency, kinematics_note
 from training.departures import Departures, read_departures
-from training.drive_constants import DriveConstants, drive_constants_note
-from training.hinge_gain import HingeGain, hinge_gain_note
+from training.drive_constants import drive_constants_note
+from training.hinge_gain import hinge_gain_note
 from training.noise_level import white_noise_std
-from training.viscosity import Viscosity, viscosity_note
-from training.zero_offset import ZeroOffset, offset_note
+from training.viscosity import viscosity_note
+from training.zero_offset import offset_note
 
 MAX_RATE_HZ = 10_000.0
 MAX_SAMPLES = 10_000
@@ -67,7 +67,7 @@ class Prepared:
     glitches: dict[str, int]  # per sensor, samples of glitches replaced by the line between their flanks
     consistency: Consistency  # how its signals relate: the kinematic gain, the loop, Eq. 5.1's readings
     lags: Lags  # how late the current (behind the speed) and the hinge moment were logged, undone
-    departures: Departures  # what it shows beyond the spec's model (an offset, k_T and J_M, C), undone
+    departures: Departures  # what it shows beyond the spec's model (an offset, k_T and J_M, g, C), undone
 
     @property
     def window(self) -> Window:
@@ -78,22 +78,6 @@ class Prepared:
     def actuator(self) -> ActuatorParams:
         """What every reconstruction and fit of the window reads it with: the spec's, J_M and C as read."""
         return self.departures.actuator
-
-    @property
-    def offset(self) -> ZeroOffset:
-        return self.departures.offset
-
-    @property
-    def drive(self) -> DriveConstants:
-        return self.departures.drive
-
-    @property
-    def viscosity(self) -> Viscosity:
-        return self.departures.viscosity
-
-    @property
-    def hinge(self) -> HingeGain:
-        return self.departures.hinge
 
 
 def averaging_factor(n_samples: int, rate_hz: float) -> int:
@@ -187,12 +171,12 @@ def conditioning_done(prepared: Prepared) -> dict[str, Any]:
         "kinematic_gain": prepared.consistency.travel_gain,
         "current_lag_s": prepared.lags.current_s,
         "hinge_lag_s": prepared.lags.hinge_s,
-        "hinge_offset_nm": prepared.offset.hinge_nm,
-        "current_offset_a": prepared.offset.current_a,
-        "torque_scale": prepared.drive.torque_factor,
-        "inertia_factor": prepared.drive.inertia_factor,
-        "viscous_factor": prepared.viscosity.factor,
-        "hinge_gain": prepared.hinge.gain,
+        "hinge_offset_nm": prepared.departures.offset.hinge_nm,
+        "current_offset_a": prepared.departures.offset.current_a,
+        "torque_scale": prepared.departures.drive.torque_factor,
+        "inertia_factor": prepared.departures.drive.inertia_factor,
+        "viscous_factor": prepared.departures.viscosity.factor,
+        "hinge_gain": prepared.departures.hinge.gain,
     }
 
 
@@ -217,10 +201,10 @@ def conditioning_notes(prepared: Prepared) -> list[str]:
         )
     found = (
         kinematics_note(prepared.consistency),
-        offset_note(prepared.offset),
-        drive_constants_note(prepared.drive),
-        hinge_gain_note(prepared.hinge),
-        viscosity_note(prepared.viscosity),
+        offset_note(prepared.departures.offset),
+        drive_constants_note(prepared.departures.drive),
+        hinge_gain_note(prepared.departures.hinge),
+        viscosity_note(prepared.departures.viscosity),
     )
     notes.extend(note for note in found if note)
     if prepared.glitches:

@@ -114,7 +114,7 @@ def estimate_window(
     seen = replace(w, signals=as_read(w.signals, w.sample_rate_hz))
     physics = fit_window(seen.signals, w.sample_rate_hz, prepared.actuator)
     stage(f"simulating {config.total_simulations} windows around the physics estimate")
-    data = simulate_dataset(w, seen, physics, config, prepared.actuator, prepared.viscosity.effects())
+    data = simulate_dataset(w, seen, physics, config, prepared.actuator, prepared.departures.viscosity.effects())
     clock.append(time.perf_counter())
     stage(f"training {config.members} network(s) of {config.hidden_units} neurons")
     network = train_network(data, config)

@@ -14,14 +14,14 @@ def test_where_a_scale_and_an_inertia_cannot_be_told_apart_the_stds_reach_both_e
     of range off; read as ΔJ, 1.0x and right. The window cannot tell which: the std must reach both."""
     drawn = worn(32057, family="gust", effects=Effects(inertia_factor=0.99465))
     prepared = prepare(window_from_dict(drawn.document))
-    assert prepared.drive.alternative is not None
+    assert prepared.departures.drive.alternative is not None
     w = prepared.window
     fitted = fit_window(as_read(w.signals, w.sample_rate_hz), w.sample_rate_hz, prepared.actuator)
     std = widened({"FDJ": float(fitted.fdj_std_nm[0])}, prepared)["FDJ"]
     error = abs(float(fitted.fdj_nm[0]) - drawn.truth["FDJ"])
     assert error > 0.3 * 0.02  # the γ end is far off ...
     assert error < 2 * std  # ... and the std says so,
-    assert prepared.drive.spread["FDJ"] > 0.5 * error  # by the gap between the two ends
+    assert prepared.departures.drive.spread["FDJ"] > 0.5 * error  # by the gap between the two ends
 
 
 def test_a_heavier_inertia_is_told_from_a_weaker_motor_where_the_replay_follows_the_drive():
@@ -29,5 +29,5 @@ def test_a_heavier_inertia_is_told_from_a_weaker_motor_where_the_replay_follows_
     speed and current are followed within the noise and with γ they are not (2.1 against 15 noise stds)."""
     drawn = draw(85, "thesis", effects=Effects(inertia_factor=1.09))
     prepared = prepare(window_from_dict(drawn.document))
-    assert prepared.drive.alternative is None and prepared.drive.torque_scale == 0.0
-    assert prepared.drive.inertia_factor == pytest.approx(1.09, abs=0.003)
+    assert prepared.departures.drive.alternative is None and prepared.departures.drive.torque_scale == 0.0
+    assert prepared.departures.drive.inertia_factor == pytest.approx(1.09, abs=0.003)

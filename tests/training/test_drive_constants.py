@@ -13,7 +13,7 @@ FAMILIES = ("thesis", "cruise", "gust", "doublet", "steps")
 
 def _read(seed: int, effects: Effects) -> DriveConstants:
     drawn = draw(seed, FAMILIES[seed % 5], effects=effects)
-    return prepare(window_from_dict(drawn.document)).drive
+    return prepare(window_from_dict(drawn.document)).departures.drive
 
 
 @pytest.mark.parametrize("gain", [0.96, 1.02, 1.05])

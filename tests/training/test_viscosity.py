@@ -14,7 +14,7 @@ SPEC_C = ActuatorParams().viscous_nms
 
 def _read(seed: int, factor: float) -> Viscosity:
     drawn = draw(seed, FAMILIES[seed % 5], effects=Effects(viscous_factor=factor))
-    return prepare(window_from_dict(drawn.document)).viscosity
+    return prepare(window_from_dict(drawn.document)).departures.viscosity
 
 
 @pytest.mark.parametrize("factor", [1.3, 2.0])

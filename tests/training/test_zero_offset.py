@@ -14,7 +14,7 @@ GEAR, TORQUE_CONSTANT = 500.0, 0.0752
 
 
 def _offset(seed: int, effects: Effects) -> ZeroOffset:
-    return prepare(window_from_dict(draw(seed, FAMILIES[seed % 5], effects=effects).document)).offset
+    return prepare(window_from_dict(draw(seed, FAMILIES[seed % 5], effects=effects).document)).departures.offset
 
 
 def _torque_nm(offset: ZeroOffset) -> float:
