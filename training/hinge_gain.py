@@ -45,6 +45,7 @@ from training.baseline import (
     nuisance_columns,
     regressors,
 )
+from training.drive_constants import BESIDE, FIELDS
 from training.preprocess import as_read, fit_as_read
 from training.zero_offset import rms_log_likelihood_ratio
 
@@ -52,8 +53,6 @@ MIN_Z = 4.0  # stds by which the free load coefficients must explain the window 
 PLAUSIBLE = (0.7, 1.35)  # lbf·ft for N·m is 0.74; outside, no sensor's (a 0.1 s window read 1.47): not taken
 MIN_CHANGE = 0.01  # a gain nearer 1 than this changes nothing worth a note
 DECISIVE = 12.0  # ln LR by which g must beat γ and ΔJ to be read before them (as ΔJ must beat γ)
-BESIDE = FitSettings(offset=True, viscous=True)  # what g, γ and ΔJ are weighed beside
-DRIVE_CONSTANTS = ("torque_scale", "inertia")
 
 
 @dataclass(frozen=True)
@@ -128,7 +127,7 @@ def read_hinge_gain(window: Window, actuator: ActuatorParams = ActuatorParams(),
         return HingeGain()
     if not 2.0 * _margin(window, actuator, free_rms, used, [BESIDE]) > MIN_Z**2:
         return HingeGain()
-    rivals = [replace(BESIDE, **{name: True}) for name in DRIVE_CONSTANTS]
+    rivals = [replace(BESIDE, **{name: True}) for name in FIELDS]  # γ alone, ΔJ alone
     if leading and not _margin(window, actuator, free_rms, used, rivals) > DECISIVE:
         return HingeGain()
     std = float(jackknife_std(gain[None, 1:])[0])
