@@ -62,6 +62,7 @@ UNIT_SLIPS = (  # a travel gain of about (factor): the field, and the slip it po
     (np.pi / 30.0, "signals.motor_speed_radps", "in rpm?"),
 )
 UNIT_SLIP_TOLERANCE = 0.1
+AGAINST_THE_MOTION = ("current sign", "torque signs")  # readings that say the motor's motion runs backwards
 MIN_LEVELS = 3  # distinct values a logged sensor shows over a window
 MIN_BETTER = 3.0  # how many times better a reading of a field must fit Eq. 5.1 to call the field wrong
 READINGS = {  # fields read otherwise: ({signal: factor}, the field named, what it would mean)
@@ -190,18 +191,21 @@ def kinematics_note(found: Consistency) -> str | None:
     )
 
 
-def _travel_error(gain: float, lost: bool, loop: str, window: Window, actuator: ActuatorParams) -> InputError:
-    """The error for a travel gain outside ``TRAVEL_GAIN``, naming the field it points to: the position if it
-    has ``lost`` the command too, else the speed (a sign), a known unit slip, or the sample rate."""
+def _travel_error(
+    gain: float, reading: tuple[str, float] | None, loop: str, window: Window, actuator: ActuatorParams
+) -> InputError:
+    """The error for a travel gain outside ``TRAVEL_GAIN``, naming the field it points to: for a sign, the
+    speed where Eq. 5.1 reads the torques against the motion (24–940x better flipped), else the position
+    (a command near 0° is followed by either sign: it cannot tell); otherwise a known unit slip, or the
+    sample rate."""
     travel = (
         f"the position's travel is {gain:.3g}x the speed's integral over the window / gear ratio "
         f"{actuator.gear_ratio:g} (1 in a working drive){loop}"
     )
-    if gain < 0 and lost:
-        return InputError("signals.position_deg", f"runs against motor_speed_radps and the command: {travel}: a sign?")
+    if gain < 0 and reading is not None and reading[0] in AGAINST_THE_MOTION:
+        return InputError("signals.motor_speed_radps", f"runs against position_deg and the torques: {travel}: a sign?")
     if gain < 0:
-        which = "" if loop else " (or the position against it: the command moves too little to tell which)"
-        return InputError("signals.motor_speed_radps", f"runs against position_deg{which}: {travel}: a sign?")
+        return InputError("signals.position_deg", f"runs against motor_speed_radps: {travel}: a sign?")
     for factor, field, slip in UNIT_SLIPS:
         if abs(gain / factor - 1.0) < UNIT_SLIP_TOLERANCE:
             return InputError(field, f"{slip} {travel}")
@@ -226,8 +230,8 @@ def check_consistency(window: Window, actuator: ActuatorParams = ActuatorParams(
         f"steps begun over {FOLLOW_GAP_DEG:g}° from it (97–100 % in a working closed loop)"
     )
     if gain is not None and not TRAVEL_GAIN[0] <= gain <= TRAVEL_GAIN[1]:
-        raise _travel_error(gain, lost, loop, window, actuator)
-    if lost and reading is not None and reading[0] in ("current sign", "torque signs"):
+        raise _travel_error(gain, reading, loop, window, actuator)
+    if lost and reading is not None and reading[0] in AGAINST_THE_MOTION:
         raise InputError(
             "signals.position_deg",
             f"and motor_speed_radps both run against the command and the current{loop}: a sign convention?",
