@@ -25,6 +25,11 @@ but an answer). Three relations hold in every window of a working drive, whateve
    much what η_O 0.74x as high reads (Eq. 5.1's load term), and seldom told; what is missed, the fit
    check still flags.
 
+4. One clock: a sensor's filter logs it up to ~1 ms late (``training.alignment`` reads that), but a
+   channel exported out of step by 5–20 ms put FDJ 0.2–20 ranges off (said weak). Where Eq. 5.1
+   fits ``MIN_BETTER`` times better with the current or the hinge moment read ``STEP_LAGS_S`` away,
+   the window is refused naming it and the lag.
+
 Before these, every sensor must show that it logs: a working one shows at least ``MIN_LEVELS``
 values over a window (its noise, its quantization). A hinge moment logged as zeros (an aircraft
 without the strain gauge) or stuck at one value was answered 0.2–2.5 ranges off, η_O once at 15 of
@@ -43,6 +48,7 @@ from sim.checks import InputError
 from sim.dead_band import dead_band_paths
 from sim.params import ActuatorParams
 from sim.window import Window
+from training.alignment import equation_errors
 from training.baseline import fit_friction
 from training.preprocess import as_read
 from training.zero_offset import OFFSET_FIT
@@ -64,6 +70,7 @@ UNIT_SLIPS = (  # a travel gain of about (factor): the field, and the slip it po
 UNIT_SLIP_TOLERANCE = 0.1
 AGAINST_THE_MOTION = ("current sign", "torque signs")  # readings that say the motor's motion runs backwards
 MIN_LEVELS = 3  # distinct values a logged sensor shows over a window
+STEP_LAGS_S = np.array([-50, -20, -10, -5, -3, 3, 5, 10, 20, 50]) * 1e-3  # channel lags tried, beyond any filter
 MIN_BETTER = 3.0  # how many times better a reading of a field must fit Eq. 5.1 to call the field wrong
 READINGS = {  # fields read otherwise: ({signal: factor}, the field named, what it would mean)
     "current sign": (
@@ -161,6 +168,23 @@ def better_reading(window: Window, actuator: ActuatorParams) -> tuple[str, float
     return list(READINGS)[best], float(gains[best])
 
 
+def out_of_step(window: Window) -> tuple[str, float, float] | None:
+    """The channel (current or hinge moment), its lag [s] and how many times better Eq. 5.1 fits with it,
+    where a lag of ``STEP_LAGS_S`` fits ``MIN_BETTER`` times better than none; else None."""
+    signals, rate = window.signals, window.sample_rate_hz
+    lags = STEP_LAGS_S * rate
+    lags = lags[np.abs(lags) < window.n_samples / 4]  # a quarter of the window at most overlaps the rest
+    if not len(lags):
+        return None
+    logged = float(fit_friction(as_read(signals, rate), rate).residual_rms_nm[0])
+    for name in ("current_a", "hinge_moment_nm"):
+        errors = equation_errors(dict(signals), rate, lags, name)
+        best = int(np.nanargmin(errors)) if np.any(np.isfinite(errors)) else -1
+        if best >= 0 and logged >= MIN_BETTER * errors[best]:
+            return name, float(lags[best] / rate), logged / float(errors[best])
+    return None
+
+
 def check_logged(window: Window) -> None:
     """An InputError naming the first sensor with fewer than ``MIN_LEVELS`` distinct values over ``window``."""
     for name in ("position_deg", "motor_speed_radps", "current_a", "hinge_moment_nm"):
@@ -240,6 +264,14 @@ def check_consistency(window: Window, actuator: ActuatorParams = ActuatorParams(
         raise InputError(
             "signals.command_deg",
             f"the position does not follow it{loop}: a command in other units, of the other sign or of another window?",
+        )
+    shifted = out_of_step(window)
+    if shifted is not None:
+        name, lag_s, better = shifted
+        raise InputError(
+            f"signals.{name}",
+            f"is out of step with the other channels: Eq. 5.1 fits the window {better:.3g}x better with it read "
+            f"{1e3 * lag_s:+g} ms later (a sensor's filter delays ~1 ms at most): exported on another clock?",
         )
     if reading is not None:
         _, name, meaning = READINGS[reading[0]]

@@ -7,13 +7,14 @@ field the product should refuse it by.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 
 @dataclass(frozen=True)
 class Slip:
     factors: dict[str, float]  # signal name (or "sample_rate_hz") -> what the export multiplied it by
     field: str  # the field a refusal should name
+    early_s: dict[str, float] = field(default_factory=dict)  # signal name -> how early the export logged it
 
 
 SLIPS: dict[str, Slip] = {
@@ -35,15 +36,16 @@ SLIPS: dict[str, Slip] = {
         {"current_a": -1.0, "hinge_moment_nm": -1.0}, "signals.current_a"
     ),
     "hinge moment not logged (zeros)": Slip({"hinge_moment_nm": 0.0}, "signals.hinge_moment_nm"),
+    "current 20 ms out of step": Slip({}, "signals.current_a", {"current_a": 0.02}),
+    "hinge moment 20 ms out of step": Slip({}, "signals.hinge_moment_nm", {"hinge_moment_nm": 0.02}),
 }
 
 
 def exported(document: dict, slip: Slip) -> dict:
-    """``document`` as the careless export wrote it."""
-    factors = slip.factors
+    """``document`` as the careless export wrote it (a channel logged early holds its last value at the end)."""
+    factors, rate = slip.factors, document["sample_rate_hz"]
     signals = {name: [v * factors.get(name, 1.0) for v in values] for name, values in document["signals"].items()}
-    return {
-        **document,
-        "signals": signals,
-        "sample_rate_hz": document["sample_rate_hz"] * factors.get("sample_rate_hz", 1.0),
-    }
+    for name, early_s in slip.early_s.items():
+        n = round(early_s * rate)
+        signals[name] = signals[name][n:] + signals[name][-1:] * n
+    return {**document, "signals": signals, "sample_rate_hz": rate * factors.get("sample_rate_hz", 1.0)}
