@@ -56,6 +56,14 @@ class HingeGeometry:
     tail_arm_m: float = 4.6  # l_t [m]
     alpha_t_limit_rad: float = float(np.radians(15.0))  # |α_t| saturation [rad]
 
+    def scale_nm(self, condition: FlightCondition) -> float:
+        """q̄·S_e·c_e [N·m]: the moment per unit of hinge-moment coefficient at ``condition``."""
+        return condition.dynamic_pressure_pa * self.area_m2 * self.chord_m
+
+    def per_deflection_nm_per_rad(self, condition: FlightCondition) -> float:
+        """q̄·S_e·c_e·C_hδ [N·m/rad]: the part of the moment that follows the deflection at ``condition``."""
+        return self.scale_nm(condition) * self.ch_delta_per_rad
+
 
 @dataclass(frozen=True)
 class FlightCondition:
@@ -173,7 +181,7 @@ def flight_load_model(
     a, b = state_space(condition)
     ad, bd = discretize(a, b, interval_s)
     alpha_trim, delta_trim = trim(condition)
-    scale = condition.dynamic_pressure_pa * hinge.area_m2 * hinge.chord_m
+    scale = hinge.scale_nm(condition)
     lift_slope = 1.0 - hinge.downwash_gradient
     return LoadModel(
         ad=ad,
@@ -236,7 +244,7 @@ class LoggedLoad:
 
 def logged_load_model(load: LoggedLoad, hinge: HingeGeometry = HingeGeometry()) -> LoadModel:
     """The slow part of the moment, per interval, from the log; the δ term from the condition."""
-    delta_nm = load.condition.dynamic_pressure_pa * hinge.area_m2 * hinge.chord_m * hinge.ch_delta_per_rad
+    delta_nm = hinge.per_deflection_nm_per_rad(load.condition)
     return _without_aircraft(
         delta_nm=delta_nm, table_nm=load.hinge_moment_nm - delta_nm * np.radians(load.position_deg)
     )
