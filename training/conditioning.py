@@ -40,6 +40,7 @@ from sim.batch import COMMAND_MARGIN_DEG
 from sim.noise import NOISY_SIGNALS
 from sim.params import ActuatorParams
 from sim.window import Window
+from training.aircraft_check import aircraft_note, check_against_aircraft
 from training.alignment import Lags, aligned
 from training.consistency import Consistency, check_consistency, kinematics_note
 from training.departures import Departures, read_departures
@@ -150,7 +151,8 @@ def prepare(window: Window, actuator: ActuatorParams = ActuatorParams(), spec_on
         window = replace(window, signals=signals, sample_rate_hz=window.sample_rate_hz / factor)
     consistent = check_consistency(window, actuator)
     window, lags = aligned(window)
-    read = Departures(window) if spec_only else read_departures(window, actuator)
+    aircraft = check_against_aircraft(window)
+    read = Departures(window, aircraft=aircraft) if spec_only else read_departures(window, actuator, aircraft)
     rate = read.window.sample_rate_hz * factor
     return Prepared(factor, len(command), rate, clipped, glitches, consistent, lags, read)
 
@@ -159,12 +161,20 @@ def widened(stds: dict[str, float], prepared: Prepared) -> dict[str, float]:
     """Each std with what conditioning could not settle (an offset's readings, a lag's band, the viscous
     coefficient's std: their spreads, per target) added in quadrature."""
     read = prepared.departures
-    spreads = (read.offset.spread, prepared.lags.spread, read.drive.spread, read.hinge.spread, read.viscosity.spread)
+    spreads = (
+        read.offset.spread,
+        prepared.lags.spread,
+        read.drive.spread,
+        read.hinge.spread,
+        read.aircraft.spread,
+        read.viscosity.spread,
+    )
     return {name: float(np.sqrt(std**2 + sum(s.get(name, 0.0) ** 2 for s in spreads))) for name, std in stds.items()}
 
 
 def conditioning_done(prepared: Prepared) -> dict[str, Any]:
     """What conditioning did to the window, as the result's ``WindowInfo`` fields."""
+    aircraft = prepared.departures.aircraft
     return {
         "command_clipped_fraction": prepared.command_clipped_fraction,
         "glitches_repaired": prepared.glitches,
@@ -176,7 +186,8 @@ def conditioning_done(prepared: Prepared) -> dict[str, Any]:
         "torque_scale": prepared.departures.drive.torque_factor,
         "inertia_factor": prepared.departures.drive.inertia_factor,
         "viscous_factor": prepared.departures.viscosity.factor,
-        "hinge_gain": prepared.departures.hinge.gain,
+        "hinge_gain": prepared.departures.hinge.gain * aircraft.factor,
+        "hinge_aircraft_ratio": aircraft.ratio if aircraft.readable else None,
     }
 
 
@@ -204,6 +215,7 @@ def conditioning_notes(prepared: Prepared) -> list[str]:
         offset_note(prepared.departures.offset),
         drive_constants_note(prepared.departures.drive),
         hinge_gain_note(prepared.departures.hinge),
+        aircraft_note(prepared.departures.aircraft),
         viscosity_note(prepared.departures.viscosity),
     )
     notes.extend(note for note in found if note)

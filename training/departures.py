@@ -1,6 +1,7 @@
-"""What a window shows beyond the spec's model, read in turn, each on the window the last corrected: a
-sensor off zero (``training.zero_offset``), the drive's k_T and J_M (``training.drive_constants``), the
-hinge moment's gain (``training.hinge_gain``), the viscous coefficient (``training.viscosity``).
+"""What a window shows beyond the spec's model, read in turn, each on the window the last corrected: the
+hinge moment's gain against the aircraft's (``training.aircraft_check``), a sensor off zero
+(``training.zero_offset``), the drive's k_T and J_M (``training.drive_constants``), the hinge moment's gain
+its loads show (``training.hinge_gain``), the viscous coefficient (``training.viscosity``).
 
 A drive constant, seen before it is read, passes in part for an offset (a thesis window's current logged
 1.5 % low read as 2.2 mN·m off zero, which left FDJ 11 % of range off once the scale was read too), so
@@ -23,6 +24,7 @@ import numpy as np
 from sim.noise import SensorNoise
 from sim.params import ActuatorParams
 from sim.window import Window
+from training.aircraft_check import AircraftCheck, banded, divided_out
 from training.design import inside
 from training.drive_constants import UNDECIDED_SHARE, DriveConstants, read_drive_constants
 from training.hinge_gain import HingeGain, read_hinge_gain
@@ -40,6 +42,7 @@ class Departures:
     drive: DriveConstants = field(default_factory=DriveConstants)
     viscosity: Viscosity = field(default_factory=Viscosity)
     hinge: HingeGain = field(default_factory=HingeGain)
+    aircraft: AircraftCheck = field(default_factory=AircraftCheck)
 
     @property
     def actuator(self) -> ActuatorParams:
@@ -53,18 +56,23 @@ class Departures:
         return {name: float(value) for name, value in fitted.values().items()}
 
 
-def read_departures(window: Window, actuator: ActuatorParams = ActuatorParams()) -> Departures:
-    """The window corrected for what it shows beyond ``actuator``, and what that was (module docstring)."""
+def read_departures(
+    window: Window, actuator: ActuatorParams = ActuatorParams(), aircraft: AircraftCheck = AircraftCheck()
+) -> Departures:
+    """The window corrected for what it shows beyond ``actuator``, and what that was (module docstring);
+    its hinge moment's gain divided out first where the ``aircraft`` reads one."""
+    aircraft = divided_out(aircraft)
+    window = aircraft.corrected(window)
     offset = read_zero_offset(window, actuator)
     hinge = read_hinge_gain(zeroed(window, offset), actuator, leading=True)
     if hinge.gain != 1.0:  # a logged g·H + b: the offset, b/g once the gain is taken off, read again
         window = hinge.corrected(window)
         offset = read_zero_offset(window, actuator)
     drive = read_drive_constants(zeroed(window, offset), actuator)
-    read = _along(window, offset, drive, hinge)
+    read = _along(window, offset, drive, hinge, aircraft)
     if drive.alternative is None:
         return read
-    other = _along(window, offset, drive.alternative, hinge)
+    other = _along(window, offset, drive.alternative, hinge, aircraft)
     told = _told_apart(window, read, other)
     if told is not None:
         return replace(told, drive=replace(told.drive, alternative=None))
@@ -101,9 +109,12 @@ def _told_apart(window: Window, scale: Departures, inertia: Departures) -> Depar
     return scale if errors[0] * (1.0 + CLEAR_MARGIN) < errors[1] else None
 
 
-def _along(window: Window, offset: ZeroOffset, drive: DriveConstants, hinge: HingeGain) -> Departures:
+def _along(
+    window: Window, offset: ZeroOffset, drive: DriveConstants, hinge: HingeGain, aircraft: AircraftCheck
+) -> Departures:
     """The offset read first (again on the corrected window where a drive constant was read), then the
-    hinge moment's gain unless it led (on the zeroed moment: a logged g·H + b), then C."""
+    hinge moment's gain unless it led (on the zeroed moment: a logged g·H + b), the band of the
+    aircraft's where that was divided out and the window reads none, then C."""
     if drive.stds:
         window = drive.corrected(window)
         offset = read_zero_offset(window, drive.actuator)
@@ -111,4 +122,5 @@ def _along(window: Window, offset: ZeroOffset, drive: DriveConstants, hinge: Hin
     if hinge.gain == 1.0:
         hinge = read_hinge_gain(window, drive.actuator)
         window = hinge.corrected(window)
-    return Departures(window, offset, drive, read_viscosity(window, drive.actuator), hinge)
+    aircraft = banded(aircraft, window, hinge.gain, drive.actuator)
+    return Departures(window, offset, drive, read_viscosity(window, drive.actuator), hinge, aircraft)

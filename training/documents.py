@@ -122,6 +122,11 @@ class WindowInfo(Document):
         description="the logged hinge moment over the load it shows (a strain gauge calibrated off, other units); "
         "the moment was divided by it before every estimator",
     )
+    hinge_aircraft_ratio: float | None = Field(
+        default=None,
+        description="the logged hinge moment's part that follows the deflection over the aircraft model's "
+        "q̄·S_e·c_e·C_hδ at the flight condition (1 where gauge and model agree; null: too little fast motion)",
+    )
     kinematic_gain: float | None = Field(
         default=None,
         description="the position's travel over the speed's integral / gear ratio through the dead band (1 in a "
