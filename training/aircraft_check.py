@@ -53,7 +53,7 @@ from sim.window import Window
 from training.baseline import JACKKNIFE_BLOCKS, jackknife_std
 from training.consistency import STEP_LAGS_S
 from training.drive_constants import BESIDE, UNDECIDED_SHARE
-from training.hinge_gain import free_load_fit
+from training.hinge_gain import divided_hinge, free_load_fit
 from training.noise_level import MAX_LAG, noise_of
 from training.preprocess import fit_as_read
 
@@ -92,10 +92,7 @@ class AircraftCheck:
 
     def corrected(self, window: Window) -> Window:
         """``window`` with its hinge moment divided by ``factor``."""
-        if self.factor == 1.0:
-            return window
-        signals = dict(window.signals, hinge_moment_nm=window.signals["hinge_moment_nm"] / self.factor)
-        return replace(window, signals=signals)
+        return divided_hinge(window, self.factor)
 
 
 def band_part(values: np.ndarray, rate: float) -> np.ndarray:
@@ -230,8 +227,7 @@ def banded(
 def _moved(window: Window, actuator: ActuatorParams, first: float, second: float, share: float) -> dict[str, float]:
     """``share`` of how far FDJ and η_O of Eq. 5.1's fit move between the hinge moment divided by
     ``first`` and by ``second``."""
-    rate, hinge = window.sample_rate_hz, window.signals["hinge_moment_nm"]
-    ends = [fit_as_read(dict(window.signals, hinge_moment_nm=hinge / g), rate, actuator) for g in (first, second)]
+    ends = [fit_as_read(divided_hinge(window, g).signals, window.sample_rate_hz, actuator) for g in (first, second)]
     return {
         "FDJ": share * abs(float(ends[1].fdj_nm[0] - ends[0].fdj_nm[0])),
         "eta_O": share * abs(float(ends[1].eta_o[0] - ends[0].eta_o[0])),

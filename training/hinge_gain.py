@@ -65,10 +65,14 @@ class HingeGain:
 
     def corrected(self, window: Window) -> Window:
         """``window`` with its hinge moment divided by the gain."""
-        if self.gain == 1.0:
-            return window
-        signals = dict(window.signals, hinge_moment_nm=window.signals["hinge_moment_nm"] / self.gain)
-        return replace(window, signals=signals)
+        return divided_hinge(window, self.gain)
+
+
+def divided_hinge(window: Window, gain: float) -> Window:
+    """``window`` with its hinge moment divided by ``gain`` (itself where the gain is 1)."""
+    if gain == 1.0:
+        return window
+    return replace(window, signals=dict(window.signals, hinge_moment_nm=window.signals["hinge_moment_nm"] / gain))
 
 
 def eta_o_from_product(product: np.ndarray, gear: float) -> np.ndarray:
