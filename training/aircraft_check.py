@@ -162,9 +162,9 @@ def check_against_aircraft(window: Window, hinge: HingeGeometry = HingeGeometry(
         lag_s, at_lag, unexplained = shifted
         raise InputError(
             "signals.hinge_moment_nm",
-            f"is out of step with position_deg: {against}, {at_lag.ratio:.3g}x read {1e3 * lag_s:+g} ms later, which "
-            f"leaves {100 * unexplained:.0f} % of what it leaves unexplained (a strain gauge's filter delays ~1 ms at "
-            "most): exported on another clock?",
+            f"is out of step with position_deg: {against}; read {1e3 * lag_s:+g} ms later it is {at_lag.ratio:.3g}x, "
+            f"and what the deflection leaves unexplained falls to {100 * unexplained:.0f} % (a strain gauge's filter "
+            "delays ~1 ms at most): exported on another clock?",
         )
     low, high = GROSS
     if read.ratio + GROSS_STDS * read.ratio_std < low or read.ratio - GROSS_STDS * read.ratio_std > high:
