@@ -104,6 +104,9 @@ def _print_history(stored: Any, prognosis: Any, plot: Path | None) -> None:
             click.echo(f": {life.threshold:g} crossed in {life.rul:.3g} (90 %: {life.rul_low:.3g} to {high})")
         else:
             click.echo("")
+    for name, trend in prognosis.sensors.items():
+        click.echo(f"{name} now {trend.level:.4g} ± {trend.level_std:.2g}, slope {trend.slope_per_unit:+.3g} "
+                   f"± {trend.slope_std:.2g} per unit ({trend.n} windows)")  # fmt: skip
     for note in prognosis.notes:
         click.echo(f"note: {note}")
     if plot is not None:

@@ -63,6 +63,12 @@ class Prognosis(Document):
     time_unit: Literal["flight_hours", "days"]
     trends: dict[str, Trend]
     remaining_life: dict[str, RemainingLife]
+    sensors: dict[str, Trend] = Field(
+        default_factory=dict,
+        description="trends of what the windows read of the sensors: hinge_aircraft_ratio, the strain gauge's gain "
+        "against the aircraft model (1 where they agree; a level off 1 in every window is the gauge's calibration or "
+        "the airframe's C_hδ, a slope the gauge drifting)",
+    )
     notes: list[str] = Field(default_factory=list)
 
 

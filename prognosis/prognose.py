@@ -8,10 +8,13 @@ from collections.abc import Sequence
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
-from prognosis.documents import PARAMETERS, Prognosis, Stored
+from prognosis.documents import PARAMETERS, Prognosis, Stored, Trend
 from prognosis.rul import remaining_life
 from prognosis.trend import fit_trend
 from sim.params import DEFAULT_RANGES, eta_a_from_eta_o
+from training.aircraft_check import TOLERANCE
+
+SENSOR_STDS = 3.0  # stds by which a sensor's level or drift must stand out to be said
 
 
 class Thresholds(BaseModel):
@@ -57,5 +60,31 @@ def prognose(actuator_id: str, stored: Sequence[Stored], thresholds: Thresholds 
         stds = np.array([np.nan if e.std is None else e.std for e in entries])
         trends[name] = fit_trend(name, times, values, stds, ids)
         lives[name] = remaining_life(trends[name], *(thresholds or Thresholds()).of(name))
+    sensors, said = sensor_trends(stored, times, unit)
     return Prognosis(actuator_id=actuator_id, time_unit=unit, trends=trends, remaining_life=lives,  # type: ignore[arg-type]
-                     notes=[note] if note else [])  # fmt: skip
+                     sensors=sensors, notes=([note] if note else []) + said)  # fmt: skip
+
+
+def sensor_trends(stored: Sequence[Stored], times: np.ndarray, unit: str) -> tuple[dict[str, Trend], list[str]]:
+    """The trend of the strain gauge's gain against the aircraft model over the windows that read it (two
+    at least), and notes where its level stands off 1 beyond the model's tolerance or it drifts
+    (``SENSOR_STDS`` stds)."""
+    read = [(t, s.window.hinge_aircraft_ratio, s.window.hinge_aircraft_ratio_std, s.window_id)
+            for t, s in zip(times, stored, strict=True) if s.window.hinge_aircraft_ratio is not None]  # fmt: skip
+    if len(read) < 2:
+        return {}, []
+    t, values, stds, ids = zip(*read, strict=True)
+    trend = fit_trend("hinge_aircraft_ratio", np.array(t), np.array(values), np.array(stds, dtype=float), list(ids))
+    notes = []
+    if abs(trend.level - 1.0) > TOLERANCE + SENSOR_STDS * trend.level_std:
+        notes.append(
+            f"the hinge moment's strain gauge reads {trend.level:.3f} ± {trend.level_std:.3f}x the aircraft model over "
+            f"{trend.n} windows, beyond the model's {100 * TOLERANCE:.0f} % tolerance: recalibrate the gauge, or the "
+            "airframe's C_hδ is off (each estimate divides the gauge's gain out where its window is long enough)"
+        )
+    if abs(trend.slope_per_unit) > SENSOR_STDS * trend.slope_std:
+        notes.append(
+            f"the hinge moment's strain gauge drifts against the aircraft model by {trend.slope_per_unit:+.2g} "
+            f"± {trend.slope_std:.2g} per {unit.replace('_', ' ').rstrip('s')}"
+        )
+    return {"hinge_aircraft_ratio": trend}, notes

@@ -188,6 +188,7 @@ def conditioning_done(prepared: Prepared) -> dict[str, Any]:
         "viscous_factor": prepared.departures.viscosity.factor,
         "hinge_gain": prepared.departures.hinge.gain * aircraft.factor,
         "hinge_aircraft_ratio": aircraft.ratio if aircraft.readable else None,
+        "hinge_aircraft_ratio_std": aircraft.ratio_std if aircraft.readable else None,
     }
 
 

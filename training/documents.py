@@ -127,6 +127,7 @@ class WindowInfo(Document):
         description="the logged hinge moment's part that follows the deflection over the aircraft model's "
         "q̄·S_e·c_e·C_hδ at the flight condition (1 where gauge and model agree; null: too little fast motion)",
     )
+    hinge_aircraft_ratio_std: float | None = Field(default=None, description="the std of hinge_aircraft_ratio")
     kinematic_gain: float | None = Field(
         default=None,
         description="the position's travel over the speed's integral / gear ratio through the dead band (1 in a "

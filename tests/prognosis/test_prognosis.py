@@ -64,3 +64,52 @@ def test_too_few_windows_and_a_crossed_threshold():
     hours, values, stds = degrading(4)
     _, crossed = rul_of(hours, values + 0.03, stds)
     assert crossed.status == "already crossed" and crossed.rul == 0.0
+
+
+@pytest.fixture(scope="module")
+def one_estimate():
+    from sim.params import HealthParams
+    from sim.synthetic import synthetic_window
+    from training.config import PipelineConfig
+    from training.pipeline import estimate_window
+
+    small = PipelineConfig(n_simulations=16, check_windows=8, n_timesteps=50, hidden_units=8)
+    return estimate_window(synthetic_window(HealthParams.single(), seed=1, duration_s=0.1), small)
+
+
+def _history(estimate, ratios, stds, hours):
+    from prognosis.documents import Stored
+
+    return [
+        Stored(
+            **estimate.model_copy(
+                update={
+                    "window_id": f"w{i}",
+                    "window": estimate.window.model_copy(
+                        update={"flight_hours": float(h), "hinge_aircraft_ratio": r, "hinge_aircraft_ratio_std": s}
+                    ),
+                }
+            ).model_dump(),
+            id=i,
+            stored_at="2026-11-23T00:00:00+00:00",
+        )
+        for i, (r, s, h) in enumerate(zip(ratios, stds, hours, strict=True))
+    ]
+
+
+def test_a_strain_gauge_drifting_against_the_aircraft_is_trended_and_said(one_estimate):
+    from prognosis.prognose import prognose
+
+    rng = np.random.default_rng(5)
+    hours = np.sort(rng.uniform(0, 200, 60))
+    drifting = 1.0 - 0.0008 * hours + 0.01 * rng.normal(size=60)  # 0.84 after 200 h
+    prognosis = prognose("tail-9", _history(one_estimate, drifting, np.full(60, 0.01), hours))
+    trend = prognosis.sensors["hinge_aircraft_ratio"]
+    assert trend.slope_per_unit == pytest.approx(-0.0008, rel=0.15)
+    assert sum("strain gauge" in note for note in prognosis.notes) == 2  # off the model, and drifting
+    steady = 1.0 + 0.01 * rng.normal(size=60)
+    unknown = [None] * 20  # windows that read no ratio are left out of the trend
+    history = _history(one_estimate, [*steady, *unknown], [*np.full(60, 0.01), *unknown], np.arange(80.0))
+    prognosis = prognose("tail-9", history)
+    assert prognosis.sensors["hinge_aircraft_ratio"].n == 60
+    assert not any("strain gauge" in note for note in prognosis.notes)
