@@ -46,8 +46,7 @@ from training.baseline import (
     regressors,
 )
 from training.drive_constants import BESIDE, FIELDS
-from training.preprocess import as_read, fit_as_read
-from training.zero_offset import rms_log_likelihood_ratio
+from training.preprocess import as_read, fit_as_read, rms_log_likelihood_ratio
 
 MIN_Z = 4.0  # stds by which the free load coefficients must explain the window better than g = 1
 PLAUSIBLE = (0.7, 1.35)  # lbf·ft for N·m is 0.74; outside, no sensor's (a 0.1 s window read 1.47): not taken

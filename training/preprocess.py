@@ -16,7 +16,7 @@ import numpy as np
 from sim.checks import InputError
 from sim.hinge import denoised_hinge_nm
 from sim.params import ActuatorParams
-from sim.residual import residual_torque_nm
+from sim.residual import DEFAULT_DERIVATIVE_WINDOW_S, kernel_samples, residual_torque_nm
 from training.baseline import FitSettings, FrictionFit, fit_friction
 
 INPUT_SETS = {
@@ -42,6 +42,12 @@ def fit_as_read(
 ) -> FrictionFit:
     """Eq. 5.1's fit (``training.baseline``) of a window's signals read as every estimator reads them."""
     return fit_friction(as_read(signals, sample_rate_hz), sample_rate_hz, actuator, settings)
+
+
+def rms_log_likelihood_ratio(worse_rms: float, better_rms: float, n_sliding: float, rate: float) -> float:
+    """ln of the likelihood ratio of two fits of one window's ``n_sliding`` samples by their RMS equation
+    errors, with one independent value per reconstruction kernel (the kernel smooths both sides of Eq. 5.1)."""
+    return n_sliding / kernel_samples(rate, DEFAULT_DERIVATIVE_WINDOW_S) * float(np.log(worse_rms / better_rms))
 
 
 def bin_means(values: np.ndarray, n_bins: int) -> np.ndarray:

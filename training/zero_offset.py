@@ -32,10 +32,9 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from sim.params import ActuatorParams
-from sim.residual import DEFAULT_DERIVATIVE_WINDOW_S, kernel_samples
 from sim.window import Window
 from training.baseline import FitSettings, FrictionFit
-from training.preprocess import fit_as_read
+from training.preprocess import fit_as_read, rms_log_likelihood_ratio
 
 MIN_Z = 4.0  # stds by which the fit with an offset must explain the window better (``equation_z``)
 # Where the motion goes one way, an offset is FDJ's twin and cannot be read: FDJ then rests on the sensors
@@ -88,12 +87,6 @@ def log_likelihood_ratio(worse: FrictionFit, better: FrictionFit, rate: float) -
     return rms_log_likelihood_ratio(
         float(worse.residual_rms_nm[0]), float(better.residual_rms_nm[0]), float(worse.n_sliding[0]), rate
     )
-
-
-def rms_log_likelihood_ratio(worse_rms: float, better_rms: float, n_sliding: float, rate: float) -> float:
-    """ln of the likelihood ratio of two fits of one window's ``n_sliding`` samples by their RMS equation
-    errors, with one independent value per reconstruction kernel (the kernel smooths both sides of Eq. 5.1)."""
-    return n_sliding / kernel_samples(rate, DEFAULT_DERIVATIVE_WINDOW_S) * float(np.log(worse_rms / better_rms))
 
 
 def equation_z(plain: FrictionFit, with_offset: FrictionFit, rate: float) -> float:
