@@ -46,18 +46,16 @@ import numpy as np
 
 from sim.aircraft import HingeGeometry
 from sim.checks import InputError
-from sim.hinge import local_line
 from sim.params import ActuatorParams
 from sim.residual import kernel_samples
 from sim.window import Window
+from training.aircraft_band import BAND_S, band_noise_variance, band_part
 from training.baseline import JACKKNIFE_BLOCKS, jackknife_std
 from training.consistency import STEP_LAGS_S
 from training.drive_constants import BESIDE, UNDECIDED_SHARE
 from training.hinge_gain import divided_hinge, free_load_fit
-from training.noise_level import MAX_LAG, noise_of
 from training.preprocess import fit_as_read
 
-BAND_S = (0.0025, 0.1)  # the band compared: slower than the noise, faster than the aircraft's own motion
 TOLERANCE = 0.1  # how far the spec's C_hδ (a design estimate) may be from an airframe's, relative
 DEPART_STDS = 2.0  # stds beyond the tolerance by which a ratio departs: the gauge is off by it
 SUSPECT_STDS = 1.0  # stds beyond the tolerance by which a ratio puts the gauge in doubt
@@ -93,22 +91,6 @@ class AircraftCheck:
     def corrected(self, window: Window) -> Window:
         """``window`` with its hinge moment divided by ``factor``."""
         return divided_hinge(window, self.factor)
-
-
-def band_part(values: np.ndarray, rate: float) -> np.ndarray:
-    """``values`` between ``BAND_S``: their local line over the shorter span (``sim.hinge.local_line``)
-    minus that over the longer, i.e. what moves faster than the aircraft and slower than the noise."""
-    short, long = (kernel_samples(rate, span) for span in BAND_S)
-    return local_line(values, short) - local_line(values, long)
-
-
-def band_noise_variance(position_deg: np.ndarray, rate: float) -> float:
-    """The variance a sample the position sensor's noise keeps in ``band_part``: σ² of its AR(1) reading
-    (``training.noise_level``), over the independent values in the shorter span."""
-    sigma, tau_s = noise_of(position_deg, rate, MAX_LAG["position_deg"])
-    rho = math.exp(-1.0 / (tau_s * rate)) if tau_s > 0 else 0.0
-    span = kernel_samples(rate, BAND_S[0])
-    return sigma**2 * min((1.0 + rho) / (1.0 - rho), span) / span
 
 
 def slope(

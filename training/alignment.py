@@ -15,16 +15,8 @@ windows without filters exactly on zero. A lag is applied only
 where it lowers the equation error by ``MIN_GAIN``; then the later of the two signals is advanced
 (a filter only delays), by linear interpolation, the end held.
 
-The hinge moment's lag barely shows in the equation error (on most windows lags of 0–3 ms fit it as
-well as none), yet through a 1–4 ms strain-gauge filter it put FDJ outside its ±2 std on 18 of 20
-windows. It shows in the noise: the filter that delays the signal correlates the noise it passes,
-and ``noise_level`` reads that correlation. The delay is read from it (``hinge_lag_samples``; on
-20 foreign windows behind 10–40 sample moving averages, 0.70–1.15 of the filter's delay, and
-0 on white noise). A strain gauge's noise enters before its amplifier's filter; noise correlated
-after an unfiltered signal would be advanced for nothing, so the read is kept only where the
-equation error bears it out (no larger than unshifted): on 20 windows each, 19 of the filtered
-signals' reads are kept and 6 of the noise-only filters' (whose answers then err by ~5 % of range).
-What a misread lag moves FDJ and η_O by goes into their stds (``hinge_lag_spread``).
+The hinge moment's lag barely shows in the equation error; it is read from its filter's trace in
+its noise, the deflection and Eq. 5.1 together (``training.hinge_lag``), and advanced by it.
 """
 
 from __future__ import annotations
@@ -33,52 +25,13 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from sim.hinge import denoised_hinge_nm
 from sim.window import Window
-from training.baseline import FrictionFit, fit_friction
-from training.noise_level import MAX_LAG, noise_of
-from training.preprocess import as_read
+from training.hinge_lag import hinge_lag
+from training.shifts import advanced, equation_errors
 
 MAX_LAG_S = 1e-3
 HALF_STEP = 0.5  # samples: the finest grid searched
 MIN_GAIN = 0.05  # the least relative drop of the equation error a lag must bring
-MAX_HINGE_LAG_S = 3e-3
-# The hinge lag as read from the noise is 0.70–1.15 of a filter's delay (RMS 12 % off on 20 windows), and
-# a lag misread moves FDJ: taken as ±15 % (one std) into its std, the physics fit's FDJ held its ±2 std in
-# 19 of 20 windows behind 10–40 sample filters, against 15 without.
-HINGE_LAG_UNCERTAINTY = 0.15
-
-
-def advanced(values: np.ndarray, samples: float) -> np.ndarray:
-    """``values`` read ``samples`` later (linear interpolation; past the end, the last value)."""
-    index = np.arange(len(values), dtype=np.float64)
-    return np.interp(index + samples, index, values)
-
-
-def shifted_fits(
-    signals: dict[str, np.ndarray], sample_rate_hz: float, lags: np.ndarray, name: str = "current_a"
-) -> FrictionFit:
-    """The physics fit with signal ``name`` read ``lags`` samples later, one row per lag, one batched fit."""
-    batch = dict(signals, **{name: np.stack([advanced(signals[name], lag) for lag in lags])})
-    if name == "hinge_moment_nm":  # its reading leans on the deflection, row by row
-        batch["position_deg"] = np.broadcast_to(signals["position_deg"], batch[name].shape)
-    read = dict(as_read(batch, sample_rate_hz), position_deg=signals["position_deg"])
-    return fit_friction(read, sample_rate_hz)
-
-
-def equation_errors(
-    signals: dict[str, np.ndarray], sample_rate_hz: float, lags: np.ndarray, name: str = "current_a"
-) -> np.ndarray:
-    """The physics fit's equation error with signal ``name`` read ``lags`` samples later."""
-    return shifted_fits(signals, sample_rate_hz, lags, name).residual_rms_nm
-
-
-def hinge_lag_spread(signals: dict[str, np.ndarray], sample_rate_hz: float, lag: float) -> dict[str, float]:
-    """What the hinge lag's read uncertainty (± ``HINGE_LAG_UNCERTAINTY`` of it) leaves in FDJ and η_O: half
-    the change of the physics fit across that band, a std to add to theirs."""
-    band = lag * (1.0 + HINGE_LAG_UNCERTAINTY * np.array([-1.0, 1.0]))
-    fits = shifted_fits(signals, sample_rate_hz, band, "hinge_moment_nm")
-    return {"FDJ": float(abs(np.diff(fits.fdj_nm)[0]) / 2), "eta_O": float(abs(np.diff(fits.eta_o)[0]) / 2)}
 
 
 def current_lag_samples(signals: dict[str, np.ndarray], sample_rate_hz: float) -> float:
@@ -103,43 +56,30 @@ def current_lag_samples(signals: dict[str, np.ndarray], sample_rate_hz: float) -
     return float(best)
 
 
-def hinge_lag_samples(signals: dict[str, np.ndarray], sample_rate_hz: float) -> float:
-    """How many samples the logged hinge moment trails the load, read from its filter's trace in its
-    noise: a filter that leaves the noise T times the low-frequency density of white noise delays
-    the signal (T − 1) / 2 samples, exactly for a moving average and a first-order lag."""
-    hinge = signals["hinge_moment_nm"]
-    difference = hinge - denoised_hinge_nm(hinge, signals["position_deg"], sample_rate_hz)
-    _, tau_s = noise_of(difference, sample_rate_hz, MAX_LAG["hinge_moment_nm"], rising_is_noise=True)
-    if tau_s == 0.0:
-        return 0.0
-    rho = float(np.exp(-1.0 / (tau_s * sample_rate_hz)))
-    lag = min(rho / (1.0 - rho), MAX_HINGE_LAG_S * sample_rate_hz)  # (T − 1) / 2, T = (1 + ρ) / (1 − ρ)
-    unshifted, shifted = equation_errors(signals, sample_rate_hz, np.array([0.0, lag]), "hinge_moment_nm")
-    return lag if shifted <= unshifted else 0.0  # noise correlated after an unfiltered signal fits worse
-
-
 @dataclass(frozen=True)
 class Lags:
     """How late each signal was logged [s], undone: the current behind the speed (negative: the speed
     behind the current), the hinge moment behind the load; and the std its read uncertainty adds, per target."""
 
     current_s: float = 0.0
-    hinge_s: float = 0.0
+    hinge_s: float = 0.0  # the hinge moment advanced by (``training.hinge_lag``)
     spread: dict[str, float] = field(default_factory=dict)
+    hinge_filter_s: float = 0.0  # the delay of the filter its noise went through
+    hinge_weight: float = 0.0  # how likely the moment is late at all (not only its noise filtered)
 
 
 def aligned(window: Window) -> tuple[Window, Lags]:
     """``window`` with the later of its current and speed advanced onto the other and its hinge moment
-    advanced by its filter's delay, and those lags."""
+    advanced by its lag's posterior mean (``training.hinge_lag``), and those lags."""
     rate, signals = window.sample_rate_hz, dict(window.signals)
     current = current_lag_samples(signals, rate)
     if current != 0.0:
         late = "current_a" if current > 0 else "motor_speed_radps"
         signals[late] = advanced(signals[late], abs(current))
-    hinge, spread = hinge_lag_samples(signals, rate), {}
-    if hinge != 0.0:
-        spread = hinge_lag_spread(signals, rate, hinge)
-        signals["hinge_moment_nm"] = advanced(signals["hinge_moment_nm"], hinge)
-    if current == 0.0 and hinge == 0.0:
+    hinge = hinge_lag(signals, rate)
+    if hinge.advance != 0.0:
+        signals["hinge_moment_nm"] = advanced(signals["hinge_moment_nm"], hinge.advance)
+    if current == 0.0 and hinge.filter_delay == 0.0:
         return window, Lags()
-    return replace(window, signals=signals), Lags(current / rate, hinge / rate, spread)
+    lags = Lags(current / rate, hinge.advance / rate, hinge.spread, hinge.filter_delay / rate, hinge.late)
+    return replace(window, signals=signals), lags

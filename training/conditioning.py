@@ -206,10 +206,11 @@ def conditioning_notes(prepared: Prepared) -> list[str]:
             f"the {late} is logged {1e6 * by:.0f} µs late (a sensor filter): advanced onto the other before Eq. 5.1, "
             "which it otherwise breaks at every acceleration"
         )
-    if lags.hinge_s:
+    if lags.hinge_filter_s:
         notes.append(
-            f"the hinge moment is logged {1e6 * lags.hinge_s:.0f} µs late (its filter, read from the "
-            "correlation of its noise): advanced before Eq. 5.1, the stds include what a misread of it moves"
+            f"the hinge moment's noise is correlated as behind a filter delaying {1e6 * lags.hinge_filter_s:.0f} µs; "
+            f"the deflection and Eq. 5.1 put weight {lags.hinge_weight:.2f} on the moment being late too: advanced "
+            f"by {1e6 * lags.hinge_s:.0f} µs (the weighted lag) before Eq. 5.1, the stds include the lags' spread"
         )
     found = (
         kinematics_note(prepared.consistency),

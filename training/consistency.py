@@ -48,9 +48,9 @@ from sim.checks import InputError
 from sim.dead_band import dead_band_paths
 from sim.params import ActuatorParams
 from sim.window import Window
-from training.alignment import equation_errors
 from training.baseline import fit_friction
 from training.preprocess import as_read
+from training.shifts import equation_errors
 from training.zero_offset import OFFSET_FIT
 
 TRAVEL_GAIN = (0.9, 1.1)  # g accepted

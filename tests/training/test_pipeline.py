@@ -173,7 +173,7 @@ def test_a_hinge_moment_logged_behind_its_filter_is_advanced_and_fdj_read_within
     drawn = through_filters(draw(seed, family), {"hinge_moment_nm": width})
     result = _estimate(drawn)
     assert result.window.hinge_lag_s * 10_000.0 == pytest.approx((width - 1) / 2, rel=0.2)
-    assert any("hinge moment is logged" in note for note in result.notes)
+    assert any("put weight" in note and "on the moment being late" in note for note in result.notes)
     for name, (of_range, z) in _errors(result, drawn.truth).items():
         assert of_range < 3.0 and z < 2.0, name
 
