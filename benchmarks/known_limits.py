@@ -63,9 +63,10 @@ GROUPS: dict[str, Callable[[int], Draw]] = {
 PROSE = """Windows of `tests/foreign` with a departure a real log can carry that the product undoes only
 in part, or not at all; the accuracy table above holds none of them. *Hinge moment late*: a
 strain-gauge amplifier's filter delays the load the fit reads (signal and noise through a causal
-moving average: `through_filters`). The window's equation error barely feels that lag, so it is read
-from the filter's trace in the noise (`training.alignment`), 0.70–1.15 of the true delay, and ±15 %
-of it goes into the stds: what is left shows in the heaviest filters. The sensor chain's lag is the
+moving average: `through_filters`). The window's equation error barely feels that lag; the filter's
+trace in the noise (0.70–1.15 of the delay) and the lag the deflection band reads from the moment
+weigh filtered against on time, and the moment is advanced by the weighted lag, its spread in the
+stds (`training.hinge_lag`): what is left shows in the heaviest filters. The sensor chain's lag is the
 same in every window of an actuator; read across them, as a calibration term, it could be pinned.
 A sensor off zero and a viscous coefficient above the spec's are read per window (groups of the
 accuracy table above), but each is a parameter more to read from the window: in a window that holds
