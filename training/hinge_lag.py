@@ -19,7 +19,7 @@ amount up to ``MAX_HINGE_LAG_S``. Each lag of the grid is weighed by
 - Eq. 5.1's equation error at that lag (``preprocess.rms_log_likelihood_ratio``; weak).
 The moment is advanced by the posterior mean lag, and FDJ's and η_O's stds grow by their posterior
 spread over the lags (the two stories' gap where neither decides). On 24 foreign windows each, the
-posterior put 0.89 on "late" where the filter delays the moment, and 0.31 where it filters only its
+posterior put 0.88 on "late" where the filter delays the moment, and 0.36 where it filters only its
 noise (a slow window's band reads too little to decide: there the stds carry both).
 """
 
