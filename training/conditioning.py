@@ -3,7 +3,8 @@ samples, its signals checked to tell one story (``training.consistency``: a sign
 rate the log got wrong is refused, naming the field), its sensors on one clock
 (``training.alignment``), what it shows beyond the spec's model read and undone
 (``training.departures``: a sensor off zero, the drive's k_T and J_M, the hinge moment's gain, the
-viscous coefficient), and what was done to it.
+viscous coefficient), how likely its hinge moment is out of step (``training.step_lag``), and what
+was done to it.
 
 A sensor's sample that jumps away from both neighbours and straight back (an EMI spike, a bit
 error) is no measurement, nor is a burst of a few of them (``MAX_GLITCH_RUN``, ``MAX_GLITCH_S``:
@@ -47,6 +48,7 @@ from training.departures import Departures, read_departures
 from training.drive_constants import drive_constants_note
 from training.hinge_gain import hinge_gain_note
 from training.noise_level import white_noise_std
+from training.step_lag import StepLag, step_lag, step_lag_note
 from training.viscosity import viscosity_note
 from training.zero_offset import offset_note
 
@@ -69,6 +71,7 @@ class Prepared:
     consistency: Consistency  # how its signals relate: the kinematic gain, the loop, Eq. 5.1's readings
     lags: Lags  # how late the current (behind the speed) and the hinge moment were logged, undone
     departures: Departures  # what it shows beyond the spec's model (an offset, k_T and J_M, g, C), undone
+    step: StepLag  # how likely its hinge moment is out of step, where that is too unclear to refuse it
 
     @property
     def window(self) -> Window:
@@ -138,9 +141,9 @@ def repaired(window: Window) -> tuple[Window, dict[str, int]]:
 def prepare(window: Window, actuator: ActuatorParams = ActuatorParams(), spec_only: bool = False) -> Prepared:
     """Repair ``window``'s glitches, average it down to the pipeline's sizes, check its signals agree
     (``training.consistency``: InputError naming the field), put its sensors on one clock
-    (``training.alignment``) and read what it shows beyond ``actuator`` (``training.departures``); say
-    what it found. ``spec_only`` skips the last: ``calibration`` reads the spec's model alone and
-    names what departs from it."""
+    (``training.alignment``), read what it shows beyond ``actuator`` (``training.departures``) and weigh
+    whether its hinge moment is out of step (``training.step_lag``); say what it found. ``spec_only``
+    skips the departures: ``calibration`` reads the spec's model alone and names what departs from it."""
     window, glitches = repaired(window)
     factor = averaging_factor(window.n_samples, window.sample_rate_hz)
     command = window.signals["command_deg"]
@@ -154,7 +157,8 @@ def prepare(window: Window, actuator: ActuatorParams = ActuatorParams(), spec_on
     aircraft = check_against_aircraft(window)
     read = Departures(window, aircraft=aircraft) if spec_only else read_departures(window, actuator, aircraft)
     rate = read.window.sample_rate_hz * factor
-    return Prepared(factor, len(command), rate, clipped, glitches, consistent, lags, read)
+    step = step_lag(read.window, read.actuator)
+    return Prepared(factor, len(command), rate, clipped, glitches, consistent, lags, read, step)
 
 
 def widened(stds: dict[str, float], prepared: Prepared) -> dict[str, float]:
@@ -168,6 +172,7 @@ def widened(stds: dict[str, float], prepared: Prepared) -> dict[str, float]:
         read.hinge.spread,
         read.aircraft.spread,
         read.viscosity.spread,
+        prepared.step.spread,
     )
     return {name: float(np.sqrt(std**2 + sum(s.get(name, 0.0) ** 2 for s in spreads))) for name, std in stds.items()}
 
@@ -219,6 +224,7 @@ def conditioning_notes(prepared: Prepared) -> list[str]:
         hinge_gain_note(prepared.departures.hinge),
         aircraft_note(prepared.departures.aircraft),
         viscosity_note(prepared.departures.viscosity),
+        step_lag_note(prepared.step),
     )
     notes.extend(note for note in found if note)
     if prepared.glitches:

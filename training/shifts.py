@@ -1,10 +1,12 @@
 """A signal read later than logged, and Eq. 5.1's fit of the window so: what every reading of a
-sensor's lag compares (``training.alignment``, ``training.hinge_lag``, ``training.consistency``)."""
+sensor's lag compares (``training.alignment``, ``training.hinge_lag``, ``training.consistency``,
+``training.step_lag``)."""
 
 from __future__ import annotations
 
 import numpy as np
 
+from sim.params import ActuatorParams
 from training.baseline import FrictionFit, fit_friction
 from training.preprocess import as_read
 
@@ -16,14 +18,18 @@ def advanced(values: np.ndarray, samples: float) -> np.ndarray:
 
 
 def shifted_fits(
-    signals: dict[str, np.ndarray], sample_rate_hz: float, lags: np.ndarray, name: str = "current_a"
+    signals: dict[str, np.ndarray],
+    sample_rate_hz: float,
+    lags: np.ndarray,
+    name: str = "current_a",
+    actuator: ActuatorParams = ActuatorParams(),
 ) -> FrictionFit:
     """The physics fit with signal ``name`` read ``lags`` samples later, one row per lag, one batched fit."""
     batch = dict(signals, **{name: np.stack([advanced(signals[name], lag) for lag in lags])})
     if name == "hinge_moment_nm":  # its reading leans on the deflection, row by row
         batch["position_deg"] = np.broadcast_to(signals["position_deg"], batch[name].shape)
     read = dict(as_read(batch, sample_rate_hz), position_deg=signals["position_deg"])
-    return fit_friction(read, sample_rate_hz)
+    return fit_friction(read, sample_rate_hz, actuator)
 
 
 def equation_errors(

@@ -37,6 +37,8 @@ SLIPS: dict[str, Slip] = {
     ),
     "hinge moment not logged (zeros)": Slip({"hinge_moment_nm": 0.0}, "signals.hinge_moment_nm"),
     "current 20 ms out of step": Slip({}, "signals.current_a", {"current_a": 0.02}),
+    "hinge moment 5 ms out of step": Slip({}, "signals.hinge_moment_nm", {"hinge_moment_nm": 0.005}),
+    "hinge moment 10 ms out of step": Slip({}, "signals.hinge_moment_nm", {"hinge_moment_nm": 0.01}),
     "hinge moment 20 ms out of step": Slip({}, "signals.hinge_moment_nm", {"hinge_moment_nm": 0.02}),
 }
 

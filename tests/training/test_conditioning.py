@@ -9,6 +9,7 @@ from sim.window import Window, window_from_dict
 from tests.foreign.windows import NOISE, draw, worn
 from training.alignment import Lags
 from training.conditioning import GLITCH_ACTIVITY, MAX_RATE_HZ, MAX_SAMPLES, averaging_factor, prepare, widened
+from training.step_lag import StepLag
 from training.viscosity import Viscosity
 from training.zero_offset import ZeroOffset
 
@@ -94,5 +95,6 @@ def test_what_conditioning_could_not_settle_widens_the_stds_in_quadrature():
     departures = replace(
         prepared.departures, offset=ZeroOffset(spread={"FDJ": 3e-4}), viscosity=Viscosity(spread={"FDJ": 0.0})
     )
-    prepared = replace(prepared, lags=Lags(spread={"FDJ": 12e-4, "eta_O": 0.0}), departures=departures)
-    assert widened({"FDJ": 4e-4, "eta_O": 0.01}, prepared) == pytest.approx({"FDJ": 13e-4, "eta_O": 0.01})
+    lags, step = Lags(spread={"FDJ": 12e-4, "eta_O": 0.0}), StepLag(spread={"eta_O": 0.0075})
+    prepared = replace(prepared, lags=lags, departures=departures, step=step)
+    assert widened({"FDJ": 4e-4, "eta_O": 0.01}, prepared) == pytest.approx({"FDJ": 13e-4, "eta_O": 0.0125})
