@@ -143,7 +143,7 @@ def prepare(window: Window, actuator: ActuatorParams = ActuatorParams(), spec_on
     (``training.consistency``: InputError naming the field), put its sensors on one clock
     (``training.alignment``), read what it shows beyond ``actuator`` (``training.departures``) and weigh
     whether its hinge moment is out of step (``training.step_lag``); say what it found. ``spec_only``
-    skips the departures: ``calibration`` reads the spec's model alone and names what departs from it."""
+    skips the departures and the step: ``calibration`` reads the spec's model alone and names what departs."""
     window, glitches = repaired(window)
     factor = averaging_factor(window.n_samples, window.sample_rate_hz)
     command = window.signals["command_deg"]
@@ -157,7 +157,8 @@ def prepare(window: Window, actuator: ActuatorParams = ActuatorParams(), spec_on
     aircraft = check_against_aircraft(window)
     read = Departures(window, aircraft=aircraft) if spec_only else read_departures(window, actuator, aircraft)
     rate = read.window.sample_rate_hz * factor
-    step = step_lag(read.window, read.actuator)
+    # with the departures left in, a lag fits what they leave (an offset: ln LR 105): the story is no test there
+    step = StepLag() if spec_only else step_lag(read.window, read.actuator)
     return Prepared(factor, len(command), rate, clipped, glitches, consistent, lags, read, step)
 
 
