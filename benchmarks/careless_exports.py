@@ -67,8 +67,11 @@ def report(counts: dict[str, Counter], per_slip: int, seconds: float) -> str:
         "past it says so; *confidently wrong* if one past it does not. A hinge moment in lbf·ft (0.74x) is",
         "much what η_O 0.74x as high would read in Eq. 5.1; the part of it that follows the deflection is",
         "0.74x the aircraft model's at the window's flight condition (`training.aircraft_check`), which",
-        "reads the gauge's gain, and a moment out of step by its lag, unless its deflection moves slowly (a",
-        "cruise window, where Eq. 5.1 hardly feels 20 ms either: FDJ 13 % of range off once, not said weak).",
+        "reads the gauge's gain, and a moment out of step by its lag, unless its deflection moves slowly. There",
+        "Eq. 5.1 fits the moment read at its lag a few % better at most, too little to refuse the window; that",
+        "story is weighed by the likelihood ratio and its gap goes into the stds (`training.step_lag`): a 20 ms",
+        "slip was answered FDJ 13 % of range off at 2.7 std before. At 5 ms the ratio often cannot tell it from",
+        "the noise.",
         f"Total {seconds:.0f} s.",
         "",
         "| export | refused, naming it | refused, naming another field | answered: within the bound or said weak "
