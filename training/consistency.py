@@ -168,12 +168,16 @@ def better_reading(window: Window, actuator: ActuatorParams) -> tuple[str, float
     return list(READINGS)[best], float(gains[best])
 
 
+def step_lags(window: Window) -> np.ndarray:
+    """``STEP_LAGS_S`` in samples of ``window``, those under a quarter of it (the rest must overlap)."""
+    lags = STEP_LAGS_S * window.sample_rate_hz
+    return lags[np.abs(lags) < window.n_samples / 4]
+
+
 def out_of_step(window: Window) -> tuple[str, float, float] | None:
     """The channel (current or hinge moment), its lag [s] and how many times better Eq. 5.1 fits with it,
     where a lag of ``STEP_LAGS_S`` fits ``MIN_BETTER`` times better than none; else None."""
-    signals, rate = window.signals, window.sample_rate_hz
-    lags = STEP_LAGS_S * rate
-    lags = lags[np.abs(lags) < window.n_samples / 4]  # a quarter of the window at most overlaps the rest
+    signals, rate, lags = window.signals, window.sample_rate_hz, step_lags(window)
     if not len(lags):
         return None
     logged = float(fit_friction(as_read(signals, rate), rate).residual_rms_nm[0])

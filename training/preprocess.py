@@ -44,6 +44,12 @@ def fit_as_read(
     return fit_friction(as_read(signals, sample_rate_hz), sample_rate_hz, actuator, settings)
 
 
+def odds_weight(log_odds: float) -> float:
+    """The posterior weight of a story whose ln posterior odds against its rival are ``log_odds`` (clipped
+    where exp would overflow)."""
+    return float(1.0 / (1.0 + np.exp(-np.clip(log_odds, -50.0, 50.0))))
+
+
 def rms_log_likelihood_ratio(worse_rms: float, better_rms: float, n_sliding: float, rate: float) -> float:
     """ln of the likelihood ratio of two fits of one window's ``n_sliding`` samples by their RMS equation
     errors, with one independent value per reconstruction kernel (the kernel smooths both sides of Eq. 5.1)."""

@@ -35,8 +35,8 @@ import numpy as np
 
 from sim.params import ActuatorParams
 from sim.window import Window
-from training.consistency import STEP_LAGS_S
-from training.preprocess import rms_log_likelihood_ratio
+from training.consistency import step_lags
+from training.preprocess import odds_weight, rms_log_likelihood_ratio
 from training.shifts import shifted_fits
 
 PRIOR_LOG_ODDS = -4.0  # ln of the prior odds of "out of step" against "in step" (module docstring)
@@ -55,9 +55,7 @@ class StepLag:
 
 def step_lag(window: Window, actuator: ActuatorParams = ActuatorParams()) -> StepLag:
     """The hinge moment's out-of-step story on ``window`` (its departures taken off, ``actuator`` as read)."""
-    rate = window.sample_rate_hz
-    lags = STEP_LAGS_S * rate
-    lags = np.concatenate([[0.0], lags[np.abs(lags) < window.n_samples / 4]])
+    rate, lags = window.sample_rate_hz, np.concatenate([[0.0], step_lags(window)])
     if len(lags) == 1:
         return StepLag()
     fits = shifted_fits(dict(window.signals), rate, lags, "hinge_moment_nm", actuator)
@@ -66,7 +64,7 @@ def step_lag(window: Window, actuator: ActuatorParams = ActuatorParams()) -> Ste
         return StepLag()  # too little sliding motion: the physics fit says so next
     best = 1 + int(np.argmin(errors[1:]))
     log_ratio = rms_log_likelihood_ratio(errors[0], errors[best], float(fits.n_sliding[0]), rate)
-    weight = float(1.0 / (1.0 + np.exp(-np.clip(log_ratio + PRIOR_LOG_ODDS, -50.0, 50.0))))
+    weight = odds_weight(log_ratio + PRIOR_LOG_ODDS)
     spread = {
         name: float(np.sqrt(weight) * abs(values[best] - values[0]))
         for name, values in fits.values(slice(None)).items()

@@ -34,7 +34,7 @@ import numpy as np
 from sim.params import ActuatorParams
 from sim.window import Window
 from training.baseline import FitSettings, FrictionFit
-from training.preprocess import fit_as_read, rms_log_likelihood_ratio
+from training.preprocess import fit_as_read, odds_weight, rms_log_likelihood_ratio
 
 MIN_Z = 4.0  # stds by which the fit with an offset must explain the window better (``equation_z``)
 # Where the motion goes one way, an offset is FDJ's twin and cannot be read: FDJ then rests on the sensors
@@ -97,7 +97,7 @@ def equation_z(plain: FrictionFit, with_offset: FrictionFit, rate: float) -> flo
 def second_weight(first: FrictionFit, second: FrictionFit, rate: float) -> float:
     """The weight of the second of two readings of a window against the first: their likelihoods, equal
     odds before."""
-    return float(1.0 / (1.0 + np.exp(-np.clip(log_likelihood_ratio(first, second, rate), -50.0, 50.0))))
+    return odds_weight(log_likelihood_ratio(first, second, rate))
 
 
 def read_zero_offset(window: Window, actuator: ActuatorParams = ActuatorParams()) -> ZeroOffset:
