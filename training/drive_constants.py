@@ -22,6 +22,16 @@ meets the motor's peak torque the model cuts it, the drive's too), the window's 
 (``DriveConstants.actuator``: every reconstruction of the window's T_R uses it; the simulations
 keep the spec's they are drawn with). FDJ's and η_O's stds grow by what each constant's std moves
 them.
+
+A current logged in other units (a tenth of it, a shunt's voltage) passed every check and was answered
+FDJ 3–11 ranges off, said weak with stds of hundreds of ranges. Fitted alone, γ then reads 9 and ΔJ
+−0.82 to −0.89 of J_M: no drive has either, and the window is refused naming the current
+(``no_drive_error``): on foreign windows of every group, a current a tenth in 104 of 104, a hundredth
+in 51 of 52, half in 3 of 52; none of 104 logged in amperes, nor of 120 with J_M 0.6x or 1.45x, a short
+window's k_T off or a slow log's viscosity. A current off by 1.4x or 0.7x (logged as RMS or as
+amplitude) is not: it reads as γ −0.29 or +0.41, but a J_M 1.3–1.45x, within ``PLAUSIBLE``, reads γ
+−0.23 to −0.46 too, and on a cruise window the likelihood ratio favoured γ by up to e⁶⁵; such answers
+stay said weak.
 """
 
 from __future__ import annotations
@@ -30,6 +40,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from sim.checks import InputError
 from sim.params import ActuatorParams
 from sim.window import Window
 from training.baseline import FitSettings, FrictionFit
@@ -44,6 +55,10 @@ FIELDS = {"torque_scale": "torque_scale", "inertia": "inertia_kgm2"}  # the fit'
 # Beyond these no drive runs (γ: k_T from −55 to 125 °C and a sensor's gain; ΔJ: of J_M): a read past them
 # is something else the model lacks (a 0.1 s foreign window read J_M 0.27x), which the fit check reports.
 PLAUSIBLE = {"torque_scale": 0.2, "inertia": 0.5}
+# Stds of its own by which a γ fitted alone must pass PLAUSIBLE for the current to be refused (``no_drive_error``):
+# on 104 clean foreign windows γ stayed within 0.05, and a J_M up to 1.45x read γ down to −0.46 but ΔJ within its
+# bound; a steps window with a current a tenth read γ 9.0 ± 2.9 (its blocks split the accelerations unevenly).
+SCALE_STDS = 2.0
 # Where both stand out, the log-likelihood ratio of the two readings that decides for each: on 110 foreign
 # windows where both did (k_T, the current gain or J_M off, healthy and worn), none with γ off read past 6
 # for ΔJ (the sensor noise sits in both columns as in the target, and favours one), but a J_M 3–10 % heavier,
@@ -105,6 +120,9 @@ def read_drive_constants(window: Window, actuator: ActuatorParams = ActuatorPara
     rate = window.sample_rate_hz
     plain = _fit(window, actuator, BESIDE)
     alone = {name: _fit(window, actuator, replace(BESIDE, **{name: True})) for name in FIELDS}
+    refusal = no_drive_error(plain, alone, rate, actuator)
+    if refusal is not None:
+        raise refusal
     found = [name for name in FIELDS if _stands_out(plain, alone[name], name, rate, actuator)]
     readings = {name: _reading(window, actuator, name, alone[name]) for name in found}
     if not readings:
@@ -116,6 +134,33 @@ def read_drive_constants(window: Window, actuator: ActuatorParams = ActuatorPara
     if ratio >= DECISIVE["inertia"] or ratio <= DECISIVE["torque_scale"]:
         return _with_spread(window, inertia if ratio > 0 else scale)
     return replace(_with_spread(window, scale), alternative=_with_spread(window, inertia))
+
+
+def no_drive_error(
+    plain: FrictionFit, alone: dict[str, FrictionFit], rate: float, spec: ActuatorParams
+) -> InputError | None:
+    """The error naming the current where Eq. 5.1 balances the window only with a motor torque per k_T·I
+    and an inertia no drive has, each fitted alone (γ beyond ``PLAUSIBLE`` by ``SCALE_STDS`` of its std,
+    standing ``MIN_Z`` out; ΔJ, its rival where the motor saturates, beyond ``PLAUSIBLE`` too): a current
+    in other units (a tenth: γ = 9). None otherwise."""
+    gamma, std = (
+        float(alone["torque_scale"].term("torque_scale")[0]),
+        float(alone["torque_scale"].term_std("torque_scale")[0]),
+    )
+    inertia = float(alone["inertia"].term("inertia")[0]) / spec.inertia_kgm2
+    if not (
+        np.isfinite(gamma)
+        and abs(gamma) > PLAUSIBLE["torque_scale"] + SCALE_STDS * std
+        and abs(inertia) >= PLAUSIBLE["inertia"]
+        and equation_z(plain, alone["torque_scale"], rate) > MIN_Z
+    ):
+        return None
+    return InputError(
+        "signals.current_a",
+        f"Eq. 5.1 balances the window only with the motor's torque {1 + gamma:.3g}x k_T·I (or J_M {1 + inertia:.3g}x "
+        f"the spec's), beyond any drive's (±{PLAUSIBLE['torque_scale']:.0%}, ±{PLAUSIBLE['inertia']:.0%}): the current "
+        "in other units, or a shunt's voltage?",
+    )
 
 
 def _stands_out(plain: FrictionFit, alone: FrictionFit, name: str, rate: float, spec: ActuatorParams) -> bool:

@@ -36,6 +36,8 @@ SLIPS: dict[str, Slip] = {
         {"current_a": -1.0, "hinge_moment_nm": -1.0}, "signals.current_a"
     ),
     "hinge moment not logged (zeros)": Slip({"hinge_moment_nm": 0.0}, "signals.hinge_moment_nm"),
+    "current a tenth (a shunt's volts)": Slip({"current_a": 0.1}, "signals.current_a"),
+    "current 0.71x (RMS for amplitude)": Slip({"current_a": 0.7071}, "signals.current_a"),
     "current 20 ms out of step": Slip({}, "signals.current_a", {"current_a": 0.02}),
     "hinge moment 5 ms out of step": Slip({}, "signals.hinge_moment_nm", {"hinge_moment_nm": 0.005}),
     "hinge moment 10 ms out of step": Slip({}, "signals.hinge_moment_nm", {"hinge_moment_nm": 0.01}),

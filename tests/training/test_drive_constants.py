@@ -3,6 +3,7 @@ sensor gain, fed back through its loop, and inertia)."""
 
 import pytest
 
+from sim.checks import InputError
 from sim.window import window_from_dict
 from tests.foreign.windows import Effects, draw
 from training.conditioning import prepare
@@ -58,3 +59,25 @@ def test_the_specs_constants_are_left_alone():
     assert _read(80, Effects(hinge_bias_nm=8.0)) == DriveConstants()
     assert _read(81, Effects(current_bias_a=-0.2)) == DriveConstants()
     assert _read(82, Effects(viscous_factor=1.8)) == DriveConstants()
+
+
+def _logged_scaled(seed: int, factor: float) -> dict:
+    """A foreign window whose current was logged ``factor`` times the true one (after the loop used it)."""
+    document = draw(seed, FAMILIES[seed % 5]).document
+    current = [factor * value for value in document["signals"]["current_a"]]
+    return {**document, "signals": {**document["signals"], "current_a": current}}
+
+
+@pytest.mark.parametrize("factor", [0.1, 0.01])
+def test_a_current_in_other_units_is_refused_naming_it(factor):
+    """Before, FDJ 3–11 ranges off, said weak with stds of hundreds of ranges."""
+    for seed in range(100, 105):
+        with pytest.raises(InputError) as refused:
+            prepare(window_from_dict(_logged_scaled(seed, factor)))
+        assert refused.value.field == "signals.current_a" and "other units" in str(refused.value), seed
+
+
+def test_a_heavy_rotor_within_the_plausible_is_read_not_refused():
+    """J_M 1.45x reads γ −0.33 to −0.46 fitted alone, past γ's bound: ΔJ, within its own, keeps it a drive."""
+    for seed in range(105, 110):
+        prepare(window_from_dict(draw(seed, FAMILIES[seed % 5], effects=Effects(inertia_factor=1.45)).document))
