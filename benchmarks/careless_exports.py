@@ -73,7 +73,8 @@ def report(counts: dict[str, Counter], per_slip: int, seconds: float) -> str:
         "slip was answered FDJ 13 % of range off at 2.7 std before. At 5 ms the ratio often cannot tell it from",
         "the noise. A current a tenth reads as a motor 10x stronger and a rotor 0.1x as heavy, which no drive",
         "has (`training.drive_constants`); one 0.71x (RMS for amplitude) reads as a motor 1.41x as strong, or as",
-        "well as a rotor ~0.7x as heavy with other friction, and the window cannot tell them apart: the open case.",
+        "well as a rotor ~0.7x as heavy with other friction: the window cannot tell them apart, and the stds carry",
+        "the gap between the two readings (7 answers were confidently wrong before).",
         f"Total {seconds:.0f} s.",
         "",
         "| export | refused, naming it | refused, naming another field | answered: within the bound or said weak "
