@@ -121,13 +121,14 @@ def read_drive_constants(window: Window, actuator: ActuatorParams = ActuatorPara
     rate = window.sample_rate_hz
     plain = _fit(window, actuator, BESIDE)
     alone = {name: _fit(window, actuator, replace(BESIDE, **{name: True})) for name in FIELDS}
-    refusal = no_drive_error(plain, alone, rate, actuator)
+    gamma = beyond_any_motor(plain, alone["torque_scale"], rate)
+    refusal = no_drive_error(gamma, alone["inertia"], actuator)
     if refusal is not None:
         raise refusal
     read = _read_constants(window, actuator, plain, alone)
     if read.alternative is not None:
-        read = replace(read, alternative=unit_story(read.alternative, plain, alone, rate))
-    return unit_story(read, plain, alone, rate)
+        read = replace(read, alternative=unit_story(read.alternative, gamma, plain, alone))
+    return unit_story(read, gamma, plain, alone)
 
 
 def _read_constants(
@@ -147,24 +148,21 @@ def _read_constants(
     return replace(_with_spread(window, scale), alternative=_with_spread(window, inertia))
 
 
-def no_drive_error(
-    plain: FrictionFit, alone: dict[str, FrictionFit], rate: float, spec: ActuatorParams
-) -> InputError | None:
+def beyond_any_motor(plain: FrictionFit, scale: FrictionFit, rate: float) -> float:
+    """γ fitted alone (``scale``) where it lies beyond any motor, ``PLAUSIBLE`` by ``SCALE_STDS`` of its std,
+    and stands ``MIN_Z`` out; else 0."""
+    gamma, std = float(scale.term("torque_scale")[0]), float(scale.term_std("torque_scale")[0])
+    beyond = abs(gamma) > PLAUSIBLE["torque_scale"] + SCALE_STDS * std and equation_z(plain, scale, rate) > MIN_Z
+    return gamma if beyond else 0.0
+
+
+def no_drive_error(gamma: float, inertia_alone: FrictionFit, spec: ActuatorParams) -> InputError | None:
     """The error naming the current where Eq. 5.1 balances the window only with a motor torque per k_T·I
-    and an inertia no drive has, each fitted alone (γ beyond ``PLAUSIBLE`` by ``SCALE_STDS`` of its std,
-    standing ``MIN_Z`` out; ΔJ, its rival where the motor saturates, beyond ``PLAUSIBLE`` too): a current
-    in other units (a tenth: γ = 9). None otherwise."""
-    gamma, std = (
-        float(alone["torque_scale"].term("torque_scale")[0]),
-        float(alone["torque_scale"].term_std("torque_scale")[0]),
-    )
-    inertia = float(alone["inertia"].term("inertia")[0]) / spec.inertia_kgm2
-    if not (
-        np.isfinite(gamma)
-        and abs(gamma) > PLAUSIBLE["torque_scale"] + SCALE_STDS * std
-        and abs(inertia) >= PLAUSIBLE["inertia"]
-        and equation_z(plain, alone["torque_scale"], rate) > MIN_Z
-    ):
+    and an inertia no drive has, each fitted alone (``gamma`` from ``beyond_any_motor``; ΔJ, its rival
+    where the motor saturates, beyond ``PLAUSIBLE`` too): a current in other units (a tenth: γ = 9). None
+    otherwise."""
+    inertia = float(inertia_alone.term("inertia")[0]) / spec.inertia_kgm2
+    if not (gamma and abs(inertia) >= PLAUSIBLE["inertia"]):
         return None
     return InputError(
         "signals.current_a",
@@ -174,20 +172,18 @@ def no_drive_error(
     )
 
 
-def unit_story(read: DriveConstants, plain: FrictionFit, alone: dict[str, FrictionFit], rate: float) -> DriveConstants:
+def unit_story(read: DriveConstants, gamma: float, plain: FrictionFit, alone: dict[str, FrictionFit]) -> DriveConstants:
     """``read`` with the story of a current in other units weighed in, where γ fitted alone lies beyond any
-    motor (``PLAUSIBLE`` by ``SCALE_STDS`` of its std, standing ``MIN_Z`` out) and yet ΔJ reads a drive: a
-    current logged 0.71x (RMS for amplitude) reads as a rotor ~0.7x as heavy with other friction, and a
-    rotor 1.3–1.45x as heavy as a current 0.7x, alike. Each target's std grows by the full gap between
-    the γ reading's answer and ``read``'s (on 104 foreign windows logged 0.71x, 7 answers past 10 % of the
-    range were not said weak, FDJ up to 1.4 ranges off; with the gap none, ±2 std holding the truth in 96 %;
-    a J_M 1.1x reads γ within it and keeps its stds)."""
-    scale = alone["torque_scale"]
-    gamma, std = float(scale.term("torque_scale")[0]), float(scale.term_std("torque_scale")[0])
-    if not (abs(gamma) > PLAUSIBLE["torque_scale"] + SCALE_STDS * std and equation_z(plain, scale, rate) > MIN_Z):
+    motor (``gamma`` from ``beyond_any_motor``) and yet ΔJ reads a drive: a current logged 0.71x (RMS for
+    amplitude) reads as a rotor ~0.7x as heavy with other friction, and a rotor 1.3–1.45x as heavy as a
+    current logged 1.41x, alike. Each target's std grows by the full gap between the γ reading's answer
+    and ``read``'s (on 104 foreign windows logged 0.71x, 7 answers past 10 % of the range were not said
+    weak, FDJ up to 1.4 ranges off; with the gap none, ±2 std holding the truth in 96 %; a J_M 1.1x reads
+    γ within any motor's and keeps its stds)."""
+    if not gamma:
         return read
     reference = (alone["inertia"] if read.inertia_kgm2 else plain).values()
-    gap = {name: abs(float(value) - float(reference[name])) for name, value in scale.values().items()}
+    gap = {name: abs(float(value) - float(reference[name])) for name, value in alone["torque_scale"].values().items()}
     spread = {name: float(np.hypot(read.spread.get(name, 0.0), gap[name])) for name in gap}
     return replace(read, unit_scale=gamma, spread=spread)
 
