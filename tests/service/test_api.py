@@ -80,6 +80,14 @@ def test_a_window_whose_signals_disagree_is_a_422_naming_the_field(client, docum
     assert "sign" in response.json()["detail"][0]["msg"]
 
 
+def test_a_current_in_other_units_is_a_422_naming_it(client, document):
+    document["signals"]["current_a"] = [v / 10 for v in document["signals"]["current_a"]]
+    response = client.post("/v1/estimate", json=document)
+    assert response.status_code == 422
+    assert response.json()["detail"][0]["loc"] == ["body", "signals", "current_a"]
+    assert "other units" in response.json()["detail"][0]["msg"]
+
+
 def test_unequal_lengths_nan_not_json_and_empty(client, document):
     document["signals"]["current_a"] = document["signals"]["current_a"][:-1]
     response = client.post("/v1/estimate", json=document)
