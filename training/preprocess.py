@@ -44,6 +44,13 @@ def fit_as_read(
     return fit_friction(as_read(signals, sample_rate_hz), sample_rate_hz, actuator, settings)
 
 
+# A departure a window leans to without showing it (a hinge moment out of step, a viscous coefficient off the
+# spec's) is weighed against the spec's reading with these prior odds (which also pay for trying several: ten
+# lags, one C), into the stds only; a note says so from this weight.
+UNDECIDED_PRIOR_LOG_ODDS = -4.0
+UNDECIDED_NOTE_WEIGHT = 0.1
+
+
 def odds_weight(log_odds: float) -> float:
     """The posterior weight of a story whose ln posterior odds against its rival are ``log_odds`` (clipped
     where exp would overflow)."""

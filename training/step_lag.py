@@ -36,11 +36,16 @@ import numpy as np
 from sim.params import ActuatorParams
 from sim.window import Window
 from training.consistency import step_lags
-from training.preprocess import odds_weight, rms_log_likelihood_ratio
+from training.preprocess import (
+    UNDECIDED_NOTE_WEIGHT,
+    UNDECIDED_PRIOR_LOG_ODDS,
+    odds_weight,
+    rms_log_likelihood_ratio,
+)
 from training.shifts import shifted_fits
 
-PRIOR_LOG_ODDS = -4.0  # ln of the prior odds of "out of step" against "in step" (module docstring)
-NOTE_WEIGHT = 0.1  # the weight from which the note is written (in-step windows: 1 of 208 reached it)
+# the prior odds of "out of step" against "in step", and the note's weight (in-step windows: 1 of 208 reached it)
+PRIOR_LOG_ODDS, NOTE_WEIGHT = UNDECIDED_PRIOR_LOG_ODDS, UNDECIDED_NOTE_WEIGHT
 
 
 @dataclass(frozen=True)

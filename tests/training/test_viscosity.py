@@ -1,12 +1,15 @@
 """The viscous coefficient read per window, on foreign windows (tests/foreign's own viscous friction)."""
 
+import numpy as np
 import pytest
 
 from sim.params import ActuatorParams
 from sim.window import window_from_dict
 from tests.foreign.windows import Effects, draw
+from training.baseline import fit_friction
 from training.conditioning import prepare
-from training.viscosity import Viscosity
+from training.preprocess import as_read
+from training.viscosity import NOTE_WEIGHT, Viscosity, viscosity_note
 
 FAMILIES = ("thesis", "cruise", "gust", "doublet", "steps")
 SPEC_C = ActuatorParams().viscous_nms
@@ -26,5 +29,32 @@ def test_a_viscous_coefficient_beyond_the_specs_is_read_within_a_few_percent(fac
 
 
 def test_the_specs_viscous_coefficient_is_left_alone():
-    """On 1200 foreign windows of every benchmark group, none was read as a change."""
-    assert all(_read(seed, 1.0) == Viscosity() for seed in range(95, 110))
+    """On 1200 foreign windows of every benchmark group, none was read as a change; of these none leans to one
+    enough to be noted, and what the leaning adds to FDJ's std stays a few tenths of a % of its range (1 % at most)."""
+    for seed in range(95, 110):
+        read = _read(seed, 1.0)
+        assert read.change_nms == 0.0 and read.leaning_weight < NOTE_WEIGHT, seed
+        assert read.spread["FDJ"] < 0.015 * 0.02 and viscosity_note(read) is None, seed
+
+
+def test_a_change_too_unclear_to_read_is_weighed_into_fdjs_std():
+    """On 1 kHz foreign logs with C 1.4x the spec's, a third of the changes are too unclear to read (on
+    windows sliding mostly at slew C·|ω| passes for FDJ); the spec's reading is then 10–60 % of FDJ's range
+    high and its own std says a few %. The change the window leans to is weighed into the std: its ±2 std
+    now holds the truth in most of them."""
+    unread, covered = 0, 0
+    for seed in range(100, 140):
+        drawn = draw(seed, FAMILIES[seed % 5], sample_rate_hz=1_000.0, effects=Effects(viscous_factor=1.4))
+        prepared = prepare(window_from_dict(drawn.document))
+        read, window = prepared.departures.viscosity, prepared.departures.window
+        if read.change_nms:
+            continue
+        unread += 1
+        fit = fit_friction(as_read(window.signals, window.sample_rate_hz), window.sample_rate_hz,
+                           prepared.departures.actuator)  # fmt: skip
+        error = abs(float(fit.fdj_nm[0]) - drawn.truth["FDJ"])
+        assert read.leaning_nms > 0.1 * SPEC_C, seed  # it leans the true way
+        assert error > 2 * float(fit.fdj_std_nm[0]), seed  # the spec's reading alone is confidently wrong
+        covered += error <= 2 * float(np.hypot(read.spread["FDJ"], fit.fdj_std_nm[0]))
+    assert unread >= 8
+    assert covered >= 0.6 * unread, (covered, unread)
