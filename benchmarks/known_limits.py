@@ -69,9 +69,12 @@ weigh filtered against on time, and the moment is advanced by the weighted lag, 
 stds (`training.hinge_lag`): what is left shows in the heaviest filters. The sensor chain's lag is the
 same in every window of an actuator; read across them, as a calibration term, it could be pinned.
 A sensor off zero and a viscous coefficient above the spec's are read per window (groups of the
-accuracy table above), but each is a parameter more to read from the window: in a window that holds
-little to begin with (a 1–2 kHz log, 0.1 s) the answers past 10 % of range are all said weak, yet
-FDJ's ±2 std holds the truth less often than 90 %. Of the 20 short windows 8 move (almost) one way,
+accuracy table above), but each is a parameter more to read from the window, which a window holding
+little to begin with (a 1–2 kHz log, 0.1 s) often cannot: the answers past 10 % of range are all said
+weak. A C too unclear to read is weighed into the stds by the weight of the change the window leans
+to (`training.viscosity`: FDJ's ±2 std held the truth in 85 % of the slow logs without). An offset
+leaves a short window nothing to lean on, and there FDJ's ±2 std holds the truth less often than
+90 %. Of the 20 short windows 8 move (almost) one way,
 where no offset can be read and FDJ's std carries only one of 0.05 A (these are up to 0.25 A); the
 offset is read in 11 and missed in 1. *J_M heavier than the spec's*: where the motor saturates as it
 accelerates, a motor k_T·I a few % weaker explains the window about as well, and the likelihood ratio
