@@ -72,7 +72,7 @@ def prognosis_figure(prognosis: Any, parameter: str, path: Path) -> Path:
     horizon = life.rul_high if life.rul_high is not None else 1.5 * (life.rul or 0.0)
     grid = np.linspace(t.min(), t.max() + horizon, 200)
     line = trend.level + trend.slope_per_unit * (grid - t.max())
-    band = 2 * np.hypot(trend.level_std, trend.slope_std * (grid - t.max()))
+    band = 2 * np.array([trend.std_at(offset) for offset in grid - t.max()])
     axis.plot(grid, line, color="tab:orange", label="trend")
     axis.fill_between(grid, line - band, line + band, color="tab:orange", alpha=0.2)
     axis.axhline(life.threshold, color="tab:red", ls="--", label=f"threshold ({life.direction})")

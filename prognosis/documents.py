@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from typing import Any, Literal
 
+import numpy as np
 from pydantic import Field
 
 from training.documents import Document, Estimate
@@ -43,8 +44,16 @@ class Trend(Document):
     level_std: float
     slope_per_unit: float
     slope_std: float
+    level_slope_correlation: float = Field(
+        0.0, ge=-1, le=1, description="of the level's and the slope's errors (the level is quoted at the last window)"
+    )
     excess_std: float = Field(description="scatter beyond the stated stds, added to every point's (0: none)")
     points: list[Point]
+
+    def std_at(self, offset: float) -> float:
+        """The std of the trend's value ``offset`` time units after the last window (level and slope correlated)."""
+        level, slope = self.level_std, self.slope_std * offset
+        return float(np.sqrt(max(level**2 + 2 * self.level_slope_correlation * level * slope + slope**2, 0.0)))
 
 
 class RemainingLife(Document):

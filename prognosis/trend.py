@@ -68,6 +68,7 @@ def fit_trend(
         level_std=float(np.sqrt(covariance[0, 0])),
         slope_per_unit=float(beta[1]),
         slope_std=float(np.sqrt(covariance[1, 1])),
+        level_slope_correlation=float(np.clip(covariance[0, 1] / np.sqrt(covariance[0, 0] * covariance[1, 1]), -1, 1)),
         excess_std=float(np.sqrt(tau2)),
         points=points,
     )

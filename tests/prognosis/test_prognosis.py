@@ -27,14 +27,18 @@ def rul_of(hours, values, stds):
     return trend, remaining_life(trend, THRESHOLD, "above")
 
 
-def test_the_rul_interval_contains_the_truth_in_most_histories():
-    hits = 0
-    for seed in range(20):
+def test_the_rul_interval_holds_the_truth_as_often_as_it_says():
+    """A 90 % interval over 200 histories: 180 ± 4 expected. Drawn with the level and the slope independent
+    (they correlate ~0.87 where the windows spread evenly before the last), it held 81 % of 300."""
+    early, late = 0, 0
+    for seed in range(200):
         hours, values, stds = degrading(seed)
         _, life = rul_of(hours, values, stds)
         assert life.status == "crossing predicted"
-        hits += life.rul_low <= truth_rul(hours) <= life.rul_high
-    assert hits >= 17  # a 90 % interval: 18 of 20 expected
+        early += truth_rul(hours) < life.rul_low
+        late += truth_rul(hours) > life.rul_high
+    assert 170 <= 200 - early - late <= 190, (early, late)
+    assert early >= 2 and late >= 2  # misses on both sides, as an interval's should be (24 and 24 of 400)
 
 
 def test_outliers_do_not_move_the_trend_and_are_flagged():
