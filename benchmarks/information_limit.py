@@ -188,7 +188,10 @@ def report(rows: dict[str, list[dict[str, np.ndarray]]], draws: int) -> str:
         "(FDJ, k) with white noise, and least squares is efficient. Where these expect windows past 10 %",
         "of the range, no reading of Eq. 5.1 avoids them. A reading of the whole closed loop would hold",
         "more, but only for a loop known to the microsecond (next section). The remedy is more window",
-        "(a longer or faster log) or the actuator's history (`ema history` weighs each window by its std).",
+        "(a longer or faster log) or the actuator's history (`ema history` weighs each window by its std:",
+        "on 16 foreign histories of 30 windows, a fifth of them 0.1 s and a fifth 1–2 kHz, with 18 answers",
+        "past 10 % of range, every trend's level at the last window stood within 1 % of the range of the",
+        "truth: docs/prognosis.md).",
     ])  # fmt: skip
 
 
