@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from sim.params import ActuatorParams
-from training.baseline import FrictionFit, fit_friction
+from training.baseline import FitSettings, FrictionFit, fit_friction
 from training.preprocess import as_read
 
 
@@ -23,13 +23,14 @@ def shifted_fits(
     lags: np.ndarray,
     name: str = "current_a",
     actuator: ActuatorParams = ActuatorParams(),
+    settings: FitSettings = FitSettings(),
 ) -> FrictionFit:
     """The physics fit with signal ``name`` read ``lags`` samples later, one row per lag, one batched fit."""
     batch = dict(signals, **{name: np.stack([advanced(signals[name], lag) for lag in lags])})
     if name == "hinge_moment_nm":  # its reading leans on the deflection, row by row
         batch["position_deg"] = np.broadcast_to(signals["position_deg"], batch[name].shape)
     read = dict(as_read(batch, sample_rate_hz), position_deg=signals["position_deg"])
-    return fit_friction(read, sample_rate_hz, actuator)
+    return fit_friction(read, sample_rate_hz, actuator, settings)
 
 
 def equation_errors(

@@ -5,7 +5,7 @@ moment passes, signal and noise, through a causal moving average here (tests/for
 import numpy as np
 import pytest
 
-from tests.foreign.windows import draw, through_filters
+from tests.foreign.windows import Effects, draw, through_filters
 from training.aircraft_band import band_lag_s
 from training.hinge_lag import PRIOR, HingeLag, hinge_lag, lag_grid
 
@@ -51,3 +51,15 @@ def test_white_noise_reads_no_filter_and_leaves_the_moment():
     drawn = draw(300, "gust")
     signals = {k: np.asarray(v) for k, v in drawn.document["signals"].items()}
     assert hinge_lag(signals, 10_000.0) == HingeLag()
+
+
+@pytest.mark.parametrize("seed", [500026, 500056, 500053, 500059])
+def test_a_grease_off_the_specs_does_not_pass_for_a_late_moment(seed):
+    """On 2 kHz logs whose grease is 1.2–2x as viscous as the spec's (the first two: cruise), Eq. 5.1 with
+    the spec's C fitted the (on time) moment best read 2–3 ms late, and the posterior followed it (weight
+    0.9+): a clean doublet so advanced was then refused as out of step with the deflection. Read with C
+    free, the lag stays put."""
+    factor = float(np.random.default_rng(seed).uniform(1.2, 2.0))
+    drawn = draw(seed, FAMILIES[seed % 5], effects=Effects(viscous_factor=factor), sample_rate_hz=2_000.0)
+    signals = {k: np.asarray(v) for k, v in drawn.document["signals"].items()}
+    assert hinge_lag(signals, 2_000.0).advance < 1e-3 * 2_000.0 / 2  # under 0.5 ms
