@@ -5,12 +5,13 @@ fleet logs them (``PROSE``); every window goes through ``estimate_window`` and t
 ``prognose``, as the service does. Per actuator: how its windows' answers fared, the trend's level
 at the last window against the truth there, and the true remaining life against the 90 % interval.
 
-    python -m benchmarks.foreign_history [--actuators 16] [--windows 30] [--docs]
+    python -m benchmarks.foreign_history [--actuators 16] [--healthy 8] [--windows 30] [--docs]
 """
 
 from __future__ import annotations
 
 import argparse
+import math
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -24,6 +25,7 @@ from clients.report import write_section
 from prognosis.documents import Prognosis, Stored
 from prognosis.prognose import Thresholds, prognose
 from sim import runtime
+from sim.checks import InputError
 from sim.window import window_from_dict
 from tests.foreign.windows import Draw, Effects, Health, draw
 from training.pipeline import estimate_window
@@ -48,11 +50,12 @@ This checks that remedy end to end. Each actuator wears linearly in flight hours
 drawn uniformly over the span, come from `tests/foreign` (the independent implementation) as a fleet
 logs them: the five families, half 0.5 s at 10 kHz, a fifth 0.1 s gusts, a fifth 1–2 kHz logs, a
 tenth 2 s cruise; in three of ten a grease 1.2–2x as viscous as the spec's (a cold flight), unlogged.
-Every window goes through `estimate_window` and the history through `prognose`
+Eight more actuators do not wear at all: a monitor that claims degradation there raises a false
+alarm. Every window goes through `estimate_window` and the history through `prognose`
 (`benchmarks/foreign_history.py`). Per actuator: its windows' FDJ answers said weak, past 10 % of the
 range, and past it without saying so; the trend's level at the last window against the truth there
 (error in % of the range and in the trend's stds); the true remaining life against the predicted one
-and its 90 % interval (✗: outside)."""
+and its 90 % interval (✗: outside; for a healthy actuator, a degradation claimed)."""
 
 
 @dataclass(frozen=True)
@@ -70,10 +73,12 @@ class Wear:
         return Health(fdj_nm=fdj, fsj_nm=2.0 * fdj, eta_o=eta_o)
 
 
-def wear(actuator: int) -> Wear:
+def wear(actuator: int, healthy: bool = False) -> Wear:
+    """A wearing actuator's, or a healthy one's (never crossing: the same start, no wear)."""
     rng = np.random.default_rng(FIRST_SEED + actuator)
-    return Wear(rng.uniform(0.045, 0.055), SPAN_H * rng.uniform(1.5, 4.0), rng.uniform(0.85, 0.95),
-                SPAN_H * rng.uniform(1.5, 4.0))  # fmt: skip
+    fdj, fdj_h, eta_o, eta_o_h = (rng.uniform(0.045, 0.055), SPAN_H * rng.uniform(1.5, 4.0), rng.uniform(0.85, 0.95),
+                                  SPAN_H * rng.uniform(1.5, 4.0))  # fmt: skip
+    return Wear(fdj, math.inf, eta_o, math.inf) if healthy else Wear(fdj, fdj_h, eta_o, eta_o_h)
 
 
 def logged_window(actuator: int, j: int, hours: float, health: Health) -> Draw:
@@ -89,18 +94,24 @@ def logged_window(actuator: int, j: int, hours: float, health: Health) -> Draw:
     return drawn
 
 
-def history(actuator: int, n_windows: int, thresholds: Thresholds) -> tuple[Prognosis, dict[str, Any]]:
-    """The actuator's prognosis from its estimated windows, and how its windows' answers fared."""
-    truth, hours = wear(actuator), np.sort(np.random.default_rng(FIRST_SEED + actuator).uniform(0, SPAN_H, n_windows))
-    stored, weak, over, unsaid = [], 0, 0, 0
+def history(actuator: int, truth: Wear, n_windows: int, thresholds: Thresholds) -> tuple[Prognosis, dict[str, Any]]:
+    """The actuator's prognosis from its estimated windows, and how its windows' answers fared (a window
+    refused is left out of the history, as the service stores none)."""
+    hours = np.sort(np.random.default_rng(FIRST_SEED + actuator).uniform(0, SPAN_H, n_windows))
+    stored, weak, over, unsaid, refused = [], 0, 0, 0, []
     for j, h in enumerate(hours):
         drawn = logged_window(actuator, j, float(h), truth.health(float(h), thresholds))
-        result = estimate_window(window_from_dict(drawn.document))
+        try:
+            result = estimate_window(window_from_dict(drawn.document))
+        except InputError as exc:
+            rate = drawn.document["sample_rate_hz"]
+            refused.append(f"{actuator}/{drawn.document['window_id']} ({drawn.family}, {rate:g} Hz): {exc}")
+            continue
         fdj = result.estimates.FDJ
         past = abs(share_of_range("FDJ", fdj.value - drawn.truth["FDJ"])) > BOUND
         weak, over, unsaid = weak + fdj.weakly_determined, over + past, unsaid + (past and not fdj.weakly_determined)
         stored.append(Stored(**result.model_dump(), id=j, stored_at="2026-01-01T00:00:00+00:00"))
-    fared = {"weak": weak, "over": over, "unsaid": unsaid, "wear": truth}
+    fared = {"weak": weak, "over": over, "unsaid": unsaid, "refused": refused}
     return prognose(f"foreign/history-{actuator}", stored, thresholds), fared
 
 
@@ -111,7 +122,7 @@ def scored(prognosis: Prognosis, wear_: Wear, thresholds: Thresholds) -> dict[st
         trend, life = prognosis.trends[name], prognosis.remaining_life[name]
         last = max(point.time for point in trend.points)
         true_level = getattr(wear_.health(last, thresholds), {"FDJ": "fdj_nm", "eta_O": "eta_o"}[name])
-        true_life = crossing - last
+        true_life = crossing - last  # inf: a healthy actuator's
         low, high = life.rul_low, np.inf if life.rul_high is None else life.rul_high
         out[name] = {
             "level_z": (trend.level - true_level) / trend.level_std,
@@ -120,13 +131,17 @@ def scored(prognosis: Prognosis, wear_: Wear, thresholds: Thresholds) -> dict[st
             "status": life.status,
             "rul": life.rul,
             "interval": (life.rul_low, life.rul_high),
-            "held": life.status == "crossing predicted" and low is not None and low <= true_life <= high,
+            "held": (life.status != "crossing predicted")
+            if math.isinf(true_life)
+            else (life.status == "crossing predicted" and low is not None and low <= true_life <= high),
         }
     return out
 
 
 def _life(score: dict[str, Any]) -> str:
     """The true life against the predicted one, in flight hours."""
+    if math.isinf(score["true_life"]):
+        return f"none: {score['status']}{'' if score['held'] else ' ✗'}"
     if score["status"] != "crossing predicted":
         return f"{score['true_life']:.0f} h: {score['status']}"
     low, high = score["interval"]
@@ -135,14 +150,14 @@ def _life(score: dict[str, Any]) -> str:
 
 
 def table(rows: list[dict[str, Any]]) -> str:
-    lines = ["| actuator | windows: FDJ weak / past 10 % of range / past it, not said weak "
+    lines = ["| actuator | windows answered: FDJ weak / past 10 % of range / past it, not said weak "
              "| FDJ level error: % of range (stds) | FDJ life: true: RUL [90 %] "
              "| η_O level error: % of range (stds) | η_O life: true: RUL [90 %] |",
              "|---|---:|---:|---:|---:|---:|"]  # fmt: skip
     for row in rows:
         f, e = row["scores"]["FDJ"], row["scores"]["eta_O"]
         lines.append(
-            f"| {row['actuator']} | {row['n']}: {row['weak']} / {row['over']} / {row['unsaid']} "
+            f"| {row['actuator']} | {row['n'] - len(row['refused'])}: {row['weak']} / {row['over']} / {row['unsaid']} "
             f"| {100 * f['level_of_range']:+.1f} ({f['level_z']:+.1f}) | {_life(f)} "
             f"| {100 * e['level_of_range']:+.1f} ({e['level_z']:+.1f}) | {_life(e)} |"
         )
@@ -150,39 +165,50 @@ def table(rows: list[dict[str, Any]]) -> str:
 
 
 def summary(rows: list[dict[str, Any]]) -> str:
+    """The table in one paragraph: the windows, the levels, the lives of the wearing and the healthy."""
+    wearing = [r for r in rows if not r["healthy"]]
+    healthy = [r for r in rows if r["healthy"]]
     parts = []
     for name, label in (("FDJ", "FDJ"), ("eta_O", "η_O")):
-        scores = [r["scores"][name] for r in rows]
-        level = sum(abs(s["level_z"]) <= 2 for s in scores)
-        held = sum(s["held"] for s in scores)
-        worst = max(abs(s["level_of_range"]) for s in scores)
-        parts.append(f"{label}: level within ±2 std in {level} of {len(rows)} (worst {100 * worst:.1f} % of range), "
-                     f"true remaining life inside the 90 % interval in {held} of {len(rows)}")  # fmt: skip
+        level = sum(abs(r["scores"][name]["level_z"]) <= 2 for r in rows)
+        worst = max(abs(r["scores"][name]["level_of_range"]) for r in rows)
+        held = sum(r["scores"][name]["held"] for r in wearing)
+        quiet = sum(r["scores"][name]["held"] for r in healthy)
+        parts.append(f"{label}: level within ±2 std in {level} of {len(rows)} (worst {100 * worst:.1f} % of range); "
+                     f"of the wearing, the true remaining life inside the 90 % interval in {held} of {len(wearing)}; "
+                     f"of the healthy, no degradation claimed in {quiet} of {len(healthy)}")  # fmt: skip
     windows = sum(r["n"] for r in rows)
     over, unsaid = sum(r["over"] for r in rows), sum(r["unsaid"] for r in rows)
-    head = f"{windows} windows, {over} of them answered FDJ past 10 % of range ({unsaid} not said weak). "
-    return head + "; ".join(parts) + "."
+    refused = [f for r in rows for f in r["refused"]]
+    head = (f"{windows} windows, {len(refused)} refused, {over} answered FDJ past 10 % of range ({unsaid} not said "
+            "weak). ")  # fmt: skip
+    tail = "".join(f"\n\nRefused: {f}" for f in refused)
+    return head + ". ".join(parts) + "." + tail
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--actuators", type=int, default=16, help="actuator histories")
+    parser.add_argument("--actuators", type=int, default=16, help="wearing actuators' histories")
+    parser.add_argument("--healthy", type=int, default=8, help="healthy actuators' histories (no wear)")
     parser.add_argument("--windows", type=int, default=30, help="windows per history")
     parser.add_argument("--docs", action="store_true", help="rewrite the section of docs/prognosis.md")
     args = parser.parse_args()
     runtime.configure()
     started, thresholds, rows = time.perf_counter(), Thresholds(), []
-    for actuator in range(args.actuators):
-        prognosis, fared = history(actuator, args.windows, thresholds)
-        rows.append(
-            {"actuator": actuator, "n": args.windows, **fared, "scores": scored(prognosis, fared["wear"], thresholds)}
-        )
+    actuators = [(a, False) for a in range(args.actuators)] + [(100 + a, True) for a in range(args.healthy)]
+    for actuator, healthy in actuators:
+        truth = wear(actuator, healthy)
+        prognosis, fared = history(actuator, truth, args.windows, thresholds)
+        scores = scored(prognosis, truth, thresholds)
+        rows.append({"actuator": f"{actuator}{' (healthy)' if healthy else ''}", "healthy": healthy, "n": args.windows,
+                     **fared, "scores": scores})  # fmt: skip
         print(table(rows[-1:]).splitlines()[-1], flush=True)
     body = "\n".join([PROSE, f"Total {time.perf_counter() - started:.0f} s.",
                       "", table(rows), "", summary(rows)])  # fmt: skip
     print(body)
     if args.docs:
-        command = f"python -m benchmarks.foreign_history --actuators {args.actuators} --windows {args.windows} --docs"
+        command = (f"python -m benchmarks.foreign_history --actuators {args.actuators} --healthy {args.healthy} "
+                   f"--windows {args.windows} --docs")  # fmt: skip
         write_section("On windows our code did not draw", command, body, PROGNOSIS_MD)
 
 
