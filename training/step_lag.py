@@ -20,8 +20,15 @@ reading from the mixture's (gap: what reading the moment at that lag changes), a
 from ``NOTE_WEIGHT``. On those windows the answers past 10 % of the range not said weak went from 5
 to 2 (5 ms), 3 to 1 (10 ms) and 2 to 0 (20 ms); on the 208 in step FDJ's std grew by a median 0.7 %
 (by over half in 6), and ±2 std held the truth as often as before. A prior of e⁻³ would catch one
-more 5 ms window and grow 26 in-step stds by over half; the 5 ms slips the ratio cannot tell from
-noise stay the limit (``docs/results.md``, "Careless exports").
+more 5 ms window and grow 26 in-step stds by over half.
+
+The deflection weighs in too: in the aircraft's band the moment follows it at once, so the lag the
+band reads (``hinge_lag.band_log_likelihood``, as for a filter's lag) is the moment's, and its
+likelihood at the best lag against none joins the ratio. Of 2 kHz foreign windows logged 5 ms
+early, Eq. 5.1 alone left 24 of 48 under weight 0.1; the band put 19 of them over 0.9, and it weighs
+against any lag where the moment is in step. Careless exports 5 ms out of step: confidently wrong
+3 → 1 of 104 (``docs/results.md``, "Careless exports"); where the deflection moves too slowly for the
+band, the ratio alone stays the limit.
 
 The current needs no such reading: its lag breaks Eq. 5.1 at every acceleration, and of 104 foreign
 windows exported with it 20 ms out of step 101 were refused, the rest answered within 10 % of range.
@@ -36,6 +43,7 @@ import numpy as np
 from sim.params import ActuatorParams
 from sim.window import Window
 from training.consistency import step_lags
+from training.hinge_lag import band_log_likelihood
 from training.preprocess import (
     UNDECIDED_NOTE_WEIGHT,
     UNDECIDED_PRIOR_LOG_ODDS,
@@ -68,7 +76,8 @@ def step_lag(window: Window, actuator: ActuatorParams = ActuatorParams()) -> Ste
     if not np.all(np.isfinite(errors)):
         return StepLag()  # too little sliding motion: the physics fit says so next
     best = 1 + int(np.argmin(errors[1:]))
-    log_ratio = rms_log_likelihood_ratio(errors[0], errors[best], float(fits.n_sliding[0]), rate)
+    band = band_log_likelihood(dict(window.signals), rate, lags[[0, best]])
+    log_ratio = rms_log_likelihood_ratio(errors[0], errors[best], float(fits.n_sliding[0]), rate) + band[1] - band[0]
     weight = odds_weight(log_ratio + PRIOR_LOG_ODDS)
     spread = {
         name: float(np.sqrt(weight) * abs(values[best] - values[0]))
