@@ -28,7 +28,9 @@ likelihood at the best lag against none joins the ratio. Of 2 kHz foreign window
 early, Eq. 5.1 alone left 24 of 48 under weight 0.1; the band put 19 of them over 0.9, and it weighs
 against any lag where the moment is in step. Careless exports 5 ms out of step: confidently wrong
 3 → 1 of 104 (``docs/results.md``, "Careless exports"); where the deflection moves too slowly for the
-band, the ratio alone stays the limit.
+band, the ratio alone stays the limit. In step, the stds lose what the story lent them: FDJ's ±2 std
+coverage went 100 → 98 / 97 % on the thesis and doublet groups of the accuracy table, 100 → 95 % behind
+the heaviest hinge filters, where the story had covered for the filter's lag.
 
 The current needs no such reading: its lag breaks Eq. 5.1 at every acceleration, and of 104 foreign
 windows exported with it 20 ms out of step 101 were refused, the rest answered within 10 % of range.
