@@ -97,8 +97,14 @@ def _print_history(stored: Any, prognosis: Any, plot: Path | None) -> None:
     click.echo(f"{prognosis.actuator_id}: {len(stored.estimates)} window(s), time in {prognosis.time_unit}")
     for name, trend in prognosis.trends.items():
         life = prognosis.remaining_life[name]
+        bending = trend.curved is not None and trend.curved.weight >= 0.5
+        bend = (
+            f", bending {trend.curved.curvature_per_unit2:+.3g} per unit² (weight {trend.curved.weight:.2f})"
+            if bending
+            else ""
+        )
         click.echo(f"{name:<6} now {trend.level:.5g} ± {trend.level_std:.2g}, slope {trend.slope_per_unit:+.3g} "
-                   f"± {trend.slope_std:.2g} per unit; {life.status}", nl=False)  # fmt: skip
+                   f"± {trend.slope_std:.2g} per unit{bend}; {life.status}", nl=False)  # fmt: skip
         if life.rul is not None:
             high = "open" if life.rul_high is None else f"{life.rul_high:.3g}"
             click.echo(f": {life.threshold:g} crossed in {life.rul:.3g} (90 %: {life.rul_low:.3g} to {high})")

@@ -74,6 +74,9 @@ def prognosis_figure(prognosis: Any, parameter: str, path: Path) -> Path:
     line = trend.level + trend.slope_per_unit * (grid - t.max())
     band = 2 * np.array([trend.std_at(offset) for offset in grid - t.max()])
     axis.plot(grid, line, color="tab:orange", label="trend")
+    if trend.curved is not None and trend.curved.weight >= 0.1:
+        axis.plot(grid, trend.curved.value_at(grid - t.max()), color="tab:orange", ls="--",
+                  label=f"bending trend (weight {trend.curved.weight:.2f})")  # fmt: skip
     axis.fill_between(grid, line - band, line + band, color="tab:orange", alpha=0.2)
     axis.axhline(life.threshold, color="tab:red", ls="--", label=f"threshold ({life.direction})")
     if life.rul_low is not None:

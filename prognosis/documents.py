@@ -35,8 +35,23 @@ class Point(Document):
     outlier: bool = False
 
 
+class Curved(Document):
+    """The quadratic beside the line, value(t) = level + slope·dt + curvature·dt² (dt = t − t_last), and the
+    weight the windows give it against the line: wear that speeds up."""
+
+    level: float
+    slope_per_unit: float
+    curvature_per_unit2: float
+    covariance: list[list[float]] = Field(description="of (level, slope, curvature), 3 x 3")
+    weight: float = Field(ge=0, le=1, description="posterior weight of the curve against the line (BIC)")
+
+    def value_at(self, offset: float | np.ndarray) -> float | np.ndarray:
+        return self.level + self.slope_per_unit * offset + self.curvature_per_unit2 * offset**2
+
+
 class Trend(Document):
-    """value(t) = level + slope·(t − t_last), weighted by each window's std, robust to outliers."""
+    """value(t) = level + slope·(t − t_last), weighted by each window's std, robust to outliers; beside it
+    the curve where the windows bend (``curved``)."""
 
     parameter: str
     n: int
@@ -49,6 +64,7 @@ class Trend(Document):
     )
     excess_std: float = Field(description="scatter beyond the stated stds, added to every point's (0: none)")
     points: list[Point]
+    curved: Curved | None = Field(None, description="the quadratic and its weight (null: too few windows to bend)")
 
     def std_at(self, offset: float) -> float:
         """The std of the trend's value ``offset`` time units after the last window (level and slope correlated)."""
