@@ -1,11 +1,12 @@
 """The thesis's aim on windows our code did not draw: an actuator's history -> trend and remaining life.
 
-Each actuator wears linearly in flight hours, and its windows come from ``tests.foreign`` as a
-fleet logs them (``PROSE``); every window goes through ``estimate_window`` and the history through
-``prognose``, as the service does. Per actuator: how its windows' answers fared, the trend's level
-at the last window against the truth there, and the true remaining life against the 90 % interval.
+Each actuator wears in flight hours (linearly, faster and faster, or not at all), and its windows
+come from ``tests.foreign`` as a fleet logs them (``PROSE``); every window goes through
+``estimate_window`` and the history through ``prognose``, as the service does. Per actuator: how
+its windows' answers fared, the trend's level at the last window against the truth there, and the
+true remaining life against the 90 % interval.
 
-    python -m benchmarks.foreign_history [--actuators 16] [--healthy 8] [--windows 30] [--docs]
+    python -m benchmarks.foreign_history [--actuators 16] [--speeding 8] [--healthy 8] [--windows 30] [--docs]
 """
 
 from __future__ import annotations
@@ -44,14 +45,15 @@ COLD_SHARE = 0.3
 
 PROSE = """A window that holds little (0.1 s, a 1–2 kHz log, a cold grease it cannot read) is answered
 weak, and the remedy `docs/results.md` names is the actuator's history, each window weighed by its std.
-This checks that remedy end to end. Each actuator wears linearly in flight hours: FDJ from
+This checks that remedy end to end. Sixteen actuators wear linearly in flight hours: FDJ from
 0.045–0.055 N·m towards its threshold (1.5x nominal), η_O from 0.85–0.95 towards 0.70, each crossing
 1.5–4 times the logged span of 1000 flight hours after the first window. Its windows, at flight hours
 drawn uniformly over the span, come from `tests/foreign` (the independent implementation) as a fleet
 logs them: the five families, half 0.5 s at 10 kHz, a fifth 0.1 s gusts, a fifth 1–2 kHz logs, a
 tenth 2 s cruise; in three of ten a grease 1.2–2x as viscous as the spec's (a cold flight), unlogged.
-Eight more actuators do not wear at all: a monitor that claims degradation there raises a false
-alarm. Every window goes through `estimate_window` and the history through `prognose`
+Eight more wear as the square of the hours (wear that speeds up: a line through their windows
+crosses the threshold ~3x too late, surely), and eight do not wear at all (a monitor that claims
+degradation there raises a false alarm). Every window goes through `estimate_window` and the history through `prognose`
 (`benchmarks/foreign_history.py`). Per actuator: its windows' FDJ answers said weak, past 10 % of the
 range, and past it without saying so; the trend's level at the last window against the truth there
 (error in % of the range and in the trend's stds); the true remaining life against the predicted one
@@ -60,25 +62,33 @@ and its 90 % interval (✗: outside; for a healthy actuator, a degradation claim
 
 @dataclass(frozen=True)
 class Wear:
-    """An actuator's true health against flight hours: linear from its start to its thresholds."""
+    """An actuator's true health against flight hours: from its start to its thresholds as (h / h*)^power
+    (1: linear; 2: wear that speeds up; h* infinite: none)."""
 
     fdj_start_nm: float
     fdj_crossing_h: float
     eta_o_start: float
     eta_o_crossing_h: float
+    power: float = 1.0
 
     def health(self, hours: float, thresholds: Thresholds) -> Health:
-        fdj = self.fdj_start_nm + (thresholds.fdj_above_nm - self.fdj_start_nm) * hours / self.fdj_crossing_h
-        eta_o = self.eta_o_start + (thresholds.eta_o_below - self.eta_o_start) * hours / self.eta_o_crossing_h
+        fdj_share, eta_o_share = ((hours / h) ** self.power for h in (self.fdj_crossing_h, self.eta_o_crossing_h))
+        fdj = self.fdj_start_nm + (thresholds.fdj_above_nm - self.fdj_start_nm) * fdj_share
+        eta_o = self.eta_o_start + (thresholds.eta_o_below - self.eta_o_start) * eta_o_share
         return Health(fdj_nm=fdj, fsj_nm=2.0 * fdj, eta_o=eta_o)
 
 
-def wear(actuator: int, healthy: bool = False) -> Wear:
-    """A wearing actuator's, or a healthy one's (never crossing: the same start, no wear)."""
+KINDS_OF_WEAR = ("linear", "speeding up", "healthy")
+
+
+def wear(actuator: int, kind: str = "linear") -> Wear:
+    """A wearing actuator's (``KINDS_OF_WEAR``), or a healthy one's (the same start, no wear)."""
     rng = np.random.default_rng(FIRST_SEED + actuator)
     fdj, fdj_h, eta_o, eta_o_h = (rng.uniform(0.045, 0.055), SPAN_H * rng.uniform(1.5, 4.0), rng.uniform(0.85, 0.95),
                                   SPAN_H * rng.uniform(1.5, 4.0))  # fmt: skip
-    return Wear(fdj, math.inf, eta_o, math.inf) if healthy else Wear(fdj, fdj_h, eta_o, eta_o_h)
+    if kind == "healthy":
+        return Wear(fdj, math.inf, eta_o, math.inf)
+    return Wear(fdj, fdj_h, eta_o, eta_o_h, power=2.0 if kind == "speeding up" else 1.0)
 
 
 def logged_window(actuator: int, j: int, hours: float, health: Health) -> Draw:
@@ -125,8 +135,8 @@ def scored(prognosis: Prognosis, wear_: Wear, thresholds: Thresholds) -> dict[st
         true_life = crossing - last  # inf: a healthy actuator's
         low, high = life.rul_low, np.inf if life.rul_high is None else life.rul_high
         out[name] = {
-            "level_z": (trend.level - true_level) / trend.level_std,
-            "level_of_range": share_of_range(name, trend.level - true_level),
+            "level_z": (trend.now()[0] - true_level) / trend.now()[1],
+            "level_of_range": share_of_range(name, trend.now()[0] - true_level),
             "true_life": true_life,
             "status": life.status,
             "rul": life.rul,
@@ -165,18 +175,18 @@ def table(rows: list[dict[str, Any]]) -> str:
 
 
 def summary(rows: list[dict[str, Any]]) -> str:
-    """The table in one paragraph: the windows, the levels, the lives of the wearing and the healthy."""
-    wearing = [r for r in rows if not r["healthy"]]
-    healthy = [r for r in rows if r["healthy"]]
+    """The table in one paragraph: the windows, the levels, and the lives by kind of wear."""
     parts = []
     for name, label in (("FDJ", "FDJ"), ("eta_O", "η_O")):
         level = sum(abs(r["scores"][name]["level_z"]) <= 2 for r in rows)
         worst = max(abs(r["scores"][name]["level_of_range"]) for r in rows)
-        held = sum(r["scores"][name]["held"] for r in wearing)
-        quiet = sum(r["scores"][name]["held"] for r in healthy)
+        lives = []
+        for kind in KINDS_OF_WEAR:
+            chosen = [r["scores"][name]["held"] for r in rows if r["kind"] == kind]
+            what = "no degradation claimed" if kind == "healthy" else "the true life inside the 90 % interval"
+            lives.append(f"{kind}: {what} in {sum(chosen)} of {len(chosen)}")
         parts.append(f"{label}: level within ±2 std in {level} of {len(rows)} (worst {100 * worst:.1f} % of range); "
-                     f"of the wearing, the true remaining life inside the 90 % interval in {held} of {len(wearing)}; "
-                     f"of the healthy, no degradation claimed in {quiet} of {len(healthy)}")  # fmt: skip
+                     + "; ".join(lives))  # fmt: skip
     windows = sum(r["n"] for r in rows)
     over, unsaid = sum(r["over"] for r in rows), sum(r["unsaid"] for r in rows)
     refused = [f for r in rows for f in r["refused"]]
@@ -188,27 +198,28 @@ def summary(rows: list[dict[str, Any]]) -> str:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--actuators", type=int, default=16, help="wearing actuators' histories")
-    parser.add_argument("--healthy", type=int, default=8, help="healthy actuators' histories (no wear)")
+    parser.add_argument("--actuators", type=int, default=16, help="histories of actuators wearing linearly")
+    parser.add_argument("--speeding", type=int, default=8, help="histories of actuators whose wear speeds up")
+    parser.add_argument("--healthy", type=int, default=8, help="histories of healthy actuators (no wear)")
     parser.add_argument("--windows", type=int, default=30, help="windows per history")
     parser.add_argument("--docs", action="store_true", help="rewrite the section of docs/prognosis.md")
     args = parser.parse_args()
     runtime.configure()
     started, thresholds, rows = time.perf_counter(), Thresholds(), []
-    actuators = [(a, False) for a in range(args.actuators)] + [(100 + a, True) for a in range(args.healthy)]
-    for actuator, healthy in actuators:
-        truth = wear(actuator, healthy)
-        prognosis, fared = history(actuator, truth, args.windows, thresholds)
-        scores = scored(prognosis, truth, thresholds)
-        rows.append({"actuator": f"{actuator}{' (healthy)' if healthy else ''}", "healthy": healthy, "n": args.windows,
-                     **fared, "scores": scores})  # fmt: skip
-        print(table(rows[-1:]).splitlines()[-1], flush=True)
+    counts = dict(zip(KINDS_OF_WEAR, (args.actuators, args.speeding, args.healthy), strict=True))
+    for offset, kind in zip((0, 200, 100), KINDS_OF_WEAR, strict=True):
+        for actuator in range(offset, offset + counts[kind]):
+            truth = wear(actuator, kind)
+            prognosis, fared = history(actuator, truth, args.windows, thresholds)
+            rows.append({"actuator": f"{actuator} ({kind})", "kind": kind, "n": args.windows, **fared,
+                         "scores": scored(prognosis, truth, thresholds)})  # fmt: skip
+            print(table(rows[-1:]).splitlines()[-1], flush=True)
     body = "\n".join([PROSE, f"Total {time.perf_counter() - started:.0f} s.",
                       "", table(rows), "", summary(rows)])  # fmt: skip
     print(body)
     if args.docs:
-        command = (f"python -m benchmarks.foreign_history --actuators {args.actuators} --healthy {args.healthy} "
-                   f"--windows {args.windows} --docs")  # fmt: skip
+        command = (f"python -m benchmarks.foreign_history --actuators {args.actuators} --speeding {args.speeding} "
+                   f"--healthy {args.healthy} --windows {args.windows} --docs")  # fmt: skip
         write_section("On windows our code did not draw", command, body, PROGNOSIS_MD)
 
 

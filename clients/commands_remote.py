@@ -103,7 +103,8 @@ def _print_history(stored: Any, prognosis: Any, plot: Path | None) -> None:
             if bending
             else ""
         )
-        click.echo(f"{name:<6} now {trend.level:.5g} ± {trend.level_std:.2g}, slope {trend.slope_per_unit:+.3g} "
+        level, level_std = trend.now()
+        click.echo(f"{name:<6} now {level:.5g} ± {level_std:.2g}, slope {trend.slope_per_unit:+.3g} "
                    f"± {trend.slope_std:.2g} per unit{bend}; {life.status}", nl=False)  # fmt: skip
         if life.rul is not None:
             high = "open" if life.rul_high is None else f"{life.rul_high:.3g}"

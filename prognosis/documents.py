@@ -55,7 +55,7 @@ class Trend(Document):
 
     parameter: str
     n: int
-    level: float = Field(description="the trend's value at the last window")
+    level: float = Field(description="the line's value at the last window (with the curve weighed in: now())")
     level_std: float
     slope_per_unit: float
     slope_std: float
@@ -65,6 +65,15 @@ class Trend(Document):
     excess_std: float = Field(description="scatter beyond the stated stds, added to every point's (0: none)")
     points: list[Point]
     curved: Curved | None = Field(None, description="the quadratic and its weight (null: too few windows to bend)")
+
+    def now(self) -> tuple[float, float]:
+        """The value at the last window and its std, the line's and the curve's weighed by the curve's weight."""
+        if self.curved is None:
+            return self.level, self.level_std
+        w, curve_std = self.curved.weight, float(np.sqrt(max(self.curved.covariance[0][0], 0.0)))
+        value = (1 - w) * self.level + w * self.curved.level
+        spread = (1 - w) * self.level_std**2 + w * curve_std**2 + w * (1 - w) * (self.curved.level - self.level) ** 2
+        return float(value), float(np.sqrt(spread))
 
     def std_at(self, offset: float) -> float:
         """The std of the trend's value ``offset`` time units after the last window (level and slope correlated)."""

@@ -5,7 +5,8 @@ The trend's (level, slope) is uncertain with the covariance of its fit, and so i
 share of the curve's weight, gives a distribution of crossing times (the line's t* = (threshold −
 level)/slope), and its 5/50/95 % quantiles are the RUL and its interval (draws that never reach the
 threshold have t* infinite, which is what leaves the upper bound open when the data cannot close
-it). A degradation is claimed only if the draws reach the threshold with ≥ 95 % probability.
+it). A degradation is claimed only if the trend moves towards the threshold at the last window
+with ≥ 95 % probability.
 """
 
 from __future__ import annotations
@@ -31,7 +32,8 @@ def remaining_life(trend: Trend, threshold: float, direction: str, seed: int = 0
                              probability_degrading=None)  # fmt: skip
     coefficients = _draws(trend, seed)
     crossing = first_crossing(coefficients[:, 0] - threshold, coefficients[:, 1], coefficients[:, 2], sign)
-    probability = float(np.mean(np.isfinite(crossing)))
+    # degrading: moving towards the threshold now (a curve that bends back may still never reach it)
+    probability = float(np.mean(sign * coefficients[:, 1] > 0))
     if probability < MIN_PROBABILITY:
         return RemainingLife(**common, status="no degradation detected", rul=None, rul_low=None, rul_high=None,
                              probability_degrading=probability)  # fmt: skip
