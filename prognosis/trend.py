@@ -21,6 +21,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from prognosis.documents import Curved, Point, Trend
+from training.preprocess import odds_weight
 
 HUBER_C = 2.5
 OUTLIER_Z = 3.5
@@ -74,10 +75,9 @@ def curved(x: np.ndarray, values: np.ndarray, variance: np.ndarray, line: dict[s
     scale = variance + curve["tau2"]
     chi2 = [float(np.sum(curve["robust"] * fit["residual"] ** 2 / scale)) for fit in (line, curve)]
     log_odds = 0.5 * (chi2[0] - chi2[1]) - 0.5 * np.log(max(float(curve["robust"].sum()), 2.0))
-    weight = float(1.0 / (1.0 + np.exp(-np.clip(log_odds, -50.0, 50.0))))
     beta, covariance = curve["beta"], curve["covariance"]
     return Curved(level=float(beta[0]), slope_per_unit=float(beta[1]), curvature_per_unit2=float(beta[2]),
-                  covariance=covariance.tolist(), weight=weight)  # fmt: skip
+                  covariance=covariance.tolist(), weight=odds_weight(float(log_odds)))  # fmt: skip
 
 
 def fit_trend(
