@@ -53,11 +53,12 @@ logs them: the five families, half 0.5 s at 10 kHz, a fifth 0.1 s gusts, a fifth
 tenth 2 s cruise; in three of ten a grease 1.2–2x as viscous as the spec's (a cold flight), unlogged.
 Eight more wear as the square of the hours (wear that speeds up: a line through their windows
 crosses the threshold ~3x too late, surely), and eight do not wear at all (a monitor that claims
-degradation there raises a false alarm). Every window goes through `estimate_window` and the history through `prognose`
-(`benchmarks/foreign_history.py`). Per actuator: its windows' FDJ answers said weak, past 10 % of the
-range, and past it without saying so; the trend's level at the last window against the truth there
-(error in % of the range and in the trend's stds); the true remaining life against the predicted one
-and its 90 % interval (✗: outside; for a healthy actuator, a degradation claimed)."""
+degradation there raises a false alarm). Every window goes through `estimate_window` and the
+history through `prognose` (`benchmarks/foreign_history.py`). Per actuator: its windows' FDJ
+answers said weak, past 10 % of the range, and past it without saying so; the trend's level at the
+last window against the truth there (error in % of the range and in the trend's stds); the true
+remaining life against the predicted one and its 90 % interval (✗: outside; for a healthy
+actuator, a degradation claimed)."""
 
 
 @dataclass(frozen=True)
@@ -134,9 +135,10 @@ def scored(prognosis: Prognosis, wear_: Wear, thresholds: Thresholds) -> dict[st
         true_level = getattr(wear_.health(last, thresholds), {"FDJ": "fdj_nm", "eta_O": "eta_o"}[name])
         true_life = crossing - last  # inf: a healthy actuator's
         low, high = life.rul_low, np.inf if life.rul_high is None else life.rul_high
+        level, level_std = trend.now()
         out[name] = {
-            "level_z": (trend.now()[0] - true_level) / trend.now()[1],
-            "level_of_range": share_of_range(name, trend.now()[0] - true_level),
+            "level_z": (level - true_level) / level_std,
+            "level_of_range": share_of_range(name, level - true_level),
             "true_life": true_life,
             "status": life.status,
             "rul": life.rul,
