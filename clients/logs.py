@@ -1,7 +1,9 @@
 """Recorded logs -> windows: JSON windows (one, a list, or a long recording), CSV, NPZ, or a folder of them.
 
 A recording longer than the window length is cut into consecutive windows of that length,
-``window_id`` = ``<recording id>#<index>``; a tail shorter than a window is dropped and said so.
+``window_id`` = ``<recording id>#<index>``; a tail shorter than a window is dropped and said so. A
+recording is one power-on of the drive: its pieces share its ``flight_id`` (the recording's id where it
+names none), so a piece moving one way is read with the sensors' zero another piece read.
 """
 
 from __future__ import annotations
@@ -43,6 +45,7 @@ def cut(window: Window, window_s: float) -> tuple[list[Window], int]:
             window,
             signals={name: values[i * n : (i + 1) * n] for name, values in window.signals.items()},
             window_id=f"{window.window_id}#{i}",
+            flight_id=window.flight_id or window.window_id,
         )
         for i in range(count)
     ]
@@ -56,7 +59,9 @@ def _from_json(path: Path) -> list[Window]:
 
 
 def _from_csv(path: Path, defaults: Defaults) -> list[Window]:
-    """Columns named as the window's signals (others ignored); ``# key: value`` lines on top give metadata."""
+    """Columns named as the window's signals (others ignored); ``# key: value`` lines on top give metadata
+    (``actuator_id``, ``window_id``, ``sample_rate_hz``, ``airspeed_mps``, ``altitude_m``, ``recorded_at``,
+    ``flight_hours``, ``flight_id``)."""
     meta: dict[str, str] = {}
     lines = path.read_text().splitlines()
     body = [line for line in lines if not line.startswith("#")]
@@ -90,7 +95,7 @@ def _from_npz(path: Path, defaults: Defaults) -> list[Window]:
 def _window(signals: dict[str, np.ndarray], meta: dict[str, Any], defaults: Defaults, path: Path) -> Window:
     """Arrays and metadata through the ema-window/1 contract, as a JSON window would go."""
     try:
-        document = {
+        document: dict[str, Any] = {
             "schema": "ema-window/1",
             "actuator_id": str(meta.get("actuator_id", defaults.actuator_id)),
             "window_id": str(meta.get("window_id", path.stem)),
@@ -100,6 +105,8 @@ def _window(signals: dict[str, np.ndarray], meta: dict[str, Any], defaults: Defa
                 "altitude_m": float(meta.get("altitude_m", defaults.altitude_m)),
             },
             "signals": {name: values.tolist() for name, values in signals.items()},
+            **{key: str(meta[key]) for key in ("recorded_at", "flight_id") if key in meta},
+            **({"flight_hours": float(meta["flight_hours"])} if "flight_hours" in meta else {}),
         }
     except ValueError as exc:
         raise InputError(str(path), f"has metadata that is not a number ({exc})") from None

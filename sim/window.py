@@ -80,6 +80,15 @@ class WindowDocument(_Contract):
     signals: SignalsDocument
     recorded_at: AwareDatetime | None = Field(None, description="when the window began (for trends)")
     flight_hours: Number | None = Field(None, ge=0, description="the airframe's flight hours then (for trends)")
+    flight_id: str | None = Field(
+        None,
+        min_length=1,
+        max_length=200,
+        pattern=IDENTIFIER,
+        description="the flight (one power-on of the drive) it was logged in: a window moving one way, which "
+        "cannot read its sensors' zero, is read with the zero of one of the same flight that moves both ways",
+        examples=["tail-123/2026-11-21T10:00:00Z"],
+    )
 
     def to_window(self) -> Window:
         """The arrays; signals of unequal lengths are refused naming the first one that differs."""
@@ -91,7 +100,14 @@ class WindowDocument(_Contract):
         condition = FlightCondition(self.flight_condition.airspeed_mps, self.flight_condition.altitude_m)
         recorded = None if self.recorded_at is None else self.recorded_at.isoformat()
         return Window(
-            arrays, self.sample_rate_hz, condition, self.actuator_id, self.window_id, recorded, self.flight_hours
+            arrays,
+            self.sample_rate_hz,
+            condition,
+            self.actuator_id,
+            self.window_id,
+            recorded_at=recorded,
+            flight_hours=self.flight_hours,
+            flight_id=self.flight_id,
         )
 
 
@@ -106,6 +122,7 @@ class Window:
     window_id: str = "unknown"
     recorded_at: str | None = None  # ISO 8601 with a time zone
     flight_hours: float | None = None
+    flight_id: str | None = None  # one power-on of the drive: its sensors keep one zero
 
     def __post_init__(self) -> None:
         lengths = {name: len(self.signals[name]) for name in SIGNALS}
@@ -145,6 +162,7 @@ def window_to_dict(window: Window) -> dict[str, Any]:
         "signals": {name: window.signals[name].tolist() for name in SIGNALS},
         **({"recorded_at": window.recorded_at} if window.recorded_at is not None else {}),
         **({"flight_hours": window.flight_hours} if window.flight_hours is not None else {}),
+        **({"flight_id": window.flight_id} if window.flight_id is not None else {}),
     }
 
 

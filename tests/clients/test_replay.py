@@ -60,7 +60,8 @@ def log_folder(tmp_path):
     (folder / "a_recording.json").write_text(json.dumps({**window_to_dict(recording), "window_id": "flight-1"}))
     short = synthetic_window(HealthParams.single(), seed=2, duration_s=0.1)
     rows = np.stack([short.signals[name] for name in SIGNALS], axis=1)
-    header = "# actuator_id: ac-7\n# window_id: csv-1\n# sample_rate_hz: 10000\n" + ",".join(SIGNALS) + "\n"
+    header = "# actuator_id: ac-7\n# window_id: csv-1\n# sample_rate_hz: 10000\n# flight_id: f-7\n" + ",".join(SIGNALS)
+    header += "\n"
     (folder / "b_window.csv").write_text(header + "\n".join(",".join(f"{v:.9g}" for v in row) for row in rows))
     np.savez(folder / "c_window.npz", **short.signals, actuator_id="ac-7", window_id="npz-1")
     return folder
@@ -73,6 +74,8 @@ def test_logs_are_read_and_cut_in_order(log_folder):
 
     ids = [w.window_id for w, _ in windows_of(log_folder, 0.1)]
     assert ids == ["flight-1#0", "flight-1#1", "flight-1#2", "csv-1", "npz-1"]
+    # a recording is one power-on: its pieces share a flight (and its sensors' zero); a CSV names its own
+    assert [w.flight_id for w, _ in windows_of(log_folder, 0.1)] == ["flight-1"] * 3 + ["f-7", None]
 
 
 def test_replay_end_to_end_resume_and_kill_9(tmp_path, log_folder, capsys):
