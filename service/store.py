@@ -3,6 +3,8 @@
 - Committed (``synchronous=FULL``, WAL) before the answer leaves: an estimate a client has
   received survives a kill -9 of the server or a power loss.
 - Idempotent: the same window posted again returns the stored answer; the trend counts it once.
+- A window's flight: ``sensor_zero`` finds the zero a window of the same flight read, for one that
+  moves one way and cannot read it.
 - Private: the file is created 0600 (SQLite gives its WAL and shared-memory files the same mode).
 - Checked at start: a file that is not an intact SQLite database is refused with the reason,
   never silently replaced (nothing a user stored is lost); ``healthy()`` answers /healthz.
@@ -24,7 +26,7 @@ from typing import Any
 from pydantic import ValidationError
 
 from prognosis.documents import Stored
-from training.documents import Estimate
+from training.documents import Estimate, SensorZero
 
 SCHEMA_SQL = """
 CREATE TABLE IF NOT EXISTS estimates (
@@ -131,6 +133,18 @@ class EstimateStore:
         if row is None:
             return None
         return Stored(**json.loads(row[2]), id=row[0], stored_at=row[1], replay=True)
+
+    def sensor_zero(self, actuator_id: str, flight_id: str) -> SensorZero | None:
+        """The most precise sensor zero a stored window of this actuator and flight read, or None
+        (``training.zero_offset``: what a window of the flight that moves one way is read with)."""
+        with self._lock:
+            rows = self._connection.execute(
+                "SELECT json_extract(result, '$.window.sensor_zero') FROM estimates "
+                "WHERE actuator_id = ? AND json_extract(result, '$.window.flight_id') = ?",
+                (actuator_id, flight_id),
+            ).fetchall()
+        zeros = [SensorZero.model_validate_json(row[0]) for row in rows if row[0] is not None]
+        return min(zeros, key=lambda zero: zero.torque_std_nm, default=None)
 
     def history(self, actuator_id: str) -> tuple[list[Stored], list[dict[str, Any]]]:
         """Every stored result of one actuator, oldest first; rows of an earlier format apart, as stored."""

@@ -50,7 +50,7 @@ from training.hinge_gain import hinge_gain_note
 from training.noise_level import white_noise_std
 from training.step_lag import StepLag, step_lag, step_lag_note
 from training.viscosity import viscosity_note
-from training.zero_offset import offset_note
+from training.zero_offset import ZeroOffset, offset_note
 
 MAX_RATE_HZ = 10_000.0
 MAX_SAMPLES = 10_000
@@ -138,12 +138,15 @@ def repaired(window: Window) -> tuple[Window, dict[str, int]]:
     return (replace(window, signals=signals) if counts else window), counts
 
 
-def prepare(window: Window, actuator: ActuatorParams = ActuatorParams(), spec_only: bool = False) -> Prepared:
+def prepare(
+    window: Window, actuator: ActuatorParams = ActuatorParams(), spec_only: bool = False, zero: ZeroOffset | None = None
+) -> Prepared:
     """Repair ``window``'s glitches, average it down to the pipeline's sizes, check its signals agree
     (``training.consistency``: InputError naming the field), put its sensors on one clock
     (``training.alignment``), read what it shows beyond ``actuator`` (``training.departures``) and weigh
     whether its hinge moment is out of step (``training.step_lag``); say what it found. ``spec_only``
-    skips the departures and the step: ``calibration`` reads the spec's model alone and names what departs."""
+    skips the departures and the step: ``calibration`` reads the spec's model alone and names what departs.
+    ``zero``: the sensors' zero a window of the same flight read, for a window moving one way."""
     window, glitches = repaired(window)
     factor = averaging_factor(window.n_samples, window.sample_rate_hz)
     command = window.signals["command_deg"]
@@ -155,7 +158,7 @@ def prepare(window: Window, actuator: ActuatorParams = ActuatorParams(), spec_on
     consistent = check_consistency(window, actuator)
     window, lags = aligned(window)
     aircraft = check_against_aircraft(window)
-    read = Departures(window, aircraft=aircraft) if spec_only else read_departures(window, actuator, aircraft)
+    read = Departures(window, aircraft=aircraft) if spec_only else read_departures(window, actuator, aircraft, zero)
     rate = read.window.sample_rate_hz * factor
     # with the departures left in, a lag fits what they leave (an offset: ln LR 105): the story is no test there
     step = StepLag() if spec_only else step_lag(read.window, read.actuator)

@@ -57,22 +57,26 @@ class Departures:
 
 
 def read_departures(
-    window: Window, actuator: ActuatorParams = ActuatorParams(), aircraft: AircraftCheck = AircraftCheck()
+    window: Window,
+    actuator: ActuatorParams = ActuatorParams(),
+    aircraft: AircraftCheck = AircraftCheck(),
+    zero: ZeroOffset | None = None,
 ) -> Departures:
     """The window corrected for what it shows beyond ``actuator``, and what that was (module docstring);
-    its hinge moment's gain divided out first where the ``aircraft`` reads one."""
+    its hinge moment's gain divided out first where the ``aircraft`` reads one; ``zero``: the sensors' zero
+    of the same flight, for a window that moves one way (``zero_offset.read_zero_offset``)."""
     aircraft = divided_out(aircraft)
     window = aircraft.corrected(window)
-    offset = read_zero_offset(window, actuator)
+    offset = read_zero_offset(window, actuator, zero)
     hinge = read_hinge_gain(zeroed(window, offset), actuator, leading=True)
     if hinge.gain != 1.0:  # a logged g·H + b: the offset, b/g once the gain is taken off, read again
         window = hinge.corrected(window)
-        offset = read_zero_offset(window, actuator)
+        offset = read_zero_offset(window, actuator, zero)
     drive = read_drive_constants(zeroed(window, offset), actuator)
-    read = _along(window, offset, drive, hinge, aircraft)
+    read = _along(window, offset, drive, hinge, aircraft, zero)
     if drive.alternative is None:
         return read
-    other = _along(window, offset, drive.alternative, hinge, aircraft)
+    other = _along(window, offset, drive.alternative, hinge, aircraft, zero)
     told = _told_apart(window, read, other)
     if told is not None:
         return replace(told, drive=replace(told.drive, alternative=None))
@@ -110,14 +114,19 @@ def _told_apart(window: Window, scale: Departures, inertia: Departures) -> Depar
 
 
 def _along(
-    window: Window, offset: ZeroOffset, drive: DriveConstants, hinge: HingeGain, aircraft: AircraftCheck
+    window: Window,
+    offset: ZeroOffset,
+    drive: DriveConstants,
+    hinge: HingeGain,
+    aircraft: AircraftCheck,
+    zero: ZeroOffset | None,
 ) -> Departures:
     """The offset read first (again on the corrected window where a drive constant was read), then the
     hinge moment's gain unless it led (on the zeroed moment: a logged g·H + b), the band of the
     aircraft's where that was divided out and the window reads none, then C."""
     if drive.stds:
         window = drive.corrected(window)
-        offset = read_zero_offset(window, drive.actuator)
+        offset = read_zero_offset(window, drive.actuator, zero)
     window = zeroed(window, offset)
     if hinge.gain == 1.0:
         hinge = read_hinge_gain(window, drive.actuator)

@@ -87,6 +87,16 @@ class FitCheck(Document):
     notes: list[str] = Field(default_factory=list)
 
 
+class SensorZero(Document):
+    """The sensors' zero as a window moving both ways read it (``training.zero_offset``): what a window of
+    the same flight that moves one way, and so cannot read it, is read with."""
+
+    window_id: str = Field(description="the window that read it")
+    hinge_nm: float = Field(description="taken off the logged hinge moment")
+    current_a: float = Field(description="taken off the logged current")
+    torque_std_nm: float = Field(ge=0, description="its std, as a constant torque at the motor shaft")
+
+
 class WindowInfo(Document):
     n_samples: int
     duration_s: float
@@ -136,6 +146,15 @@ class WindowInfo(Document):
     sliding_fraction: float = Field(description="share of samples the friction fit could use")
     recorded_at: str | None = None
     flight_hours: float | None = None
+    flight_id: str | None = None
+    sensor_zero: SensorZero | None = Field(
+        default=None,
+        description="the sensors' zero as this window read it, for the windows of its flight that move one way "
+        "(null: it moves one way itself, or was read with the spec's model alone)",
+    )
+    sensor_zero_from: str | None = Field(
+        default=None, description="it moves one way: the window of its flight whose sensor_zero it was read with"
+    )
 
 
 class DatasetInfo(Document):

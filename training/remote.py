@@ -14,15 +14,19 @@ from sim.checks import InputError
 from sim.window import Window, window_from_dict, window_to_dict
 from training import runtime
 from training.config import PipelineConfig
-from training.documents import Estimate
+from training.documents import Estimate, SensorZero
 from training.pipeline import estimate_window
 
 
-def estimate_document(window: dict[str, Any], config: dict[str, Any], threads: int) -> dict[str, Any]:
-    """The estimate of one window as a JSON-able dict, or {"error": ...} for a window refused as bad input."""
+def estimate_document(
+    window: dict[str, Any], config: dict[str, Any], threads: int, sensor_zero: dict[str, Any] | None = None
+) -> dict[str, Any]:
+    """The estimate of one window as a JSON-able dict, or {"error": ...} for a window refused as bad input;
+    ``sensor_zero``: its flight's (``estimate_window``)."""
     runtime.configure(threads)
+    zero = None if sensor_zero is None else SensorZero.model_validate(sensor_zero)
     try:
-        result = estimate_window(window_from_dict(window), PipelineConfig(**config))
+        result = estimate_window(window_from_dict(window), PipelineConfig(**config), sensor_zero=zero)
     except InputError as exc:
         return {"error": str(exc)}
     return result.model_dump(mode="json", by_alias=True)
@@ -47,11 +51,14 @@ def connect(address: str | None, cpus: int) -> None:
         ray.init(address=address, log_to_driver=False, configure_logging=False)
 
 
-def estimate_on_ray(window: Window, config: PipelineConfig, threads: int) -> Estimate:
+def estimate_on_ray(
+    window: Window, config: PipelineConfig, threads: int, sensor_zero: SensorZero | None = None
+) -> Estimate:
     """``estimate_window`` run as a Ray task (the service's EMA_BACKEND=ray); blocks this thread until done."""
     import ray
 
-    answer = ray.get(ray_task(threads).remote(window_to_dict(window), config.model_dump(), threads))
+    zero = None if sensor_zero is None else sensor_zero.model_dump()
+    answer = ray.get(ray_task(threads).remote(window_to_dict(window), config.model_dump(), threads, zero))
     if "error" in answer:
         field, _, message = answer["error"].partition(": ")
         raise InputError(field, message)

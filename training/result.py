@@ -21,6 +21,7 @@ from training.documents import (
     Estimates,
     FitCheck,
     RatioEstimate,
+    SensorZero,
     Timings,
     TrainingInfo,
     WindowInfo,
@@ -89,7 +90,10 @@ def _notes(prepared: Prepared, physics: FrictionFit, estimates: Estimates, check
 
 def _window_info(prepared: Prepared, data: Data) -> WindowInfo:
     """The window as logged, and what conditioning did to it."""
-    w = prepared.window
+    w, offset = prepared.window, prepared.departures.offset
+    zero = SensorZero(
+        window_id=w.window_id, hinge_nm=offset.hinge_nm, current_a=offset.current_a, torque_std_nm=offset.zero_std_nm
+    )
     return WindowInfo(
         n_samples=prepared.original_samples,
         duration_s=prepared.original_samples / prepared.original_rate_hz,
@@ -99,6 +103,9 @@ def _window_info(prepared: Prepared, data: Data) -> WindowInfo:
         sliding_fraction=float(np.mean(data.sliding)),
         recorded_at=w.recorded_at,
         flight_hours=w.flight_hours,
+        flight_id=w.flight_id,
+        sensor_zero=zero if offset.read else None,
+        sensor_zero_from=offset.carried_from,
     )
 
 

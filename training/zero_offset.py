@@ -21,8 +21,11 @@ sensor was never the less likely one, and was favoured more than 9:1 on 11 of th
 the current's. The window is corrected by the weighted mix (the hinge moment by w·b, the current by
 (1 − w)·c/k_T), which puts the answer between the readings, and each target's std grows by their
 disagreement (``conditioning.widened``): an offset the window cannot place is an uncertainty, said
-as one. Where the motion goes one way, no offset can be read; FDJ's std then carries one a sensor
-may keep unseen (``UNSEEN_CURRENT_OFFSET_A``), and a note says why.
+as one. Where the motion goes one way, no offset can be read. A drive keeps its sensors' zero for
+a power-on, so such a window is read with the zero a window of the same flight read moving both
+ways (``carried``: what it took off, FDJ's std carrying that reading's ``zero_std_nm``); where the
+flight has none, FDJ's std carries an offset a sensor may keep unseen (``UNSEEN_CURRENT_OFFSET_A``).
+A note says which.
 """
 
 from __future__ import annotations
@@ -37,6 +40,9 @@ from training.baseline import FitSettings, FrictionFit
 from training.preprocess import fit_as_read, odds_weight, rms_log_likelihood_ratio
 
 MIN_Z = 4.0  # stds by which the fit with an offset must explain the window better (``equation_z``)
+# A flight's zero holds on a window where, taken off it, the constant left lies within this many stds of none: a
+# sensor that drifted (or a power-on between) shows, and the window's own reading is taken.
+HOLDS_Z = 3.0
 # Where the motion goes one way, an offset is FDJ's twin and cannot be read: FDJ then rests on the sensors
 # being on zero, and its std carries the offset a Hall sensor keeps after its power-up zeroing (~0.2 % of
 # the drive's 22.5 A). One foreign window in fifty is so; one 0.075 A off was read 24 % of range off at 1.9 % std.
@@ -59,6 +65,16 @@ class ZeroOffset:
     current_a: float = 0.0  # taken off the logged current
     spread: dict[str, float] = field(default_factory=dict)  # per target, the std what is unknown of it adds
     one_way: bool = False  # the motion goes one way: no offset could be read, FDJ's std carries an unseen one
+    # the std of the zero as read, at the motor shaft (c's own, which sensor holds it; one read as none: |c| too)
+    zero_std_nm: float = 0.0
+    carried_from: str | None = None  # the window of the same flight whose zero was taken off instead
+    unheld_from: str | None = None  # the window of the same flight whose zero did not hold on this one ...
+    unheld_z: float = 0.0  # ... by how many stds
+
+    @property
+    def read(self) -> bool:
+        """Read on this window, moving both ways (not carried, not the unread default)."""
+        return not self.one_way and self.carried_from is None and self.zero_std_nm > 0.0
 
 
 def _shifted(signals: dict[str, np.ndarray], hinge_nm: float = 0.0, current_a: float = 0.0) -> dict[str, np.ndarray]:
@@ -100,17 +116,32 @@ def second_weight(first: FrictionFit, second: FrictionFit, rate: float) -> float
     return odds_weight(log_likelihood_ratio(first, second, rate))
 
 
-def read_zero_offset(window: Window, actuator: ActuatorParams = ActuatorParams()) -> ZeroOffset:
+def read_zero_offset(
+    window: Window, actuator: ActuatorParams = ActuatorParams(), carried: ZeroOffset | None = None
+) -> ZeroOffset:
     """The window's constant torque beyond friction, where the fit with it explains the window ``MIN_Z``
-    stds better, and the two readings of it (module docstring) weighed; or the note that the motion goes
-    one way."""
+    stds better, and the two readings of it (module docstring) weighed; the zero ``carried`` from a window
+    of the same flight where it is the more precise and holds here (``flight_zero``); where the motion goes
+    one way, the carried zero, or the note that none is known."""
     rate, signals = window.sample_rate_hz, dict(window.signals)
     found = fit_as_read(signals, rate, actuator, OFFSET_FIT)
+    if float(found.term_std("offset")[0]) == 0.0:  # too little motion the other way (``baseline.MIN_OFFSET_BALANCE``)
+        unseen = UNSEEN_CURRENT_OFFSET_A * actuator.torque_constant_nm_per_a
+        known = carried or ZeroOffset(zero_std_nm=unseen)
+        return replace(known, one_way=True, spread={"FDJ": known.zero_std_nm})
+    own = own_reading(signals, rate, actuator, found)
+    if carried is None or carried.zero_std_nm >= own.zero_std_nm:
+        return own
+    return flight_zero(signals, rate, actuator, carried, own)
+
+
+def own_reading(
+    signals: dict[str, np.ndarray], rate: float, actuator: ActuatorParams, found: FrictionFit
+) -> ZeroOffset:
+    """The offset the window reads itself from ``found``, Eq. 5.1's fit with one (module docstring)."""
     torque, std = float(found.term("offset")[0]), float(found.term_std("offset")[0])
-    if std == 0.0:  # too little motion the other way to tell an offset from FDJ (``baseline.MIN_OFFSET_BALANCE``)
-        return ZeroOffset(one_way=True, spread={"FDJ": UNSEEN_CURRENT_OFFSET_A * actuator.torque_constant_nm_per_a})
     if not (np.isfinite(torque) and equation_z(fit_as_read(signals, rate, actuator), found, rate) > MIN_Z):
-        return ZeroOffset()
+        return ZeroOffset(zero_std_nm=float(np.hypot(std, torque)) if np.isfinite(torque) else 0.0)
     current_a = sensor_offset(signals, rate, torque, "current_a", actuator)
     hinge_nm = sensor_offset(signals, rate, torque, "hinge_nm", actuator)
     as_current = fit_as_read(_shifted(signals, current_a=current_a), rate, actuator)
@@ -120,14 +151,28 @@ def read_zero_offset(window: Window, actuator: ActuatorParams = ActuatorParams()
         "FDJ": float(as_hinge.fdj_nm[0] - as_current.fdj_nm[0]),
         "eta_O": float(as_hinge.eta_o[0] - as_current.eta_o[0]),
     }
+    spread = {name: float(np.sqrt(share * (1.0 - share)) * abs(gap)) for name, gap in apart.items()}
     return ZeroOffset(
         torque_nm=torque,
         torque_std_nm=std,
         hinge_share=share,
         hinge_nm=share * hinge_nm,
         current_a=(1.0 - share) * current_a,
-        spread={name: float(np.sqrt(share * (1.0 - share)) * abs(gap)) for name, gap in apart.items()},
+        spread=spread,
+        zero_std_nm=float(np.hypot(std, spread["FDJ"])),
     )
+
+
+def flight_zero(
+    signals: dict[str, np.ndarray], rate: float, actuator: ActuatorParams, carried: ZeroOffset, own: ZeroOffset
+) -> ZeroOffset:
+    """The flight's zero ``carried``, where it holds on this window (taken off, the constant left lies within
+    ``HOLDS_Z`` stds of none); else the window's ``own`` reading, with how far the flight's is off."""
+    left = fit_as_read(_shifted(signals, carried.hinge_nm, carried.current_a), rate, actuator, OFFSET_FIT)
+    z = abs(float(left.term("offset")[0])) / float(np.hypot(left.term_std("offset")[0], carried.zero_std_nm))
+    if not z <= HOLDS_Z:
+        return replace(own, unheld_from=carried.carried_from, unheld_z=z)
+    return replace(carried, spread={"FDJ": carried.zero_std_nm})
 
 
 def zeroed(window: Window, offset: ZeroOffset) -> Window:
@@ -139,18 +184,33 @@ def zeroed(window: Window, offset: ZeroOffset) -> Window:
 
 def offset_note(offset: ZeroOffset) -> str | None:
     """The offset in words for the result's notes, or None."""
+    if offset.carried_from is not None:
+        why = "a sensor off zero would read as FDJ here" if offset.one_way else "it reads them less precisely"
+        return (
+            f"the motion goes {'one way' if offset.one_way else 'both ways'}, but {why}: the sensors' zero is the "
+            f"one window {offset.carried_from} of the same flight read moving both ways ({offset.hinge_nm:.2f} N·m "
+            f"of hinge moment and {offset.current_a:.3f} A of current taken off; FDJ's std includes its "
+            f"{1e3 * offset.zero_std_nm:.2f} mN·m)"
+        )
     if offset.one_way:
         return (
             "the motion goes one way: a current or hinge moment sensor off zero would read as FDJ here, and "
             f"cannot be told from it (FDJ's std includes {1e3 * offset.spread['FDJ']:.1f} mN·m for one, a current "
-            f"{UNSEEN_CURRENT_OFFSET_A:g} A off; a window moving both ways reads it)"
+            f"{UNSEEN_CURRENT_OFFSET_A:g} A off; a window of the same flight (flight_id) moving both ways reads it)"
         )
-    if not offset.torque_nm:
-        return None
-    return (
-        f"T_R holds a constant {1e3 * offset.torque_nm:.2f} ± {1e3 * offset.torque_std_nm:.2f} mN·m beyond "
-        "friction: a sensor off zero (or friction that differs by direction), taken off as "
-        f"{offset.hinge_nm:.2f} N·m of hinge moment and {offset.current_a:.3f} A of current (the hinge moment is "
-        f"the one off with weight {offset.hinge_share:.2f}; where the window cannot tell, the stds include what "
-        "that changes)"
-    )
+    own = unheld = None
+    if offset.torque_nm:
+        own = (
+            f"T_R holds a constant {1e3 * offset.torque_nm:.2f} ± {1e3 * offset.torque_std_nm:.2f} mN·m beyond "
+            "friction: a sensor off zero (or friction that differs by direction), taken off as "
+            f"{offset.hinge_nm:.2f} N·m of hinge moment and {offset.current_a:.3f} A of current (the hinge moment is "
+            f"the one off with weight {offset.hinge_share:.2f}; where the window cannot tell, the stds include what "
+            "that changes)"
+        )
+    if offset.unheld_from:
+        unheld = (
+            f"the sensors' zero window {offset.unheld_from} of the same flight read does not hold here (taken off, "
+            f"the constant left stands {offset.unheld_z:.1f} stds off none: a sensor drifted, or the drive was "
+            "powered up again), so the window's own reading is taken"
+        )
+    return "; ".join(text for text in (own, unheld) if text) or None

@@ -1,5 +1,6 @@
 from __future__ import annotations
 
+from functools import partial
 from typing import Annotated
 
 from fastapi import APIRouter, Query, Request
@@ -41,7 +42,8 @@ async def estimate(
     """Estimate FDJ, η_O, η_A (FSJ where the window shows it) of one window; store and answer.
 
     A window already stored for its (actuator_id, window_id) is answered from the history
-    (``replay: true``) without recomputing. Budget: the window's duration and its simulation work
+    (``replay: true``) without recomputing. A window that moves one way is read with the sensor zero a
+    stored window of its ``flight_id`` read moving both ways. Budget: the window's duration and its simulation work
     (simulations × seconds) are limited by the service's settings; over it, 422 naming the limit.
     """
     with runner.admit() as ticket:
@@ -52,11 +54,14 @@ async def estimate(
         sizes = {"n_simulations": n_simulations, "n_timesteps": n_timesteps, "hidden_units": hidden_units}
         config = request_config(settings, **sizes, seed=seed)
         check_budget(window, config, settings)
+        zero = None
+        if window.flight_id is not None:
+            zero = await run_in_threadpool(store.sensor_zero, window.actuator_id, window.flight_id)
         if settings.backend == "ray":
             from training.remote import estimate_on_ray
 
-            result = await runner.run(ticket, request.is_disconnected, estimate_on_ray, window, config, 1)
+            result = await runner.run(ticket, request.is_disconnected, estimate_on_ray, window, config, 1, zero)
         else:
-            result = await runner.run(ticket, request.is_disconnected, estimate_window, window, config,
-                                      stopper(ticket.cancel))  # fmt: skip
+            job = partial(estimate_window, on_stage=stopper(ticket.cancel), sensor_zero=zero)
+            result = await runner.run(ticket, request.is_disconnected, job, window, config)
         return await run_in_threadpool(store.add, result)  # committed (fsync) before the answer leaves

@@ -72,6 +72,22 @@ def test_estimate_table_and_bad_inputs(tmp_path, capsys):
     assert main(["estimate", str(tmp_path / "missing.json")]) == EXIT_BAD_INPUT
 
 
+def test_estimate_takes_a_flights_sensor_zero_from_a_result_and_names_a_bad_one(tmp_path, capsys):
+    window, result = tmp_path / "w.json", tmp_path / "r.json"
+    main(["simulate", "--out", str(window), "--duration", "0.1"])
+    capsys.readouterr()
+    assert main(["estimate", str(window), *SIZES, "--json"]) == EXIT_OK
+    document = json.loads(capsys.readouterr().out)
+    assert document["window"]["sensor_zero"]["window_id"] == document["window_id"]
+    result.write_text(json.dumps(document))
+    assert main(["estimate", str(window), *SIZES, "--zero-from", str(result)]) == EXIT_OK
+    document["window"]["sensor_zero"] = None
+    result.write_text(json.dumps(document))
+    for bad in (window, result):  # a window, not a result; a result that read no zero
+        assert main(["estimate", str(window), "--zero-from", str(bad)]) == EXIT_BAD_INPUT
+        assert "--zero-from" in capsys.readouterr().err
+
+
 def test_calibrate_writes_a_figure_and_names_a_bad_truth_file(tmp_path, capsys):
     window, truth = tmp_path / "w.json", tmp_path / "t.json"
     main(["simulate", "--out", str(window), "--duration", "0.15", "--truth-out", str(truth)])

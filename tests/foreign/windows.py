@@ -151,6 +151,15 @@ def worn(seed: int, **kwargs) -> Draw:
     return draw(seed, health=health, **kwargs)
 
 
+def of_the_same_flight(drawn: Draw, seed: int, family: str = "cruise", duration_s: float = 1.0) -> Draw:
+    """Another window of ``drawn``'s flight: the same actuator (health, effects, its sensors' offsets),
+    flight condition and logger, a command of ``family``."""
+    setup = drawn.setup
+    other = draw(seed, family, setup.health, setup.effects, setup.flight, duration_s, setup.sample_rate_hz)
+    other.document["actuator_id"] = drawn.document["actuator_id"]
+    return other
+
+
 __all__ = [
     "Draw",
     "Effects",
@@ -158,6 +167,7 @@ __all__ = [
     "Health",
     "draw",
     "filter_widths",
+    "of_the_same_flight",
     "replace",
     "through_filters",
     "with_spikes",

@@ -4,6 +4,7 @@ import pytest
 from fastapi.testclient import TestClient
 
 from service.main import create_app
+from tests.foreign.windows import Effects, draw, of_the_same_flight
 from tests.service.conftest import KEY, LOCAL, SMALL, settings_for
 
 
@@ -31,6 +32,22 @@ def test_a_window_posted_twice_is_stored_once_and_answered_from_the_history(clie
     assert again["replay"] is True and again["id"] == first["id"]
     assert again["estimates"] == first["estimates"]
     assert len(client.get("/v1/actuators/ac-1/elev/estimates").json()["estimates"]) == 1
+
+
+def test_a_window_moving_one_way_is_read_with_the_zero_its_flight_stored(client):
+    """A 0.1 s gust moving one way, its current 0.2 A off: a cruise window of its flight, stored first, read it."""
+    one_way = draw(318, "gust", duration_s=0.1, effects=Effects(current_bias_a=0.2))
+    both = of_the_same_flight(one_way, 1318)
+    for drawn, flight_id in ((both, "f-1"), (one_way, "f-1")):
+        drawn.document.update(actuator_id="ac-9/elev", flight_id=flight_id)
+    read = client.post("/v1/estimate", json=both.document).json()["window"]["sensor_zero"]
+    torque_nm = read["hinge_nm"] / 500.0 + read["current_a"] * 0.0752  # at the motor shaft: gear, k_T
+    assert torque_nm == pytest.approx(0.2 * 0.0752, rel=0.05)
+    answered = client.post("/v1/estimate", json=one_way.document).json()
+    assert answered["window"]["sensor_zero_from"] == both.document["window_id"]
+    assert answered["window"]["current_offset_a"] == read["current_a"]
+    other_flight = {**one_way.document, "flight_id": "f-2", "window_id": "other"}
+    assert client.post("/v1/estimate", json=other_flight).json()["window"]["sensor_zero_from"] is None
 
 
 def test_sizes_are_overridable_within_the_services_ceilings(client, document):

@@ -10,6 +10,7 @@ from service.store import EstimateStore, StorageError
 from sim.params import HealthParams
 from sim.synthetic import synthetic_window
 from tests.service.conftest import SMALL
+from training.documents import SensorZero
 from training.pipeline import estimate_window
 
 
@@ -57,3 +58,19 @@ def test_a_round_one_history_is_migrated_and_nothing_is_lost(tmp_path, result):
     current, kept = store.history("a")
     assert len(current) == 1 and len(kept) == 1  # one row per window, the old format returned as stored
     assert sqlite3.connect(path).execute("SELECT count(*) FROM estimates_v1").fetchone()[0] == 3
+
+
+def test_the_sensor_zero_is_the_most_precise_of_the_actuators_flight(tmp_path, result):
+    store = EstimateStore(tmp_path / "h.sqlite3")
+
+    def stored(actuator_id: str, window_id: str, flight_id: str | None, std: float | None) -> None:
+        zero = None if std is None else SensorZero(window_id=window_id, hinge_nm=0.0, current_a=std, torque_std_nm=std)
+        window = result.window.model_copy(update={"flight_id": flight_id, "sensor_zero": zero})
+        store.add(result.model_copy(update={"actuator_id": actuator_id, "window_id": window_id, "window": window}))
+
+    for args in [("a", "w1", "f", 3e-4), ("a", "w2", "f", 1e-4), ("a", "w3", "f", None), ("a", "w4", "g", 1e-5),
+                 ("b", "w5", "f", 1e-6), ("a", "w6", None, 1e-6)]:  # fmt: skip
+        stored(*args)
+    assert store.sensor_zero("a", "f").window_id == "w2"
+    assert store.sensor_zero("a", "g").window_id == "w4"
+    assert store.sensor_zero("a", "h") is None and store.sensor_zero("c", "f") is None

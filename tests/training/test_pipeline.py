@@ -7,7 +7,7 @@ from sim.checks import InputError
 from sim.params import HealthParams
 from sim.synthetic import synthetic_window
 from sim.window import window_from_dict
-from tests.foreign.windows import NOISE, Effects, draw, filter_widths, noisy, through_filters, worn
+from tests.foreign.windows import NOISE, Effects, draw, filter_widths, noisy, of_the_same_flight, through_filters, worn
 from training.config import PipelineConfig
 from training.documents import Estimate
 from training.pipeline import estimate_window
@@ -223,6 +223,23 @@ def test_a_window_moving_one_way_says_fdj_rests_on_the_sensors_zero(seed):
     result = _estimate(drawn)
     assert result.estimates.FDJ.weakly_determined and any("motion goes one way" in n for n in result.notes)
     assert _errors(result, drawn.truth)["FDJ"][1] < 2.0  # within ±2 std, though 0.06 A is ~23 % of the range
+
+
+@pytest.mark.parametrize(("seed", "family", "effects"), [
+    (318, "gust", Effects(current_bias_a=0.2)), (323, "steps", Effects(hinge_bias_nm=-6.0)),
+])  # fmt: skip
+def test_a_window_moving_one_way_is_answered_with_the_zero_its_flight_read(seed, family, effects):
+    """Alone, the offset (15 and 24 % of FDJ's range) is an unseen one; a cruise window of the flight reads it."""
+    one_way = draw(seed, family, duration_s=0.1 if family == "gust" else 0.5, effects=effects)
+    both = of_the_same_flight(one_way, seed + 1000)
+    zero = _estimate(both).window.sensor_zero
+    assert zero is not None and zero.window_id == both.document["window_id"]
+    result = estimate_window(window_from_dict(one_way.document), SMALL, sensor_zero=zero)
+    assert result.window.sensor_zero is None and result.window.sensor_zero_from == zero.window_id
+    assert any("of the same flight read moving both ways" in note for note in result.notes)
+    of_range, z = _errors(result, one_way.truth)["FDJ"]
+    assert of_range < 3.0 and z < 2.0 and not result.estimates.FDJ.weakly_determined
+    assert _estimate(one_way).estimates.FDJ.weakly_determined
 
 
 def test_a_network_that_disagrees_with_the_window_is_set_aside(monkeypatch):
