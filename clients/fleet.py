@@ -5,14 +5,16 @@ thread budget (one thread by default: a worker is a core, so throughput grows wi
 results are written as they complete (``ray.wait``), the CSV is
 the checkpoint (a rerun skips what it holds, so a crash never duplicates a window), and the same
 rows can go into a service's SQLite history (idempotent as well). Without Ray and with one
-worker the archive is processed in this process, one window after another.
+worker the archive is processed in this process, one window after another. A window of a named
+flight that moves one way is answered last, with the sensor zero the most precise window of its
+flight read (``training.zero_offset``), as the service answers it after its flight's windows.
 """
 
 from __future__ import annotations
 
 import sys
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -40,14 +42,17 @@ class Progress:
               f"{rate:.2f} windows/s, {(self.total - self.done) / rate:.0f} s left", file=sys.stderr)  # fmt: skip
 
 
-def _in_process(windows: list[Window], config: PipelineConfig, threads: int) -> Iterator[tuple[Window, dict]]:
+Job = tuple[Window, dict[str, Any] | None]  # a window and its flight's sensor zero (``window.sensor_zero``), if known
+
+
+def _in_process(jobs: list[Job], config: PipelineConfig, threads: int) -> Iterator[tuple[Window, dict]]:
     from training.remote import estimate_document
 
-    for window in windows:
-        yield window, estimate_document(window_to_dict(window), config.model_dump(), threads)
+    for window, zero in jobs:
+        yield window, estimate_document(window_to_dict(window), config.model_dump(), threads, zero)
 
 
-def _on_ray(windows: list[Window], config: PipelineConfig, workers: int, threads: int,
+def _on_ray(jobs: list[Job], config: PipelineConfig, workers: int, threads: int,
             address: str | None) -> Iterator[tuple[Window, dict]]:  # fmt: skip
     import ray
 
@@ -56,14 +61,43 @@ def _on_ray(windows: list[Window], config: PipelineConfig, workers: int, threads
     connect(address, workers * threads)
     task = ray_task(threads)
     pending: dict[Any, Window] = {}
-    queue = list(reversed(windows))
+    queue = list(reversed(jobs))
     while queue or pending:
         while queue and len(pending) < IN_FLIGHT_PER_WORKER * workers:
-            window = queue.pop()
-            pending[task.remote(window_to_dict(window), config.model_dump(), threads)] = window
+            window, zero = queue.pop()
+            pending[task.remote(window_to_dict(window), config.model_dump(), threads, zero)] = window
         ready, _ = ray.wait(list(pending), num_returns=1)
         for reference in ready:
             yield pending.pop(reference), ray.get(reference)
+
+
+def _waits_for_its_flight(window: Window, answer: dict[str, Any]) -> bool:
+    """A window of a named flight that read no sensor zero (it moves one way) and was given none."""
+    read = answer.get("window", {})
+    unread = read.get("sensor_zero") is None and read.get("sensor_zero_from") is None
+    return window.flight_id is not None and "error" not in answer and unread
+
+
+def _with_flight_zeros(
+    first: Iterator[tuple[Window, dict]], again: Callable[[list[Job]], Iterator[tuple[Window, dict]]]
+) -> Iterator[tuple[Window, dict]]:
+    """The answers of ``first``; a window that waits for its flight (``_waits_for_its_flight``) held back and,
+    where a window of its flight read a sensor zero, answered ``again`` with the most precise (as the service
+    reads it from its history)."""
+    held: list[tuple[Window, dict]] = []
+    zeros: dict[tuple[str, str], dict[str, Any]] = {}
+    for window, answer in first:
+        if _waits_for_its_flight(window, answer):
+            held.append((window, answer))
+            continue
+        zero = answer.get("window", {}).get("sensor_zero")
+        key = (window.actuator_id, str(window.flight_id))
+        if zero is not None and (key not in zeros or zero["torque_std_nm"] < zeros[key]["torque_std_nm"]):
+            zeros[key] = zero
+        yield window, answer
+    known = [(w, zeros.get((w.actuator_id, str(w.flight_id)))) for w, _ in held]
+    yield from ((w, a) for w, a in held if (w.actuator_id, str(w.flight_id)) not in zeros)
+    yield from again([(w, zero) for w, zero in known if zero is not None])
 
 
 def run_fleet(windows: list[Window], out: Path, config: PipelineConfig, workers: int, address: str | None,
@@ -74,7 +108,11 @@ def run_fleet(windows: list[Window], out: Path, config: PipelineConfig, workers:
     todo = [w for w in windows if (w.actuator_id, w.window_id) not in done]
     progress = Progress(len(todo), started=time.perf_counter())
     in_process = workers == 1 and address is None and not ray_installed()
-    results = _in_process(todo, config, threads) if in_process else _on_ray(todo, config, workers, threads, address)
+
+    def engine(jobs: list[Job]) -> Iterator[tuple[Window, dict]]:
+        return _in_process(jobs, config, threads) if in_process else _on_ray(jobs, config, workers, threads, address)
+
+    results = _with_flight_zeros(engine([(w, None) for w in todo]), engine)
     store = _store(database)
     with ResultsWriter(out) as writer:
         for window, answer in results:

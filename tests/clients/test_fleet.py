@@ -56,6 +56,29 @@ def test_one_worker_without_ray_runs_in_process(archive, tmp_path, capsys, monke
     assert "[7/7]" in captured.err and "windows/s" in captured.err  # progress: done, rate, time left
 
 
+def test_a_window_moving_one_way_is_answered_with_its_flights_zero(tmp_path, capsys, monkeypatch):
+    """Its file first in the archive, a 0.1 s gust moving one way (current 0.2 A off) waits for the cruise
+    window of its flight; a window of another flight does not take that zero."""
+    from clients import fleet
+    from service.store import EstimateStore
+    from tests.foreign.windows import Effects, draw, of_the_same_flight
+
+    monkeypatch.setattr(fleet, "ray_installed", lambda: False)
+    folder, database = tmp_path / "archive", tmp_path / "history.sqlite3"
+    folder.mkdir()
+    one_way = draw(318, "gust", duration_s=0.1, effects=Effects(current_bias_a=0.2))
+    cruise = of_the_same_flight(one_way, 1318)
+    for name, drawn, flight_id in (("a", one_way, "f-1"), ("b", cruise, "f-1"), ("c", one_way, "f-2")):
+        document = {**drawn.document, "actuator_id": "tail-9", "flight_id": flight_id, "window_id": name}
+        (folder / f"{name}.json").write_text(json.dumps(document))
+    arguments = ["fleet", str(folder), "--out", str(tmp_path / "r.csv"), "--workers", "1", "--database", str(database)]
+    assert main([*arguments, *SIZES, "--json"]) == EXIT_OK
+    answers = {s.window_id: s.window for s in EstimateStore(database).history("tail-9")[0]}
+    cruise_pieces = {name for name in answers if name.startswith("b#")}  # the archive's windows are cut
+    assert answers["a"].sensor_zero_from in cruise_pieces and answers["c"].sensor_zero_from is None
+    assert f"[{len(answers)}/{len(answers)}]" in capsys.readouterr().err
+
+
 def test_history_plots_a_prognosis_whose_interval_holds_the_truth(tmp_path, capsys):
     import numpy as np
 
