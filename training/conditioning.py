@@ -44,13 +44,13 @@ from sim.window import Window
 from training.aircraft_check import aircraft_note, check_against_aircraft
 from training.alignment import Lags, aligned
 from training.consistency import Consistency, check_consistency, kinematics_note
-from training.departures import Departures, read_departures
+from training.departures import Departures, Known, history_note, read_departures
 from training.drive_constants import drive_constants_note
 from training.hinge_gain import hinge_gain_note
 from training.noise_level import white_noise_std
 from training.step_lag import StepLag, step_lag, step_lag_note
 from training.viscosity import viscosity_note
-from training.zero_offset import ZeroOffset, offset_note
+from training.zero_offset import offset_note
 
 MAX_RATE_HZ = 10_000.0
 MAX_SAMPLES = 10_000
@@ -139,14 +139,14 @@ def repaired(window: Window) -> tuple[Window, dict[str, int]]:
 
 
 def prepare(
-    window: Window, actuator: ActuatorParams = ActuatorParams(), spec_only: bool = False, zero: ZeroOffset | None = None
+    window: Window, actuator: ActuatorParams = ActuatorParams(), spec_only: bool = False, known: Known | None = None
 ) -> Prepared:
     """Repair ``window``'s glitches, average it down to the pipeline's sizes, check its signals agree
     (``training.consistency``: InputError naming the field), put its sensors on one clock
     (``training.alignment``), read what it shows beyond ``actuator`` (``training.departures``) and weigh
     whether its hinge moment is out of step (``training.step_lag``); say what it found. ``spec_only``
     skips the departures and the step: ``calibration`` reads the spec's model alone and names what departs.
-    ``zero``: the sensors' zero a window of the same flight read, for a window moving one way."""
+    ``known``: what other windows of the actuator read (``departures.read_departures``)."""
     window, glitches = repaired(window)
     factor = averaging_factor(window.n_samples, window.sample_rate_hz)
     command = window.signals["command_deg"]
@@ -158,7 +158,11 @@ def prepare(
     consistent = check_consistency(window, actuator)
     window, lags = aligned(window)
     aircraft = check_against_aircraft(window)
-    read = Departures(window, aircraft=aircraft) if spec_only else read_departures(window, actuator, aircraft, zero)
+    read = (
+        Departures(window, aircraft=aircraft)
+        if spec_only
+        else read_departures(window, actuator, aircraft, known or Known())
+    )
     rate = read.window.sample_rate_hz * factor
     # with the departures left in, a lag fits what they leave (an offset: ln LR 105): the story is no test there
     step = StepLag() if spec_only else step_lag(read.window, read.actuator)
@@ -194,6 +198,8 @@ def conditioning_done(prepared: Prepared) -> dict[str, Any]:
         "current_offset_a": prepared.departures.offset.current_a,
         "torque_scale": prepared.departures.drive.torque_factor,
         "inertia_factor": prepared.departures.drive.inertia_factor,
+        "inertia_from": list(prepared.departures.inertia_from) or None,
+        "inertia_undecided": prepared.departures.drive.alternative is not None,
         "viscous_factor": prepared.departures.viscosity.factor,
         "hinge_gain": prepared.departures.hinge.gain * aircraft.factor,
         "hinge_aircraft_ratio": aircraft.ratio if aircraft.readable else None,
@@ -225,6 +231,7 @@ def conditioning_notes(prepared: Prepared) -> list[str]:
         kinematics_note(prepared.consistency),
         offset_note(prepared.departures.offset),
         drive_constants_note(prepared.departures.drive),
+        history_note(prepared.departures),
         hinge_gain_note(prepared.departures.hinge),
         aircraft_note(prepared.departures.aircraft),
         viscosity_note(prepared.departures.viscosity),

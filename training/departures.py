@@ -34,6 +34,19 @@ from training.reproduction import CLEAR_MARGIN, MAX_RATIO, following_error
 from training.viscosity import Viscosity, read_viscosity
 from training.zero_offset import ZeroOffset, read_zero_offset, zeroed
 
+# A reading agrees with the J_M an actuator's history holds where it lies within this many stds of it.
+AGREES_Z = 3.0
+
+
+@dataclass(frozen=True)
+class Known:
+    """What other windows of the actuator read that this one may not (``documents.HistoryReadings``)."""
+
+    zero: ZeroOffset | None = None  # the sensor zero of its flight
+    inertia_factor: float | None = None  # its J_M over the spec's ...
+    inertia_std: float = 0.0
+    inertia_from: tuple[str, ...] = ()  # ... and the windows that read it
+
 
 @dataclass(frozen=True)
 class Departures:
@@ -43,6 +56,7 @@ class Departures:
     viscosity: Viscosity = field(default_factory=Viscosity)
     hinge: HingeGain = field(default_factory=HingeGain)
     aircraft: AircraftCheck = field(default_factory=AircraftCheck)
+    inertia_from: tuple[str, ...] = ()  # γ or ΔJ undecided by the window: the windows whose J_M decided
 
     @property
     def actuator(self) -> ActuatorParams:
@@ -60,11 +74,13 @@ def read_departures(
     window: Window,
     actuator: ActuatorParams = ActuatorParams(),
     aircraft: AircraftCheck = AircraftCheck(),
-    zero: ZeroOffset | None = None,
+    known: Known = Known(),
 ) -> Departures:
     """The window corrected for what it shows beyond ``actuator``, and what that was (module docstring);
-    its hinge moment's gain divided out first where the ``aircraft`` reads one; ``zero``: the sensors' zero
-    of the same flight, for a window that moves one way (``zero_offset.read_zero_offset``)."""
+    its hinge moment's gain divided out first where the ``aircraft`` reads one; what other windows of the
+    actuator read (``known``): the sensors' zero of its flight (``zero_offset.read_zero_offset``), its J_M
+    where the window cannot tell a heavier rotor from a weaker motor (``_by_history``)."""
+    zero = known.zero
     aircraft = divided_out(aircraft)
     window = aircraft.corrected(window)
     offset = read_zero_offset(window, actuator, zero)
@@ -77,7 +93,7 @@ def read_departures(
     if drive.alternative is None:
         return read
     other = _along(window, offset, drive.alternative, hinge, aircraft, zero)
-    told = _told_apart(window, read, other)
+    told = _told_apart(window, read, other) or _by_history(read, other, known)
     if told is not None:
         return replace(told, drive=replace(told.drive, alternative=None))
     mine, theirs = read.answer, other.answer
@@ -113,6 +129,23 @@ def _told_apart(window: Window, scale: Departures, inertia: Departures) -> Depar
     return scale if errors[0] * (1.0 + CLEAR_MARGIN) < errors[1] else None
 
 
+def _by_history(scale: Departures, inertia: Departures, known: Known) -> Departures | None:
+    """Of γ's reading and ΔJ's, which the window cannot tell apart, the one whose J_M agrees with the
+    actuator's (``known``, read by windows that could: ``AGREES_Z``) where the other does not; else None.
+    J_M stays with the build, k_T moves with the magnets' temperature."""
+    factor = known.inertia_factor
+    if factor is None:
+        return None
+
+    def z(read: Departures) -> float:
+        drive = read.drive
+        std = drive.stds.get("inertia_kgm2", 0.0) / drive.spec.inertia_kgm2
+        return abs(drive.inertia_factor - factor) / float(np.hypot(std, known.inertia_std))
+
+    agree = [read for read in (scale, inertia) if z(read) <= AGREES_Z]
+    return replace(agree[0], inertia_from=known.inertia_from) if len(agree) == 1 else None
+
+
 def _along(
     window: Window,
     offset: ZeroOffset,
@@ -133,3 +166,17 @@ def _along(
         window = hinge.corrected(window)
     aircraft = banded(aircraft, window, hinge.gain, drive.actuator)
     return Departures(window, offset, drive, read_viscosity(window, drive.actuator), hinge, aircraft)
+
+
+def history_note(read: Departures) -> str | None:
+    """Where the actuator's J_M decided between γ and ΔJ, in words for the result's notes; or None."""
+    if not read.inertia_from:
+        return None
+    windows = ", ".join(read.inertia_from[:3]) + (
+        f" and {len(read.inertia_from) - 3} more" if len(read.inertia_from) > 3 else ""
+    )
+    chosen = "a heavier rotor" if read.drive.inertia_kgm2 else "the motor's torque per k_T·I"
+    return (
+        "the window alone could not tell a heavier rotor from a weaker motor; the actuator's J_M as windows that "
+        f"could read it ({windows}) decided for {chosen}"
+    )

@@ -97,6 +97,23 @@ class SensorZero(Document):
     torque_std_nm: float = Field(ge=0, description="its std, as a constant torque at the motor shaft")
 
 
+class InertiaReading(Document):
+    """J_M as windows of an actuator read it where each told a heavier rotor from a weaker motor itself
+    (``training.drive_constants``): a window that cannot is read with it (J_M stays with the build)."""
+
+    factor: float = Field(description="the inertia at the motor shaft over the spec's J_M")
+    std: float = Field(ge=0, description="its std")
+    window_ids: list[str] = Field(description="the windows that read it")
+
+
+class HistoryReadings(Document):
+    """What other windows of an actuator read that one window may not: the sensor zero of its flight
+    (``flight_id``) and the actuator's J_M. The service takes them from its history."""
+
+    sensor_zero: SensorZero | None = None
+    inertia: InertiaReading | None = None
+
+
 class WindowInfo(Document):
     n_samples: int
     duration_s: float
@@ -153,7 +170,21 @@ class WindowInfo(Document):
         "(null: it moves one way itself, or was read with the spec's model alone)",
     )
     sensor_zero_from: str | None = Field(
-        default=None, description="it moves one way: the window of its flight whose sensor_zero it was read with"
+        default=None, description="the window of its flight whose sensor_zero it was read with (null: its own)"
+    )
+    inertia_read: InertiaReading | None = Field(
+        default=None,
+        description="J_M as this window read it, where it told a heavier rotor from a weaker motor itself (null: "
+        "it read none, or could not tell)",
+    )
+    inertia_undecided: bool = Field(
+        default=False,
+        description="it could not tell a heavier rotor from a weaker motor, nor did a J_M read by other windows of "
+        "the actuator decide: its stds carry both readings",
+    )
+    inertia_from: list[str] | None = Field(
+        default=None,
+        description="it could not tell a heavier rotor from a weaker motor: the windows whose J_M (history) decided",
     )
 
 

@@ -30,14 +30,14 @@ from training.baseline import FIT_ARRAYS, FrictionFit, fit_friction, fit_window
 from training.conditioning import prepare, widened
 from training.config import PipelineConfig
 from training.dataset import Data, simulate_dataset
-from training.documents import Estimate, FitCheck, SensorZero
+from training.documents import Estimate, FitCheck, HistoryReadings
 from training.estimator import NetworkEstimator
+from training.history import known_from
 from training.network import TrainConfig
 from training.preprocess import as_read
 from training.reproduction import MAX_RATIO, output_error_ratios
 from training.result import estimate_document
 from training.static_friction import read_static_friction
-from training.zero_offset import ZeroOffset
 
 # On a few dozen noisy simulations the network stops improving within a few epochs, and the physics fit
 # carries most of the answer (training.assess): the thesis's 12 failures and 1000 epochs made its time
@@ -98,31 +98,22 @@ def fit_check(window: Window, data: Data, answer: Assessed, equation_ratio: floa
     )
 
 
-def carried_zero(zero: SensorZero | None) -> ZeroOffset | None:
-    """A window's ``sensor_zero`` as conditioning takes it off a one-way window of the same flight."""
-    if zero is None:
-        return None
-    return ZeroOffset(
-        hinge_nm=zero.hinge_nm, current_a=zero.current_a, zero_std_nm=zero.torque_std_nm, carried_from=zero.window_id
-    )
-
-
 def estimate_window(
     window: Window,
     config: PipelineConfig = PipelineConfig(),
     on_stage: Callable[[str], None] | None = None,
     spec_only: bool = False,
-    sensor_zero: SensorZero | None = None,
+    history: HistoryReadings | None = None,
 ) -> Estimate:
     """The ``ema-estimate/1`` result for one window; ``on_stage`` hears each stage as it starts (and may
     raise to stop the job there); ``spec_only`` reads the window with the spec's model alone, no offset
-    (``calibration``'s base); ``sensor_zero``: the zero a window of the same flight read moving both ways,
-    taken off this one where it moves one way. Raises InputError (field ``signals``) for a window with too
-    little sliding motion.
+    (``calibration``'s base); ``history``: what other windows of the actuator read that this one may not
+    (its flight's sensor zero, its J_M: ``training.departures``). Raises InputError (field ``signals``) for a
+    window with too little sliding motion.
     """
     stage = on_stage or (lambda _: None)
     clock = [time.perf_counter()]
-    prepared = prepare(window, spec_only=spec_only, zero=carried_zero(sensor_zero))
+    prepared = prepare(window, spec_only=spec_only, known=known_from(history))
     w, n = prepared.window, config.n_simulations
     seen = replace(w, signals=as_read(w.signals, w.sample_rate_hz))
     physics = fit_window(seen.signals, w.sample_rate_hz, prepared.actuator)

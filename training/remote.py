@@ -14,19 +14,19 @@ from sim.checks import InputError
 from sim.window import Window, window_from_dict, window_to_dict
 from training import runtime
 from training.config import PipelineConfig
-from training.documents import Estimate, SensorZero
+from training.documents import Estimate, HistoryReadings
 from training.pipeline import estimate_window
 
 
 def estimate_document(
-    window: dict[str, Any], config: dict[str, Any], threads: int, sensor_zero: dict[str, Any] | None = None
+    window: dict[str, Any], config: dict[str, Any], threads: int, history: dict[str, Any] | None = None
 ) -> dict[str, Any]:
     """The estimate of one window as a JSON-able dict, or {"error": ...} for a window refused as bad input;
-    ``sensor_zero``: its flight's (``estimate_window``)."""
+    ``history``: what other windows of the actuator read (``estimate_window``)."""
     runtime.configure(threads)
-    zero = None if sensor_zero is None else SensorZero.model_validate(sensor_zero)
+    known = None if history is None else HistoryReadings.model_validate(history)
     try:
-        result = estimate_window(window_from_dict(window), PipelineConfig(**config), sensor_zero=zero)
+        result = estimate_window(window_from_dict(window), PipelineConfig(**config), history=known)
     except InputError as exc:
         return {"error": str(exc)}
     return result.model_dump(mode="json", by_alias=True)
@@ -52,13 +52,13 @@ def connect(address: str | None, cpus: int) -> None:
 
 
 def estimate_on_ray(
-    window: Window, config: PipelineConfig, threads: int, sensor_zero: SensorZero | None = None
+    window: Window, config: PipelineConfig, threads: int, history: HistoryReadings | None = None
 ) -> Estimate:
     """``estimate_window`` run as a Ray task (the service's EMA_BACKEND=ray); blocks this thread until done."""
     import ray
 
-    zero = None if sensor_zero is None else sensor_zero.model_dump()
-    answer = ray.get(ray_task(threads).remote(window_to_dict(window), config.model_dump(), threads, zero))
+    known = None if history is None else history.model_dump()
+    answer = ray.get(ray_task(threads).remote(window_to_dict(window), config.model_dump(), threads, known))
     if "error" in answer:
         field, _, message = answer["error"].partition(": ")
         raise InputError(field, message)

@@ -20,6 +20,7 @@ from training.documents import (
     Estimate,
     Estimates,
     FitCheck,
+    InertiaReading,
     RatioEstimate,
     SensorZero,
     Timings,
@@ -90,10 +91,14 @@ def _notes(prepared: Prepared, physics: FrictionFit, estimates: Estimates, check
 
 def _window_info(prepared: Prepared, data: Data) -> WindowInfo:
     """The window as logged, and what conditioning did to it."""
-    w, offset = prepared.window, prepared.departures.offset
+    w, offset, drive = prepared.window, prepared.departures.offset, prepared.departures.drive
     zero = SensorZero(
         window_id=w.window_id, hinge_nm=offset.hinge_nm, current_a=offset.current_a, torque_std_nm=offset.zero_std_nm
     )
+    inertia = None
+    if drive.inertia_kgm2 and not prepared.departures.inertia_from:  # told apart from γ by the window itself
+        std = drive.stds["inertia_kgm2"] / drive.spec.inertia_kgm2
+        inertia = InertiaReading(factor=drive.inertia_factor, std=std, window_ids=[w.window_id])
     return WindowInfo(
         n_samples=prepared.original_samples,
         duration_s=prepared.original_samples / prepared.original_rate_hz,
@@ -106,6 +111,7 @@ def _window_info(prepared: Prepared, data: Data) -> WindowInfo:
         flight_id=w.flight_id,
         sensor_zero=zero if offset.read else None,
         sensor_zero_from=offset.carried_from,
+        inertia_read=inertia,
     )
 
 

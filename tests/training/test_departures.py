@@ -3,9 +3,11 @@
 import pytest
 
 from sim.window import window_from_dict
-from tests.foreign.windows import Effects, draw, worn
+from tests.foreign.windows import Effects, draw, of_the_same_flight, worn
 from training.baseline import fit_window
 from training.conditioning import prepare, widened
+from training.documents import HistoryReadings, InertiaReading
+from training.history import known_from
 from training.preprocess import as_read
 
 
@@ -31,3 +33,27 @@ def test_a_heavier_inertia_is_told_from_a_weaker_motor_where_the_replay_follows_
     prepared = prepare(window_from_dict(drawn.document))
     assert prepared.departures.drive.alternative is None and prepared.departures.drive.torque_scale == 0.0
     assert prepared.departures.drive.inertia_factor == pytest.approx(1.09, abs=0.003)
+
+
+# Foreign windows that cannot tell J_M 1.08x from k_T 0.94x (``drive.alternative`` set on either).
+UNDECIDED = [(401, "cruise"), (403, "doublet"), (407, "gust"), (419, "steps"), (436, "cruise")]
+
+
+def _drive(drawn, inertia: InertiaReading | None = None):
+    return prepare(window_from_dict(drawn.document), known=known_from(HistoryReadings(inertia=inertia))).departures
+
+
+@pytest.mark.parametrize(("seed", "family"), UNDECIDED)
+def test_the_actuators_j_m_read_by_a_window_that_could_decides_where_this_one_cannot(seed, family):
+    heavier = draw(seed, family, effects=Effects(inertia_factor=1.08))
+    assert _drive(heavier).drive.alternative is not None  # alone, undecided
+    thesis = prepare(window_from_dict(of_the_same_flight(heavier, seed + 1000, "thesis", 0.5).document)).departures
+    read = thesis.drive.inertia_factor, thesis.drive.stds["inertia_kgm2"] / thesis.drive.spec.inertia_kgm2
+    assert read[0] == pytest.approx(1.08, abs=0.003)  # a thesis window tells them apart (the replay)
+    decided = _drive(heavier, InertiaReading(factor=read[0], std=read[1], window_ids=["thesis"]))
+    assert decided.drive.alternative is None and decided.inertia_from == ("thesis",)
+    assert decided.drive.inertia_factor == pytest.approx(1.08, abs=0.005) and decided.drive.torque_scale == 0.0
+    weaker = draw(seed, family, effects=Effects(torque_constant_gain=0.94))  # J_M the spec's, the motor weaker
+    spec = _drive(weaker, InertiaReading(factor=1.0, std=0.001, window_ids=["w"]))
+    assert spec.drive.alternative is None and spec.drive.torque_factor == pytest.approx(0.94, abs=0.005)
+    assert _drive(weaker, InertiaReading(factor=1.08, std=0.001, window_ids=["w"])).drive.alternative is not None

@@ -9,7 +9,7 @@ from sim.synthetic import synthetic_window
 from sim.window import window_from_dict
 from tests.foreign.windows import NOISE, Effects, draw, filter_widths, noisy, of_the_same_flight, through_filters, worn
 from training.config import PipelineConfig
-from training.documents import Estimate
+from training.documents import Estimate, HistoryReadings
 from training.pipeline import estimate_window
 from training.result import share_of_range
 
@@ -234,12 +234,29 @@ def test_a_window_moving_one_way_is_answered_with_the_zero_its_flight_read(seed,
     both = of_the_same_flight(one_way, seed + 1000)
     zero = _estimate(both).window.sensor_zero
     assert zero is not None and zero.window_id == both.document["window_id"]
-    result = estimate_window(window_from_dict(one_way.document), SMALL, sensor_zero=zero)
+    result = estimate_window(window_from_dict(one_way.document), SMALL, history=HistoryReadings(sensor_zero=zero))
     assert result.window.sensor_zero is None and result.window.sensor_zero_from == zero.window_id
     assert any("of the same flight read moving both ways" in note for note in result.notes)
     of_range, z = _errors(result, one_way.truth)["FDJ"]
     assert of_range < 3.0 and z < 2.0 and not result.estimates.FDJ.weakly_determined
     assert _estimate(one_way).estimates.FDJ.weakly_determined
+
+
+@pytest.mark.parametrize(("seed", "family"), [(403, "doublet"), (419, "steps")])
+def test_a_window_that_cannot_tell_j_m_from_k_t_is_answered_with_the_actuators_j_m(seed, family):
+    """J_M 1.08x: alone, the window reads a weaker motor as likely, FDJ far off and said weak; a thesis
+    window of the actuator (a pre-flight check) reads J_M, which decides."""
+    heavier = draw(seed, family, effects=Effects(inertia_factor=1.08))
+    inertia = _estimate(of_the_same_flight(heavier, seed + 1000, "thesis", 0.5)).window.inertia_read
+    assert inertia is not None and inertia.factor == pytest.approx(1.08, abs=0.003)
+    alone = _estimate(heavier)
+    assert alone.window.inertia_undecided and alone.estimates.FDJ.weakly_determined
+    result = estimate_window(window_from_dict(heavier.document), SMALL, history=HistoryReadings(inertia=inertia))
+    assert result.window.inertia_from == inertia.window_ids and not result.window.inertia_undecided
+    assert result.window.inertia_read is None  # decided by the history, not read: it does not count twice
+    assert any("decided for a heavier rotor" in note for note in result.notes)
+    for name, (of_range, z) in _errors(result, heavier.truth).items():
+        assert of_range < 3.0 and z < 2.0, name
 
 
 def test_a_network_that_disagrees_with_the_window_is_set_aside(monkeypatch):

@@ -9,8 +9,8 @@ import pytest
 from sim.window import window_from_dict
 from tests.foreign.windows import Draw, Effects, draw, of_the_same_flight
 from training.conditioning import prepare
-from training.documents import SensorZero
-from training.pipeline import carried_zero
+from training.documents import HistoryReadings, SensorZero
+from training.history import known_from
 from training.zero_offset import ZeroOffset
 
 FAMILIES = ("thesis", "cruise", "gust", "doublet", "steps")
@@ -66,6 +66,10 @@ def sensor_zero(offset: ZeroOffset, window_id: str) -> SensorZero:
     )
 
 
+def carried_zero(zero: SensorZero):
+    return known_from(HistoryReadings(sensor_zero=zero))
+
+
 @pytest.mark.parametrize(
     ("effects", "torque_nm"),
     [(Effects(current_bias_a=0.2), 0.2 * TORQUE_CONSTANT), (Effects(hinge_bias_nm=-6.0), -6.0 / GEAR)],
@@ -76,7 +80,7 @@ def test_a_window_moving_one_way_takes_off_the_zero_its_flight_read(effects, tor
         read = prepare(window_from_dict(both.document)).departures.offset
         assert read.read and _torque_nm(read) == pytest.approx(torque_nm, rel=0.05)
         offset = prepare(
-            window_from_dict(one_way.document), zero=carried_zero(sensor_zero(read, "w"))
+            window_from_dict(one_way.document), known=carried_zero(sensor_zero(read, "w"))
         ).departures.offset
         assert offset.one_way and offset.carried_from == "w"
         assert _torque_nm(offset) == pytest.approx(_torque_nm(read)) and offset.spread["FDJ"] == read.zero_std_nm
@@ -91,11 +95,11 @@ def test_a_window_moving_both_ways_takes_its_flights_zero_where_it_holds(seed, f
     cruise = prepare(window_from_dict(of_the_same_flight(both, seed + 1000).document)).departures.offset
     alone = prepare(window_from_dict(both.document)).departures.offset
     assert alone.read and cruise.zero_std_nm < alone.zero_std_nm
-    with_flight = prepare(window_from_dict(both.document), zero=carried_zero(sensor_zero(cruise, "w"))).departures
+    with_flight = prepare(window_from_dict(both.document), known=carried_zero(sensor_zero(cruise, "w"))).departures
     assert with_flight.offset.carried_from == "w" and not with_flight.offset.read
     assert _torque_nm(with_flight.offset) == pytest.approx(0.1 * TORQUE_CONSTANT, rel=0.05)
     drifted = carried_zero(SensorZero(window_id="w", hinge_nm=0.0, current_a=0.05, torque_std_nm=1e-5))
-    unheld = prepare(window_from_dict(both.document), zero=drifted).departures.offset
+    unheld = prepare(window_from_dict(both.document), known=drifted).departures.offset
     assert (
         unheld.unheld_from == "w"
         and unheld.carried_from is None
