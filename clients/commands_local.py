@@ -25,32 +25,39 @@ SIMULATE_FLAGS = {
 }
 
 
-def sensor_zero_of(path: Path) -> Any:
-    """The ``window.sensor_zero`` of the ema-estimate/1 result in ``path``; InputError naming --zero-from."""
+def history_of(window: Any, paths: tuple[Path, ...]) -> Any:
+    """What the ema-estimate/1 results in ``paths``, of other windows of ``window``'s actuator, read that it may
+    not (``training.history``); InputError naming --history."""
     from pydantic import ValidationError
 
     from sim.checks import InputError
     from training.documents import Estimate
+    from training.history import readings_of
 
-    try:
-        result = Estimate.model_validate_json(path.read_bytes())
-    except (OSError, ValidationError) as exc:
-        first = str(exc).splitlines()[0]
-        raise InputError("--zero-from", f"{path} is not an ema-estimate/1 result ({first})") from None
-    if result.window.sensor_zero is None:
-        raise InputError("--zero-from", f"{path}: window {result.window_id} read no sensor zero (it moves one way)")
-    return result.window.sensor_zero
+    results = []
+    for path in paths:
+        try:
+            result = Estimate.model_validate_json(path.read_bytes())
+        except (OSError, ValidationError) as exc:
+            first = str(exc).splitlines()[0]
+            raise InputError("--history", f"{path} is not an ema-estimate/1 result ({first})") from None
+        if result.actuator_id != window.actuator_id:
+            raise InputError(
+                "--history", f"{path} is of actuator {result.actuator_id}, the window of {window.actuator_id}"
+            )
+        results.append(result)
+    return readings_of([result.window for result in results], window.flight_id)
 
 
 @click.command()
 @click.argument("window", type=EXISTING)
-@click.option("--zero-from", "zero_from", type=EXISTING, metavar="RESULT.json",
-              help="the ema-estimate/1 result of a window of the same flight moving both ways: its sensors' zero "
-              "is taken off this window where it moves one way")  # fmt: skip
+@click.option("--history", "history", type=EXISTING, multiple=True, metavar="RESULT.json",
+              help="the ema-estimate/1 result of another window of the actuator (repeatable): J_M where it read one, "
+              "its sensors' zero where it is of the window's flight_id")  # fmt: skip
 @sizes
 @threads
 @as_json
-def estimate(window: Path, zero_from: Path | None, threads: int | None, as_json: bool, **size_values: int) -> None:
+def estimate(window: Path, history: tuple[Path, ...], threads: int | None, as_json: bool, **size_values: int) -> None:
     """Estimate FDJ, η_O, η_A (FSJ where it shows) of one ema-window/1 JSON file, in-process."""
     from clients.printing import print_estimate
     from sim.window import read_window
@@ -58,9 +65,10 @@ def estimate(window: Path, zero_from: Path | None, threads: int | None, as_json:
     from training.pipeline import estimate_window
 
     config = pipeline_config(size_values)
-    zero = None if zero_from is None else sensor_zero_of(zero_from)
+    read = read_window(window)
+    known = history_of(read, history) if history else None
     runtime.configure(threads)
-    result = estimate_window(read_window(window), config, on_stage=progress, sensor_zero=zero)
+    result = estimate_window(read, config, on_stage=progress, history=known)
     emit(result, as_json, print_estimate)
 
 

@@ -5,9 +5,10 @@ thread budget (one thread by default: a worker is a core, so throughput grows wi
 results are written as they complete (``ray.wait``), the CSV is
 the checkpoint (a rerun skips what it holds, so a crash never duplicates a window), and the same
 rows can go into a service's SQLite history (idempotent as well). Without Ray and with one
-worker the archive is processed in this process, one window after another. A window of a named
-flight that moves one way is answered last, with the sensor zero the most precise window of its
-flight read (``training.zero_offset``), as the service answers it after its flight's windows.
+worker the archive is processed in this process, one window after another. A window that lacks
+what other windows of its actuator read (a one-way window, its flight's sensor zero; one that cannot
+tell a heavier rotor from a weaker motor, J_M) is answered again at the end with what they read
+(``training.history``), as the service answers it from its history.
 """
 
 from __future__ import annotations
@@ -42,14 +43,14 @@ class Progress:
               f"{rate:.2f} windows/s, {(self.total - self.done) / rate:.0f} s left", file=sys.stderr)  # fmt: skip
 
 
-Job = tuple[Window, dict[str, Any] | None]  # a window and its flight's sensor zero (``window.sensor_zero``), if known
+Job = tuple[Window, dict[str, Any] | None]  # a window and what other windows of its actuator read (HistoryReadings)
 
 
 def _in_process(jobs: list[Job], config: PipelineConfig, threads: int) -> Iterator[tuple[Window, dict]]:
     from training.remote import estimate_document
 
-    for window, zero in jobs:
-        yield window, estimate_document(window_to_dict(window), config.model_dump(), threads, zero)
+    for window, history in jobs:
+        yield window, estimate_document(window_to_dict(window), config.model_dump(), threads, history)
 
 
 def _on_ray(jobs: list[Job], config: PipelineConfig, workers: int, threads: int,
@@ -64,40 +65,51 @@ def _on_ray(jobs: list[Job], config: PipelineConfig, workers: int, threads: int,
     queue = list(reversed(jobs))
     while queue or pending:
         while queue and len(pending) < IN_FLIGHT_PER_WORKER * workers:
-            window, zero = queue.pop()
-            pending[task.remote(window_to_dict(window), config.model_dump(), threads, zero)] = window
+            window, history = queue.pop()
+            pending[task.remote(window_to_dict(window), config.model_dump(), threads, history)] = window
         ready, _ = ray.wait(list(pending), num_returns=1)
         for reference in ready:
             yield pending.pop(reference), ray.get(reference)
 
 
-def _waits_for_its_flight(window: Window, answer: dict[str, Any]) -> bool:
-    """A window of a named flight that read no sensor zero (it moves one way) and was given none."""
+def _wants(window: Window, answer: dict[str, Any]) -> set[str]:
+    """What the window could not read and other windows of its actuator may have: its flight's sensor zero
+    (it moves one way), J_M (it could not tell a heavier rotor from a weaker motor)."""
     read = answer.get("window", {})
-    unread = read.get("sensor_zero") is None and read.get("sensor_zero_from") is None
-    return window.flight_id is not None and "error" not in answer and unread
+    wants = set()
+    if window.flight_id is not None and read.get("sensor_zero") is None and read.get("sensor_zero_from") is None:
+        wants.add("sensor_zero")
+    if read.get("inertia_undecided"):
+        wants.add("inertia")
+    return wants if "error" not in answer else set()
 
 
-def _with_flight_zeros(
+def _with_history(
     first: Iterator[tuple[Window, dict]], again: Callable[[list[Job]], Iterator[tuple[Window, dict]]]
 ) -> Iterator[tuple[Window, dict]]:
-    """The answers of ``first``; a window that waits for its flight (``_waits_for_its_flight``) held back and,
-    where a window of its flight read a sensor zero, answered ``again`` with the most precise (as the service
+    """The answers of ``first``; a window that wants what other windows of its actuator read (``_wants``)
+    held back and, where they read it, answered ``again`` with it (``training.history``, as the service
     reads it from its history)."""
+    from training.documents import WindowInfo
+    from training.history import readings_of
+
     held: list[tuple[Window, dict]] = []
-    zeros: dict[tuple[str, str], dict[str, Any]] = {}
+    read: dict[str, list[WindowInfo]] = {}
     for window, answer in first:
-        if _waits_for_its_flight(window, answer):
+        if _wants(window, answer):
             held.append((window, answer))
             continue
-        zero = answer.get("window", {}).get("sensor_zero")
-        key = (window.actuator_id, str(window.flight_id))
-        if zero is not None and (key not in zeros or zero["torque_std_nm"] < zeros[key]["torque_std_nm"]):
-            zeros[key] = zero
+        if "error" not in answer:
+            read.setdefault(window.actuator_id, []).append(WindowInfo.model_validate(answer["window"]))
         yield window, answer
-    known = [(w, zeros.get((w.actuator_id, str(w.flight_id)))) for w, _ in held]
-    yield from ((w, a) for w, a in held if (w.actuator_id, str(w.flight_id)) not in zeros)
-    yield from again([(w, zero) for w, zero in known if zero is not None])
+    jobs: list[Job] = []
+    for window, answer in held:
+        history = readings_of(read.get(window.actuator_id, []), window.flight_id)
+        if any(getattr(history, name) is not None for name in _wants(window, answer)):
+            jobs.append((window, history.model_dump()))
+        else:
+            yield window, answer
+    yield from again(jobs)
 
 
 def run_fleet(windows: list[Window], out: Path, config: PipelineConfig, workers: int, address: str | None,
@@ -112,7 +124,7 @@ def run_fleet(windows: list[Window], out: Path, config: PipelineConfig, workers:
     def engine(jobs: list[Job]) -> Iterator[tuple[Window, dict]]:
         return _in_process(jobs, config, threads) if in_process else _on_ray(jobs, config, workers, threads, address)
 
-    results = _with_flight_zeros(engine([(w, None) for w in todo]), engine)
+    results = _with_history(engine([(w, None) for w in todo]), engine)
     store = _store(database)
     with ResultsWriter(out) as writer:
         for window, answer in results:

@@ -3,8 +3,7 @@
 - Committed (``synchronous=FULL``, WAL) before the answer leaves: an estimate a client has
   received survives a kill -9 of the server or a power loss.
 - Idempotent: the same window posted again returns the stored answer; the trend counts it once.
-- A window's flight: ``sensor_zero`` finds the zero a window of the same flight read, for one that
-  moves one way and cannot read it.
+- What windows read that another may not (``readings``): its flight's sensor zero, the actuator's J_M.
 - Private: the file is created 0600 (SQLite gives its WAL and shared-memory files the same mode).
 - Checked at start: a file that is not an intact SQLite database is refused with the reason,
   never silently replaced (nothing a user stored is lost); ``healthy()`` answers /healthz.
@@ -26,7 +25,8 @@ from typing import Any
 from pydantic import ValidationError
 
 from prognosis.documents import Stored
-from training.documents import Estimate, SensorZero
+from training.documents import Estimate, HistoryReadings, InertiaReading, SensorZero
+from training.history import best_zero, combined_inertia
 
 SCHEMA_SQL = """
 CREATE TABLE IF NOT EXISTS estimates (
@@ -134,17 +134,26 @@ class EstimateStore:
             return None
         return Stored(**json.loads(row[2]), id=row[0], stored_at=row[1], replay=True)
 
-    def sensor_zero(self, actuator_id: str, flight_id: str) -> SensorZero | None:
-        """The most precise sensor zero a stored window of this actuator and flight read, or None
-        (``training.zero_offset``: what a window of the flight that moves one way is read with)."""
+    def readings(self, actuator_id: str, flight_id: str | None) -> HistoryReadings:
+        """What the stored windows of this actuator read that another may not (``training.history``): the
+        most precise sensor zero of the flight, J_M from every window that told it apart."""
+        zeros = [] if flight_id is None else self._column(actuator_id, "sensor_zero", flight_id)
+        inertias = self._column(actuator_id, "inertia_read")
+        return HistoryReadings(
+            sensor_zero=best_zero(SensorZero.model_validate_json(zero) for zero in zeros),
+            inertia=combined_inertia([InertiaReading.model_validate_json(reading) for reading in inertias]),
+        )
+
+    def _column(self, actuator_id: str, name: str, flight_id: str | None = None) -> list[str]:
+        """The non-null ``window.<name>`` of the actuator's stored results (of ``flight_id``'s), oldest first."""
+        field = f"json_extract(result, '$.window.{name}')"  # a field of ours, never a caller's string
+        query = f"SELECT {field} FROM estimates WHERE actuator_id = ? AND {field} IS NOT NULL"
+        arguments = [actuator_id]
+        if flight_id is not None:
+            query += " AND json_extract(result, '$.window.flight_id') = ?"
+            arguments.append(flight_id)
         with self._lock:
-            rows = self._connection.execute(
-                "SELECT json_extract(result, '$.window.sensor_zero') FROM estimates "
-                "WHERE actuator_id = ? AND json_extract(result, '$.window.flight_id') = ?",
-                (actuator_id, flight_id),
-            ).fetchall()
-        zeros = [SensorZero.model_validate_json(row[0]) for row in rows if row[0] is not None]
-        return min(zeros, key=lambda zero: zero.torque_std_nm, default=None)
+            return [row[0] for row in self._connection.execute(query + " ORDER BY id", arguments).fetchall()]
 
     def history(self, actuator_id: str) -> tuple[list[Stored], list[dict[str, Any]]]:
         """Every stored result of one actuator, oldest first; rows of an earlier format apart, as stored."""

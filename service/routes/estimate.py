@@ -42,9 +42,10 @@ async def estimate(
     """Estimate FDJ, η_O, η_A (FSJ where the window shows it) of one window; store and answer.
 
     A window already stored for its (actuator_id, window_id) is answered from the history
-    (``replay: true``) without recomputing. A window that moves one way is read with the sensor zero a
-    stored window of its ``flight_id`` read moving both ways. Budget: the window's duration and its simulation work
-    (simulations × seconds) are limited by the service's settings; over it, 422 naming the limit.
+    (``replay: true``) without recomputing. What the stored windows of the actuator read that this one
+    may not (its ``flight_id``'s sensor zero, the actuator's J_M: ``training.history``) is read with it.
+    Budget: the window's duration and its simulation work (simulations × seconds) are limited by the
+    service's settings; over it, 422 naming the limit.
     """
     with runner.admit() as ticket:
         window = (await parse(WindowDocument, await request.body())).to_window()
@@ -54,14 +55,12 @@ async def estimate(
         sizes = {"n_simulations": n_simulations, "n_timesteps": n_timesteps, "hidden_units": hidden_units}
         config = request_config(settings, **sizes, seed=seed)
         check_budget(window, config, settings)
-        zero = None
-        if window.flight_id is not None:
-            zero = await run_in_threadpool(store.sensor_zero, window.actuator_id, window.flight_id)
+        history = await run_in_threadpool(store.readings, window.actuator_id, window.flight_id)
         if settings.backend == "ray":
             from training.remote import estimate_on_ray
 
-            result = await runner.run(ticket, request.is_disconnected, estimate_on_ray, window, config, 1, zero)
+            result = await runner.run(ticket, request.is_disconnected, estimate_on_ray, window, config, 1, history)
         else:
-            job = partial(estimate_window, on_stage=stopper(ticket.cancel), sensor_zero=zero)
+            job = partial(estimate_window, on_stage=stopper(ticket.cancel), history=history)
             result = await runner.run(ticket, request.is_disconnected, job, window, config)
         return await run_in_threadpool(store.add, result)  # committed (fsync) before the answer leaves

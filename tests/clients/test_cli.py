@@ -72,7 +72,7 @@ def test_estimate_table_and_bad_inputs(tmp_path, capsys):
     assert main(["estimate", str(tmp_path / "missing.json")]) == EXIT_BAD_INPUT
 
 
-def test_estimate_takes_a_flights_sensor_zero_from_a_result_and_names_a_bad_one(tmp_path, capsys):
+def test_estimate_reads_other_windows_results_as_history_and_names_a_bad_one(tmp_path, capsys):
     window, result = tmp_path / "w.json", tmp_path / "r.json"
     main(["simulate", "--out", str(window), "--duration", "0.1"])
     capsys.readouterr()
@@ -80,12 +80,12 @@ def test_estimate_takes_a_flights_sensor_zero_from_a_result_and_names_a_bad_one(
     document = json.loads(capsys.readouterr().out)
     assert document["window"]["sensor_zero"]["window_id"] == document["window_id"]
     result.write_text(json.dumps(document))
-    assert main(["estimate", str(window), *SIZES, "--zero-from", str(result)]) == EXIT_OK
-    document["window"]["sensor_zero"] = None
-    result.write_text(json.dumps(document))
-    for bad in (window, result):  # a window, not a result; a result that read no zero
-        assert main(["estimate", str(window), "--zero-from", str(bad)]) == EXIT_BAD_INPUT
-        assert "--zero-from" in capsys.readouterr().err
+    assert main(["estimate", str(window), *SIZES, "--history", str(result), "--history", str(result)]) == EXIT_OK
+    other = tmp_path / "other.json"
+    other.write_text(json.dumps({**document, "actuator_id": "another/elevator"}))
+    for bad, named in ((window, "is not an ema-estimate/1 result"), (other, "another/elevator")):
+        assert main(["estimate", str(window), "--history", str(bad)]) == EXIT_BAD_INPUT
+        assert "--history" in (err := capsys.readouterr().err) and named in err
 
 
 def test_calibrate_writes_a_figure_and_names_a_bad_truth_file(tmp_path, capsys):

@@ -56,9 +56,10 @@ def test_one_worker_without_ray_runs_in_process(archive, tmp_path, capsys, monke
     assert "[7/7]" in captured.err and "windows/s" in captured.err  # progress: done, rate, time left
 
 
-def test_a_window_moving_one_way_is_answered_with_its_flights_zero(tmp_path, capsys, monkeypatch):
-    """Its file first in the archive, a 0.1 s gust moving one way (current 0.2 A off) waits for the cruise
-    window of its flight; a window of another flight does not take that zero."""
+def test_windows_wanting_what_others_read_are_answered_with_it(tmp_path, capsys, monkeypatch):
+    """Their files first in the archive: a 0.1 s gust moving one way (current 0.2 A off) waits for the cruise
+    window of its flight (a window of another flight does not take that zero), a doublet that cannot tell
+    J_M 1.08x from a weaker motor for the thesis window of its actuator."""
     from clients import fleet
     from service.store import EstimateStore
     from tests.foreign.windows import Effects, draw, of_the_same_flight
@@ -71,12 +72,18 @@ def test_a_window_moving_one_way_is_answered_with_its_flights_zero(tmp_path, cap
     for name, drawn, flight_id in (("a", one_way, "f-1"), ("b", cruise, "f-1"), ("c", one_way, "f-2")):
         document = {**drawn.document, "actuator_id": "tail-9", "flight_id": flight_id, "window_id": name}
         (folder / f"{name}.json").write_text(json.dumps(document))
+    heavier = draw(403, "doublet", effects=Effects(inertia_factor=1.08))
+    for name, drawn in (("d", heavier), ("e", of_the_same_flight(heavier, 1403, "thesis", 0.5))):
+        (folder / f"{name}.json").write_text(json.dumps({**drawn.document, "actuator_id": "tail-8", "window_id": name}))
     arguments = ["fleet", str(folder), "--out", str(tmp_path / "r.csv"), "--workers", "1", "--database", str(database)]
     assert main([*arguments, *SIZES, "--json"]) == EXIT_OK
     answers = {s.window_id: s.window for s in EstimateStore(database).history("tail-9")[0]}
     cruise_pieces = {name for name in answers if name.startswith("b#")}  # the archive's windows are cut
     assert answers["a"].sensor_zero_from in cruise_pieces and answers["c"].sensor_zero_from is None
-    assert f"[{len(answers)}/{len(answers)}]" in capsys.readouterr().err
+    drive = {s.window_id: s.window for s in EstimateStore(database).history("tail-8")[0]}
+    assert drive["d"].inertia_from == ["e"] and not drive["d"].inertia_undecided
+    count = len(answers) + len(drive)
+    assert f"[{count}/{count}]" in capsys.readouterr().err
 
 
 def test_history_plots_a_prognosis_whose_interval_holds_the_truth(tmp_path, capsys):

@@ -50,6 +50,19 @@ def test_a_window_moving_one_way_is_read_with_the_zero_its_flight_stored(client)
     assert client.post("/v1/estimate", json=other_flight).json()["window"]["sensor_zero_from"] is None
 
 
+def test_the_actuators_j_m_read_by_one_window_decides_for_another(client):
+    """J_M 1.08x: a thesis window tells a heavier rotor from a weaker motor, a doublet cannot alone."""
+    doublet = draw(403, "doublet", effects=Effects(inertia_factor=1.08))
+    thesis = of_the_same_flight(doublet, 1403, "thesis", 0.5)
+    for drawn in (thesis, doublet):
+        drawn.document["actuator_id"] = "ac-8/elev"
+    read = client.post("/v1/estimate", json=thesis.document).json()["window"]["inertia_read"]
+    assert read["factor"] == pytest.approx(1.08, abs=0.003) and read["window_ids"] == [thesis.document["window_id"]]
+    answered = client.post("/v1/estimate", json=doublet.document).json()["window"]
+    assert answered["inertia_from"] == read["window_ids"]
+    assert answered["inertia_factor"] == pytest.approx(1.08, abs=0.005)
+
+
 def test_sizes_are_overridable_within_the_services_ceilings(client, document):
     ok = client.post("/v1/estimate?n_simulations=24&hidden_units=5", json=document)
     assert ok.status_code == 200 and ok.json()["dataset"]["n_simulations"] == 24

@@ -71,6 +71,7 @@ def test_the_sensor_zero_is_the_most_precise_of_the_actuators_flight(tmp_path, r
     for args in [("a", "w1", "f", 3e-4), ("a", "w2", "f", 1e-4), ("a", "w3", "f", None), ("a", "w4", "g", 1e-5),
                  ("b", "w5", "f", 1e-6), ("a", "w6", None, 1e-6)]:  # fmt: skip
         stored(*args)
-    assert store.sensor_zero("a", "f").window_id == "w2"
-    assert store.sensor_zero("a", "g").window_id == "w4"
-    assert store.sensor_zero("a", "h") is None and store.sensor_zero("c", "f") is None
+    assert store.readings("a", "f").sensor_zero.window_id == "w2"
+    assert store.readings("a", "g").sensor_zero.window_id == "w4"
+    assert store.readings("a", "h").sensor_zero is None and store.readings("c", "f").sensor_zero is None
+    assert store.readings("a", None).sensor_zero is None
