@@ -26,7 +26,7 @@ from sim import runtime
 from sim.checks import InputError
 from sim.window import window_from_dict
 from tests.foreign.windows import Draw
-from training.documents import SensorZero
+from training.documents import HistoryReadings
 from training.pipeline import estimate_window
 from training.result import HEALTHY_RANGE, WEAK_SHARE_OF_RANGE, share_of_range
 
@@ -34,11 +34,11 @@ RESULTS_MD = Path(__file__).resolve().parent.parent / "docs" / "results.md"
 BOUND = 0.10  # issue 9: no window's error over 10 % of the range
 
 
-def run_one(window: Draw, sensor_zero: SensorZero | None = None) -> dict[str, Any]:
-    """The answer for one window (with its flight's ``sensor_zero``, if given), as errors and z-scores
-    against its truth (or the refusal)."""
+def run_one(window: Draw, history: HistoryReadings | None = None) -> dict[str, Any]:
+    """The answer for one window (with what other windows of its actuator read, if given), as errors and
+    z-scores against its truth (or the refusal)."""
     try:
-        result = estimate_window(window_from_dict(window.document), sensor_zero=sensor_zero)
+        result = estimate_window(window_from_dict(window.document), history=history)
     except InputError as exc:
         return {"refused": str(exc)}
     row: dict[str, Any] = {"seconds": result.timings_s.total}

@@ -17,6 +17,7 @@ from clients.report import write_section
 from sim import runtime
 from sim.window import window_from_dict
 from tests.foreign.windows import Draw, Effects, draw, filter_widths, of_the_same_flight, through_filters
+from training.history import readings_of
 from training.pipeline import estimate_window
 
 FIRST_SEED = 60_000  # apart from foreign_accuracy's 7000–26000 and the tests'
@@ -52,12 +53,16 @@ def _short_drive_off(seed: int) -> Draw:
     return draw(seed, "gust", duration_s=0.1, effects=drive_off(seed))
 
 
-def _with_its_flight(make: Callable[[int], Draw], seed: int) -> dict[str, Any]:
-    """The answer for the window ``make`` draws, with the sensor zero a 1 s cruise window of its flight read
-    (as the service reads a one-way window after a window of its flight_id)."""
+def _after_another(make: Callable[[int], Draw], seed: int, family: str, duration_s: float) -> dict[str, Any]:
+    """The answer for the window ``make`` draws, after a window of ``family`` of its flight (the same actuator,
+    sensors and flight condition) was read: with what that read (``training.history``), as the service
+    answers a window after others of its actuator and flight_id."""
     drawn = make(seed)
-    cruise = of_the_same_flight(drawn, seed + 500_000)
-    return run_one(drawn, estimate_window(window_from_dict(cruise.document)).window.sensor_zero)
+    other = of_the_same_flight(drawn, seed + 500_000, family, duration_s)
+    for document in (drawn.document, other.document):
+        document["flight_id"] = f"flight-{seed}"
+    read = estimate_window(window_from_dict(other.document)).window
+    return run_one(drawn, readings_of([read], f"flight-{seed}"))
 
 
 GROUPS: dict[str, Callable[[int], Draw]] = {
@@ -69,16 +74,20 @@ GROUPS: dict[str, Callable[[int], Draw]] = {
     "J_M 1.04-1.1x the spec's": _heavier_inertia,
     "k_T, current gain or J_M off in a 0.1 s window": _short_drive_off,
 }
-# a group's windows answered again, each after a window of its flight (as the service answers a flight's windows)
-AFTER_ITS_FLIGHT = {"the same, a 1 s window of its flight read first": "a sensor off zero in a 0.1 s window"}
+# A group's windows answered again, each after another window of its flight (its family and duration): as the
+# service answers them once it holds others of the actuator and flight_id.
+AFTER_ANOTHER = {
+    "the same, a 1 s cruise window of its flight read first": ("a sensor off zero in a 0.1 s window", "cruise", 1.0),
+    "J_M 1.04-1.1x, a 0.5 s thesis window of the actuator read first": ("J_M 1.04-1.1x the spec's", "thesis", 0.5),
+}
 
 
 def _rows(name: str, per_group: int) -> list[dict[str, Any]]:
-    """The answers for a group's windows (``GROUPS``, or ``AFTER_ITS_FLIGHT``: the group's windows again)."""
-    group = AFTER_ITS_FLIGHT.get(name, name)
+    """The answers for a group's windows (``GROUPS``, or ``AFTER_ANOTHER``: the group's windows again)."""
+    group, family, duration_s = AFTER_ANOTHER.get(name, (name, "", 0.0))
     seeds = [FIRST_SEED + 1000 * list(GROUPS).index(group) + i for i in range(per_group)]
-    if name in AFTER_ITS_FLIGHT:
-        return [_with_its_flight(GROUPS[group], seed) for seed in seeds]
+    if name in AFTER_ANOTHER:
+        return [_after_another(GROUPS[group], seed, family, duration_s) for seed in seeds]
     return [run_one(GROUPS[name](seed)) for seed in seeds]
 
 
@@ -98,15 +107,17 @@ to (`training.viscosity`: FDJ's ±2 std held the truth in 85 % of the slow logs 
 leaves a short window nothing to lean on, and there FDJ's ±2 std holds the truth less often than
 90 %. Of the 20 short windows 8 move (almost) one way,
 where no offset can be read and FDJ's std carries only one of 0.05 A (these are up to 0.25 A); the
-offset is read in 11 and missed in 1. A drive keeps its sensors' zero for a power-on: the last row
-answers the same windows as the service answers a flight's (`flight_id`), after a 1 s cruise window
+offset is read in 11 and missed in 1. A drive keeps its sensors' zero for a power-on: the next to last
+row answers the same windows as the service answers a flight's (`flight_id`), after a 1 s cruise window
 of their flight (the same actuator, offset and flight condition) was read; its zero is taken off the
 windows moving one way, and off those moving both ways where it is the more precise and holds
 (`training.zero_offset`). *J_M heavier than the spec's*: where the motor saturates as it
 accelerates, a motor k_T·I a few % weaker explains the window about as well, and the likelihood ratio
 does not decide; a replay of the window with each tells them apart only where it follows the drive
 within the noise (thesis windows), and elsewhere γ is read with FDJ's std widened by 0.6 of what
-reading ΔJ would change (`training.departures`): honest, but often weak."""
+reading ΔJ would change (`training.departures`): honest, but often weak. J_M stays with the build: the
+last row answers the same windows after a 0.5 s thesis window of the actuator (a pre-flight check) read
+it, which decides between the two readings where one agrees with it (`training.history`)."""
 
 
 def main() -> None:
@@ -117,7 +128,7 @@ def main() -> None:
     runtime.configure()
     started = time.perf_counter()
     summaries: dict[str, dict[str, Any]] = {}
-    for name in [*GROUPS, *AFTER_ITS_FLIGHT]:
+    for name in [*GROUPS, *AFTER_ANOTHER]:
         summaries[name] = summarize(_rows(name, args.per_group))
         print(f"{name}: {summaries[name]}", flush=True)
     body = "\n".join([
