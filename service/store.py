@@ -38,7 +38,11 @@ CREATE TABLE IF NOT EXISTS estimates (
     UNIQUE (actuator_id, window_id)
 );
 CREATE INDEX IF NOT EXISTS estimates_by_actuator ON estimates (actuator_id, id);
-"""
+CREATE INDEX IF NOT EXISTS estimates_sensor_zeros ON estimates (actuator_id, json_extract(result, '$.window.flight_id'))
+    WHERE json_extract(result, '$.window.sensor_zero') IS NOT NULL;
+CREATE INDEX IF NOT EXISTS estimates_inertia_reads ON estimates (actuator_id, id)
+    WHERE json_extract(result, '$.window.inertia_read') IS NOT NULL;
+"""  # the last two: what ``readings`` looks up before every estimate, found without reading the history
 
 
 class StorageError(Exception):
