@@ -25,7 +25,10 @@ as one. Where the motion goes one way, no offset can be read. A drive keeps its 
 a power-on, so such a window is read with the zero a window of the same flight read moving both
 ways (``carried``: what it took off, FDJ's std carrying that reading's ``zero_std_nm``); where the
 flight has none, FDJ's std carries an offset a sensor may keep unseen (``UNSEEN_CURRENT_OFFSET_A``).
-A note says which.
+A short window moving both ways reads its zero less precisely than a long one of its flight: it takes
+the flight's where that holds on it (``flight_zero``: on foreign 0.1 s gusts FDJ 12 % of range off
+became 1 %, an η_O 2.5 std off 0.1); where it does not, a sensor drifted or the drive was powered up
+again, and the window's own reading stands. A note says which.
 """
 
 from __future__ import annotations
@@ -185,7 +188,7 @@ def zeroed(window: Window, offset: ZeroOffset) -> Window:
 def offset_note(offset: ZeroOffset) -> str | None:
     """The offset in words for the result's notes, or None."""
     if offset.carried_from is not None:
-        why = "a sensor off zero would read as FDJ here" if offset.one_way else "it reads them less precisely"
+        why = "a sensor off zero would read as FDJ here" if offset.one_way else "it reads their zero less precisely"
         return (
             f"the motion goes {'one way' if offset.one_way else 'both ways'}, but {why}: the sensors' zero is the "
             f"one window {offset.carried_from} of the same flight read moving both ways ({offset.hinge_nm:.2f} N·m "
