@@ -114,6 +114,9 @@ def _print_history(stored: Any, prognosis: Any, plot: Path | None) -> None:
     for name, trend in prognosis.sensors.items():
         click.echo(f"{name} now {trend.level:.4g} ± {trend.level_std:.2g}, slope {trend.slope_per_unit:+.3g} "
                    f"± {trend.slope_std:.2g} per unit ({trend.n} windows)")  # fmt: skip
+    if prognosis.inertia is not None:
+        inertia = prognosis.inertia
+        click.echo(f"J_M {inertia.factor:.4f} ± {inertia.std:.2g}x the spec's, as windows that could tell it read it")
     for note in prognosis.notes:
         click.echo(f"note: {note}")
     if plot is not None:

@@ -12,7 +12,7 @@ from typing import Any, Literal
 import numpy as np
 from pydantic import Field
 
-from training.documents import Document, Estimate
+from training.documents import Document, Estimate, InertiaReading
 
 PARAMETERS = ("FDJ", "eta_O", "eta_A")
 
@@ -102,6 +102,11 @@ class Prognosis(Document):
         description="trends of what the windows read of the sensors: hinge_aircraft_ratio, the strain gauge's gain "
         "against the aircraft model (1 where they agree; a level off 1 in every window is the gauge's calibration or "
         "the airframe's C_hδ, a slope the gauge drifting)",
+    )
+    inertia: InertiaReading | None = Field(
+        None,
+        description="the actuator's J_M as its windows that told a heavier rotor from a weaker motor read it: "
+        "what a window that cannot is read with (null: none read one)",
     )
     notes: list[str] = Field(default_factory=list)
 

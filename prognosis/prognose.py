@@ -13,6 +13,7 @@ from prognosis.rul import remaining_life
 from prognosis.trend import fit_trend
 from sim.params import DEFAULT_RANGES, eta_a_from_eta_o
 from training.aircraft_check import TOLERANCE
+from training.history import combined_inertia, inertia_change_note
 
 SENSOR_STDS = 3.0  # stds by which a sensor's level or drift must stand out to be said
 
@@ -61,8 +62,11 @@ def prognose(actuator_id: str, stored: Sequence[Stored], thresholds: Thresholds 
         trends[name] = fit_trend(name, times, values, stds, ids)
         lives[name] = remaining_life(trends[name], *(thresholds or Thresholds()).of(name))
     sensors, said = sensor_trends(stored, times, unit)
+    inertias = [s.window.inertia_read for s in stored if s.window.inertia_read is not None]
+    scatter = inertia_change_note(inertias)
     return Prognosis(actuator_id=actuator_id, time_unit=unit, trends=trends, remaining_life=lives,  # type: ignore[arg-type]
-                     sensors=sensors, notes=([note] if note else []) + said)  # fmt: skip
+                     sensors=sensors, inertia=combined_inertia(inertias),
+                     notes=[n for n in (note, *said, scatter) if n])  # fmt: skip
 
 
 def sensor_trends(stored: Sequence[Stored], times: np.ndarray, unit: str) -> tuple[dict[str, Trend], list[str]]:

@@ -19,6 +19,7 @@ from training.documents import HistoryReadings, InertiaReading, SensorZero, Wind
 from training.zero_offset import ZeroOffset
 
 NAMED_WINDOWS = 10  # the latest windows an actuator's J_M names as read by (all weigh in)
+SCATTER_NOTED = 3.0  # stds (a reading's from the others', or the Birge ratio) from which J_M readings disagree
 
 
 def best_zero(zeros: Iterable[SensorZero]) -> SensorZero | None:
@@ -26,21 +27,75 @@ def best_zero(zeros: Iterable[SensorZero]) -> SensorZero | None:
     return min(zeros, key=lambda zero: zero.torque_std_nm, default=None)
 
 
-def combined_inertia(readings: Sequence[InertiaReading]) -> InertiaReading | None:
-    """J_M of an actuator from its windows' readings, oldest first: their inverse-variance mean, its std
-    scaled by the Birge ratio where they scatter more than their stds allow (a reading's std too small
-    shows in the scatter, not in the answer); or None without one."""
-    if not readings:
-        return None
+def _weighted(readings: Sequence[InertiaReading]) -> tuple[float, float, float]:
+    """(inverse-variance mean, its std, Birge ratio: how many times their stds the readings scatter) of
+    at least one reading (the ratio 1 for one)."""
     factors = np.array([r.factor for r in readings])
     weights = 1.0 / np.maximum([r.std for r in readings], 1e-12) ** 2
     mean = float(np.sum(weights * factors) / np.sum(weights))
-    std = float(1.0 / np.sqrt(np.sum(weights)))
-    if len(readings) > 1:
-        chi2 = float(np.sum(weights * (factors - mean) ** 2))
-        std *= max(1.0, float(np.sqrt(chi2 / (len(readings) - 1))))
-    names = [name for r in readings for name in r.window_ids][-NAMED_WINDOWS:]
-    return InertiaReading(factor=mean, std=std, window_ids=names)
+    chi2 = float(np.sum(weights * (factors - mean) ** 2))
+    birge = float(np.sqrt(chi2 / (len(readings) - 1))) if len(readings) > 1 else 1.0
+    return mean, float(1.0 / np.sqrt(np.sum(weights))), birge
+
+
+def since_change(readings: Sequence[InertiaReading]) -> Sequence[InertiaReading]:
+    """The readings since J_M last changed: split where the two parts' means stand furthest apart, by more
+    than ``SCATTER_NOTED`` stds of them (each std scaled by its part's Birge ratio, so readings that only
+    scatter beyond their stds do not pass for a change), the later part at least two readings; else all."""
+    n = len(readings)
+    if n < 3:
+        return readings
+    factors = np.array([r.factor for r in readings])
+    weights = 1.0 / np.maximum([r.std for r in readings], 1e-12) ** 2
+    sums = [np.cumsum(weights * factors**p) for p in range(3)]  # Σw, Σwf, Σwf² of the first k readings
+
+    def parts(k: np.ndarray, before: bool) -> tuple[np.ndarray, np.ndarray]:
+        s0, s1, s2 = (c[k - 1] if before else c[-1] - c[k - 1] for c in sums)
+        count = k if before else n - k
+        chi2 = np.maximum(s2 - s1**2 / s0, 0.0)
+        birge = np.where(count > 1, np.sqrt(chi2 / np.maximum(count - 1, 1)), 1.0)
+        return s1 / s0, np.maximum(birge, 1.0) / np.sqrt(s0)
+
+    k = np.arange(1, n - 1)  # the later part holds readings k … n−1, two at least
+    (mean_before, std_before), (mean_after, std_after) = parts(k, True), parts(k, False)
+    z = np.abs(mean_after - mean_before) / np.hypot(std_before, std_after)
+    best = int(np.argmax(z))
+    return readings[k[best] :] if z[best] > SCATTER_NOTED else readings
+
+
+def combined_inertia(readings: Sequence[InertiaReading]) -> InertiaReading | None:
+    """J_M of an actuator from its windows' readings, oldest first, since it last changed (``since_change``):
+    their inverse-variance mean, its std scaled by the Birge ratio where they scatter more than their
+    stds allow (a reading's std too small shows in the scatter, not in the answer); or None without one."""
+    if not readings:
+        return None
+    used = since_change(readings)
+    mean, std, birge = _weighted(used)
+    names = [name for r in used for name in r.window_ids][-NAMED_WINDOWS:]
+    return InertiaReading(factor=mean, std=std * max(1.0, birge), window_ids=names)
+
+
+def inertia_change_note(readings: Sequence[InertiaReading]) -> str | None:
+    """A note where an actuator's J_M readings do not agree (J_M stays with the build: a part was replaced,
+    or readings are off): since which window it reads otherwise, or how far they scatter; or None."""
+    if len(readings) < 2:
+        return None
+    used = since_change(readings)
+    if len(used) < len(readings):
+        before = _weighted(readings[: len(readings) - len(used)])[0]
+        return (
+            f"J_M read {before:.3f}x the spec's before window {used[0].window_ids[0]} and {_weighted(used)[0]:.3f}x "
+            f"since ({len(used)} windows): a rotor, screw or gear replaced? The actuator's J_M is read since"
+        )
+    mean, _, birge = _weighted(readings)
+    if birge < SCATTER_NOTED:
+        return None
+    low, high = min(r.factor for r in readings), max(r.factor for r in readings)
+    return (
+        f"the {len(readings)} windows that read J_M read {low:.3f}–{high:.3f}x the spec's, {birge:.1f} times as far "
+        f"apart as their stds allow (a part replaced, or readings gone wrong?): the actuator's J_M ({mean:.3f}) is "
+        "said with its std widened as much"
+    )
 
 
 def readings_of(windows: Iterable[WindowInfo], flight_id: str | None) -> HistoryReadings:

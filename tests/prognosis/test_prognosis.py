@@ -150,3 +150,31 @@ def test_a_strain_gauge_drifting_against_the_aircraft_is_trended_and_said(one_es
     prognosis = prognose("tail-9", history)
     assert prognosis.sensors["hinge_aircraft_ratio"].n == 60
     assert not any("strain gauge" in note for note in prognosis.notes)
+
+
+def test_the_actuators_j_m_is_its_windows_readings_and_a_replaced_part_is_said(one_estimate):
+    from prognosis.prognose import prognose
+    from training.documents import InertiaReading
+
+    def with_reads(factors):
+        n = len(factors)
+        history = _history(one_estimate, [1.0] * n, [0.01] * n, np.arange(n, dtype=float))
+        for i, (stored, factor) in enumerate(zip(history, factors, strict=True)):
+            read = None if factor is None else InertiaReading(factor=factor, std=0.002, window_ids=[stored.window_id])
+            history[i] = stored.model_copy(update={"window": stored.window.model_copy(update={"inertia_read": read})})
+        return prognose("tail-9", history)
+
+    rng = np.random.default_rng(6)
+    steady = [None if i % 3 else float(1.06 + 0.002 * rng.normal()) for i in range(30)]  # every third reads J_M
+    prognosis = with_reads(steady)
+    assert prognosis.inertia.factor == pytest.approx(1.06, abs=0.002) and len(prognosis.inertia.window_ids) == 10
+    assert not any("J_M" in note for note in prognosis.notes)
+    replaced = [None if i % 3 else (1.06 if i < 15 else 1.0) + 0.002 * float(rng.normal()) for i in range(30)]
+    prognosis = with_reads(replaced)  # J_M read 1.06x up to w12, 1.00x from w15 on
+    assert prognosis.inertia.factor == pytest.approx(1.0, abs=0.003) and prognosis.inertia.window_ids[0] == "w15"
+    assert any("before window w15" in note and "replaced" in note for note in prognosis.notes)
+    scattered = [None if i % 3 else 1.06 + 0.01 * float(rng.normal()) for i in range(30)]  # each says ± 0.002
+    prognosis = with_reads(scattered)
+    assert len(prognosis.inertia.window_ids) == 10 and prognosis.inertia.std > 0.002  # no change: all, widened
+    assert any("times as far apart as their stds allow" in note for note in prognosis.notes)
+    assert with_reads([None] * 5).inertia is None

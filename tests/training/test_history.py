@@ -7,7 +7,7 @@ from sim.params import HealthParams
 from sim.synthetic import synthetic_window
 from tests.service.conftest import SMALL
 from training.documents import HistoryReadings, InertiaReading, SensorZero
-from training.history import NAMED_WINDOWS, best_zero, combined_inertia, known_from, readings_of
+from training.history import NAMED_WINDOWS, best_zero, combined_inertia, known_from, readings_of, since_change
 from training.pipeline import estimate_window
 
 
@@ -54,3 +54,12 @@ def test_history_reaches_conditioning_as_read():
     assert known.zero.carried_from == "z" and not known.zero.read
     assert (known.inertia_factor, known.inertia_std, known.inertia_from) == (1.04, 0.002, ("j",))
     assert known_from(None) == known_from(HistoryReadings())
+
+
+def test_j_m_is_read_since_it_last_changed_where_two_readings_say_so():
+    before = [_reading(1.06, 0.002, f"b{i}") for i in range(5)]
+    after = [_reading(1.0, 0.002, f"a{i}") for i in range(3)]
+    assert since_change([*before, *after]) == after  # a part replaced: the readings since
+    assert combined_inertia([*before, *after]).factor == pytest.approx(1.0)
+    alone = [*before, _reading(1.0, 0.002, "a0")]  # one reading against five: replaced, or gone wrong
+    assert since_change(alone) == alone and combined_inertia(alone).std > 0.01
