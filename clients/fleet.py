@@ -96,12 +96,12 @@ def _with_history(
     held: list[tuple[Window, dict]] = []
     read: dict[str, list[WindowInfo]] = {}
     for window, answer in first:
+        if "error" not in answer:  # a window held back may still have read what another wants (a flight's zero)
+            read.setdefault(window.actuator_id, []).append(WindowInfo.model_validate(answer["window"]))
         if _wants(window, answer):
             held.append((window, answer))
-            continue
-        if "error" not in answer:
-            read.setdefault(window.actuator_id, []).append(WindowInfo.model_validate(answer["window"]))
-        yield window, answer
+        else:
+            yield window, answer
     jobs: list[Job] = []
     for window, answer in held:
         history = readings_of(read.get(window.actuator_id, []), window.flight_id)
