@@ -10,7 +10,6 @@ its run; ``known_from`` hands them to conditioning.
 from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
-from dataclasses import replace
 
 import numpy as np
 
@@ -27,11 +26,15 @@ def best_zero(zeros: Iterable[SensorZero]) -> SensorZero | None:
     return min(zeros, key=lambda zero: zero.torque_std_nm, default=None)
 
 
+def _arrays(readings: Sequence[InertiaReading]) -> tuple[np.ndarray, np.ndarray]:
+    """The readings' factors and inverse variances."""
+    return np.array([r.factor for r in readings]), 1.0 / np.maximum([r.std for r in readings], 1e-12) ** 2
+
+
 def _weighted(readings: Sequence[InertiaReading]) -> tuple[float, float, float]:
     """(inverse-variance mean, its std, Birge ratio: how many times their stds the readings scatter) of
     at least one reading (the ratio 1 for one)."""
-    factors = np.array([r.factor for r in readings])
-    weights = 1.0 / np.maximum([r.std for r in readings], 1e-12) ** 2
+    factors, weights = _arrays(readings)
     mean = float(np.sum(weights * factors) / np.sum(weights))
     chi2 = float(np.sum(weights * (factors - mean) ** 2))
     birge = float(np.sqrt(chi2 / (len(readings) - 1))) if len(readings) > 1 else 1.0
@@ -45,9 +48,9 @@ def since_change(readings: Sequence[InertiaReading]) -> Sequence[InertiaReading]
     n = len(readings)
     if n < 3:
         return readings
-    factors = np.array([r.factor for r in readings])
-    weights = 1.0 / np.maximum([r.std for r in readings], 1e-12) ** 2
-    sums = [np.cumsum(weights * factors**p) for p in range(3)]  # Σw, Σwf, Σwf² of the first k readings
+    factors, weights = _arrays(readings)
+    centred = factors - factors.mean()  # the sums' differences below lose no digits to the common 1.0x
+    sums = [np.cumsum(weights * centred**p) for p in range(3)]  # Σw, Σwf, Σwf² of the first k readings
 
     def parts(k: np.ndarray, before: bool) -> tuple[np.ndarray, np.ndarray]:
         s0, s1, s2 = (c[k - 1] if before else c[-1] - c[k - 1] for c in sums)
@@ -116,8 +119,12 @@ def known_from(history: HistoryReadings | None) -> Known:
         return Known()
     zero, inertia, carried = history.sensor_zero, history.inertia, None
     if zero is not None:
-        carried = ZeroOffset(hinge_nm=zero.hinge_nm, current_a=zero.current_a, zero_std_nm=zero.torque_std_nm)
-        carried = replace(carried, carried_from=zero.window_id)
+        carried = ZeroOffset(
+            hinge_nm=zero.hinge_nm,
+            current_a=zero.current_a,
+            zero_std_nm=zero.torque_std_nm,
+            carried_from=zero.window_id,
+        )
     if inertia is None:
         return Known(zero=carried)
     return Known(carried, inertia.factor, inertia.std, tuple(inertia.window_ids))
