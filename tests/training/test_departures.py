@@ -57,3 +57,15 @@ def test_the_actuators_j_m_read_by_a_window_that_could_decides_where_this_one_ca
     spec = _drive(weaker, InertiaReading(factor=1.0, std=0.001, window_ids=["w"]))
     assert spec.drive.alternative is None and spec.drive.torque_factor == pytest.approx(0.94, abs=0.005)
     assert _drive(weaker, InertiaReading(factor=1.08, std=0.001, window_ids=["w"])).drive.alternative is not None
+
+
+@pytest.mark.parametrize(("seed", "family", "factor"), [(702, "doublet", 1.05), (707, "steps", 1.1)])
+def test_on_a_worn_actuator_too_the_j_m_its_thesis_window_read_decides(seed, family, factor):
+    """Worn (FDJ 1.3–2.5x nominal): read alone, FDJ 29 and 65 % of range off; with the thesis window's J_M, right."""
+    heavier = worn(seed, family=family, effects=Effects(inertia_factor=factor))
+    assert _drive(heavier).drive.alternative is not None
+    thesis = prepare(window_from_dict(of_the_same_flight(heavier, seed + 1000, "thesis", 0.5).document)).departures
+    std = thesis.drive.stds["inertia_kgm2"] / thesis.drive.spec.inertia_kgm2
+    decided = _drive(heavier, InertiaReading(factor=thesis.drive.inertia_factor, std=std, window_ids=["thesis"]))
+    assert decided.inertia_from == ("thesis",) and decided.drive.inertia_factor == pytest.approx(factor, abs=0.005)
+    assert abs(decided.answer["FDJ"] - heavier.truth["FDJ"]) < 0.03 * 0.02  # within 3 % of FDJ's range
