@@ -13,6 +13,8 @@ the spec's C or more (a 10 % change at slew is 15 % of FDJ's range). Then every 
 window uses the read C, the fits and the simulations alike, and the stds of FDJ and η_O grow by what
 C's own std moves them (``spread``; its floor, ``READ_ERROR_OF_C``).
 
+Where the speed hardly varies (one way, at slew), ΔC cannot be fitted at all, and the stds carry a C
+``UNSEEN_SHARE`` off the spec's either way, as the offset stage carries an unseen sensor offset there.
 Where the change does not stand out, the window is read with the spec's C, but not as if it had
 shown C to be the spec's: on 1–2 kHz logs with C 1.2–2x, 6 of 40 changes stood 1.3–3.7 stds out, too
 few to read, and FDJ was read 40–95 % of the range high at 6–20 % std (FDJ moves by ~1.4 ranges per
@@ -43,6 +45,10 @@ MIN_CHANGE = 0.1  # of the spec's C
 # mostly low), beyond what its jackknife std, often 0.5 %, said: the reconstruction's bias follows the speed
 # a little. Taken as a floor of C's std, FDJ's ±2 std held the truth in 19 of 20 instead of 16.
 READ_ERROR_OF_C = 0.025
+# Where the speed hardly varies (one way at slew) C·|ω| is FDJ's twin and ΔC cannot be fitted: the stds then
+# carry a C this share of the spec's off, either way (the spread of C over foreign windows a third of them cold,
+# 1.2–2x: 0.30). A one-way 0.1 s gust, C 1.24x, was read FDJ 40 % of range high at 3.8 % std without it.
+UNSEEN_SHARE = 0.3
 CHANGE_BOUNDS_NMS = (-5e-5, 5e-3)  # what the simulator's viscous effect accepts (``sim.effects``)
 VISCOUS_FIT = FitSettings(offset=True, viscous=True)
 # the prior odds of "C is off" where the change does not stand out, and the note's weight (as step_lag's)
@@ -59,6 +65,7 @@ class Viscosity:
     spec_nms: float = ActuatorParams().viscous_nms  # the C_M it was read against
     leaning_nms: float = 0.0  # where no change was read: the ΔC the window leans to, weighed into ``spread``
     leaning_weight: float = 0.0  # the posterior weight of "C is off by ``leaning_nms``"
+    unseen: bool = False  # the window cannot tell C·|ω| from FDJ: ``spread`` carries a C ``UNSEEN_SHARE`` off
 
     @property
     def factor(self) -> float:
@@ -81,8 +88,8 @@ def read_viscosity(window: Window, spec: ActuatorParams = ActuatorParams()) -> V
     seen = as_read(window.signals, rate)
     fitted = fit_friction(seen, rate, spec, VISCOUS_FIT)
     change, std = float(fitted.term("viscous")[0]), float(fitted.term_std("viscous")[0])
-    if not (np.isfinite(change) and std > 0):
-        return Viscosity()
+    if not (np.isfinite(change) and std > 0):  # the speed hardly varies: C·|ω| is FDJ's twin
+        return _unseen(seen, rate, spec)
     stands_out = abs(change) > max(MIN_Z * std, MIN_CHANGE * spec.viscous_nms)
     std = float(np.hypot(std, READ_ERROR_OF_C * spec.viscous_nms))
     if not stands_out:
@@ -101,6 +108,17 @@ def _targets_at(
     return [{name: float(value) for name, value in fit.values().items()} for fit in fits]
 
 
+def _unseen(seen: dict[str, np.ndarray], rate: float, spec: ActuatorParams) -> Viscosity:
+    """The spec's C where the window cannot tell C·|ω| from FDJ, with the stds carrying a change of
+    ``UNSEEN_SHARE`` of it either way (module docstring)."""
+    change = UNSEEN_SHARE * spec.viscous_nms
+    low, high = _targets_at(seen, rate, spec, (-change, change))
+    spread = {name: abs(high[name] - low[name]) / 2 for name in low}
+    if not all(np.isfinite(v) for v in spread.values()):
+        return Viscosity()  # too little sliding motion to fit at all: the physics fit says so next
+    return Viscosity(spread=spread, spec_nms=spec.viscous_nms, unseen=True)
+
+
 def _leaning(seen: dict[str, np.ndarray], rate: float, spec: ActuatorParams, change: float, std: float) -> Viscosity:
     """The spec's C, with the story "off by ``change``" weighed into the stds (module docstring)."""
     weight = odds_weight((change / std) ** 2 / 2 + PRIOR_LOG_ODDS)
@@ -114,6 +132,11 @@ def _leaning(seen: dict[str, np.ndarray], rate: float, spec: ActuatorParams, cha
 
 def viscosity_note(viscosity: Viscosity) -> str | None:
     """The change in words for the result's notes, or None."""
+    if viscosity.unseen:
+        return (
+            "the speed hardly varies: a viscous coefficient off the spec's (a cold grease) would read as FDJ here, "
+            f"and cannot be told from it (the stds include a coefficient {100 * UNSEEN_SHARE:.0f} % off either way)"
+        )
     if not viscosity.change_nms:
         return _leaning_note(viscosity)
     return (

@@ -5,9 +5,10 @@ import pytest
 
 from sim.params import ActuatorParams
 from sim.window import window_from_dict
-from tests.foreign.windows import Effects, draw
+from tests.foreign.windows import Effects, draw, of_the_same_flight
 from training.baseline import fit_friction
 from training.conditioning import prepare
+from training.documents import SensorZero
 from training.preprocess import as_read
 from training.viscosity import NOTE_WEIGHT, Viscosity, viscosity_note
 
@@ -58,3 +59,27 @@ def test_a_change_too_unclear_to_read_is_weighed_into_fdjs_std():
         covered += error <= 2 * float(np.hypot(read.spread["FDJ"], fit.fdj_std_nm[0]))
     assert unread >= 8
     assert covered >= 0.6 * unread, (covered, unread)
+
+
+@pytest.mark.parametrize("factor", [0.8, 1.24, 1.5])
+def test_where_the_speed_hardly_varies_an_unseen_coefficient_is_in_the_stds(factor):
+    """A 0.1 s gust moving one way near slew, its current 0.2 A off and that zero known from a cruise window of
+    its flight: C·|ω| is FDJ's twin. Read with the spec's C and a std without it, C 1.24x put FDJ 40 % of
+    range high at 10 std (foreign history, actuator 407)."""
+    from training.baseline import fit_window
+    from training.conditioning import widened
+    from training.documents import HistoryReadings
+    from training.history import known_from
+    from training.result import weakly_determined
+
+    effects = Effects(viscous_factor=factor, current_bias_a=0.2)
+    gust = draw(318, "gust", duration_s=0.1, effects=effects)
+    cruise = prepare(window_from_dict(of_the_same_flight(gust, 1318).document)).departures.offset
+    zero = SensorZero(window_id="c", hinge_nm=cruise.hinge_nm, current_a=cruise.current_a, torque_std_nm=1e-4)
+    prepared = prepare(window_from_dict(gust.document), known=known_from(HistoryReadings(sensor_zero=zero)))
+    assert prepared.departures.viscosity.unseen and prepared.departures.offset.carried_from == "c"
+    assert "speed hardly varies" in viscosity_note(prepared.departures.viscosity)
+    w = prepared.window
+    fitted = fit_window(as_read(w.signals, w.sample_rate_hz), w.sample_rate_hz, prepared.actuator)
+    std = widened({"FDJ": float(fitted.fdj_std_nm[0])}, prepared)["FDJ"]
+    assert abs(float(fitted.fdj_nm[0]) - gust.truth["FDJ"]) < 2 * std and weakly_determined("FDJ", std)
