@@ -96,7 +96,9 @@ def _window_info(prepared: Prepared, data: Data) -> WindowInfo:
         window_id=w.window_id, hinge_nm=offset.hinge_nm, current_a=offset.current_a, torque_std_nm=offset.zero_std_nm
     )
     inertia = None
-    if drive.inertia_kgm2 and not prepared.departures.inertia_from:  # told apart from γ by the window itself
+    # told apart from γ by the window itself, and moving both ways: a window moving one way holds too little to
+    # read J_M for the actuator (a one-way 0.5 s cruise read 0.61x, the spec's J_M true), and the history keeps it
+    if drive.inertia_kgm2 and not prepared.departures.inertia_from and not offset.one_way:
         std = drive.stds["inertia_kgm2"] / drive.spec.inertia_kgm2
         inertia = InertiaReading(factor=drive.inertia_factor, std=std, window_ids=[w.window_id])
     return WindowInfo(

@@ -7,7 +7,17 @@ from sim.checks import InputError
 from sim.params import HealthParams
 from sim.synthetic import synthetic_window
 from sim.window import window_from_dict
-from tests.foreign.windows import NOISE, Effects, draw, filter_widths, noisy, of_the_same_flight, through_filters, worn
+from tests.foreign.windows import (
+    NOISE,
+    Effects,
+    Health,
+    draw,
+    filter_widths,
+    noisy,
+    of_the_same_flight,
+    through_filters,
+    worn,
+)
 from training.config import PipelineConfig
 from training.documents import Estimate, HistoryReadings
 from training.pipeline import estimate_window
@@ -257,6 +267,15 @@ def test_a_window_that_cannot_tell_j_m_from_k_t_is_answered_with_the_actuators_j
     assert any("decided for a heavier rotor" in note for note in result.notes)
     for name, (of_range, z) in _errors(result, heavier.truth).items():
         assert of_range < 3.0 and z < 2.0, name
+
+
+def test_a_window_moving_one_way_gives_the_history_no_j_m():
+    """This 0.5 s cruise moves one way and reads J_M 0.61x, the spec's true (said weak): kept in the history, it
+    would stand for the actuator's J_M."""
+    health = Health(fdj_nm=0.053955677018290515, fsj_nm=0.10791135403658103, eta_o=0.82544057379369)
+    result = _estimate(draw(608021, "cruise", health=health, duration_s=0.5))
+    assert result.window.inertia_factor < 0.7 and result.estimates.FDJ.weakly_determined
+    assert result.window.inertia_read is None and result.window.sensor_zero is None  # one way: no zero either
 
 
 def test_a_network_that_disagrees_with_the_window_is_set_aside(monkeypatch):
