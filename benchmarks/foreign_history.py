@@ -59,7 +59,10 @@ the spec's J_M, unlogged: a window whose motor saturates as it accelerates canno
 weaker motor, and is read with the J_M earlier windows of the actuator read (thesis-like windows can;
 each read alone, `--actuators 0 --speeding 0 --healthy 0 --alone`, 143 of their 240 FDJ answers were
 past 10 % of the range, all said weak, the level up to 12 % of range off, and 4 of 8 FDJ lives
-missed: 3 with no degradation detected, 1 outside its interval).
+missed: 3 with no degradation detected, 1 outside its interval). Eight more wear linearly and log
+three windows a flight, 0.3 h apart, their current sensor 0.04–0.2 A off zero, drawn anew each flight
+(`flight_id`): a window moving one way cannot read that, and is read with the zero an earlier window
+of its flight read.
 Every window goes through `estimate_window` with what the actuator's earlier windows read
 (`training.history`), and the history through `prognose`, as the service does
 (`benchmarks/foreign_history.py`). Per actuator: its windows' FDJ
@@ -80,6 +83,7 @@ class Wear:
     eta_o_crossing_h: float
     power: float = 1.0
     inertia_factor: float = 1.0  # its rotor's J_M over the spec's, unlogged (it stays with the build)
+    zeroed_per_flight: bool = False  # its current sensor keeps a zero off by 0.04–0.2 A, new each flight
 
     def health(self, hours: float, thresholds: Thresholds) -> Health:
         fdj_share, eta_o_share = ((hours / h) ** self.power for h in (self.fdj_crossing_h, self.eta_o_crossing_h))
@@ -88,7 +92,8 @@ class Wear:
         return Health(fdj_nm=fdj, fsj_nm=2.0 * fdj, eta_o=eta_o)
 
 
-KINDS_OF_WEAR = ("linear", "speeding up", "healthy", "linear, heavier rotor")
+KINDS_OF_WEAR = ("linear", "speeding up", "healthy", "linear, heavier rotor", "linear, zero off by flight")
+WINDOWS_PER_FLIGHT = 3  # of an actuator whose sensor's zero changes by flight, 0.3 h apart
 
 
 def wear(actuator: int, kind: str = "linear") -> Wear:
@@ -99,11 +104,30 @@ def wear(actuator: int, kind: str = "linear") -> Wear:
     if kind == "healthy":
         return Wear(fdj, math.inf, eta_o, math.inf)
     inertia = float(rng.uniform(1.03, 1.1)) if kind == "linear, heavier rotor" else 1.0
-    return Wear(fdj, fdj_h, eta_o, eta_o_h, power=2.0 if kind == "speeding up" else 1.0, inertia_factor=inertia)
+    power = 2.0 if kind == "speeding up" else 1.0
+    return Wear(fdj, fdj_h, eta_o, eta_o_h, power, inertia, zeroed_per_flight=kind == "linear, zero off by flight")
 
 
-def logged_window(actuator: int, j: int, hours: float, truth: Wear, thresholds: Thresholds) -> Draw:
-    """Window ``j`` of the actuator's history, at ``hours``: a kind of ``KINDS``, cold or not."""
+def flights(actuator: int, truth: Wear, n_windows: int) -> tuple[np.ndarray, list[str | None], np.ndarray]:
+    """The actuator's windows: flight hours, flight_id and the current sensor's offset [A] of each. Most
+    actuators log one window a flight (their sensors on zero); one whose zero changes by flight logs
+    ``WINDOWS_PER_FLIGHT``, its offset drawn per flight."""
+    rng = np.random.default_rng(FIRST_SEED + actuator)
+    if not truth.zeroed_per_flight:
+        return np.sort(rng.uniform(0, SPAN_H, n_windows)), [None] * n_windows, np.zeros(n_windows)
+    n_flights = n_windows // WINDOWS_PER_FLIGHT
+    starts = np.repeat(np.sort(rng.uniform(0, SPAN_H, n_flights)), WINDOWS_PER_FLIGHT)
+    hours = starts + np.tile(0.3 * np.arange(WINDOWS_PER_FLIGHT), n_flights)
+    flight = np.repeat(np.arange(n_flights), WINDOWS_PER_FLIGHT)
+    offsets = rng.choice([-1.0, 1.0], n_flights) * rng.uniform(0.04, 0.2, n_flights)
+    return hours, [f"flight-{k}" for k in flight], offsets[flight]
+
+
+def logged_window(
+    actuator: int, j: int, hours: float, truth: Wear, thresholds: Thresholds, offset_a: float = 0.0
+) -> Draw:
+    """Window ``j`` of the actuator's history, at ``hours``: a kind of ``KINDS``, cold or not, its current
+    sensor ``offset_a`` off zero."""
     seed = FIRST_SEED + 1000 * (actuator + 1) + j
     rng = np.random.default_rng(seed)
     _, duration, rates, family = KINDS[rng.choice(len(KINDS), p=[k[0] for k in KINDS])]
@@ -111,7 +135,7 @@ def logged_window(actuator: int, j: int, hours: float, truth: Wear, thresholds: 
     viscous = float(rng.uniform(1.2, 2.0)) if cold else 1.0
     health, effects = (
         truth.health(hours, thresholds),
-        Effects(viscous_factor=viscous, inertia_factor=truth.inertia_factor),
+        Effects(viscous_factor=viscous, inertia_factor=truth.inertia_factor, current_bias_a=offset_a),
     )
     drawn = draw(seed, family or FAMILIES[j % 5], health=health, effects=effects, duration_s=duration,
                  sample_rate_hz=float(rng.choice(rates)))  # fmt: skip
@@ -125,11 +149,13 @@ def history(
     """The actuator's prognosis from its estimated windows, and how its windows' answers fared (a window
     refused is left out of the history, as the service stores none); ``alone``: each window read without
     what earlier ones read."""
-    hours = np.sort(np.random.default_rng(FIRST_SEED + actuator).uniform(0, SPAN_H, n_windows))
-    stored, weak, over, unsaid, refused, undecided, decided = [], 0, 0, 0, [], 0, 0
-    for j, h in enumerate(hours):
-        drawn = logged_window(actuator, j, float(h), truth, thresholds)
-        known = None if alone else readings_of([s.window for s in stored], None)  # as the service reads its history
+    hours, flight_ids, offsets = flights(actuator, truth, n_windows)
+    stored, weak, over, unsaid, refused, undecided, decided, zeroed = [], 0, 0, 0, [], 0, 0, 0
+    for j, (h, flight_id) in enumerate(zip(hours, flight_ids, strict=True)):
+        drawn = logged_window(actuator, j, float(h), truth, thresholds, float(offsets[j]))
+        if flight_id is not None:
+            drawn.document["flight_id"] = flight_id
+        known = None if alone else readings_of([s.window for s in stored], flight_id)  # as the service reads it
         try:
             result = estimate_window(window_from_dict(drawn.document), history=known)
         except InputError as exc:
@@ -140,9 +166,10 @@ def history(
         past = abs(share_of_range("FDJ", fdj.value - drawn.truth["FDJ"])) > BOUND
         weak, over, unsaid = weak + fdj.weakly_determined, over + past, unsaid + (past and not fdj.weakly_determined)
         undecided, decided = undecided + result.window.inertia_undecided, decided + bool(result.window.inertia_from)
+        zeroed += result.window.sensor_zero_from is not None
         stored.append(Stored(**result.model_dump(), id=j, stored_at="2026-01-01T00:00:00+00:00"))
     fared = {"weak": weak, "over": over, "unsaid": unsaid, "refused": refused, "undecided": undecided,
-             "decided": decided}  # fmt: skip
+             "decided": decided, "zeroed": zeroed}  # fmt: skip
     return prognose(f"foreign/history-{actuator}", stored, thresholds), fared
 
 
@@ -215,6 +242,10 @@ def summary(rows: list[dict[str, Any]]) -> str:
     parts.append(f"Heavier rotors: of their {sum(r['n'] for r in heavier)} windows, "
                  f"{sum(r['decided'] + r['undecided'] for r in heavier)} could not tell J_M from k_T alone; the "
                  f"actuator's J_M read by earlier windows decided {sum(r['decided'] for r in heavier)}")  # fmt: skip
+    zeroed = [r for r in rows if r["kind"] == "linear, zero off by flight"]
+    carried = sum(r["zeroed"] for r in zeroed)
+    parts.append(f"Zero off by flight: of their {sum(r['n'] for r in zeroed)} windows, {carried} were read with "
+                 "the zero an earlier window of their flight read")  # fmt: skip
     refused = [f for r in rows for f in r["refused"]]
     head = (f"{windows} windows, {len(refused)} refused, {over} answered FDJ past 10 % of range ({unsaid} not said "
             "weak). ")  # fmt: skip
@@ -228,14 +259,16 @@ def main() -> None:
     parser.add_argument("--speeding", type=int, default=8, help="histories of actuators whose wear speeds up")
     parser.add_argument("--healthy", type=int, default=8, help="histories of healthy actuators (no wear)")
     parser.add_argument("--heavier", type=int, default=8, help="histories of linearly wearing heavier rotors")
+    parser.add_argument("--zeroed", type=int, default=8, help="histories whose current sensor's zero changes by flight")
     parser.add_argument("--windows", type=int, default=30, help="windows per history")
     parser.add_argument("--alone", action="store_true", help="each window without what earlier ones read")
     parser.add_argument("--docs", action="store_true", help="rewrite the section of docs/prognosis.md")
     args = parser.parse_args()
     runtime.configure()
     started, thresholds, rows = time.perf_counter(), Thresholds(), []
-    counts = dict(zip(KINDS_OF_WEAR, (args.actuators, args.speeding, args.healthy, args.heavier), strict=True))
-    for offset, kind in zip((0, 200, 100, 300), KINDS_OF_WEAR, strict=True):
+    sizes = (args.actuators, args.speeding, args.healthy, args.heavier, args.zeroed)
+    counts = dict(zip(KINDS_OF_WEAR, sizes, strict=True))
+    for offset, kind in zip((0, 200, 100, 300, 400), KINDS_OF_WEAR, strict=True):
         for actuator in range(offset, offset + counts[kind]):
             truth = wear(actuator, kind)
             prognosis, fared = history(actuator, truth, args.windows, thresholds, args.alone)
@@ -247,7 +280,8 @@ def main() -> None:
     print(body)
     if args.docs and not args.alone:
         command = (f"python -m benchmarks.foreign_history --actuators {args.actuators} --speeding {args.speeding} "
-                   f"--healthy {args.healthy} --heavier {args.heavier} --windows {args.windows} --docs")  # fmt: skip
+                   f"--healthy {args.healthy} --heavier {args.heavier} --zeroed {args.zeroed} --windows {args.windows} "
+                   "--docs")  # fmt: skip
         write_section("On windows our code did not draw", command, body, PROGNOSIS_MD)
 
 
