@@ -239,7 +239,8 @@ def test_a_window_moving_one_way_says_fdj_rests_on_the_sensors_zero(seed):
     (318, "gust", Effects(current_bias_a=0.2)), (323, "steps", Effects(hinge_bias_nm=-6.0)),
 ])  # fmt: skip
 def test_a_window_moving_one_way_is_answered_with_the_zero_its_flight_read(seed, family, effects):
-    """Alone, the offset (15 and 24 % of FDJ's range) is an unseen one; a cruise window of the flight reads it."""
+    """Alone, the offset (15 and 24 % of FDJ's range) is an unseen one; a cruise window of the flight reads it.
+    The gust slides one way near slew, where C·|ω| is FDJ's twin too: right, and said weak for that alone."""
     one_way = draw(seed, family, duration_s=0.1 if family == "gust" else 0.5, effects=effects)
     both = of_the_same_flight(one_way, seed + 1000)
     zero = _estimate(both).window.sensor_zero
@@ -248,7 +249,9 @@ def test_a_window_moving_one_way_is_answered_with_the_zero_its_flight_read(seed,
     assert result.window.sensor_zero is None and result.window.sensor_zero_from == zero.window_id
     assert any("of the same flight read moving both ways" in note for note in result.notes)
     of_range, z = _errors(result, one_way.truth)["FDJ"]
-    assert of_range < 3.0 and z < 2.0 and not result.estimates.FDJ.weakly_determined
+    assert of_range < 3.0 and z < 2.0
+    unseen_c = any("speed hardly varies" in note for note in result.notes)
+    assert unseen_c == (family == "gust") and result.estimates.FDJ.weakly_determined == unseen_c
     assert _estimate(one_way).estimates.FDJ.weakly_determined
 
 
