@@ -57,7 +57,7 @@ crosses the threshold ~3x too late, surely), and eight do not wear at all (a mon
 degradation there raises a false alarm). Eight more wear linearly with a rotor 1.03–1.1x as heavy as
 the spec's J_M, unlogged: a window whose motor saturates as it accelerates cannot tell that from a
 weaker motor, and is read with the J_M earlier windows of the actuator read (thesis-like windows can;
-each read alone, `--actuators 0 --speeding 0 --healthy 0 --alone`, 143 of their 240 FDJ answers were
+each read alone, `--actuators 0 --speeding 0 --healthy 0 --zeroed 0 --alone`, 143 of their 240 FDJ answers were
 past 10 % of the range, all said weak, the level up to 12 % of range off, and 4 of 8 FDJ lives
 missed: 3 with no degradation detected, 1 outside its interval). Eight more wear linearly and log
 three windows a flight, 0.3 h apart, their current sensor 0.04–0.2 A off zero, drawn anew each flight
