@@ -95,9 +95,7 @@ def read_viscosity(window: Window, spec: ActuatorParams = ActuatorParams()) -> V
     if not stands_out:
         return _leaning(seen, rate, spec, change, std)
     change = float(np.clip(change, *CHANGE_BOUNDS_NMS))
-    low, high = _targets_at(seen, rate, spec, (change - std, change + std))
-    spread = {name: abs(high[name] - low[name]) / 2 for name in low}
-    return Viscosity(change, std, spread, spec.viscous_nms)
+    return Viscosity(change, std, _half_change(seen, rate, spec, change, std), spec.viscous_nms)
 
 
 def _targets_at(
@@ -108,12 +106,18 @@ def _targets_at(
     return [{name: float(value) for name, value in fit.values().items()} for fit in fits]
 
 
+def _half_change(
+    seen: dict[str, np.ndarray], rate: float, spec: ActuatorParams, change: float, std: float
+) -> dict[str, float]:
+    """Per target, half its change across the spec's C plus ``change`` ± ``std``: the std that uncertainty adds."""
+    low, high = _targets_at(seen, rate, spec, (change - std, change + std))
+    return {name: abs(high[name] - low[name]) / 2 for name in low}
+
+
 def _unseen(seen: dict[str, np.ndarray], rate: float, spec: ActuatorParams) -> Viscosity:
     """The spec's C where the window cannot tell C·|ω| from FDJ, with the stds carrying a change of
     ``UNSEEN_SHARE`` of it either way (module docstring)."""
-    change = UNSEEN_SHARE * spec.viscous_nms
-    low, high = _targets_at(seen, rate, spec, (-change, change))
-    spread = {name: abs(high[name] - low[name]) / 2 for name in low}
+    spread = _half_change(seen, rate, spec, 0.0, UNSEEN_SHARE * spec.viscous_nms)
     if not all(np.isfinite(v) for v in spread.values()):
         return Viscosity()  # too little sliding motion to fit at all: the physics fit says so next
     return Viscosity(spread=spread, spec_nms=spec.viscous_nms, unseen=True)
