@@ -63,10 +63,10 @@ def prognose(actuator_id: str, stored: Sequence[Stored], thresholds: Thresholds 
         lives[name] = remaining_life(trends[name], *(thresholds or Thresholds()).of(name))
     sensors, said = sensor_trends(stored, times, unit)
     inertias = [s.window.inertia_read for s in stored if s.window.inertia_read is not None]
-    scatter = inertia_change_note(inertias)
+    changed = inertia_change_note(inertias)
     return Prognosis(actuator_id=actuator_id, time_unit=unit, trends=trends, remaining_life=lives,  # type: ignore[arg-type]
                      sensors=sensors, inertia=combined_inertia(inertias),
-                     notes=[n for n in (note, *said, scatter) if n])  # fmt: skip
+                     notes=[n for n in (note, *said, changed) if n])  # fmt: skip
 
 
 def sensor_trends(stored: Sequence[Stored], times: np.ndarray, unit: str) -> tuple[dict[str, Trend], list[str]]:

@@ -167,7 +167,8 @@ class WindowInfo(Document):
     sensor_zero: SensorZero | None = Field(
         default=None,
         description="the sensors' zero as this window read it, for the windows of its flight that move one way "
-        "(null: it moves one way itself, or was read with the spec's model alone)",
+        "(null: it moves one way itself, took its flight's instead (sensor_zero_from), or was read with the spec's "
+        "model alone)",
     )
     sensor_zero_from: str | None = Field(
         default=None, description="the window of its flight whose sensor_zero it was read with (null: its own)"
