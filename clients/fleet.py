@@ -6,17 +6,20 @@ results are written as they complete (``ray.wait``), the CSV is
 the checkpoint (a rerun skips what it holds, so a crash never duplicates a window), and the same
 rows can go into a service's SQLite history (idempotent as well). Without Ray and with one
 worker the archive is processed in this process, one window after another. A window that lacks
-what other windows of its actuator read (a one-way window, its flight's sensor zero; one that cannot
-tell a heavier rotor from a weaker motor, J_M) is answered again at the end with what they read
-(``training.history``), as the service answers it from its history.
+what other windows of its actuator read (its flight's sensor zero, where it moved one way or read its
+own less precisely; J_M, where it could not tell a heavier rotor from a weaker motor) is answered again
+at the end with what they read (``training.history``), as the service answers it from its history. A
+window of a named flight is written once its flight's windows are answered (a recording's pieces come
+together), one that could not tell J_M at the end of the run.
 """
 
 from __future__ import annotations
 
 import sys
 import time
+from collections import Counter
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -44,9 +47,10 @@ class Progress:
 
 
 Job = tuple[Window, dict[str, Any] | None]  # a window and what other windows of its actuator read (HistoryReadings)
+Answer = tuple[Window, dict]  # a window and its ema-estimate/1 document (or {"error": ...})
 
 
-def _in_process(jobs: list[Job], config: PipelineConfig, threads: int) -> Iterator[tuple[Window, dict]]:
+def _in_process(jobs: list[Job], config: PipelineConfig, threads: int) -> Iterator[Answer]:
     from training.remote import estimate_document
 
     for window, history in jobs:
@@ -54,7 +58,7 @@ def _in_process(jobs: list[Job], config: PipelineConfig, threads: int) -> Iterat
 
 
 def _on_ray(jobs: list[Job], config: PipelineConfig, workers: int, threads: int,
-            address: str | None) -> Iterator[tuple[Window, dict]]:  # fmt: skip
+            address: str | None) -> Iterator[Answer]:  # fmt: skip
     import ray
 
     from training.remote import connect, ray_task
@@ -72,43 +76,80 @@ def _on_ray(jobs: list[Job], config: PipelineConfig, workers: int, threads: int,
             yield pending.pop(reference), ray.get(reference)
 
 
-def _wants(window: Window, answer: dict[str, Any]) -> set[str]:
-    """What the window could not read and other windows of its actuator may have: its flight's sensor zero
-    (it moves one way), J_M (it could not tell a heavier rotor from a weaker motor)."""
-    read = answer.get("window", {})
-    wants = set()
-    if window.flight_id is not None and read.get("sensor_zero") is None and read.get("sensor_zero_from") is None:
-        wants.add("sensor_zero")
-    if read.get("inertia_undecided"):
-        wants.add("inertia")
-    return wants if "error" not in answer else set()
+@dataclass
+class _Readings:
+    """What the run's windows read that others may lack (``training.history``): sensor zeros by (actuator,
+    flight), J_M readings by actuator, in the order answered; indexed so that each lookup reads one flight."""
+
+    zeros: dict[tuple[str, str | None], list[Any]] = field(default_factory=dict)
+    inertias: dict[str, list[Any]] = field(default_factory=dict)
+
+    def add(self, window: Window, answer: dict[str, Any]) -> None:
+        from training.documents import WindowInfo
+
+        info = WindowInfo.model_validate(answer["window"])
+        if info.sensor_zero is not None and window.flight_id is not None:
+            self.zeros.setdefault((window.actuator_id, window.flight_id), []).append(info.sensor_zero)
+        if info.inertia_read is not None:
+            self.inertias.setdefault(window.actuator_id, []).append(info.inertia_read)
+
+    def lacked(self, window: Window, answer: dict[str, Any]) -> dict[str, Any] | None:
+        """What the other windows read that this one lacks, as the service would give it: its flight's sensor
+        zero where the window moved one way or read its own less precisely (``training.zero_offset`` takes it
+        where it holds), J_M where it could not tell a heavier rotor from a weaker motor; or None."""
+        from training.documents import HistoryReadings
+        from training.history import best_zero, combined_inertia
+
+        read = answer["window"]
+        flight = self.zeros.get((window.actuator_id, window.flight_id), [])
+        zero = best_zero(z for z in flight if z.window_id != window.window_id)
+        undecided = bool(read.get("inertia_undecided"))
+        inertia = combined_inertia(self.inertias.get(window.actuator_id, [])) if undecided else None
+        own = read.get("sensor_zero")
+        takes_zero = zero is not None and (own is None or zero.torque_std_nm < own["torque_std_nm"])
+        takes_inertia = inertia is not None
+        return HistoryReadings(sensor_zero=zero, inertia=inertia).model_dump() if takes_zero or takes_inertia else None
 
 
 def _with_history(
-    first: Iterator[tuple[Window, dict]], again: Callable[[list[Job]], Iterator[tuple[Window, dict]]]
-) -> Iterator[tuple[Window, dict]]:
-    """The answers of ``first``; a window that wants what other windows of its actuator read (``_wants``)
-    held back and, where they read it, answered ``again`` with it (``training.history``, as the service
-    reads it from its history)."""
-    from training.documents import WindowInfo
-    from training.history import readings_of
-
-    held: list[tuple[Window, dict]] = []
-    read: dict[str, list[WindowInfo]] = {}
-    for window, answer in first:
-        if "error" not in answer:  # a window held back may still have read what another wants (a flight's zero)
-            read.setdefault(window.actuator_id, []).append(WindowInfo.model_validate(answer["window"]))
-        if _wants(window, answer):
-            held.append((window, answer))
-        else:
-            yield window, answer
+    windows: list[Window],
+    first: Iterator[Answer],
+    again: Callable[[list[Job]], Iterator[Answer]],
+) -> Iterator[Answer]:
+    """The answers of ``first`` (one per window of ``windows``), each given out once what other windows of its
+    actuator read is known: a window of a named flight once its flight's windows are answered (a recording's
+    pieces come together), one that could not tell J_M once the run's are. A window that lacks what they
+    read (``_Readings.lacked``) is answered ``again`` with it at the end, as the service reads it from its
+    history."""
+    unanswered = Counter((w.actuator_id, w.flight_id) for w in windows)
+    readings = _Readings()
+    held: list[Answer] = []  # until their flight is answered
+    at_end: list[Answer] = []  # could not tell J_M: until the run is answered
     jobs: list[Job] = []
-    for window, answer in held:
-        history = readings_of(read.get(window.actuator_id, []), window.flight_id)
-        if any(getattr(history, name) is not None for name in _wants(window, answer)):
-            jobs.append((window, history.model_dump()))
-        else:
+
+    def settled(window: Window, answer: dict) -> Iterator[Answer]:
+        history = readings.lacked(window, answer)
+        if history is None:
             yield window, answer
+        else:
+            jobs.append((window, history))
+
+    for window, answer in first:
+        unanswered[(window.actuator_id, window.flight_id)] -= 1
+        if "error" in answer:
+            yield window, answer
+            continue
+        readings.add(window, answer)
+        (at_end if answer["window"].get("inertia_undecided") else held).append((window, answer))
+        waiting: list[Answer] = []
+        for w, a in held:
+            if w.flight_id is not None and unanswered[(w.actuator_id, w.flight_id)] > 0:
+                waiting.append((w, a))
+            else:
+                yield from settled(w, a)
+        held = waiting
+    for w, a in held + at_end:
+        yield from settled(w, a)
     yield from again(jobs)
 
 
@@ -121,10 +162,10 @@ def run_fleet(windows: list[Window], out: Path, config: PipelineConfig, workers:
     progress = Progress(len(todo), started=time.perf_counter())
     in_process = workers == 1 and address is None and not ray_installed()
 
-    def engine(jobs: list[Job]) -> Iterator[tuple[Window, dict]]:
+    def engine(jobs: list[Job]) -> Iterator[Answer]:
         return _in_process(jobs, config, threads) if in_process else _on_ray(jobs, config, workers, threads, address)
 
-    results = _with_history(engine([(w, None) for w in todo]), engine)
+    results = _with_history(todo, engine([(w, None) for w in todo]), engine)
     store = _store(database)
     with ResultsWriter(out) as writer:
         for window, answer in results:

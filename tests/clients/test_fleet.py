@@ -58,8 +58,9 @@ def test_one_worker_without_ray_runs_in_process(archive, tmp_path, capsys, monke
 
 def test_windows_wanting_what_others_read_are_answered_with_it(tmp_path, capsys, monkeypatch):
     """Their files first in the archive: a 0.1 s gust moving one way (current 0.2 A off) waits for the cruise
-    window of its flight (a window of another flight does not take that zero), a doublet that cannot tell
-    J_M 1.08x from a weaker motor for the thesis window of its actuator."""
+    window of its flight (a window of another flight does not take that zero), and so does one moving both ways
+    that reads the zero less precisely (0.10 A alone), as the service answers it; a doublet that cannot tell
+    J_M 1.08x from a weaker motor waits for the thesis window of its actuator."""
     from clients import fleet
     from service.store import EstimateStore
     from tests.foreign.windows import Effects, draw, of_the_same_flight
@@ -68,8 +69,9 @@ def test_windows_wanting_what_others_read_are_answered_with_it(tmp_path, capsys,
     folder, database = tmp_path / "archive", tmp_path / "history.sqlite3"
     folder.mkdir()
     one_way = draw(318, "gust", duration_s=0.1, effects=Effects(current_bias_a=0.2))
-    cruise = of_the_same_flight(one_way, 1318)
-    for name, drawn, flight_id in (("a", one_way, "f-1"), ("b", cruise, "f-1"), ("c", one_way, "f-2")):
+    cruise, both_ways = of_the_same_flight(one_way, 1318), of_the_same_flight(one_way, 2318, "gust", 0.1)
+    flights = (("a", one_way, "f-1"), ("a2", both_ways, "f-1"), ("b", cruise, "f-1"), ("c", one_way, "f-2"))
+    for name, drawn, flight_id in flights:
         document = {**drawn.document, "actuator_id": "tail-9", "flight_id": flight_id, "window_id": name}
         (folder / f"{name}.json").write_text(json.dumps(document))
     heavier = draw(403, "doublet", effects=Effects(inertia_factor=1.08))
@@ -80,6 +82,7 @@ def test_windows_wanting_what_others_read_are_answered_with_it(tmp_path, capsys,
     answers = {s.window_id: s.window for s in EstimateStore(database).history("tail-9")[0]}
     cruise_pieces = {name for name in answers if name.startswith("b#")}  # the archive's windows are cut
     assert answers["a"].sensor_zero_from in cruise_pieces and answers["c"].sensor_zero_from is None
+    assert answers["a2"].sensor_zero_from in cruise_pieces and answers["a2"].sensor_zero is None
     drive = {s.window_id: s.window for s in EstimateStore(database).history("tail-8")[0]}
     assert drive["d"].inertia_from == ["e"] and not drive["d"].inertia_undecided
     count = len(answers) + len(drive)
@@ -119,3 +122,26 @@ def test_history_plots_a_prognosis_whose_interval_holds_the_truth(tmp_path, caps
     assert life["status"] == "crossing predicted"
     assert life["rul_low"] <= 250 - hours.max() <= life["rul_high"]
     assert plot.stat().st_size > 10_000
+
+
+def test_a_flights_windows_are_given_out_once_the_flight_is_answered_not_at_the_runs_end(monkeypatch):
+    """The results CSV is the checkpoint: a window waits for its flight's other windows, not for the run."""
+    from dataclasses import replace
+
+    from clients import fleet
+
+    monkeypatch.setattr(fleet._Readings, "add", lambda self, window, answer: None)
+    monkeypatch.setattr(fleet._Readings, "lacked", lambda self, window, answer: None)
+    base = synthetic_window(HealthParams.single(), seed=1, duration_s=0.05)
+    flights = [("f-1", "a"), ("f-1", "b"), (None, "c"), ("f-2", "d"), ("f-2", "e")]
+    windows = [replace(base, flight_id=flight, window_id=name) for flight, name in flights]
+    consumed: list[str] = []
+
+    def first():
+        for window in windows:
+            consumed.append(window.window_id)
+            yield window, {"window": {}}
+
+    given = [(w.window_id, list(consumed)) for w, _ in fleet._with_history(windows, first(), lambda jobs: iter(()))]
+    assert given == [("a", ["a", "b"]), ("b", ["a", "b"]), ("c", ["a", "b", "c"]),
+                     ("d", ["a", "b", "c", "d", "e"]), ("e", ["a", "b", "c", "d", "e"])]  # fmt: skip
