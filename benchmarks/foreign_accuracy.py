@@ -192,6 +192,8 @@ def report(rows: dict[str, list[dict[str, Any]]], per_group: int, seconds: float
         "and corrected (`training.drive_constants`); and on worn actuators. *Hinge moment gain*: the five",
         "families with the hinge moment logged 0.95–1.05x the true one (`with_hinge_gain`), read per window",
         "from Eq. 5.1's aiding and opposing load terms with Eq. 3.4 and corrected (`training.hinge_gain`).",
+        "*Longest window*: the five families over 10 s, the longest the issue names, processed at 5 kHz (the",
+        "pipeline averages a long log down, not below 5 kHz up to 10 s: `training.conditioning`).",
         f"Total {seconds:.0f} s.",
         "",
         table(summaries),

@@ -58,6 +58,7 @@ def groups() -> dict[str, Callable[..., Draw]]:
         s, family=FAMILIES[s % 5], effects=drive_off(s), **kw
     )
     out["hinge moment gain 0.95-1.05x"] = lambda s, **kw: with_hinge_gain(draw(s, FAMILIES[s % 5], **kw), hinge_gain(s))
+    out["longest window (10 s, 10 kHz)"] = lambda s, **kw: draw(s, FAMILIES[s % 5], duration_s=10.0, **kw)
     return out
 
 

@@ -17,7 +17,8 @@ from training.zero_offset import ZeroOffset
 def test_averaging_keeps_rate_and_samples_bounded():
     assert averaging_factor(5_000, 10_000.0) == 1
     assert averaging_factor(50_000, 100_000.0) == 10
-    assert averaging_factor(100_000, 10_000.0) == 10  # a 10 s window is processed at 1 kHz
+    assert averaging_factor(100_000, 10_000.0) == 2  # a 10 s window is processed at 5 kHz
+    assert averaging_factor(1_000_000, 100_000.0) == 20  # ... however fast it was logged
     for n, rate in ((1_000_000, 100_000.0), (30_000, 12_800.0), (100, 1_000.0)):
         f = averaging_factor(n, rate)
         assert rate / f <= MAX_RATE_HZ and n / f <= MAX_SAMPLES
