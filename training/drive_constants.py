@@ -69,6 +69,13 @@ DECISIVE = {"inertia": 12.0, "torque_scale": -30.0}
 # stds grow by this share of what reading ΔJ instead would change (``training.departures``): on 7 such
 # foreign windows with J_M off, the truth lay 0.87–1.07 of that change from γ's answer.
 UNDECIDED_SHARE = 0.6
+# The 2 ms reconstruction reads J_M low where its kernel spans few samples, as h² shrinks. On foreign windows with
+# the spec's J_M (cruise, gust, steps; 2 and 10 s, two seeds): 0.4–1.25 % low at 1 kHz at a jackknife std of
+# 0.03 %, 0.15–0.45 % at 2 kHz, none read at 5 kHz. ΔJ's std carries this share of J_M at 1 kHz, scaled by
+# (1 kHz / rate)²: each such window's J_M within 1.8 std. The bias is systematic, so averaging windows does not
+# shrink it: the history keeps J_M only from windows processed at KERNEL_FREE_RATE_HZ or more (``training.result``).
+KERNEL_INERTIA_SHARE = 0.01
+KERNEL_FREE_RATE_HZ = 5_000.0
 
 
 @dataclass(frozen=True)
@@ -202,16 +209,22 @@ def _stands_out(plain: FrictionFit, alone: FrictionFit, name: str, rate: float, 
 def _reading(
     window: Window, actuator: ActuatorParams, name: str, first: FrictionFit
 ) -> tuple[DriveConstants, FrictionFit]:
-    """Constant ``name``, refitted on the corrected window until nothing is left; and the last fit (its
-    likelihood)."""
+    """Constant ``name``, refitted on the corrected window until nothing is left, its std ΔJ's with the
+    kernel's (``kernel_inertia_std``); and the last fit (its likelihood)."""
     settings, std = replace(BESIDE, **{name: True}), float(first.term_std(name)[0])
-    read, left = DriveConstants(spec=actuator, stds={FIELDS[name]: std}), first
+    kernel = kernel_inertia_std(window.sample_rate_hz, actuator) if name == "inertia" else 0.0
+    read, left = DriveConstants(spec=actuator, stds={FIELDS[name]: float(np.hypot(std, kernel))}), first
     for _ in range(ITERATIONS + 1):
         read = read.added(left)
         left = _fit(read.corrected(window), read.actuator, settings)
         if abs(float(left.term(name)[0])) < SETTLED * std:  # ΔJ is linear: settled at once; γ within a few
             break
     return read, left
+
+
+def kernel_inertia_std(rate_hz: float, spec: ActuatorParams) -> float:
+    """The std [kg·m²] the reconstruction's kernel at ``rate_hz`` adds to ΔJ (``KERNEL_INERTIA_SHARE``)."""
+    return KERNEL_INERTIA_SHARE * (1_000.0 / rate_hz) ** 2 * spec.inertia_kgm2
 
 
 def _plain(window: Window, read: DriveConstants) -> dict[str, float]:

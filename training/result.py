@@ -28,6 +28,7 @@ from training.documents import (
     WindowInfo,
     parameter,
 )
+from training.drive_constants import KERNEL_FREE_RATE_HZ
 from training.estimator import NetworkEstimator
 from training.static_friction import StaticFriction
 
@@ -97,8 +98,10 @@ def _window_info(prepared: Prepared, data: Data) -> WindowInfo:
     )
     inertia = None
     # told apart from γ by the window itself, and moving both ways: a window moving one way holds too little to
-    # read J_M for the actuator (a one-way 0.5 s cruise read 0.61x, the spec's J_M true), and the history keeps it
-    if drive.inertia_kgm2 and not prepared.departures.inertia_from and not offset.one_way:
+    # read J_M for the actuator (a one-way 0.5 s cruise read 0.61x, the spec's J_M true), and the history keeps it;
+    # and processed fast enough that the kernel reads no bias every window would share (``KERNEL_FREE_RATE_HZ``)
+    unbiased = w.sample_rate_hz >= KERNEL_FREE_RATE_HZ
+    if drive.inertia_kgm2 and not prepared.departures.inertia_from and not offset.one_way and unbiased:
         std = drive.stds["inertia_kgm2"] / drive.spec.inertia_kgm2
         inertia = InertiaReading(factor=drive.inertia_factor, std=std, window_ids=[w.window_id])
     return WindowInfo(

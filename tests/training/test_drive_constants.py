@@ -105,3 +105,13 @@ def test_a_current_logged_as_rms_is_answered_weak_and_within_its_std():
         assert found.weakly_determined, seed
         within += abs(found.value - truth["FDJ"]) < 2 * found.std
     assert within >= 4  # the gap to the γ reading's answer, not its truth: a doublet's 1.05 ranges off at 3 std
+
+
+@pytest.mark.parametrize(("family", "seed", "rate_hz"), [("steps", 1, 1e3), ("cruise", 2, 1e3), ("cruise", 2, 2e3)])
+def test_a_slow_logs_inertia_reading_carries_the_kernels_bias(family, seed, rate_hz):
+    """10 s windows logged slowly read J_M 0.4–1.25 % low through the few-sample kernel, at a jackknife std of
+    0.03 %: the spec's J_M must lie within the reading's 2 std."""
+    drawn = draw(seed, family, duration_s=10.0, sample_rate_hz=rate_hz)
+    read = prepare(window_from_dict(drawn.document)).departures.drive
+    std = read.stds.get("inertia_kgm2", 0.0) / read.spec.inertia_kgm2
+    assert read.inertia_kgm2 < 0.0 and abs(read.inertia_factor - 1.0) < 2 * std
