@@ -26,9 +26,9 @@ f adjacent samples first: interval means of interval means are the interval mean
 intervals, exactly, which is also what the simulations record at the lower rate. ``f`` keeps the
 rate at or below ``MAX_RATE_HZ`` (the 2 ms reconstruction needs no more) and the samples at or
 below ``MAX_SAMPLES``: memory and time grow at most linearly with the duration, and are bounded.
-A window of up to 10 s is kept at 5 kHz or more where it was logged so: at 1 kHz the 2 ms kernel
-spans 3 samples and reads a clean foreign window's J_M 0.4–0.5 % low (2 kHz: 0.1 %, 5 kHz: none),
-and a long window's stds are small enough to show it: processed at 1 kHz, a 10 s cruise logged at
+A window of up to 10 s is kept at ``KERNEL_FREE_RATE_HZ`` or more where it was logged so: below it the
+2 ms kernel spans few samples and reads J_M low (``training.drive_constants``), and a long window's
+stds are small enough to show it: processed at 1 kHz, a 10 s cruise logged at
 100 kHz read J_M 0.9885 ± 0.0003 (the spec's true), and of 30 foreign 10 s windows logged at 10 kHz
 7 held η_O's truth outside their ±2 std (to 4.3 std), 2 FDJ's; at 5 kHz 0 and 1, for 1.6x the time
 (``benchmarks.foreign_accuracy``'s 10 s group). Memory grows with the samples too (~1.2 GB at the
@@ -51,7 +51,7 @@ from training.aircraft_check import aircraft_note, check_against_aircraft
 from training.alignment import Lags, aligned
 from training.consistency import Consistency, check_consistency, kinematics_note
 from training.departures import Departures, Known, history_note, read_departures
-from training.drive_constants import drive_constants_note
+from training.drive_constants import KERNEL_FREE_RATE_HZ, drive_constants_note
 from training.hinge_gain import hinge_gain_note
 from training.noise_level import white_noise_std
 from training.step_lag import StepLag, step_lag, step_lag_note
@@ -59,7 +59,7 @@ from training.viscosity import viscosity_note
 from training.zero_offset import offset_note
 
 MAX_RATE_HZ = 10_000.0
-MAX_SAMPLES = 50_000  # 10 s at 5 kHz (module docstring)
+MAX_SAMPLES = int(10.0 * KERNEL_FREE_RATE_HZ)  # a 10 s window (0.1–10 s are answered) at the unbiased rate
 GLITCH_STDS = 30.0
 GLITCH_ACTIVITY = 5.0
 ACTIVITY_HALF_WIDTH = 10  # samples each side whose median step sets the signal's local activity
