@@ -12,8 +12,9 @@ import time
 from collections import Counter
 from dataclasses import replace
 
-from benchmarks.foreign_accuracy import BOUND, RESULTS_MD, run_one
+from benchmarks.foreign_accuracy import RESULTS_MD, run_one
 from benchmarks.foreign_groups import group_seed, groups
+from benchmarks.tails import BOUND
 from clients.report import write_section
 from sim import runtime
 from tests.foreign.careless import SLIPS, Slip, exported

@@ -20,8 +20,8 @@ from typing import Any
 
 import numpy as np
 
-from benchmarks.foreign_accuracy import BOUND
 from benchmarks.foreign_groups import FAMILIES
+from benchmarks.tails import BOUND
 from clients.report import write_section
 from prognosis.documents import Prognosis, Stored
 from prognosis.prognose import Thresholds, prognose

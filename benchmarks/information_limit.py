@@ -33,8 +33,9 @@ from typing import Any
 
 import numpy as np
 
-from benchmarks.foreign_accuracy import BOUND, RESULTS_MD
+from benchmarks.foreign_accuracy import RESULTS_MD
 from benchmarks.foreign_groups import group_seed, groups
+from benchmarks.tails import expected_over
 from clients.report import write_section
 from sim import runtime
 from sim.hinge import HINGE_SMOOTHING_S, local_line
@@ -146,11 +147,6 @@ def one_window(group: str, i: int, draws: int) -> dict[str, np.ndarray]:
         "current": efficient_std(X, mask, operators, levels, ("current_a",)),
         "ours": our_rms(clean, truth, levels, draws, group_seed(group, i)),
     }
-
-
-def expected_over(stds: np.ndarray) -> float:
-    """Windows expected past ``BOUND`` for an unbiased Gaussian estimator with these stds."""
-    return float(sum(math.erfc(BOUND / s / math.sqrt(2)) for s in stds))
 
 
 def table(rows: dict[str, list[dict[str, np.ndarray]]]) -> str:

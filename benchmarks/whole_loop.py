@@ -35,7 +35,8 @@ import numpy as np
 
 from benchmarks.foreign_accuracy import RESULTS_MD
 from benchmarks.foreign_groups import group_seed, groups
-from benchmarks.information_limit import GROUPS, SENSORS, expected_over, noise_levels
+from benchmarks.information_limit import GROUPS, SENSORS, noise_levels
+from benchmarks.tails import expected_over
 from clients.report import write_section
 from sim import runtime
 from sim.params import HealthParams

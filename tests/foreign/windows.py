@@ -92,15 +92,23 @@ def with_spikes(drawn: Draw, seed: int) -> Draw:
 
 
 def noisy(
-    signals: dict[str, np.ndarray], rng: np.random.Generator, level: float, filter_samples: Mapping[str, int] = {}
+    signals: dict[str, np.ndarray],
+    rng: np.random.Generator,
+    level: float,
+    filter_samples: Mapping[str, int] = {},
+    samples_rng: np.random.Generator | None = None,
 ) -> dict[str, np.ndarray]:
     """Gaussian noise at ``level`` × NOISE (each signal ±30 % around it), each sensor's behind its
-    ``filter_samples`` moving average if given, then sensor quantization."""
+    ``filter_samples`` moving average if given, then sensor quantization. The levels come from ``rng``,
+    the samples from ``samples_rng`` if given (another realization at the same levels), else ``rng``."""
     out = {}
     for name, values in signals.items():
         sigma = NOISE.get(name, 0.0) * level * rng.uniform(0.7, 1.3)
         width = filter_samples.get(name, 1)
-        noisy_values = values + sigma * filtered(rng.standard_normal(len(values) + width - 1), width)
+        white = rng.standard_normal(len(values) + width - 1)  # drawn either way: the next levels stay
+        if samples_rng is not None:
+            white = samples_rng.standard_normal(len(white))
+        noisy_values = values + sigma * filtered(white, width)
         if name in QUANTUM:
             noisy_values = QUANTUM[name] * np.round(noisy_values / QUANTUM[name])
         out[name] = noisy_values
@@ -118,9 +126,11 @@ def draw(
     noise_level: float = 1.0,
     preroll_s: float | None = None,
     filter_samples: Mapping[str, int] = {},
+    noise_seed: int | None = None,
 ) -> Draw:
     """One window. Unset health and flight are drawn (health inside the thesis's ranges); windows of
-    the flight families start mid-motion (a pre-roll of 20–100 ms), the thesis family from rest."""
+    the flight families start mid-motion (a pre-roll of 20–100 ms), the thesis family from rest. A
+    ``noise_seed`` draws another realization of the same window's sensor noise (levels and filters kept)."""
     rng = np.random.default_rng(seed)
     if health is None:
         health = Health(fdj_nm=rng.uniform(0.04, 0.06), fsj_nm=rng.uniform(0.08, 0.12), eta_o=rng.uniform(0.68, 0.98))
@@ -130,7 +140,8 @@ def draw(
         preroll_s = 0.0 if family == "thesis" else float(rng.uniform(0.02, 0.1))
     command = commands.BY_NAME[family](rng, duration_s)
     setup = Setup(health, effects, flight, sample_rate_hz)
-    signals = noisy(simulate(setup, command, duration_s, preroll_s), rng, noise_level, filter_samples)
+    samples_rng = None if noise_seed is None else np.random.default_rng(noise_seed)
+    signals = noisy(simulate(setup, command, duration_s, preroll_s), rng, noise_level, filter_samples, samples_rng)
     document = {
         "schema": "ema-window/1",
         "actuator_id": f"foreign/{family}",
