@@ -32,9 +32,10 @@ In turn:
    the window's loads then read no gain more precisely (``training.hinge_gain``; a small load, where
    the gain is η_O's twin), the stds grow by half of what the ends of the ratio's band (the
    tolerance and its std) move FDJ and η_O (``banded``): 10 % moves FDJ by up to its range on a
-   steady load. Beyond the tolerance by ``SUSPECT_STDS`` only, the gauge is in doubt: the moment is
-   read as logged and the stds grow by ``UNDECIDED_SHARE`` of what dividing the ratio out would move
-   (1 of the 364 clean foreign windows, a 0.1 s one).
+   steady load. Beyond the tolerance by ``SUSPECT_STDS`` only, or in a shorter window, the gauge is
+   in doubt (``in_doubt``): the moment is read as logged and the stds grow by ``UNDECIDED_SHARE`` of
+   what reading the window with the ratio divided out first would move (``training.departures``; 1 of
+   the 364 clean foreign windows, a 0.1 s one).
 """
 
 from __future__ import annotations
@@ -52,7 +53,7 @@ from sim.window import Window
 from training.aircraft_band import BAND_S, band_noise_variance, band_part
 from training.baseline import JACKKNIFE_BLOCKS, jackknife_std
 from training.consistency import STEP_LAGS_S
-from training.drive_constants import BESIDE, UNDECIDED_SHARE
+from training.drive_constants import BESIDE
 from training.hinge_gain import divided_hinge, free_load_fit
 from training.preprocess import fit_as_read
 
@@ -87,6 +88,11 @@ class AircraftCheck:
     def beyond(self, stds: float) -> bool:
         """Whether the ratio lies beyond the tolerance by ``stds`` of its stds."""
         return bool(abs(self.ratio - 1.0) > TOLERANCE + stds * self.ratio_std)
+
+    @property
+    def in_doubt(self) -> bool:
+        """Beyond the tolerance by ``SUSPECT_STDS`` but not divided out (module docstring, 3)."""
+        return self.factor == 1.0 and self.beyond(SUSPECT_STDS)
 
     def corrected(self, window: Window) -> Window:
         """``window`` with its hinge moment divided by ``factor``."""
@@ -192,11 +198,9 @@ def banded(
     it departs) where the window's own loads read no ``gain`` (``training.hinge_gain``); as it is
     otherwise. Divided out: half of what the ends of the ratio's band move them (the tolerance and the
     ratio's std, narrowed by what the loads' free fit knows of the gain where it agrees within 2 stds).
-    In doubt: ``UNDECIDED_SHARE`` of what dividing the ratio out would move them."""
-    if gain != 1.0 or not read.beyond(SUSPECT_STDS):
+    In doubt, the whole reading moves (``training.departures``)."""
+    if gain != 1.0 or read.factor == 1.0 or not read.beyond(SUSPECT_STDS):
         return read
-    if read.factor == 1.0:
-        return replace(read, spread=_moved(window, actuator, 1.0, read.ratio, UNDECIDED_SHARE))
     band = math.hypot(TOLERANCE, read.ratio_std / read.ratio)
     fitted = free_load_fit(window, actuator, BESIDE)
     if fitted is not None:

@@ -11,7 +11,9 @@ end and the window simulated with each: the one whose replay follows the motor s
 clearly better, and within twice the noise, is taken (``_told_apart``). Where neither does, both ends
 stand: what is read after them moves with the choice (a worn gust window read γ where J_M was 0.5 %
 light, then its viscous coefficient 0.63x, FDJ 66 % of range off; read with ΔJ instead, 1.0x and
-right), so the stds grow by ``UNDECIDED_SHARE`` of how far the two ends lie apart.
+right), so the stds grow by ``UNDECIDED_SHARE`` of how far the two ends lie apart. So too where the
+aircraft only puts the strain gauge's gain in doubt: the window is read as logged and with the aircraft's
+ratio divided out first (``_doubted``).
 """
 
 from __future__ import annotations
@@ -79,9 +81,29 @@ def read_departures(
     """The window corrected for what it shows beyond ``actuator``, and what that was (module docstring);
     its hinge moment's gain divided out first where the ``aircraft`` reads one; what other windows of the
     actuator read (``known``): the sensors' zero of its flight (``zero_offset.read_zero_offset``), its J_M
-    where the window cannot tell a heavier rotor from a weaker motor (``_by_history``)."""
-    zero = known.zero
+    where the window cannot tell a heavier rotor from a weaker motor (``_by_history``). Where the aircraft
+    only puts the gauge's gain in doubt, its stds grow by ``UNDECIDED_SHARE`` of how far the reading moves
+    with the gain divided out first (``_doubted``)."""
     aircraft = divided_out(aircraft)
+    read = _read(window, actuator, aircraft, known)
+    if not aircraft.in_doubt:
+        return read
+    return _doubted(read, _read(window, actuator, replace(aircraft, factor=aircraft.ratio), known))
+
+
+def _doubted(read: Departures, divided: Departures) -> Departures:
+    """``read``, its aircraft's spread ``UNDECIDED_SHARE`` of how far the answer of the window read with the
+    aircraft's ratio ``divided`` out first lies: what an offset read on the moment as logged took in of the
+    gain stays there (dividing the ratio out of the zeroed moment of a 0.1 s window in lbf·ft moved η_O
+    0.004, dividing it out first 0.18, to the truth)."""
+    mine, theirs = read.answer, divided.answer
+    spread = {name: UNDECIDED_SHARE * abs(mine[name] - theirs[name]) for name in mine}
+    return replace(read, aircraft=replace(read.aircraft, spread=spread))
+
+
+def _read(window: Window, actuator: ActuatorParams, aircraft: AircraftCheck, known: Known) -> Departures:
+    """``read_departures`` with ``aircraft``'s factor as decided."""
+    zero = known.zero
     window = aircraft.corrected(window)
     offset = read_zero_offset(window, actuator, zero)
     hinge = read_hinge_gain(zeroed(window, offset), actuator, leading=True)

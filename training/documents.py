@@ -31,7 +31,8 @@ class ParameterEstimate(Document):
     weakly_determined: bool = Field(
         default=False,
         description="the window holds little of this parameter: its ±2 std spans more than 10 % of the healthy "
-        "range (a short window, a slow log, a hinge load that barely varies); the notes say so in words",
+        "range (a short window, a slow log, a hinge load that barely varies), or Eq. 5.1 put η_O at an end of the "
+        "physical search range (a bound rather than a value, FDJ read with it held there); the notes say so in words",
     )
 
 

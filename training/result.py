@@ -50,8 +50,10 @@ def weakly_determined(name: str, std: float) -> bool:
     return share_of_range(name, 2 * std) > WEAK_SHARE_OF_RANGE
 
 
-def _estimates(answer: Assessed, fsj: StaticFriction) -> Estimates:
-    """FDJ and η_O as assessed, η_A by Eq. 3.4 (its std through the derivative), FSJ and FSD if read."""
+def _estimates(answer: Assessed, fsj: StaticFriction, eta_o_bound: bool) -> Estimates:
+    """FDJ and η_O as assessed, η_A by Eq. 3.4 (its std through the derivative), FSJ and FSD if read; each
+    weakly determined where its std says so, and both where Eq. 5.1 put η_O at a bound (``eta_o_bound``):
+    FDJ was read with η_O held there."""
     eta_o, eta_o_std = answer.values["eta_O"], answer.stds["eta_O"]
     slope = float((eta_a_from_eta_o(eta_o + 1e-6) - eta_a_from_eta_o(eta_o - 1e-6)) / 2e-6)
     fdj = answer.values["FDJ"]
@@ -59,9 +61,13 @@ def _estimates(answer: Assessed, fsj: StaticFriction) -> Estimates:
     if fsj.value_nm is not None and fsj.std_nm is not None:
         relative = np.hypot(fsj.std_nm / fsj.value_nm, answer.stds["FDJ"] / fdj)
         ratio = RatioEstimate(value=fsj.value_nm / fdj, std=fsj.value_nm / fdj * relative)
-    weak_eta = weakly_determined("eta_O", eta_o_std)  # η_A is η_O's through Eq. 3.4, and as weak
+    # η_A is η_O's through Eq. 3.4, and as weak; a bound of the search is no value, whatever its std (a 0.1 s
+    # window with its current logged 0.71x read η_O 0.999 ± 0.009 at the bound, the truth 0.70; a cruise
+    # window's moment in lbf·ft put η_O there and FDJ 15 % of its range off at 3.3 std)
+    weak_eta = weakly_determined("eta_O", eta_o_std) or eta_o_bound
+    weak_fdj = weakly_determined("FDJ", answer.stds["FDJ"]) or eta_o_bound
     return Estimates(
-        FDJ=parameter(fdj, answer.stds["FDJ"], NOMINAL["FDJ"], weakly_determined("FDJ", answer.stds["FDJ"])),
+        FDJ=parameter(fdj, answer.stds["FDJ"], NOMINAL["FDJ"], weak_fdj),
         eta_O=parameter(eta_o, eta_o_std, NOMINAL["eta_O"], weak_eta),
         eta_A=parameter(float(eta_a_from_eta_o(eta_o)), abs(slope) * eta_o_std, NOMINAL_ETA_A, weak_eta),
         FSJ=None if fsj.value_nm is None else parameter(fsj.value_nm, fsj.std_nm, DEFAULT_RANGES.nominal_fsj_nm),
@@ -73,7 +79,7 @@ def _notes(prepared: Prepared, physics: FrictionFit, estimates: Estimates, check
     notes = [*check.notes, *conditioning_notes(prepared)]
     for name in TARGETS:
         entry = getattr(estimates, name)
-        if entry.weakly_determined:
+        if weakly_determined(name, entry.std):
             low, high = HEALTHY_RANGE[name]
             spread = share_of_range(name, 2 * entry.std)
             notes.append(
@@ -82,7 +88,10 @@ def _notes(prepared: Prepared, physics: FrictionFit, estimates: Estimates, check
                 "holds little of it (trend it with its std)"
             )
     if physics.at_search_edge[0]:
-        notes.append("η_O lies at an end of the physical search range: read it as a bound, not a value")
+        notes.append(
+            "η_O lies at an end of the physical search range: read it as a bound, not a value, and FDJ, read with "
+            "η_O held there, as weakly determined"
+        )
     if estimates.FDJ.value <= 0:
         notes.append("FDJ ≤ 0 is not a friction: the model does not describe this window (see fit_check)")
     if estimates.eta_A.value < 0:
@@ -133,7 +142,7 @@ def estimate_document(
 ) -> Estimate:
     """The document of one window's run; ``clock`` holds the stages' start times and the end."""
     w = prepared.window
-    estimates = _estimates(answer, fsj)
+    estimates = _estimates(answer, fsj, bool(physics.at_search_edge[0]))
     first = network.fits_[0]
     return Estimate(
         actuator_id=w.actuator_id,
