@@ -69,3 +69,17 @@ def test_on_a_worn_actuator_too_the_j_m_its_thesis_window_read_decides(seed, fam
     decided = _drive(heavier, InertiaReading(factor=thesis.drive.inertia_factor, std=std, window_ids=["thesis"]))
     assert decided.inertia_from == ("thesis",) and decided.drive.inertia_factor == pytest.approx(factor, abs=0.005)
     assert abs(decided.answer["FDJ"] - heavier.truth["FDJ"]) < 0.03 * 0.02  # within 3 % of FDJ's range
+
+
+def test_a_gauge_gain_in_doubt_that_only_a_drive_no_one_has_explains_does_not_refuse_the_window():
+    """A clean foreign 0.1 s gust whose deflection band reads the moment 2.8x the aircraft's (its curvature,
+    where α_t answers δ): with that ratio divided out first, Eq. 5.1 wants a motor 0.33x as strong, and the
+    window was refused as a current in other units. The story is refuted; the window is answered as logged."""
+    drawn = draw(4821, "gust", duration_s=0.1)
+    prepared = prepare(window_from_dict(drawn.document))
+    aircraft = prepared.departures.aircraft
+    assert aircraft.in_doubt and aircraft.spread == {}
+    w = prepared.window
+    fitted = fit_window(as_read(w.signals, w.sample_rate_hz), w.sample_rate_hz, prepared.actuator)
+    std = widened({"FDJ": float(fitted.fdj_std_nm[0])}, prepared)["FDJ"]
+    assert abs(float(fitted.fdj_nm[0]) - drawn.truth["FDJ"]) < 2 * std
