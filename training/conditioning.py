@@ -38,7 +38,7 @@ default sizes for 10 s at 5 kHz): within what the service already admits for a 1
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -54,6 +54,7 @@ from training.departures import Departures, Known, history_note, read_departures
 from training.drive_constants import KERNEL_FREE_RATE_HZ, drive_constants_note
 from training.hinge_gain import hinge_gain_note
 from training.noise_level import white_noise_std
+from training.stale import Stale, line_between_flanks, stale_note, without_stale
 from training.step_lag import StepLag, step_lag, step_lag_note
 from training.viscosity import viscosity_note
 from training.zero_offset import offset_note
@@ -78,6 +79,7 @@ class Prepared:
     lags: Lags  # how late the current (behind the speed) and the hinge moment were logged, undone
     departures: Departures  # what it shows beyond the spec's model (an offset, k_T and J_M, g, C), undone
     step: StepLag  # how likely its hinge moment is out of step, where that is too unclear to refuse it
+    stale: Stale = field(default_factory=Stale)  # sensors that repeated one value while the shaft slid: cut out
 
     @property
     def window(self) -> Window:
@@ -136,8 +138,7 @@ def repaired(window: Window) -> tuple[Window, dict[str, int]]:
         floor = glitch_floor(values)
         for run in range(1, longest + 1):
             for start in glitch_starts(values, run, floor):
-                share = np.arange(1, run + 1) / (run + 1)
-                values[start : start + run] = values[start - 1] + share * (values[start + run] - values[start - 1])
+                values[start : start + run] = line_between_flanks(values, start, start + run)
                 replaced += run
         if replaced:
             signals[name], counts[name] = values, replaced
@@ -147,12 +148,15 @@ def repaired(window: Window) -> tuple[Window, dict[str, int]]:
 def prepare(
     window: Window, actuator: ActuatorParams = ActuatorParams(), spec_only: bool = False, known: Known | None = None
 ) -> Prepared:
-    """Repair ``window``'s glitches, average it down to the pipeline's sizes, check its signals agree
-    (``training.consistency``: InputError naming the field), put its sensors on one clock
-    (``training.alignment``), read what it shows beyond ``actuator`` (``training.departures``) and weigh
-    whether its hinge moment is out of step (``training.step_lag``); say what it found. ``spec_only``
-    skips the departures and the step: ``calibration`` reads the spec's model alone and names what departs.
-    ``known``: what other windows of the actuator read (``departures.read_departures``)."""
+    """Cut ``window`` to a stretch its sensors kept updating in (``training.stale``), repair its glitches,
+    average it down to the pipeline's sizes, check its signals agree (``training.consistency``: InputError
+    naming the field), put its sensors on one clock (``training.alignment``), read what it shows beyond
+    ``actuator`` (``training.departures``) and weigh whether its hinge moment is out of step
+    (``training.step_lag``); say what it found. ``spec_only`` skips the departures and the step:
+    ``calibration`` reads the spec's model alone and names what departs. ``known``: what other windows of
+    the actuator read (``departures.read_departures``)."""
+    logged = window.n_samples
+    window, stale = without_stale(window, actuator)
     window, glitches = repaired(window)
     factor = averaging_factor(window.n_samples, window.sample_rate_hz)
     command = window.signals["command_deg"]
@@ -172,7 +176,7 @@ def prepare(
     rate = read.window.sample_rate_hz * factor
     # with the departures left in, a lag fits what they leave (an offset: ln LR 105): the story is no test there
     step = StepLag() if spec_only else step_lag(read.window, read.actuator)
-    return Prepared(factor, len(command), rate, clipped, glitches, consistent, lags, read, step)
+    return Prepared(factor, logged, rate, clipped, glitches, consistent, lags, read, step, stale)
 
 
 def widened(stds: dict[str, float], prepared: Prepared) -> dict[str, float]:
@@ -197,6 +201,8 @@ def conditioning_done(prepared: Prepared) -> dict[str, Any]:
     return {
         "command_clipped_fraction": prepared.command_clipped_fraction,
         "glitches_repaired": prepared.glitches,
+        "stale_samples": prepared.stale.samples,
+        "read_span": None if prepared.stale.span is None else list(prepared.stale.span),
         "kinematic_gain": prepared.consistency.travel_gain,
         "current_lag_s": prepared.lags.current_s,
         "hinge_lag_s": prepared.lags.hinge_s,
@@ -234,6 +240,7 @@ def conditioning_notes(prepared: Prepared) -> list[str]:
             f"by {1e6 * lags.hinge_s:.0f} µs (the weighted lag) before Eq. 5.1, the stds include the lags' spread"
         )
     found = (
+        stale_note(prepared.stale),
         kinematics_note(prepared.consistency),
         offset_note(prepared.departures.offset),
         drive_constants_note(prepared.departures.drive),

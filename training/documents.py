@@ -126,6 +126,15 @@ class WindowInfo(Document):
         description=f"per sensor, samples of glitches (runs off both flanks by > {GLITCH_STDS:g} noise stds), "
         "replaced by the line between the flanks",
     )
+    stale_samples: dict[str, int] = Field(
+        default_factory=dict,
+        description="per sensor, samples of runs that repeated one value exactly while the shaft slid (a sensor that "
+        "stopped updating, a logging gap filled in): left out, the window read from read_span",
+    )
+    read_span: list[int] | None = Field(
+        default=None,
+        description="[first, one past the last] logged sample read, where stale runs cut the window (null: all)",
+    )
     current_lag_s: float = Field(
         default=0.0, description="how late the current is logged behind the speed (negative: the speed), undone"
     )
