@@ -1,5 +1,5 @@
-"""Sensors that stopped updating: found only where they cannot be a working sensor, cut out, and the window
-read from what is left, on windows of the independent implementation (``tests.foreign``)."""
+"""Sensors that stopped updating: found only where they cannot be a working sensor, bridged or cut out, and
+the window read from what is left, on windows of the independent implementation (``tests.foreign``)."""
 
 import copy
 
@@ -9,9 +9,10 @@ import pytest
 from benchmarks.foreign_groups import groups
 from sim.checks import InputError
 from sim.window import window_from_dict
+from tests.foreign.faults import FAULTS, Fault, frozen, stretch, with_fault
 from tests.foreign.windows import draw
 from training.baseline import fit_window
-from training.conditioning import conditioning_done, conditioning_notes, prepare, widened
+from training.conditioning import Prepared, conditioning_done, conditioning_notes, prepare, widened
 from training.preprocess import as_read
 from training.result import share_of_range
 from training.stale import MIN_STALE_SAMPLES, stale_runs
@@ -19,21 +20,18 @@ from training.stale import MIN_STALE_SAMPLES, stale_runs
 FAMILIES = ("thesis", "cruise", "gust", "doublet", "steps")
 
 
-def _frozen(document: dict, name: str, start: int, stop: int, value: float | None = None) -> dict:
-    """``document`` with ``name`` repeating its sample at ``start`` (or ``value``: a gap filled in) until ``stop``."""
-    out = copy.deepcopy(document)
-    samples = out["signals"][name]
-    samples[start:stop] = [samples[start] if value is None else value] * (stop - start)
-    return out
+def _physics(document: dict) -> tuple[dict[str, float], dict[str, float], Prepared]:
+    """Eq. 5.1's answer to the window as prepared, its stds widened by what conditioning left open."""
+    prepared = prepare(window_from_dict(document))
+    w = prepared.window
+    fitted = fit_window(as_read(w.signals, w.sample_rate_hz), w.sample_rate_hz, prepared.actuator)
+    stds = widened({"FDJ": float(fitted.fdj_std_nm[0]), "eta_O": float(fitted.eta_o_std[0])}, prepared)
+    return {"FDJ": float(fitted.fdj_nm[0]), "eta_O": float(fitted.eta_o[0])}, stds, prepared
 
 
-def _fault(seed: int, n: int) -> tuple[str, int, int, float | None]:
-    """A sensor, a run of 5–25 % of the window somewhere inside it, and whether it holds its last value or 0."""
-    rng = np.random.default_rng(seed)
-    name = ("current_a", "motor_speed_radps", "hinge_moment_nm")[seed % 3]
-    length = int(rng.uniform(0.05, 0.25) * n)
-    start = int(rng.integers(1, n - length - 1))
-    return name, start, start + length, (None, 0.0)[seed % 2]
+def _fault(seed: int) -> Fault:
+    """A sensor of the three Eq. 5.1 reads, in turn, holding its last value or at 0 in turn, over 5–25 %."""
+    return Fault(("current_a", "motor_speed_radps", "hinge_moment_nm")[seed % 3], (None, 0.0)[seed % 2])
 
 
 @pytest.mark.parametrize("group", ["gust", "low log rate (1-2 kHz)", "held position", "sensors behind filters"])
@@ -47,18 +45,14 @@ def test_a_frozen_or_dropped_out_sensor_is_cut_out_and_the_rest_read_within_its_
     """Left in, a speed frozen over a fifth of a window put FDJ 0.3–7 ranges off, said weak."""
     covered, errors = 0, []
     for k, seed in enumerate(range(5300, 5312)):
-        drawn = draw(seed, FAMILIES[k % 5])
-        n = len(drawn.document["signals"]["current_a"])
-        name, start, stop, value = _fault(seed, n)
-        prepared = prepare(window_from_dict(_frozen(drawn.document, name, start, stop, value)))
+        drawn, fault = draw(seed, FAMILIES[k % 5]), _fault(seed)
+        name, n = fault.signal, len(drawn.document["signals"]["current_a"])
+        start, stop = stretch(drawn.document, fault, seed)
+        answer, std, prepared = _physics(with_fault(drawn.document, fault, seed))
         span = conditioning_done(prepared)["read_span"]
         assert span in ([0, start], [stop, n]), f"{name} frozen over [{start}, {stop}), read {span}"
         assert prepared.stale.samples[name] >= stop - start - 1
         assert any(note.startswith(f"{name} repeats") for note in conditioning_notes(prepared))
-        w = prepared.window
-        fitted = fit_window(as_read(w.signals, w.sample_rate_hz), w.sample_rate_hz, prepared.actuator)
-        std = widened({"FDJ": float(fitted.fdj_std_nm[0]), "eta_O": float(fitted.eta_o_std[0])}, prepared)
-        answer = {"FDJ": float(fitted.fdj_nm[0]), "eta_O": float(fitted.eta_o[0])}
         covered += all(abs(answer[p] - drawn.truth[p]) <= 2 * std[p] for p in answer)
         errors.extend(abs(share_of_range(p, answer[p] - drawn.truth[p])) for p in answer)
     assert covered >= 11 and max(errors) < 0.1, f"{covered} of 12 covered, worst {max(errors):.3f} of range"
@@ -91,26 +85,20 @@ def test_a_window_with_too_little_sliding_left_is_refused_naming_the_sensor():
     drawn = draw(5600, "doublet")
     n = len(drawn.document["signals"]["current_a"])
     with pytest.raises(InputError, match="repeats 0 exactly") as refused:
-        prepare(window_from_dict(_frozen(drawn.document, "current_a", n // 20, n - n // 20, 0.0)))
+        prepare(window_from_dict(frozen(drawn.document, "current_a", n // 20, n - n // 20, 0.0)))
     assert refused.value.field == "signals.current_a"
 
 
 def test_a_dropout_shorter_than_the_kernel_is_bridged_and_the_window_read_whole():
-    """A current dropping to zero for 1.8 ms at slew moved FDJ by a median 4 of its stds (up to 80); 5 samples
+    """A current dropping to zero for 1.8 ms at slew moved FDJ by a median 4 of its stds (up to 84); 5 samples
     at 0 are no glitch for the glitch repair (3 at most) and barely improbable as repeats: they jump."""
-    shifts = []
+    shifts, dropout = [], FAULTS["current at 0 for 0.5-2 ms at slew"]
     for k, seed in enumerate(range(5800, 5810)):
         drawn = draw(seed, FAMILIES[k % 5])
-        fast = np.flatnonzero(np.abs(drawn.document["signals"]["motor_speed_radps"]) > 300)
-        at = int(fast[len(fast) // 2])
+        start, _ = stretch(drawn.document, dropout, seed)
+        clean, _, _ = _physics(drawn.document)
         for length in (5, 18):
-            answers = []
-            for document in (drawn.document, _frozen(drawn.document, "current_a", at, at + length, 0.0)):
-                prepared = prepare(window_from_dict(document))
-                w = prepared.window
-                fitted = fit_window(as_read(w.signals, w.sample_rate_hz), w.sample_rate_hz, prepared.actuator)
-                answers.append((float(fitted.fdj_nm[0]), widened({"FDJ": float(fitted.fdj_std_nm[0])}, prepared)))
+            bridged, std, prepared = _physics(frozen(drawn.document, "current_a", start, start + length, 0.0))
             assert prepared.stale.samples == {"current_a": length} and prepared.stale.span is None
-            (clean, _), (bridged, std) = answers
-            shifts.append(abs(bridged - clean) / std["FDJ"])
+            shifts.append(abs(bridged["FDJ"] - clean["FDJ"]) / std["FDJ"])
     assert np.median(shifts) < 0.3 and max(shifts) < 1.5, f"FDJ moved by {np.round(shifts, 2)} of its std"
