@@ -113,16 +113,20 @@ def line_between_flanks(values: np.ndarray, start: int, stop: int) -> np.ndarray
     return values[start - 1] + share * (values[stop] - values[start - 1])
 
 
-def shows_noise(values: np.ndarray, starts: np.ndarray, stops: np.ndarray) -> bool:
-    """Whether the sensor's noise spans its resolution (module docstring, 1), read outside the runs
-    [``starts``, ``stops``) (a robust std, which a run over most of the window would bring to 0)."""
+def noise_outside(values: np.ndarray, starts: np.ndarray, stops: np.ndarray) -> float | None:
+    """The sensor's white noise std read outside the runs [``starts``, ``stops``) (a robust std, which a run
+    over most of the window would bring to 0), or None where it does not span the resolution (module
+    docstring, 1) or too few samples are left to read it."""
     outside = np.ones(len(values), dtype=bool)
     for start, stop in zip(starts, stops, strict=True):
         outside[start:stop] = False
     rest = values[outside]
     steps = np.abs(np.diff(rest))
     moved = steps[steps > 0]
-    return len(rest) >= NOISE_SAMPLES and len(moved) > 0 and white_noise_std(rest) >= float(moved.min())
+    if len(rest) < NOISE_SAMPLES or not len(moved):
+        return None
+    noise = white_noise_std(rest)
+    return noise if noise >= float(moved.min()) else None
 
 
 def improbable(repeats: int, repeats_in_signal: int, pairs: int) -> bool:
@@ -166,9 +170,10 @@ def stale_runs(window: Window, actuator: ActuatorParams = ActuatorParams()) -> t
         values = window.signals[name]
         starts, stops = equal_runs(values)
         long = (stops - starts >= MIN_STALE_SAMPLES) & (stops - starts < n)  # a whole window: consistency's
-        if not long.any() or not shows_noise(values, starts[long], stops[long]):
+        noise = noise_outside(values, starts[long], stops[long]) if long.any() else None
+        if noise is None:
             continue
-        repeats, jump = int(np.sum(stops - starts - 1)), DROPOUT_STDS * white_noise_std(values)
+        repeats, jump = int(np.sum(stops - starts - 1)), DROPOUT_STDS * noise
         for start, stop in zip(starts[long], stops[long], strict=True):
             run = StaleRun(name, int(start), int(stop), float(values[start]))
             unlikely = improbable(run.stop - run.start - 1, repeats, n - 1) or stands_off(values, run, jump)
