@@ -128,8 +128,9 @@ class WindowInfo(Document):
     )
     stale_samples: dict[str, int] = Field(
         default_factory=dict,
-        description="per sensor, samples of runs that repeated one value exactly while the shaft slid (a sensor that "
-        "stopped updating, a logging gap filled in): left out, the window read from read_span",
+        description="per sensor, samples of runs that repeated one value exactly where a working sensor shows its "
+        "noise (it stopped updating, or a logging gap was filled in): a run up to the 2 ms reconstruction kernel "
+        "bridged by the line between its flanks, a longer one cut out with the window read from read_span",
     )
     read_span: list[int] | None = Field(
         default=None,

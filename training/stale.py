@@ -52,7 +52,7 @@ import numpy as np
 from sim.checks import InputError
 from sim.noise import NOISY_SIGNALS
 from sim.params import ActuatorParams
-from sim.residual import kernel_samples
+from sim.residual import DEFAULT_DERIVATIVE_WINDOW_S, kernel_samples
 from sim.window import Window
 from training.baseline import MIN_SLIDING_KERNELS, FitSettings
 from training.noise_level import white_noise_std
@@ -231,7 +231,8 @@ def stale_note(stale: Stale) -> str | None:
         return None
     listed = "; ".join(f"{run.signal} {run.describe(stale.rate_hz)}" for run in runs[:3])
     more = f" (and {len(runs) - 3} more runs)" if len(runs) > 3 else ""
-    done = "the runs of up to 2 ms bridged by the line between their flanks" if stale.bridged else ""
+    bridge_ms = 1e3 * DEFAULT_DERIVATIVE_WINDOW_S
+    done = f"the runs of up to {bridge_ms:g} ms bridged by the line between their flanks" if stale.bridged else ""
     if stale.span is not None:
         start, stop = stale.span
         done += "; " if done else ""
