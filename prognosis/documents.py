@@ -57,8 +57,10 @@ class Trend(Document):
     n: int
     level: float = Field(description="the line's value at the last window (with the curve weighed in: now())")
     level_std: float
-    slope_per_unit: float
-    slope_std: float
+    slope_per_unit: float = Field(description="0 where the windows span no time (slope_std null)")
+    slope_std: float | None = Field(
+        description="null: the windows span no time (one window, or all at one time): a level with no slope"
+    )
     level_slope_correlation: float = Field(
         0.0, ge=-1, le=1, description="of the level's and the slope's errors (the level is quoted at the last window)"
     )
@@ -77,6 +79,8 @@ class Trend(Document):
 
     def std_at(self, offset: float) -> float:
         """The std of the trend's value ``offset`` time units after the last window (level and slope correlated)."""
+        if self.slope_std is None:
+            return self.level_std if offset == 0 else float("inf")
         level, slope = self.level_std, self.slope_std * offset
         return float(np.sqrt(max(level**2 + 2 * self.level_slope_correlation * level * slope + slope**2, 0.0)))
 

@@ -86,7 +86,7 @@ def sensor_trends(stored: Sequence[Stored], times: np.ndarray, unit: str) -> tup
             f"{trend.n} windows, beyond the model's {100 * TOLERANCE:.0f} % tolerance: recalibrate the gauge, or the "
             "airframe's C_hδ is off (each estimate divides the gauge's gain out where its window is long enough)"
         )
-    if abs(trend.slope_per_unit) > SENSOR_STDS * trend.slope_std:
+    if trend.slope_std is not None and abs(trend.slope_per_unit) > SENSOR_STDS * trend.slope_std:
         notes.append(
             f"the hinge moment's strain gauge drifts against the aircraft model by {trend.slope_per_unit:+.2g} "
             f"± {trend.slope_std:.2g} per {unit.replace('_', ' ').rstrip('s')}"

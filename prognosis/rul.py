@@ -24,7 +24,7 @@ def remaining_life(trend: Trend, threshold: float, direction: str, seed: int = 0
     """RUL of ``trend`` to ``threshold``, crossed going ``direction`` ("above" or "below")."""
     sign = 1.0 if direction == "above" else -1.0
     common = {"parameter": trend.parameter, "threshold": threshold, "direction": direction}
-    if trend.n < MIN_WINDOWS:
+    if trend.n < MIN_WINDOWS or trend.slope_std is None:  # a level at one time says nothing of where it goes
         return RemainingLife(**common, status="too few windows", rul=None, rul_low=None, rul_high=None,
                              probability_degrading=None)  # fmt: skip
     if sign * (trend.level - threshold) >= 0:

@@ -87,12 +87,17 @@ def fit_trend(
     x = times - times.max()
     known = np.isfinite(stds) & (stds > 0)
     variance = np.where(known, stds, np.median(stds[known]) if known.any() else 0.0) ** 2
-    line = robust_fit(x, values, variance, 1)
+    spans_time = len(np.unique(x)) > 1
+    line = robust_fit(x, values, variance, 1 if spans_time else 0)
     beta, covariance, z = line["beta"], line["covariance"], line["z"]
     points = [
         Point(window_id=w, time=float(t), value=float(v), std=float(s) if k else None, outlier=bool(zz > OUTLIER_Z))
         for w, t, v, s, k, zz in zip(window_ids, times, values, stds, known, z, strict=True)
     ]
+    if not spans_time:  # one time holds no slope: the level alone, said so by a null slope_std
+        level_std = float(np.sqrt(covariance[0, 0]))
+        return Trend(parameter=parameter, n=len(x), level=float(beta[0]), level_std=level_std, slope_per_unit=0.0,
+                     slope_std=None, excess_std=float(np.sqrt(line["tau2"])), points=points)  # fmt: skip
     return Trend(
         parameter=parameter,
         n=len(x),

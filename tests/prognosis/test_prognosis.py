@@ -178,3 +178,13 @@ def test_the_actuators_j_m_is_its_windows_readings_and_a_replaced_part_is_said(o
     assert len(prognosis.inertia.window_ids) == 10 and prognosis.inertia.std > 0.002  # no change: all, widened
     assert any("times as far apart as their stds allow" in note for note in prognosis.notes)
     assert with_reads([None] * 5).inertia is None
+
+
+@pytest.mark.parametrize("times", [[5.0], [5.0, 5.0], [5.0, 5.0, 5.0, 5.0]])
+def test_windows_at_one_time_are_a_level_with_no_slope(times):
+    n = len(times)
+    trend = fit_trend("FDJ", np.array(times), np.full(n, 0.06), np.full(n, 1e-3), [str(i) for i in range(n)])
+    assert trend.level == pytest.approx(0.06) and trend.slope_std is None
+    assert trend.level_std == pytest.approx(1e-3 / np.sqrt(n))
+    assert remaining_life(trend, THRESHOLD, "above").status == "too few windows"
+    trend.model_dump_json()  # finite: JSON carries it
