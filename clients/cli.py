@@ -14,7 +14,7 @@ from collections.abc import Sequence
 import click
 
 from clients import commands_fleet, commands_local, commands_remote
-from clients.options import PipeClosedError
+from clients.options import NothingAnsweredError, PipeClosedError
 
 EXIT_OK, EXIT_INTERNAL, EXIT_BAD_INPUT, EXIT_INTERRUPTED = 0, 1, 2, 130
 
@@ -45,8 +45,17 @@ def _bad_input(exc: BaseException) -> str | None:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Run ``ema`` and return its exit status (never a traceback for input errors or interruptions)."""
-    arguments = list(sys.argv[1:] if argv is None else argv)
+    """Run ``ema`` and return its exit status (never a traceback for input errors or interruptions); the
+    simulator's threads end with it, however it ends."""
+    try:
+        return _run(list(sys.argv[1:] if argv is None else argv))
+    finally:
+        simulator = sys.modules.get("sim.runtime")
+        if simulator is not None:
+            simulator.shutdown()
+
+
+def _run(arguments: list[str]) -> int:
     name = next((a for a in arguments if not a.startswith("-")), "")
     try:
         ema.main(args=arguments, prog_name="ema", standalone_mode=False)
@@ -60,6 +69,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("\nema: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
+    except NothingAnsweredError as exc:
+        print(f"ema {name}: {exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
     except PipeClosedError:
         # The reader stopped reading (| head): nothing left to say, and Python must not try at exit.
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())

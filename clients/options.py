@@ -69,6 +69,10 @@ def progress(text: str) -> None:
     print(f"ema: {text}…", file=sys.stderr, flush=True)
 
 
+class NothingAnsweredError(Exception):
+    """A batch command ran, but no window of its input was answered: exit 2 after its report."""
+
+
 class PipeClosedError(Exception):
     """The reader of our output went away (``| head``): not an OSError, so that click leaves it to us."""
 

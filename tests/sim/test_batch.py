@@ -201,3 +201,30 @@ def test_bad_input_names_the_argument(kwargs, field):
     with pytest.raises(InputError) as error:
         simulate_batch(**arguments)
     assert error.value.field == field
+
+
+def test_an_interrupted_batch_runs_none_of_its_queued_groups(monkeypatch):
+    """Ctrl-C while a batch runs: the groups still queued are cancelled, and ``runtime.shutdown`` lets the
+    threads end after the group each runs (Python's exit would otherwise run every queued group first)."""
+    import _thread
+    import threading
+    import time
+
+    from sim import batch, runtime
+
+    ran = []
+
+    def slow_group(*args):
+        time.sleep(0.02)
+        ran.append(1)
+
+    monkeypatch.setattr(batch.kernels, "run_group", slow_group)
+    runtime.set_threads(2)
+    timer = threading.Timer(0.1, _thread.interrupt_main)
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        batch.run_groups((), np.empty((1, 400 * 8, 1)), 8)  # 400 groups: 4 s on two threads
+    runtime.shutdown()
+    settled = len(ran)
+    time.sleep(0.2)
+    assert settled < 50 and len(ran) <= settled + 2
