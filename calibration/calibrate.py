@@ -83,22 +83,27 @@ class Calibrator:
         windows: Sequence[Window],
         truth: Mapping[str, float] | None = None,
         on_stage: Callable[[str], None] | None = None,
+        checkpoint: Callable[[], None] | None = None,
     ) -> Calibrator:
+        """Run the stages once each (see the module docstring); ``on_stage`` hears each stage as it starts,
+        ``checkpoint`` is called between the pieces of a stage (both may raise to stop the job there)."""
         stage = on_stage or (lambda _: None)
+        check = checkpoint or (lambda: None)
         started = time.perf_counter()
         prepared = self._check(windows)
         stage(f"estimating {len(prepared)} window(s) with the base model")
-        base = [estimate_window(w, self.pipeline, spec_only=True) for w in prepared]
+        base = [estimate_window(w, self.pipeline, on_stage=lambda _: check(), spec_only=True) for w in prepared]
         before = combined(base)
         bias = {n: float(np.mean([r.methods[n].physics_bias for r in base])) for n in TARGETS}
         noise = [SensorNoise(**r.dataset.noise_estimated) for r in base]
         rate = prepared[0].sample_rate_hz
         measured = equations([w.signals for w in prepared], rate, COGGING_ORDERS)
         stage(f"simulating {self.copies} noise-only copies")
-        copies = noise_copies(clean_replicas(prepared, before), noise, rate, COGGING_ORDERS, self.seed, self.copies)
+        copies = noise_copies(clean_replicas(prepared, before), noise, rate, COGGING_ORDERS, self.seed, self.copies,
+                              on_copy=check)  # fmt: skip
         families = named_families(measured, ActuatorParams()) + generic_families(measured)
         stage(f"scoring {len(families)} candidate families against the noise floor")
-        chosen, steps, first_round, unnamed = self._select(measured, copies, families, prepared, before, noise)
+        chosen, steps, first_round, unnamed = self._select(measured, copies, families, prepared, before, noise, check)
         held, chosen = self._held_out(measured, chosen)
         after = corrected(fit_with(measured, chosen).values, bias) if chosen else before
         self.measured_, self.chosen_ = measured, chosen
@@ -117,15 +122,19 @@ class Calibrator:
         windows: Sequence[Window],
         before: Mapping[str, float],
         noise: Sequence[SensorNoise],
+        check: Callable[[], None],
     ) -> tuple[list[Chosen], list[Step], list[Evidence], list[Evidence]]:
         """Forward selection; returns the chosen families, each step, the first round's evidence, and the
-        curves that describe what no name fits."""
+        curves that describe what no name fits (``check`` before each family is scored)."""
         chosen: list[Chosen] = []
         steps: list[Step] = []
         first_round: list[Evidence] = []
         while len(chosen) < self.max_effects:
             taken = {c.family.name for c in chosen} | {TWINS.get(c.family.name) for c in chosen}
-            found = [evidence(measured, copies, chosen, f) for f in families if f.name not in taken]
+            found = []
+            for family in (f for f in families if f.name not in taken):
+                check()
+                found.append(evidence(measured, copies, chosen, family))
             first_round = first_round or found
             decision = decide(found, measured, copies, chosen)
             if decision.chosen is None:

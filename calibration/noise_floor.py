@@ -11,7 +11,7 @@ spread (no effective-sample-size guess, no BIC on correlated samples).
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 
 import numpy as np
 
@@ -37,11 +37,15 @@ def noise_copies(
     orders: Sequence[float],
     seed: int,
     copies: int = COPIES,
+    on_copy: Callable[[], None] | None = None,
 ) -> list[Equations]:
-    """``copies`` noisy versions of the clean replicas, each as the selection sees a window set."""
+    """``copies`` noisy versions of the clean replicas, each as the selection sees a window set; ``on_copy`` is
+    called before each (and may raise to stop there)."""
     rng = np.random.default_rng(seed)
     out = []
     for _ in range(copies):
+        if on_copy is not None:
+            on_copy()
         noisy = [add_sensor_noise(signals, level, rng, rate) for signals, level in zip(clean, noise, strict=True)]
         out.append(equations(noisy, rate, orders))
     return out

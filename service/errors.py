@@ -1,12 +1,15 @@
-"""Errors as HTTP answers: bad input 422 naming the field, overload 503 with Retry-After."""
+"""Errors as HTTP answers: bad input 422 naming the field, another window under a stored key 409, overload
+503 with Retry-After."""
 
 from __future__ import annotations
 
 from fastapi import FastAPI, Request, status
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse
+from starlette.requests import ClientDisconnect
 
 from service.jobs import CancelledError, OverloadedError
+from service.store import ConflictError
 from sim.checks import InputError
 
 
@@ -25,6 +28,13 @@ async def input_error(request: Request, exc: Exception) -> JSONResponse:
     return JSONResponse({"detail": detail}, status_code=status.HTTP_422_UNPROCESSABLE_CONTENT)
 
 
+async def conflict(request: Request, exc: Exception) -> JSONResponse:
+    """Another window under a stored key: 409, never the stored window's answer."""
+    assert isinstance(exc, ConflictError)
+    detail = [{"loc": ["body", "window_id"], "msg": str(exc), "type": "conflict"}]
+    return JSONResponse({"detail": detail}, status_code=status.HTTP_409_CONFLICT)
+
+
 async def overloaded(request: Request, exc: Exception) -> JSONResponse:
     assert isinstance(exc, OverloadedError)
     return JSONResponse(
@@ -36,7 +46,7 @@ async def overloaded(request: Request, exc: Exception) -> JSONResponse:
 
 async def cancelled(request: Request, exc: Exception) -> JSONResponse:
     """The client is gone; nobody reads this, but the log shows why the request ended."""
-    return JSONResponse({"detail": str(exc)}, status_code=499)
+    return JSONResponse({"detail": str(exc) or "the client left before its body arrived"}, status_code=499)
 
 
 async def request_validation_error(request: Request, exc: Exception) -> JSONResponse:
@@ -51,4 +61,6 @@ def install(app: FastAPI) -> None:
     app.add_exception_handler(RequestValidationError, request_validation_error)
     app.add_exception_handler(InputError, input_error)
     app.add_exception_handler(OverloadedError, overloaded)
+    app.add_exception_handler(ConflictError, conflict)
     app.add_exception_handler(CancelledError, cancelled)
+    app.add_exception_handler(ClientDisconnect, cancelled)  # an abandoned upload: a log line, not a traceback

@@ -21,6 +21,7 @@ from service.routes import actuators, calibrate, estimate, health
 from service.schemas import CalibrateIn
 from service.store import EstimateStore
 from service.warmup import warm_up
+from sim import runtime as sim_runtime
 from sim.window import WindowDocument
 from training import runtime
 
@@ -28,9 +29,12 @@ log = logging.getLogger("ema.service")
 DESCRIPTION = """Onboard health monitor for an elevator EMA: one logged window in, FDJ, η_O, η_A out.
 
 Budget per request (defaults; the operator's EMA_* settings may change them): a window of at most
-10 s (EMA_MAX_WINDOW_S), simulations × window seconds at most 1500 (EMA_MAX_SIMULATED_S), a body
-of at most 128 MB (EMA_MAX_BODY_BYTES). Over it: 422 (413 for the body) naming the limit, at once.
-One job runs at a time; at most EMA_MAX_QUEUE wait; the rest get 503 with Retry-After."""
+10 s (EMA_MAX_WINDOW_S), simulations × window seconds at most 1500 (EMA_MAX_SIMULATED_S), a
+calibration of at most 4 s of windows together (EMA_MAX_CALIBRATE_S), a body of at most 128 MB
+(EMA_MAX_BODY_BYTES) that arrives within 60 s (EMA_BODY_TIMEOUT_S). Over it: 422 (413 for the
+body, 408 for a late one) naming the limit. Writes are application/json only (else 415), never
+from a web page of another origin (403). One job runs at a time; at most EMA_MAX_QUEUE wait; the
+rest get 503 with Retry-After. Another body under a stored (actuator_id, window_id): 409."""
 
 
 def _openapi(app: FastAPI) -> dict[str, Any]:
@@ -54,7 +58,7 @@ def create_app(settings: Settings) -> FastAPI:
         threads = runtime.configure(settings.threads)
         app.state.store = EstimateStore(settings.database)
         slots = settings.ray_jobs if settings.backend == "ray" else 1
-        app.state.runner = JobRunner(settings.max_queue, settings.queue_timeout_s, slots)
+        app.state.runner = JobRunner(settings.max_queue, settings.queue_timeout_s, slots, settings.max_uploads)
         if settings.backend == "ray":
             from training.remote import connect
 
@@ -65,6 +69,7 @@ def create_app(settings: Settings) -> FastAPI:
         app.state.warm.set()
         yield
         app.state.runner.shutdown()
+        sim_runtime.shutdown()
         app.state.store.close()
 
     app = FastAPIOffline(title="ema", version=version("ema"), description=DESCRIPTION, lifespan=lifespan)
@@ -73,7 +78,8 @@ def create_app(settings: Settings) -> FastAPI:
     app.openapi = lambda: _openapi(app)  # type: ignore[method-assign]
     errors.install(app)
     app.add_middleware(Guard, key=settings.key_bytes(), prefix=settings.api_prefix,
-                       max_body_bytes=settings.max_body_bytes)  # fmt: skip
+                       max_body_bytes=settings.max_body_bytes, body_timeout_s=settings.body_timeout_s,
+                       allowed_origins=settings.allowed_origins)  # fmt: skip
     app.include_router(health.router)
     for router in (estimate.router, actuators.router, calibrate.router):
         app.include_router(router, prefix=settings.api_prefix)

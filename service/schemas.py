@@ -53,7 +53,10 @@ def responses(*codes: int) -> dict[int | str, dict[str, Any]]:
     """The error answers a route may give, for its OpenAPI entry."""
     described = {
         401: {"model": ErrorOut, "description": "missing or wrong X-API-Key"},
+        403: {"model": ErrorOut, "description": "a write from a page of another origin (a browser's Origin header)"},
+        409: {"model": ErrorOut, "description": "another window's content under a stored (actuator_id, window_id)"},
         413: {"model": ErrorOut, "description": "the body exceeds EMA_MAX_BODY_BYTES"},
+        415: {"model": ErrorOut, "description": "the body is not application/json"},
         422: {"model": ErrorOut, "description": "bad input or over the request budget; `loc` names the field"},
         503: {
             "model": BusyOut,

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import datetime as dt
 import json
+import logging
 import os
 import sqlite3
 import threading
@@ -28,6 +29,8 @@ from prognosis.documents import Stored
 from training.documents import Estimate, HistoryReadings, InertiaReading, SensorZero
 from training.history import best_zero, combined_inertia
 
+log = logging.getLogger("ema.service")
+
 SCHEMA_SQL = """
 CREATE TABLE IF NOT EXISTS estimates (
     id INTEGER PRIMARY KEY AUTOINCREMENT,
@@ -35,6 +38,7 @@ CREATE TABLE IF NOT EXISTS estimates (
     window_id TEXT NOT NULL,
     stored_at TEXT NOT NULL,
     result TEXT NOT NULL,
+    content_sha256 TEXT,
     UNIQUE (actuator_id, window_id)
 );
 CREATE INDEX IF NOT EXISTS estimates_by_actuator ON estimates (actuator_id, id);
@@ -43,6 +47,18 @@ CREATE INDEX IF NOT EXISTS estimates_sensor_zeros ON estimates (actuator_id, jso
 CREATE INDEX IF NOT EXISTS estimates_inertia_reads ON estimates (actuator_id, id)
     WHERE json_extract(result, '$.window.inertia_read') IS NOT NULL;
 """  # the last two: what ``readings`` looks up before every estimate, found without reading the history
+
+
+class ConflictError(Exception):
+    """A window posted under a stored (actuator_id, window_id) with other content: another window."""
+
+    def __init__(self, stored: Stored, digest: str) -> None:
+        super().__init__(
+            f"window_id {stored.window_id!r} of actuator {stored.actuator_id!r} was stored at {stored.stored_at} "
+            f"from other content (SHA-256 {str(stored.window.content_sha256)[:12]}…, this body's {digest[:12]}…): "
+            "give a new window its own window_id"
+        )
+        self.stored = stored
 
 
 class StorageError(Exception):
@@ -55,9 +71,16 @@ class StorageError(Exception):
 
 
 def _private_file(path: Path) -> None:
+    """Create ``path`` 0600, or make an existing file (and its WAL and shared-memory files) 0600 again, with a
+    warning: another user of the machine could read or change an actuator's history."""
     path.parent.mkdir(parents=True, exist_ok=True)
     if not path.exists():
         os.close(os.open(path, os.O_CREAT | os.O_WRONLY, 0o600))
+        return
+    for part in (path, path.with_name(path.name + "-wal"), path.with_name(path.name + "-shm")):
+        if part.exists() and part.stat().st_mode & 0o077:
+            log.warning("%s was readable by others (mode %o): made private (0600)", part, part.stat().st_mode & 0o777)
+            part.chmod(0o600)
 
 
 class EstimateStore:
@@ -93,6 +116,9 @@ class EstimateStore:
                 self._connection.execute("DROP INDEX IF EXISTS estimates_by_window")
             for statement in filter(str.strip, SCHEMA_SQL.split(";")):
                 self._connection.execute(statement)
+            columns = {row[1] for row in self._connection.execute("PRAGMA table_info(estimates)")}
+            if "content_sha256" not in columns:  # a history from before digests: its rows keep NULL (unknown)
+                self._connection.execute("ALTER TABLE estimates ADD COLUMN content_sha256 TEXT")
             if "estimates" in tables and not keyed:
                 self._connection.execute(
                     "INSERT OR IGNORE INTO estimates (actuator_id, window_id, stored_at, result) "
@@ -113,30 +139,37 @@ class EstimateStore:
             return False, f"{self.path}: {exc}"
 
     def add(self, result: Estimate) -> Stored:
-        """Store one result; if its (actuator_id, window_id) is stored already, that row, marked as a replay."""
+        """Store one result; if its (actuator_id, window_id) is stored already from the same content, that row,
+        marked as a replay (ConflictError if from other content)."""
         stored_at = dt.datetime.now(dt.UTC).isoformat(timespec="milliseconds")
         document = result.model_dump_json(by_alias=True)
+        digest = result.window.content_sha256
         with self._lock:
             cursor = self._connection.execute(
-                "INSERT OR IGNORE INTO estimates (actuator_id, window_id, stored_at, result) VALUES (?, ?, ?, ?)",
-                (result.actuator_id, result.window_id, stored_at, document),
+                "INSERT OR IGNORE INTO estimates (actuator_id, window_id, stored_at, result, content_sha256) "
+                "VALUES (?, ?, ?, ?, ?)",
+                (result.actuator_id, result.window_id, stored_at, document, digest),
             )
         if cursor.rowcount == 0:
-            found = self.get(result.actuator_id, result.window_id)
+            found = self.get(result.actuator_id, result.window_id, digest)
             assert found is not None
             return found
         return Stored(**json.loads(document), id=cursor.lastrowid, stored_at=stored_at)
 
-    def get(self, actuator_id: str, window_id: str) -> Stored | None:
-        """The stored answer for this window, marked as a replay, or None."""
+    def get(self, actuator_id: str, window_id: str, digest: str | None = None) -> Stored | None:
+        """The stored answer for this window, marked as a replay, or None; ConflictError where it was stored
+        from content other than ``digest`` (a row stored before digests is taken for the same window)."""
         with self._lock:
             row = self._connection.execute(
-                "SELECT id, stored_at, result FROM estimates WHERE actuator_id = ? AND window_id = ?",
+                "SELECT id, stored_at, result, content_sha256 FROM estimates WHERE actuator_id = ? AND window_id = ?",
                 (actuator_id, window_id),
             ).fetchone()
         if row is None:
             return None
-        return Stored(**json.loads(row[2]), id=row[0], stored_at=row[1], replay=True)
+        stored = Stored(**json.loads(row[2]), id=row[0], stored_at=row[1], replay=True)
+        if digest is not None and row[3] is not None and row[3] != digest:
+            raise ConflictError(stored, digest)
+        return stored
 
     def readings(self, actuator_id: str, flight_id: str | None) -> HistoryReadings:
         """What the stored windows of this actuator read that another may not (``training.history``): the

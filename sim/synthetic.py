@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from sim.aircraft import FlightCondition
@@ -28,7 +30,9 @@ def synthetic_window(
     """One window logged from the model: a command of ``command``'s family (``sim.commands.FAMILIES``),
     the actuator at rest where the command starts, sensor noise.
 
-    ``seed`` fixes the command and the noise; ``health`` must hold one simulation.
+    ``seed`` fixes the command and the noise; ``health`` must hold one simulation. Without a ``window_id``
+    the window is named by its content (``synthetic-`` and its digest), so two different windows never
+    share a name.
     """
     rng = np.random.default_rng(seed)
     n_samples = round(duration_s * sample_rate_hz)
@@ -36,10 +40,5 @@ def synthetic_window(
     start = InitialState(position_deg=float(np.clip(knots[0], -29.0, 29.0)))
     result = simulate_batch(knots, health, condition, start, sample_rate_hz, effects)
     signals = add_sensor_noise(result.simulation(0), noise, rng)
-    return Window(
-        signals=signals,
-        sample_rate_hz=sample_rate_hz,
-        flight_condition=condition,
-        actuator_id=actuator_id,
-        window_id=window_id or f"synthetic-seed{seed}",
-    )
+    window = Window(signals, sample_rate_hz, condition, actuator_id, window_id or "synthetic")
+    return window if window_id else replace(window, window_id=f"synthetic-{window.content_sha256()[:16]}")

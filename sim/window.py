@@ -9,8 +9,9 @@ compute with: numpy arrays, built from a validated document or by our own code.
 
 from __future__ import annotations
 
+import hashlib
 import json
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
@@ -132,6 +133,18 @@ class Window:
     @property
     def n_samples(self) -> int:
         return len(self.signals["command_deg"])
+
+    def content_sha256(self) -> str:
+        """SHA-256 of everything the window says but its key (actuator_id, window_id): two bodies posted
+        under one key are the same window exactly when their digests agree."""
+        digest = hashlib.sha256()
+        meta = window_to_dict(replace(self, signals={name: self.signals[name][:0] for name in SIGNALS}))
+        for key in ("actuator_id", "window_id", "signals"):
+            meta.pop(key)
+        digest.update(json.dumps(meta, sort_keys=True).encode())
+        for name in SIGNALS:
+            digest.update(np.ascontiguousarray(self.signals[name], dtype="<f8").tobytes())
+        return digest.hexdigest()
 
     @property
     def duration_s(self) -> float:

@@ -116,6 +116,11 @@ class HistoryReadings(Document):
 
 
 class WindowInfo(Document):
+    content_sha256: str | None = Field(
+        default=None,
+        description="SHA-256 of the window as posted, but its actuator_id and window_id (sim.window): another "
+        "body under the same key is another window",
+    )
     n_samples: int
     duration_s: float
     sample_rate_hz: float

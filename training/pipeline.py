@@ -113,6 +113,7 @@ def estimate_window(
     """
     stage = on_stage or (lambda _: None)
     clock = [time.perf_counter()]
+    digest = window.content_sha256()
     prepared = prepare(window, spec_only=spec_only, known=known_from(history))
     w, n = prepared.window, config.n_simulations
     seen = replace(w, signals=as_read(w.signals, w.sample_rate_hz))
@@ -136,4 +137,4 @@ def estimate_window(
         seen.signals, w.sample_rate_hz, answer.values["FDJ"], answer.values["eta_O"], data.noise, data.actuator
     )
     clock.append(time.perf_counter())
-    return estimate_document(prepared, physics, data, network, answer, check, fsj, config, clock)
+    return estimate_document(prepared, physics, data, network, answer, check, fsj, config, clock, digest)

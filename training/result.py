@@ -99,7 +99,7 @@ def _notes(prepared: Prepared, physics: FrictionFit, estimates: Estimates, check
     return notes
 
 
-def _window_info(prepared: Prepared, data: Data) -> WindowInfo:
+def _window_info(prepared: Prepared, data: Data, digest: str) -> WindowInfo:
     """The window as logged, and what conditioning did to it."""
     w, offset, drive = prepared.window, prepared.departures.offset, prepared.departures.drive
     zero = SensorZero(
@@ -114,6 +114,7 @@ def _window_info(prepared: Prepared, data: Data) -> WindowInfo:
         std = drive.stds["inertia_kgm2"] / drive.spec.inertia_kgm2
         inertia = InertiaReading(factor=drive.inertia_factor, std=std, window_ids=[w.window_id])
     return WindowInfo(
+        content_sha256=digest,
         n_samples=prepared.original_samples,
         duration_s=prepared.original_samples / prepared.original_rate_hz,
         sample_rate_hz=prepared.original_rate_hz,
@@ -139,8 +140,10 @@ def estimate_document(
     fsj: StaticFriction,
     config: PipelineConfig,
     clock: list[float],
+    digest: str,
 ) -> Estimate:
-    """The document of one window's run; ``clock`` holds the stages' start times and the end."""
+    """The document of one window's run; ``clock`` holds the stages' start times and the end, ``digest`` the
+    window's content as posted (``Window.content_sha256``)."""
     w = prepared.window
     estimates = _estimates(answer, fsj, bool(physics.at_search_edge[0]))
     first = network.fits_[0]
@@ -176,6 +179,6 @@ def estimate_document(
         ),
         methods=answer.methods,
         fit_check=check,
-        window=_window_info(prepared, data),
+        window=_window_info(prepared, data, digest),
         config=config,
     )

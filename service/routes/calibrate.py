@@ -5,11 +5,16 @@ from fastapi import APIRouter, Request
 from calibration.calibrate import Calibrator
 from calibration.documents import CalibrationReport
 from service.deps import RunnerDep, SettingsDep, stopper
-from service.parsing import check_budget, parse
+from service.parsing import check_calibration_budget, read_body
 from service.schemas import CalibrateIn, json_body, responses
-from sim.checks import InputError
+from sim.window import Window
 
 router = APIRouter(tags=["calibrate"])
+
+
+def _windows_and_truth(body: CalibrateIn) -> tuple[list[Window], dict[str, float] | None]:
+    truth = None if body.truth is None else body.truth.model_dump(exclude_none=True)
+    return [document.to_window() for document in body.windows], truth
 
 
 @router.post(
@@ -21,18 +26,13 @@ router = APIRouter(tags=["calibrate"])
 )
 async def calibrate(request: Request, settings: SettingsDep, runner: RunnerDep) -> CalibrationReport:
     """Trace what the model misses in the windows to an effect, add it, re-estimate: ema-calibration/1."""
+    windows, truth = await read_body(request, runner, CalibrateIn, _windows_and_truth)
     with runner.admit() as ticket:
-        body = await parse(CalibrateIn, await request.body())
-        if len(body.windows) > settings.max_calibrate_windows:
-            raise InputError("windows", f"{len(body.windows)} windows; this service's limit is "
-                                        f"{settings.max_calibrate_windows} (EMA_MAX_CALIBRATE_WINDOWS)")  # fmt: skip
-        windows = [document.to_window() for document in body.windows]
-        for i, window in enumerate(windows):
-            check_budget(window, settings.pipeline, settings, field=f"windows.{i}.signals")
-        truth = None if body.truth is None else body.truth.model_dump(exclude_none=True)
+        check_calibration_budget(windows, settings.pipeline, settings)
         calibrator = Calibrator(settings.pipeline, seed=settings.pipeline.seed)
+        stop = stopper(ticket.cancel)
 
         def run() -> CalibrationReport:
-            return calibrator.fit(windows, truth, on_stage=stopper(ticket.cancel)).report_
+            return calibrator.fit(windows, truth, on_stage=stop, checkpoint=lambda: stop("")).report_
 
         return await runner.run(ticket, request.is_disconnected, run)

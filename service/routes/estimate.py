@@ -8,9 +8,9 @@ from starlette.concurrency import run_in_threadpool
 
 from prognosis.documents import Stored
 from service.deps import RunnerDep, SettingsDep, StoreDep, request_config, stopper
-from service.parsing import check_budget, parse
+from service.parsing import check_budget, read_body
 from service.schemas import json_body, responses
-from sim.window import WindowDocument
+from sim.window import Window, WindowDocument
 from training.config import bounds
 from training.pipeline import estimate_window
 
@@ -22,11 +22,16 @@ def _query(name: str, what: str) -> object:
     return Query(ge=low, le=high, description=f"{what} (default and ceiling: the service's settings)")
 
 
+def _window_and_digest(document: WindowDocument) -> tuple[Window, str]:
+    window = document.to_window()
+    return window, window.content_sha256()
+
+
 @router.post(
     "/estimate",
     response_model=Stored,
     response_model_by_alias=True,
-    responses=responses(401, 413, 422, 503),
+    responses=responses(401, 409, 413, 415, 422, 503),
     openapi_extra=json_body(WindowDocument, "one ema-window/1 window"),
 )
 async def estimate(
@@ -42,14 +47,15 @@ async def estimate(
     """Estimate FDJ, η_O, η_A (FSJ where the window shows it) of one window; store and answer.
 
     A window already stored for its (actuator_id, window_id) is answered from the history
-    (``replay: true``) without recomputing. What the stored windows of the actuator read that this one
-    may not (its ``flight_id``'s sensor zero, the actuator's J_M: ``training.history``) is read with it.
+    (``replay: true``) without recomputing; other content under a stored key is another window: 409.
+    What the stored windows of the actuator read that this one may not (its ``flight_id``'s sensor
+    zero, the actuator's J_M: ``training.history``) is read with it.
     Budget: the window's duration and its simulation work (simulations × seconds) are limited by the
     service's settings; over it, 422 naming the limit.
     """
+    window, digest = await read_body(request, runner, WindowDocument, _window_and_digest)
     with runner.admit() as ticket:
-        window = (await parse(WindowDocument, await request.body())).to_window()
-        stored = await run_in_threadpool(store.get, window.actuator_id, window.window_id)
+        stored = await run_in_threadpool(store.get, window.actuator_id, window.window_id, digest)
         if stored is not None:
             return stored
         sizes = {"n_simulations": n_simulations, "n_timesteps": n_timesteps, "hidden_units": hidden_units}

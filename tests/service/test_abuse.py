@@ -6,6 +6,7 @@ import os
 import socket
 import subprocess
 import sys
+import threading
 import time
 
 import httpx
@@ -28,7 +29,7 @@ def _free_port() -> int:
 
 
 @pytest.fixture(scope="module")
-def live(tmp_path_factory):
+def server(tmp_path_factory):
     port = _free_port()
     env = {
         **os.environ,
@@ -40,18 +41,27 @@ def live(tmp_path_factory):
         "EMA_PIPELINE__CHECK_WINDOWS": "8",
         "EMA_PIPELINE__N_TIMESTEPS": "50",
         "EMA_PIPELINE__HIDDEN_UNITS": "8",
+        "EMA_BODY_TIMEOUT_S": "4",
     }
-    process = subprocess.Popen([sys.executable, "-c", SERVER.format(port=port)], env=env)
+    log = (tmp_path_factory.mktemp("log") / "server.log").open("w")
+    process = subprocess.Popen([sys.executable, "-c", SERVER.format(port=port)], env=env, stderr=log)
     url = f"http://127.0.0.1:{port}"
+    process.log_path = log.name  # type: ignore[attr-defined]
     for _ in range(300):
         try:
             if httpx.get(f"{url}/healthz", timeout=1).status_code == 200:
                 break
         except httpx.HTTPError:
             time.sleep(0.1)
-    yield url
+    yield url, process.log_path
     process.terminate()
     process.wait(timeout=30)
+    log.close()
+
+
+@pytest.fixture
+def live(server):
+    return server[0]
 
 
 def _post(url: str, body, key: str = KEY, path: str = "/v1/estimate", timeout: float = 120) -> httpx.Response:
@@ -110,3 +120,49 @@ def test_a_window_posted_twice_is_stored_once(live, window_document):
     assert second.json()["replay"] is True and second.json()["id"] == first.json()["id"]
     history = httpx.get(f"{live}/v1/actuators/ac-1/elev/estimates", headers={"x-api-key": KEY}, timeout=10).json()
     assert [h["window_id"] for h in history["estimates"]].count("twice") == 1
+
+
+def _trickle(url: str, stop: threading.Event) -> None:
+    """A body announced at 100 kB that arrives a byte every 0.3 s (on a raw socket: no client library waits)."""
+    host, port = url.removeprefix("http://").split(":")
+    with socket.create_connection((host, int(port))) as connection:
+        head = (f"POST /v1/estimate HTTP/1.1\r\nHost: 127.0.0.1\r\nX-API-Key: {KEY}\r\n"
+                "Content-Type: application/json\r\nContent-Length: 100000\r\n\r\n")  # fmt: skip
+        connection.sendall(head.encode())
+        while not stop.wait(0.3):
+            try:
+                connection.sendall(b" ")
+            except OSError:
+                return
+
+
+def test_slow_uploads_hold_their_connections_not_the_queue(live, window_document):
+    stop = threading.Event()
+    trickles = [threading.Thread(target=_trickle, args=(live, stop)) for _ in range(5)]
+    for thread in trickles:
+        thread.start()
+    try:
+        time.sleep(1.0)
+        answer = _post(live, {**window_document, "window_id": "beside-slow-uploads"})
+        assert answer.status_code == 200, answer.text
+        assert httpx.get(f"{live}/healthz", timeout=5).json()["queued"] == 0
+    finally:
+        stop.set()
+        for thread in trickles:
+            thread.join()
+
+
+def test_a_body_that_does_not_arrive_in_time_is_a_408_and_an_abandoned_one_leaves_no_traceback(server):
+    url, log_path = server
+    host, port = url.removeprefix("http://").split(":")
+    head = (f"POST /v1/estimate HTTP/1.1\r\nHost: 127.0.0.1\r\nX-API-Key: {KEY}\r\n"
+            "Content-Type: application/json\r\nContent-Length: 1000\r\n\r\n{")  # fmt: skip
+    with socket.create_connection((host, int(port)), timeout=30) as connection:
+        connection.sendall(head.encode())
+        assert b" 408 " in connection.recv(4096).split(b"\r\n")[0] + b" "
+    with socket.create_connection((host, int(port)), timeout=30) as connection:
+        connection.sendall(head.encode())
+        time.sleep(0.5)  # the client leaves half-way through its body
+    time.sleep(1.0)
+    with open(log_path) as log:
+        assert "Traceback" not in log.read()

@@ -1,5 +1,8 @@
 """The HTTP contract through TestClient: answers, stored history, errors naming fields."""
 
+import json
+import time
+
 import pytest
 from fastapi.testclient import TestClient
 
@@ -170,6 +173,55 @@ def test_history_survives_a_restart(tmp_path, document):
     assert [h["id"] for h in history["estimates"]] == [first["id"], second["id"]]  # oldest first
     assert prognosis["trends"]["FDJ"]["n"] == 2
     assert prognosis["remaining_life"]["FDJ"]["status"] == "too few windows"
+
+
+def test_the_first_prognosis_of_a_new_actuator_is_a_level_with_no_slope(client, document):
+    """One window, or windows at one time, hold no slope: a 200 that says so, never a 500 (0/0 stored as NaN)."""
+    assert client.post("/v1/estimate", json={**document, "flight_hours": 12.0}).status_code == 200
+    first = client.get("/v1/actuators/ac-1/elev/prognosis")
+    assert first.status_code == 200, first.text
+    trend = first.json()["trends"]["FDJ"]
+    assert trend["n"] == 1 and trend["slope_std"] is None
+    assert first.json()["remaining_life"]["FDJ"]["status"] == "too few windows"
+    assert client.post("/v1/estimate", json={**document, "window_id": "w2", "flight_hours": 12.0}).status_code == 200
+    second = client.get("/v1/actuators/ac-1/elev/prognosis")
+    assert second.status_code == 200 and second.json()["trends"]["eta_O"]["slope_std"] is None
+
+
+def test_another_body_under_a_stored_window_id_is_a_409_naming_both(client, document):
+    first = client.post("/v1/estimate", json=document).json()
+    current = [v + 0.01 for v in document["signals"]["current_a"]]
+    other = {**document, "signals": {**document["signals"], "current_a": current}}
+    response = client.post("/v1/estimate", json=other)
+    assert response.status_code == 409
+    detail = response.json()["detail"][0]
+    assert detail["loc"] == ["body", "window_id"] and document["window_id"] in detail["msg"]
+    assert first["window"]["content_sha256"][:12] in detail["msg"]
+    assert client.post("/v1/estimate", json=document).json()["replay"] is True  # the same body: still a replay
+
+
+def test_writes_are_json_only_and_never_from_another_origin(client, document):
+    body = json.dumps(document)
+    plain = client.post("/v1/estimate", content=body, headers={"content-type": "text/plain"})
+    assert plain.status_code == 415 and plain.json()["detail"][0]["loc"] == ["header", "content-type"]
+    foreign = client.post("/v1/estimate", json=document, headers={"origin": "http://evil.example"})
+    assert foreign.status_code == 403 and foreign.json()["detail"][0]["loc"] == ["header", "origin"]
+    hidden = client.post("/v1/estimate", content=body, headers={"content-type": "text/plain", "origin": "null"})
+    assert hidden.status_code == 403
+    assert client.get("/v1/actuators/ac-1/elev/estimates").json()["estimates"] == []  # nothing was stored
+    own = client.post("/v1/estimate", json=document, headers={"origin": LOCAL})
+    assert own.status_code == 200
+
+
+def test_one_budget_covers_a_whole_calibration(client, document):
+    """Four 10 s windows are each within the window budget, and far past one calibration's."""
+    long = {**document, "sample_rate_hz": 1000.0}
+    long["signals"] = {name: values * 10 for name, values in document["signals"].items()}  # 10 000 samples: 10 s
+    started = time.perf_counter()
+    response = client.post("/v1/calibrate", json={"windows": [long] * 4})
+    assert response.status_code == 422 and time.perf_counter() - started < 5
+    detail = response.json()["detail"][0]
+    assert detail["loc"] == ["body", "windows"] and "EMA_MAX_CALIBRATE_S" in detail["msg"]
 
 
 def test_calibrate_answers_the_report(client, document):

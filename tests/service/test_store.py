@@ -32,6 +32,31 @@ def test_the_file_is_private(tmp_path, result):
     assert stat.S_IMODE((tmp_path / "h.sqlite3").stat().st_mode) == 0o600
 
 
+def test_a_file_others_could_read_is_made_private_with_a_warning(tmp_path, result, caplog):
+    path = tmp_path / "h.sqlite3"
+    EstimateStore(path).close()
+    path.chmod(0o644)
+    with caplog.at_level("WARNING", logger="ema.service"):
+        EstimateStore(path).close()
+    assert stat.S_IMODE(path.stat().st_mode) == 0o600 and "made private" in caplog.text
+
+
+def test_another_window_under_a_stored_key_is_a_conflict_and_an_old_row_a_replay(tmp_path, result):
+    from service.store import ConflictError
+
+    store = EstimateStore(tmp_path / "h.sqlite3")
+    store.add(result)
+    other = result.model_copy(update={"window": result.window.model_copy(update={"content_sha256": "f" * 64})})
+    with pytest.raises(ConflictError, match=result.window_id):
+        store.add(other)
+    with pytest.raises(ConflictError):
+        store.get(result.actuator_id, result.window_id, "f" * 64)
+    assert store.get(result.actuator_id, result.window_id, result.window.content_sha256).replay
+    with store._lock:  # a row stored before digests were kept: its content unknown, taken as the window's
+        store._connection.execute("UPDATE estimates SET content_sha256 = NULL")
+    assert store.get(result.actuator_id, result.window_id, "f" * 64).replay
+
+
 def test_a_file_that_is_not_a_database_is_refused_naming_it(tmp_path):
     broken = tmp_path / "broken.sqlite3"
     broken.write_bytes(b"this is not sqlite" * 100)
