@@ -7,7 +7,7 @@ from pathlib import Path
 
 import click
 
-from clients.options import as_json, emit, pipeline_config, sizes
+from clients.options import NothingAnsweredError, as_json, emit, pipeline_config, sizes
 
 ARCHIVE = click.Path(exists=True, path_type=Path)
 
@@ -26,17 +26,31 @@ ARCHIVE = click.Path(exists=True, path_type=Path)
 @as_json
 def fleet(archive: Path, out: Path, workers: int, threads: int, ray_address: str | None, window_s: float,
           database: Path | None, as_json: bool, **size_values: int) -> None:  # fmt: skip
-    """Reprocess an archive (folder, NPZ, CSV or JSON logs) on Ray workers; one CSV row per window."""
-    from clients.fleet import run_fleet
-    from clients.logs import windows_of
+    """Reprocess an archive (folder, NPZ, CSV or JSON logs) on Ray workers; one CSV row per window.
+
+    Without Ray (``pip install 'ema[fleet]'``) one worker runs in this process. Exit status 2 when no window
+    was answered; a folder's unreadable files are skipped and listed."""
+    from clients.commands_remote import report_log
+    from clients.fleet import check_engine, run_fleet
+    from clients.logs import read_log
 
     config = pipeline_config(size_values)
-    windows = [window for window, _ in windows_of(archive, window_s)]
-    print(f"ema fleet: {len(windows)} window(s) from {archive}, {workers} worker(s)", file=sys.stderr)
-    result = run_fleet(windows, out, config, workers, ray_address, threads, database)
-    emit(result, as_json, lambda r: click.echo(
-        f"{r['answered']} answered, {r['refused']} refused, {r['skipped']} already in {r['csv']}; "
-        f"{r['windows_per_s']:.2f} windows/s on {r['workers']} worker(s) ({r['engine']})"))  # fmt: skip
+    check_engine(workers, ray_address)
+    read = read_log(archive, window_s)
+    report_log(read)
+    print(f"ema fleet: {len(read.windows)} window(s) from {archive}, {workers} worker(s)", file=sys.stderr)
+    result = {**run_fleet(read.windows, out, config, workers, ray_address, threads, database),
+              "bad_files": read.bad_files}  # fmt: skip
+    emit(result, as_json, _print_fleet)
+    if result["answered"] + result["skipped"] == 0 and result["refused"]:
+        raise NothingAnsweredError(f"none of the {result['refused']} window(s) was answered (see {out})")
+
+
+def _print_fleet(result: dict) -> None:
+    skipped = f", {len(result['bad_files'])} unreadable file(s) skipped" if result["bad_files"] else ""
+    click.echo(f"{result['answered']} answered, {result['refused']} refused, {result['skipped']} already in "
+               f"{result['csv']}{skipped}; {result['windows_per_s']:.2f} windows/s on {result['workers']} worker(s) "
+               f"({result['engine']})")  # fmt: skip
 
 
 @click.command()

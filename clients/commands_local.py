@@ -102,13 +102,13 @@ def simulate(as_json: bool, **options: Any) -> None:
 @click.command()
 @click.argument("windows", type=EXISTING, nargs=-1, required=True)
 @click.option("--truth", type=EXISTING, help='JSON {"FDJ": ..., "eta_O": ...} of synthetic windows')
-@click.option("--figure", type=click.Path(dir_okay=False, path_type=Path), default=Path("calibration.png"),
-              help="PNG of the residual before and after")  # fmt: skip
+@click.option("--figure", type=click.Path(dir_okay=False, path_type=Path), default=None,
+              help="also write a PNG of the residual before and after")  # fmt: skip
 @click.option("--copies", type=click.IntRange(8, 500), default=30, help="noise-only copies behind the noise floor")
 @sizes
 @threads
 @as_json
-def calibrate(windows: tuple[Path, ...], truth: Path | None, figure: Path, copies: int, threads: int | None,
+def calibrate(windows: tuple[Path, ...], truth: Path | None, figure: Path | None, copies: int, threads: int | None,
               as_json: bool, **size_values: int) -> None:  # fmt: skip
     """Trace what the model misses in windows of one actuator to an effect, add it, re-estimate."""
     from calibration.calibrate import Calibrator
@@ -121,8 +121,8 @@ def calibrate(windows: tuple[Path, ...], truth: Path | None, figure: Path, copie
     runtime.configure(threads)
     loaded = [read_window(path) for path in windows]
     calibrator = Calibrator(config, copies=copies, seed=config.seed).fit(loaded, read_truth(truth), on_stage=progress)
-    written = calibration_figure(calibrator, figure)
-    emit({**calibrator.report_.model_dump(mode="json", by_alias=True), "figure": str(written)}, as_json,
+    written = None if figure is None else str(calibration_figure(calibrator, figure))
+    emit({**calibrator.report_.model_dump(mode="json", by_alias=True), "figure": written}, as_json,
          print_calibration)  # fmt: skip
 
 
@@ -130,7 +130,7 @@ def calibrate(windows: tuple[Path, ...], truth: Path | None, figure: Path, copie
 @click.option("--host", default=None, help="bind address [default: EMA_HOST, else 127.0.0.1]")
 @click.option("--port", type=click.IntRange(1, 65535), default=None, help="port [default: EMA_PORT, else 8000]")
 @click.option("--database", type=click.Path(dir_okay=False, path_type=Path), default=None,
-              help="SQLite history file [default: EMA_DATABASE, else ./ema-history.sqlite3]")  # fmt: skip
+              help="SQLite history file [default: EMA_DATABASE, else $XDG_DATA_HOME/ema/history.sqlite3]")  # fmt: skip
 @click.option("--api-key-file", type=EXISTING, default=None, help="a file holding the API key (or EMA_API_KEY)")
 def serve(**flags: Any) -> None:
     """Run the HTTP service (all settings: EMA_* environment variables; the flags win)."""
@@ -149,12 +149,26 @@ def serve(**flags: Any) -> None:
         field = "host" if error.field == "document" else error.field  # the one check across fields: host vs key
         raise InputError(f"--{field.replace('_', '-')} / EMA_{field.upper()}", error.message) from None
     EstimateStore(settings.database).close()  # refused here, naming the file, before the server starts
+    _check_port_free(settings.host, settings.port)
     uvicorn.run(create_app(settings), host=settings.host, port=settings.port, log_level="info")
 
 
+def _check_port_free(host: str, port: int) -> None:
+    """InputError naming --port where the address is taken (uvicorn would exit 3 after loading everything)."""
+    import socket
+
+    from sim.checks import InputError
+
+    try:
+        with socket.create_server((host, port)):
+            pass
+    except OSError as exc:
+        raise InputError("--port / EMA_PORT", f"{host}:{port} cannot be bound ({exc.strerror})") from None
+
+
 @click.command()
-@click.option("--out", type=click.Path(file_okay=False, path_type=Path), default=Path("docs/schemas"),
-              help="folder for the JSON Schemas")  # fmt: skip
+@click.option("--out", type=click.Path(file_okay=False, path_type=Path), required=True,
+              help="folder for the JSON Schemas (the repository keeps them in docs/schemas)")  # fmt: skip
 @click.option("--check", is_flag=True, help="exit 1 if the files there differ from the code")
 def schemas(out: Path, check: bool) -> None:
     """Export the JSON Schema of every public document (or check the exported ones)."""

@@ -10,7 +10,7 @@ from typing import Any
 
 import click
 
-from clients.options import as_json, emit, flags_named
+from clients.options import NothingAnsweredError, as_json, emit, flags_named
 from sim.envelope import DEFAULT_AIRSPEED_MPS
 
 URL = "http://127.0.0.1:8000"
@@ -39,31 +39,45 @@ def api_key(path: Path | None) -> str | None:
 @as_json
 def replay(log: Path, url: str, out: Path, window_s: float, api_key_file: Path | None, actuator_id: str,
            rate: float, airspeed: float, altitude: float, as_json: bool) -> None:  # fmt: skip
-    """Post a recorded log (JSON window(s), CSV, NPZ or a folder) to the service, window by window."""
-    from clients.logs import Defaults, windows_of
+    """Post a recorded log (JSON window(s), CSV, NPZ or a folder) to the service, window by window.
+
+    Exit status 2 when no window was answered; a folder's unreadable files are skipped and listed."""
+    from clients.logs import Defaults, read_log
     from clients.replay import replay as post_all
 
     defaults = Defaults(actuator_id, rate, airspeed, altitude)
-    windows = []
     with flags_named({"sample_rate_hz": "--rate", "airspeed_mps": "--airspeed", "altitude_m": "--altitude"}):
-        for window, dropped in windows_of(log, window_s, defaults):
-            windows.append(window)
-            if dropped:
-                print(f"{window.window_id}: the last {dropped} sample(s) do not fill a window", file=sys.stderr)
-    print(f"replaying {len(windows)} window(s) from {log} to {url}", file=sys.stderr)
-    rows = post_all(windows, url, out, api_key(api_key_file))
-    emit({"csv": str(out), "posted": len(rows), "rows": rows}, as_json, _print_replay)
+        read = read_log(log, window_s, defaults)
+    report_log(read)
+    print(f"replaying {len(read.windows)} window(s) from {log} to {url}", file=sys.stderr)
+    rows = post_all(read.windows, url, out, api_key(api_key_file))
+    refused = [row for row in rows if row.get("error")]
+    result = {"csv": str(out), "posted": len(rows), "answered": len(rows) - len(refused), "refused": len(refused),
+              "bad_files": read.bad_files, "rows": rows}  # fmt: skip
+    emit(result, as_json, _print_replay)
+    if rows and not result["answered"]:
+        raise NothingAnsweredError(f"none of the {len(rows)} window(s) posted was answered (see {out})")
+
+
+def report_log(read: Any) -> None:
+    """What reading a log left out, on standard error: each skipped file and each dropped tail."""
+    for file, reason in read.bad_files.items():
+        print(f"skipped {file}: {reason}", file=sys.stderr)
+    for window_id, dropped in read.dropped.items():
+        print(f"{window_id}: the last {dropped} sample(s) after it do not fill a window", file=sys.stderr)
 
 
 def _print_replay(result: dict[str, Any]) -> None:
     click.echo(f"{'window':<36}{'FDJ [N·m]':>12}{'η_O':>9}{'η_A':>9}{'total [s]':>11}")
     for row in result["rows"]:
         if row.get("error"):
-            click.echo(f"{row['window_id']:<36}  refused: {row['error'][:60]}")
+            click.echo(f"{row['window_id']:<36}  refused: {row['error']}")
             continue
         click.echo(f"{row['window_id']:<36}{row['FDJ']:>12.5f}{row['eta_O']:>9.4f}{row['eta_A']:>9.4f}"
                    f"{row['total_s']:>11.2f}")  # fmt: skip
-    click.echo(f"{result['posted']} window(s) posted; all answers in {result['csv']}")
+    skipped = f", {len(result['bad_files'])} unreadable file(s) skipped" if result["bad_files"] else ""
+    click.echo(f"{result['posted']} window(s) posted: {result['answered']} answered, {result['refused']} refused"
+               f"{skipped}; all answers in {result['csv']}")  # fmt: skip
 
 
 @click.command()
@@ -104,16 +118,24 @@ def _print_history(stored: Any, prognosis: Any, plot: Path | None) -> None:
             else ""
         )
         level, level_std = trend.now()
-        click.echo(f"{name:<6} now {level:.5g} ± {level_std:.2g}, slope {trend.slope_per_unit:+.3g} "
-                   f"± {trend.slope_std:.2g} per unit{bend}; {life.status}", nl=False)  # fmt: skip
+        slope = (
+            "no slope yet"
+            if trend.slope_std is None
+            else f"slope {trend.slope_per_unit:+.3g} ± {trend.slope_std:.2g} per unit{bend}"
+        )
+        click.echo(f"{name:<6} now {level:.5g} ± {level_std:.2g}, {slope}; {life.status}", nl=False)
         if life.rul is not None:
             high = "open" if life.rul_high is None else f"{life.rul_high:.3g}"
             click.echo(f": {life.threshold:g} crossed in {life.rul:.3g} (90 %: {life.rul_low:.3g} to {high})")
         else:
             click.echo("")
     for name, trend in prognosis.sensors.items():
-        click.echo(f"{name} now {trend.level:.4g} ± {trend.level_std:.2g}, slope {trend.slope_per_unit:+.3g} "
-                   f"± {trend.slope_std:.2g} per unit ({trend.n} windows)")  # fmt: skip
+        slope = (
+            "no slope yet"
+            if trend.slope_std is None
+            else f"slope {trend.slope_per_unit:+.3g} ± {trend.slope_std:.2g} per unit"
+        )
+        click.echo(f"{name} now {trend.level:.4g} ± {trend.level_std:.2g}, {slope} ({trend.n} windows)")
     if prognosis.inertia is not None:
         inertia = prognosis.inertia
         click.echo(f"J_M {inertia.factor:.4f} ± {inertia.std:.2g}x the spec's, as windows that could tell it read it")

@@ -170,11 +170,9 @@ def run_fleet(windows: list[Window], out: Path, config: PipelineConfig, workers:
     with ResultsWriter(out) as writer:
         for window, answer in results:
             row = row_of(window.actuator_id, window.window_id, answer)
-            writer.write(row)
             if store is not None and "error" not in answer:
-                from training.documents import Estimate
-
-                store.add(Estimate.model_validate(answer))
+                row = _stored(store, row, answer)
+            writer.write(row)
             progress.tick(row)
     seconds = time.perf_counter() - progress.started
     return {"csv": str(out), "skipped": len(done & {(w.actuator_id, w.window_id) for w in windows}),
@@ -183,10 +181,34 @@ def run_fleet(windows: list[Window], out: Path, config: PipelineConfig, workers:
             "engine": "in-process" if in_process else "ray"}  # fmt: skip
 
 
+def check_engine(workers: int, address: str | None) -> None:
+    """InputError naming the flag where it asks for Ray and Ray is not installed (before any file is written)."""
+    if ray_installed() or (workers == 1 and address is None):
+        return
+    from sim.checks import InputError
+
+    flag = "--ray-address" if address is not None else "--workers"
+    raise InputError(flag, "needs Ray, an optional extra: pip install 'ema[fleet]' (or run one worker in this "
+                     "process: --workers 1)")  # fmt: skip
+
+
 def ray_installed() -> bool:
     import importlib.util
 
     return importlib.util.find_spec("ray") is not None
+
+
+def _stored(store: Any, row: dict[str, Any], answer: dict[str, Any]) -> dict[str, Any]:
+    """``row`` once its answer is in the history, or refused where the history holds another window's content
+    under its window_id (``service.store.ConflictError``)."""
+    from service.store import ConflictError
+    from training.documents import Estimate
+
+    try:
+        store.add(Estimate.model_validate(answer))
+    except ConflictError as exc:
+        return {"actuator_id": row["actuator_id"], "window_id": row["window_id"], "error": f"conflict: {exc}"}
+    return row
 
 
 def _store(database: Path | None) -> Any:

@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import csv
 import json
-from collections.abc import Iterator
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
@@ -113,16 +112,8 @@ def _window(signals: dict[str, np.ndarray], meta: dict[str, Any], defaults: Defa
     return window_from_dict(document)
 
 
-def read_log(path: Path, defaults: Defaults = Defaults()) -> list[Window]:
-    """Every window in ``path`` (a file or a folder, files in name order); errors name the file."""
-    path = Path(path)
-    if path.is_dir():
-        files = sorted(p for p in path.iterdir() if p.suffix.lower() in SUFFIXES)
-        if not files:
-            raise InputError(str(path), f"holds no {'/'.join(SUFFIXES)} file")
-        return [window for file in files for window in read_log(file, defaults)]
-    if not path.exists():
-        raise InputError(str(path), "does not exist")
+def read_file(path: Path, defaults: Defaults = Defaults()) -> list[Window]:
+    """Every window in one file; errors name the file."""
     readers = {".json": lambda: _from_json(path), ".csv": lambda: _from_csv(path, defaults)}
     readers[".npz"] = lambda: _from_npz(path, defaults)
     if path.suffix.lower() not in readers:
@@ -137,9 +128,43 @@ def read_log(path: Path, defaults: Defaults = Defaults()) -> list[Window]:
         raise InputError(str(path), f"cannot be read ({exc})") from None
 
 
-def windows_of(path: Path, window_s: float, defaults: Defaults = Defaults()) -> Iterator[tuple[Window, int]]:
-    """The windows of a log, long recordings cut to ``window_s``; with each, the samples its cut dropped."""
-    for recording in read_log(path, defaults):
-        pieces, dropped = cut(recording, window_s)
-        for i, piece in enumerate(pieces):
-            yield piece, dropped if i == len(pieces) - 1 else 0
+@dataclass(frozen=True)
+class Log:
+    """What a log holds: its windows in order, the tails its cuts dropped, and the files of a folder that
+    could not be read (each skipped with its reason: one bad file does not stop an archive job)."""
+
+    windows: list[Window]
+    dropped: dict[str, int]  # window_id -> samples after it that did not fill a window
+    bad_files: dict[str, str]  # file -> why it was skipped
+
+
+def read_log(path: Path, window_s: float, defaults: Defaults = Defaults()) -> Log:
+    """The windows of a file, or of a folder's files in name order, long recordings cut to ``window_s``. A
+    bad file given alone is an InputError naming it; in a folder it is skipped and listed, and only a folder
+    with no readable window is an error."""
+    path = Path(path)
+    if not path.exists():
+        raise InputError(str(path), "does not exist")
+    files = sorted(p for p in path.iterdir() if p.suffix.lower() in SUFFIXES) if path.is_dir() else [path]
+    if not files:
+        raise InputError(str(path), f"holds no {'/'.join(SUFFIXES)} file")
+    windows: list[Window] = []
+    dropped: dict[str, int] = {}
+    bad: dict[str, str] = {}
+    for file in files:
+        try:
+            recordings = read_file(file, defaults)
+        except InputError as exc:
+            if not path.is_dir():
+                raise
+            bad[str(file)] = exc.message
+            continue
+        for recording in recordings:
+            pieces, tail = cut(recording, window_s)
+            windows.extend(pieces)
+            if tail:
+                dropped[pieces[-1].window_id] = tail
+    if not windows:
+        first = next(iter(bad.items()), None)
+        raise InputError(str(path), "holds no readable window" + (f" ({first[0]}: {first[1]})" if first else ""))
+    return Log(windows, dropped, bad)

@@ -79,4 +79,5 @@ def print_calibration(report: dict[str, Any]) -> None:
         if report.get("error_pct_before"):
             line += f"   error {report['error_pct_before'][name]:.2f} % -> {report['error_pct_after'][name]:.2f} %"
         click.echo(line)
-    click.echo(f"figure: {report['figure']}")
+    if report["figure"] is not None:
+        click.echo(f"figure: {report['figure']}")

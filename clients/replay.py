@@ -1,7 +1,9 @@
 """``ema replay``: post a recorded log to the service window by window, in order, and keep the answers.
 
-Answers are appended to a CSV as they arrive (``clients.results``); a rerun skips what the CSV
-holds, answered or refused. A 503 is waited out (Retry-After) and the same window retried. The
+Answers are appended to a CSV as they arrive (``clients.results``); a rerun skips the windows the CSV
+holds answered and posts the refused ones again (a refusal may be the service's, such as a budget an
+operator has since raised). A 503 is waited out (Retry-After) and the same window retried. A refusal
+(422, or 409 for another window under a stored window_id) is kept as its fields and messages. The
 API key comes from a file or EMA_API_KEY, never from the command line (where ``ps`` shows it).
 """
 
@@ -53,14 +55,24 @@ def post_window(url: str, window: Window, api_key: str | None, sleep: Callable[[
                 sleep(pause)
                 waited += pause
                 continue
-            if error.code == 422:
-                return {"error": detail}
+            if error.code in (409, 422):
+                return {"error": refusal_text(error.code, detail)}
             raise ServiceError(f"HTTP {error.code} for {window.window_id}: {detail[:300]}") from None
+
+
+def refusal_text(status: int, body: str) -> str:
+    """A 422 or 409 answer as a person reads it: each ``field: message`` (the body as is if it is not ours)."""
+    try:
+        items = json.loads(body)["detail"]
+        parts = [f"{'.'.join(str(p) for p in item['loc'] if p != 'body')}: {item['msg']}" for item in items]
+    except (ValueError, KeyError, TypeError):
+        return f"HTTP {status}: {body}"
+    return ("conflict: " if status == 409 else "") + "; ".join(parts)
 
 
 def replay(windows: list[Window], url: str, out: Path, api_key: str | None = None) -> list[dict[str, Any]]:
     """Post every window not yet in ``out``, appending each answer as it comes; returns the new rows."""
-    done = done_windows(out)
+    done = done_windows(out, answered_only=True)
     todo = [w for w in windows if (w.actuator_id, w.window_id) not in done]
     if done:
         print(f"resuming: {len(windows) - len(todo)} window(s) already in {out}", file=sys.stderr)
@@ -71,7 +83,7 @@ def replay(windows: list[Window], url: str, out: Path, api_key: str | None = Non
             row = row_of(window.actuator_id, window.window_id, post_window(url, window, api_key))
             writer.write(row)
             rows.append(row)
-            status = row["error"][:80] if row.get("error") else f"FDJ {row['FDJ']:.5f}  η_O {row['eta_O']:.4f}"
+            status = f"refused: {row['error']}" if row.get("error") else f"FDJ {row['FDJ']:.5f}  η_O {row['eta_O']:.4f}"
             elapsed = time.perf_counter() - started
             eta = elapsed / index * (len(todo) - index)
             print(f"[{index}/{len(todo)}] {window.window_id}: {status}  ({index / elapsed:.2f} windows/s, "

@@ -1,9 +1,10 @@
 """The results CSV of ``ema replay`` and ``ema fleet``: one row per window, appended as answers arrive.
 
-A row is written and flushed as soon as its window is answered (or refused for good), so a crash
-loses nothing, and a rerun skips every window already in the file: nothing is posted or computed
-twice. The service's history is idempotent too, so the window that was in flight when a client
-died is answered from the history on the rerun, not stored twice.
+A row is written and flushed as soon as its window is answered (or refused), so a crash loses
+nothing, and a rerun skips the windows already in the file (``ema replay`` posts its refused ones
+again, in a row of their own): nothing answered is posted or computed twice. The service's history
+is idempotent too, so the window that was in flight when a client died is answered from the history
+on the rerun, not stored twice.
 """
 
 from __future__ import annotations
@@ -34,12 +35,14 @@ def row_of(actuator_id: str, window_id: str, answer: dict[str, Any]) -> dict[str
     return row
 
 
-def done_windows(path: Path) -> set[tuple[str, str]]:
-    """(actuator_id, window_id) of every row already in ``path``: answered, or refused as bad input."""
+def done_windows(path: Path, answered_only: bool = False) -> set[tuple[str, str]]:
+    """(actuator_id, window_id) of every row already in ``path``: answered, or refused as bad input (only
+    the answered ones with ``answered_only``)."""
     if not path.exists():
         return set()
     with path.open(newline="") as handle:
-        return {(r["actuator_id"], r["window_id"]) for r in csv.DictReader(handle)}
+        rows = csv.DictReader(handle)
+        return {(r["actuator_id"], r["window_id"]) for r in rows if not (answered_only and r["error"])}
 
 
 class ResultsWriter:

@@ -1,4 +1,5 @@
 import json
+import socket
 import subprocess
 import sys
 
@@ -19,6 +20,17 @@ def test_simulate_writes_a_valid_window_and_the_truth(tmp_path, capsys):
     assert report["truth"]["FDJ"] == 0.055 and report["command"] == "cruise"
     assert read_window(out).n_samples == 500
     assert json.loads(truth.read_text())["FDJ"] == 0.055
+
+
+def test_simulate_names_each_window_by_its_content(tmp_path, capsys):
+    """Two windows that differ only in FDJ never share a window_id (a service would answer the second with the
+    first's estimates); the same options give the same window, and its name."""
+    names = []
+    for fdj in ("0.05", "0.06", "0.06"):
+        out = tmp_path / f"w{len(names)}.json"
+        assert main(["simulate", "--out", str(out), "--fdj", fdj, "--duration", "0.05"]) == EXIT_OK
+        names.append(read_window(out).window_id)
+    assert names[0] != names[1] and names[1] == names[2] and names[0].startswith("synthetic-")
 
 
 def test_simulate_with_an_effect_and_a_table(tmp_path, capsys):
@@ -88,13 +100,17 @@ def test_estimate_reads_other_windows_results_as_history_and_names_a_bad_one(tmp
         assert "--history" in (err := capsys.readouterr().err) and named in err
 
 
-def test_calibrate_writes_a_figure_and_names_a_bad_truth_file(tmp_path, capsys):
+def test_calibrate_writes_a_figure_only_when_asked_and_names_a_bad_truth_file(tmp_path, capsys, monkeypatch):
     window, truth = tmp_path / "w.json", tmp_path / "t.json"
     main(["simulate", "--out", str(window), "--duration", "0.15", "--truth-out", str(truth)])
     capsys.readouterr()
-    figure = tmp_path / "cal.png"
-    arguments = ["calibrate", str(window), "--truth", str(truth), "--figure", str(figure), "--copies", "8", *SIZES]
+    monkeypatch.chdir(tmp_path)
+    arguments = ["calibrate", str(window), "--truth", str(truth), "--copies", "8", *SIZES]
     assert main([*arguments, "--json"]) == EXIT_OK
+    assert json.loads(capsys.readouterr().out)["figure"] is None
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["t.json", "w.json"]  # nothing written unasked
+    figure = tmp_path / "cal.png"
+    assert main([*arguments, "--figure", str(figure), "--json"]) == EXIT_OK
     captured = capsys.readouterr()
     report = json.loads(captured.out)
     assert report["schema"] == "ema-calibration/1" and figure.stat().st_size > 1000
@@ -155,6 +171,26 @@ def test_serve_refuses_unsafe_or_unusable_settings_naming_them(tmp_path, capsys,
         monkeypatch.setenv(key, value)
     assert main(["serve", "--database", str(tmp_path / "h.sqlite3"), *arguments]) == EXIT_BAD_INPUT
     assert named in capsys.readouterr().err
+
+
+def test_serve_names_a_short_key_file_and_a_port_in_use(tmp_path, capsys, monkeypatch):
+    monkeypatch.delenv("EMA_API_KEY", raising=False)
+    key = tmp_path / "key"
+    key.write_text("short")
+    assert main(["serve", "--database", str(tmp_path / "h.sqlite3"), "--api-key-file", str(key)]) == EXIT_BAD_INPUT
+    assert "--api-key-file" in (err := capsys.readouterr().err) and "16" in err
+    with socket.create_server(("127.0.0.1", 0)) as taken:
+        port = str(taken.getsockname()[1])
+        assert main(["serve", "--database", str(tmp_path / "h.sqlite3"), "--port", port]) == EXIT_BAD_INPUT
+    assert "--port" in capsys.readouterr().err
+
+
+def test_schemas_are_written_only_where_asked(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    assert main(["schemas"]) == EXIT_BAD_INPUT and "--out" in capsys.readouterr().err
+    assert not (tmp_path / "docs").exists()
+    assert main(["schemas", "--out", str(tmp_path / "s")]) == EXIT_OK
+    assert (tmp_path / "s" / "ema-window-1.json").exists()
 
 
 def test_serve_refuses_a_file_that_is_not_a_database(tmp_path, capsys):

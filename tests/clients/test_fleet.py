@@ -5,7 +5,7 @@ import json
 
 import pytest
 
-from clients.cli import EXIT_OK, main
+from clients.cli import EXIT_BAD_INPUT, EXIT_OK, main
 from sim.params import HealthParams
 from sim.synthetic import synthetic_window
 from sim.window import window_to_dict
@@ -44,16 +44,28 @@ def test_a_local_ray_run_answers_every_window_once_and_resumes(archive, tmp_path
     assert json.loads(capsys.readouterr().out)["skipped"] == 7 and len(_rows(out)) == 7
 
 
-def test_one_worker_without_ray_runs_in_process(archive, tmp_path, capsys, monkeypatch):
+def test_one_worker_without_ray_runs_in_process_and_skips_a_bad_file(archive, tmp_path, capsys, monkeypatch):
     from clients import fleet
 
     monkeypatch.setattr(fleet, "ray_installed", lambda: False)
+    (archive / "5-broken.json").write_text("{not json")
     out = tmp_path / "results.csv"
     assert main(["fleet", str(archive), "--out", str(out), "--workers", "1", "--json", *SIZES]) == EXIT_OK
     captured = capsys.readouterr()
     summary = json.loads(captured.out)
     assert summary["engine"] == "in-process" and summary["answered"] == 6
+    assert list(summary["bad_files"]) == [str(archive / "5-broken.json")] and "5-broken.json" in captured.err
     assert "[7/7]" in captured.err and "windows/s" in captured.err  # progress: done, rate, time left
+
+
+def test_more_workers_without_ray_say_how_to_install_it_and_write_nothing(archive, tmp_path, capsys, monkeypatch):
+    from clients import fleet
+
+    monkeypatch.setattr(fleet, "ray_installed", lambda: False)
+    out = tmp_path / "results.csv"
+    assert main(["fleet", str(archive), "--out", str(out), "--workers", "2"]) == EXIT_BAD_INPUT
+    assert "--workers" in (err := capsys.readouterr().err) and "pip install 'ema[fleet]'" in err
+    assert not out.exists()
 
 
 def test_windows_wanting_what_others_read_are_answered_with_it(tmp_path, capsys, monkeypatch):

@@ -9,6 +9,7 @@ import sys
 import threading
 import time
 import urllib.request
+from dataclasses import replace
 from http.server import BaseHTTPRequestHandler, HTTPServer
 
 import numpy as np
@@ -17,10 +18,16 @@ import pytest
 from clients.cli import EXIT_BAD_INPUT, EXIT_OK, main
 from clients.logs import read_log
 from clients.replay import post_window
+from sim.checks import InputError
 from sim.params import HealthParams
 from sim.synthetic import synthetic_window
 from sim.window import SIGNALS, window_to_dict
 
+ANSWER = {
+    "estimates": {name: {"value": 0.85, "std": 0.01} for name in ("FDJ", "eta_O", "eta_A")} | {"FSJ": None},
+    "timings_s": {"simulate": 0.1, "train": 0.1, "predict": 0.1, "total": 0.3},
+    "fit_check": {"reproduced": True},
+}
 SMALL_ENV = {
     "EMA_PIPELINE__N_SIMULATIONS": "16",
     "EMA_PIPELINE__CHECK_WINDOWS": "8",
@@ -68,24 +75,33 @@ def log_folder(tmp_path):
 
 
 def test_logs_are_read_and_cut_in_order(log_folder):
-    windows = read_log(log_folder)
-    assert [w.window_id for w in windows] == ["flight-1", "csv-1", "npz-1"]
-    from clients.logs import windows_of
-
-    ids = [w.window_id for w, _ in windows_of(log_folder, 0.1)]
-    assert ids == ["flight-1#0", "flight-1#1", "flight-1#2", "csv-1", "npz-1"]
+    assert [w.window_id for w in read_log(log_folder, 10.0).windows] == ["flight-1", "csv-1", "npz-1"]
+    read = read_log(log_folder, 0.1)
+    assert [w.window_id for w in read.windows] == ["flight-1#0", "flight-1#1", "flight-1#2", "csv-1", "npz-1"]
     # a recording is one power-on: its pieces share a flight (and its sensors' zero); a CSV names its own
-    assert [w.flight_id for w, _ in windows_of(log_folder, 0.1)] == ["flight-1"] * 3 + ["f-7", None]
+    assert [w.flight_id for w in read.windows] == ["flight-1"] * 3 + ["f-7", None]
+    assert read.bad_files == {}
+
+
+def test_a_bad_file_in_a_folder_is_skipped_and_named_alone_it_is_an_error(log_folder):
+    (log_folder / "d_broken.csv").write_text("command_deg,position_deg\n1,2\n")
+    read = read_log(log_folder, 0.1)
+    assert len(read.windows) == 5 and list(read.bad_files) == [str(log_folder / "d_broken.csv")]
+    assert "motor_speed_radps" in read.bad_files[str(log_folder / "d_broken.csv")]
+    with pytest.raises(InputError, match=r"d_broken\.csv"):
+        read_log(log_folder / "d_broken.csv", 0.1)
 
 
 def test_replay_end_to_end_resume_and_kill_9(tmp_path, log_folder, capsys):
     port, database, out = _free_port(), tmp_path / "history.sqlite3", tmp_path / "estimates.csv"
     url = f"http://127.0.0.1:{port}"
+    (log_folder / "d_broken.json").write_text('{"schema": "ema-window/1"')  # skipped and said so
     server = _start_server(port, database)
     try:
         assert main(["replay", str(log_folder), "--url", url, "--out", str(out), "--window-s", "0.1"]) == EXIT_OK
         printed = capsys.readouterr()
         assert "flight-1#2" in printed.out and "[5/5]" in printed.err
+        assert "skipped" in printed.err and "d_broken.json" in printed.err and "1 unreadable file" in printed.out
         assert len(out.read_text().strip().splitlines()) == 1 + 5
         assert main(["replay", str(log_folder), "--url", url, "--out", str(out), "--window-s", "0.1", "--json"]) == 0
         assert json.loads(capsys.readouterr().out)["posted"] == 0  # resumed: nothing sent twice
@@ -116,20 +132,55 @@ def test_replay_end_to_end_resume_and_kill_9(tmp_path, log_folder, capsys):
         "flight-1#2",
         "csv-1",
         "npz-1",
-        "synthetic-seed4",
+        in_flight.window_id,
     ]
 
 
-def test_a_refused_window_is_not_posted_again_on_a_rerun(tmp_path, monkeypatch):
+def test_a_rerun_posts_the_refused_windows_again_and_not_the_answered(tmp_path, monkeypatch):
     from clients import replay as replaying
 
-    posted = []
-    monkeypatch.setattr(replaying, "post_window", lambda url, w, key: posted.append(w.window_id) or {"error": "422"})
-    window = synthetic_window(HealthParams.single(), seed=5, duration_s=0.02)
+    posted, refuse = [], {"first"}
+
+    def answer(url, window, key):
+        posted.append(window.window_id)
+        return {"error": "signals: too little motion"} if window.window_id in refuse else ANSWER
+
+    monkeypatch.setattr(replaying, "post_window", answer)
+    base = synthetic_window(HealthParams.single(), seed=5, duration_s=0.02)
+    windows = [replace(base, window_id=name) for name in ("first", "second")]
     out = tmp_path / "estimates.csv"
-    replaying.replay([window], "http://127.0.0.1:9", out)
-    replaying.replay([window], "http://127.0.0.1:9", out)
-    assert posted == [window.window_id]
+    replaying.replay(windows, "http://127.0.0.1:9", out)
+    refuse.clear()  # e.g. the operator raised a budget
+    replaying.replay(windows, "http://127.0.0.1:9", out)
+    assert posted == ["first", "second", "first"]
+
+
+def test_a_replay_whose_every_window_is_refused_exits_2_and_says_why_in_full(tmp_path, capsys):
+    message = "the position's travel is 1.56x the speed's integral through the gear ratio of this actuator"
+    detail = json.dumps({"detail": [{"loc": ["body", "signals", "motor_speed_radps"], "msg": message}]}).encode()
+
+    class Handler(BaseHTTPRequestHandler):
+        def do_POST(self):
+            self.rfile.read(int(self.headers["content-length"]))
+            self.send_response(422)
+            self.end_headers()
+            self.wfile.write(detail)
+
+        def log_message(self, *args):
+            pass
+
+    server = HTTPServer(("127.0.0.1", 0), Handler)
+    threading.Thread(target=server.serve_forever, daemon=True).start()
+    window = tmp_path / "w.json"
+    window.write_text(json.dumps(window_to_dict(synthetic_window(HealthParams.single(), seed=3, duration_s=0.02))))
+    try:
+        code = main(["replay", str(window), "--url", f"http://127.0.0.1:{server.server_port}",
+                     "--out", str(tmp_path / "e.csv")])  # fmt: skip
+    finally:
+        server.shutdown()
+    captured = capsys.readouterr()
+    assert code == EXIT_BAD_INPUT and "none of the 1 window(s)" in captured.err
+    assert f"signals.motor_speed_radps: {message}" in captured.out
 
 
 def test_a_bad_file_exits_2_naming_it(tmp_path, capsys):
