@@ -29,7 +29,7 @@ from sim.window import window_from_dict
 from tests.foreign.windows import Draw
 from training.documents import HistoryReadings
 from training.pipeline import estimate_window
-from training.result import HEALTHY_RANGE, WEAK_SHARE_OF_RANGE, share_of_range
+from training.report import HEALTHY_RANGE, WEAK_SHARE_OF_RANGE, share_of_range
 
 RESULTS_MD = Path(__file__).resolve().parent.parent / "docs" / "results.md"
 
@@ -219,22 +219,25 @@ def report(rows: dict[str, list[dict[str, Any]]], per_group: int, seconds: float
         "same filters on the noise alone (`draw(filter_samples=...)`), as an amplifier's own noise behind its",
         "output filter would be: the noise reads as a filter's delay either way, and the product weighs the two",
         "readings by the lag the deflection shows in the aircraft's band and by the equation error",
-        "(`training.alignment`), its stds carrying both where neither decides.",
+        "(`training.prepare.alignment`), its stds carrying both where neither decides.",
         "*Sensor glitches*: the five families with",
         "1–5 spikes of 50–500 noise stds on each sensor, one in four two samples long (`with_spikes`).",
         "*Sensors off zero*: the five families with the hinge moment 1–10 N·m or the current 0.04–0.25 A",
-        "off zero, in turn (`off_zero`), read and taken off per window (`training.zero_offset`).",
+        "off zero, in turn (`off_zero`), read and taken off per window (`training.prepare.departures.zero_offset`).",
         "*Viscous friction 1.2–2x the spec's*: the five families with C above the spec's, as a cold grease",
-        "has it (`viscous`), read per window and used by every estimator (`training.viscosity`). The",
+        "has it (`viscous`), read per window and used by every estimator",
+        "(`training.prepare.departures.viscosity`). The",
         "*worn* groups with these two: a worn transmission's k = 1/η_O − 1 reaches 1.2, and so does the",
         "share of a hinge offset that passes for FDJ where the window cannot tell which sensor is off.",
         "*k_T, current gain or J_M off*: the five families with, in turn, k_T 0.95–1.05x the spec's (magnets",
         "warm or cold), the current sensor's gain 0.97–1.03 and J_M 0.9–1.1x (`drive_off`), read per window",
-        "and corrected (`training.drive_constants`); and on worn actuators. *Hinge moment gain*: the five",
+        "and corrected (`training.prepare.departures.drive_constants`); and on worn actuators. *Hinge moment",
+        "gain*: the five",
         "families with the hinge moment logged 0.95–1.05x the true one (`with_hinge_gain`), read per window",
-        "from Eq. 5.1's aiding and opposing load terms with Eq. 3.4 and corrected (`training.hinge_gain`).",
+        "from Eq. 5.1's aiding and opposing load terms with Eq. 3.4 and corrected",
+        "(`training.prepare.departures.hinge_gain`).",
         "*Longest window*: the five families over 10 s, the longest the issue names, processed at 5 kHz (the",
-        "pipeline averages a long log down, not below 5 kHz up to 10 s: `training.conditioning`).",
+        "pipeline averages a long log down, not below 5 kHz up to 10 s: `training.prepare.conditioning`).",
         f"Total {seconds:.0f} s.",
         "",
         table(summaries),

@@ -31,7 +31,7 @@ from sim.window import window_from_dict
 from tests.foreign.windows import Draw, Effects, Health, draw
 from training.history import readings_of
 from training.pipeline import estimate_window
-from training.result import share_of_range
+from training.report import share_of_range
 
 PROGNOSIS_MD = Path(__file__).resolve().parent.parent / "docs" / "prognosis.md"
 FIRST_SEED = 200_000  # apart from every other benchmark's and the tests'

@@ -42,10 +42,10 @@ from sim.hinge import HINGE_SMOOTHING_S, local_line
 from sim.params import ActuatorParams, eta_a_from_eta_o
 from sim.residual import kernel_samples
 from sim.window import Window, window_from_dict
-from training.baseline import FitSettings, fit_friction, regressors
-from training.conditioning import prepare
-from training.preprocess import as_read
-from training.result import HEALTHY_RANGE
+from training.physics.features import as_read
+from training.physics.friction import FitSettings, fit_friction, regressors
+from training.prepare.conditioning import prepare
+from training.report import HEALTHY_RANGE
 
 GROUPS = ("short window (0.1 s, gust)", "low log rate (1-2 kHz)")  # the groups with errors past 10 % of range
 SENSORS = ("current_a", "motor_speed_radps", "hinge_moment_nm", "position_deg")
@@ -128,7 +128,8 @@ def efficient_std(
 
 
 def our_rms(clean: Window, truth: dict[str, float], levels: dict[str, float], draws: int, seed: int) -> np.ndarray:
-    """(2,) RMS error (share of range) of ``training.baseline`` on ``draws`` Gaussian noise draws at ``levels``."""
+    """(2,) RMS error (share of range) of ``training.physics.friction`` on ``draws`` Gaussian noise draws at
+    ``levels``."""
     rng = np.random.default_rng(seed)
     signals = {name: np.repeat(values[None], draws, axis=0) for name, values in clean.signals.items()}
     for name in SENSORS:

@@ -18,7 +18,7 @@ from clients.report import write_section
 from sim import runtime
 from sim.window import window_from_dict
 from tests.foreign.faults import FAULTS, with_fault
-from training.stale import stale_runs
+from training.prepare.stale import stale_runs
 
 FIRST_SEED = 1_000_000  # apart from every other benchmark's (foreign_history's reach ~610 000) and the tests'
 CLEAN = "none: the windows as drawn"
@@ -34,7 +34,7 @@ def report(rows: dict[str, list[dict[str, Any]]], found: dict[str, int], per_fau
         "1–100 kHz, worn, filtered, off zero, drives unlike the spec's), each logged once more with one fault",
         "(`tests/foreign/faults.py`): a sensor whose logger kept writing its last value after it stopped",
         "updating, or a gap filled with zeros, over 5–25 % of the window somewhere in it, or for 0.5–2 ms",
-        "where the motor slews past 300 rad/s. *Found in*: windows where `training.stale` takes a run of that",
+        "where the motor slews past 300 rad/s. *Found in*: windows where `training.prepare.stale` takes a run of that",
         "sensor for one (a sensor quantized coarser than its noise, or a speed or position at rest, is left",
         "alone; a current at 0 a few noise stds from its flanks matters little). A run of up to 2 ms is",
         "bridged by the line between its flanks, a longer one cuts the window to the stretch with the most",

@@ -25,7 +25,7 @@ from sim.synthetic import synthetic_window
 from sim.window import read_window, write_window
 from training import runtime
 from training.pipeline import estimate_window
-from training.result import HEALTHY_RANGE, share_of_range
+from training.report import HEALTHY_RANGE, share_of_range
 
 LEGACY = "b8987e4"  # the last commit of round 1
 ROOT = Path(__file__).resolve().parent.parent

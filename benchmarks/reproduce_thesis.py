@@ -25,11 +25,11 @@ from sim.commands import random_command_knots
 from sim.noise import NO_NOISE, SensorNoise, add_sensor_noise
 from sim.params import DEFAULT_RANGES, IRREVERSIBLE_RANGES, HealthParams, HealthRanges
 from sim.synthetic import synthetic_window
-from training.baseline import fit_window
-from training.dataset import Scenario
-from training.design import Box
-from training.network import TrainConfig, fit, predict
-from training.preprocess import features
+from training.learn.network import TrainConfig, fit, predict
+from training.physics.features import features
+from training.physics.friction import fit_window
+from training.physics.scenario import Scenario
+from training.simulate.design import Box
 
 DOCS = Path(__file__).resolve().parent.parent / "docs"
 RATE_HZ, SAMPLES = 10_000.0, 5000

@@ -16,10 +16,10 @@ range), this computes:
   and the same with the loop's bus voltage, lag and position gain fitted as unknowns too;
 - its first-order bias b = F⁻¹ Σ_s J_sᵀ Δs / σ_s² when the model it trusts is *our* simulator of
   the same spec (started where the window starts, fed its command and logged hinge moment: what
-  ``training.dataset`` simulates), and when the real loop departs from the spec's by less than any
+  ``training.simulate.dataset`` simulates), and when the real loop departs from the spec's by less than any
   log shows: the PWM bus 1 % high, the command reaching the loop 10 µs late, the position gain
   0.1 % high, the loop reading a speed as noisy as the logged one (``tests.foreign.physics.Effects``);
-- how far our Eq. 5.1 fit (``training.baseline``) moves on the same departures, noise-free;
+- how far our Eq. 5.1 fit (``training.physics.friction``) moves on the same departures, noise-free;
 - where the whole-loop information lies: its share in the richest 2 % of the samples.
 
     python -m benchmarks.whole_loop [--per-group 60] [--docs]
@@ -43,11 +43,11 @@ from sim.params import HealthParams
 from sim.window import Window, window_from_dict
 from tests.foreign.physics import Effects
 from tests.foreign.windows import Draw
-from training.baseline import fit_friction
-from training.conditioning import prepare
-from training.dataset import scenario_from_window
-from training.preprocess import as_read
-from training.result import HEALTHY_RANGE
+from training.physics.features import as_read
+from training.physics.friction import fit_friction
+from training.physics.scenario import scenario_from_window
+from training.prepare.conditioning import prepare
+from training.report import HEALTHY_RANGE
 
 WIDTH = np.array([np.ptp(HEALTHY_RANGE["FDJ"]), np.ptp(HEALTHY_RANGE["eta_O"])])  # the ranges, for shares
 STEP = 0.025  # central-difference step, share of each range
@@ -84,7 +84,7 @@ def _as_window(window: Draw, signals: dict[str, np.ndarray]) -> Window:
 
 def our_simulator_bias(window: Draw, clean: dict[str, np.ndarray], levels: dict[str, float]) -> np.ndarray:
     """(2,) first-order bias of a whole-loop reading that simulates the window with *our* simulator
-    (``training.dataset``'s scenario of the noise-free window: its command, start and logged load)."""
+    (``training.simulate.dataset``'s scenario of the noise-free window: its command, start and logged load)."""
     scenario = scenario_from_window(_as_window(window, clean))
     truth, (d_fdj, d_eta) = window.truth, STEP * WIDTH
     fdj, eta_o = truth["FDJ"] + np.array([0, d_fdj, -d_fdj, 0, 0]), truth["eta_O"] + np.array([0, 0, 0, d_eta, -d_eta])

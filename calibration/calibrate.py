@@ -35,10 +35,10 @@ from sim.checks import InputError
 from sim.noise import SensorNoise
 from sim.params import ActuatorParams
 from sim.window import Window
-from training.conditioning import prepare
 from training.config import PipelineConfig
 from training.documents import TARGETS, Estimate
 from training.pipeline import estimate_window
+from training.prepare.conditioning import prepare
 
 MIN_HELD_OUT_GAIN = 0.01  # the model with the effect must cut the held-out residual by at least 1 %
 

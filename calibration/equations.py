@@ -8,7 +8,7 @@ states, sample by sample, over the sliding samples:
     t = sgn(ω)·(T_R − C_M·ω) = FDJ + k_aid·a + k_opp·o + Σ effect columns + noise,
 
 with a and o the smoothed aiding and opposing |T_ext|, the hinge moment read as the estimators
-read it (``training.preprocess.as_read``). A second channel carries the backlash:
+read it (``training.physics.features.as_read``). A second channel carries the backlash:
 the motor angle (integrated measured speed) minus the elevator angle, d = θ_m/n − θ_u, sits at
 c ± BLK/2 depending on which side of the dead band the motor pushes. Simulated windows go
 through this very function, so the noise floor (``calibration.noise_floor``) sees what the
@@ -24,8 +24,8 @@ import numpy as np
 
 from sim.params import ActuatorParams
 from sim.residual import smooth_derivative, smoothed
-from training.baseline import FitSettings, regressors
-from training.preprocess import as_read
+from training.physics.features import as_read
+from training.physics.friction import FitSettings, regressors
 
 FOLDS = 5
 FOLD_BLOCK_S = 0.02  # held-out folds are interleaved 20 ms blocks: each fold sees every regime of the window

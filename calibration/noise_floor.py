@@ -18,8 +18,7 @@ import numpy as np
 from calibration.equations import Equations, equations
 from sim.noise import SensorNoise, add_sensor_noise
 from sim.window import Window
-from training.dataset import scenario_from_window
-from training.design import inside
+from training.physics.scenario import inside, scenario_from_window
 
 COPIES = 30
 

@@ -1,6 +1,6 @@
 """Stage 5, the estimates once the effect is in: Eq. 5.1 with its columns, η_A tied by Eq. 3.4.
 
-The same profile search over η_O as ``training.baseline``, with FDJ and the effect's
+The same profile search over η_O as ``training.physics.friction``, with FDJ and the effect's
 coefficients solved in closed form at each point. The physics fit's bias on this window's
 scenario, measured by the base pipeline on its held-out simulations, is subtracted as it is
 there, so that before and after differ only by the effect. "Never worse" is judged the same
@@ -18,7 +18,7 @@ import numpy as np
 from calibration.equations import FOLDS, Equations
 from calibration.selection import Chosen
 from sim.params import eta_a_from_eta_o
-from training.baseline import ETA_O_SEARCH, GRID_POINTS, REFINEMENTS
+from training.physics.friction import ETA_O_SEARCH, GRID_POINTS, REFINEMENTS
 
 
 @dataclass(frozen=True)

@@ -19,8 +19,7 @@ import numpy as np
 from calibration.selection import Evidence
 from sim.noise import SensorNoise
 from sim.window import Window
-from training.design import inside
-from training.reproduction import CLEAR_MARGIN, following_error
+from training.physics.scenario import CLEAR_MARGIN, following_error, inside
 
 # Look-alikes, each with the others of its group. An inertia ΔJ leaves ΔJ·dω/dt, which a gain of k_T·I
 # (mostly the load and J_M·dω/dt) nearly matches; only its simulation moves the speed otherwise.

@@ -26,9 +26,9 @@ from sim.synthetic import synthetic_window
 from training import runtime
 from training.config import PipelineConfig
 from training.pipeline import estimate_window
-from training.result import share_of_range
+from training.report import share_of_range
 
-STAGES = ("simulate", "train", "predict", "check", "total")
+STAGES = ("prepare", "physics", "simulate", "train", "predict", "check", "total")  # predict: the assess stage
 BUSY = "import itertools\nfor _ in itertools.count(): pass"
 
 
@@ -76,8 +76,9 @@ def markdown(rows: list[dict[str, Any]], config: PipelineConfig) -> str:
         "p50 (p95) seconds per stage; real-time factor = pipeline seconds per second of window (≤ 1: real time);",
         "error = mean |error| in % of the thesis's range (0.02 N·m for FDJ, 0.30 for η_O).",
         "",
-        "| load | window | simulate | train | predict | check | total | real-time factor p50 (p95) | error FDJ / η_O |",
-        "|---|---:|---:|---:|---:|---:|---:|---:|---:|",
+        "| load | window | prepare | physics | simulate | train | assess | check | total | real-time factor p50 (p95) "
+        "| error FDJ / η_O |",
+        "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
     ]
     for r in rows:
         cells = " | ".join(f"{r['p50_s'][s]:.2f} ({r['p95_s'][s]:.2f})" for s in STAGES)

@@ -94,21 +94,15 @@ class _Readings:
             self.inertias.setdefault(window.actuator_id, []).append(info.inertia_read)
 
     def lacked(self, window: Window, answer: dict[str, Any]) -> dict[str, Any] | None:
-        """What the other windows read that this one lacks, as the service would give it: its flight's sensor
-        zero where the window moved one way or read its own less precisely (``training.zero_offset`` takes it
-        where it holds), J_M where it could not tell a heavier rotor from a weaker motor; or None."""
-        from training.documents import HistoryReadings
-        from training.history import best_zero, combined_inertia
+        """What the run's other windows lend this one that it lacks (``training.history.wanted``), as JSON; or
+        None."""
+        from training.documents import WindowInfo
+        from training.history import lent, wanted
 
-        read = answer["window"]
         flight = self.zeros.get((window.actuator_id, window.flight_id), [])
-        zero = best_zero(z for z in flight if z.window_id != window.window_id)
-        undecided = bool(read.get("inertia_undecided"))
-        inertia = combined_inertia(self.inertias.get(window.actuator_id, [])) if undecided else None
-        own = read.get("sensor_zero")
-        takes_zero = zero is not None and (own is None or zero.torque_std_nm < own["torque_std_nm"])
-        takes_inertia = inertia is not None
-        return HistoryReadings(sensor_zero=zero, inertia=inertia).model_dump() if takes_zero or takes_inertia else None
+        others = lent((z for z in flight if z.window_id != window.window_id), self.inertias.get(window.actuator_id, []))
+        lacking = wanted(WindowInfo.model_validate(answer["window"]), others)
+        return None if lacking is None else lacking.model_dump()
 
 
 def _with_history(

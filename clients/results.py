@@ -24,7 +24,8 @@ def row_of(actuator_id: str, window_id: str, answer: dict[str, Any]) -> dict[str
     """A CSV row from an ema-estimate/1 document (as JSON), or from {"error": ...}."""
     row: dict[str, Any] = {"actuator_id": actuator_id, "window_id": window_id}
     if "error" in answer:
-        return {**row, "error": answer["error"]}
+        error = answer["error"]
+        return {**row, "error": f"{error['field']}: {error['message']}" if isinstance(error, dict) else error}
     for name in ("FDJ", "eta_O", "eta_A", "FSJ"):
         entry = answer["estimates"][name]
         row[name], row[f"{name}_std"] = (None, None) if entry is None else (entry["value"], entry["std"])

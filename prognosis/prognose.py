@@ -12,8 +12,8 @@ from prognosis.documents import PARAMETERS, Prognosis, Stored, Trend
 from prognosis.rul import remaining_life
 from prognosis.trend import fit_trend
 from sim.params import DEFAULT_RANGES, eta_a_from_eta_o
-from training.aircraft_check import TOLERANCE
 from training.history import combined_inertia, inertia_change_note
+from training.prepare.departures.aircraft_check import TOLERANCE
 
 SENSOR_STDS = 3.0  # stds by which a sensor's level or drift must stand out to be said
 

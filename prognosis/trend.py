@@ -21,7 +21,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from prognosis.documents import Curved, Point, Trend
-from training.preprocess import odds_weight
+from training.stats import odds_weight
 
 HUBER_C = 2.5
 OUTLIER_Z = 3.5

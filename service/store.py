@@ -27,7 +27,7 @@ from pydantic import ValidationError
 
 from prognosis.documents import Stored
 from training.documents import Estimate, HistoryReadings, InertiaReading, SensorZero
-from training.history import best_zero, combined_inertia
+from training.history import lent
 
 log = logging.getLogger("ema.service")
 
@@ -172,13 +172,12 @@ class EstimateStore:
         return stored
 
     def readings(self, actuator_id: str, flight_id: str | None) -> HistoryReadings:
-        """What the stored windows of this actuator read that another may not (``training.history``): the
-        most precise sensor zero of the flight, J_M from every window that told it apart."""
+        """What the stored windows of this actuator lend a window of ``flight_id`` (``training.history.lent``)."""
         zeros = [] if flight_id is None else self._column(actuator_id, "sensor_zero", flight_id)
         inertias = self._column(actuator_id, "inertia_read")
-        return HistoryReadings(
-            sensor_zero=best_zero(SensorZero.model_validate_json(zero) for zero in zeros),
-            inertia=combined_inertia([InertiaReading.model_validate_json(reading) for reading in inertias]),
+        return lent(
+            (SensorZero.model_validate_json(zero) for zero in zeros),
+            [InertiaReading.model_validate_json(reading) for reading in inertias],
         )
 
     def _column(self, actuator_id: str, name: str, flight_id: str | None = None) -> list[str]:

@@ -1,4 +1,4 @@
-"""``ema-estimate/1``: the one definition of an estimate result (shared/spec/interfaces.md).
+"""``ema-estimate/1``: the one definition of an estimate result.
 
 The pipeline returns it, the service declares it as its response model, the CLI prints it, the
 history stores it and the tests construct it; ``docs/schemas/ema-estimate-1.json`` is exported
@@ -11,7 +11,6 @@ from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
-from training.conditioning import GLITCH_STDS
 from training.config import PipelineConfig
 
 TARGETS = ("FDJ", "eta_O")  # what the estimators fit; η_A follows by Eq. 3.4, FSD from FSJ
@@ -50,10 +49,14 @@ class Estimates(Document):
 
 
 class Timings(Document):
-    simulate: float
-    train: float
-    predict: float
-    check: float = 0.0
+    """Seconds of each stage of ``training.pipeline``, in order."""
+
+    prepare: float = Field(0.0, description="the window checked, repaired, aligned, its departures read")
+    physics: float = Field(0.0, description="Eq. 5.1 fitted by least squares")
+    simulate: float = Field(description="the window's own dataset simulated")
+    train: float = Field(description="the network trained")
+    predict: float = Field(description="assess: both estimators on held-out simulations, blended")
+    check: float = Field(0.0, description="the window simulated at the answer, and FSJ read")
     total: float
 
 
@@ -89,7 +92,8 @@ class FitCheck(Document):
 
 
 class SensorZero(Document):
-    """The sensors' zero as a window moving both ways read it (``training.zero_offset``): what a window of
+    """The sensors' zero as a window moving both ways read it (``training.prepare.departures.zero_offset``):
+    what a window of
     the same flight that moves one way, and so cannot read it, is read with."""
 
     window_id: str = Field(description="the window that read it")
@@ -100,7 +104,8 @@ class SensorZero(Document):
 
 class InertiaReading(Document):
     """J_M as windows of an actuator read it where each told a heavier rotor from a weaker motor itself
-    (``training.drive_constants``): a window that cannot is read with it (J_M stays with the build)."""
+    (``training.prepare.departures.drive_constants``): a window that cannot is read with it (J_M stays with
+    the build)."""
 
     factor: float = Field(description="the inertia at the motor shaft over the spec's J_M")
     std: float = Field(ge=0, description="its std")
@@ -128,7 +133,7 @@ class WindowInfo(Document):
     command_clipped_fraction: float = Field(description="share of command samples past the end stops, saturating")
     glitches_repaired: dict[str, int] = Field(
         default_factory=dict,
-        description=f"per sensor, samples of glitches (runs off both flanks by > {GLITCH_STDS:g} noise stds), "
+        description="per sensor, samples of glitches (short runs far off both flanks, which agree), "
         "replaced by the line between the flanks",
     )
     stale_samples: dict[str, int] = Field(

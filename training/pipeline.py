@@ -3,44 +3,46 @@
 The thesis's §6.3 proposal, made to hold on data our simulator did not draw:
 
 1. **prepare**: repair, average, align and zero the window's sensors, read its viscous coefficient
-   (``training.conditioning``);
-2. **physics**: fit Eq. 5.1 by least squares (``training.baseline``), a block-jackknife std beside;
+   (``training.prepare.conditioning``);
+2. **physics**: fit Eq. 5.1 by least squares (``training.physics.friction``), a block-jackknife std beside;
 3. **simulate**: a Case-1B dataset of the window's own command, logged load and first state, its
-   health drawn in a box around the physics estimate (``training.design``: no fixed range, so no
+   health drawn in a box around the physics estimate (``training.simulate.design``: no fixed range, so no
    cap on a worn actuator), with the window's own sensor noise;
 4. **train**: the shallow network on the residual torque of the sliding samples;
 5. **assess**: both estimators scored on held-out simulations, blended per parameter, checked
-   against the window itself (``training.assess``) and by simulating it at the answer
-   (``training.reproduction``);
-6. **FSJ** where the window shows a quasi-static break-away (``training.static_friction``).
+   against the window itself (``training.assess.weighing``) and by simulating it at the answer
+   (``training.assess.reproduction``);
+6. **FSJ** where the window shows a quasi-static break-away (``training.physics.static_friction``).
 """
 
 from __future__ import annotations
 
+import contextlib
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import replace
 
 import numpy as np
 
 from sim.window import Window
-from training import design
-from training.assess import Assessed, Candidates, assess
-from training.baseline import FIT_ARRAYS, FrictionFit, fit_friction, fit_window
-from training.conditioning import prepare, widened
+from training.assess.reproduction import output_error_ratios
+from training.assess.weighing import Assessed, Candidates, assess
 from training.config import PipelineConfig
-from training.dataset import Data, simulate_dataset
-from training.documents import Estimate, FitCheck, HistoryReadings
-from training.estimator import NetworkEstimator
+from training.documents import Estimate, FitCheck, HistoryReadings, Timings
 from training.history import known_from
-from training.network import TrainConfig
-from training.preprocess import as_read
-from training.reproduction import MAX_RATIO, output_error_ratios
-from training.result import estimate_document
-from training.static_friction import read_static_friction
+from training.learn.estimator import NetworkEstimator
+from training.learn.network import TrainConfig
+from training.physics.features import as_read
+from training.physics.friction import FIT_ARRAYS, FrictionFit, fit_friction, fit_window
+from training.physics.scenario import MAX_RATIO
+from training.physics.static_friction import read_static_friction
+from training.prepare.conditioning import prepare, widened
+from training.report import estimate_document
+from training.simulate import design
+from training.simulate.dataset import Data, simulate_dataset
 
 # On a few dozen noisy simulations the network stops improving within a few epochs, and the physics fit
-# carries most of the answer (training.assess): the thesis's 12 failures and 1000 epochs made its time
+# carries most of the answer (training.assess.weighing): the thesis's 12 failures and 1000 epochs made its time
 # the pipeline's least predictable.
 PIPELINE_TRAINING = TrainConfig(max_epochs=60, max_validation_failures=6)
 
@@ -78,7 +80,7 @@ def candidates(
 
 
 def fit_check(window: Window, data: Data, answer: Assessed, equation_ratio: float, n: int) -> FitCheck:
-    """Simulate the window at the answer and compare (``training.reproduction``)."""
+    """Simulate the window at the answer and compare (``training.assess.reproduction``)."""
     health = design.inside(answer.values["FDJ"], answer.values["eta_O"])
     floor = float(np.sqrt(np.mean((data.sims.residual_nm[n:] - data.sims.clean_residual_nm)[:, data.sliding] ** 2)))
     ratios = output_error_ratios(window, data.scenario, health, data.noise, floor, data.sliding, data.actuator)
@@ -98,6 +100,26 @@ def fit_check(window: Window, data: Data, answer: Assessed, equation_ratio: floa
     )
 
 
+class Stopwatch:
+    """Each stage's seconds, announced to ``on_stage`` as it starts (which may raise to stop the job there)."""
+
+    def __init__(self, on_stage: Callable[[str], None] | None) -> None:
+        self.on_stage = on_stage or (lambda _: None)
+        self.seconds: dict[str, float] = {}
+
+    @contextlib.contextmanager
+    def __call__(self, name: str, announcement: str) -> Iterator[None]:
+        self.on_stage(announcement)
+        started = time.perf_counter()
+        yield
+        self.seconds[name] = time.perf_counter() - started
+
+    def timings(self) -> Timings:
+        s = self.seconds
+        return Timings(prepare=s["prepare"], physics=s["physics"], simulate=s["simulate"], train=s["train"],
+                       predict=s["assess"], check=s["check"], total=sum(s.values()))  # fmt: skip
+
+
 def estimate_window(
     window: Window,
     config: PipelineConfig = PipelineConfig(),
@@ -105,36 +127,34 @@ def estimate_window(
     spec_only: bool = False,
     history: HistoryReadings | None = None,
 ) -> Estimate:
-    """The ``ema-estimate/1`` result for one window; ``on_stage`` hears each stage as it starts (and may
-    raise to stop the job there); ``spec_only`` reads the window with the spec's model alone, no offset
-    (``calibration``'s base); ``history``: what other windows of the actuator read that this one may not
-    (its flight's sensor zero, its J_M: ``training.departures``). Raises InputError (field ``signals``) for a
-    window with too little sliding motion.
+    """The ``ema-estimate/1`` result for one window, its stages timed.
+
+    ``on_stage`` hears each stage as it starts (and may raise to stop the job there); ``spec_only`` reads
+    the window with the spec's model alone, no departures taken off (calibration's base); ``history``: what
+    other windows of the actuator lend this one (``training.history``). Raises InputError naming the field
+    for a window that cannot be read.
     """
-    stage = on_stage or (lambda _: None)
-    clock = [time.perf_counter()]
-    digest = window.content_sha256()
-    prepared = prepare(window, spec_only=spec_only, known=known_from(history))
-    w, n = prepared.window, config.n_simulations
-    seen = replace(w, signals=as_read(w.signals, w.sample_rate_hz))
-    physics = fit_window(seen.signals, w.sample_rate_hz, prepared.actuator)
-    stage(f"simulating {config.total_simulations} windows around the physics estimate")
-    data = simulate_dataset(w, seen, physics, config, prepared.actuator, prepared.departures.viscosity.effects())
-    clock.append(time.perf_counter())
-    stage(f"training {config.members} network(s) of {config.hidden_units} neurons")
-    network = train_network(data, config)
-    clock.append(time.perf_counter())
-    stage("estimating")
-    found, check_physics = candidates(w, physics, data, network, n)
-    floor = np.median(check_physics.residual_rms_nm) if len(check_physics.residual_rms_nm) else np.nan
-    equation_ratio = float(physics.residual_rms_nm[0] / floor) if np.isfinite(floor) else 1.0
-    answer = assess(found, equation_ratio)
-    answer = replace(answer, stds=widened(answer.stds, prepared))
-    clock.append(time.perf_counter())
-    stage("checking the answer against the window")
-    check = fit_check(seen, data, answer, equation_ratio, n)
-    fsj = read_static_friction(
-        seen.signals, w.sample_rate_hz, answer.values["FDJ"], answer.values["eta_O"], data.noise, data.actuator
-    )
-    clock.append(time.perf_counter())
-    return estimate_document(prepared, physics, data, network, answer, check, fsj, config, clock, digest)
+    watch = Stopwatch(on_stage)
+    with watch("prepare", "preparing the window"):
+        digest = window.content_sha256()
+        prepared = prepare(window, spec_only=spec_only, known=known_from(history))
+        w, n = prepared.window, config.n_simulations
+        seen = replace(w, signals=as_read(w.signals, w.sample_rate_hz))
+    with watch("physics", "fitting Eq. 5.1"):
+        physics = fit_window(seen.signals, w.sample_rate_hz, prepared.actuator)
+    with watch("simulate", f"simulating {config.total_simulations} windows around the physics estimate"):
+        data = simulate_dataset(w, seen, physics, config, prepared.actuator, prepared.departures.viscosity.effects())
+    with watch("train", f"training {config.members} network(s) of {config.hidden_units} neurons"):
+        network = train_network(data, config)
+    with watch("assess", "weighing the estimators on held-out simulations"):
+        found, check_physics = candidates(w, physics, data, network, n)
+        floor = np.median(check_physics.residual_rms_nm) if len(check_physics.residual_rms_nm) else np.nan
+        equation_ratio = float(physics.residual_rms_nm[0] / floor) if np.isfinite(floor) else 1.0
+        answer = assess(found, equation_ratio)
+        answer = replace(answer, stds=widened(answer.stds, prepared))
+    with watch("check", "checking the answer against the window"):
+        check = fit_check(seen, data, answer, equation_ratio, n)
+        fsj = read_static_friction(
+            seen.signals, w.sample_rate_hz, answer.values["FDJ"], answer.values["eta_O"], data.noise, data.actuator
+        )
+    return estimate_document(prepared, physics, data, network, answer, check, fsj, config, watch.timings(), digest)

@@ -2,7 +2,8 @@
 
 The task carries the window as its ``ema-window/1`` JSON and the config as a dict, pins its own
 thread budget (``training.runtime``) before it computes, and returns the ``ema-estimate/1``
-document as JSON-able data, or the reason a window was refused. Ray is imported only here, and
+document as JSON-able data, or the refusal as ``{"error": {"field", "message"}}`` (an ``InputError``'s
+parts, so that it crosses a process boundary typed, never as a sentence to parse back). Ray is imported only here, and
 only when asked for: it is an optional extra (``pip install -e '.[fleet]'``).
 """
 
@@ -21,14 +22,14 @@ from training.pipeline import estimate_window
 def estimate_document(
     window: dict[str, Any], config: dict[str, Any], threads: int, history: dict[str, Any] | None = None
 ) -> dict[str, Any]:
-    """The estimate of one window as a JSON-able dict, or {"error": ...} for a window refused as bad input;
+    """The estimate of one window as a JSON-able dict, or {"error": {"field", "message"}} for a window refused;
     ``history``: what other windows of the actuator read (``estimate_window``)."""
     runtime.configure(threads)
     known = None if history is None else HistoryReadings.model_validate(history)
     try:
         result = estimate_window(window_from_dict(window), PipelineConfig(**config), history=known)
     except InputError as exc:
-        return {"error": str(exc)}
+        return {"error": {"field": exc.field, "message": exc.message}}
     return result.model_dump(mode="json", by_alias=True)
 
 
@@ -60,6 +61,5 @@ def estimate_on_ray(
     known = None if history is None else history.model_dump()
     answer = ray.get(ray_task(threads).remote(window_to_dict(window), config.model_dump(), threads, known))
     if "error" in answer:
-        field, _, message = answer["error"].partition(": ")
-        raise InputError(field, message)
+        raise InputError(**answer["error"])
     return Estimate.model_validate(answer)

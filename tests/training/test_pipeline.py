@@ -21,7 +21,7 @@ from tests.foreign.windows import (
 from training.config import PipelineConfig
 from training.documents import Estimate, HistoryReadings
 from training.pipeline import estimate_window
-from training.result import share_of_range
+from training.report import share_of_range
 
 SMALL = PipelineConfig(n_simulations=48, check_windows=16, n_timesteps=100, hidden_units=20)
 
@@ -290,7 +290,7 @@ def test_a_slow_log_gives_the_history_no_j_m():
 
 def test_a_network_that_disagrees_with_the_window_is_set_aside(monkeypatch):
     # A network that reads nonsense: the window's own consistency check must not trust it.
-    from training import estimator
+    from training.learn import estimator
 
     real = estimator.NetworkEstimator.predict_unit
 

@@ -1,0 +1,57 @@
+"""Does the model, at the estimates, reproduce the measured window? The output-error check.
+
+The window is simulated once more, clean, at the final estimates, from its own command, logged
+load and first state; each signal's RMS difference to the measurement (after the first
+``SETTLE_S``, while the simulation settles from an estimated state) is divided by the floor that
+sensor noise alone would leave: the estimated noise of that signal, and for the residual torque
+the RMS difference between noisy and clean reconstructions of the held-out simulations. A ratio
+near 1 means the model reproduces the window; a ratio of several means it does not, and the
+result says so. Position, speed and current also carry timing differences a model may have
+without any bias in friction (they are reported, and only the residual torque decides).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import numpy as np
+
+from sim.noise import SensorNoise
+from sim.params import ActuatorParams, HealthParams
+from sim.residual import residual_torque_nm
+from sim.window import Window
+from training.physics.features import as_read
+from training.physics.scenario import SETTLE_S, Scenario, rms
+
+
+def output_error_ratios(
+    window: Window,
+    scenario: Scenario,
+    health: HealthParams,
+    noise: SensorNoise,
+    residual_floor_nm: float,
+    sliding: np.ndarray,
+    actuator: ActuatorParams = ActuatorParams(),
+) -> dict[str, float]:
+    """Per signal, RMS(measured − simulated at ``health``) over its noise-only floor; the measured T_R
+    reconstructed with ``actuator`` (as the window is read), the simulated with the spec's it is drawn with."""
+    rate = window.sample_rate_hz
+    simulated = as_read(scenario.simulate(health, lanes=1).simulation(0), rate)
+    measured = window.signals
+    keep = np.arange(window.n_samples) >= round(SETTLE_S * rate)
+    floors = {
+        "position_deg": noise.position_deg,
+        "motor_speed_radps": noise.motor_speed_radps,
+        "current_a": noise.current_a,
+    }
+    ratios = {
+        name: rms(measured[name][keep] - simulated[name][keep]) / max(floor, 1e-12) for name, floor in floors.items()
+    }
+    torque = _residual(measured, rate, actuator) - _residual(simulated, rate, ActuatorParams())
+    ratios["residual_torque"] = rms(torque[keep & sliding]) / max(residual_floor_nm, 1e-12)
+    return ratios
+
+
+def _residual(signals: Mapping[str, np.ndarray], rate: float, actuator: ActuatorParams) -> np.ndarray:
+    current, speed, hinge = signals["current_a"], signals["motor_speed_radps"], signals["hinge_moment_nm"]
+    return residual_torque_nm(current, speed, hinge, rate, actuator)

@@ -1,0 +1,160 @@
+"""The viscous coefficient a window shows, read where it departs from the spec's.
+
+The spec fixes C_M; a grease's viscosity is not fixed (it grows several-fold in the cold). With C
+1.2–2x the spec's, foreign windows were read 92 % of range off in FDJ on average, none within its
+±2 std: the excess ΔC·|ω| is read as friction. Where a window slides at one speed the two are twins,
+but most windows slide across 100–600 rad/s (the accelerations to and from slew), and there ΔC is
+fitted beside FDJ (``FitSettings(viscous=True)``): on 10 foreign windows with C 1.6x the spec's it
+was read 1.52–1.61x, 15–66 jackknife stds from the spec's.
+
+Freeing C costs FDJ where C is right (on 10 clean windows FDJ erred up to 12 % of range with C free,
+2.5 % without), so a change is read only where it stands ``DECISIVE_Z`` stds out and is ``MIN_CHANGE`` of
+the spec's C or more (a 10 % change at slew is 15 % of FDJ's range). Then every estimator of the
+window uses the read C, the fits and the simulations alike, and the stds of FDJ and η_O grow by what
+C's own std moves them (``spread``; its floor, ``READ_ERROR_OF_C``).
+
+Where the speed hardly varies (one way, at slew), ΔC cannot be fitted at all, and the stds carry a C
+``UNSEEN_SHARE`` off the spec's either way, as the offset stage carries an unseen sensor offset there.
+Where the change does not stand out, the window is read with the spec's C, but not as if it had
+shown C to be the spec's: on 1–2 kHz logs with C 1.2–2x, 6 of 40 changes stood 1.3–3.7 stds out, too
+few to read, and FDJ was read 40–95 % of the range high at 6–20 % std (FDJ moves by ~1.4 ranges per
+C_M of ΔC). As for a hinge moment out of step (``training.prepare.step_lag``), the story "C is off by the
+change the window leans to" is weighed against the spec's by the likelihood ratio of the nested fit
+(z²/2, z over the std with its floor) and a prior of e⁻⁴: its weight w. Each target's std grows by
+√w·|gap|, the gap what reading C so would change, and a note says so from ``NOTE_WEIGHT``. On those
+40 windows FDJ's ±2 std then held the truth in 93 % instead of 82 %; on 170 foreign windows with the
+spec's C (thesis, cruise, doublet, 0.1 s and 1–2 kHz) FDJ's std grew by a median 0.03 % of the
+range, 3.5 % at most.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from sim.effects import EffectSet
+from sim.params import ActuatorParams
+from sim.window import Window
+from training.physics.features import as_read
+from training.physics.friction import FitSettings, fit_friction
+from training.stats import DECISIVE_Z, UNDECIDED_NOTE_WEIGHT, UNDECIDED_PRIOR_LOG_ODDS, odds_weight
+
+MIN_CHANGE = 0.1  # of the spec's C
+# On 20 foreign windows with C 1.2–2x the spec's the read erred by 2.2 % of the spec's C (RMS; up to 7 %,
+# mostly low), beyond what its jackknife std, often 0.5 %, said: the reconstruction's bias follows the speed
+# a little. Taken as a floor of C's std, FDJ's ±2 std held the truth in 19 of 20 instead of 16.
+READ_ERROR_OF_C = 0.025
+# Where the speed hardly varies (one way at slew) C·|ω| is FDJ's twin and ΔC cannot be fitted: the stds then
+# carry a C this share of the spec's off, either way (the spread of C over foreign windows a third of them cold,
+# 1.2–2x: 0.30). A one-way 0.1 s gust, C 1.24x, was read FDJ 40 % of range high at 3.8 % std without it.
+UNSEEN_SHARE = 0.3
+CHANGE_BOUNDS_NMS = (-5e-5, 5e-3)  # what the simulator's viscous effect accepts (``sim.effects``)
+VISCOUS_FIT = FitSettings(offset=True, viscous=True)
+# the prior odds of "C is off" where the change does not stand out, and the note's weight (as step_lag's)
+PRIOR_LOG_ODDS, NOTE_WEIGHT = UNDECIDED_PRIOR_LOG_ODDS, UNDECIDED_NOTE_WEIGHT
+
+
+@dataclass(frozen=True)
+class Viscosity:
+    """The change of the viscous coefficient read on a window (0: the spec's), and what its std adds."""
+
+    change_nms: float = 0.0  # ΔC [N·m·s/rad] at the motor shaft
+    change_std_nms: float = 0.0
+    spread: dict[str, float] = field(default_factory=dict)  # per target, the std C's uncertainty adds
+    spec_nms: float = ActuatorParams().viscous_nms  # the C_M it was read against
+    leaning_nms: float = 0.0  # where no change was read: the ΔC the window leans to, weighed into ``spread``
+    leaning_weight: float = 0.0  # the posterior weight of "C is off by ``leaning_nms``"
+    unseen: bool = False  # the window cannot tell C·|ω| from FDJ: ``spread`` carries a C ``UNSEEN_SHARE`` off
+
+    @property
+    def factor(self) -> float:
+        """The coefficient read over the spec's."""
+        return 1.0 + self.change_nms / self.spec_nms
+
+    def actuator(self, spec: ActuatorParams = ActuatorParams()) -> ActuatorParams:
+        """The actuator every fit of the window reads it with."""
+        return replace(spec, viscous_nms=spec.viscous_nms + self.change_nms) if self.change_nms else spec
+
+    def effects(self) -> EffectSet:
+        """What every simulation of the window adds to the spec's model."""
+        return EffectSet({"viscous": {"coefficient_nms": self.change_nms}}) if self.change_nms else EffectSet()
+
+
+def read_viscosity(window: Window, spec: ActuatorParams = ActuatorParams()) -> Viscosity:
+    """ΔC where it stands out, with FDJ's and η_O's change across C ± its std; elsewhere the spec's C,
+    with what the change the window leans to would move them, by its weight (module docstring)."""
+    rate = window.sample_rate_hz
+    seen = as_read(window.signals, rate)
+    fitted = fit_friction(seen, rate, spec, VISCOUS_FIT)
+    change, std = float(fitted.term("viscous")[0]), float(fitted.term_std("viscous")[0])
+    if not (np.isfinite(change) and std > 0):  # the speed hardly varies: C·|ω| is FDJ's twin
+        return _unseen(seen, rate, spec)
+    stands_out = abs(change) > max(DECISIVE_Z * std, MIN_CHANGE * spec.viscous_nms)
+    std = float(np.hypot(std, READ_ERROR_OF_C * spec.viscous_nms))
+    if not stands_out:
+        return _leaning(seen, rate, spec, change, std)
+    change = float(np.clip(change, *CHANGE_BOUNDS_NMS))
+    return Viscosity(change, std, _half_change(seen, rate, spec, change, std), spec.viscous_nms)
+
+
+def _targets_at(
+    seen: dict[str, np.ndarray], rate: float, spec: ActuatorParams, changes: tuple[float, ...]
+) -> list[dict[str, float]]:
+    """FDJ and η_O read with the spec's C plus each change."""
+    fits = (fit_friction(seen, rate, replace(spec, viscous_nms=spec.viscous_nms + d)) for d in changes)
+    return [{name: float(value) for name, value in fit.values().items()} for fit in fits]
+
+
+def _half_change(
+    seen: dict[str, np.ndarray], rate: float, spec: ActuatorParams, change: float, std: float
+) -> dict[str, float]:
+    """Per target, half its change across the spec's C plus ``change`` ± ``std``: the std that uncertainty adds."""
+    low, high = _targets_at(seen, rate, spec, (change - std, change + std))
+    return {name: abs(high[name] - low[name]) / 2 for name in low}
+
+
+def _unseen(seen: dict[str, np.ndarray], rate: float, spec: ActuatorParams) -> Viscosity:
+    """The spec's C where the window cannot tell C·|ω| from FDJ, with the stds carrying a change of
+    ``UNSEEN_SHARE`` of it either way (module docstring)."""
+    spread = _half_change(seen, rate, spec, 0.0, UNSEEN_SHARE * spec.viscous_nms)
+    if not all(np.isfinite(v) for v in spread.values()):
+        return Viscosity()  # too little sliding motion to fit at all: the physics fit says so next
+    return Viscosity(spread=spread, spec_nms=spec.viscous_nms, unseen=True)
+
+
+def _leaning(seen: dict[str, np.ndarray], rate: float, spec: ActuatorParams, change: float, std: float) -> Viscosity:
+    """The spec's C, with the story "off by ``change``" weighed into the stds (module docstring)."""
+    weight = odds_weight((change / std) ** 2 / 2 + PRIOR_LOG_ODDS)
+    change = float(np.clip(change, *CHANGE_BOUNDS_NMS))
+    spec_read, off_read = _targets_at(seen, rate, spec, (0.0, change))
+    spread = {name: float(np.sqrt(weight) * abs(off_read[name] - spec_read[name])) for name in spec_read}
+    if not all(np.isfinite(v) for v in spread.values()):
+        return Viscosity()
+    return Viscosity(spread=spread, spec_nms=spec.viscous_nms, leaning_nms=change, leaning_weight=weight)
+
+
+def viscosity_note(viscosity: Viscosity) -> str | None:
+    """The change in words for the result's notes, or None."""
+    if viscosity.unseen:
+        return (
+            "the speed hardly varies: a viscous coefficient off the spec's (a cold grease) would read as FDJ here, "
+            f"and cannot be told from it (the stds include a coefficient {100 * UNSEEN_SHARE:.0f} % off either way)"
+        )
+    if not viscosity.change_nms:
+        return _leaning_note(viscosity)
+    return (
+        f"the viscous coefficient reads {viscosity.factor:.2f} ± {viscosity.change_std_nms / viscosity.spec_nms:.2f} "
+        "times the spec's (a cold or aged grease): every estimator of this window used it, and the stds include "
+        "its uncertainty; read with the spec's, C·|ω| would have passed for friction"
+    )
+
+
+def _leaning_note(viscosity: Viscosity) -> str | None:
+    if viscosity.leaning_weight < NOTE_WEIGHT:
+        return None
+    return (
+        f"the viscous coefficient leans to {1 + viscosity.leaning_nms / viscosity.spec_nms:.2f} times the spec's, too "
+        f"unclear to read (weight {viscosity.leaning_weight:.2f}); read with the spec's, the stds include what that "
+        "coefficient would change"
+    )

@@ -1,0 +1,1 @@
+"""Stage 3, simulate: the window's own dataset, its health drawn in a box around the physics estimate."""

@@ -1,0 +1,108 @@
+"""Window -> Case-1B dataset: simulations of that very command, preprocessed as the window is, in a box
+around the physics estimate (``simulate_dataset``)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from sim.effects import EffectSet
+from sim.noise import SensorNoise, add_sensor_noise
+from sim.params import ActuatorParams, HealthParams
+from sim.residual import residual_torque_nm
+from sim.window import Window
+from training.config import PipelineConfig
+from training.physics.features import as_read, sliding_features
+from training.physics.friction import FitSettings, FrictionFit, regressors
+from training.physics.noise import excess_noise
+from training.physics.scenario import Scenario, scenario_from_window
+from training.simulate import design
+
+# All the estimators read, and so all drawn with the window's noise (position too: the hinge
+# moment is read along it, sim.hinge, and b·0.01° ≈ 0.1 N·m).
+SIGNALS_READ = ("current_a", "motor_speed_radps", "hinge_moment_nm", "position_deg")
+
+
+@dataclass(frozen=True)
+class Simulated:
+    """A batch of noisy simulated windows and what the estimators read of them."""
+
+    health: HealthParams  # the truth of every simulation (FSJ included)
+    noise: SensorNoise  # the window's own sensor noise, added to every simulation
+    signals: dict[str, np.ndarray]  # SIGNALS_READ, (n, n_samples), sensor noise added, then as_read
+    residual_nm: np.ndarray  # (n, n_samples) T_R of the noisy signals
+    clean_residual_nm: np.ndarray  # (k, n_samples) T_R without sensor noise, of the last k: the noise floor's reference
+
+
+def simulate_noisy(
+    scenario: Scenario, health: HealthParams, window: Window, reference: HealthParams, seed: int, clean_last: int
+) -> Simulated:
+    """Simulate ``health``, add the window's own noise to what the estimators read, read it as the window
+    is read (``as_read``) and reconstruct T_R (and without noise for the last ``clean_last`` simulations).
+
+    The noise is measured against a clean simulation of the window at ``reference`` (one point),
+    run in the same batch: it takes a lane the batch would have padded anyway.
+    """
+    together = HealthParams(
+        *(np.concatenate([getattr(health, name), getattr(reference, name)]) for name in ("fsj_nm", "fdj_nm", "eta_o"))
+    )
+    result = scenario.simulate(together)
+    rate = scenario.sample_rate_hz
+    noise = excess_noise(window.signals, {name: values[-1] for name, values in result.signals.items()}, rate)
+    clean = {name: result.signals[name][:-1] for name in SIGNALS_READ}
+    rng = np.random.default_rng(seed)
+    noisy = add_sensor_noise(clean, noise, rng, rate)
+
+    def residual(s: dict[str, np.ndarray]) -> np.ndarray:
+        return residual_torque_nm(s["current_a"], s["motor_speed_radps"], s["hinge_moment_nm"], rate)
+
+    seen = as_read(noisy, rate)
+    tail = as_read({name: values[len(health) - clean_last :] for name, values in clean.items()}, rate)
+    return Simulated(health, noise, seen, residual(seen), residual(tail))
+
+
+def window_noise(window: Window, scenario: Scenario, health: HealthParams) -> SensorNoise:
+    """The window's sensor noise, measured against a clean simulation of its own command at ``health``."""
+    clean = scenario.simulate(health, lanes=1).simulation(0)
+    return excess_noise(window.signals, clean, window.sample_rate_hz)
+
+
+@dataclass(frozen=True)
+class Data:
+    """Everything simulated for one window."""
+
+    scenario: Scenario
+    box: design.Box
+    noise: SensorNoise
+    sims: Simulated  # n_simulations for training, then check_windows held out
+    sliding: np.ndarray  # (n_samples,) the window's Eq. 5.1 samples
+    inputs: np.ndarray  # (n_total, n_timesteps) network inputs of every simulation
+    window_inputs: np.ndarray  # (1, n_timesteps)
+    actuator: ActuatorParams  # as the window is read (``Prepared.actuator``: J_M and C as it shows them)
+
+
+def simulate_dataset(
+    window: Window,
+    seen: Window,
+    physics: FrictionFit,
+    config: PipelineConfig,
+    actuator: ActuatorParams,
+    effects: EffectSet,
+) -> Data:
+    """The box around the physics estimate, the window's sensor noise (measured on ``window`` as logged),
+    the simulations (the spec's model with ``effects``: the window's viscous coefficient), and the features
+    of both (the window read as ``seen``: through ``as_read``, its T_R with ``actuator``)."""
+    box = design.box_around(physics.fdj_nm[0], physics.fdj_std_nm[0], physics.eta_o[0], physics.eta_o_std[0])
+    scenario = scenario_from_window(seen, effects)
+    health = design.draw(box, config.total_simulations, config.seed)
+    sims = simulate_noisy(scenario, health, window, design.centre(box), config.seed + 1, config.check_windows)
+    rate = window.sample_rate_hz
+    residual = residual_torque_nm(
+        seen.signals["current_a"], seen.signals["motor_speed_radps"], seen.signals["hinge_moment_nm"], rate, actuator
+    )
+    sliding = regressors(seen.signals, rate, actuator, FitSettings(), residual_nm=residual)[3][0]
+    n_timesteps = min(config.n_timesteps, window.n_samples)
+    inputs = sliding_features(sims.residual_nm, sliding, n_timesteps)
+    features = sliding_features(residual, sliding, n_timesteps)
+    return Data(scenario, box, sims.noise, sims, sliding, inputs, features, actuator)
