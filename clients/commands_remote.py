@@ -140,7 +140,7 @@ def _print_history(stored: Any, prognosis: Any, plot: Path | None) -> None:
         inertia = prognosis.inertia
         click.echo(f"J_M {inertia.factor:.4f} ± {inertia.std:.2g}x the spec's, as windows that could tell it read it")
     for note in prognosis.notes:
-        click.echo(f"note: {note}")
+        click.echo(f"note [{note.code}]: {note.text}")
     if plot is not None:
         click.echo(f"figure: {plot}")
 

@@ -37,12 +37,12 @@ def print_estimate(result: Any) -> None:
         click.echo(f"{name:<10}{entry.value:>12.5g}{_std(entry.std):>12}{entry.nominal:>12.4g}{entry.drift_pct:>9.2f}%"
                    f"{weak}")  # fmt: skip
     if result.estimates.FSJ is None:
-        click.echo(f"FSJ: not estimated: {result.fsj_note}")
+        click.echo(f"FSJ: not estimated: {result.fsj_note.text}")
     check = result.fit_check
     click.echo(f"check: the model {'reproduces' if check.reproduced else 'does NOT reproduce'} the window "
                f"(residual torque {check.output_error_ratio['residual_torque']:.2f}x its noise floor)")  # fmt: skip
     for note in result.notes:
-        click.echo(f"note: {note}")
+        click.echo(f"note [{note.code}]: {note.text}")
     click.echo("time: " + "  ".join(f"{stage} {seconds:.2f} s" for stage, seconds in result.timings_s))
 
 

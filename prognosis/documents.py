@@ -12,7 +12,7 @@ from typing import Any, Literal
 import numpy as np
 from pydantic import Field
 
-from training.documents import Document, Estimate, InertiaReading
+from training.documents import Document, Estimate, InertiaReading, Notes
 
 PARAMETERS = ("FDJ", "eta_O", "eta_A")
 
@@ -112,7 +112,7 @@ class Prognosis(Document):
         description="the actuator's J_M as its windows that told a heavier rotor from a weaker motor read it: "
         "what a window that cannot is read with (null: none read one)",
     )
-    notes: list[str] = Field(default_factory=list)
+    notes: Notes = Field(default_factory=list)
 
 
 class History(Document):

@@ -12,6 +12,7 @@ from prognosis.documents import PARAMETERS, Prognosis, Stored, Trend
 from prognosis.rul import remaining_life
 from prognosis.trend import fit_trend
 from sim.params import DEFAULT_RANGES, eta_a_from_eta_o
+from training.documents import Note
 from training.history import combined_inertia, inertia_change_note
 from training.prepare.departures.aircraft_check import TOLERANCE
 
@@ -35,14 +36,15 @@ class Thresholds(BaseModel):
         }[parameter]
 
 
-def _times(stored: Sequence[Stored]) -> tuple[np.ndarray, str, str | None]:
+def _times(stored: Sequence[Stored]) -> tuple[np.ndarray, str, Note | None]:
     """Flight hours where every window has them, else days from the windows' or the storage's dates."""
     if all(s.window.flight_hours is not None for s in stored):
         return np.array([s.window.flight_hours for s in stored], dtype=float), "flight_hours", None
     if all(s.window.recorded_at is not None for s in stored):
         stamps, note = [s.window.recorded_at for s in stored], None
     else:
-        stamps, note = [s.stored_at for s in stored], "windows carry no recorded_at: time is when they were stored"
+        text = "windows carry no recorded_at: time is when they were stored"
+        stamps, note = [s.stored_at for s in stored], Note(code="time_from_storage", text=text)
     seconds = np.array([dt.datetime.fromisoformat(str(t)).timestamp() for t in stamps])
     return (seconds - seconds.min()) / 86_400.0, "days", note
 
@@ -51,7 +53,7 @@ def prognose(actuator_id: str, stored: Sequence[Stored], thresholds: Thresholds 
     """Trends and remaining lives of FDJ, η_O and η_A over ``stored`` (any order)."""
     if not stored:
         return Prognosis(actuator_id=actuator_id, time_unit="days", trends={}, remaining_life={},
-                         notes=["no estimates stored for this actuator"])  # fmt: skip
+                         notes=[Note(code="no_estimates", text="no estimates stored for this actuator")])  # fmt: skip
     times, unit, note = _times(stored)
     ids = [s.window_id for s in stored]
     trends, lives = {}, {}
@@ -69,7 +71,7 @@ def prognose(actuator_id: str, stored: Sequence[Stored], thresholds: Thresholds 
                      notes=[n for n in (note, *said, changed) if n])  # fmt: skip
 
 
-def sensor_trends(stored: Sequence[Stored], times: np.ndarray, unit: str) -> tuple[dict[str, Trend], list[str]]:
+def sensor_trends(stored: Sequence[Stored], times: np.ndarray, unit: str) -> tuple[dict[str, Trend], list[Note]]:
     """The trend of the strain gauge's gain against the aircraft model over the windows that read it (two
     at least), and notes where its level stands off 1 beyond the model's tolerance or it drifts
     (``SENSOR_STDS`` stds)."""
@@ -81,14 +83,14 @@ def sensor_trends(stored: Sequence[Stored], times: np.ndarray, unit: str) -> tup
     trend = fit_trend("hinge_aircraft_ratio", np.array(t), np.array(values), np.array(stds, dtype=float), list(ids))
     notes = []
     if abs(trend.level - 1.0) > TOLERANCE + SENSOR_STDS * trend.level_std:
-        notes.append(
+        notes.append(Note(code="gauge_off_model", parameter="hinge_moment_nm", text=
             f"the hinge moment's strain gauge reads {trend.level:.3f} ± {trend.level_std:.3f}x the aircraft model over "
             f"{trend.n} windows, beyond the model's {100 * TOLERANCE:.0f} % tolerance: recalibrate the gauge, or the "
             "airframe's C_hδ is off (each estimate divides the gauge's gain out where its window is long enough)"
-        )
+        ))
     if trend.slope_std is not None and abs(trend.slope_per_unit) > SENSOR_STDS * trend.slope_std:
-        notes.append(
+        notes.append(Note(code="gauge_drift", parameter="hinge_moment_nm", text=
             f"the hinge moment's strain gauge drifts against the aircraft model by {trend.slope_per_unit:+.2g} "
             f"± {trend.slope_std:.2g} per {unit.replace('_', ' ').rstrip('s')}"
-        )
+        ))
     return {"hinge_aircraft_ratio": trend}, notes

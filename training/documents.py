@@ -7,19 +7,59 @@ from it. Fields may be added; those of interfaces.md are never renamed or remove
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import Annotated, Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import BaseModel, BeforeValidator, ConfigDict, Field
 
 from training.config import PipelineConfig
 
 TARGETS = ("FDJ", "eta_O")  # what the estimators fit; η_A follows by Eq. 3.4, FSD from FSJ
+
+NoteCode = Literal[
+    # what preparation did to the window, or found in it
+    "command_clipped", "current_lag", "hinge_lag", "glitches_repaired", "stale_sensor", "kinematic_gain",
+    "sensor_offset", "sensor_zero_carried", "sensor_zero_unheld", "sensor_zero_unseen", "drive_constants",
+    "current_units", "inertia_from_history", "hinge_gain", "hinge_vs_aircraft", "hinge_vs_aircraft_undecided",
+    "aircraft_check_skipped", "viscosity", "viscosity_unseen", "viscosity_leaning", "hinge_out_of_step",
+    "default_actuator", "on_ground", "no_load",
+    # how the answer was reached, and how far to trust it
+    "network_absent", "network_too_few_checks", "network_out_of_box", "network_disagrees", "network_not_better",
+    "physics_only", "model_misfit", "not_reproduced", "weakly_determined", "eta_o_at_bound", "eta_o_unread",
+    "fdj_not_friction", "irreversible", "fsj_read", "fsj_no_break_away", "fsj_below_fdj",
+    # the prognosis
+    "no_estimates", "time_from_storage", "gauge_off_model", "gauge_drift", "inertia_changed", "inertia_scatter",
+    "speeding_up",
+    # a note stored by an earlier version, as a sentence only
+    "unspecified",
+]  # fmt: skip
 
 
 class Document(BaseModel):
     """A public document: immutable, strict about unknown fields."""
 
     model_config = ConfigDict(frozen=True, extra="forbid", populate_by_name=True)
+
+
+class Note(Document):
+    """Something a reader of a document should know: a stable ``code`` a client or a test matches, and the
+    same in words."""
+
+    code: NoteCode
+    text: str
+    parameter: str | None = Field(None, description="the parameter or signal it concerns, where it is one")
+
+
+def _sentences_as_notes(value: Any) -> Any:
+    """A note stored as a sentence (before notes had codes) is read as ``unspecified``."""
+    if isinstance(value, str):
+        return {"code": "unspecified", "text": value}
+    if isinstance(value, list):
+        return [_sentences_as_notes(item) for item in value]
+    return value
+
+
+Notes = Annotated[list[Note], BeforeValidator(_sentences_as_notes)]
+OptionalNote = Annotated[Note | None, BeforeValidator(_sentences_as_notes)]
 
 
 class ParameterEstimate(Document):
@@ -74,7 +114,7 @@ class MethodReport(Document):
     rms_error_physics: float = Field(description="on held-out simulations of this window")
     rms_error_network: float | None
     rms_error_blend: float
-    network_note: str | None = None
+    network_note: OptionalNote = Field(None, description="why the network's answer was not used, or not alone")
 
 
 class FitCheck(Document):
@@ -88,7 +128,7 @@ class FitCheck(Document):
         description="per signal: RMS(measured − simulated at the estimates) over the noise-only floor"
     )
     uncertainty_inflation: float = Field(description="factor applied to the stds for what the model did not reproduce")
-    notes: list[str] = Field(default_factory=list)
+    notes: Notes = Field(default_factory=list)
 
 
 class SensorZero(Document):
@@ -235,9 +275,9 @@ class Estimate(Document):
     actuator_id: str
     window_id: str
     estimates: Estimates
-    fsj_note: str
+    fsj_note: Annotated[Note, BeforeValidator(_sentences_as_notes)] = Field(description="how FSJ was read, or why not")
     irreversible: bool = Field(description="η_A < 0: the load can never back-drive the transmission (thesis Case 1C)")
-    notes: list[str] = Field(default_factory=list, description="what a reader of this answer should know")
+    notes: Notes = Field(default_factory=list, description="what a reader of this answer should know")
     timings_s: Timings
     dataset: DatasetInfo
     training: TrainingInfo

@@ -13,7 +13,7 @@ from collections.abc import Iterable, Sequence
 
 import numpy as np
 
-from training.documents import HistoryReadings, InertiaReading, SensorZero, WindowInfo
+from training.documents import HistoryReadings, InertiaReading, Note, SensorZero, WindowInfo
 from training.prepare.departures.read import Known
 from training.prepare.departures.zero_offset import ZeroOffset
 
@@ -78,7 +78,7 @@ def combined_inertia(readings: Sequence[InertiaReading]) -> InertiaReading | Non
     return InertiaReading(factor=mean, std=std * max(1.0, birge), window_ids=names)
 
 
-def inertia_change_note(readings: Sequence[InertiaReading]) -> str | None:
+def inertia_change_note(readings: Sequence[InertiaReading]) -> Note | None:
     """A note where an actuator's J_M readings do not agree (J_M stays with the build: a part was replaced,
     or readings are off): since which window it reads otherwise, or how far they scatter; or None."""
     if len(readings) < 2:
@@ -86,19 +86,19 @@ def inertia_change_note(readings: Sequence[InertiaReading]) -> str | None:
     used = since_change(readings)
     if len(used) < len(readings):
         before = _weighted(readings[: len(readings) - len(used)])[0]
-        return (
+        return Note(code="inertia_changed", text=(
             f"J_M read {before:.3f}x the spec's before window {used[0].window_ids[0]} and {_weighted(used)[0]:.3f}x "
             f"since ({len(used)} windows): a rotor, screw or gear replaced? The actuator's J_M is read since"
-        )
+        ))
     mean, _, birge = _weighted(readings)
     if birge < SCATTER_NOTED:
         return None
     low, high = min(r.factor for r in readings), max(r.factor for r in readings)
-    return (
+    return Note(code="inertia_scatter", text=(
         f"the {len(readings)} windows that read J_M read {low:.3f}–{high:.3f}x the spec's, {birge:.1f} times as far "
         f"apart as their stds allow (a part replaced, or readings gone wrong?): the actuator's J_M ({mean:.3f}) is "
         "said with its std widened as much"
-    )
+    ))
 
 
 def lent(zeros: Iterable[SensorZero], inertias: Sequence[InertiaReading]) -> HistoryReadings:

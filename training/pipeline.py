@@ -28,7 +28,7 @@ from sim.window import Window
 from training.assess.reproduction import output_error_ratios
 from training.assess.weighing import Assessed, Candidates, assess
 from training.config import PipelineConfig
-from training.documents import Estimate, FitCheck, HistoryReadings, Timings
+from training.documents import Estimate, FitCheck, HistoryReadings, Note, Timings
 from training.history import known_from
 from training.learn.estimator import NetworkEstimator
 from training.learn.network import TrainConfig
@@ -87,10 +87,10 @@ def fit_check(window: Window, data: Data, answer: Assessed, equation_ratio: floa
     reproduced = ratios["residual_torque"] <= MAX_RATIO
     notes = list(answer.notes)
     if not reproduced:
-        notes.append(
+        notes.append(Note(code="not_reproduced", text=(
             f"simulated at these estimates, the window's residual torque differs by {ratios['residual_torque']:.1f}x "
             "its noise floor: the model does not reproduce this window"
-        )
+        )))  # fmt: skip
     return FitCheck(
         reproduced=reproduced,
         equation_error_ratio=equation_ratio,

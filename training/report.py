@@ -18,6 +18,7 @@ from training.documents import (
     Estimates,
     FitCheck,
     InertiaReading,
+    Note,
     RatioEstimate,
     SensorZero,
     Timings,
@@ -75,27 +76,29 @@ def _estimates(answer: Assessed, fsj: StaticFriction, eta_o_bound: bool) -> Esti
     )
 
 
-def _notes(prepared: Prepared, physics: FrictionFit, estimates: Estimates, check: FitCheck) -> list[str]:
+def _notes(prepared: Prepared, physics: FrictionFit, estimates: Estimates, check: FitCheck) -> list[Note]:
     notes = [*check.notes, *conditioning_notes(prepared)]
     for name in TARGETS:
         entry = getattr(estimates, name)
         if weakly_determined(name, entry.std):
             low, high = HEALTHY_RANGE[name]
             spread = share_of_range(name, 2 * entry.std)
-            notes.append(
+            notes.append(Note(code="weakly_determined", parameter=name, text=(
                 f"{name} is weakly determined by this window: ±2 std spans {100 * spread:.0f} % of the healthy "
                 f"range ({low:g}–{high:g}); a short window, a slow log or a hinge load that barely varies "
                 "holds little of it (trend it with its std)"
-            )
+            )))  # fmt: skip
     if physics.at_search_edge[0]:
-        notes.append(
+        notes.append(Note(code="eta_o_at_bound", parameter="eta_O", text=(
             "η_O lies at an end of the physical search range: read it as a bound, not a value, and FDJ, read with "
             "η_O held there, as weakly determined"
-        )
+        )))  # fmt: skip
     if estimates.FDJ.value <= 0:
-        notes.append("FDJ ≤ 0 is not a friction: the model does not describe this window (see fit_check)")
+        text = "FDJ ≤ 0 is not a friction: the model does not describe this window (see fit_check)"
+        notes.append(Note(code="fdj_not_friction", parameter="FDJ", text=text))
     if estimates.eta_A.value < 0:
-        notes.append("η_A < 0: the transmission is irreversible (the load cannot back-drive it; thesis Case 1C)")
+        text = "η_A < 0: the transmission is irreversible (the load cannot back-drive it; thesis Case 1C)"
+        notes.append(Note(code="irreversible", parameter="eta_A", text=text))
     return notes
 
 

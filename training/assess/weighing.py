@@ -31,7 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from training.assess.blend import fit_blend
-from training.documents import TARGETS, MethodReport
+from training.documents import TARGETS, MethodReport, Note
 
 MAX_DISAGREEMENT_Z = 3.0
 MIN_CHECKS = 4  # held-out simulations the scoring needs (those that could not slide are left out)
@@ -59,7 +59,7 @@ class Assessed:
     stds: dict[str, float]
     methods: dict[str, MethodReport]
     inflation: float
-    notes: list[str]
+    notes: list[Note]
 
 
 def _rms(errors: np.ndarray) -> float:
@@ -89,33 +89,36 @@ def bias_corrected(physics: np.ndarray, truth: np.ndarray) -> tuple[float, np.nd
     return shrink * bias, physics - shrink * left_out
 
 
-def network_note(c: Candidates, name: str) -> str | None:
+def network_note(c: Candidates, name: str) -> Note | None:
     """Why the network's answer for ``name`` cannot be used on this window, or None."""
     if c.network is None or c.check_network is None or c.network_unit is None:
-        return "no network"
+        return Note(code="network_absent", parameter=name, text="no network")
     if len(c.check_truth[name]) < MIN_CHECKS:
-        return "too few held-out simulations could be scored to trust the network with"
+        text = "too few held-out simulations could be scored to trust the network with"
+        return Note(code="network_too_few_checks", parameter=name, text=text)
     index = TARGETS.index(name)
     if not -BOX_TOLERANCE <= c.network_unit[index] <= 1 + BOX_TOLERANCE:
-        return f"the network answered {c.network_unit[index]:.2f} box units: outside the box it was trained in"
+        text = f"the network answered {c.network_unit[index]:.2f} box units: outside the box it was trained in"
+        return Note(code="network_out_of_box", parameter=name, text=text)
     spread = c.check_network[name] - c.check_physics[name]
     centre, scale = float(np.mean(spread)), max(float(np.std(spread)), 1e-12)
     z = (c.network[name] - c.physics[name] - centre) / scale
     if abs(z) > MAX_DISAGREEMENT_Z:
-        return (
-            f"network and physics disagree by {z:.1f} times their spread on simulations: the network reads "
-            "a residual-torque trace the simulator does not produce"
-        )
+        text = (f"network and physics disagree by {z:.1f} times their spread on simulations: the network reads "
+                "a residual-torque trace the simulator does not produce")  # fmt: skip
+        return Note(code="network_disagrees", parameter=name, text=text)
     return None
 
 
-def _assess_parameter(c: Candidates, name: str, inflation: float) -> tuple[float, float, MethodReport, str | None]:
+def _assess_parameter(c: Candidates, name: str, inflation: float) -> tuple[float, float, MethodReport, Note | None]:
     """(value, std, report, note for the answer) of one parameter."""
     truth = c.check_truth[name]
     bias, phys = bias_corrected(c.check_physics[name], truth)
     physics, rms_physics = c.physics[name] - bias, _rms(phys - truth)
     note = network_note(c, name)
-    answer_note = None if note is None or c.network is None else f"{name}: physics fit only; {note}"
+    answer_note = None
+    if note is not None and c.network is not None:
+        answer_note = Note(code="physics_only", parameter=name, text=f"{name}: physics fit only; {note.text}")
     weight, rms, rms_net, value = 0.0, rms_physics, None, physics
     if note is None and c.network is not None and c.check_network is not None:
         blend = fit_blend(truth, c.check_network[name], phys)
@@ -123,9 +126,10 @@ def _assess_parameter(c: Candidates, name: str, inflation: float) -> tuple[float
         if blend.rms_error <= NETWORK_MARGIN * rms_physics:
             weight, rms, value = blend.weight_network, blend.rms_error, blend.apply(c.network[name], physics)
         else:  # routine, so the method report says it and the answer does not
-            note = (f"the network would cut the physics fit's error on held-out simulations by "
-                    f"{100 * (1 - blend.rms_error / max(rms_physics, 1e-300)):.0f} %, under the "
-                    f"{100 * (1 - NETWORK_MARGIN):.0f} % it must")  # fmt: skip
+            note = Note(code="network_not_better", parameter=name, text=(
+                f"the network would cut the physics fit's error on held-out simulations by "
+                f"{100 * (1 - blend.rms_error / max(rms_physics, 1e-300)):.0f} %, under the "
+                f"{100 * (1 - NETWORK_MARGIN):.0f} % it must"))  # fmt: skip
     std = inflation * max(_t_factor(len(truth)) * rms, c.physics_std[name])
     report = MethodReport(
         physics=c.physics[name],
@@ -145,14 +149,14 @@ def assess(c: Candidates, equation_error_ratio: float) -> Assessed:
     """Per target, the bias-corrected physics fit, blended with the network where it earns it; the stds
     widened by the equation-error ratio and never below the window's jackknife std."""
     inflation = max(1.0, equation_error_ratio)
-    values, stds, methods, notes = {}, {}, {}, []
+    values, stds, methods, notes = {}, {}, {}, list[Note]()
     for name in TARGETS:
         values[name], stds[name], methods[name], note = _assess_parameter(c, name, inflation)
         if note is not None:
             notes.append(note)
     if inflation > 1.0:
-        notes.append(
+        notes.append(Note(code="model_misfit", text=(
             f"the window's Eq. 5.1 residual is {equation_error_ratio:.2f}x what noise alone leaves: "
             "the model lacks something this window holds (stds widened by that factor; `ema calibrate` traces it)"
-        )
+        )))  # fmt: skip
     return Assessed(values, stds, methods, inflation, notes)

@@ -36,6 +36,7 @@ import numpy as np
 from sim.noise import NO_NOISE, SensorNoise, ar1_mean_variance
 from sim.params import ActuatorParams, eta_a_from_eta_o
 from sim.residual import END_STOP_MARGIN_DEG, smoothed
+from training.documents import Note
 from training.physics.noise import white_noise_std
 
 REST_SPEED_RADPS = 0.5  # at rest: the smoothed speed below this (the sensor noise alone exceeds a creep of 1 rad/s)
@@ -52,7 +53,7 @@ class StaticFriction:
     value_nm: float | None  # FSJ [N·m], or None
     std_nm: float | None
     n_events: int
-    reason: str  # how it was read, or why it could not be
+    reason: Note  # how it was read, or why it could not be
 
 
 def _rests(speed_radps: np.ndarray, run: int) -> list[tuple[int, int]]:
@@ -174,11 +175,11 @@ def read_static_friction(
     measured sensor noise (``NO_NOISE``: the traces' own white-noise level alone)."""
     events = _events(signals, rate, actuator, noise)
     if not events:
-        return StaticFriction(None, None, 0, (
+        return StaticFriction(None, None, 0, Note(code="fsj_no_break_away", parameter="FSJ", text=(
             "no quasi-static break-away in the window: the shaft never rests for 1 ms and then creeps "
             "free (in flight the position loop keeps it hunting in the backlash; after a step the drive "
             "jumps past the static level within one log interval)"
-        ))  # fmt: skip
+        )))  # fmt: skip
     load = smoothed(signals["hinge_moment_nm"] / actuator.gear_ratio, rate)
     direction = np.sign(smoothed(signals["motor_speed_radps"], rate))
     k_aid, k_opp = 1.0 - float(eta_a_from_eta_o(eta_o)), 1.0 / eta_o - 1.0
@@ -189,10 +190,10 @@ def read_static_friction(
         levels.append(event.drive_nm - k * abs(load[event.index]))
     value = float(np.median(levels))
     if value < fdj_nm:
-        return StaticFriction(None, None, len(levels), (
+        return StaticFriction(None, None, len(levels), Note(code="fsj_below_fdj", parameter="FSJ", text=(
             f"{len(levels)} break-away(s) read {value:.4f} N·m, below the dynamic friction {fdj_nm:.4f} N·m: "
             "not a static level (the drive did not build up against a stuck shaft)"
-        ))  # fmt: skip
+        )))  # fmt: skip
     current_noise = max(white_noise_std(signals["current_a"]) / np.sqrt(3), noise.mean_std("current_a", 3, rate))
     sensor = actuator.torque_constant_nm_per_a * current_noise
     floor = max(sensor, DITHER_STDS * float(np.median([event.scatter_nm for event in events])))
@@ -201,4 +202,5 @@ def read_static_friction(
         std = max(spread, floor)
     else:
         std = max(floor, 0.1 * value)  # one or two events: no spread to read, so a wide 10 %
-    return StaticFriction(value, std, len(levels), f"median of {len(levels)} quasi-static break-away(s)")
+    text = f"median of {len(levels)} quasi-static break-away(s)"
+    return StaticFriction(value, std, len(levels), Note(code="fsj_read", parameter="FSJ", text=text))

@@ -47,6 +47,7 @@ from sim.batch import COMMAND_MARGIN_DEG
 from sim.noise import NOISY_SIGNALS
 from sim.params import ActuatorParams
 from sim.window import Window
+from training.documents import Note
 from training.physics.noise import white_noise_std
 from training.prepare.alignment import Lags, aligned
 from training.prepare.consistency import Consistency, check_consistency, kinematics_note
@@ -219,26 +220,26 @@ def conditioning_done(prepared: Prepared) -> dict[str, Any]:
     }
 
 
-def conditioning_notes(prepared: Prepared) -> list[str]:
-    """What conditioning did to the window, in words for the result's notes."""
+def conditioning_notes(prepared: Prepared) -> list[Note]:
+    """What conditioning did to the window and found in it, for the result's notes."""
     notes, lags = [], prepared.lags
     if prepared.command_clipped_fraction > 0:
-        notes.append(
+        notes.append(Note(code="command_clipped", parameter="command_deg", text=(
             f"{100 * prepared.command_clipped_fraction:.1f} % of the command lies past the end stops: "
             "the actuator saturates there, and so do its simulations"
-        )
+        )))  # fmt: skip
     if lags.current_s:
         late, by = ("current", lags.current_s) if lags.current_s > 0 else ("speed", -lags.current_s)
-        notes.append(
+        notes.append(Note(code="current_lag", text=(
             f"the {late} is logged {1e6 * by:.0f} µs late (a sensor filter): advanced onto the other before Eq. 5.1, "
             "which it otherwise breaks at every acceleration"
-        )
+        )))  # fmt: skip
     if lags.hinge_filter_s:
-        notes.append(
+        notes.append(Note(code="hinge_lag", parameter="hinge_moment_nm", text=(
             f"the hinge moment's noise is correlated as behind a filter delaying {1e6 * lags.hinge_filter_s:.0f} µs; "
             f"the deflection and Eq. 5.1 put weight {lags.hinge_weight:.2f} on the moment being late too: advanced "
             f"by {1e6 * lags.hinge_s:.0f} µs (the weighted lag) before Eq. 5.1, the stds include the lags' spread"
-        )
+        )))  # fmt: skip
     found = (
         stale_note(prepared.stale),
         kinematics_note(prepared.consistency),
@@ -250,11 +251,11 @@ def conditioning_notes(prepared: Prepared) -> list[str]:
         viscosity_note(prepared.departures.viscosity),
         step_lag_note(prepared.step),
     )
-    notes.extend(note for note in found if note)
+    notes.extend(note for group in found for note in group)
     if prepared.glitches:
         counts = ", ".join(f"{count} of {name}" for name, count in prepared.glitches.items())
-        notes.append(
+        notes.append(Note(code="glitches_repaired", text=(
             f"glitches replaced by the line between their flanking samples ({counts}): a sample, or a few, "
             f"that left both flanks by over {GLITCH_STDS:g} noise stds and came straight back (EMI, bit errors)"
-        )
+        )))  # fmt: skip
     return notes

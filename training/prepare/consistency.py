@@ -48,6 +48,7 @@ from sim.checks import InputError
 from sim.dead_band import dead_band_paths
 from sim.params import ActuatorParams
 from sim.window import Window
+from training.documents import Note
 from training.physics.features import as_read
 from training.physics.friction import fit_friction
 from training.physics.shifts import equation_errors
@@ -207,16 +208,17 @@ def consistency(window: Window, actuator: ActuatorParams = ActuatorParams()) -> 
     return Consistency(travel_gain(window, actuator), following(window, actuator), better_reading(window, actuator))
 
 
-def kinematics_note(found: Consistency) -> str | None:
+def kinematics_note(found: Consistency) -> list[Note]:
     """What a kinematic gain outside ``NOTED_GAIN`` may mean, for the result's notes."""
     gain = found.travel_gain
     if gain is None or NOTED_GAIN[0] <= gain <= NOTED_GAIN[1]:
-        return None
-    return (
+        return []
+    text = (
         f"the position travels {gain:.3f}x the speed's integral / gear ratio (1 in a consistent log): the sample "
         "rate, the speed's or the position's gain is that far off; read as logged (a time base off puts J·dω/dt off "
         "as much)"
     )
+    return [Note(code="kinematic_gain", text=text)]
 
 
 def _travel_error(

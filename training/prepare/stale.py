@@ -54,6 +54,7 @@ from sim.noise import NOISY_SIGNALS
 from sim.params import ActuatorParams
 from sim.residual import DEFAULT_DERIVATIVE_WINDOW_S, kernel_samples
 from sim.window import Window
+from training.documents import Note
 from training.physics.friction import MIN_SLIDING_KERNELS, FitSettings
 from training.physics.noise import white_noise_std
 
@@ -224,11 +225,11 @@ def without_stale(window: Window, actuator: ActuatorParams = ActuatorParams()) -
     return replace(window, signals=signals), Stale(short, cut, (start, stop), rate)
 
 
-def stale_note(stale: Stale) -> str | None:
-    """The stale runs and what was done with them, in words for the result's notes; or None."""
+def stale_note(stale: Stale) -> list[Note]:
+    """The stale runs and what was done with them, for the result's notes."""
     runs = (*stale.bridged, *stale.cut)
     if not runs:
-        return None
+        return []
     listed = "; ".join(f"{run.signal} {run.describe(stale.rate_hz)}" for run in runs[:3])
     more = f" (and {len(runs) - 3} more runs)" if len(runs) > 3 else ""
     bridge_ms = 1e3 * DEFAULT_DERIVATIVE_WINDOW_S
@@ -241,4 +242,4 @@ def stale_note(stale: Stale) -> str | None:
             "of the longer runs with the most sliding motion"
         )
     why = "where a working sensor shows its noise (it stopped updating, or a gap was filled in)"
-    return f"{listed}{more}, {why}: {done}"
+    return [Note(code="stale_sensor", text=f"{listed}{more}, {why}: {done}", parameter=runs[0].signal)]

@@ -44,6 +44,7 @@ import numpy as np
 
 from sim.params import ActuatorParams
 from sim.window import Window
+from training.documents import Note
 from training.physics.shifts import shifted_fits
 from training.prepare.consistency import step_lags
 from training.prepare.hinge_lag import band_log_likelihood
@@ -83,12 +84,12 @@ def step_lag(window: Window, actuator: ActuatorParams = ActuatorParams()) -> Ste
     return StepLag(float(lags[best] / rate), float(errors[0] / errors[best]), weight, spread)
 
 
-def step_lag_note(found: StepLag) -> str | None:
-    """The story in words for the result's notes, where it weighs ``NOTE_WEIGHT`` or more; else None."""
+def step_lag_note(found: StepLag) -> list[Note]:
+    """The story, for the result's notes, where it weighs ``NOTE_WEIGHT`` or more."""
     if found.weight < NOTE_WEIGHT:
-        return None
-    return (
+        return []
+    return [Note(code="hinge_out_of_step", parameter="hinge_moment_nm", text=
         f"the hinge moment fits Eq. 5.1 {100 * (found.better - 1):.1f} % better read {1e3 * found.lag_s:+g} ms later: "
         f"out of step with the other channels (exported on another clock?) with weight {found.weight:.2f}, too little "
         "to refuse the window; read as logged, the stds include what reading it so would change"
-    )
+    )]

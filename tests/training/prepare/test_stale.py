@@ -52,7 +52,7 @@ def test_a_frozen_or_dropped_out_sensor_is_cut_out_and_the_rest_read_within_its_
         span = conditioning_done(prepared)["read_span"]
         assert span in ([0, start], [stop, n]), f"{name} frozen over [{start}, {stop}), read {span}"
         assert prepared.stale.samples[name] >= stop - start - 1
-        assert any(note.startswith(f"{name} repeats") for note in conditioning_notes(prepared))
+        assert any(n.code == "stale_sensor" and n.parameter == name for n in conditioning_notes(prepared))
         covered += all(abs(answer[p] - drawn.truth[p]) <= 2 * std[p] for p in answer)
         errors.extend(abs(share_of_range(p, answer[p] - drawn.truth[p])) for p in answer)
     assert covered >= 11 and max(errors) < 0.1, f"{covered} of 12 covered, worst {max(errors):.3f} of range"

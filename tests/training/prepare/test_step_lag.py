@@ -68,7 +68,7 @@ def test_a_cruise_window_out_of_step_is_answered_weak_and_within_its_std():
     read 20 ms away, not 3x): without the story FDJ was 25 % of the range off at 5 std."""
     drawn = draw(6, "cruise")
     window = window_from_dict(logged_early(drawn.document, 0.02))
-    assert any("out of step" in note for note in conditioning_notes(prepare(window)))
+    assert any(note.code == "hinge_out_of_step" for note in conditioning_notes(prepare(window)))
     found = estimate_window(window).estimates
     for name in ("FDJ", "eta_O"):
         estimate = getattr(found, name)

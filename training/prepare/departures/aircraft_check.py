@@ -50,6 +50,7 @@ from sim.checks import InputError
 from sim.params import ActuatorParams
 from sim.residual import kernel_samples
 from sim.window import Window
+from training.documents import Note
 from training.physics.features import fit_as_read
 from training.prepare.consistency import STEP_LAGS_S
 from training.prepare.departures.aircraft_band import BAND_S, band_noise_variance, band_part
@@ -220,23 +221,23 @@ def _moved(window: Window, actuator: ActuatorParams, first: float, second: float
     }
 
 
-def aircraft_note(read: AircraftCheck) -> str | None:
-    """The disagreement in words for the result's notes, or None."""
+def aircraft_note(read: AircraftCheck) -> list[Note]:
+    """The disagreement, for the result's notes."""
     if read.factor == 1.0 and not read.spread:
-        return None
+        return []
     against = (
         f"the hinge moment's part that follows the deflection is {read.ratio:.3f} ± {read.ratio_std:.3f}x the "
         f"aircraft model's at this flight condition (q̄·S_e·c_e·C_hδ = {read.per_rad_nm:.4g} N·m/rad), beyond the "
         f"model's {100 * TOLERANCE:.0f} % tolerance"
     )
     if read.factor == 1.0:
-        return (
+        return [Note(code="hinge_vs_aircraft_undecided", parameter="hinge_moment_nm", text=
             f"{against}, by under {DEPART_STDS:g} stds or in a window under {DECISIVE_SPANS * BAND_S[1]:g} s: the "
             "strain gauge's gain may be off (lbf·ft for N·m is 0.74x); read as logged, the stds include what that gain "
             "would move"
-        )
-    return (
+        )]
+    return [Note(code="hinge_vs_aircraft", parameter="hinge_moment_nm", text=
         f"{against}: taken as the strain gauge's gain (lbf·ft for N·m is 0.74x) and divided out before anything else "
         "is read; where the window's loads read no gain more precisely, the stds include what the tolerance moves (if "
         "the airframe's hinge coefficients or the flight condition are that far off instead, every window shows it)"
-    )
+    )]

@@ -43,6 +43,7 @@ import numpy as np
 from sim.checks import InputError
 from sim.params import ActuatorParams
 from sim.window import Window
+from training.documents import Note
 from training.physics.features import fit_as_read
 from training.physics.friction import FitSettings, FrictionFit
 from training.prepare.departures.zero_offset import equation_z, log_likelihood_ratio
@@ -242,16 +243,19 @@ def _with_spread(window: Window, read: DriveConstants) -> DriveConstants:
     return replace(read, spread=spread)
 
 
-def drive_constants_note(read: DriveConstants) -> str | None:
-    """The constants in words for the result's notes, and the story of a current in other units; or None."""
-    unit = (
-        f"Eq. 5.1 balances the window as well with the motor giving {1 + read.unit_scale:.3g}x the spec's k_T·I, "
-        "which no motor does: a current logged in other units (RMS for amplitude?) would read so, and the stds "
-        "include what that reading would change"
-        if read.unit_scale
-        else None
-    )
-    return "; ".join(note for note in (_constants_note(read), unit) if note) or None
+def drive_constants_note(read: DriveConstants) -> list[Note]:
+    """The constants, and the story of a current in other units, for the result's notes."""
+    notes = []
+    constants = _constants_note(read)
+    if constants is not None:
+        notes.append(Note(code="drive_constants", text=constants))
+    if read.unit_scale:
+        notes.append(Note(code="current_units", parameter="current_a", text=(
+            f"Eq. 5.1 balances the window as well with the motor giving {1 + read.unit_scale:.3g}x the spec's k_T·I, "
+            "which no motor does: a current logged in other units (RMS for amplitude?) would read so, and the stds "
+            "include what that reading would change"
+        )))  # fmt: skip
+    return notes
 
 
 def _constants_note(read: DriveConstants) -> str | None:

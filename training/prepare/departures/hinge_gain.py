@@ -37,6 +37,7 @@ import numpy as np
 from sim.params import ActuatorParams
 from sim.residual import DEFAULT_DERIVATIVE_WINDOW_S, kernel_samples
 from sim.window import Window
+from training.documents import Note
 from training.physics.features import as_read, fit_as_read
 from training.physics.friction import MIN_SLIDING_KERNELS, FitSettings, nuisance_columns, regressors
 from training.prepare.departures.drive_constants import BESIDE, FIELDS
@@ -138,12 +139,12 @@ def read_hinge_gain(window: Window, actuator: ActuatorParams = ActuatorParams(),
     return HingeGain(float(gain[0]), std, spread)
 
 
-def hinge_gain_note(read: HingeGain) -> str | None:
-    """The gain in words for the result's notes, or None."""
+def hinge_gain_note(read: HingeGain) -> list[Note]:
+    """The gain, for the result's notes."""
     if read.gain == 1.0:
-        return None
-    return (
+        return []
+    return [Note(code="hinge_gain", parameter="hinge_moment_nm", text=
         f"the hinge moment is logged {read.gain:.3f} ± {read.gain_std:.3f} times the load it shows (a strain gauge "
         "calibrated off, or other units): divided by that before every estimator, read from the opposing and "
         "aiding loads' terms of Eq. 5.1 together with Eq. 3.4; the stds include its uncertainty"
-    )
+    )]

@@ -29,6 +29,7 @@ from sim.checks import InputError
 from sim.noise import SensorNoise
 from sim.params import ActuatorParams
 from sim.window import Window
+from training.documents import Note
 from training.physics.features import fit_as_read
 from training.physics.noise import white_noise_std
 from training.physics.scenario import CLEAR_MARGIN, MAX_RATIO, following_error, inside
@@ -198,15 +199,15 @@ def _along(
     return Departures(window, offset, drive, read_viscosity(window, drive.actuator), hinge, aircraft)
 
 
-def history_note(read: Departures) -> str | None:
-    """Where the actuator's J_M decided between γ and ΔJ, in words for the result's notes; or None."""
+def history_note(read: Departures) -> list[Note]:
+    """Where the actuator's J_M decided between γ and ΔJ, for the result's notes."""
     if not read.inertia_from:
-        return None
+        return []
     windows = ", ".join(read.inertia_from[:3]) + (
         f" and {len(read.inertia_from) - 3} more" if len(read.inertia_from) > 3 else ""
     )
     chosen = "a heavier rotor" if read.drive.inertia_kgm2 else "the motor's torque per k_T·I"
-    return (
+    return [Note(code="inertia_from_history", text=(
         "the window alone could not tell a heavier rotor from a weaker motor; the actuator's J_M as windows that "
         f"could read it ({windows}) decided for {chosen}"
-    )
+    ))]  # fmt: skip

@@ -36,6 +36,7 @@ import numpy as np
 from sim.effects import EffectSet
 from sim.params import ActuatorParams
 from sim.window import Window
+from training.documents import Note
 from training.physics.features import as_read
 from training.physics.friction import FitSettings, fit_friction
 from training.stats import DECISIVE_Z, UNDECIDED_NOTE_WEIGHT, UNDECIDED_PRIOR_LOG_ODDS, odds_weight
@@ -134,27 +135,27 @@ def _leaning(seen: dict[str, np.ndarray], rate: float, spec: ActuatorParams, cha
     return Viscosity(spread=spread, spec_nms=spec.viscous_nms, leaning_nms=change, leaning_weight=weight)
 
 
-def viscosity_note(viscosity: Viscosity) -> str | None:
-    """The change in words for the result's notes, or None."""
+def viscosity_note(viscosity: Viscosity) -> list[Note]:
+    """The change, or what the window could not tell of it, for the result's notes."""
     if viscosity.unseen:
-        return (
+        return [Note(code="viscosity_unseen", text=
             "the speed hardly varies: a viscous coefficient off the spec's (a cold grease) would read as FDJ here, "
             f"and cannot be told from it (the stds include a coefficient {100 * UNSEEN_SHARE:.0f} % off either way)"
-        )
+        )]
     if not viscosity.change_nms:
         return _leaning_note(viscosity)
-    return (
+    return [Note(code="viscosity", text=
         f"the viscous coefficient reads {viscosity.factor:.2f} ± {viscosity.change_std_nms / viscosity.spec_nms:.2f} "
         "times the spec's (a cold or aged grease): every estimator of this window used it, and the stds include "
         "its uncertainty; read with the spec's, C·|ω| would have passed for friction"
-    )
+    )]
 
 
-def _leaning_note(viscosity: Viscosity) -> str | None:
+def _leaning_note(viscosity: Viscosity) -> list[Note]:
     if viscosity.leaning_weight < NOTE_WEIGHT:
-        return None
-    return (
+        return []
+    return [Note(code="viscosity_leaning", text=
         f"the viscous coefficient leans to {1 + viscosity.leaning_nms / viscosity.spec_nms:.2f} times the spec's, too "
         f"unclear to read (weight {viscosity.leaning_weight:.2f}); read with the spec's, the stds include what that "
         "coefficient would change"
-    )
+    )]

@@ -39,6 +39,7 @@ import numpy as np
 
 from sim.params import ActuatorParams
 from sim.window import Window
+from training.documents import Note
 from training.physics.features import fit_as_read
 from training.physics.friction import FitSettings, FrictionFit
 from training.stats import DECISIVE_Z, odds_weight, rms_log_likelihood_ratio
@@ -185,35 +186,35 @@ def zeroed(window: Window, offset: ZeroOffset) -> Window:
     return replace(window, signals=_shifted(dict(window.signals), offset.hinge_nm, offset.current_a))
 
 
-def offset_note(offset: ZeroOffset) -> str | None:
-    """The offset in words for the result's notes, or None."""
+def offset_note(offset: ZeroOffset) -> list[Note]:
+    """The offset, or where the window's zero came from, for the result's notes."""
     if offset.carried_from is not None:
         why = "a sensor off zero would read as FDJ here" if offset.one_way else "it reads their zero less precisely"
-        return (
+        return [Note(code="sensor_zero_carried", text=
             f"the motion goes {'one way' if offset.one_way else 'both ways'}, but {why}: the sensors' zero is the "
             f"one window {offset.carried_from} of the same flight read moving both ways ({offset.hinge_nm:.2f} N·m "
             f"of hinge moment and {offset.current_a:.3f} A of current taken off; FDJ's std includes its "
             f"{1e3 * offset.zero_std_nm:.2f} mN·m)"
-        )
+        )]
     if offset.one_way:
-        return (
+        return [Note(code="sensor_zero_unseen", text=
             "the motion goes one way: a current or hinge moment sensor off zero would read as FDJ here, and "
             f"cannot be told from it (FDJ's std includes {1e3 * offset.spread['FDJ']:.1f} mN·m for one, a current "
             f"{UNSEEN_CURRENT_OFFSET_A:g} A off; a window of the same flight (flight_id) moving both ways reads it)"
-        )
-    own = unheld = None
+        )]
+    notes = []
     if offset.torque_nm:
-        own = (
+        notes.append(Note(code="sensor_offset", text=
             f"T_R holds a constant {1e3 * offset.torque_nm:.2f} ± {1e3 * offset.torque_std_nm:.2f} mN·m beyond "
             "friction: a sensor off zero (or friction that differs by direction), taken off as "
             f"{offset.hinge_nm:.2f} N·m of hinge moment and {offset.current_a:.3f} A of current (the hinge moment is "
             f"the one off with weight {offset.hinge_share:.2f}; where the window cannot tell, the stds include what "
             "that changes)"
-        )
+        ))
     if offset.unheld_from:
-        unheld = (
+        notes.append(Note(code="sensor_zero_unheld", text=
             f"the sensors' zero window {offset.unheld_from} of the same flight read does not hold here (taken off, "
             f"the constant left stands {offset.unheld_z:.1f} stds off none: a sensor drifted, or the drive was "
             "powered up again), so the window's own reading is taken"
-        )
-    return "; ".join(text for text in (own, unheld) if text) or None
+        ))
+    return notes

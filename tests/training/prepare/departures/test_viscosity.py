@@ -35,7 +35,7 @@ def test_the_specs_viscous_coefficient_is_left_alone():
     for seed in range(95, 110):
         read = _read(seed, 1.0)
         assert read.change_nms == 0.0 and read.leaning_weight < NOTE_WEIGHT, seed
-        assert read.spread["FDJ"] < 0.015 * 0.02 and viscosity_note(read) is None, seed
+        assert read.spread["FDJ"] < 0.015 * 0.02 and viscosity_note(read) == [], seed
 
 
 def test_a_change_too_unclear_to_read_is_weighed_into_fdjs_std():
@@ -78,7 +78,7 @@ def test_where_the_speed_hardly_varies_an_unseen_coefficient_is_in_the_stds(fact
     zero = SensorZero(window_id="c", hinge_nm=cruise.hinge_nm, current_a=cruise.current_a, torque_std_nm=1e-4)
     prepared = prepare(window_from_dict(gust.document), known=known_from(HistoryReadings(sensor_zero=zero)))
     assert prepared.departures.viscosity.unseen and prepared.departures.offset.carried_from == "c"
-    assert "speed hardly varies" in viscosity_note(prepared.departures.viscosity)
+    assert viscosity_note(prepared.departures.viscosity)[0].code == "viscosity_unseen"
     w = prepared.window
     fitted = fit_window(as_read(w.signals, w.sample_rate_hz), w.sample_rate_hz, prepared.actuator)
     std = widened({"FDJ": float(fitted.fdj_std_nm[0])}, prepared)["FDJ"]
