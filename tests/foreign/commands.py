@@ -60,6 +60,15 @@ def steps(rng: np.random.Generator, duration_s: float) -> Command:
     return lambda t: levels[np.searchsorted(edges, t)]
 
 
+def sweep(rng: np.random.Generator, duration_s: float) -> Command:
+    """A pre-flight or bench sweep: the surface driven from rest through a slow sine of 5–20° at 0.5–3 Hz,
+    its amplitude ramped in over the first tenth of the window."""
+    amplitude, frequency = rng.uniform(5.0, 20.0), rng.uniform(0.5, 3.0)
+    offset = rng.uniform(-2.0, 2.0)
+    ramp_in = 0.1 * duration_s
+    return lambda t: np.clip(t / ramp_in, 0.0, 1.0) * (offset + amplitude * np.sin(2 * np.pi * frequency * t))
+
+
 def hold(rng: np.random.Generator, duration_s: float) -> Command:
     """A held position: no motion at all (carries no friction information)."""
     level = rng.uniform(-5.0, 5.0)
@@ -68,4 +77,5 @@ def hold(rng: np.random.Generator, duration_s: float) -> Command:
 
 BY_NAME: dict[str, Callable[[np.random.Generator, float], Command]] = {
     "thesis": thesis, "cruise": cruise, "gust": gust, "doublet": doublet, "steps": steps, "hold": hold,
+    "sweep": sweep,
 }  # fmt: skip

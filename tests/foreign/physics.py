@@ -12,7 +12,10 @@ Deliberate differences in form from ``sim.kernels`` (each one a legitimate readi
 - effects in forms ``sim.effects`` does not have: a Gaussian friction bump over elevator position,
   a tanh Stribeck curve, dynamic friction drifting in time, cogging as a cosine of any order;
 - a loop that may depart from the spec's, unlogged: bus voltage, position gain, a lag between the
-  logged command and the one the loop follows, a noisy speed reading.
+  logged command and the one the loop follows, a noisy speed reading;
+- any actuator of the architecture (``Drive``: gear ratio, motor, inertia, gains, backlash, stops),
+  and on the ground (``Ground``) a load cell's prescribed load, constant or ramped, in place of the
+  aircraft.
 """
 
 from __future__ import annotations
@@ -26,13 +29,34 @@ STEP_S = 1e-6
 COMMAND_TABLE_HZ = 100_000.0
 AIRCRAFT_EVERY = 100  # steps between RK4 steps of the aircraft
 LOOP_SAMPLE_STEPS = 100  # the loop's sensors are read at 10 kHz
-GEAR = 500.0
-
 # Indices of the parameter vector the loop reads.
 (P_GP, P_GAP, P_R, P_L, P_KT, P_KE, P_TMAX, P_VMAX, P_IMAX, P_J, P_C, P_BLK, P_STOP,
  P_FSJ, P_FDJ, P_ASYM, P_KAID, P_KOPP, P_ISENSE, P_IBIAS, P_HBIAS,
  P_BUMP_A, P_BUMP_C, P_BUMP_W, P_STRIB_A, P_STRIB_W, P_DRIFT, P_COG_A, P_COG_P, P_COG_PHI,
- P_QSC, P_CHA, P_CHD, P_DWN, P_LT, P_V, P_ALPHA_TRIM, P_DELTA_TRIM, P_ALPHA_LIM, P_VBUS, N_P) = range(41)  # fmt: skip
+ P_QSC, P_CHA, P_CHD, P_DWN, P_LT, P_V, P_ALPHA_TRIM, P_DELTA_TRIM, P_ALPHA_LIM, P_VBUS,
+ P_GEAR, P_KT_LOOP, P_GROUND, P_LOAD0, P_LOAD_RAMP, N_P) = range(46)  # fmt: skip
+
+
+@dataclass(frozen=True)
+class Drive:
+    """An actuator of the spec's architecture: its constants (the thesis's Table 3.1 by default)."""
+
+    position_gain_per_s: float = 1e5
+    speed_gain_nms: float = 5e-2
+    resistance_ohm: float = 2.13
+    inductance_h: float = 7.2e-4
+    torque_constant_nm_per_a: float = 0.0752
+    max_motor_torque_nm: float = 1.689
+    supply_voltage_v: float = 48.0
+    max_current_a: float = 22.5
+    gear_ratio: float = 500.0
+    inertia_kgm2: float = 2.5e-5
+    viscous_nms: float = 5.172e-5
+    backlash_rad: float = 5e-3
+    end_stop_deg: float = 30.0
+
+
+THESIS = Drive()
 
 
 @dataclass(frozen=True)
@@ -41,9 +65,8 @@ class Health:
     fsj_nm: float = 0.10
     eta_o: float = 0.85
 
-    @property
-    def eta_a(self) -> float:
-        n = GEAR
+    def eta_a(self, gear: float = THESIS.gear_ratio) -> float:
+        n = gear
         return (2 * n * n * self.eta_o - n * n + n) / (n * n * self.eta_o + n - self.eta_o + 1)
 
 
@@ -83,11 +106,21 @@ class Flight:
 
 
 @dataclass(frozen=True)
+class Ground:
+    """On the ground: a load cell's prescribed hinge moment, H = load_nm + ramp_nmps · t (t from the window's
+    start), in place of the aircraft; zero for a pre-flight sweep."""
+
+    load_nm: float = 0.0
+    ramp_nmps: float = 0.0
+
+
+@dataclass(frozen=True)
 class Setup:
     health: Health = field(default_factory=Health)
     effects: Effects = field(default_factory=Effects)
-    flight: Flight = field(default_factory=Flight)
+    flight: Flight | Ground = field(default_factory=Flight)
     sample_rate_hz: float = 10_000.0
+    drive: Drive = THESIS
 
 
 def _density(altitude_m: float) -> float:
@@ -124,23 +157,29 @@ def trim_rad(flight: Flight) -> tuple[float, float]:
 
 
 def parameters(setup: Setup) -> np.ndarray:
-    h, e, f = setup.health, setup.effects, setup.flight
+    h, e, f, d = setup.health, setup.effects, setup.flight, setup.drive
     p = np.zeros(N_P)
-    p[P_GP], p[P_GAP], p[P_R], p[P_L] = 1e5 * e.position_gain_factor, 5e-2, 2.13, 7.2e-4
-    p[P_KT] = p[P_KE] = 0.0752 * e.torque_constant_gain
-    p[P_TMAX], p[P_VMAX], p[P_IMAX], p[P_J] = 1.689, 48.0, 22.5, 2.5e-5 * e.inertia_factor
-    p[P_C], p[P_BLK], p[P_STOP] = 5.172e-5 * e.viscous_factor, 5e-3 * e.backlash_factor, np.radians(30.0)
+    p[P_GP], p[P_GAP] = d.position_gain_per_s * e.position_gain_factor, d.speed_gain_nms
+    p[P_R], p[P_L] = d.resistance_ohm, d.inductance_h
+    p[P_KT] = p[P_KE] = d.torque_constant_nm_per_a * e.torque_constant_gain
+    p[P_KT_LOOP], p[P_GEAR] = d.torque_constant_nm_per_a, d.gear_ratio
+    p[P_TMAX], p[P_VMAX], p[P_IMAX] = d.max_motor_torque_nm, d.supply_voltage_v, d.max_current_a
+    p[P_J], p[P_C] = d.inertia_kgm2 * e.inertia_factor, d.viscous_nms * e.viscous_factor
+    p[P_BLK], p[P_STOP] = d.backlash_rad * e.backlash_factor, np.radians(d.end_stop_deg)
     p[P_FSJ], p[P_FDJ], p[P_ASYM] = h.fsj_nm, h.fdj_nm, e.fdj_asymmetry
-    p[P_KAID], p[P_KOPP] = 1.0 - h.eta_a, 1.0 / h.eta_o - 1.0
+    p[P_KAID], p[P_KOPP] = 1.0 - h.eta_a(d.gear_ratio), 1.0 / h.eta_o - 1.0
     p[P_ISENSE], p[P_IBIAS], p[P_HBIAS] = e.current_sensor_gain, e.current_bias_a, e.hinge_bias_nm
     p[P_BUMP_A], p[P_BUMP_C], p[P_BUMP_W] = e.bump_nm, np.radians(e.bump_centre_deg), np.radians(e.bump_width_deg)
     p[P_STRIB_A], p[P_STRIB_W], p[P_DRIFT] = e.stribeck_nm, e.stribeck_speed_radps, e.drift_per_s
     p[P_COG_A], p[P_COG_P], p[P_COG_PHI] = e.cogging_nm, e.cogging_periods, e.cogging_phase_rad
+    p[P_ALPHA_LIM] = np.radians(15.0)
+    p[P_VBUS] = d.supply_voltage_v * e.supply_voltage_factor
+    if isinstance(f, Ground):
+        p[P_GROUND], p[P_LOAD0], p[P_LOAD_RAMP], p[P_V] = 1.0, f.load_nm, f.ramp_nmps, 1.0
+        return p
     p[P_QSC] = 0.5 * _density(f.altitude_m) * f.airspeed_mps**2 * 0.34 * 0.25
     p[P_CHA], p[P_CHD], p[P_DWN], p[P_LT], p[P_V] = -0.25, -0.55, 0.4, 4.6, f.airspeed_mps
     p[P_ALPHA_TRIM], p[P_DELTA_TRIM] = trim_rad(f)
-    p[P_ALPHA_LIM] = np.radians(15.0)
-    p[P_VBUS] = 48.0 * e.supply_voltage_factor
     return p
 
 
@@ -150,7 +189,9 @@ def _derivative(a, b, x, u):
 
 
 @njit(cache=True)
-def _hinge(p, x, theta_u):
+def _hinge(p, x, theta_u, t):
+    if p[P_GROUND] > 0.0:
+        return p[P_LOAD0] + p[P_LOAD_RAMP] * max(t, 0.0)
     alpha = p[P_ALPHA_TRIM] + x[1]
     alpha_t = (1.0 - p[P_DWN]) * alpha + p[P_LT] * x[3] / p[P_V]
     alpha_t = max(-p[P_ALPHA_LIM], min(p[P_ALPHA_LIM], alpha_t))
@@ -161,8 +202,9 @@ def _hinge(p, x, theta_u):
 def _current(p, command, theta_u, speed, current, decay):
     """The current after one step: the speed and current loops bang the supply on the *measured* current."""
     measured_current = p[P_ISENSE] * current + p[P_IBIAS]
-    speed_ref = max(-p[P_VMAX] / 0.0752, min(p[P_VMAX] / 0.0752, p[P_GP] * (command - theta_u)))
-    current_ref = max(-p[P_IMAX], min(p[P_IMAX], p[P_GAP] * (speed_ref - speed) / 0.0752))
+    top = p[P_VMAX] / p[P_KT_LOOP]
+    speed_ref = max(-top, min(top, p[P_GP] * (command - theta_u)))
+    current_ref = max(-p[P_IMAX], min(p[P_IMAX], p[P_GAP] * (speed_ref - speed) / p[P_KT_LOOP]))
     voltage = 0.0
     if current_ref > measured_current:
         voltage = p[P_VBUS]
@@ -209,9 +251,10 @@ def _run(p, a, b, command_rad, logged_rad, loop_noise_radps, first_step, n_steps
     loop follows ``command_rad`` and reads the speed with ``loop_noise_radps`` (one value per block of
     LOOP_SAMPLE_STEPS) added, the log records ``logged_rad`` (both 100 kHz tables) and the true states."""
     h = 1e-6
+    gear = p[P_GEAR]
     current, speed = 0.0, 0.0
     theta_u = theta0
-    theta_m = theta0 * GEAR
+    theta_m = theta0 * gear
     x = np.zeros(4)
     decay = np.exp(-h * p[P_R] / p[P_L])
     sums = np.zeros(5)
@@ -224,17 +267,17 @@ def _run(p, a, b, command_rad, logged_rad, loop_noise_radps, first_step, n_steps
         logged = logged_rad[j] + (pos - j) * (logged_rad[j + 1] - logged_rad[j])
         block = (i - first_step) // LOOP_SAMPLE_STEPS
         current = _current(p, command, theta_u, speed + loop_noise_radps[block], current, decay)
-        new_speed = _new_speed(p, i * h, h, theta_u, theta_m, speed, current, _hinge(p, x, theta_u) / GEAR)
+        new_speed = _new_speed(p, i * h, h, theta_u, theta_m, speed, current, _hinge(p, x, theta_u, i * h) / gear)
         theta_m += 0.5 * h * (speed + new_speed)
         speed = new_speed
-        limit = p[P_STOP] * GEAR
+        limit = p[P_STOP] * gear
         if theta_m > limit:
             theta_m = limit
             speed = min(speed, 0.0)
         elif theta_m < -limit:
             theta_m = -limit
             speed = max(speed, 0.0)
-        motor_side = theta_m / GEAR
+        motor_side = theta_m / gear
         if motor_side - theta_u > 0.5 * p[P_BLK]:
             theta_u = motor_side - 0.5 * p[P_BLK]
         elif motor_side - theta_u < -0.5 * p[P_BLK]:
@@ -245,7 +288,7 @@ def _run(p, a, b, command_rad, logged_rad, loop_noise_radps, first_step, n_steps
             sums[0] += theta_u
             sums[1] += speed
             sums[2] += p[P_ISENSE] * current + p[P_IBIAS]
-            sums[3] += _hinge(p, x, theta_u) + p[P_HBIAS]
+            sums[3] += _hinge(p, x, theta_u, i * h) + p[P_HBIAS]
             sums[4] += logged
             count += 1
             if (i + 1) * h * rate_hz >= sample + 1 - 1e-9:
@@ -272,10 +315,11 @@ def simulate(setup: Setup, command_deg, duration_s: float, preroll_s: float = 0.
     table_t = np.arange(-preroll_s, duration_s + 2e-5, 1.0 / COMMAND_TABLE_HZ)
     logged_rad = np.radians(np.asarray(command_deg(table_t), dtype=np.float64))
     command_rad = np.radians(np.asarray(command_deg(table_t - setup.effects.loop_delay_s), dtype=np.float64))
-    a, b = aircraft_matrices(setup.flight)
+    a, b = (np.zeros((4, 4)), np.zeros(4)) if isinstance(setup.flight, Ground) else aircraft_matrices(setup.flight)
     out = np.zeros((5, n_samples))
     first, last = -round(preroll_s / STEP_S), round(duration_s / STEP_S) + 10
-    start = float(np.clip(command_rad[0], -np.radians(30.0), np.radians(30.0)))
+    stop = np.radians(setup.drive.end_stop_deg)
+    start = float(np.clip(command_rad[0], -stop, stop))
     _run(parameters(setup), a, b, command_rad, logged_rad, _loop_noise(setup.effects, last - first), first, last, rate,
          start, out)  # fmt: skip
     names = ("position_deg", "motor_speed_radps", "current_a", "hinge_moment_nm", "command_deg")

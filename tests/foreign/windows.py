@@ -13,7 +13,9 @@ import numpy as np
 
 from tests.foreign import commands
 from tests.foreign.commands import Command
-from tests.foreign.physics import Effects, Flight, Health, Setup, simulate
+from tests.foreign.physics import THESIS, Drive, Effects, Flight, Ground, Health, Setup, simulate
+
+THESIS_NOMINAL = Health()
 
 NOISE = {"position_deg": 0.01, "motor_speed_radps": 0.5, "current_a": 0.05, "hinge_moment_nm": 2.0}
 QUANTUM = {"position_deg": 0.0025, "current_a": 0.005}  # resolver and ADC resolution
@@ -120,26 +122,31 @@ def draw(
     family: str = "thesis",
     health: Health | None = None,
     effects: Effects = Effects(),
-    flight: Flight | None = None,
+    flight: Flight | Ground | None = None,
     duration_s: float = 0.5,
     sample_rate_hz: float = 10_000.0,
     noise_level: float = 1.0,
     preroll_s: float | None = None,
     filter_samples: Mapping[str, int] = {},
     noise_seed: int | None = None,
+    drive: Drive = THESIS,
+    nominal: Health = THESIS_NOMINAL,
 ) -> Draw:
-    """One window. Unset health and flight are drawn (health inside the thesis's ranges); windows of
-    the flight families start mid-motion (a pre-roll of 20–100 ms), the thesis family from rest. A
-    ``noise_seed`` draws another realization of the same window's sensor noise (levels and filters kept)."""
+    """One window. Unset health and flight are drawn (health within ±20 % of ``nominal``'s FDJ and FSJ and
+    η_O in the thesis's range); windows of the flight families start mid-motion (a pre-roll of 20–100 ms),
+    the thesis family and ground sweeps from rest. A ``noise_seed`` draws another realization of the same
+    window's sensor noise (levels and filters kept). On the ground (``Ground``) the window names no flight
+    condition and its hinge moment is the load cell's."""
     rng = np.random.default_rng(seed)
     if health is None:
-        health = Health(fdj_nm=rng.uniform(0.04, 0.06), fsj_nm=rng.uniform(0.08, 0.12), eta_o=rng.uniform(0.68, 0.98))
+        health = Health(fdj_nm=nominal.fdj_nm * rng.uniform(0.8, 1.2), fsj_nm=nominal.fsj_nm * rng.uniform(0.8, 1.2),
+                        eta_o=rng.uniform(0.68, 0.98))  # fmt: skip
     if flight is None:
         flight = Flight(airspeed_mps=rng.uniform(100.0, 210.0), altitude_m=rng.uniform(0.0, 9000.0))
     if preroll_s is None:
-        preroll_s = 0.0 if family == "thesis" else float(rng.uniform(0.02, 0.1))
+        preroll_s = 0.0 if family in ("thesis", "sweep") else float(rng.uniform(0.02, 0.1))
     command = commands.BY_NAME[family](rng, duration_s)
-    setup = Setup(health, effects, flight, sample_rate_hz)
+    setup = Setup(health, effects, flight, sample_rate_hz, drive)
     samples_rng = None if noise_seed is None else np.random.default_rng(noise_seed)
     signals = noisy(simulate(setup, command, duration_s, preroll_s), rng, noise_level, filter_samples, samples_rng)
     document = {
@@ -147,10 +154,11 @@ def draw(
         "actuator_id": f"foreign/{family}",
         "window_id": f"{family}-{seed}",
         "sample_rate_hz": sample_rate_hz,
-        "flight_condition": {"airspeed_mps": flight.airspeed_mps, "altitude_m": flight.altitude_m},
+        "flight_condition": None if isinstance(flight, Ground) else
+        {"airspeed_mps": flight.airspeed_mps, "altitude_m": flight.altitude_m},
         "signals": {name: values.tolist() for name, values in signals.items()},
-    }
-    truth = {"FDJ": health.fdj_nm, "eta_O": health.eta_o, "eta_A": health.eta_a, "FSJ": health.fsj_nm}
+    }  # fmt: skip
+    truth = {"FDJ": health.fdj_nm, "eta_O": health.eta_o, "eta_A": health.eta_a(drive.gear_ratio), "FSJ": health.fsj_nm}
     return Draw(document, truth, family, setup, command, duration_s, preroll_s)
 
 
@@ -166,15 +174,18 @@ def of_the_same_flight(drawn: Draw, seed: int, family: str = "cruise", duration_
     """Another window of ``drawn``'s flight: the same actuator (health, effects, its sensors' offsets),
     flight condition and logger, a command of ``family``."""
     setup = drawn.setup
-    other = draw(seed, family, setup.health, setup.effects, setup.flight, duration_s, setup.sample_rate_hz)
+    other = draw(seed, family, setup.health, setup.effects, setup.flight, duration_s, setup.sample_rate_hz,
+                 drive=setup.drive)  # fmt: skip
     other.document["actuator_id"] = drawn.document["actuator_id"]
     return other
 
 
 __all__ = [
     "Draw",
+    "Drive",
     "Effects",
     "Flight",
+    "Ground",
     "Health",
     "draw",
     "filter_widths",
