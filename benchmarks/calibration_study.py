@@ -24,6 +24,7 @@ import numpy as np
 from calibration.calibrate import Calibrator
 from clients.figures import calibration_figure
 from clients.report import write_section
+from sim.actuator import THESIS
 from sim.checks import InputError
 from sim.window import window_from_dict
 from tests.foreign.effects import CASES
@@ -38,7 +39,7 @@ def one(case: str, scale: float, seed: int, figure: Path | None) -> dict[str, An
     effects = CASES[case](np.random.default_rng(seed), scale)
     drawn = draw(seed, "thesis", effects=effects)
     started = time.perf_counter()
-    calibrator = Calibrator(seed=seed).fit([window_from_dict(drawn.document)], drawn.truth)
+    calibrator = Calibrator(seed=seed, actuator=THESIS).fit([window_from_dict(drawn.document)], drawn.truth)
     seconds = time.perf_counter() - started
     report = calibrator.report_
     if figure is not None:

@@ -26,6 +26,7 @@ from clients.report import write_section
 from prognosis.documents import Prognosis, Stored
 from prognosis.prognose import Thresholds, prognose
 from sim import runtime
+from sim.actuator import THESIS
 from sim.checks import InputError
 from sim.window import window_from_dict
 from tests.foreign.windows import Draw, Effects, Health, draw
@@ -157,13 +158,13 @@ def history(
             drawn.document["flight_id"] = flight_id
         known = None if alone else readings_of([s.window for s in stored], flight_id)  # as the service reads it
         try:
-            result = estimate_window(window_from_dict(drawn.document), history=known)
+            result = estimate_window(window_from_dict(drawn.document), history=known, actuator=THESIS)
         except InputError as exc:
             rate = drawn.document["sample_rate_hz"]
             refused.append(f"{actuator}/{drawn.document['window_id']} ({drawn.family}, {rate:g} Hz): {exc}")
             continue
         fdj = result.estimates.FDJ
-        past = abs(share_of_range("FDJ", fdj.value - drawn.truth["FDJ"])) > BOUND
+        past = abs(share_of_range("FDJ", fdj.value - drawn.truth["FDJ"], ranges=THESIS.ranges)) > BOUND
         weak, over, unsaid = weak + fdj.weakly_determined, over + past, unsaid + (past and not fdj.weakly_determined)
         undecided, decided = undecided + result.window.inertia_undecided, decided + bool(result.window.inertia_from)
         zeroed += result.window.sensor_zero_from is not None
@@ -185,7 +186,7 @@ def scored(prognosis: Prognosis, wear_: Wear, thresholds: Thresholds) -> dict[st
         level, level_std = trend.now()
         out[name] = {
             "level_z": (level - true_level) / level_std,
-            "level_of_range": share_of_range(name, level - true_level),
+            "level_of_range": share_of_range(name, level - true_level, ranges=THESIS.ranges),
             "true_life": true_life,
             "status": life.status,
             "rul": life.rul,

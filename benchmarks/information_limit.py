@@ -38,6 +38,7 @@ from benchmarks.foreign_groups import group_seed, groups
 from benchmarks.tails import expected_over
 from clients.report import write_section
 from sim import runtime
+from sim.actuator import THESIS
 from sim.hinge import HINGE_SMOOTHING_S, local_line
 from sim.params import ActuatorParams, eta_a_from_eta_o
 from sim.residual import kernel_samples
@@ -45,7 +46,7 @@ from sim.window import Window, window_from_dict
 from training.physics.features import as_read
 from training.physics.friction import FitSettings, fit_friction, regressors
 from training.prepare.conditioning import prepare
-from training.report import HEALTHY_RANGE
+from training.report import healthy_range
 
 GROUPS = ("short window (0.1 s, gust)", "low log rate (1-2 kHz)")  # the groups with errors past 10 % of range
 SENSORS = ("current_a", "motor_speed_radps", "hinge_moment_nm", "position_deg")
@@ -57,8 +58,8 @@ def twins(group: str, i: int) -> tuple[Window, Window, dict[str, float]]:
     them), and its truth."""
     make, seed = groups()[group], group_seed(group, i)
     logged, clean = make(seed), make(seed, noise_level=0.0)
-    as_logged = prepare(window_from_dict(logged.document)).window
-    return as_logged, prepare(window_from_dict(clean.document)).window, logged.truth
+    as_logged = prepare(window_from_dict(logged.document), actuator=THESIS).window
+    return as_logged, prepare(window_from_dict(clean.document), actuator=THESIS).window, logged.truth
 
 
 def noise_levels(logged: Mapping[str, Any], clean: Mapping[str, np.ndarray]) -> dict[str, float]:
@@ -68,7 +69,7 @@ def noise_levels(logged: Mapping[str, Any], clean: Mapping[str, np.ndarray]) -> 
 
 def _k_slopes(eta_o: float, step: float = 1e-5) -> tuple[float, float]:
     """d(1 − η_A)/dη_O and d(1/η_O − 1)/dη_O at ``eta_o`` (Eq. 3.4 ties η_A to η_O)."""
-    aid = (eta_a_from_eta_o(eta_o - step) - eta_a_from_eta_o(eta_o + step)) / (2 * step)
+    aid = (eta_a_from_eta_o(eta_o - step, 500.0) - eta_a_from_eta_o(eta_o + step, 500.0)) / (2 * step)
     return float(aid), -1.0 / eta_o**2
 
 
@@ -83,7 +84,7 @@ def linearized(clean: Window, truth: dict[str, float]) -> tuple[np.ndarray, np.n
     aiding = load * direction > 0
     eta_o = truth["eta_O"]
     slope_aid, slope_opp = _k_slopes(eta_o)
-    k = np.where(aiding, 1.0 - eta_a_from_eta_o(eta_o), 1.0 / eta_o - 1.0)
+    k = np.where(aiding, 1.0 - eta_a_from_eta_o(eta_o, 500.0), 1.0 / eta_o - 1.0)
     X = np.stack([np.ones(n), np.abs(load) * np.where(aiding, slope_aid, slope_opp)], axis=1)[mask]
     identity = np.eye(n)
     central = (np.roll(identity, -1, axis=0) - np.roll(identity, 1, axis=0)) * rate / 2
@@ -124,7 +125,7 @@ def efficient_std(
     covariance = sum(r @ r.T for r in rows)
     information = X.T @ np.linalg.solve(covariance, X)
     std = np.sqrt(np.diag(np.linalg.inv(information)))
-    return std / np.array([np.ptp(HEALTHY_RANGE["FDJ"]), np.ptp(HEALTHY_RANGE["eta_O"])])
+    return std / np.array([np.ptp(healthy_range("FDJ", THESIS.ranges)), np.ptp(healthy_range("eta_O", THESIS.ranges))])
 
 
 def our_rms(clean: Window, truth: dict[str, float], levels: dict[str, float], draws: int, seed: int) -> np.ndarray:
@@ -134,9 +135,11 @@ def our_rms(clean: Window, truth: dict[str, float], levels: dict[str, float], dr
     signals = {name: np.repeat(values[None], draws, axis=0) for name, values in clean.signals.items()}
     for name in SENSORS:
         signals[name] = signals[name] + levels[name] * rng.standard_normal(signals[name].shape)
-    fit = fit_friction(as_read(signals, clean.sample_rate_hz), clean.sample_rate_hz)
+    fit = fit_friction(as_read(signals, clean.sample_rate_hz), clean.sample_rate_hz, actuator=THESIS.params)
     errors = np.stack([fit.fdj_nm - truth["FDJ"], fit.eta_o - truth["eta_O"]])
-    return np.sqrt(np.nanmean(errors**2, axis=1)) / np.array([np.ptp(HEALTHY_RANGE[k]) for k in ("FDJ", "eta_O")])
+    return np.sqrt(np.nanmean(errors**2, axis=1)) / np.array(
+        [np.ptp(healthy_range(k, THESIS.ranges)) for k in ("FDJ", "eta_O")]
+    )
 
 
 def one_window(group: str, i: int, draws: int) -> dict[str, np.ndarray]:

@@ -15,6 +15,7 @@ from benchmarks.foreign_accuracy import RESULTS_MD, run_one, summarize, table
 from benchmarks.foreign_groups import FAMILIES, drive_off, off_zero, viscous
 from clients.report import write_section
 from sim import runtime
+from sim.actuator import THESIS
 from sim.window import window_from_dict
 from tests.foreign.windows import Draw, Effects, draw, filter_widths, of_the_same_flight, through_filters
 from training.history import readings_of
@@ -61,7 +62,7 @@ def _after_another(make: Callable[[int], Draw], seed: int, family: str, duration
     other = of_the_same_flight(drawn, seed + 500_000, family, duration_s)
     for document in (drawn.document, other.document):
         document["flight_id"] = f"flight-{seed}"
-    read = estimate_window(window_from_dict(other.document)).window
+    read = estimate_window(window_from_dict(other.document), actuator=THESIS).window
     return run_one(drawn, readings_of([read], f"flight-{seed}"))
 
 

@@ -16,6 +16,7 @@ from benchmarks.foreign_accuracy import RESULTS_MD, run_one, summarize, table
 from benchmarks.foreign_groups import group_seed, groups
 from clients.report import write_section
 from sim import runtime
+from sim.actuator import THESIS
 from sim.window import window_from_dict
 from tests.foreign.faults import FAULTS, with_fault
 from training.prepare.stale import stale_runs
@@ -68,7 +69,10 @@ def main() -> None:
         rows[CLEAN].append(run_one(drawn))
         for label, fault in FAULTS.items():
             logged = replace(drawn, document=with_fault(drawn.document, fault, seed))
-            found[label] += any(run.signal == fault.signal for run in stale_runs(window_from_dict(logged.document)))
+            found[label] += any(
+                run.signal == fault.signal
+                for run in stale_runs(window_from_dict(logged.document), actuator=THESIS.params)
+            )
             rows[label].append(run_one(logged))
         print(i, name, flush=True)
     body = report(rows, found, args.per_fault, time.perf_counter() - started)

@@ -14,6 +14,8 @@ from pathlib import Path
 
 import matplotlib
 
+from sim.actuator import THESIS
+
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
@@ -136,11 +138,11 @@ def baseline_comparison(n_windows: int) -> list[str]:
     for seed in range(n_windows):
         health = HealthParams.uniform(1, DEFAULT_RANGES, rng)
         window = synthetic_window(health, seed=500 + seed)
-        result = estimate_window(window)
+        result = estimate_window(window, actuator=THESIS)
         truth = np.array([health.fdj_nm[0], health.eta_o[0]])
         methods = result.methods
         errors["network"].append(np.array([methods["FDJ"].network, methods["eta_O"].network]) / truth - 1)
-        base = fit_window(window.signals, window.sample_rate_hz)
+        base = fit_window(window.signals, window.sample_rate_hz, actuator=THESIS.params)
         errors["baseline"].append(np.array([base.fdj_nm[0], base.eta_o[0]]) / truth - 1)
         errors["blend"].append(np.array([result.estimates.FDJ.value, result.estimates.eta_O.value]) / truth - 1)
     for name, values in errors.items():

@@ -16,6 +16,7 @@ import numpy as np
 
 from clients.report import write_section
 from sim import runtime
+from sim.actuator import THESIS
 from sim.aircraft import FlightCondition, load_model
 from sim.batch import kernel_constants, simulate_batch
 from sim.commands import random_command_knots
@@ -50,17 +51,21 @@ def main() -> None:
     rng = np.random.default_rng(0)
     health = HealthParams.uniform(args.sims, DEFAULT_RANGES, rng)
     knots = random_command_knots(args.samples, RATE_HZ, rng)[0]
-    simulate_batch(knots[:11], health)  # JIT (or cache load) outside the timing
-    simulate_batch(knots[:11], health, lanes=1)
+    simulate_batch(knots[:11], health, actuator=THESIS.params)  # JIT (or cache load) outside the timing
+    simulate_batch(knots[:11], health, lanes=1, actuator=THESIS.params)
     steps = args.sims * args.samples * STEPS_PER_SAMPLE
 
-    fast_s = best_of(args.repeats, lambda: simulate_batch(knots, health))
+    fast_s = best_of(args.repeats, lambda: simulate_batch(knots, health, actuator=THESIS.params))
     short = args.samples // 10
-    scalar_s = best_of(1, lambda: simulate_batch(knots[: short + 1], health, lanes=1)) * args.samples / short
+    scalar_s = (
+        best_of(1, lambda: simulate_batch(knots[: short + 1], health, lanes=1, actuator=THESIS.params))
+        * args.samples
+        / short
+    )
 
     c = kernel_constants(ActuatorParams(), EffectSet())
     load = load_model(FlightCondition(), STEPS_PER_SAMPLE * 1e-6)
-    eta_a = health.eta_a()
+    eta_a = health.eta_a(500.0)
     per_sim = np.stack([health.fdj_nm, health.fsj_nm, 1 - eta_a, 1 / health.eta_o - 1])
     initial = np.zeros((3, args.sims))
     knots_rad = np.radians(knots[: args.numpy_samples + 1])[None]

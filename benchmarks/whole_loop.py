@@ -39,6 +39,7 @@ from benchmarks.information_limit import GROUPS, SENSORS, noise_levels
 from benchmarks.tails import expected_over
 from clients.report import write_section
 from sim import runtime
+from sim.actuator import THESIS
 from sim.params import HealthParams
 from sim.window import Window, window_from_dict
 from tests.foreign.physics import Effects
@@ -47,9 +48,11 @@ from training.physics.features import as_read
 from training.physics.friction import fit_friction
 from training.physics.scenario import scenario_from_window
 from training.prepare.conditioning import prepare
-from training.report import HEALTHY_RANGE
+from training.report import healthy_range
 
-WIDTH = np.array([np.ptp(HEALTHY_RANGE["FDJ"]), np.ptp(HEALTHY_RANGE["eta_O"])])  # the ranges, for shares
+WIDTH = np.array(
+    [np.ptp(healthy_range("FDJ", THESIS.ranges)), np.ptp(healthy_range("eta_O", THESIS.ranges))]
+)  # the ranges, for shares
 STEP = 0.025  # central-difference step, share of each range
 DEPARTURES = {
     "bus +1 %": Effects(supply_voltage_factor=1.01),
@@ -85,7 +88,7 @@ def _as_window(window: Draw, signals: dict[str, np.ndarray]) -> Window:
 def our_simulator_bias(window: Draw, clean: dict[str, np.ndarray], levels: dict[str, float]) -> np.ndarray:
     """(2,) first-order bias of a whole-loop reading that simulates the window with *our* simulator
     (``training.simulate.dataset``'s scenario of the noise-free window: its command, start and logged load)."""
-    scenario = scenario_from_window(_as_window(window, clean))
+    scenario = scenario_from_window(_as_window(window, clean), actuator=THESIS.params, hinge=THESIS.hinge)
     truth, (d_fdj, d_eta) = window.truth, STEP * WIDTH
     fdj, eta_o = truth["FDJ"] + np.array([0, d_fdj, -d_fdj, 0, 0]), truth["eta_O"] + np.array([0, 0, 0, d_eta, -d_eta])
     signals = scenario.simulate(HealthParams(fsj_nm=np.full(5, truth["FSJ"]), fdj_nm=fdj, eta_o=eta_o)).signals
@@ -96,9 +99,9 @@ def our_simulator_bias(window: Draw, clean: dict[str, np.ndarray], levels: dict[
 
 def our_fit(window: Draw, signals: dict[str, np.ndarray]) -> np.ndarray:
     """(2,) FDJ and η_O of the Eq. 5.1 fit on these signals, as shares of the range."""
-    prepared = prepare(_as_window(window, signals)).window
+    prepared = prepare(_as_window(window, signals), actuator=THESIS).window
     rate = prepared.sample_rate_hz
-    fit = fit_friction(as_read({k: v[None] for k, v in prepared.signals.items()}, rate), rate)
+    fit = fit_friction(as_read({k: v[None] for k, v in prepared.signals.items()}, rate), rate, actuator=THESIS.params)
     return np.array([fit.fdj_nm[0], fit.eta_o[0]]) / WIDTH
 
 

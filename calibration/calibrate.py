@@ -31,9 +31,9 @@ from calibration.noise_floor import COPIES, clean_replicas, noise_copies
 from calibration.refit import corrected, fit_with, held_out_rss
 from calibration.selection import MAX_EFFECTS, Chosen, Decision, Evidence, decide, evidence
 from calibration.twins import TWINS, tell_apart
+from sim.actuator import Actuator
 from sim.checks import InputError
 from sim.noise import SensorNoise
-from sim.params import ActuatorParams
 from sim.window import Window
 from training.config import PipelineConfig
 from training.documents import TARGETS, Estimate
@@ -43,12 +43,17 @@ from training.prepare.conditioning import prepare
 MIN_HELD_OUT_GAIN = 0.01  # the model with the effect must cut the held-out residual by at least 1 %
 
 
-def combined(results: Sequence[Estimate]) -> dict[str, float]:
-    """Inverse-variance mean of FDJ and η_O over windows (one actuator, one health)."""
+def combined(results: Sequence[Estimate], actuator: Actuator) -> dict[str, float]:
+    """Inverse-variance mean of FDJ and η_O over windows (one actuator, one health); η_O the nominal where no
+    window carries a load to read it by."""
     out = {}
     for name in TARGETS:
-        values = np.array([getattr(r.estimates, name).value for r in results])
-        weights = 1.0 / np.maximum([getattr(r.estimates, name).std or 1.0 for r in results], 1e-12) ** 2
+        entries = [e for e in (getattr(r.estimates, name) for r in results) if e is not None]
+        if not entries:
+            out[name] = actuator.nominal.eta_o
+            continue
+        values = np.array([e.value for e in entries])
+        weights = 1.0 / np.maximum([e.std or 1.0 for e in entries], 1e-12) ** 2
         out[name] = float(values @ weights / weights.sum())
     return out
 
@@ -60,7 +65,10 @@ class Calibrator:
         max_effects: int = MAX_EFFECTS,
         copies: int = COPIES,
         seed: int = 0,
+        *,
+        actuator: Actuator,
     ) -> None:
+        self.actuator = actuator
         self.pipeline = pipeline
         self.max_effects = max_effects
         self.copies = copies
@@ -73,7 +81,8 @@ class Calibrator:
             raise InputError("copies", f"must be in [8, 500], got {self.copies}")
         if not windows:
             raise InputError("windows", "at least one window is needed")
-        prepared = [prepare(w, spec_only=True).window for w in windows]  # what departs is named, not taken off
+        # what departs is named, not taken off
+        prepared = [prepare(w, self.actuator, spec_only=True).window for w in windows]
         if len({w.sample_rate_hz for w in prepared}) > 1:
             raise InputError("windows", "must share one sample rate (after averaging to at most 10 kHz)")
         return prepared
@@ -92,16 +101,18 @@ class Calibrator:
         started = time.perf_counter()
         prepared = self._check(windows)
         stage(f"estimating {len(prepared)} window(s) with the base model")
-        base = [estimate_window(w, self.pipeline, on_stage=lambda _: check(), spec_only=True) for w in prepared]
-        before = combined(base)
+        base = [estimate_window(w, self.pipeline, actuator=self.actuator, on_stage=lambda _: check(), spec_only=True)
+                for w in prepared]  # fmt: skip
+        before = combined(base, self.actuator)
         bias = {n: float(np.mean([r.methods[n].physics_bias for r in base])) for n in TARGETS}
         noise = [SensorNoise(**r.dataset.noise_estimated) for r in base]
         rate = prepared[0].sample_rate_hz
-        measured = equations([w.signals for w in prepared], rate, COGGING_ORDERS)
+        spec = self.actuator.params
+        measured = equations([w.signals for w in prepared], rate, COGGING_ORDERS, spec)
         stage(f"simulating {self.copies} noise-only copies")
-        copies = noise_copies(clean_replicas(prepared, before), noise, rate, COGGING_ORDERS, self.seed, self.copies,
-                              on_copy=check)  # fmt: skip
-        families = named_families(measured, ActuatorParams()) + generic_families(measured)
+        clean = clean_replicas(prepared, before, self.actuator)
+        copies = noise_copies(clean, noise, rate, COGGING_ORDERS, self.seed, spec, self.copies, on_copy=check)
+        families = named_families(measured, spec) + generic_families(measured)
         stage(f"scoring {len(families)} candidate families against the noise floor")
         chosen, steps, first_round, unnamed = self._select(measured, copies, families, prepared, before, noise, check)
         held, chosen = self._held_out(measured, chosen)
@@ -160,7 +171,7 @@ class Calibrator:
         if not twins:
             return pick, Step(selected=pick.family.name, reason=decision.reason, indistinguishable_from=decision.alike)
         options = [pick, *twins]
-        pick, errors, clear = tell_apart(windows, before, options, noise)
+        pick, errors, clear = tell_apart(windows, before, options, noise, self.actuator)
         others = [o.family.name for o in options if o is not pick]
         runner = min(others, key=errors.__getitem__)
         reason = f"{decision.reason}; told from {' and '.join(others)} by the motor speed and current it predicts"

@@ -45,6 +45,7 @@ class Equations:
     kinematic: np.ndarray  # (m,) d = θ_m/n − θ_u [rad]
     folds: np.ndarray  # (m,) held-out fold of each sample
     window: np.ndarray  # (m,) which window each sample comes from
+    gear_ratio: float  # the actuator's n: Eq. 3.4 ties η_A to η_O with it
 
     @property
     def m(self) -> int:
@@ -113,6 +114,7 @@ def _one_window(
         kinematic=smoothed(angle / actuator.gear_ratio - np.radians(signals["position_deg"]), rate)[mask],
         folds=(np.arange(len(t)) // block % FOLDS)[mask],
         window=np.full(int(mask.sum()), index),
+        gear_ratio=actuator.gear_ratio,
     )
 
 
@@ -120,7 +122,7 @@ def equations(
     windows: Sequence[Mapping[str, np.ndarray]],
     rate: float,
     orders: Sequence[float],
-    actuator: ActuatorParams = ActuatorParams(),
+    actuator: ActuatorParams,
 ) -> Equations:
     """The stacked equation-error problem of ``windows`` (each a dict of signals at ``rate``)."""
     parts = [_one_window(signals, rate, actuator, orders, i) for i, signals in enumerate(windows)]
@@ -139,4 +141,5 @@ def equations(
         kinematic=stack([p.kinematic for p in parts]),
         folds=stack([p.folds for p in parts]),
         window=stack([p.window for p in parts]),
+        gear_ratio=first.gear_ratio,
     )

@@ -16,17 +16,22 @@ from collections.abc import Callable, Mapping, Sequence
 import numpy as np
 
 from calibration.equations import Equations, equations
+from sim.actuator import Actuator
 from sim.noise import SensorNoise, add_sensor_noise
+from sim.params import ActuatorParams
 from sim.window import Window
 from training.physics.scenario import inside, scenario_from_window
 
 COPIES = 30
 
 
-def clean_replicas(windows: Sequence[Window], estimates: Mapping[str, float]) -> list[dict[str, np.ndarray]]:
+def clean_replicas(
+    windows: Sequence[Window], estimates: Mapping[str, float], actuator: Actuator
+) -> list[dict[str, np.ndarray]]:
     """Each window simulated at ``estimates`` (FSJ at twice FDJ), without noise."""
-    health = inside(estimates["FDJ"], estimates["eta_O"])
-    return [scenario_from_window(w).simulate(health, lanes=1).simulation(0) for w in windows]
+    health = inside(estimates["FDJ"], estimates["eta_O"], actuator.nominal.fdj_nm)
+    return [scenario_from_window(w, actuator.params, actuator.hinge).simulate(health, lanes=1).simulation(0)
+            for w in windows]  # fmt: skip
 
 
 def noise_copies(
@@ -35,6 +40,7 @@ def noise_copies(
     rate: float,
     orders: Sequence[float],
     seed: int,
+    actuator: ActuatorParams,
     copies: int = COPIES,
     on_copy: Callable[[], None] | None = None,
 ) -> list[Equations]:
@@ -46,5 +52,5 @@ def noise_copies(
         if on_copy is not None:
             on_copy()
         noisy = [add_sensor_noise(signals, level, rng, rate) for signals, level in zip(clean, noise, strict=True)]
-        out.append(equations(noisy, rate, orders))
+        out.append(equations(noisy, rate, orders, actuator))
     return out

@@ -55,9 +55,9 @@ def _loads(e: Equations, chosen: Sequence[Chosen]) -> np.ndarray:
     return loads
 
 
-def _target(y: np.ndarray, eta_o: float, loads: np.ndarray) -> np.ndarray:
+def _target(y: np.ndarray, eta_o: float, loads: np.ndarray, gear_ratio: float) -> np.ndarray:
     """t minus the load-dependent friction at η_O (η_A by Eq. 3.4): what FDJ and the effect must explain."""
-    k_aid, k_opp = 1.0 - float(eta_a_from_eta_o(eta_o)), 1.0 / eta_o - 1.0
+    k_aid, k_opp = 1.0 - float(eta_a_from_eta_o(eta_o, gear_ratio)), 1.0 / eta_o - 1.0
     return y - k_aid * loads[:, 0] - k_opp * loads[:, 1]
 
 
@@ -68,7 +68,7 @@ def fit_with(e: Equations, chosen: Sequence[Chosen], rows: np.ndarray | None = N
     low, high = ETA_O_SEARCH
     for _ in range(REFINEMENTS):
         grid = np.linspace(low, high, GRID_POINTS)
-        targets = [_target(y, eta, loads) for eta in grid]
+        targets = [_target(y, eta, loads, e.gear_ratio) for eta in grid]
         betas = [np.linalg.lstsq(design, t, rcond=None)[0] for t in targets]
         sse = [float(np.sum((t - design @ b) ** 2)) for t, b in zip(targets, betas, strict=True)]
         best = int(np.argmin(sse))
@@ -84,7 +84,7 @@ def held_out_rss(e: Equations, chosen: Sequence[Chosen]) -> float:
     for f in range(FOLDS):
         fitted = fit_with(e, chosen, np.flatnonzero(e.folds != f))
         held = e.folds == f
-        error = _target(y, fitted.eta_o, loads)[held] - design[held] @ fitted.beta
+        error = _target(y, fitted.eta_o, loads, e.gear_ratio)[held] - design[held] @ fitted.beta
         total += float(error @ error)
     return total
 

@@ -17,9 +17,10 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 
 from calibration.selection import Evidence
+from sim.actuator import Actuator
 from sim.noise import SensorNoise
 from sim.window import Window
-from training.physics.scenario import CLEAR_MARGIN, following_error, inside
+from training.physics.scenario import CLEAR_MARGIN, following_error, inside, scenario_from_window
 
 # Look-alikes, each with the others of its group. An inertia ΔJ leaves ΔJ·dω/dt, which a gain of k_T·I
 # (mostly the load and J_M·dω/dt) nearly matches; only its simulation moves the speed otherwise.
@@ -28,14 +29,21 @@ TWINS = {name: tuple(other for other in GROUP if other != name) for name in GROU
 
 
 def output_error(
-    windows: Sequence[Window], estimates: Mapping[str, float], option: Evidence, noise: Sequence[SensorNoise]
+    windows: Sequence[Window],
+    estimates: Mapping[str, float],
+    option: Evidence,
+    noise: Sequence[SensorNoise],
+    actuator: Actuator,
 ) -> float:
     """Mean over windows of RMS(speed)/σ_speed + RMS(current)/σ_current, simulated with ``option`` added."""
     effects = option.family.term(option.beta, option.grid)
     if effects is None:
         return float("inf")  # a gain outside what the simulator admits: not this twin
-    health = inside(estimates["FDJ"], estimates["eta_O"])
-    errors = [following_error(w, effects, health, level) for w, level in zip(windows, noise, strict=True)]
+    health = inside(estimates["FDJ"], estimates["eta_O"], actuator.nominal.fdj_nm)
+    errors = [
+        following_error(scenario_from_window(w, actuator.params, actuator.hinge, effects), w, health, level)
+        for w, level in zip(windows, noise, strict=True)
+    ]
     return float(np.mean(errors))
 
 
@@ -44,9 +52,10 @@ def tell_apart(
     estimates: Mapping[str, float],
     options: Sequence[Evidence],
     noise: Sequence[SensorNoise],
+    actuator: Actuator,
 ) -> tuple[Evidence, dict[str, float], bool]:
     """The twin whose simulation follows the windows best, each one's output error, and whether the call is clear."""
-    errors = {o.family.name: output_error(windows, estimates, o, noise) for o in options}
+    errors = {o.family.name: output_error(windows, estimates, o, noise, actuator) for o in options}
     ranked = sorted(options, key=lambda o: errors[o.family.name])
     best, runner = errors[ranked[0].family.name], errors[ranked[1].family.name]
     return ranked[0], errors, runner > (1 + CLEAR_MARGIN) * best

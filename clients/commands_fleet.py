@@ -7,7 +7,7 @@ from pathlib import Path
 
 import click
 
-from clients.options import NothingAnsweredError, as_json, emit, pipeline_config, sizes
+from clients.options import NothingAnsweredError, actuator, as_json, emit, pipeline_config, sizes
 
 ARCHIVE = click.Path(exists=True, path_type=Path)
 
@@ -22,24 +22,29 @@ ARCHIVE = click.Path(exists=True, path_type=Path)
 @click.option("--window-s", type=click.FloatRange(0.1, 10.0), default=0.5, help="cut recordings into windows [s]")
 @click.option("--database", type=click.Path(dir_okay=False, path_type=Path), default=None,
               help="also store every answer in this SQLite history (the service's)")  # fmt: skip
+@actuator
 @sizes
 @as_json
 def fleet(archive: Path, out: Path, workers: int, threads: int, ray_address: str | None, window_s: float,
-          database: Path | None, as_json: bool, **size_values: int) -> None:  # fmt: skip
+          database: Path | None, actuator_file: Path | None, as_json: bool, **size_values: int) -> None:  # fmt: skip
     """Reprocess an archive (folder, NPZ, CSV or JSON logs) on Ray workers; one CSV row per window.
 
-    Without Ray (``pip install 'ema[fleet]'``) one worker runs in this process. Exit status 2 when no window
-    was answered; a folder's unreadable files are skipped and listed."""
+    Each window is read with its actuator's document: the archive folder's actuators.json maps actuator_ids to
+    ema-actuator/1 documents; the others take --actuator (the thesis's where none is given). Without Ray
+    (``pip install 'ema[fleet]'``) one worker runs in this process. Exit status 2 when no window was
+    answered; a folder's unreadable files are skipped and listed."""
     from clients.commands_remote import report_log
-    from clients.fleet import check_engine, run_fleet
-    from clients.logs import read_log
+    from clients.fleet import Documents, check_engine, run_fleet
+    from clients.logs import read_actuators, read_log
+    from sim.actuator import read_actuator
 
     config = pipeline_config(size_values)
     check_engine(workers, ray_address)
+    documents = Documents(read_actuators(archive), None if actuator_file is None else read_actuator(actuator_file))
     read = read_log(archive, window_s)
     report_log(read)
     print(f"ema fleet: {len(read.windows)} window(s) from {archive}, {workers} worker(s)", file=sys.stderr)
-    result = {**run_fleet(read.windows, out, config, workers, ray_address, threads, database),
+    result = {**run_fleet(read.windows, out, config, workers, ray_address, threads, database, documents),
               "bad_files": read.bad_files}  # fmt: skip
     emit(result, as_json, _print_fleet)
     if result["answered"] + result["skipped"] == 0 and result["refused"]:

@@ -8,7 +8,17 @@ from typing import Any
 
 import click
 
-from clients.options import as_json, emit, flags_named, pipeline_config, progress, sizes, threads
+from clients.options import (
+    actuator,
+    actuator_document,
+    as_json,
+    emit,
+    flags_named,
+    pipeline_config,
+    progress,
+    sizes,
+    threads,
+)
 from sim.envelope import DEFAULT_AIRSPEED_MPS
 
 FAMILIES = ("thesis", "cruise", "gust", "doublet", "steps")  # sim.commands.FAMILIES, without importing numpy here
@@ -22,6 +32,8 @@ SIMULATE_FLAGS = {
     "sample_rate_hz": "--rate",
     "command": "--command",
     "effects": "--effect",
+    "ground_load.constant_nm": "--load",
+    "ground_load.ramp_nmps": "--load-ramp",
 }
 
 
@@ -54,10 +66,12 @@ def history_of(window: Any, paths: tuple[Path, ...]) -> Any:
 @click.option("--history", "history", type=EXISTING, multiple=True, metavar="RESULT.json",
               help="the ema-estimate/1 result of another window of the actuator (repeatable): J_M where it read one, "
               "its sensors' zero where it is of the window's flight_id")  # fmt: skip
+@actuator
 @sizes
 @threads
 @as_json
-def estimate(window: Path, history: tuple[Path, ...], threads: int | None, as_json: bool, **size_values: int) -> None:
+def estimate(window: Path, history: tuple[Path, ...], actuator_file: Path | None, threads: int | None, as_json: bool,
+             **size_values: int) -> None:  # fmt: skip
     """Estimate FDJ, η_O, η_A (FSJ where it shows) of one ema-window/1 JSON file, in-process."""
     from clients.printing import print_estimate
     from sim.window import read_window
@@ -65,20 +79,24 @@ def estimate(window: Path, history: tuple[Path, ...], threads: int | None, as_js
     from training.pipeline import estimate_window
 
     config = pipeline_config(size_values)
+    document = actuator_document(actuator_file)
     read = read_window(window)
     known = history_of(read, history) if history else None
     runtime.configure(threads)
-    result = estimate_window(read, config, on_stage=progress, history=known)
+    result = estimate_window(read, config, actuator=document, on_stage=progress, history=known)
     emit(result, as_json, print_estimate)
 
 
 @click.command()
 @click.option("--out", required=True, type=click.Path(dir_okay=False, path_type=Path), help="window JSON to write")
-@click.option("--fdj", type=float, default=0.05, help="dynamic friction FDJ [N·m]")
-@click.option("--eta-o", "eta_o", type=float, default=0.85, help="opposing efficiency η_O")
-@click.option("--fsj", type=float, default=0.10, help="static friction FSJ [N·m]")
+@click.option("--fdj", type=float, default=None, help="dynamic friction FDJ [N·m]  [default: the actuator's nominal]")
+@click.option("--eta-o", "eta_o", type=float, default=None, help="opposing efficiency η_O  [default: nominal]")
+@click.option("--fsj", type=float, default=None, help="static friction FSJ [N·m]  [default: nominal]")
 @click.option("--airspeed", type=float, default=DEFAULT_AIRSPEED_MPS, help="true airspeed [m/s], 90–215")
 @click.option("--altitude", type=float, default=0.0, help="altitude [m], 0–10000")
+@click.option("--ground", is_flag=True, help="on the ground: a load cell's load (--load, --load-ramp), no aircraft")
+@click.option("--load", "load_nm", type=float, default=0.0, help="with --ground: the hinge moment at t = 0 [N·m]")
+@click.option("--load-ramp", "load_ramp_nmps", type=float, default=0.0, help="with --ground: its rate [N·m/s]")
 @click.option("--command", type=click.Choice(FAMILIES), default="thesis", help="the command's family")
 @click.option("--seed", type=int, default=0, help="seed of the command and the noise")
 @click.option("--duration", type=click.FloatRange(0.01, 60.0), default=0.5, help="window length [s]")
@@ -88,6 +106,7 @@ def estimate(window: Path, history: tuple[Path, ...], threads: int | None, as_js
               help="an effect the base model lacks, e.g. cogging:amplitude_nm=0.02 (repeatable)")  # fmt: skip
 @click.option("--actuator-id", default="synthetic/elevator", help="actuator_id written to the window")
 @click.option("--truth-out", type=click.Path(dir_okay=False, path_type=Path), help="also write the truth as JSON")
+@actuator
 @as_json
 def simulate(as_json: bool, **options: Any) -> None:
     """Write a synthetic ema-window/1 file from the model (sensor noise unless --clean)."""
@@ -105,11 +124,12 @@ def simulate(as_json: bool, **options: Any) -> None:
 @click.option("--figure", type=click.Path(dir_okay=False, path_type=Path), default=None,
               help="also write a PNG of the residual before and after")  # fmt: skip
 @click.option("--copies", type=click.IntRange(8, 500), default=30, help="noise-only copies behind the noise floor")
+@actuator
 @sizes
 @threads
 @as_json
-def calibrate(windows: tuple[Path, ...], truth: Path | None, figure: Path | None, copies: int, threads: int | None,
-              as_json: bool, **size_values: int) -> None:  # fmt: skip
+def calibrate(windows: tuple[Path, ...], truth: Path | None, figure: Path | None, copies: int,
+              actuator_file: Path | None, threads: int | None, as_json: bool, **size_values: int) -> None:  # fmt: skip
     """Trace what the model misses in windows of one actuator to an effect, add it, re-estimate."""
     from calibration.calibrate import Calibrator
     from clients.figures import calibration_figure
@@ -120,7 +140,8 @@ def calibrate(windows: tuple[Path, ...], truth: Path | None, figure: Path | None
     config = pipeline_config(size_values)
     runtime.configure(threads)
     loaded = [read_window(path) for path in windows]
-    calibrator = Calibrator(config, copies=copies, seed=config.seed).fit(loaded, read_truth(truth), on_stage=progress)
+    calibrator = Calibrator(config, copies=copies, seed=config.seed, actuator=actuator_document(actuator_file))
+    calibrator.fit(loaded, read_truth(truth), on_stage=progress)
     written = None if figure is None else str(calibration_figure(calibrator, figure))
     emit({**calibrator.report_.model_dump(mode="json", by_alias=True), "figure": written}, as_json,
          print_calibration)  # fmt: skip

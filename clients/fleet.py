@@ -19,7 +19,7 @@ import sys
 import time
 from collections import Counter
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -50,15 +50,34 @@ Job = tuple[Window, dict[str, Any] | None]  # a window and what other windows of
 Answer = tuple[Window, dict]  # a window and its ema-estimate/1 document (or {"error": ...})
 
 
-def _in_process(jobs: list[Job], config: PipelineConfig, threads: int) -> Iterator[Answer]:
+@dataclass(frozen=True)
+class Documents:
+    """The actuators' ema-actuator/1 documents a run reads its windows with (by actuator_id; the rest with
+    ``default``, the thesis's where none is given), and the versions a history stored them under."""
+
+    by_actuator: dict[str, Any] = field(default_factory=dict)  # actuator_id -> sim.actuator.Actuator
+    default: Any = None  # an Actuator, or None: the thesis's (the answer then says so)
+    versions: dict[str, int] = field(default_factory=dict)
+
+    def task_arguments(self, window: Window) -> tuple[dict[str, Any] | None, int | None]:
+        """(the document as JSON, its version) for ``window``'s task (None: the default, ``sim.actuator.THESIS``)."""
+        document = self.by_actuator.get(window.actuator_id, self.default)
+        if document is None:
+            return None, None
+        return document.model_dump(mode="json", by_alias=True), self.versions.get(window.actuator_id)
+
+
+def _in_process(jobs: list[Job], config: PipelineConfig, threads: int, documents: Documents) -> Iterator[Answer]:
     from training.remote import estimate_document
 
     for window, history in jobs:
-        yield window, estimate_document(window_to_dict(window), config.model_dump(), threads, history)
+        actuator, version = documents.task_arguments(window)
+        yield window, estimate_document(window_to_dict(window), config.model_dump(), threads, history, actuator,
+                                        version)  # fmt: skip
 
 
 def _on_ray(jobs: list[Job], config: PipelineConfig, workers: int, threads: int,
-            address: str | None) -> Iterator[Answer]:  # fmt: skip
+            address: str | None, documents: Documents) -> Iterator[Answer]:  # fmt: skip
     import ray
 
     from training.remote import connect, ray_task
@@ -70,7 +89,9 @@ def _on_ray(jobs: list[Job], config: PipelineConfig, workers: int, threads: int,
     while queue or pending:
         while queue and len(pending) < IN_FLIGHT_PER_WORKER * workers:
             window, history = queue.pop()
-            pending[task.remote(window_to_dict(window), config.model_dump(), threads, history)] = window
+            actuator, version = documents.task_arguments(window)
+            reference = task.remote(window_to_dict(window), config.model_dump(), threads, history, actuator, version)
+            pending[reference] = window
         ready, _ = ray.wait(list(pending), num_returns=1)
         for reference in ready:
             yield pending.pop(reference), ray.get(reference)
@@ -148,19 +169,25 @@ def _with_history(
 
 
 def run_fleet(windows: list[Window], out: Path, config: PipelineConfig, workers: int, address: str | None,
-              threads: int = 1, database: Path | None = None) -> dict[str, Any]:  # fmt: skip
+              threads: int = 1, database: Path | None = None,
+              documents: Documents = Documents()) -> dict[str, Any]:  # fmt: skip
     """Every window of ``windows`` not yet in ``out``, on ``workers`` Ray workers of ``threads`` threads each
-    (in-process with one worker and no Ray)."""
+    (in-process with one worker and no Ray), each read with its actuator's document; with a ``database``, the
+    documents go into that history first, and the answers record the versions they got there."""
     done = done_windows(out)
     todo = [w for w in windows if (w.actuator_id, w.window_id) not in done]
     progress = Progress(len(todo), started=time.perf_counter())
     in_process = workers == 1 and address is None and not ray_installed()
+    store = _store(database)
+    if store is not None:
+        documents = _stored_documents(store, documents, {w.actuator_id for w in todo})
 
     def engine(jobs: list[Job]) -> Iterator[Answer]:
-        return _in_process(jobs, config, threads) if in_process else _on_ray(jobs, config, workers, threads, address)
+        if in_process:
+            return _in_process(jobs, config, threads, documents)
+        return _on_ray(jobs, config, workers, threads, address, documents)
 
     results = _with_history(todo, engine([(w, None) for w in todo]), engine)
-    store = _store(database)
     with ResultsWriter(out) as writer:
         for window, answer in results:
             row = row_of(window.actuator_id, window.window_id, answer)
@@ -203,6 +230,17 @@ def _stored(store: Any, row: dict[str, Any], answer: dict[str, Any]) -> dict[str
     except ConflictError as exc:
         return {"actuator_id": row["actuator_id"], "window_id": row["window_id"], "error": f"conflict: {exc}"}
     return row
+
+
+def _stored_documents(store: Any, documents: Documents, actuator_ids: set[str]) -> Documents:
+    """``documents`` put into ``store`` (each actuator of the run with a document: its own or the default given),
+    with the versions the history gave them."""
+    versions = {}
+    for actuator_id in sorted(actuator_ids):
+        document = documents.by_actuator.get(actuator_id, documents.default)
+        if document is not None:
+            versions[actuator_id] = store.put_actuator(actuator_id, document).version
+    return replace(documents, versions=versions)
 
 
 def _store(database: Path | None) -> Any:

@@ -16,11 +16,13 @@ from typing import Any
 
 import numpy as np
 
+from sim.actuator import Actuator, actuator_from_dict
 from sim.checks import InputError
 from sim.envelope import DEFAULT_AIRSPEED_MPS
 from sim.window import SIGNALS, Window, window_from_dict
 
 SUFFIXES = (".json", ".csv", ".npz")
+ACTUATORS_FILE = "actuators.json"  # in an archive's folder: {actuator_id: its ema-actuator/1 document}
 
 
 @dataclass(frozen=True)
@@ -145,7 +147,10 @@ def read_log(path: Path, window_s: float, defaults: Defaults = Defaults()) -> Lo
     path = Path(path)
     if not path.exists():
         raise InputError(str(path), "does not exist")
-    files = sorted(p for p in path.iterdir() if p.suffix.lower() in SUFFIXES) if path.is_dir() else [path]
+    if path.is_dir():
+        files = sorted(p for p in path.iterdir() if p.suffix.lower() in SUFFIXES and p.name != ACTUATORS_FILE)
+    else:
+        files = [path]
     if not files:
         raise InputError(str(path), f"holds no {'/'.join(SUFFIXES)} file")
     windows: list[Window] = []
@@ -168,3 +173,24 @@ def read_log(path: Path, window_s: float, defaults: Defaults = Defaults()) -> Lo
         first = next(iter(bad.items()), None)
         raise InputError(str(path), "holds no readable window" + (f" ({first[0]}: {first[1]})" if first else ""))
     return Log(windows, dropped, bad)
+
+
+def read_actuators(folder: Path) -> dict[str, Actuator]:
+    """The documents of an archive's actuators, from its ``ACTUATORS_FILE`` (none where it has none); a bad
+    one is an InputError naming the file and the actuator."""
+    path = Path(folder) / ACTUATORS_FILE
+    if not Path(folder).is_dir() or not path.exists():
+        return {}
+    try:
+        documents = json.loads(path.read_bytes())
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise InputError(str(path), f"cannot be read as JSON ({exc})") from None
+    if not isinstance(documents, dict):
+        raise InputError(str(path), "must map each actuator_id to its ema-actuator/1 document")
+    read = {}
+    for actuator_id, document in documents.items():
+        try:
+            read[actuator_id] = actuator_from_dict(document)
+        except InputError as exc:
+            raise InputError(f"{path}: {actuator_id}: {exc.field}", exc.message) from None
+    return read

@@ -6,6 +6,7 @@ import contextlib
 import json
 import sys
 from collections.abc import Callable, Iterator, Mapping
+from pathlib import Path
 from typing import Any, TypeVar
 
 import click
@@ -31,6 +32,20 @@ def sizes(function: F) -> F:
         kind = click.IntRange(size.low, size.high)
         function = click.option(flag, field, type=kind, default=size.default, help=size.description)(function)
     return function
+
+
+def actuator(function: F) -> F:
+    return click.option(
+        "--actuator", "actuator_file", type=click.Path(exists=True, dir_okay=False, path_type=Path), default=None,
+        metavar="A.json", help="the actuator's ema-actuator/1 document [default: the thesis's, examples/actuator.json]",
+    )(function)  # fmt: skip
+
+
+def actuator_document(path: Path | None) -> Any:
+    """The document in ``path``, or the default (``sim.actuator.THESIS``) where none was given."""
+    from sim.actuator import THESIS, read_actuator
+
+    return THESIS if path is None else read_actuator(path)
 
 
 def as_json(function: F) -> F:

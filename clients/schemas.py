@@ -11,11 +11,14 @@ from pydantic import BaseModel
 def documents() -> dict[str, type[BaseModel]]:
     """File stem -> the model (imported here: the CLI's help must not pay for them)."""
     from calibration.documents import CalibrationReport
-    from prognosis.documents import History, Prognosis
+    from prognosis.documents import History, Prognosis, StoredActuator
+    from sim.actuator import Actuator
     from sim.window import WindowDocument
     from training.documents import Estimate
 
     return {
+        "ema-actuator-1": Actuator,
+        "stored-actuator": StoredActuator,
         "ema-window-1": WindowDocument,
         "ema-estimate-1": Estimate,
         "ema-calibration-1": CalibrationReport,

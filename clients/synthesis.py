@@ -8,11 +8,13 @@ from typing import Any
 
 import numpy as np
 
-from sim.aircraft import FlightCondition
+from clients.options import actuator_document
+from sim.actuator import Actuator
+from sim.aircraft import FlightCondition, GroundLoad
 from sim.checks import InputError
 from sim.effects import EffectSet
-from sim.noise import NO_NOISE, SensorNoise
-from sim.params import HealthParams, eta_a_from_eta_o
+from sim.noise import NO_NOISE
+from sim.params import HealthParams
 from sim.residual import residual_torque_nm
 from sim.synthetic import synthetic_window
 from sim.window import Window, write_window
@@ -33,10 +35,11 @@ def parse_effect(text: str) -> tuple[str, dict[str, float]]:
     return name.strip(), parameters
 
 
-def summary(window: Window) -> dict[str, Any]:
+def summary(window: Window, actuator: Actuator) -> dict[str, Any]:
     """Ranges of the signals and of the reconstructed residual torque, for a human or a script."""
     s = window.signals
-    residual = residual_torque_nm(s["current_a"], s["motor_speed_radps"], s["hinge_moment_nm"], window.sample_rate_hz)
+    residual = residual_torque_nm(s["current_a"], s["motor_speed_radps"], s["hinge_moment_nm"], window.sample_rate_hz,
+                                  actuator.params)  # fmt: skip
     ranges = {name: [float(values.min()), float(values.max())] for name, values in s.items()}
     ranges["residual_torque_nm"] = [float(residual.min()), float(residual.max())]
     return {
@@ -45,31 +48,41 @@ def summary(window: Window) -> dict[str, Any]:
         "n_samples": window.n_samples,
         "duration_s": window.duration_s,
         "sample_rate_hz": window.sample_rate_hz,
+        "on_ground": window.on_ground,
         "ranges": ranges,
         "moving_fraction": float(np.mean(np.abs(s["motor_speed_radps"]) > 5.0)),
     }
 
 
 def synthesize(
-    out: Path, fdj: float, eta_o: float, fsj: float, airspeed: float, altitude: float, command: str, seed: int,
-    duration: float, rate: float, clean: bool, effect: tuple[str, ...], actuator_id: str, truth_out: Path | None,
+    out: Path, fdj: float | None, eta_o: float | None, fsj: float | None, airspeed: float, altitude: float,
+    ground: bool, load_nm: float, load_ramp_nmps: float, command: str, seed: int, duration: float, rate: float,
+    clean: bool, effect: tuple[str, ...], actuator_id: str, truth_out: Path | None, actuator_file: Path | None,
 ) -> dict[str, Any]:  # fmt: skip
-    """Simulate, write the window (and the truth), return what was written."""
+    """Simulate the actuator of ``actuator_file`` (the thesis's by default) at the given health (its nominal
+    where none is given), write the window (and the truth), return what was written."""
+    actuator = actuator_document(actuator_file)
+    nominal = actuator.nominal
+    health = {"FDJ": nominal.fdj_nm if fdj is None else fdj, "eta_O": nominal.eta_o if eta_o is None else eta_o,
+              "FSJ": nominal.fsj_nm if fsj is None else fsj}  # fmt: skip
     effects = EffectSet(dict(parse_effect(text) for text in effect))
+    load = GroundLoad(load_nm, load_ramp_nmps) if ground else FlightCondition(airspeed, altitude)
+    noise = NO_NOISE if clean else actuator.noise
     window = synthetic_window(
-        HealthParams.single(fsj_nm=fsj, fdj_nm=fdj, eta_o=eta_o), FlightCondition(airspeed, altitude), seed=seed,
-        duration_s=duration, sample_rate_hz=rate, noise=NO_NOISE if clean else SensorNoise(), effects=effects,
-        actuator_id=actuator_id, command=command,
+        HealthParams.single(fsj_nm=health["FSJ"], fdj_nm=health["FDJ"], eta_o=health["eta_O"]), load, seed=seed,
+        duration_s=duration, sample_rate_hz=rate, noise=noise, effects=effects, actuator_id=actuator_id,
+        command=command, actuator=actuator,
     )  # fmt: skip
     write_window(window, out)
-    truth = {"FDJ": fdj, "eta_O": eta_o, "FSJ": fsj}
     if truth_out is not None:
-        truth_out.write_text(json.dumps(truth, indent=2))
+        truth_out.write_text(json.dumps(health, indent=2))
     return {
         "window": str(out),
-        "truth": {**truth, "eta_A": float(eta_a_from_eta_o(eta_o))},
+        "actuator": actuator.name,
+        "truth": {**health, "eta_A": float(actuator.eta_a(health["eta_O"]))},
         "command": command,
+        "load": "ground" if ground else "flight",
         "effects": effects.as_dict(),
-        "noise": "none" if clean else SensorNoise().as_dict(),
-        "summary": summary(window),
+        "noise": "none" if clean else noise.as_dict(),
+        "summary": summary(window, actuator),
     }

@@ -12,6 +12,7 @@ from typing import Any, Literal
 import numpy as np
 from pydantic import Field
 
+from sim.actuator import Actuator
 from training.documents import Document, Estimate, InertiaReading, Notes
 
 PARAMETERS = ("FDJ", "eta_O", "eta_A")
@@ -23,6 +24,15 @@ class Stored(Estimate):
     id: int
     stored_at: str = Field(description="when the service stored it (UTC, ISO 8601)")
     replay: bool = Field(False, description="this window was posted before: the stored answer, not recomputed")
+
+
+class StoredActuator(Document):
+    """An actuator's ``ema-actuator/1`` document as the service keeps it: one version of several."""
+
+    actuator_id: str
+    version: int = Field(ge=1, description="1 for the first document PUT, then one more for each that differs")
+    stored_at: str = Field(description="when this version was stored (UTC, ISO 8601)")
+    document: Actuator
 
 
 class Point(Document):

@@ -6,34 +6,16 @@ import datetime as dt
 from collections.abc import Sequence
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field
 
 from prognosis.documents import PARAMETERS, Prognosis, Stored, Trend
 from prognosis.rul import remaining_life
 from prognosis.trend import fit_trend
-from sim.params import DEFAULT_RANGES, eta_a_from_eta_o
+from sim.actuator import Actuator, Airframe
 from training.documents import Note
 from training.history import combined_inertia, inertia_change_note
-from training.prepare.departures.aircraft_check import TOLERANCE
 
+AIRFRAME_TOLERANCE = Airframe.model_fields["tolerance"].default
 SENSOR_STDS = 3.0  # stds by which a sensor's level or drift must stand out to be said
-
-
-class Thresholds(BaseModel):
-    """Where each parameter ends the actuator's useful life (the service's settings may move them)."""
-
-    model_config = ConfigDict(frozen=True, extra="forbid")
-
-    fdj_above_nm: float = Field(1.5 * DEFAULT_RANGES.nominal_fdj_nm, gt=0, description="FDJ +50 % of nominal")
-    eta_o_below: float = Field(0.70, gt=0, lt=1)
-    eta_a_below: float = Field(float(eta_a_from_eta_o(0.70)), lt=1, description="Eq. 3.4 at η_O = 0.70")
-
-    def of(self, parameter: str) -> tuple[float, str]:
-        return {
-            "FDJ": (self.fdj_above_nm, "above"),
-            "eta_O": (self.eta_o_below, "below"),
-            "eta_A": (self.eta_a_below, "below"),
-        }[parameter]
 
 
 def _times(stored: Sequence[Stored]) -> tuple[np.ndarray, str, Note | None]:
@@ -49,8 +31,9 @@ def _times(stored: Sequence[Stored]) -> tuple[np.ndarray, str, Note | None]:
     return (seconds - seconds.min()) / 86_400.0, "days", note
 
 
-def prognose(actuator_id: str, stored: Sequence[Stored], thresholds: Thresholds | None = None) -> Prognosis:
-    """Trends and remaining lives of FDJ, η_O and η_A over ``stored`` (any order)."""
+def prognose(actuator_id: str, stored: Sequence[Stored], actuator: Actuator) -> Prognosis:
+    """Trends and remaining lives of FDJ, η_O and η_A over ``stored`` (any order), to ``actuator``'s
+    thresholds; a parameter a window did not read (η_O without a load) is left out of its trend."""
     if not stored:
         return Prognosis(actuator_id=actuator_id, time_unit="days", trends={}, remaining_life={},
                          notes=[Note(code="no_estimates", text="no estimates stored for this actuator")])  # fmt: skip
@@ -58,12 +41,16 @@ def prognose(actuator_id: str, stored: Sequence[Stored], thresholds: Thresholds 
     ids = [s.window_id for s in stored]
     trends, lives = {}, {}
     for name in PARAMETERS:
-        entries = [getattr(s.estimates, name) for s in stored]
-        values = np.array([e.value for e in entries])
-        stds = np.array([np.nan if e.std is None else e.std for e in entries])
-        trends[name] = fit_trend(name, times, values, stds, ids)
-        lives[name] = remaining_life(trends[name], *(thresholds or Thresholds()).of(name))
-    sensors, said = sensor_trends(stored, times, unit)
+        read = [(t, e, i) for t, e, i in zip(times, (getattr(s.estimates, name) for s in stored), ids, strict=True)
+                if e is not None]  # fmt: skip
+        if not read:
+            continue
+        values = np.array([e.value for _, e, _ in read])
+        stds = np.array([np.nan if e.std is None else e.std for _, e, _ in read])
+        trends[name] = fit_trend(name, np.array([t for t, _, _ in read]), values, stds, [i for _, _, i in read])
+        lives[name] = remaining_life(trends[name], *actuator.threshold(name))
+    tolerance = actuator.airframe.tolerance if actuator.airframe is not None else AIRFRAME_TOLERANCE
+    sensors, said = sensor_trends(stored, times, unit, tolerance)
     inertias = [s.window.inertia_read for s in stored if s.window.inertia_read is not None]
     changed = inertia_change_note(inertias)
     return Prognosis(actuator_id=actuator_id, time_unit=unit, trends=trends, remaining_life=lives,  # type: ignore[arg-type]
@@ -71,9 +58,11 @@ def prognose(actuator_id: str, stored: Sequence[Stored], thresholds: Thresholds 
                      notes=[n for n in (note, *said, changed) if n])  # fmt: skip
 
 
-def sensor_trends(stored: Sequence[Stored], times: np.ndarray, unit: str) -> tuple[dict[str, Trend], list[Note]]:
+def sensor_trends(
+    stored: Sequence[Stored], times: np.ndarray, unit: str, tolerance: float
+) -> tuple[dict[str, Trend], list[Note]]:
     """The trend of the strain gauge's gain against the aircraft model over the windows that read it (two
-    at least), and notes where its level stands off 1 beyond the model's tolerance or it drifts
+    at least), and notes where its level stands off 1 beyond the airframe model's ``tolerance`` or it drifts
     (``SENSOR_STDS`` stds)."""
     read = [(t, s.window.hinge_aircraft_ratio, s.window.hinge_aircraft_ratio_std, s.window_id)
             for t, s in zip(times, stored, strict=True) if s.window.hinge_aircraft_ratio is not None]  # fmt: skip
@@ -82,10 +71,10 @@ def sensor_trends(stored: Sequence[Stored], times: np.ndarray, unit: str) -> tup
     t, values, stds, ids = zip(*read, strict=True)
     trend = fit_trend("hinge_aircraft_ratio", np.array(t), np.array(values), np.array(stds, dtype=float), list(ids))
     notes = []
-    if abs(trend.level - 1.0) > TOLERANCE + SENSOR_STDS * trend.level_std:
+    if abs(trend.level - 1.0) > tolerance + SENSOR_STDS * trend.level_std:
         notes.append(Note(code="gauge_off_model", parameter="hinge_moment_nm", text=
             f"the hinge moment's strain gauge reads {trend.level:.3f} ± {trend.level_std:.3f}x the aircraft model over "
-            f"{trend.n} windows, beyond the model's {100 * TOLERANCE:.0f} % tolerance: recalibrate the gauge, or the "
+            f"{trend.n} windows, beyond the model's {100 * tolerance:.0f} % tolerance: recalibrate the gauge, or the "
             "airframe's C_hδ is off (each estimate divides the gauge's gain out where its window is long enough)"
         ))
     if trend.slope_std is not None and abs(trend.slope_per_unit) > SENSOR_STDS * trend.slope_std:

@@ -14,7 +14,6 @@ from typing import Literal
 from pydantic import Field, SecretStr, field_validator, model_validator
 from pydantic_settings import BaseSettings, SettingsConfigDict
 
-from prognosis.prognose import Thresholds
 from training.config import PipelineConfig
 
 LOOPBACK_NAMES = ("localhost", "127.0.0.1", "::1")
@@ -82,7 +81,6 @@ class Settings(BaseSettings):
     )
     threads: int | None = Field(None, ge=1, le=256, description="the thread budget; default: the usable cores")
     warm_up: bool = True
-    thresholds: Thresholds = Thresholds()
 
     @field_validator("api_key")
     @classmethod

@@ -7,10 +7,12 @@ from collections.abc import Callable
 from typing import Annotated
 
 from fastapi import Depends, Request
+from starlette.concurrency import run_in_threadpool
 
 from service.config import Settings
 from service.jobs import CancelledError, JobRunner
 from service.store import EstimateStore
+from sim.actuator import THESIS, Actuator
 from sim.checks import InputError
 from training.config import PipelineConfig, validated
 
@@ -45,6 +47,13 @@ def request_config(settings: Settings, **overrides: int | None) -> PipelineConfi
         if ceiling is not None and value > ceiling:
             raise InputError(f"query.{name}", f"{value} exceeds this service's limit of {ceiling}")
     return validated(PipelineConfig, {**settings.pipeline.model_dump(), **given}, prefix="query.")
+
+
+async def actuator_of(store: EstimateStore, actuator_id: str) -> tuple[Actuator, int | None]:
+    """The actuator's latest stored document and its version, or the default (``sim.actuator.THESIS``, no
+    version) where it has none: its windows are then read with the default, and their answers say so."""
+    stored = await run_in_threadpool(store.get_actuator, actuator_id)
+    return (THESIS, None) if stored is None else (stored.document, stored.version)
 
 
 def stopper(cancel: threading.Event) -> Callable[[str], None]:

@@ -28,6 +28,19 @@ async def input_error(request: Request, exc: Exception) -> JSONResponse:
     return JSONResponse({"detail": detail}, status_code=status.HTTP_422_UNPROCESSABLE_CONTENT)
 
 
+class NotStoredError(Exception):
+    """Nothing is stored under the path's actuator_id."""
+
+    def __init__(self, actuator_id: str) -> None:
+        super().__init__(f"no ema-actuator/1 document is stored for {actuator_id!r}: its windows are read with "
+                         "the default actuator (PUT one to this path)")  # fmt: skip
+
+
+async def not_stored(request: Request, exc: Exception) -> JSONResponse:
+    detail = [{"loc": ["path", "actuator_id"], "msg": str(exc), "type": "not_found"}]
+    return JSONResponse({"detail": detail}, status_code=status.HTTP_404_NOT_FOUND)
+
+
 async def conflict(request: Request, exc: Exception) -> JSONResponse:
     """Another window under a stored key: 409, never the stored window's answer."""
     assert isinstance(exc, ConflictError)
@@ -62,5 +75,6 @@ def install(app: FastAPI) -> None:
     app.add_exception_handler(InputError, input_error)
     app.add_exception_handler(OverloadedError, overloaded)
     app.add_exception_handler(ConflictError, conflict)
+    app.add_exception_handler(NotStoredError, not_stored)
     app.add_exception_handler(CancelledError, cancelled)
     app.add_exception_handler(ClientDisconnect, cancelled)  # an abandoned upload: a log line, not a traceback

@@ -22,6 +22,7 @@ from service.schemas import CalibrateIn
 from service.store import EstimateStore
 from service.warmup import warm_up
 from sim import runtime as sim_runtime
+from sim.actuator import Actuator
 from sim.window import WindowDocument
 from training import runtime
 
@@ -44,7 +45,7 @@ def _openapi(app: FastAPI) -> dict[str, Any]:
 
         schema = get_openapi(title=app.title, version=app.version, description=app.description, routes=app.routes)
         components = schema.setdefault("components", {}).setdefault("schemas", {})
-        for model in (WindowDocument, CalibrateIn):
+        for model in (WindowDocument, CalibrateIn, Actuator):
             document = model.model_json_schema(ref_template="#/components/schemas/{model}", by_alias=True)
             components.update(document.pop("$defs", {}))
             components[model.__name__] = document

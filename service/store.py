@@ -25,7 +25,8 @@ from typing import Any
 
 from pydantic import ValidationError
 
-from prognosis.documents import Stored
+from prognosis.documents import Stored, StoredActuator
+from sim.actuator import Actuator
 from training.documents import Estimate, HistoryReadings, InertiaReading, SensorZero
 from training.history import lent
 
@@ -42,6 +43,13 @@ CREATE TABLE IF NOT EXISTS estimates (
     UNIQUE (actuator_id, window_id)
 );
 CREATE INDEX IF NOT EXISTS estimates_by_actuator ON estimates (actuator_id, id);
+CREATE TABLE IF NOT EXISTS actuators (
+    actuator_id TEXT NOT NULL,
+    version INTEGER NOT NULL,
+    stored_at TEXT NOT NULL,
+    document TEXT NOT NULL,
+    PRIMARY KEY (actuator_id, version)
+);
 CREATE INDEX IF NOT EXISTS estimates_sensor_zeros ON estimates (actuator_id, json_extract(result, '$.window.flight_id'))
     WHERE json_extract(result, '$.window.sensor_zero') IS NOT NULL;
 CREATE INDEX IF NOT EXISTS estimates_inertia_reads ON estimates (actuator_id, id)
@@ -170,6 +178,53 @@ class EstimateStore:
         if digest is not None and row[3] is not None and row[3] != digest:
             raise ConflictError(stored, digest)
         return stored
+
+    def put_actuator(self, actuator_id: str, document: Actuator) -> StoredActuator:
+        """Store ``document`` as the actuator's next version (the latest version itself where it is the same
+        document: a PUT repeated stores nothing new). Earlier versions stay, as do the estimates read with them."""
+        text = document.model_dump_json(by_alias=True)
+        with self._lock:
+            self._connection.execute("BEGIN IMMEDIATE")
+            try:
+                latest = self._connection.execute(
+                    "SELECT version, stored_at, document FROM actuators WHERE actuator_id = ? "
+                    "ORDER BY version DESC LIMIT 1", (actuator_id,)
+                ).fetchone()  # fmt: skip
+                if latest is not None and latest[2] == text:
+                    self._connection.execute("COMMIT")
+                    return StoredActuator(actuator_id=actuator_id, version=latest[0], stored_at=latest[1],
+                                          document=document)  # fmt: skip
+                version = 1 if latest is None else latest[0] + 1
+                stored_at = dt.datetime.now(dt.UTC).isoformat(timespec="milliseconds")
+                self._connection.execute(
+                    "INSERT INTO actuators (actuator_id, version, stored_at, document) VALUES (?, ?, ?, ?)",
+                    (actuator_id, version, stored_at, text),
+                )
+                self._connection.execute("COMMIT")
+            except BaseException:
+                self._connection.execute("ROLLBACK")
+                raise
+        return StoredActuator(actuator_id=actuator_id, version=version, stored_at=stored_at, document=document)
+
+    def get_actuator(self, actuator_id: str) -> StoredActuator | None:
+        """The actuator's latest stored document, or None where it has none."""
+        with self._lock:
+            row = self._connection.execute(
+                "SELECT version, stored_at, document FROM actuators WHERE actuator_id = ? ORDER BY version DESC "
+                "LIMIT 1", (actuator_id,)
+            ).fetchone()  # fmt: skip
+        if row is None:
+            return None
+        return StoredActuator(actuator_id=actuator_id, version=row[0], stored_at=row[1],
+                              document=Actuator.model_validate_json(row[2]))  # fmt: skip
+
+    def actuator_ids(self) -> list[str]:
+        """Every actuator with a stored estimate or document, in name order."""
+        with self._lock:
+            rows = self._connection.execute(
+                "SELECT actuator_id FROM estimates UNION SELECT actuator_id FROM actuators ORDER BY actuator_id"
+            ).fetchall()
+        return [row[0] for row in rows]
 
     def readings(self, actuator_id: str, flight_id: str | None) -> HistoryReadings:
         """What the stored windows of this actuator lend a window of ``flight_id`` (``training.history.lent``)."""

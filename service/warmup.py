@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from sim.actuator import THESIS
 from sim.params import HealthParams
 from sim.synthetic import synthetic_window
 from training.config import PipelineConfig
@@ -12,4 +13,4 @@ WARM_UP = PipelineConfig(n_simulations=16, check_windows=8, n_timesteps=20, hidd
 
 def warm_up() -> None:
     """A tiny pipeline run: simulation kernels, residual, network and the physics fit all exercised once."""
-    estimate_window(synthetic_window(HealthParams.single(), seed=0, duration_s=0.05), WARM_UP)
+    estimate_window(synthetic_window(HealthParams.single(), seed=0, duration_s=0.05), WARM_UP, actuator=THESIS)

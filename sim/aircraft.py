@@ -229,22 +229,27 @@ class LoggedLoad:
     Per log interval the simulated moment is H_logged + q̄·S·c·C_hδ·(θ_sim − θ_logged): what the
     aircraft really did, corrected to first order for the simulation's own deflection. Nothing is
     assumed about the aircraft's state when the window starts (a window cut from a flight is
-    rarely at trim), and a flight condition enters only through q̄. Arrays are (K,), one value
-    per log interval, already smoothed of sensor noise by the caller.
+    rarely at trim), and a flight condition enters only through q̄. On the ground (``condition``
+    None), or without an airframe's ``hinge`` model, the moment is the logged one as it was: a load
+    cell's load follows time, not the deflection. Arrays are (K,), one value per log interval,
+    already smoothed of sensor noise by the caller.
     """
 
-    condition: FlightCondition
+    condition: FlightCondition | None
     hinge_moment_nm: np.ndarray  # H_e logged [N·m]
     position_deg: np.ndarray  # θ_u logged [deg]
+    hinge: HingeGeometry | None = None
 
     def __post_init__(self) -> None:
         if self.hinge_moment_nm.shape != self.position_deg.shape or self.hinge_moment_nm.ndim != 1:
             raise InputError("load", "hinge_moment_nm and position_deg must be (K,) arrays of one length")
 
 
-def logged_load_model(load: LoggedLoad, hinge: HingeGeometry = HingeGeometry()) -> LoadModel:
-    """The slow part of the moment, per interval, from the log; the δ term from the condition."""
-    delta_nm = hinge.per_deflection_nm_per_rad(load.condition)
+def logged_load_model(load: LoggedLoad) -> LoadModel:
+    """The slow part of the moment, per interval, from the log; the δ term from the condition (none on the
+    ground or without an airframe)."""
+    flying = load.condition is not None and load.hinge is not None
+    delta_nm = load.hinge.per_deflection_nm_per_rad(load.condition) if flying else 0.0  # type: ignore[union-attr,arg-type]
     return _without_aircraft(
         delta_nm=delta_nm, table_nm=load.hinge_moment_nm - delta_nm * np.radians(load.position_deg)
     )
@@ -253,10 +258,11 @@ def logged_load_model(load: LoggedLoad, hinge: HingeGeometry = HingeGeometry()) 
 Load = FlightCondition | GroundLoad | LoggedLoad
 
 
-def load_model(load: Load, interval_s: float) -> LoadModel:
-    """Dispatch on the kind of load: in flight, on ground, or as logged."""
+def load_model(load: Load, interval_s: float, hinge: HingeGeometry | None = None) -> LoadModel:
+    """Dispatch on the kind of load: in flight (the airframe's ``hinge`` model, the spec's elevator by
+    default), on ground, or as logged."""
     if isinstance(load, FlightCondition):
-        return flight_load_model(load, interval_s)
+        return flight_load_model(load, interval_s, hinge or HingeGeometry())
     if isinstance(load, GroundLoad):
         return ground_load_model(load)
     if isinstance(load, LoggedLoad):

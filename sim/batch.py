@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from sim import kernels, runtime
-from sim.aircraft import FlightCondition, Load, load_model
+from sim.aircraft import FlightCondition, HingeGeometry, Load, load_model
 from sim.checks import InputError, finite_array, in_range
 from sim.effects import TABLE_VARIABLES, EffectSet
 from sim.params import ActuatorParams, HealthParams
@@ -19,8 +19,7 @@ LANE_MULTIPLE = 8  # one AVX-512 register of float64
 # Past the end stops a command only saturates the speed reference: ω_ref = sat(G_P·(θ_cmd − θ_u)) is
 # already ±ω_max once θ_cmd is ω_max/G_P ≈ 0.37° beyond them, so clipping there changes nothing.
 COMMAND_MARGIN_DEG = 1.0
-MAX_INITIAL_SPEED_RADPS = 700.0
-MAX_INITIAL_CURRENT_A = 30.0
+INITIAL_MARGIN = 1.1  # a first state may stand this far past the drive's saturations (read through noise)
 
 
 @dataclass(frozen=True)
@@ -98,7 +97,7 @@ def kernel_constants(actuator: ActuatorParams, effects: EffectSet) -> kernels.Ke
     )
 
 
-def interval_steps(n_samples: int, sample_rate_hz: float, actuator: ActuatorParams = ActuatorParams()) -> np.ndarray:
+def interval_steps(n_samples: int, sample_rate_hz: float, actuator: ActuatorParams) -> np.ndarray:
     """(n_samples,) steps of h in each log interval: interval k spans steps round(k/(f·h)) to round((k+1)/(f·h)).
 
     Any rate is exact: at 3 kHz the intervals hold 333 or 334 steps, as a logger's clock would.
@@ -121,10 +120,13 @@ def clipped_knots(command_knots_deg: np.ndarray, n_health: int, end_stop_deg: fl
     return np.clip(knots, -limit, limit)
 
 
-def _checked_initial(initial: InitialState, end_stop_deg: float) -> InitialState:
-    in_range("initial.position_deg", initial.position_deg, -end_stop_deg, end_stop_deg, "deg")
-    in_range("initial.motor_speed_radps", initial.motor_speed_radps, -MAX_INITIAL_SPEED_RADPS, MAX_INITIAL_SPEED_RADPS)
-    in_range("initial.current_a", initial.current_a, -MAX_INITIAL_CURRENT_A, MAX_INITIAL_CURRENT_A, "A")
+def _checked_initial(initial: InitialState, actuator: ActuatorParams) -> InitialState:
+    """``initial``, within the end stops and ``INITIAL_MARGIN`` of the drive's speed and current saturations."""
+    stop = actuator.end_stop_deg
+    speed, current = (INITIAL_MARGIN * limit for limit in (actuator.max_motor_speed_radps, actuator.max_current_a))
+    in_range("initial.position_deg", initial.position_deg, -stop, stop, "deg")
+    in_range("initial.motor_speed_radps", initial.motor_speed_radps, -speed, speed, "rad/s")
+    in_range("initial.current_a", initial.current_a, -current, current, "A")
     return initial
 
 
@@ -171,22 +173,25 @@ def simulate_batch(
     initial: InitialState = InitialState(),
     sample_rate_hz: float = DEFAULT_SAMPLE_RATE_HZ,
     effects: EffectSet = EffectSet(),
-    actuator: ActuatorParams = ActuatorParams(),
+    *,
+    actuator: ActuatorParams,
+    hinge: HingeGeometry | None = None,
     lanes: int | None = None,
 ) -> BatchResult:
     """Simulate one simulation per entry of ``health`` and record interval means at ``sample_rate_hz``.
 
     ``command_knots_deg`` is the command at the log-interval boundaries (see ``sim.commands``):
     (n_samples + 1,) shared by the batch (Case 1) or (n_simulations, n_samples + 1) (Case 2).
-    The 1 µs trajectory is never stored. Deterministic: the same inputs give the same output,
-    whatever ``lanes`` (simulations per lock-step group; by default as many as keep every
-    thread busy, up to 64) and whatever the thread budget.
+    ``actuator``: the drive's constants; ``hinge``: the airframe's hinge-moment model where ``load`` is a
+    flight condition (the spec's elevator by default). The 1 µs trajectory is never stored.
+    Deterministic: the same inputs give the same output, whatever ``lanes`` (simulations per lock-step
+    group; by default as many as keep every thread busy, up to 64) and whatever the thread budget.
     """
     if not isinstance(health, HealthParams):
         raise InputError("health", f"must be HealthParams, got {type(health).__name__}")
     n_sims = len(health)
     knots = clipped_knots(command_knots_deg, n_sims, actuator.end_stop_deg)
-    _checked_initial(initial, actuator.end_stop_deg)
+    _checked_initial(initial, actuator)
     if not isinstance(effects, EffectSet):
         raise InputError("effects", f"must be an EffectSet, got {type(effects).__name__}")
     lanes = default_lanes(n_sims) if lanes is None else lanes
@@ -194,7 +199,7 @@ def simulate_batch(
         raise InputError("lanes", f"must be in [1, 512], got {lanes}")
     n_samples = knots.shape[1] - 1
     steps = interval_steps(n_samples, sample_rate_hz, actuator)
-    loads = load_model(load, interval_s=1.0 / sample_rate_hz)
+    loads = load_model(load, 1.0 / sample_rate_hz, hinge)
     if len(loads.slow_table_nm) not in (0, n_samples):
         raise InputError("load", f"a logged load needs {n_samples} values, got {len(loads.slow_table_nm)}")
 

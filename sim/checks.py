@@ -52,9 +52,13 @@ def array_in_range(field: str, values: np.ndarray, low: float, high: float, unit
 
 def from_validation(exc: Any, prefix: str = "") -> InputError:
     """A pydantic ValidationError's first error as an InputError naming the field (list indices go
-    into the message: ``signals.current_a``, "sample 17: Input should be a finite number")."""
+    into the message: ``signals.current_a``, "sample 17: Input should be a finite number"). A check across
+    fields names the one it reports on first in its message ("fsj_nm: ..."): that field is named."""
     first = exc.errors()[0]
     names = [str(part) for part in first["loc"] if not isinstance(part, int)]
     indices = [part for part in first["loc"] if isinstance(part, int)]
     message = first["msg"] if not indices else f"sample {indices[0]}: {first['msg']}"
+    head, _, rest = message.removeprefix("Value error, ").partition(": ")
+    if first["type"] == "value_error" and rest and head.replace("_", "").replace(".", "").isalnum():
+        names, message = [*names, head], rest
     return InputError(prefix + (".".join(names) or "document"), message)

@@ -18,9 +18,9 @@ import numpy as np
 from numba import njit
 
 from sim.checks import in_range
+from sim.params import MAX_CORRELATION_S
 
 NOISY_SIGNALS = ("position_deg", "motor_speed_radps", "current_a", "hinge_moment_nm")
-MAX_CORRELATION_S = 0.1  # far beyond any sensor filter; a longer "noise" is signal
 
 
 @dataclass(frozen=True)

@@ -8,6 +8,8 @@ import numpy as np
 
 from sim.checks import InputError, array_in_range, finite_array
 
+MAX_CORRELATION_S = 0.1  # a sensor noise's correlation time: far beyond any filter; a longer "noise" is signal
+
 
 @dataclass(frozen=True)
 class ActuatorParams:
@@ -34,7 +36,7 @@ class ActuatorParams:
         return self.supply_voltage_v / self.torque_constant_nm_per_a
 
 
-def eta_a_from_eta_o(eta_o: np.ndarray | float, gear_ratio: float = 500.0) -> np.ndarray:
+def eta_a_from_eta_o(eta_o: np.ndarray | float, gear_ratio: float) -> np.ndarray:
     """Aiding efficiency from opposing efficiency, thesis Eq. 3.4 with τ = n."""
     n = gear_ratio
     eta_o = np.asarray(eta_o, dtype=np.float64)
@@ -91,7 +93,7 @@ class HealthParams:
     def __len__(self) -> int:
         return len(self.fdj_nm)
 
-    def eta_a(self, gear_ratio: float = 500.0) -> np.ndarray:
+    def eta_a(self, gear_ratio: float) -> np.ndarray:
         """η_A by Eq. 3.4."""
         return eta_a_from_eta_o(self.eta_o, gear_ratio)
 

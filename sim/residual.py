@@ -118,7 +118,7 @@ def residual_torque_nm(
     motor_speed_radps: np.ndarray,
     hinge_moment_nm: np.ndarray,
     sample_rate_hz: float,
-    actuator: ActuatorParams = ActuatorParams(),
+    actuator: ActuatorParams,
     derivative_window_s: float = DEFAULT_DERIVATIVE_WINDOW_S,
 ) -> np.ndarray:
     """T_R [N·m] at the motor shaft, one value per sample; works on one window or a batch (last axis = time)."""

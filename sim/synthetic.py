@@ -6,7 +6,8 @@ from dataclasses import replace
 
 import numpy as np
 
-from sim.aircraft import FlightCondition
+from sim.actuator import THESIS, Actuator
+from sim.aircraft import FlightCondition, GroundLoad
 from sim.batch import InitialState, simulate_batch
 from sim.commands import family_knots
 from sim.effects import EffectSet
@@ -17,7 +18,7 @@ from sim.window import Window
 
 def synthetic_window(
     health: HealthParams,
-    condition: FlightCondition = FlightCondition(),
+    condition: FlightCondition | GroundLoad = FlightCondition(),
     seed: int = 0,
     duration_s: float = 0.5,
     sample_rate_hz: float = 10_000.0,
@@ -26,9 +27,12 @@ def synthetic_window(
     actuator_id: str = "synthetic/elevator",
     window_id: str | None = None,
     command: str = "thesis",
+    actuator: Actuator = THESIS,
 ) -> Window:
-    """One window logged from the model: a command of ``command``'s family (``sim.commands.FAMILIES``),
-    the actuator at rest where the command starts, sensor noise.
+    """One window logged from the model of ``actuator``: a command of ``command``'s family
+    (``sim.commands.FAMILIES``), the actuator at rest where the command starts, sensor noise; in flight at
+    ``condition``, or on the ground under a load cell's ``GroundLoad`` (the window then names no flight
+    condition).
 
     ``seed`` fixes the command and the noise; ``health`` must hold one simulation. Without a ``window_id``
     the window is named by its content (``synthetic-`` and its digest), so two different windows never
@@ -37,8 +41,11 @@ def synthetic_window(
     rng = np.random.default_rng(seed)
     n_samples = round(duration_s * sample_rate_hz)
     knots = family_knots(command, n_samples, sample_rate_hz, rng)
-    start = InitialState(position_deg=float(np.clip(knots[0], -29.0, 29.0)))
-    result = simulate_batch(knots, health, condition, start, sample_rate_hz, effects)
+    stop = actuator.drive.end_stop_deg - 1.0
+    start = InitialState(position_deg=float(np.clip(knots[0], -stop, stop)))
+    result = simulate_batch(knots, health, condition, start, sample_rate_hz, effects, actuator=actuator.params,
+                            hinge=actuator.hinge)  # fmt: skip
     signals = add_sensor_noise(result.simulation(0), noise, rng)
-    window = Window(signals, sample_rate_hz, condition, actuator_id, window_id or "synthetic")
+    flight = condition if isinstance(condition, FlightCondition) else None
+    window = Window(signals, sample_rate_hz, flight, actuator_id, window_id or "synthetic")
     return window if window_id else replace(window, window_id=f"synthetic-{window.content_sha256()[:16]}")

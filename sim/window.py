@@ -77,7 +77,11 @@ class WindowDocument(_Contract):
     actuator_id: str = Field(min_length=1, max_length=200, pattern=IDENTIFIER, examples=["tail-123/elevator-left"])
     window_id: str = Field(min_length=1, max_length=200, pattern=IDENTIFIER, examples=["2026-11-21T10:00:00Z#17"])
     sample_rate_hz: Number = Field(ge=WINDOW_RATE_RANGE_HZ[0], le=WINDOW_RATE_RANGE_HZ[1])
-    flight_condition: FlightConditionDocument
+    flight_condition: FlightConditionDocument | None = Field(
+        None,
+        description="where the aircraft flew; null or absent: logged on the ground (a pre-flight test or a "
+        "bench), where no aircraft model applies and the logged hinge moment is the load",
+    )
     signals: SignalsDocument
     recorded_at: AwareDatetime | None = Field(None, description="when the window began (for trends)")
     flight_hours: Number | None = Field(None, ge=0, description="the airframe's flight hours then (for trends)")
@@ -98,7 +102,8 @@ class WindowDocument(_Contract):
         for name, array in arrays.items():
             if len(array) != length:
                 raise InputError(f"signals.{name}", f"has {len(array)} samples, command_deg has {length}")
-        condition = FlightCondition(self.flight_condition.airspeed_mps, self.flight_condition.altitude_m)
+        flight = self.flight_condition
+        condition = None if flight is None else FlightCondition(flight.airspeed_mps, flight.altitude_m)
         recorded = None if self.recorded_at is None else self.recorded_at.isoformat()
         return Window(
             arrays,
@@ -114,11 +119,12 @@ class WindowDocument(_Contract):
 
 @dataclass(frozen=True)
 class Window:
-    """A logged window as arrays: five uniformly sampled signals from t = 0 and where the aircraft flew."""
+    """A logged window as arrays: five uniformly sampled signals from t = 0 and where the aircraft flew (None:
+    on the ground)."""
 
     signals: dict[str, np.ndarray]
     sample_rate_hz: float = 10_000.0
-    flight_condition: FlightCondition = field(default_factory=FlightCondition)
+    flight_condition: FlightCondition | None = field(default_factory=FlightCondition)
     actuator_id: str = "unknown"
     window_id: str = "unknown"
     recorded_at: str | None = None  # ISO 8601 with a time zone
@@ -150,6 +156,10 @@ class Window:
     def duration_s(self) -> float:
         return self.n_samples / self.sample_rate_hz
 
+    @property
+    def on_ground(self) -> bool:
+        return self.flight_condition is None
+
 
 def window_from_dict(document: Any) -> Window:
     """Parse and validate an ``ema-window/1`` document (a dict); errors name the field."""
@@ -168,7 +178,7 @@ def window_to_dict(window: Window) -> dict[str, Any]:
         "actuator_id": window.actuator_id,
         "window_id": window.window_id,
         "sample_rate_hz": float(window.sample_rate_hz),
-        "flight_condition": {
+        "flight_condition": None if window.flight_condition is None else {
             "airspeed_mps": float(window.flight_condition.airspeed_mps),
             "altitude_m": float(window.flight_condition.altitude_m),
         },

@@ -82,8 +82,8 @@ class RatioEstimate(Document):
 
 class Estimates(Document):
     FDJ: ParameterEstimate
-    eta_O: ParameterEstimate
-    eta_A: ParameterEstimate
+    eta_O: ParameterEstimate | None = Field(description="null: the window carries no load (the notes say why)")
+    eta_A: ParameterEstimate | None = Field(description="null with eta_O")
     FSJ: ParameterEstimate | None
     FSD: RatioEstimate | None = None
 
@@ -268,12 +268,24 @@ class TrainingInfo(Document):
     hidden_units: int
 
 
+class ActuatorRead(Document):
+    """The ``ema-actuator/1`` document a window was read with."""
+
+    name: str
+    version: int | None = Field(None, description="the service's stored version (null: given in-process)")
+    default: bool = Field(False, description="no document was given for the actuator: the thesis's was used")
+
+
 class Estimate(Document):
     """``ema-estimate/1``."""
 
     schema_: Literal["ema-estimate/1"] = Field("ema-estimate/1", alias="schema")
     actuator_id: str
     window_id: str
+    actuator: ActuatorRead = Field(
+        default_factory=lambda: ActuatorRead(name="thesis elevator EMA (Table 3.1)", default=True),
+        description="the actuator's document it was read with (results stored before documents: the thesis's)",
+    )
     estimates: Estimates
     fsj_note: Annotated[Note, BeforeValidator(_sentences_as_notes)] = Field(description="how FSJ was read, or why not")
     irreversible: bool = Field(description="η_A < 0: the load can never back-drive the transmission (thesis Case 1C)")

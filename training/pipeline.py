@@ -24,21 +24,21 @@ from dataclasses import replace
 
 import numpy as np
 
+from sim.actuator import THESIS, Actuator
 from sim.window import Window
 from training.assess.reproduction import output_error_ratios
 from training.assess.weighing import Assessed, Candidates, assess
 from training.config import PipelineConfig
-from training.documents import Estimate, FitCheck, HistoryReadings, Note, Timings
+from training.documents import ActuatorRead, Estimate, FitCheck, HistoryReadings, Note, Timings
 from training.history import known_from
 from training.learn.estimator import NetworkEstimator
 from training.learn.network import TrainConfig
 from training.physics.features import as_read
 from training.physics.friction import FIT_ARRAYS, FrictionFit, fit_friction, fit_window
-from training.physics.scenario import MAX_RATIO
+from training.physics.scenario import MAX_RATIO, inside
 from training.physics.static_friction import read_static_friction
 from training.prepare.conditioning import prepare, widened
 from training.report import estimate_document
-from training.simulate import design
 from training.simulate.dataset import Data, simulate_dataset
 
 # On a few dozen noisy simulations the network stops improving within a few epochs, and the physics fit
@@ -79,9 +79,11 @@ def candidates(
     ), check_physics
 
 
-def fit_check(window: Window, data: Data, answer: Assessed, equation_ratio: float, n: int) -> FitCheck:
+def fit_check(
+    window: Window, data: Data, answer: Assessed, equation_ratio: float, n: int, nominal_fdj_nm: float
+) -> FitCheck:
     """Simulate the window at the answer and compare (``training.assess.reproduction``)."""
-    health = design.inside(answer.values["FDJ"], answer.values["eta_O"])
+    health = inside(answer.values["FDJ"], answer.values["eta_O"], nominal_fdj_nm)
     floor = float(np.sqrt(np.mean((data.sims.residual_nm[n:] - data.sims.clean_residual_nm)[:, data.sliding] ** 2)))
     ratios = output_error_ratios(window, data.scenario, health, data.noise, floor, data.sliding, data.actuator)
     reproduced = ratios["residual_torque"] <= MAX_RATIO
@@ -123,27 +125,34 @@ class Stopwatch:
 def estimate_window(
     window: Window,
     config: PipelineConfig = PipelineConfig(),
+    *,
+    actuator: Actuator,
+    version: int | None = None,
     on_stage: Callable[[str], None] | None = None,
     spec_only: bool = False,
     history: HistoryReadings | None = None,
 ) -> Estimate:
     """The ``ema-estimate/1`` result for one window, its stages timed.
 
-    ``on_stage`` hears each stage as it starts (and may raise to stop the job there); ``spec_only`` reads
-    the window with the spec's model alone, no departures taken off (calibration's base); ``history``: what
-    other windows of the actuator lend this one (``training.history``). Raises InputError naming the field
-    for a window that cannot be read.
+    ``actuator``: the document every stage reads its constants from (``sim.actuator.THESIS`` itself is the
+    default a caller chose for a user who gave none, and the answer says so), ``version`` its stored
+    version; ``on_stage`` hears each stage as it starts (and may raise to stop the job there);
+    ``spec_only`` reads the window with the document's model alone, no departures taken off (calibration's
+    base); ``history``: what other windows of the actuator lend this one (``training.history``). Raises
+    InputError naming the field for a window that cannot be read.
     """
     watch = Stopwatch(on_stage)
+    read_with = ActuatorRead(name=actuator.name, version=version, default=actuator is THESIS)
     with watch("prepare", "preparing the window"):
         digest = window.content_sha256()
-        prepared = prepare(window, spec_only=spec_only, known=known_from(history))
+        prepared = prepare(window, actuator, spec_only=spec_only, known=known_from(history))
         w, n = prepared.window, config.n_simulations
         seen = replace(w, signals=as_read(w.signals, w.sample_rate_hz))
     with watch("physics", "fitting Eq. 5.1"):
         physics = fit_window(seen.signals, w.sample_rate_hz, prepared.actuator)
     with watch("simulate", f"simulating {config.total_simulations} windows around the physics estimate"):
-        data = simulate_dataset(w, seen, physics, config, prepared.actuator, prepared.departures.viscosity.effects())
+        effects = prepared.departures.viscosity.effects()
+        data = simulate_dataset(w, seen, physics, config, actuator, prepared.actuator, effects)
     with watch("train", f"training {config.members} network(s) of {config.hidden_units} neurons"):
         network = train_network(data, config)
     with watch("assess", "weighing the estimators on held-out simulations"):
@@ -153,8 +162,9 @@ def estimate_window(
         answer = assess(found, equation_ratio)
         answer = replace(answer, stds=widened(answer.stds, prepared))
     with watch("check", "checking the answer against the window"):
-        check = fit_check(seen, data, answer, equation_ratio, n)
+        check = fit_check(seen, data, answer, equation_ratio, n, actuator.nominal.fdj_nm)
         fsj = read_static_friction(
-            seen.signals, w.sample_rate_hz, answer.values["FDJ"], answer.values["eta_O"], data.noise, data.actuator
+            seen.signals, w.sample_rate_hz, answer.values["FDJ"], answer.values["eta_O"], data.actuator, data.noise
         )
-    return estimate_document(prepared, physics, data, network, answer, check, fsj, config, watch.timings(), digest)
+    return estimate_document(prepared, physics, data, network, answer, check, fsj, config, watch.timings(), digest,
+                             read_with)  # fmt: skip

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from typing import Any
 
+from sim.actuator import THESIS, Actuator, actuator_from_dict
 from sim.checks import InputError
 from sim.window import Window, window_from_dict, window_to_dict
 from training import runtime
@@ -20,14 +21,22 @@ from training.pipeline import estimate_window
 
 
 def estimate_document(
-    window: dict[str, Any], config: dict[str, Any], threads: int, history: dict[str, Any] | None = None
+    window: dict[str, Any],
+    config: dict[str, Any],
+    threads: int,
+    history: dict[str, Any] | None = None,
+    actuator: dict[str, Any] | None = None,
+    version: int | None = None,
 ) -> dict[str, Any]:
     """The estimate of one window as a JSON-able dict, or {"error": {"field", "message"}} for a window refused;
-    ``history``: what other windows of the actuator read (``estimate_window``)."""
+    ``history``: what other windows of the actuator read, ``actuator``: its ema-actuator/1 document and
+    ``version`` (none: the default, ``sim.actuator.THESIS``; ``estimate_window``)."""
     runtime.configure(threads)
     known = None if history is None else HistoryReadings.model_validate(history)
     try:
-        result = estimate_window(window_from_dict(window), PipelineConfig(**config), history=known)
+        document = THESIS if actuator is None else actuator_from_dict(actuator)
+        result = estimate_window(window_from_dict(window), PipelineConfig(**config), actuator=document,
+                                 version=version, history=known)  # fmt: skip
     except InputError as exc:
         return {"error": {"field": exc.field, "message": exc.message}}
     return result.model_dump(mode="json", by_alias=True)
@@ -53,13 +62,20 @@ def connect(address: str | None, cpus: int) -> None:
 
 
 def estimate_on_ray(
-    window: Window, config: PipelineConfig, threads: int, history: HistoryReadings | None = None
+    window: Window,
+    config: PipelineConfig,
+    threads: int,
+    history: HistoryReadings | None = None,
+    actuator: Actuator = THESIS,
+    version: int | None = None,
 ) -> Estimate:
     """``estimate_window`` run as a Ray task (the service's EMA_BACKEND=ray); blocks this thread until done."""
     import ray
 
     known = None if history is None else history.model_dump()
-    answer = ray.get(ray_task(threads).remote(window_to_dict(window), config.model_dump(), threads, known))
+    document = None if actuator is THESIS else actuator.model_dump(mode="json", by_alias=True)
+    task = ray_task(threads).remote(window_to_dict(window), config.model_dump(), threads, known, document, version)
+    answer = ray.get(task)
     if "error" in answer:
         raise InputError(**answer["error"])
     return Estimate.model_validate(answer)

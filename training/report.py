@@ -1,18 +1,21 @@
 """The stages' outputs -> the ``ema-estimate/1`` document: values, stds, what each stage found, in words.
 
-"% of range" and "weakly determined" are defined here, once: the result, the CLI's table and the
-benchmarks read them.
+"% of range" and "weakly determined" are defined here, once, against the actuator's healthy range: the
+result, the CLI's table and the benchmarks read them.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from sim.params import DEFAULT_RANGES, eta_a_from_eta_o
+from sim.actuator import Actuator
+from sim.hinge import denoised_hinge_nm
+from sim.params import HealthRanges
 from training.assess.weighing import Assessed
 from training.config import PipelineConfig
 from training.documents import (
     TARGETS,
+    ActuatorRead,
     DatasetInfo,
     Estimate,
     Estimates,
@@ -27,36 +30,42 @@ from training.documents import (
     parameter,
 )
 from training.learn.estimator import NetworkEstimator
-from training.physics.friction import FrictionFit
+from training.physics.friction import FitSettings, FrictionFit
 from training.physics.static_friction import StaticFriction
 from training.prepare.conditioning import Prepared, conditioning_done, conditioning_notes
 from training.prepare.departures.drive_constants import KERNEL_FREE_RATE_HZ
 from training.simulate.dataset import Data
 
-NOMINAL = {"FDJ": DEFAULT_RANGES.nominal_fdj_nm, "eta_O": DEFAULT_RANGES.nominal_eta_o}
-NOMINAL_ETA_A = float(eta_a_from_eta_o(DEFAULT_RANGES.nominal_eta_o))
-HEALTHY_RANGE = {"FDJ": DEFAULT_RANGES.fdj_nm, "eta_O": DEFAULT_RANGES.eta_o}  # Table 3.1: "% of range" is of these
 # ±2 std wider than this share of the healthy range: the window is said to determine the parameter weakly.
 WEAK_SHARE_OF_RANGE = 0.10
 
 
-def share_of_range(name: str, amount: float) -> float:
-    """``amount`` (in the parameter's unit) as a share of the width of its Table 3.1 range."""
-    low, high = HEALTHY_RANGE[name]
+def healthy_range(name: str, ranges: HealthRanges) -> tuple[float, float]:
+    """The healthy range of FDJ or eta_O (``sim.actuator.Actuator.ranges``)."""
+    return ranges.fdj_nm if name == "FDJ" else ranges.eta_o
+
+
+def share_of_range(name: str, amount: float, ranges: HealthRanges) -> float:
+    """``amount`` (in the parameter's unit) as a share of the width of its healthy range."""
+    low, high = healthy_range(name, ranges)
     return amount / (high - low)
 
 
-def weakly_determined(name: str, std: float) -> bool:
+def weakly_determined(name: str, std: float, ranges: HealthRanges) -> bool:
     """±2 std wider than ``WEAK_SHARE_OF_RANGE`` of ``name``'s healthy range."""
-    return share_of_range(name, 2 * std) > WEAK_SHARE_OF_RANGE
+    return share_of_range(name, 2 * std, ranges) > WEAK_SHARE_OF_RANGE
 
 
-def _estimates(answer: Assessed, fsj: StaticFriction, eta_o_bound: bool) -> Estimates:
-    """FDJ and η_O as assessed, η_A by Eq. 3.4 (its std through the derivative), FSJ and FSD if read; each
-    weakly determined where its std says so, and both where Eq. 5.1 put η_O at a bound (``eta_o_bound``):
-    FDJ was read with η_O held there."""
+def _estimates(
+    answer: Assessed, fsj: StaticFriction, eta_o_bound: bool, actuator: Actuator, loaded: bool
+) -> Estimates:
+    """FDJ and η_O as assessed, η_A by Eq. 3.4 with the actuator's gear ratio (its std through the derivative),
+    FSJ and FSD if read; each weakly determined where its std says so, and both where Eq. 5.1 put η_O at a
+    bound (``eta_o_bound``): FDJ was read with η_O held there. Without a load (``loaded``) η_O and η_A are
+    none: no load, no efficiency."""
+    ranges, nominal = actuator.ranges, actuator.nominal
     eta_o, eta_o_std = answer.values["eta_O"], answer.stds["eta_O"]
-    slope = float((eta_a_from_eta_o(eta_o + 1e-6) - eta_a_from_eta_o(eta_o - 1e-6)) / 2e-6)
+    slope = float((actuator.eta_a(eta_o + 1e-6) - actuator.eta_a(eta_o - 1e-6)) / 2e-6)
     fdj = answer.values["FDJ"]
     ratio = None
     if fsj.value_nm is not None and fsj.std_nm is not None:
@@ -65,30 +74,39 @@ def _estimates(answer: Assessed, fsj: StaticFriction, eta_o_bound: bool) -> Esti
     # η_A is η_O's through Eq. 3.4, and as weak; a bound of the search is no value, whatever its std (a 0.1 s
     # window with its current logged 0.71x read η_O 0.999 ± 0.009 at the bound, the truth 0.70; a cruise
     # window's moment in lbf·ft put η_O there and FDJ 15 % of its range off at 3.3 std)
-    weak_eta = weakly_determined("eta_O", eta_o_std) or eta_o_bound
-    weak_fdj = weakly_determined("FDJ", answer.stds["FDJ"]) or eta_o_bound
+    weak_eta = weakly_determined("eta_O", eta_o_std, ranges) or eta_o_bound
+    weak_fdj = weakly_determined("FDJ", answer.stds["FDJ"], ranges) or (eta_o_bound and loaded)
+    eta_a = parameter(float(actuator.eta_a(eta_o)), abs(slope) * eta_o_std, float(actuator.eta_a(nominal.eta_o)),
+                      weak_eta)  # fmt: skip
     return Estimates(
-        FDJ=parameter(fdj, answer.stds["FDJ"], NOMINAL["FDJ"], weak_fdj),
-        eta_O=parameter(eta_o, eta_o_std, NOMINAL["eta_O"], weak_eta),
-        eta_A=parameter(float(eta_a_from_eta_o(eta_o)), abs(slope) * eta_o_std, NOMINAL_ETA_A, weak_eta),
-        FSJ=None if fsj.value_nm is None else parameter(fsj.value_nm, fsj.std_nm, DEFAULT_RANGES.nominal_fsj_nm),
+        FDJ=parameter(fdj, answer.stds["FDJ"], nominal.fdj_nm, weak_fdj),
+        eta_O=parameter(eta_o, eta_o_std, nominal.eta_o, weak_eta) if loaded else None,
+        eta_A=eta_a if loaded else None,
+        FSJ=None if fsj.value_nm is None else parameter(fsj.value_nm, fsj.std_nm, nominal.fsj_nm),
         FSD=ratio,
     )
 
 
 def _notes(prepared: Prepared, physics: FrictionFit, estimates: Estimates, check: FitCheck) -> list[Note]:
     notes = [*check.notes, *conditioning_notes(prepared)]
+    ranges = prepared.document.ranges
     for name in TARGETS:
         entry = getattr(estimates, name)
-        if weakly_determined(name, entry.std):
-            low, high = HEALTHY_RANGE[name]
-            spread = share_of_range(name, 2 * entry.std)
+        if entry is not None and weakly_determined(name, entry.std, ranges):
+            low, high = healthy_range(name, ranges)
+            spread = share_of_range(name, 2 * entry.std, ranges)
             notes.append(Note(code="weakly_determined", parameter=name, text=(
                 f"{name} is weakly determined by this window: ±2 std spans {100 * spread:.0f} % of the healthy "
                 f"range ({low:g}–{high:g}); a short window, a slow log or a hinge load that barely varies "
                 "holds little of it (trend it with its std)"
             )))  # fmt: skip
-    if physics.at_search_edge[0]:
+    if estimates.eta_O is None:
+        notes.append(Note(code="no_load", parameter="eta_O", text=(
+            "the window carries no load (its hinge moment at the motor moves the friction by under "
+            f"{100 * NO_LOAD_SHARE:g} % of the nominal FDJ at any efficiency): η_O and η_A cannot show, and are "
+            "not read; FDJ is"
+        )))  # fmt: skip
+    elif physics.at_search_edge[0]:
         notes.append(Note(code="eta_o_at_bound", parameter="eta_O", text=(
             "η_O lies at an end of the physical search range: read it as a bound, not a value, and FDJ, read with "
             "η_O held there, as weakly determined"
@@ -96,10 +114,26 @@ def _notes(prepared: Prepared, physics: FrictionFit, estimates: Estimates, check
     if estimates.FDJ.value <= 0:
         text = "FDJ ≤ 0 is not a friction: the model does not describe this window (see fit_check)"
         notes.append(Note(code="fdj_not_friction", parameter="FDJ", text=text))
-    if estimates.eta_A.value < 0:
+    if estimates.eta_A is not None and estimates.eta_A.value < 0:
         text = "η_A < 0: the transmission is irreversible (the load cannot back-drive it; thesis Case 1C)"
         notes.append(Note(code="irreversible", parameter="eta_A", text=text))
     return notes
+
+
+NO_LOAD_SHARE = 0.02  # a load term under this share of the nominal FDJ: the window carries no load
+
+
+def carries_load(prepared: Prepared) -> bool:
+    """Whether the window's load can show η_O: its opposing term (1/η_O − 1)·|H/n| at the nominal η_O, its RMS
+    over the samples Eq. 5.1 reads, reaches ``NO_LOAD_SHARE`` of the nominal FDJ. A pre-flight sweep logs only
+    its gauge's noise there; any flight and any bench load carries more."""
+    document, w = prepared.document, prepared.window
+    load_nm = denoised_hinge_nm(w.signals["hinge_moment_nm"], w.signals["position_deg"], w.sample_rate_hz)
+    sliding = np.abs(w.signals["motor_speed_radps"]) > FitSettings().sliding_speed_radps(document.params)
+    if not np.any(sliding):
+        return True  # nothing slides: the physics fit refuses the window, not this rule
+    term = (1.0 / document.nominal.eta_o - 1.0) * np.sqrt(np.mean((load_nm[sliding] / document.gear_ratio) ** 2))
+    return bool(term >= NO_LOAD_SHARE * document.nominal.fdj_nm)
 
 
 def _window_info(prepared: Prepared, data: Data, digest: str) -> WindowInfo:
@@ -144,18 +178,28 @@ def estimate_document(
     config: PipelineConfig,
     timings: Timings,
     digest: str,
+    read_with: ActuatorRead,
 ) -> Estimate:
-    """The document of one window's run; ``digest``: the window's content as posted (``Window.content_sha256``)."""
+    """The document of one window's run; ``digest``: the window's content as posted (``Window.content_sha256``),
+    ``read_with``: the actuator's document it was read with."""
     w = prepared.window
-    estimates = _estimates(answer, fsj, bool(physics.at_search_edge[0]))
+    loaded = carries_load(prepared)
+    estimates = _estimates(answer, fsj, bool(physics.at_search_edge[0]), prepared.document, loaded)
     first = network.fits_[0]
+    notes = _notes(prepared, physics, estimates, check)
+    if read_with.default:
+        notes.insert(0, Note(code="default_actuator", text=(
+            f"read with the default actuator ({read_with.name}): no ema-actuator/1 document was given for "
+            f"{w.actuator_id}"
+        )))  # fmt: skip
     return Estimate(
         actuator_id=w.actuator_id,
         window_id=w.window_id,
+        actuator=read_with,
         estimates=estimates,
         fsj_note=fsj.reason,
-        irreversible=estimates.eta_A.value < 0,
-        notes=_notes(prepared, physics, estimates, check),
+        irreversible=estimates.eta_A is not None and estimates.eta_A.value < 0,
+        notes=notes,
         timings_s=timings,
         dataset=DatasetInfo(
             n_simulations=config.n_simulations,

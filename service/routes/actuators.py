@@ -1,12 +1,16 @@
+"""An actuator: its ``ema-actuator/1`` document (versioned), its stored estimates, its prognosis."""
+
 from __future__ import annotations
 
-from fastapi import APIRouter
+from fastapi import APIRouter, Request
 from starlette.concurrency import run_in_threadpool
 
-from prognosis.documents import History, Prognosis
+from prognosis.documents import History, Prognosis, StoredActuator
 from prognosis.prognose import prognose
-from service.deps import SettingsDep, StoreDep
-from service.schemas import responses
+from service.deps import RunnerDep, StoreDep, actuator_of
+from service.parsing import read_body
+from service.schemas import json_body, responses
+from sim.actuator import Actuator
 
 router = APIRouter(prefix="/actuators", tags=["actuators"])
 
@@ -19,7 +23,35 @@ async def history(actuator_id: str, store: StoreDep) -> History:
 
 
 @router.get("/{actuator_id:path}/prognosis", response_model=Prognosis, responses=responses(401))
-async def prognosis(actuator_id: str, store: StoreDep, settings: SettingsDep) -> Prognosis:
-    """Trend of FDJ, η_O and η_A and the remaining useful life to the service's thresholds (EMA_THRESHOLDS__*)."""
+async def prognosis(actuator_id: str, store: StoreDep) -> Prognosis:
+    """Trend of FDJ, η_O and η_A and the remaining useful life to the thresholds of the actuator's document
+    (the default actuator's where it has none)."""
     current, _ = await run_in_threadpool(store.history, actuator_id)
-    return await run_in_threadpool(prognose, actuator_id, current, settings.thresholds)
+    document, _ = await actuator_of(store, actuator_id)
+    return await run_in_threadpool(prognose, actuator_id, current, document)
+
+
+@router.put(
+    "/{actuator_id:path}",
+    response_model=StoredActuator,
+    response_model_by_alias=True,
+    responses=responses(401, 403, 413, 415, 422, 503),
+    openapi_extra=json_body(Actuator, "the actuator's ema-actuator/1 document"),
+)
+async def put_actuator(actuator_id: str, request: Request, store: StoreDep, runner: RunnerDep) -> StoredActuator:
+    """Store the actuator's document as its next version: its windows are read with it from now on (those
+    stored keep the version they were read with). The same document again stores nothing new."""
+    document = await read_body(request, runner, Actuator, lambda d: d)
+    return await run_in_threadpool(store.put_actuator, actuator_id, document)
+
+
+@router.get("/{actuator_id:path}", response_model=StoredActuator, response_model_by_alias=True,
+            responses=responses(401, 404))  # fmt: skip
+async def get_actuator(actuator_id: str, store: StoreDep) -> StoredActuator:
+    """The actuator's latest document; 404 where none was stored (its windows are read with the default)."""
+    from service.errors import NotStoredError
+
+    stored = await run_in_threadpool(store.get_actuator, actuator_id)
+    if stored is None:
+        raise NotStoredError(actuator_id)
+    return stored

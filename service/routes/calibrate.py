@@ -4,9 +4,10 @@ from fastapi import APIRouter, Request
 
 from calibration.calibrate import Calibrator
 from calibration.documents import CalibrationReport
-from service.deps import RunnerDep, SettingsDep, stopper
+from service.deps import RunnerDep, SettingsDep, StoreDep, actuator_of, stopper
 from service.parsing import check_calibration_budget, read_body
 from service.schemas import CalibrateIn, json_body, responses
+from sim.checks import InputError
 from sim.window import Window
 
 router = APIRouter(tags=["calibrate"])
@@ -24,12 +25,18 @@ def _windows_and_truth(body: CalibrateIn) -> tuple[list[Window], dict[str, float
     responses=responses(401, 413, 422, 503),
     openapi_extra=json_body(CalibrateIn, "windows of one actuator, and their truth if synthetic"),
 )
-async def calibrate(request: Request, settings: SettingsDep, runner: RunnerDep) -> CalibrationReport:
-    """Trace what the model misses in the windows to an effect, add it, re-estimate: ema-calibration/1."""
+async def calibrate(request: Request, settings: SettingsDep, store: StoreDep, runner: RunnerDep) -> CalibrationReport:
+    """Trace what the model misses in the windows of one actuator to an effect, add it, re-estimate
+    (with the actuator's document, the default where it has none): ema-calibration/1."""
     windows, truth = await read_body(request, runner, CalibrateIn, _windows_and_truth)
     with runner.admit() as ticket:
         check_calibration_budget(windows, settings.pipeline, settings)
-        calibrator = Calibrator(settings.pipeline, seed=settings.pipeline.seed)
+        for i, window in enumerate(windows):
+            if window.actuator_id != windows[0].actuator_id:
+                raise InputError(f"windows.{i}.actuator_id", f"is {window.actuator_id!r}; a calibration reads the "
+                                 f"windows of one actuator ({windows[0].actuator_id!r})")  # fmt: skip
+        actuator, _ = await actuator_of(store, windows[0].actuator_id)
+        calibrator = Calibrator(settings.pipeline, seed=settings.pipeline.seed, actuator=actuator)
         stop = stopper(ticket.cancel)
 
         def run() -> CalibrationReport:

@@ -7,7 +7,7 @@ from fastapi import APIRouter, Query, Request
 from starlette.concurrency import run_in_threadpool
 
 from prognosis.documents import Stored
-from service.deps import RunnerDep, SettingsDep, StoreDep, request_config, stopper
+from service.deps import RunnerDep, SettingsDep, StoreDep, actuator_of, request_config, stopper
 from service.parsing import check_budget, read_body
 from service.schemas import json_body, responses
 from sim.window import Window, WindowDocument
@@ -49,7 +49,8 @@ async def estimate(
     A window already stored for its (actuator_id, window_id) is answered from the history
     (``replay: true``) without recomputing; other content under a stored key is another window: 409.
     What the stored windows of the actuator read that this one may not (its ``flight_id``'s sensor
-    zero, the actuator's J_M: ``training.history``) is read with it.
+    zero, the actuator's J_M: ``training.history``) is read with it, and so is the actuator's latest
+    ``ema-actuator/1`` document (the default where it has none; the answer records which).
     Budget: the window's duration and its simulation work (simulations × seconds) are limited by the
     service's settings; over it, 422 naming the limit.
     """
@@ -62,11 +63,13 @@ async def estimate(
         config = request_config(settings, **sizes, seed=seed)
         check_budget(window, config, settings)
         history = await run_in_threadpool(store.readings, window.actuator_id, window.flight_id)
+        actuator, version = await actuator_of(store, window.actuator_id)
         if settings.backend == "ray":
             from training.remote import estimate_on_ray
 
-            result = await runner.run(ticket, request.is_disconnected, estimate_on_ray, window, config, 1, history)
+            job = partial(estimate_on_ray, window, config, 1, history, actuator, version)
         else:
-            job = partial(estimate_window, on_stage=stopper(ticket.cancel), history=history)
-            result = await runner.run(ticket, request.is_disconnected, job, window, config)
+            job = partial(estimate_window, window, config, actuator=actuator, version=version,
+                          on_stage=stopper(ticket.cancel), history=history)  # fmt: skip
+        result = await runner.run(ticket, request.is_disconnected, job)
         return await run_in_threadpool(store.add, result)  # committed (fsync) before the answer leaves

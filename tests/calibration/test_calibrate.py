@@ -5,6 +5,7 @@ import pytest
 
 from calibration.calibrate import Calibrator
 from calibration.documents import CalibrationReport
+from sim.actuator import THESIS
 from sim.checks import InputError
 from sim.window import window_from_dict
 from tests.foreign.effects import CASES
@@ -17,7 +18,7 @@ SMALL = PipelineConfig(n_simulations=32, check_windows=16, n_timesteps=100, hidd
 def calibrate(case: str, seed: int, scale: float = 1.0) -> tuple[CalibrationReport, dict]:
     effects = CASES[case](np.random.default_rng(seed), scale)
     drawn = draw(seed, "thesis", effects=effects)
-    report = Calibrator(SMALL, copies=16).fit([window_from_dict(drawn.document)], drawn.truth).report_
+    report = Calibrator(SMALL, copies=16, actuator=THESIS).fit([window_from_dict(drawn.document)], drawn.truth).report_
     return report, drawn.truth
 
 
@@ -41,7 +42,7 @@ def test_a_drive_whose_loop_departs_from_the_spec_is_no_effect():
     loop = Effects(supply_voltage_factor=1.08, position_gain_factor=0.985, loop_delay_s=3e-5,
                    loop_noise_radps=0.4, loop_noise_seed=5)  # fmt: skip
     drawn = draw(903, "doublet", effects=loop)
-    report = Calibrator(SMALL, copies=16).fit([window_from_dict(drawn.document)], drawn.truth).report_
+    report = Calibrator(SMALL, copies=16, actuator=THESIS).fit([window_from_dict(drawn.document)], drawn.truth).report_
     assert report.selected_effect is None and report.unexplained is None
     assert report.estimates_after == report.estimates_before
 
@@ -51,7 +52,7 @@ def test_sensors_behind_filters_are_no_effect(seed, family):
     # Correlated sensor noise (moving averages of 2–40 samples) is noise: drawn white into the noise
     # floor's copies, it was described as an unexplained effect on 5 of 6 such windows.
     drawn = draw(seed, family, filter_samples=filter_widths(seed))
-    report = Calibrator(SMALL, copies=16).fit([window_from_dict(drawn.document)], drawn.truth).report_
+    report = Calibrator(SMALL, copies=16, actuator=THESIS).fit([window_from_dict(drawn.document)], drawn.truth).report_
     assert report.selected_effect is None and report.unexplained is None
 
 
@@ -141,9 +142,9 @@ def test_a_term_the_load_mimics_is_offered_without_estimates():
 
 def test_settings_and_windows_are_checked():
     with pytest.raises(InputError, match="windows"):
-        Calibrator().fit([])
+        Calibrator(actuator=THESIS).fit([])
     with pytest.raises(InputError, match="copies"):
-        Calibrator(copies=2).fit([window_from_dict(draw(1, "thesis").document)])
+        Calibrator(copies=2, actuator=THESIS).fit([window_from_dict(draw(1, "thesis").document)])
 
 
 @pytest.mark.slow

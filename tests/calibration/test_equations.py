@@ -5,6 +5,7 @@ import pytest
 
 from calibration.backlash import width_rad
 from calibration.equations import cogging_columns, equations, motor_angle_rad
+from sim.actuator import THESIS
 from sim.noise import NO_NOISE
 from sim.params import HealthParams
 from sim.synthetic import synthetic_window
@@ -30,7 +31,7 @@ def test_a_cogging_column_carries_the_logs_interval_mean_attenuation():
 
 def test_the_dead_band_width_is_read_from_the_windows_own_angles():
     window = synthetic_window(HealthParams.single(), seed=3, noise=NO_NOISE)
-    problem = equations([window.signals], window.sample_rate_hz, [])
+    problem = equations([window.signals], window.sample_rate_hz, [], actuator=THESIS.params)
     # BLK of Table 3.1, within the few % that smoothing over the reversals takes (the noise floor's
     # copies carry the same, so calibration.backlash reads extra width against them, not against BLK)
     assert width_rad(problem) == pytest.approx(5e-3, rel=0.1)

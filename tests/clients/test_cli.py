@@ -33,6 +33,27 @@ def test_simulate_names_each_window_by_its_content(tmp_path, capsys):
     assert names[0] != names[1] and names[1] == names[2] and names[0].startswith("synthetic-")
 
 
+def test_simulate_and_estimate_another_actuator_on_a_bench(tmp_path, capsys):
+    """ema simulate --actuator --ground --load-ramp writes a bench window of that actuator (no flight condition);
+    ema estimate --actuator reads it with the same document."""
+    from tests.foreign.actuators import document
+
+    actuator = tmp_path / "heavier.json"
+    actuator.write_text(json.dumps(document("heavier")))
+    window = tmp_path / "bench.json"
+    arguments = ["simulate", "--out", str(window), "--actuator", str(actuator), "--ground", "--load", "-100",
+                 "--load-ramp", "400", "--command", "cruise", "--duration", "0.3", "--json"]  # fmt: skip
+    assert main(arguments) == EXIT_OK
+    written = json.loads(capsys.readouterr().out)
+    assert written["truth"]["FDJ"] == 0.08 and written["load"] == "ground" and written["actuator"].startswith("foreign")
+    assert json.loads(window.read_text())["flight_condition"] is None and read_window(window).on_ground
+    assert main(["estimate", str(window), "--actuator", str(actuator), *SIZES, "--json"]) == EXIT_OK
+    result = json.loads(capsys.readouterr().out)
+    assert abs(result["estimates"]["FDJ"]["value"] / 0.08 - 1) < 0.03 and result["estimates"]["eta_O"] is not None
+    assert main(["estimate", str(window), *SIZES]) == EXIT_BAD_INPUT  # the thesis's document: another gear ratio
+    assert "actuator.drive.gear_ratio" in capsys.readouterr().err
+
+
 def test_simulate_with_an_effect_and_a_table(tmp_path, capsys):
     code = main(["simulate", "--out", str(tmp_path / "w.json"), "--duration", "0.05",
                  "--effect", "cogging:amplitude_nm=0.02"])  # fmt: skip

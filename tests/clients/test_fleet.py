@@ -6,6 +6,7 @@ import json
 import pytest
 
 from clients.cli import EXIT_BAD_INPUT, EXIT_OK, main
+from sim.actuator import THESIS
 from sim.params import HealthParams
 from sim.synthetic import synthetic_window
 from sim.window import window_to_dict
@@ -111,7 +112,7 @@ def test_history_plots_a_prognosis_whose_interval_holds_the_truth(tmp_path, caps
     from training.pipeline import estimate_window
 
     small = PipelineConfig(n_simulations=16, check_windows=8, n_timesteps=50, hidden_units=8)
-    base = estimate_window(synthetic_window(HealthParams.single(), seed=1, duration_s=0.1), small)
+    base = estimate_window(synthetic_window(HealthParams.single(), seed=1, duration_s=0.1), small, actuator=THESIS)
     rng, store = np.random.default_rng(0), EstimateStore(tmp_path / "history.sqlite3")
     hours = np.sort(rng.uniform(0, 200, 200))
     for i, h in enumerate(hours):  # FDJ rising 1e-4 N·m per flight hour: crosses 0.075 at 250 h
@@ -157,3 +158,29 @@ def test_a_flights_windows_are_given_out_once_the_flight_is_answered_not_at_the_
     given = [(w.window_id, list(consumed)) for w, _ in fleet._with_history(windows, first(), lambda jobs: iter(()))]
     assert given == [("a", ["a", "b"]), ("b", ["a", "b"]), ("c", ["a", "b", "c"]),
                      ("d", ["a", "b", "c", "d", "e"]), ("e", ["a", "b", "c", "d", "e"])]  # fmt: skip
+
+
+def test_an_archive_carries_its_actuators_documents(tmp_path, capsys, monkeypatch):
+    """actuators.json maps an actuator to its document: its windows are read with it (and the history stores
+    it, versioned); an actuator it does not list is read with the default, and said so."""
+    from clients import fleet
+    from service.store import EstimateStore
+    from tests.foreign.actuators import DRIVES, NOMINAL, document
+    from tests.foreign.windows import Ground, draw
+
+    monkeypatch.setattr(fleet, "ray_installed", lambda: False)
+    folder, database = tmp_path / "archive", tmp_path / "history.sqlite3"
+    folder.mkdir()
+    bench = draw(31, "sweep", drive=DRIVES["smaller"], nominal=NOMINAL["smaller"], flight=Ground(-100.0, 500.0))
+    (folder / "a.json").write_text(json.dumps({**bench.document, "actuator_id": "small-1", "window_id": "b"}))
+    thesis = synthetic_window(HealthParams.single(), seed=4, duration_s=0.1, actuator_id="thesis-1")
+    (folder / "t.json").write_text(json.dumps(window_to_dict(thesis)))
+    (folder / "actuators.json").write_text(json.dumps({"small-1": document("smaller")}))
+    arguments = ["fleet", str(folder), "--out", str(tmp_path / "r.csv"), "--workers", "1", "--database", str(database)]
+    assert main([*arguments, *SIZES, "--json"]) == EXIT_OK
+    assert json.loads(capsys.readouterr().out)["answered"] == 2
+    store = EstimateStore(database)
+    small = store.history("small-1")[0][0]
+    assert small.actuator.version == 1 and store.get_actuator("small-1").document.drive.gear_ratio == 800.0
+    assert abs(small.estimates.FDJ.value / bench.truth["FDJ"] - 1) < 0.03
+    assert store.history("thesis-1")[0][0].actuator.default and store.get_actuator("thesis-1") is None

@@ -5,6 +5,7 @@ import pytest
 
 from prognosis.rul import remaining_life
 from prognosis.trend import fit_trend
+from sim.actuator import THESIS
 
 THRESHOLD = 0.075  # FDJ +50 % of nominal
 
@@ -111,7 +112,7 @@ def one_estimate():
     from training.pipeline import estimate_window
 
     small = PipelineConfig(n_simulations=16, check_windows=8, n_timesteps=50, hidden_units=8)
-    return estimate_window(synthetic_window(HealthParams.single(), seed=1, duration_s=0.1), small)
+    return estimate_window(synthetic_window(HealthParams.single(), seed=1, duration_s=0.1), small, actuator=THESIS)
 
 
 def _history(estimate, ratios, stds, hours):
@@ -140,14 +141,14 @@ def test_a_strain_gauge_drifting_against_the_aircraft_is_trended_and_said(one_es
     rng = np.random.default_rng(5)
     hours = np.sort(rng.uniform(0, 200, 60))
     drifting = 1.0 - 0.0008 * hours + 0.01 * rng.normal(size=60)  # 0.84 after 200 h
-    prognosis = prognose("tail-9", _history(one_estimate, drifting, np.full(60, 0.01), hours))
+    prognosis = prognose("tail-9", _history(one_estimate, drifting, np.full(60, 0.01), hours), actuator=THESIS)
     trend = prognosis.sensors["hinge_aircraft_ratio"]
     assert trend.slope_per_unit == pytest.approx(-0.0008, rel=0.15)
     assert {n.code for n in prognosis.notes} >= {"gauge_off_model", "gauge_drift"}  # off the model, and drifting
     steady = 1.0 + 0.01 * rng.normal(size=60)
     unknown = [None] * 20  # windows that read no ratio are left out of the trend
     history = _history(one_estimate, [*steady, *unknown], [*np.full(60, 0.01), *unknown], np.arange(80.0))
-    prognosis = prognose("tail-9", history)
+    prognosis = prognose("tail-9", history, actuator=THESIS)
     assert prognosis.sensors["hinge_aircraft_ratio"].n == 60
     assert not any(n.code.startswith("gauge") for n in prognosis.notes)
 
@@ -162,7 +163,7 @@ def test_the_actuators_j_m_is_its_windows_readings_and_a_replaced_part_is_said(o
         for i, (stored, factor) in enumerate(zip(history, factors, strict=True)):
             read = None if factor is None else InertiaReading(factor=factor, std=0.002, window_ids=[stored.window_id])
             history[i] = stored.model_copy(update={"window": stored.window.model_copy(update={"inertia_read": read})})
-        return prognose("tail-9", history)
+        return prognose("tail-9", history, actuator=THESIS)
 
     rng = np.random.default_rng(6)
     steady = [None if i % 3 else float(1.06 + 0.002 * rng.normal()) for i in range(30)]  # every third reads J_M

@@ -262,3 +262,41 @@ def test_a_ground_station_fans_out_to_ray(tmp_path, document):
     assert first.status_code == second.status_code == 200
     # all zeros: no sensor logged anything (training.prepare.consistency), named before any motion is looked for
     assert refused.status_code == 422 and refused.json()["detail"][0]["loc"] == ["body", "signals", "position_deg"]
+
+
+def test_an_actuators_document_is_stored_versioned_and_read_with_its_windows(client):
+    from tests.foreign.actuators import DRIVES, NOMINAL, document
+    from tests.foreign.windows import Ground, draw
+
+    path = "/v1/actuators/tail-7/elevator-right"
+    assert client.get(path).status_code == 404
+    first = client.put(path, json=document("heavier"))
+    assert first.status_code == 200 and first.json()["version"] == 1
+    assert client.put(path, json=document("heavier")).json()["version"] == 1  # the same document: nothing new
+    stored = client.get(path).json()
+    assert stored["document"]["drive"]["gear_ratio"] == 320.0 and stored["actuator_id"] == "tail-7/elevator-right"
+    bench = draw(21, "sweep", drive=DRIVES["heavier"], nominal=NOMINAL["heavier"], flight=Ground(-150.0, 600.0))
+    window = {**bench.document, "actuator_id": "tail-7/elevator-right", "window_id": "bench-1"}
+    del window["flight_condition"]  # absent: on the ground
+    answer = client.post("/v1/estimate", json=window).json()
+    assert answer["actuator"] == {"name": "foreign heavier actuator", "version": 1, "default": False}
+    assert abs(answer["estimates"]["FDJ"]["value"] / bench.truth["FDJ"] - 1) < 0.03
+    assert "on_ground" in {note["code"] for note in answer["notes"]}
+    changed = document("heavier") | {"name": "heavier, reworked"}
+    assert client.put(path, json=changed).json()["version"] == 2
+    history = client.get(f"{path}/estimates").json()["estimates"]
+    assert history[0]["actuator"]["version"] == 1  # a stored estimate keeps the version it was read with
+
+
+def test_a_window_of_an_actuator_without_a_document_is_read_with_the_default_and_says_so(client, document):
+    answer = client.post("/v1/estimate", json=document).json()
+    assert answer["actuator"]["default"] and answer["notes"][0]["code"] == "default_actuator"
+
+
+def test_a_bad_actuator_document_is_a_422_naming_its_field(client):
+    from tests.foreign.actuators import document as actuator_document
+
+    bad = actuator_document("smaller")
+    bad["nominal"]["fsj_nm"] = 0.001
+    response = client.put("/v1/actuators/x", json=bad)
+    assert response.status_code == 422 and response.json()["detail"][0]["loc"] == ["body", "nominal", "fsj_nm"]

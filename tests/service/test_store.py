@@ -7,6 +7,7 @@ import stat
 import pytest
 
 from service.store import EstimateStore, StorageError
+from sim.actuator import THESIS
 from sim.params import HealthParams
 from sim.synthetic import synthetic_window
 from tests.service.conftest import SMALL
@@ -16,7 +17,7 @@ from training.pipeline import estimate_window
 
 @pytest.fixture(scope="module")
 def result():
-    return estimate_window(synthetic_window(HealthParams.single(), seed=1, duration_s=0.1), SMALL)
+    return estimate_window(synthetic_window(HealthParams.single(), seed=1, duration_s=0.1), SMALL, actuator=THESIS)
 
 
 def test_one_row_per_window_and_the_repeat_is_a_replay(tmp_path, result):

@@ -3,6 +3,7 @@
 import numpy as np
 import pytest
 
+from sim.actuator import THESIS
 from sim.aircraft import GroundLoad
 from sim.batch import simulate_batch
 from sim.checks import InputError
@@ -17,7 +18,7 @@ LOAD = GroundLoad(-100.0)
 
 
 def run(effects: EffectSet = EffectSet()):
-    return simulate_batch(KNOTS, NOMINAL, LOAD, effects=effects)
+    return simulate_batch(KNOTS, NOMINAL, LOAD, effects=effects, actuator=THESIS.params)
 
 
 @pytest.fixture(scope="module")
@@ -77,8 +78,10 @@ def test_current_scale_effects_scale_the_logged_current(base, effect):
 
 def test_backlash_delays_the_elevator_at_a_reversal():
     knots = np.concatenate([ramp_knots(0.0, 10.0, 1500), ramp_knots(1.5, -10.0, 1500)[1:]])
-    base = simulate_batch(knots, NOMINAL, LOAD)
-    wide = simulate_batch(knots, NOMINAL, LOAD, effects=EffectSet({"backlash": {"extra_rad": 0.01}}))
+    base = simulate_batch(knots, NOMINAL, LOAD, actuator=THESIS.params)
+    wide = simulate_batch(
+        knots, NOMINAL, LOAD, effects=EffectSet({"backlash": {"extra_rad": 0.01}}), actuator=THESIS.params
+    )
     lag = np.abs(wide.signals["position_deg"][0] - base.signals["position_deg"][0]).max()
     assert lag > np.degrees(0.01) / 4
 

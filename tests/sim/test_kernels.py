@@ -10,7 +10,7 @@ from sim.params import ActuatorParams, eta_a_from_eta_o
 
 ACTUATOR = ActuatorParams()
 FDJ, FSJ, ETA_O = 0.05, 0.10, 0.85
-K_AID = 1.0 - float(eta_a_from_eta_o(ETA_O))
+K_AID = 1.0 - float(eta_a_from_eta_o(ETA_O, 500.0))
 K_OPP = 1.0 / ETA_O - 1.0
 H_OVER_J = ACTUATOR.step_s / ACTUATOR.inertia_kgm2
 
@@ -74,7 +74,7 @@ def test_aiding_and_opposing_use_their_own_efficiency():
 
 def test_irreversible_transmission_never_back_drives():
     eta_o = 0.44  # Case 1C low end: η_A < 0
-    k_aid = 1.0 - float(eta_a_from_eta_o(eta_o))
+    k_aid = 1.0 - float(eta_a_from_eta_o(eta_o, 500.0))
     assert k_aid > 1.0
     c = kernel_constants(ACTUATOR, EffectSet())._replace(position_gain=0.0, speed_gain_over_kt=0.0)
     for load in (0.1, 0.5, 1.0):

@@ -6,15 +6,15 @@ from sim.params import DEFAULT_RANGES, IRREVERSIBLE_RANGES, HealthParams, Health
 
 
 def test_eq_3_4_reproduces_the_thesis_case_1c_range():
-    assert eta_a_from_eta_o(0.44) == pytest.approx(-0.2668, abs=3e-4)  # the thesis prints 4 digits
-    assert eta_a_from_eta_o(0.66) == pytest.approx(0.4864, abs=3e-4)
+    assert eta_a_from_eta_o(0.44, 500.0) == pytest.approx(-0.2668, abs=3e-4)  # the thesis prints 4 digits
+    assert eta_a_from_eta_o(0.66, 500.0) == pytest.approx(0.4864, abs=3e-4)
 
 
 def test_eq_3_4_at_nominal_and_its_limits():
-    assert eta_a_from_eta_o(0.85) == pytest.approx(0.824, abs=1e-3)
-    assert eta_a_from_eta_o(1.0) == pytest.approx(1.0)
+    assert eta_a_from_eta_o(0.85, 500.0) == pytest.approx(0.824, abs=1e-3)
+    assert eta_a_from_eta_o(1.0, 500.0) == pytest.approx(1.0)
     eta_o = np.linspace(0.3, 1.0, 50)
-    assert np.all(np.diff(eta_a_from_eta_o(eta_o)) > 0)  # monotonic: η_A is a function of η_O
+    assert np.all(np.diff(eta_a_from_eta_o(eta_o, 500.0)) > 0)  # monotonic: η_A is a function of η_O
 
 
 def test_uniform_draws_stay_in_range_and_are_seeded():
@@ -28,7 +28,7 @@ def test_uniform_draws_stay_in_range_and_are_seeded():
 
 def test_case_1c_ranges_make_eta_a_change_sign():
     draws = HealthParams.uniform(500, IRREVERSIBLE_RANGES, np.random.default_rng(0))
-    eta_a = draws.eta_a()
+    eta_a = draws.eta_a(500.0)
     assert eta_a.min() < 0 < eta_a.max()
     assert IRREVERSIBLE_RANGES.nominal_eta_o == 0.55
 

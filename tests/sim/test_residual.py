@@ -1,6 +1,7 @@
 import numpy as np
 import pytest
 
+from sim.actuator import THESIS
 from sim.aircraft import GroundLoad
 from sim.batch import simulate_batch
 from sim.checks import InputError
@@ -27,9 +28,11 @@ def test_smoothing_keeps_a_line_and_a_constant():
 
 def test_residual_torque_reconstructs_the_true_loss_on_clean_data():
     knots = random_command_knots(3000, RATE, np.random.default_rng(11))[0]
-    result = simulate_batch(knots, HealthParams.single(), GroundLoad(-60.0, 100.0))
+    result = simulate_batch(knots, HealthParams.single(), GroundLoad(-60.0, 100.0), actuator=THESIS.params)
     signals = result.simulation(0)
-    residual = residual_torque_nm(signals["current_a"], signals["motor_speed_radps"], signals["hinge_moment_nm"], RATE)
+    residual = residual_torque_nm(
+        signals["current_a"], signals["motor_speed_radps"], signals["hinge_moment_nm"], RATE, actuator=THESIS.params
+    )
     truth = smoothed(result.loss_torque_nm[0], RATE)  # the same kernel: T_R is the true loss seen through it
     moving = np.abs(signals["motor_speed_radps"]) > 20
     error = residual[moving] - truth[moving]
@@ -39,11 +42,13 @@ def test_residual_torque_reconstructs_the_true_loss_on_clean_data():
 def test_filter_cuts_speed_noise_below_fdj():
     rng = np.random.default_rng(1)
     knots = random_command_knots(5000, RATE, rng)[0]
-    clean = simulate_batch(knots, HealthParams.single()).simulation(0)
+    clean = simulate_batch(knots, HealthParams.single(), actuator=THESIS.params).simulation(0)
     noisy = add_sensor_noise(clean, SensorNoise(), rng)
 
     def reconstruct(signals):
-        return residual_torque_nm(signals["current_a"], signals["motor_speed_radps"], signals["hinge_moment_nm"], RATE)
+        return residual_torque_nm(
+            signals["current_a"], signals["motor_speed_radps"], signals["hinge_moment_nm"], RATE, actuator=THESIS.params
+        )
 
     difference = reconstruct(noisy) - reconstruct(clean)
     assert difference.std() < 0.01  # a plain 10 kHz difference would give ≈ 0.09 N·m
@@ -52,17 +57,19 @@ def test_filter_cuts_speed_noise_below_fdj():
 def test_batch_and_single_reconstruction_agree():
     rng = np.random.default_rng(2)
     current, speed, hinge = rng.normal(size=(3, 4, 500))
-    batch = residual_torque_nm(current, speed, hinge, RATE)
-    np.testing.assert_allclose(batch[2], residual_torque_nm(current[2], speed[2], hinge[2], RATE))
+    batch = residual_torque_nm(current, speed, hinge, RATE, actuator=THESIS.params)
+    np.testing.assert_allclose(
+        batch[2], residual_torque_nm(current[2], speed[2], hinge[2], RATE, actuator=THESIS.params)
+    )
 
 
 def test_bad_inputs_are_named():
     with pytest.raises(InputError, match="motor_speed_radps"):
-        residual_torque_nm(np.zeros(100), np.full(100, np.nan), np.zeros(100), RATE)
+        residual_torque_nm(np.zeros(100), np.full(100, np.nan), np.zeros(100), RATE, actuator=THESIS.params)
     with pytest.raises(InputError, match="shapes differ"):
-        residual_torque_nm(np.zeros(100), np.zeros(99), np.zeros(100), RATE)
+        residual_torque_nm(np.zeros(100), np.zeros(99), np.zeros(100), RATE, actuator=THESIS.params)
     with pytest.raises(InputError, match="need more than"):
-        residual_torque_nm(np.zeros(10), np.zeros(10), np.zeros(10), RATE)
+        residual_torque_nm(np.zeros(10), np.zeros(10), np.zeros(10), RATE, actuator=THESIS.params)
 
 
 def test_sliding_mask_leaves_out_the_edges_where_the_kernel_is_padded():
@@ -73,7 +80,7 @@ def test_sliding_mask_leaves_out_the_edges_where_the_kernel_is_padded():
     noisy = speed + np.random.default_rng(3).normal(0.0, 0.5, (2000, t.size))
     current = np.full_like(noisy, 5.0)
     hinge = np.full_like(noisy, -40.0)
-    spread = residual_torque_nm(current, noisy, hinge, RATE).std(axis=0)
+    spread = residual_torque_nm(current, noisy, hinge, RATE, actuator=THESIS.params).std(axis=0)
     kept = above_throughout(speed, 30.0, kernel_samples(RATE))
     assert not kept[: kernel_samples(RATE) // 2].any() and not kept[-(kernel_samples(RATE) // 2) :].any()
     assert spread[kept].max() < 1.15 * np.median(spread)

@@ -3,6 +3,7 @@
 import numpy as np
 import pytest
 
+from sim.actuator import THESIS
 from sim.params import HealthParams
 from sim.synthetic import synthetic_window
 from tests.service.conftest import SMALL
@@ -34,7 +35,9 @@ def test_readings_that_scatter_beyond_their_stds_widen_the_std_by_the_birge_rati
 
 
 def test_the_zero_is_the_flights_most_precise_and_j_m_the_actuators():
-    base = estimate_window(synthetic_window(HealthParams.single(), seed=1, duration_s=0.1), SMALL).window
+    base = estimate_window(
+        synthetic_window(HealthParams.single(), seed=1, duration_s=0.1), SMALL, actuator=THESIS
+    ).window
 
     def info(flight_id, zero_std, inertia=None):
         zero = SensorZero(window_id=f"{flight_id}-{zero_std}", hinge_nm=0.0, current_a=0.1, torque_std_nm=zero_std)

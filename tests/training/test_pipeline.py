@@ -3,6 +3,7 @@
 import numpy as np
 import pytest
 
+from sim.actuator import THESIS
 from sim.checks import InputError
 from sim.params import HealthParams
 from sim.synthetic import synthetic_window
@@ -31,7 +32,7 @@ def _codes(result) -> set[str]:
 
 
 def _estimate(drawn, config=SMALL) -> Estimate:
-    return estimate_window(window_from_dict(drawn.document), config)
+    return estimate_window(window_from_dict(drawn.document), config, actuator=THESIS)
 
 
 def _errors(result: Estimate, truth: dict) -> dict[str, tuple[float, float]]:
@@ -40,7 +41,7 @@ def _errors(result: Estimate, truth: dict) -> dict[str, tuple[float, float]]:
     for name in ("FDJ", "eta_O"):
         entry = getattr(result.estimates, name)
         error = entry.value - truth[name]
-        out[name] = (100 * share_of_range(name, abs(error)), abs(error) / entry.std)
+        out[name] = (100 * share_of_range(name, abs(error), ranges=THESIS.ranges), abs(error) / entry.std)
     return out
 
 
@@ -155,7 +156,7 @@ def test_glitches_are_repaired_and_reported_and_the_answer_is_the_clean_twins():
     for name, sigma in NOISE.items():
         for at in rng.choice(np.arange(100, 4900), size=2, replace=False):
             signals[name][at] += float(rng.choice([-1, 1]) * rng.uniform(100, 200) * sigma)
-    result = estimate_window(window_from_dict({**drawn.document, "signals": signals}), SMALL)
+    result = estimate_window(window_from_dict({**drawn.document, "signals": signals}), SMALL, actuator=THESIS)
     assert result.window.glitches_repaired == dict.fromkeys(NOISE, 2)
     assert "glitches_repaired" in _codes(result)
     for name in ("FDJ", "eta_O"):
@@ -172,7 +173,9 @@ def test_a_current_logged_behind_a_filter_is_aligned_and_read_within_its_std(see
     current = np.concatenate([np.full(5, signals["current_a"][0]), signals["current_a"]])
     signals["current_a"] = np.convolve(current, np.ones(6) / 6, mode="valid")
     result = estimate_window(
-        window_from_dict({**drawn.document, "signals": {k: v.tolist() for k, v in signals.items()}}), SMALL
+        window_from_dict({**drawn.document, "signals": {k: v.tolist() for k, v in signals.items()}}),
+        SMALL,
+        actuator=THESIS,
     )
     assert result.window.current_lag_s == pytest.approx(2.5e-4, abs=1e-5)
     assert "current_lag" in _codes(result)
@@ -249,7 +252,9 @@ def test_a_window_moving_one_way_is_answered_with_the_zero_its_flight_read(seed,
     both = of_the_same_flight(one_way, seed + 1000)
     zero = _estimate(both).window.sensor_zero
     assert zero is not None and zero.window_id == both.document["window_id"]
-    result = estimate_window(window_from_dict(one_way.document), SMALL, history=HistoryReadings(sensor_zero=zero))
+    result = estimate_window(
+        window_from_dict(one_way.document), SMALL, history=HistoryReadings(sensor_zero=zero), actuator=THESIS
+    )
     assert result.window.sensor_zero is None and result.window.sensor_zero_from == zero.window_id
     assert "sensor_zero_carried" in _codes(result)
     of_range, z = _errors(result, one_way.truth)["FDJ"]
@@ -268,7 +273,9 @@ def test_a_window_that_cannot_tell_j_m_from_k_t_is_answered_with_the_actuators_j
     assert inertia is not None and inertia.factor == pytest.approx(1.08, abs=0.003)
     alone = _estimate(heavier)
     assert alone.window.inertia_undecided and alone.estimates.FDJ.weakly_determined
-    result = estimate_window(window_from_dict(heavier.document), SMALL, history=HistoryReadings(inertia=inertia))
+    result = estimate_window(
+        window_from_dict(heavier.document), SMALL, history=HistoryReadings(inertia=inertia), actuator=THESIS
+    )
     assert result.window.inertia_from == inertia.window_ids and not result.window.inertia_undecided
     assert result.window.inertia_read is None  # decided by the history, not read: it does not count twice
     assert "inertia_from_history" in _codes(result)
@@ -313,7 +320,7 @@ def test_a_network_that_disagrees_with_the_window_is_set_aside(monkeypatch):
 
 def test_the_result_is_the_typed_contract_and_carries_its_config():
     window = synthetic_window(HealthParams.single(0.1, 0.054, 0.78), seed=21, duration_s=0.25)
-    result = estimate_window(window, SMALL)
+    result = estimate_window(window, SMALL, actuator=THESIS)
     document = result.model_dump(by_alias=True)
     assert document["schema"] == "ema-estimate/1"
     assert set(document["timings_s"]) >= {"simulate", "train", "predict", "total"}

@@ -31,10 +31,10 @@ def output_error_ratios(
     noise: SensorNoise,
     residual_floor_nm: float,
     sliding: np.ndarray,
-    actuator: ActuatorParams = ActuatorParams(),
+    actuator: ActuatorParams,
 ) -> dict[str, float]:
     """Per signal, RMS(measured − simulated at ``health``) over its noise-only floor; the measured T_R
-    reconstructed with ``actuator`` (as the window is read), the simulated with the spec's it is drawn with."""
+    reconstructed with ``actuator`` (as the window is read), the simulated with the drive it is drawn with."""
     rate = window.sample_rate_hz
     simulated = as_read(scenario.simulate(health, lanes=1).simulation(0), rate)
     measured = window.signals
@@ -47,7 +47,7 @@ def output_error_ratios(
     ratios = {
         name: rms(measured[name][keep] - simulated[name][keep]) / max(floor, 1e-12) for name, floor in floors.items()
     }
-    torque = _residual(measured, rate, actuator) - _residual(simulated, rate, ActuatorParams())
+    torque = _residual(measured, rate, actuator) - _residual(simulated, rate, scenario.actuator)
     ratios["residual_torque"] = rms(torque[keep & sliding]) / max(residual_floor_nm, 1e-12)
     return ratios
 

@@ -37,7 +37,7 @@ def as_read(signals: Mapping[str, np.ndarray], sample_rate_hz: float) -> dict[st
 def fit_as_read(
     signals: Mapping[str, np.ndarray],
     sample_rate_hz: float,
-    actuator: ActuatorParams = ActuatorParams(),
+    actuator: ActuatorParams,
     settings: FitSettings = FitSettings(),
 ) -> FrictionFit:
     """Eq. 5.1's fit (``training.physics.friction``) of a window's signals read as every estimator reads them."""
@@ -93,8 +93,8 @@ def features(
     signals: Mapping[str, np.ndarray],
     sample_rate_hz: float,
     n_timesteps: int,
+    actuator: ActuatorParams,
     input_set: str = "residual_torque",
-    actuator: ActuatorParams = ActuatorParams(),
 ) -> np.ndarray:
     """Network inputs from window signals: (n_windows, n_channels · n_timesteps), channels side by side.
 

@@ -47,7 +47,9 @@ NUISANCES = ("offset", "viscous", "torque_scale", "inertia")  # the terms a fit 
 
 @dataclass(frozen=True)
 class FitSettings:
-    min_speed_radps: float = 30.0  # sliding: |ω| above this over a whole kernel, one sign throughout
+    # sliding: |ω| above this share of the drive's top speed V_max/k_e over a whole kernel, one sign throughout
+    # (30 rad/s of the thesis's 638: far past the speed sensor's noise, clear of the stick-slip near rest)
+    min_speed_share: float = 0.047
     derivative_window_s: float = DEFAULT_DERIVATIVE_WINDOW_S
     blocks: int = JACKKNIFE_BLOCKS
     offset: bool = False  # also fit a constant torque at the shaft (a current or hinge sensor off zero)
@@ -56,14 +58,18 @@ class FitSettings:
     inertia: bool = False  # also fit ΔJ, the inertia at the motor shaft beyond the actuator's J_M
 
     def __post_init__(self) -> None:
-        if self.min_speed_radps <= 0:
-            raise InputError("min_speed_radps", f"must be positive, got {self.min_speed_radps}")
+        if not 0 < self.min_speed_share < 1:
+            raise InputError("min_speed_share", f"must be in (0, 1), got {self.min_speed_share}")
         if not 2 <= self.blocks <= 100:
             raise InputError("blocks", f"must be in [2, 100], got {self.blocks}")
 
     @property
     def nuisances(self) -> tuple[str, ...]:
         return tuple(name for name in NUISANCES if getattr(self, name))
+
+    def sliding_speed_radps(self, actuator: ActuatorParams) -> float:
+        """The |ω| past which the shaft slides, for Eq. 5.1, on ``actuator``."""
+        return self.min_speed_share * actuator.max_motor_speed_radps
 
 
 FIT_ARRAYS = ("fdj_nm", "eta_o", "fdj_std_nm", "eta_o_std", "terms", "term_stds", "residual_rms_nm", "n_sliding",
@@ -118,7 +124,7 @@ def regressors(
     residual = np.atleast_2d(residual_nm)
     load = smoothed(np.atleast_2d(signals["hinge_moment_nm"]) / actuator.gear_ratio, rate, window_s)
     width = kernel_samples(rate, window_s)
-    sliding = above_throughout(np.abs(speed), settings.min_speed_radps, width)  # one sign over the whole kernel
+    sliding = above_throughout(np.abs(speed), settings.sliding_speed_radps(actuator), width)  # one sign throughout
     sliding &= np.abs(np.atleast_2d(signals["position_deg"])) < actuator.end_stop_deg - END_STOP_MARGIN_DEG
     direction = np.sign(speed)
     aiding = load * direction > 0
@@ -243,7 +249,7 @@ def solve(stats: np.ndarray, gear: float, nuisances: tuple[str, ...] = ()) -> tu
 def fit_friction(
     signals: Mapping[str, np.ndarray],
     rate: float,
-    actuator: ActuatorParams = ActuatorParams(),
+    actuator: ActuatorParams,
     settings: FitSettings = FitSettings(),
     residual_nm: np.ndarray | None = None,
 ) -> FrictionFit:
@@ -280,7 +286,7 @@ def fit_friction(
 
 
 def fit_window(
-    signals: Mapping[str, np.ndarray], rate: float, actuator: ActuatorParams = ActuatorParams()
+    signals: Mapping[str, np.ndarray], rate: float, actuator: ActuatorParams
 ) -> FrictionFit:
     """One window's fit; a window that never slides long enough is bad input naming its signals."""
     fitted = fit_friction(signals, rate, actuator)
@@ -288,7 +294,7 @@ def fit_window(
         raise InputError(
             "signals",
             f"too little sliding motion to estimate friction: {int(fitted.n_sliding[0])} samples with "
-            f"|motor speed| > {FitSettings().min_speed_radps:g} rad/s away from the end stops "
+            f"|motor speed| > {FitSettings().sliding_speed_radps(actuator):.3g} rad/s away from the end stops "
             "(a held or barely moving elevator carries no friction information)",
         )
     return fitted

@@ -31,7 +31,8 @@ from collections.abc import Mapping
 import numpy as np
 
 from sim.hinge import denoised_hinge_nm
-from sim.noise import MAX_CORRELATION_S, NOISY_SIGNALS, SensorNoise
+from sim.noise import NOISY_SIGNALS, SensorNoise
+from sim.params import MAX_CORRELATION_S
 
 # Lags where the window's difference from its clean simulation is still noise: beyond 16 samples the
 # loop's timing differences from the model reach the current and speed; the hinge moment is read

@@ -11,12 +11,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from sim.aircraft import FlightCondition, Load, LoggedLoad
+from sim.aircraft import FlightCondition, HingeGeometry, Load, LoggedLoad
 from sim.batch import BatchResult, InitialState, simulate_batch
 from sim.commands import knots_from_samples
 from sim.effects import EffectSet
 from sim.noise import SensorNoise
-from sim.params import DEFAULT_RANGES, HealthParams
+from sim.params import ActuatorParams, HealthParams
 from sim.residual import smoothed
 from sim.window import Window
 
@@ -24,16 +24,22 @@ INITIAL_FIT_SAMPLES = 8
 SETTLE_S = 0.02  # the simulation settles from an estimated first state: compared after this
 MAX_RATIO = 2.0  # residual torque within twice its noise floor: reproduced
 CLEAR_MARGIN = 0.05  # of two models, the loser's ``following_error`` this far above the winner's: a clear call
-# What is physical, whatever the window: FDJ from a tenth of nominal to ten times it, η_O down into the
-# irreversible range (thesis Case 1C).
-PHYSICAL_FDJ_NM = (0.1 * DEFAULT_RANGES.nominal_fdj_nm, 10.0 * DEFAULT_RANGES.nominal_fdj_nm)
+# What is physical, whatever the window: FDJ from a tenth of the actuator's nominal to ten times it, η_O
+# down into the irreversible range (thesis Case 1C).
+PHYSICAL_FDJ_SHARE = (0.1, 10.0)
 PHYSICAL_ETA_O = (0.25, 0.995)
+
+
+def physical_fdj_nm(nominal_fdj_nm: float) -> tuple[float, float]:
+    """The FDJ an actuator of this nominal can physically have."""
+    return PHYSICAL_FDJ_SHARE[0] * nominal_fdj_nm, PHYSICAL_FDJ_SHARE[1] * nominal_fdj_nm
 
 
 @dataclass(frozen=True)
 class Scenario:
-    """What every simulation of a dataset shares: the command, the load, the start, the rate."""
+    """What every simulation of a dataset shares: the actuator, the command, the load, the start, the rate."""
 
+    actuator: ActuatorParams  # the drive's constants the simulations run with
     command_knots_deg: np.ndarray  # (n_samples + 1,) one command (Case 1) or (n_sims, n_samples + 1) (Case 2)
     load: Load = field(default_factory=FlightCondition)
     initial: InitialState = field(default_factory=InitialState)
@@ -45,12 +51,11 @@ class Scenario:
         return self.command_knots_deg.shape[-1] - 1
 
     def simulate(self, health: HealthParams, lanes: int | None = None) -> BatchResult:
-        return simulate_batch(
-            self.command_knots_deg, health, self.load, self.initial, self.sample_rate_hz, self.effects, lanes=lanes
-        )
+        return simulate_batch(self.command_knots_deg, health, self.load, self.initial, self.sample_rate_hz,
+                              self.effects, actuator=self.actuator, lanes=lanes)  # fmt: skip
 
 
-def initial_state(window: Window) -> InitialState:
+def initial_state(window: Window, actuator: ActuatorParams) -> InitialState:
     """The state at t = 0: a parabola through the first samples (at their interval centres), taken at 0.
 
     Not the first sample: the fit averages the sensor noise down, and a parabola follows the motor,
@@ -62,45 +67,52 @@ def initial_state(window: Window) -> InitialState:
     def at_zero(values: np.ndarray) -> float:
         return float(np.polyfit(centres, values[:n], 2)[-1])
 
+    speed, current = actuator.max_motor_speed_radps, actuator.max_current_a
     return InitialState(
-        position_deg=float(np.clip(at_zero(window.signals["position_deg"]), -30.0, 30.0)),
-        motor_speed_radps=float(np.clip(at_zero(window.signals["motor_speed_radps"]), -700.0, 700.0)),
-        current_a=float(np.clip(at_zero(window.signals["current_a"]), -30.0, 30.0)),
-    )
+        position_deg=float(np.clip(at_zero(window.signals["position_deg"]), -actuator.end_stop_deg,
+                                   actuator.end_stop_deg)),
+        motor_speed_radps=float(np.clip(at_zero(window.signals["motor_speed_radps"]), -speed, speed)),
+        current_a=float(np.clip(at_zero(window.signals["current_a"]), -current, current)),
+    )  # fmt: skip
 
 
-def logged_load(window: Window) -> LoggedLoad:
-    """The window's own hinge moment (smoothed of sensor noise) as the load its simulations feel."""
+def logged_load(window: Window, hinge: HingeGeometry | None) -> LoggedLoad:
+    """The window's own hinge moment (smoothed of sensor noise) as the load its simulations feel; with the
+    airframe's ``hinge`` model in flight, corrected for the simulation's own deflection."""
     rate = window.sample_rate_hz
     return LoggedLoad(
         window.flight_condition,
         smoothed(window.signals["hinge_moment_nm"], rate),
         smoothed(window.signals["position_deg"], rate),
+        hinge,
     )
 
 
-def scenario_from_window(window: Window, effects: EffectSet = EffectSet()) -> Scenario:
-    """Case 1B for a logged window: its command, its logged load, its first state."""
+def scenario_from_window(
+    window: Window, actuator: ActuatorParams, hinge: HingeGeometry | None, effects: EffectSet = EffectSet()
+) -> Scenario:
+    """Case 1B for a logged window: its actuator, its command, its logged load, its first state."""
     return Scenario(
+        actuator=actuator,
         command_knots_deg=knots_from_samples(window.signals["command_deg"])[0],
-        load=logged_load(window),
-        initial=initial_state(window),
+        load=logged_load(window, hinge),
+        initial=initial_state(window, actuator),
         sample_rate_hz=window.sample_rate_hz,
         effects=effects,
     )
 
 
-def inside(fdj_nm: float, eta_o: float, fsd: float = 2.0) -> HealthParams:
-    """One health point at (FDJ, η_O), held inside the physical limits (a window the model cannot
-    explain may be fitted with a negative FDJ: it is still simulated, at the limit)."""
-    fdj = float(np.clip(fdj_nm, *PHYSICAL_FDJ_NM))
+def inside(fdj_nm: float, eta_o: float, nominal_fdj_nm: float, fsd: float = 2.0) -> HealthParams:
+    """One health point at (FDJ, η_O), held inside the physical limits of an actuator of ``nominal_fdj_nm`` (a
+    window the model cannot explain may be fitted with a negative FDJ: it is still simulated, at the limit)."""
+    fdj = float(np.clip(fdj_nm, *physical_fdj_nm(nominal_fdj_nm)))
     return HealthParams.single(fsd * fdj, fdj, float(np.clip(eta_o, *PHYSICAL_ETA_O)))
 
 
-def following_error(window: Window, effects: EffectSet, health: HealthParams, noise: SensorNoise) -> float:
-    """RMS(speed)/σ_speed + RMS(current)/σ_current of ``window`` simulated clean at ``health`` with ``effects``
-    (after ``SETTLE_S``): how closely a model with those effects follows the drive itself."""
-    simulated = scenario_from_window(window, effects).simulate(health, lanes=1).simulation(0)
+def following_error(scenario: Scenario, window: Window, health: HealthParams, noise: SensorNoise) -> float:
+    """RMS(speed)/σ_speed + RMS(current)/σ_current of ``window`` simulated clean at ``health`` in ``scenario``
+    (after ``SETTLE_S``): how closely a model with its effects follows the drive itself."""
+    simulated = scenario.simulate(health, lanes=1).simulation(0)
     keep = slice(round(SETTLE_S * window.sample_rate_hz), None)
     return sum(
         rms(window.signals[name][keep] - simulated[name][keep]) / max(sigma, 1e-9)

@@ -21,8 +21,8 @@ def shifted_fits(
     signals: dict[str, np.ndarray],
     sample_rate_hz: float,
     lags: np.ndarray,
+    actuator: ActuatorParams,
     name: str = "current_a",
-    actuator: ActuatorParams = ActuatorParams(),
     settings: FitSettings = FitSettings(),
 ) -> FrictionFit:
     """The physics fit with signal ``name`` read ``lags`` samples later, one row per lag, one batched fit."""
@@ -34,7 +34,8 @@ def shifted_fits(
 
 
 def equation_errors(
-    signals: dict[str, np.ndarray], sample_rate_hz: float, lags: np.ndarray, name: str = "current_a"
+    signals: dict[str, np.ndarray], sample_rate_hz: float, lags: np.ndarray, actuator: ActuatorParams,
+    name: str = "current_a",
 ) -> np.ndarray:
     """The physics fit's equation error with signal ``name`` read ``lags`` samples later."""
-    return shifted_fits(signals, sample_rate_hz, lags, name).residual_rms_nm
+    return shifted_fits(signals, sample_rate_hz, lags, actuator, name).residual_rms_nm

@@ -168,8 +168,8 @@ def read_static_friction(
     rate: float,
     fdj_nm: float,
     eta_o: float,
+    actuator: ActuatorParams,
     noise: SensorNoise = NO_NOISE,
-    actuator: ActuatorParams = ActuatorParams(),
 ) -> StaticFriction:
     """FSJ from the quasi-static break-aways of a window, given its dynamic-friction estimates and its
     measured sensor noise (``NO_NOISE``: the traces' own white-noise level alone)."""
@@ -182,7 +182,7 @@ def read_static_friction(
         )))  # fmt: skip
     load = smoothed(signals["hinge_moment_nm"] / actuator.gear_ratio, rate)
     direction = np.sign(smoothed(signals["motor_speed_radps"], rate))
-    k_aid, k_opp = 1.0 - float(eta_a_from_eta_o(eta_o)), 1.0 / eta_o - 1.0
+    k_aid, k_opp = 1.0 - float(eta_a_from_eta_o(eta_o, actuator.gear_ratio)), 1.0 / eta_o - 1.0
     levels = []
     for event in events:
         moving = direction[min(event.index + round(MIN_RUN_S * rate), len(direction) - 1)]

@@ -25,6 +25,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from sim.params import ActuatorParams
 from sim.window import Window
 from training.physics.shifts import advanced, equation_errors
 from training.prepare.hinge_lag import hinge_lag
@@ -34,18 +35,18 @@ HALF_STEP = 0.5  # samples: the finest grid searched
 MIN_GAIN = 0.05  # the least relative drop of the equation error a lag must bring
 
 
-def current_lag_samples(signals: dict[str, np.ndarray], sample_rate_hz: float) -> float:
+def current_lag_samples(signals: dict[str, np.ndarray], sample_rate_hz: float, actuator: ActuatorParams) -> float:
     """How many samples the logged current trails the logged speed (negative: the speed trails), 0
     unless that lag lowers the window's equation error by ``MIN_GAIN``: whole samples within
     ``MAX_LAG_S`` first, then half a sample either side of the best, then the parabola's vertex."""
     reach = max(1.0, np.floor(MAX_LAG_S * sample_rate_hz))
     grid = np.arange(-reach, reach + 0.5)
-    coarse = equation_errors(signals, sample_rate_hz, grid)
+    coarse = equation_errors(signals, sample_rate_hz, grid, actuator)
     if not np.all(np.isfinite(coarse)):
         return 0.0  # too little sliding motion: the physics fit says so next
     near = grid[int(np.argmin(coarse))] + np.array([-HALF_STEP, HALF_STEP])
     errors = dict(zip(grid, coarse, strict=True)) | dict(
-        zip(near, equation_errors(signals, sample_rate_hz, near), strict=True)
+        zip(near, equation_errors(signals, sample_rate_hz, near, actuator), strict=True)
     )
     best = min(errors, key=errors.__getitem__)
     if errors[best] >= (1.0 - MIN_GAIN) * errors[0.0]:
@@ -68,15 +69,15 @@ class Lags:
     hinge_weight: float = 0.0  # how likely the moment is late at all (not only its noise filtered)
 
 
-def aligned(window: Window) -> tuple[Window, Lags]:
+def aligned(window: Window, actuator: ActuatorParams) -> tuple[Window, Lags]:
     """``window`` with the later of its current and speed advanced onto the other and its hinge moment
     advanced by its lag's posterior mean (``training.prepare.hinge_lag``), and those lags."""
     rate, signals = window.sample_rate_hz, dict(window.signals)
-    current = current_lag_samples(signals, rate)
+    current = current_lag_samples(signals, rate, actuator)
     if current != 0.0:
         late = "current_a" if current > 0 else "motor_speed_radps"
         signals[late] = advanced(signals[late], abs(current))
-    hinge = hinge_lag(signals, rate)
+    hinge = hinge_lag(signals, rate, actuator, in_flight=not window.on_ground)
     if hinge.advance != 0.0:
         signals["hinge_moment_nm"] = advanced(signals["hinge_moment_nm"], hinge.advance)
     if current == 0.0 and hinge.filter_delay == 0.0:

@@ -43,6 +43,7 @@ from typing import Any
 
 import numpy as np
 
+from sim.actuator import Actuator
 from sim.batch import COMMAND_MARGIN_DEG
 from sim.noise import NOISY_SIGNALS
 from sim.params import ActuatorParams
@@ -51,8 +52,8 @@ from training.documents import Note
 from training.physics.noise import white_noise_std
 from training.prepare.alignment import Lags, aligned
 from training.prepare.consistency import Consistency, check_consistency, kinematics_note
-from training.prepare.departures.aircraft_check import aircraft_note, check_against_aircraft
-from training.prepare.departures.drive_constants import KERNEL_FREE_RATE_HZ, drive_constants_note
+from training.prepare.departures.aircraft_check import TOLERANCE, aircraft_note, check_against_aircraft
+from training.prepare.departures.drive_constants import KERNEL_FREE_RATE_HZ, DriveConstants, drive_constants_note
 from training.prepare.departures.hinge_gain import hinge_gain_note
 from training.prepare.departures.read import Departures, Known, history_note, read_departures
 from training.prepare.departures.viscosity import viscosity_note
@@ -71,6 +72,7 @@ MAX_GLITCH_S = 3e-4  # ... and so may a shorter one at a low rate: a current pul
 
 @dataclass(frozen=True)
 class Prepared:
+    document: Actuator  # the actuator's document the window is read with
     factor: int  # adjacent samples averaged into one
     original_samples: int
     original_rate_hz: float
@@ -146,9 +148,7 @@ def repaired(window: Window) -> tuple[Window, dict[str, int]]:
     return (replace(window, signals=signals) if counts else window), counts
 
 
-def prepare(
-    window: Window, actuator: ActuatorParams = ActuatorParams(), spec_only: bool = False, known: Known | None = None
-) -> Prepared:
+def prepare(window: Window, actuator: Actuator, spec_only: bool = False, known: Known | None = None) -> Prepared:
     """Cut ``window`` to a stretch its sensors kept updating in (``training.prepare.stale``), repair its glitches,
     average it down to the pipeline's sizes, check its signals agree (``training.prepare.consistency``: InputError
     naming the field), put its sensors on one clock (``training.prepare.alignment``), read what it shows beyond
@@ -156,28 +156,29 @@ def prepare(
     (``training.prepare.step_lag``); say what it found. ``spec_only`` skips the departures and the step:
     ``calibration`` reads the spec's model alone and names what departs. ``known``: what other windows of
     the actuator read (``departures.read_departures``)."""
-    logged = window.n_samples
-    window, stale = without_stale(window, actuator)
+    logged, spec = window.n_samples, actuator.params
+    window, stale = without_stale(window, spec)
     window, glitches = repaired(window)
     factor = averaging_factor(window.n_samples, window.sample_rate_hz)
     command = window.signals["command_deg"]
-    clipped = float(np.mean(np.abs(command) > actuator.end_stop_deg + COMMAND_MARGIN_DEG))
+    clipped = float(np.mean(np.abs(command) > spec.end_stop_deg + COMMAND_MARGIN_DEG))
     if factor > 1:
         n = window.n_samples // factor * factor
         signals = {name: values[:n].reshape(-1, factor).mean(axis=1) for name, values in window.signals.items()}
         window = replace(window, signals=signals, sample_rate_hz=window.sample_rate_hz / factor)
-    consistent = check_consistency(window, actuator)
-    window, lags = aligned(window)
-    aircraft = check_against_aircraft(window)
+    consistent = check_consistency(window, spec)
+    window, lags = aligned(window, spec)
+    airframe = actuator.airframe
+    aircraft = check_against_aircraft(window, actuator.hinge, airframe.tolerance if airframe else TOLERANCE)
     read = (
-        Departures(window, aircraft=aircraft)
+        Departures(window, DriveConstants(spec), aircraft=aircraft)
         if spec_only
         else read_departures(window, actuator, aircraft, known or Known())
     )
     rate = read.window.sample_rate_hz * factor
     # with the departures left in, a lag fits what they leave (an offset: ln LR 105): the story is no test there
     step = StepLag() if spec_only else step_lag(read.window, read.actuator)
-    return Prepared(factor, logged, rate, clipped, glitches, consistent, lags, read, step, stale)
+    return Prepared(actuator, factor, logged, rate, clipped, glitches, consistent, lags, read, step, stale)
 
 
 def widened(stds: dict[str, float], prepared: Prepared) -> dict[str, float]:

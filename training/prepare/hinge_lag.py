@@ -84,11 +84,13 @@ def lag_grid(delay: float, sample_rate_hz: float) -> tuple[np.ndarray, np.ndarra
     return lags, prior
 
 
-def band_log_likelihood(signals: dict[str, np.ndarray], sample_rate_hz: float, lags: np.ndarray) -> np.ndarray:
+def band_log_likelihood(
+    signals: dict[str, np.ndarray], sample_rate_hz: float, lags: np.ndarray, gear_ratio: float
+) -> np.ndarray:
     """ln of the density of the lag the deflection reads (``band_lag_s``) were the moment ``lags`` late:
     Student's t (the std is a jackknife's), widened by half of what the position sensor's own filter may
     delay it by and by ``BAND_LAG_UNCERTAINTY`` of the lag; 0 where the band reads none."""
-    read, std = band_lag_s(signals, sample_rate_hz, ActuatorParams().gear_ratio)
+    read, std = band_lag_s(signals, sample_rate_hz, gear_ratio)
     if not np.isfinite(std):
         return np.zeros(len(lags))
     position = filter_delay_samples(signals["position_deg"], sample_rate_hz, MAX_LAG["position_deg"], False) / 2
@@ -97,8 +99,11 @@ def band_log_likelihood(signals: dict[str, np.ndarray], sample_rate_hz: float, l
     return -np.log(scale) - (dof + 1) / 2 * np.log1p(((read * sample_rate_hz + position - lags) / scale) ** 2 / dof)
 
 
-def hinge_lag(signals: dict[str, np.ndarray], sample_rate_hz: float) -> HingeLag:
-    """The hinge moment's lag, where its noise shows a filter: the model average of the module docstring."""
+def hinge_lag(
+    signals: dict[str, np.ndarray], sample_rate_hz: float, actuator: ActuatorParams, in_flight: bool = True
+) -> HingeLag:
+    """The hinge moment's lag, where its noise shows a filter: the model average of the module docstring (on
+    the ground the moment follows no deflection, and the band reads no lag)."""
     hinge = signals["hinge_moment_nm"]
     noise = hinge - denoised_hinge_nm(hinge, signals["position_deg"], sample_rate_hz)
     delay = min(
@@ -107,12 +112,13 @@ def hinge_lag(signals: dict[str, np.ndarray], sample_rate_hz: float) -> HingeLag
     if delay == 0.0:
         return HingeLag()
     lags, prior = lag_grid(delay, sample_rate_hz)
-    fits = shifted_fits(signals, sample_rate_hz, lags, "hinge_moment_nm")
-    rms = shifted_fits(signals, sample_rate_hz, lags, "hinge_moment_nm", settings=DEPARTURES_FREE).residual_rms_nm
+    fits = shifted_fits(signals, sample_rate_hz, lags, actuator, "hinge_moment_nm")
+    rms = shifted_fits(signals, sample_rate_hz, lags, actuator, "hinge_moment_nm", DEPARTURES_FREE).residual_rms_nm
     if not np.all(np.isfinite(rms)):
         return HingeLag(delay)  # too little sliding motion: the physics fit says so next
     equation = [rms_log_likelihood_ratio(rms[0], r, float(fits.n_sliding[0]), sample_rate_hz) for r in rms]
-    log_posterior = np.log(prior) + band_log_likelihood(signals, sample_rate_hz, lags) + np.array(equation)
+    band = band_log_likelihood(signals, sample_rate_hz, lags, actuator.gear_ratio) if in_flight else 0.0
+    log_posterior = np.log(prior) + band + np.array(equation)
     weight = np.exp(log_posterior - log_posterior.max())
     weight /= weight.sum()
     spread = {

@@ -60,7 +60,6 @@ from training.physics.noise import white_noise_std
 
 MIN_STALE_SAMPLES = 4  # equal samples: fewer is the glitch repair's (3 at most)
 STALE_CHANCE = 1e-6  # expected number of such runs in a working sensor of this signal's repeat rate
-SLIDING_RADPS = FitSettings().min_speed_radps
 NOISE_SAMPLES = 20  # outside the runs, to read a sensor's noise from: fewer, and it is not judged
 DROPOUT_STDS = 10.0  # a flat run this far from both flanks, in noise stds, is a gap filled in
 TRAVEL_STDS = 4.0  # a frozen speed's run: the position's travel across it, in stds of its kernel means
@@ -146,14 +145,16 @@ def stands_off(values: np.ndarray, run: StaleRun, jump: float) -> bool:
 
 def slides_during(window: Window, actuator: ActuatorParams, run: StaleRun) -> bool:
     """Whether the shaft slides during ``run`` of a motion sensor by the other one (module docstring, 3): the
-    speed past ``SLIDING_RADPS`` for the position; for the speed, its frozen value past it, or the position
+    speed past the sliding speed (``FitSettings.sliding_speed_radps``) for the position; for the speed, its
+    frozen value past it, or the position
     travelling ``TRAVEL_STDS`` of its noise at that mean speed or faster. True for a torque sensor."""
     signals, rate = window.signals, window.sample_rate_hz
+    sliding_radps = FitSettings().sliding_speed_radps(actuator)
     if run.signal in ("current_a", "hinge_moment_nm"):
         return True
     if run.signal == "position_deg":
-        return bool(np.any(np.abs(signals["motor_speed_radps"][run.start : run.stop]) > SLIDING_RADPS))
-    if abs(run.value) > SLIDING_RADPS:
+        return bool(np.any(np.abs(signals["motor_speed_radps"][run.start : run.stop]) > sliding_radps))
+    if abs(run.value) > sliding_radps:
         return True
     width = kernel_samples(rate)  # the position's means over a kernel's width, from the run's start to its end
     position = signals["position_deg"]
@@ -161,10 +162,10 @@ def slides_during(window: Window, actuator: ActuatorParams, run: StaleRun) -> bo
     means = np.convolve(around, np.ones(width) / width, mode="valid") if len(around) > width else np.zeros(1)
     travel_deg = float(np.ptp(means))
     mean_speed = np.deg2rad(travel_deg) * actuator.gear_ratio * rate / (run.stop - run.start)
-    return travel_deg > TRAVEL_STDS * white_noise_std(position) / math.sqrt(width) and mean_speed > SLIDING_RADPS
+    return travel_deg > TRAVEL_STDS * white_noise_std(position) / math.sqrt(width) and mean_speed > sliding_radps
 
 
-def stale_runs(window: Window, actuator: ActuatorParams = ActuatorParams()) -> tuple[StaleRun, ...]:
+def stale_runs(window: Window, actuator: ActuatorParams) -> tuple[StaleRun, ...]:
     """Every sensor's stale runs (module docstring), in the order of the samples."""
     n, found = window.n_samples, []
     for name in NOISY_SIGNALS:
@@ -183,21 +184,22 @@ def stale_runs(window: Window, actuator: ActuatorParams = ActuatorParams()) -> t
     return tuple(sorted(found, key=lambda r: r.start))
 
 
-def best_stretch(window: Window, runs: tuple[StaleRun, ...]) -> tuple[int, int, int]:
+def best_stretch(window: Window, runs: tuple[StaleRun, ...], actuator: ActuatorParams) -> tuple[int, int, int]:
     """(start, stop, sliding samples) of the stretch free of ``runs`` with the most sliding samples by the
     speed (the longest of equals)."""
     free = np.ones(window.n_samples, dtype=bool)
     for run in runs:
         free[run.start : run.stop] = False
     starts, stops = edges(free)
-    sliding = np.cumsum(np.concatenate([[0], (np.abs(window.signals["motor_speed_radps"]) > SLIDING_RADPS) & free]))
+    moving = np.abs(window.signals["motor_speed_radps"]) > FitSettings().sliding_speed_radps(actuator)
+    sliding = np.cumsum(np.concatenate([[0], moving & free]))
     if not len(starts):
         return 0, 0, 0
     best = max(range(len(starts)), key=lambda k: (sliding[stops[k]] - sliding[starts[k]], stops[k] - starts[k]))
     return int(starts[best]), int(stops[best]), int(sliding[stops[best]] - sliding[starts[best]])
 
 
-def without_stale(window: Window, actuator: ActuatorParams = ActuatorParams()) -> tuple[Window, Stale]:
+def without_stale(window: Window, actuator: ActuatorParams) -> tuple[Window, Stale]:
     """``window`` with its short stale runs bridged and cut to its best stretch free of the long ones, and
     what was found; InputError naming the sensor where too little sliding motion is left (module docstring)."""
     rate, n = window.sample_rate_hz, window.n_samples
@@ -211,7 +213,7 @@ def without_stale(window: Window, actuator: ActuatorParams = ActuatorParams()) -
     cut = tuple(r for r in runs if r not in short)
     if not cut:
         return replace(window, signals=signals), Stale(short, rate_hz=rate)
-    start, stop, sliding = best_stretch(window, cut)
+    start, stop, sliding = best_stretch(window, cut, actuator)
     needed = MIN_SLIDING_KERNELS * kernel_samples(rate)
     if sliding < needed:
         worst = max(cut, key=lambda r: r.stop - r.start)

@@ -7,6 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from sim.actuator import Actuator
 from sim.effects import EffectSet
 from sim.noise import SensorNoise, add_sensor_noise
 from sim.params import ActuatorParams, HealthParams
@@ -55,7 +56,7 @@ def simulate_noisy(
     noisy = add_sensor_noise(clean, noise, rng, rate)
 
     def residual(s: dict[str, np.ndarray]) -> np.ndarray:
-        return residual_torque_nm(s["current_a"], s["motor_speed_radps"], s["hinge_moment_nm"], rate)
+        return residual_torque_nm(s["current_a"], s["motor_speed_radps"], s["hinge_moment_nm"], rate, scenario.actuator)
 
     seen = as_read(noisy, rate)
     tail = as_read({name: values[len(health) - clean_last :] for name, values in clean.items()}, rate)
@@ -87,14 +88,17 @@ def simulate_dataset(
     seen: Window,
     physics: FrictionFit,
     config: PipelineConfig,
+    document: Actuator,
     actuator: ActuatorParams,
     effects: EffectSet,
 ) -> Data:
     """The box around the physics estimate, the window's sensor noise (measured on ``window`` as logged),
-    the simulations (the spec's model with ``effects``: the window's viscous coefficient), and the features
-    of both (the window read as ``seen``: through ``as_read``, its T_R with ``actuator``)."""
-    box = design.box_around(physics.fdj_nm[0], physics.fdj_std_nm[0], physics.eta_o[0], physics.eta_o_std[0])
-    scenario = scenario_from_window(seen, effects)
+    the simulations (the ``document``'s drive with ``effects``: the window's viscous coefficient), and the
+    features of both (the window read as ``seen``: through ``as_read``, its T_R with ``actuator``, the
+    document's drive with J_M and C as the window shows them)."""
+    fdj, eta_o = physics.fdj_nm[0], physics.eta_o[0]
+    box = design.box_around(fdj, physics.fdj_std_nm[0], eta_o, physics.eta_o_std[0], document.nominal.fdj_nm)
+    scenario = scenario_from_window(seen, document.params, document.hinge, effects)
     health = design.draw(box, config.total_simulations, config.seed)
     sims = simulate_noisy(scenario, health, window, design.centre(box), config.seed + 1, config.check_windows)
     rate = window.sample_rate_hz

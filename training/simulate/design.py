@@ -17,8 +17,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from sim.checks import InputError
-from sim.params import DEFAULT_RANGES, HealthParams
-from training.physics.scenario import PHYSICAL_ETA_O, PHYSICAL_FDJ_NM, inside
+from sim.params import HealthParams
+from training.physics.scenario import PHYSICAL_ETA_O, physical_fdj_nm
 
 SPAN_SIGMAS = 6.0  # the box's half-width in jackknife standard deviations of the centre
 MIN_HALF_SPAN = {"fdj_nm": 0.05, "eta_o": 0.025}  # FDJ relative to the centre, η_O absolute
@@ -48,8 +48,9 @@ class Box:
         return _scale(normalized[:, 0], self.fdj_nm), _scale(normalized[:, 1], self.eta_o)
 
 
-PHYSICAL = Box(fdj_nm=PHYSICAL_FDJ_NM, eta_o=PHYSICAL_ETA_O)
-THESIS_BOX = Box(fdj_nm=DEFAULT_RANGES.fdj_nm, eta_o=DEFAULT_RANGES.eta_o)  # Table 3.1 ranges
+def physical(nominal_fdj_nm: float) -> Box:
+    """What an actuator of this nominal FDJ can physically be (``training.physics.scenario``)."""
+    return Box(fdj_nm=physical_fdj_nm(nominal_fdj_nm), eta_o=PHYSICAL_ETA_O)
 
 
 def _unit(values: np.ndarray, interval: tuple[float, float]) -> np.ndarray:
@@ -70,24 +71,27 @@ def _interval(centre: float, half: float, limits: tuple[float, float]) -> tuple[
     return low, high
 
 
-def box_around(fdj_nm: float, fdj_std_nm: float, eta_o: float, eta_o_std: float) -> Box:
-    """The box for a window whose physics estimate is (FDJ ± std, η_O ± std)."""
+def box_around(fdj_nm: float, fdj_std_nm: float, eta_o: float, eta_o_std: float, nominal_fdj_nm: float) -> Box:
+    """The box for a window whose physics estimate is (FDJ ± std, η_O ± std), inside what an actuator of
+    ``nominal_fdj_nm`` can physically be."""
     for name, value in (("fdj_nm", fdj_nm), ("eta_o", eta_o), ("fdj_std_nm", fdj_std_nm), ("eta_o_std", eta_o_std)):
         if not np.isfinite(value):
             raise InputError(name, f"must be finite to centre a dataset on, got {value}")
-    fdj_nm = float(np.clip(fdj_nm, *PHYSICAL.fdj_nm))
-    eta_o = float(np.clip(eta_o, *PHYSICAL.eta_o))
+    limits = physical(nominal_fdj_nm)
+    fdj_nm = float(np.clip(fdj_nm, *limits.fdj_nm))
+    eta_o = float(np.clip(eta_o, *limits.eta_o))
     fdj_half = max(SPAN_SIGMAS * fdj_std_nm, MIN_HALF_SPAN["fdj_nm"] * fdj_nm)
     eta_half = max(SPAN_SIGMAS * eta_o_std, MIN_HALF_SPAN["eta_o"])
     return Box(
-        fdj_nm=_interval(fdj_nm, fdj_half, PHYSICAL.fdj_nm),
-        eta_o=_interval(eta_o, eta_half, PHYSICAL.eta_o),
+        fdj_nm=_interval(fdj_nm, fdj_half, limits.fdj_nm),
+        eta_o=_interval(eta_o, eta_half, limits.eta_o),
     )
 
 
 def centre(box: Box) -> HealthParams:
     """The box's centre, FSJ at twice FDJ."""
-    return inside(float(np.mean(box.fdj_nm)), float(np.mean(box.eta_o)))
+    fdj = float(np.mean(box.fdj_nm))
+    return HealthParams.single(2.0 * fdj, fdj, float(np.mean(box.eta_o)))
 
 
 def halton(n: int, seed: int) -> np.ndarray:

@@ -1,6 +1,7 @@
 import numpy as np
 import pytest
 
+from sim.actuator import THESIS
 from sim.checks import InputError
 from sim.params import HealthParams
 from sim.synthetic import synthetic_window
@@ -22,16 +23,17 @@ def test_bin_means_cover_every_sample():
 def test_the_same_features_for_a_batch_row_and_a_single_window():
     windows = [synthetic_window(HealthParams.single(fdj_nm=f), seed=2, duration_s=0.05) for f in (0.045, 0.055)]
     batch = {name: np.stack([w.signals[name] for w in windows]) for name in windows[0].signals}
-    together = features(batch, 10_000.0, 100, "input_map")
+    together = features(batch, 10_000.0, 100, THESIS.params, "input_map")
     assert together.shape == (2, 300)
     for i, window in enumerate(windows):
-        np.testing.assert_array_equal(features(window.signals, 10_000.0, 100, "input_map")[0], together[i])
+        single = features(window.signals, 10_000.0, 100, THESIS.params, "input_map")
+        np.testing.assert_array_equal(single[0], together[i])
 
 
 def test_unknown_input_set_is_named():
     window = synthetic_window(HealthParams.single(), seed=2, duration_s=0.05)
     with pytest.raises(InputError) as error:
-        features(window.signals, 10_000.0, 100, "torque")
+        features(window.signals, 10_000.0, 100, THESIS.params, "torque")
     assert error.value.field == "inputs"
 
 
@@ -45,7 +47,7 @@ def test_reading_the_hinge_along_the_deflection_lowers_the_fit_error_on_foreign_
         batch = [noisy(dict(signals), np.random.default_rng(k), 1.0) for k in range(40)]
         stacked = {name: np.stack([b[name] for b in batch]) for name in signals}
         for label, read in (("logged", stacked), ("read", as_read(stacked, 10_000.0))):
-            fit = fit_friction(read, 10_000.0)
+            fit = fit_friction(read, 10_000.0, actuator=THESIS.params)
             # η_O in FDJ units of range (0.30 against 0.02 N·m)
             error = np.hypot(fit.fdj_nm - clean.truth["FDJ"], (fit.eta_o - clean.truth["eta_O"]) / 15)
             squares[label].append(np.mean(error**2))

@@ -4,6 +4,7 @@ sit behind moving-average filters (``sim.noise`` draws AR(1) noise: another shap
 import numpy as np
 import pytest
 
+from sim.actuator import THESIS
 from sim.params import HealthParams
 from sim.window import window_from_dict
 from tests.foreign.windows import draw, filter_widths
@@ -20,9 +21,9 @@ SENSORS = ("position_deg", "motor_speed_radps", "current_a", "hinge_moment_nm")
 def _measured_and_realized(seed: int, family: str, widths: dict[str, int]):
     d = draw(seed, family, filter_samples=widths)
     window = window_from_dict(d.document)
-    physics = fit_window(as_read(window.signals, RATE), RATE)
+    physics = fit_window(as_read(window.signals, RATE), RATE, actuator=THESIS.params)
     at = HealthParams.single(fdj_nm=float(physics.fdj_nm[0]), eta_o=float(physics.eta_o[0]))
-    measured = window_noise(window, scenario_from_window(window), at)
+    measured = window_noise(window, scenario_from_window(window, actuator=THESIS.params, hinge=THESIS.hinge), at)
     clean = d.clean_signals()
     return measured, {name: window.signals[name] - clean[name] for name in SENSORS}
 

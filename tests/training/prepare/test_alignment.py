@@ -4,6 +4,7 @@ filter acts on the signal and its noise, as a real one does: tests/foreign filte
 import numpy as np
 import pytest
 
+from sim.actuator import THESIS
 from sim.window import window_from_dict
 from tests.foreign.windows import draw, noisy
 from training.prepare.alignment import Lags, aligned
@@ -38,12 +39,12 @@ def _window(seed: int, filters: dict):
 @pytest.mark.parametrize("seed", range(5))
 def test_a_filtered_current_or_speed_is_read_late_by_its_filters_delay(seed):
     width = 2 + seed  # 0.5–2.5 samples of delay
-    _, lags = aligned(_window(seed, {"current_a": lambda x: moving_average(x, width)}))
+    _, lags = aligned(_window(seed, {"current_a": lambda x: moving_average(x, width)}), actuator=THESIS.params)
     assert lags.current_s * RATE == pytest.approx((width - 1) / 2, abs=0.1)
-    _, lags = aligned(_window(seed, {"motor_speed_radps": lambda x: moving_average(x, width)}))
+    _, lags = aligned(_window(seed, {"motor_speed_radps": lambda x: moving_average(x, width)}), actuator=THESIS.params)
     assert lags.current_s * RATE == pytest.approx(-(width - 1) / 2, abs=0.1)
     tau, a = 1.0 + seed, np.exp(-1.0 / (1.0 + seed))
-    _, lags = aligned(_window(seed, {"current_a": lambda x: first_order(x, tau)}))
+    _, lags = aligned(_window(seed, {"current_a": lambda x: first_order(x, tau)}), actuator=THESIS.params)
     # an RC filter delays fast content less than slow; Eq. 5.1 reads it at the accelerations
     assert lags.current_s * RATE == pytest.approx(a / (1 - a), rel=0.1)
 
@@ -54,7 +55,9 @@ def test_a_filtered_hinge_moment_is_read_late_by_about_its_filters_delay():
     read, weights = [], []
     for seed in range(5):
         width = 10 + 7 * seed  # 0.45–1.8 ms late
-        _, lags = aligned(_window(seed, {"hinge_moment_nm": lambda x, w=width: moving_average(x, w)}))
+        _, lags = aligned(
+            _window(seed, {"hinge_moment_nm": lambda x, w=width: moving_average(x, w)}), actuator=THESIS.params
+        )
         read.append(lags.hinge_filter_s * RATE / ((width - 1) / 2))
         weights.append(lags.hinge_weight)
         assert 0.0 < lags.hinge_s <= 1.3 * lags.hinge_filter_s or lags.hinge_weight < 0.9
@@ -69,7 +72,7 @@ def test_noise_correlated_after_an_unfiltered_moment_is_mostly_not_taken_for_its
     weights = []
     for seed in range(12):
         drawn = draw(seed, FAMILIES[seed % 5], filter_samples={"hinge_moment_nm": 10 + 3 * seed})
-        _, lags = aligned(window_from_dict(drawn.document))
+        _, lags = aligned(window_from_dict(drawn.document), actuator=THESIS.params)
         if lags.hinge_filter_s:
             weights.append(lags.hinge_weight)
             if 0.05 < lags.hinge_weight < 0.95:
@@ -80,12 +83,12 @@ def test_noise_correlated_after_an_unfiltered_moment_is_mostly_not_taken_for_its
 def test_unfiltered_sensors_are_left_as_logged():
     for seed in range(5, 15):
         window = _window(seed, {})
-        out, lags = aligned(window)
+        out, lags = aligned(window, actuator=THESIS.params)
         assert lags == Lags() and out is window, seed
 
 
 def test_the_hinge_lags_read_uncertainty_is_carried_as_a_spread_only_where_one_is_read():
     """Behind a 30-sample filter FDJ moves with the lag; its ±15 % band goes into the stds."""
-    _, lags = aligned(_window(3, {"hinge_moment_nm": lambda x: moving_average(x, 30)}))
+    _, lags = aligned(_window(3, {"hinge_moment_nm": lambda x: moving_average(x, 30)}), actuator=THESIS.params)
     assert lags.hinge_s > 0 and 0.0 < lags.spread["FDJ"] < 2e-3 and lags.spread["eta_O"] >= 0.0
-    assert aligned(_window(3, {}))[1] == Lags()
+    assert aligned(_window(3, {}), actuator=THESIS.params)[1] == Lags()

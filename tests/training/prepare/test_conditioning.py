@@ -3,6 +3,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+from sim.actuator import THESIS
 from sim.params import HealthParams
 from sim.synthetic import synthetic_window
 from sim.window import Window, window_from_dict
@@ -26,7 +27,7 @@ def test_averaging_keeps_rate_and_samples_bounded():
 
 def test_averaged_samples_are_the_means_of_the_longer_intervals():
     window = synthetic_window(HealthParams.single(), seed=1, duration_s=0.05, sample_rate_hz=40_000.0)
-    prepared = prepare(window)
+    prepared = prepare(window, actuator=THESIS)
     assert prepared.factor == 4 and prepared.window.sample_rate_hz == 10_000.0
     np.testing.assert_allclose(
         prepared.window.signals["current_a"][:3], window.signals["current_a"][:12].reshape(3, 4).mean(1)
@@ -36,7 +37,7 @@ def test_averaged_samples_are_the_means_of_the_longer_intervals():
 def test_a_command_past_the_end_stops_is_measured_not_refused():
     window = synthetic_window(HealthParams.single(), seed=2, duration_s=0.05)
     signals = dict(window.signals, command_deg=np.where(np.arange(500) < 100, 45.0, 0.0))
-    assert prepare(Window(signals)).command_clipped_fraction == 0.2
+    assert prepare(Window(signals), actuator=THESIS).command_clipped_fraction == 0.2
 
 
 FAMILIES = ("thesis", "cruise", "gust", "doublet", "steps")
@@ -51,7 +52,7 @@ def test_no_sample_of_a_foreign_window_is_taken_for_a_glitch(rate):
     """A 1 kHz log's fastest turns reach 36 noise stds from sample to sample: legitimate, and kept."""
     for seed in range(10):
         window = _foreign(seed, rate)
-        assert prepare(window).glitches == {}, seed
+        assert prepare(window, actuator=THESIS).glitches == {}, seed
 
 
 @pytest.mark.parametrize(
@@ -65,7 +66,7 @@ def test_a_current_pulse_at_a_reversal_is_no_glitch_at_a_low_log_rate(drawn, lab
     """At 1–2 kHz the current's kick as the motion reverses lasts 2–3 samples, 300 noise stds tall,
     between flanks that agree: these windows' pulses were taken for glitches before the rule said
     a glitch's flanks are quiet and a burst lasts at most 0.3 ms."""
-    assert prepare(window_from_dict(drawn().document)).glitches == {}, label
+    assert prepare(window_from_dict(drawn().document), actuator=THESIS).glitches == {}, label
 
 
 def test_glitches_are_found_and_replaced_by_the_line_between_their_flanks():
@@ -81,7 +82,7 @@ def test_glitches_are_found_and_replaced_by_the_line_between_their_flanks():
             signals[name] = signals[name].copy()
             signals[name][at] += rng.choice([-1, 1], 3) * rng.uniform(50, 1000, 3) * sigma
             planted += 3
-        prepared = prepare(replace(window, signals=signals))
+        prepared = prepare(replace(window, signals=signals), actuator=THESIS)
         found += sum(prepared.glitches.values())
         for name, sigma in NOISE.items():  # repaired to within the noise, or a few local steps, of the log
             left = np.abs(prepared.window.signals[name] - window.signals[name])
@@ -92,7 +93,7 @@ def test_glitches_are_found_and_replaced_by_the_line_between_their_flanks():
 
 
 def test_what_conditioning_could_not_settle_widens_the_stds_in_quadrature():
-    prepared = prepare(synthetic_window(HealthParams.single(), seed=1))
+    prepared = prepare(synthetic_window(HealthParams.single(), seed=1), actuator=THESIS)
     departures = replace(
         prepared.departures, offset=ZeroOffset(spread={"FDJ": 3e-4}), viscosity=Viscosity(spread={"FDJ": 0.0})
     )

@@ -4,6 +4,7 @@ careless export is refused naming its field, and no window of a working drive is
 import numpy as np
 import pytest
 
+from sim.actuator import THESIS
 from sim.checks import InputError
 from sim.window import window_from_dict
 from tests.foreign.careless import SLIPS, Slip, exported
@@ -31,7 +32,7 @@ def _windows(seed: int) -> list[dict]:
 @pytest.mark.parametrize("seed", SEEDS)
 def test_windows_of_a_working_drive_pass_with_their_travel_and_loop_in_agreement(seed):
     for document in _windows(seed):
-        found = check_consistency(window_from_dict(document))
+        found = check_consistency(window_from_dict(document), actuator=THESIS.params)
         assert found.better_reading is None
         assert found.travel_gain is None or 0.98 < found.travel_gain < 1.02, found
         assert found.following is None or found.following > 0.97, found
@@ -42,7 +43,8 @@ def test_a_dead_band_of_any_width_is_no_unit_error(width):
     """A worn band (or a transmission the surface barely follows) is for calibration to name, not refused."""
     for seed in SEEDS:
         found = check_consistency(
-            window_from_dict(draw(seed, "thesis", effects=Effects(backlash_factor=width)).document)
+            window_from_dict(draw(seed, "thesis", effects=Effects(backlash_factor=width)).document),
+            actuator=THESIS.params,
         )
         assert found.travel_gain is None or 0.98 < found.travel_gain < 1.02, (width, found)
 
@@ -72,7 +74,9 @@ def test_a_careless_export_is_refused_naming_its_field(slip):
     named = []
     for seed in SEEDS:
         try:
-            check_consistency(window_from_dict(exported(draw(seed, FAMILIES[seed % 5]).document, SLIPS[slip])))
+            check_consistency(
+                window_from_dict(exported(draw(seed, FAMILIES[seed % 5]).document, SLIPS[slip])), actuator=THESIS.params
+            )
         except InputError as refused:
             named.append(refused.field)
     assert named == [SLIPS[slip].field] * len(named) and len(named) >= CAUGHT.get(slip, len(SEEDS)), named
@@ -81,7 +85,7 @@ def test_a_careless_export_is_refused_naming_its_field(slip):
 def test_the_pipeline_refuses_before_reading_anything():
     document = exported(draw(4410, "doublet").document, SLIPS["current of the other sign"])
     with pytest.raises(InputError, match=r"current_a.*sign"):
-        prepare(window_from_dict(document))
+        prepare(window_from_dict(document), actuator=THESIS)
 
 
 def test_the_travel_gain_follows_a_misstated_sample_rate():
@@ -90,7 +94,7 @@ def test_the_travel_gain_follows_a_misstated_sample_rate():
     for factor in (0.8, 1.0, 1.25):
         window = window_from_dict(exported(document, Slip({"sample_rate_hz": factor}, "sample_rate_hz")))
         try:
-            gains.append(check_consistency(window).travel_gain)
+            gains.append(check_consistency(window, actuator=THESIS.params).travel_gain)
         except InputError as refused:
             gains.append(float(refused.message.split("travel is ")[1].split("x")[0]))
     assert np.allclose(np.array(gains) / gains[1], [0.8, 1.0, 1.25], rtol=1e-3)
@@ -98,10 +102,15 @@ def test_the_travel_gain_follows_a_misstated_sample_rate():
 
 def test_a_time_base_a_few_percent_off_is_answered_with_a_note():
     document = draw(4412, "cruise").document
-    slow = prepare(window_from_dict(exported(document, Slip({"sample_rate_hz": 0.95}, "sample_rate_hz"))))
+    slow = prepare(
+        window_from_dict(exported(document, Slip({"sample_rate_hz": 0.95}, "sample_rate_hz"))), actuator=THESIS
+    )
     assert slow.consistency.travel_gain == pytest.approx(0.95, abs=0.005)
     assert any(note.code == "kinematic_gain" for note in conditioning_notes(slow))
-    assert not any(note.code == "kinematic_gain" for note in conditioning_notes(prepare(window_from_dict(document))))
+    assert not any(
+        note.code == "kinematic_gain"
+        for note in conditioning_notes(prepare(window_from_dict(document), actuator=THESIS))
+    )
 
 
 @pytest.mark.parametrize("name", ["position_deg", "motor_speed_radps", "current_a", "hinge_moment_nm"])
@@ -109,5 +118,5 @@ def test_a_sensor_stuck_at_one_value_is_refused_naming_it(name):
     document = draw(4413, "doublet").document
     stuck = {**document, "signals": {**document["signals"], name: [document["signals"][name][100]] * 5000}}
     with pytest.raises(InputError, match="stuck") as refused:
-        check_consistency(window_from_dict(stuck))
+        check_consistency(window_from_dict(stuck), actuator=THESIS.params)
     assert refused.value.field == f"signals.{name}"

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from benchmarks.foreign_groups import group_seed, groups
+from sim.actuator import THESIS
 from sim.checks import InputError
 from sim.window import window_from_dict
 from tests.foreign.faults import FAULTS, Fault, frozen, stretch, with_fault
@@ -22,7 +23,7 @@ FAMILIES = ("thesis", "cruise", "gust", "doublet", "steps")
 
 def _physics(document: dict) -> tuple[dict[str, float], dict[str, float], Prepared]:
     """Eq. 5.1's answer to the window as prepared, its stds widened by what conditioning left open."""
-    prepared = prepare(window_from_dict(document))
+    prepared = prepare(window_from_dict(document), actuator=THESIS)
     w = prepared.window
     fitted = fit_window(as_read(w.signals, w.sample_rate_hz), w.sample_rate_hz, prepared.actuator)
     stds = widened({"FDJ": float(fitted.fdj_std_nm[0]), "eta_O": float(fitted.eta_o_std[0])}, prepared)
@@ -38,7 +39,7 @@ def _fault(seed: int) -> Fault:
 def test_no_working_sensor_of_a_foreign_window_is_taken_for_a_stale_one(group):
     make = groups()[group]
     for seed in range(5200, 5206):
-        assert stale_runs(window_from_dict(make(seed).document)) == ()
+        assert stale_runs(window_from_dict(make(seed).document), actuator=THESIS.params) == ()
 
 
 def test_a_frozen_or_dropped_out_sensor_is_cut_out_and_the_rest_read_within_its_std():
@@ -54,7 +55,7 @@ def test_a_frozen_or_dropped_out_sensor_is_cut_out_and_the_rest_read_within_its_
         assert prepared.stale.samples[name] >= stop - start - 1
         assert any(n.code == "stale_sensor" and n.parameter == name for n in conditioning_notes(prepared))
         covered += all(abs(answer[p] - drawn.truth[p]) <= 2 * std[p] for p in answer)
-        errors.extend(abs(share_of_range(p, answer[p] - drawn.truth[p])) for p in answer)
+        errors.extend(abs(share_of_range(p, answer[p] - drawn.truth[p], ranges=THESIS.ranges)) for p in answer)
     assert covered >= 11 and max(errors) < 0.1, f"{covered} of 12 covered, worst {max(errors):.3f} of range"
 
 
@@ -65,7 +66,7 @@ def test_a_sensor_quantized_coarser_than_its_noise_is_not_taken_for_a_frozen_one
     document["signals"]["current_a"] = [round(i / 0.5) * 0.5 for i in document["signals"]["current_a"]]
     window = window_from_dict(document)
     assert np.max(np.diff(np.flatnonzero(np.diff(window.signals["current_a"]) != 0))) > 20  # long flat runs
-    assert stale_runs(window) == ()
+    assert stale_runs(window, actuator=THESIS.params) == ()
 
 
 def test_a_speed_reading_exactly_zero_at_rest_is_no_frozen_sensor():
@@ -78,14 +79,14 @@ def test_a_speed_reading_exactly_zero_at_rest_is_no_frozen_sensor():
     window = window_from_dict(document)
     longest = max(len(run) for run in np.split(speed, np.flatnonzero(np.diff(speed != 0)) + 1) if run[0] == 0)
     assert longest > 100 * MIN_STALE_SAMPLES  # rests long enough to be taken for one
-    assert stale_runs(window) == ()
+    assert stale_runs(window, actuator=THESIS.params) == ()
 
 
 def test_a_window_with_too_little_sliding_left_is_refused_naming_the_sensor():
     drawn = draw(5600, "doublet")
     n = len(drawn.document["signals"]["current_a"])
     with pytest.raises(InputError, match="repeats 0 exactly") as refused:
-        prepare(window_from_dict(frozen(drawn.document, "current_a", n // 20, n - n // 20, 0.0)))
+        prepare(window_from_dict(frozen(drawn.document, "current_a", n // 20, n - n // 20, 0.0)), actuator=THESIS)
     assert refused.value.field == "signals.current_a"
 
 
@@ -111,4 +112,4 @@ def test_a_chance_run_of_a_quantized_position_is_no_stale_run():
     window = window_from_dict(groups()["cruise"](group_seed("cruise", 0)).document)
     starts, stops = equal_runs(window.signals["position_deg"])
     assert (stops - starts).max() == 8
-    assert stale_runs(window) == ()
+    assert stale_runs(window, actuator=THESIS.params) == ()

@@ -4,6 +4,7 @@ its tail continued by point reflection: not ``tests.foreign.careless``'s held va
 import numpy as np
 import pytest
 
+from sim.actuator import THESIS
 from sim.window import window_from_dict
 from tests.foreign.windows import draw
 from training.pipeline import estimate_window
@@ -25,14 +26,17 @@ def logged_early(document: dict, seconds: float) -> dict:
 
 
 def test_a_moment_in_step_adds_next_to_nothing():
-    steps = [prepare(window_from_dict(draw(seed, FAMILIES[seed % 5]).document)).step for seed in range(10)]
+    steps = [
+        prepare(window_from_dict(draw(seed, FAMILIES[seed % 5]).document), actuator=THESIS).step for seed in range(10)
+    ]
     assert all(step.weight < NOTE_WEIGHT for step in steps), [step.weight for step in steps]
     assert all(step.spread["FDJ"] < 0.05 * 0.02 for step in steps), [step.spread for step in steps]
 
 
 def test_a_moment_20_ms_early_is_read_out_of_step_by_that_lag():
     steps = [
-        step_lag(window_from_dict(logged_early(draw(seed, FAMILIES[seed % 5]).document, 0.02))) for seed in range(10)
+        step_lag(window_from_dict(logged_early(draw(seed, FAMILIES[seed % 5]).document, 0.02)), actuator=THESIS.params)
+        for seed in range(10)
     ]
     assert sum(step.weight > 0.9 and step.lag_s == pytest.approx(-0.02) for step in steps) >= 9, steps
 
@@ -45,7 +49,7 @@ def test_the_deflection_weighs_for_a_moment_5_ms_out_of_step_and_against_one_in_
         drawn = draw(seed, FAMILIES[seed % 5])
         for document, sign in ((logged_early(drawn.document, 0.005), 1.0), (drawn.document, -1.0)):
             signals = {name: np.asarray(values) for name, values in document["signals"].items()}
-            in_step, early = band_log_likelihood(signals, 10_000.0, np.array([0.0, -50.0]))
+            in_step, early = band_log_likelihood(signals, 10_000.0, np.array([0.0, -50.0]), gear_ratio=500.0)
             assert sign * (early - in_step) > 4.0 or abs(early - in_step) < 0.5, (seed, sign, early - in_step)
 
 
@@ -55,9 +59,11 @@ def test_on_2_khz_logs_5_ms_out_of_step_the_band_decides_what_eq_5_1_cannot(monk
     deflection's band in most (19 of 24 over 0.9 on seeds 12–59)."""
     windows = [window_from_dict(logged_early(draw(seed, FAMILIES[seed % 5], sample_rate_hz=2_000.0).document, 0.005))
                for seed in range(12, 36)]  # fmt: skip
-    with_band = [step_lag(window).weight for window in windows]
-    monkeypatch.setattr(step_lag_module, "band_log_likelihood", lambda signals, rate, lags: np.zeros(len(lags)))
-    undecided = [w for w, window in zip(with_band, windows, strict=True) if step_lag(window).weight < 0.1]
+    with_band = [step_lag(window, actuator=THESIS.params).weight for window in windows]
+    monkeypatch.setattr(step_lag_module, "band_log_likelihood", lambda signals, rate, lags, gear: np.zeros(len(lags)))
+    undecided = [
+        w for w, window in zip(with_band, windows, strict=True) if step_lag(window, actuator=THESIS.params).weight < 0.1
+    ]
     assert len(undecided) >= 8
     assert sum(w > 0.5 for w in undecided) >= 2 / 3 * len(undecided), undecided
 
@@ -68,8 +74,8 @@ def test_a_cruise_window_out_of_step_is_answered_weak_and_within_its_std():
     read 20 ms away, not 3x): without the story FDJ was 25 % of the range off at 5 std."""
     drawn = draw(6, "cruise")
     window = window_from_dict(logged_early(drawn.document, 0.02))
-    assert any(note.code == "hinge_out_of_step" for note in conditioning_notes(prepare(window)))
-    found = estimate_window(window).estimates
+    assert any(note.code == "hinge_out_of_step" for note in conditioning_notes(prepare(window, actuator=THESIS)))
+    found = estimate_window(window, actuator=THESIS).estimates
     for name in ("FDJ", "eta_O"):
         estimate = getattr(found, name)
         assert estimate.weakly_determined and abs(estimate.value - drawn.truth[name]) < 2 * estimate.std, name

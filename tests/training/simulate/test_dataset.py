@@ -1,6 +1,7 @@
 import numpy as np
 import pytest
 
+from sim.actuator import THESIS
 from sim.batch import InitialState
 from sim.noise import NO_NOISE, SensorNoise
 from sim.params import HealthParams
@@ -12,7 +13,7 @@ from training.simulate.dataset import simulate_noisy, window_noise
 def test_a_clean_window_is_reproduced_by_its_own_scenario():
     truth = HealthParams.single(0.11, 0.055, 0.8)
     window = synthetic_window(truth, seed=4, duration_s=0.1, noise=NO_NOISE)
-    replay = scenario_from_window(window).simulate(truth).simulation(0)
+    replay = scenario_from_window(window, actuator=THESIS.params, hinge=THESIS.hinge).simulate(truth).simulation(0)
     # Command through knots and back, the start through a parabola, the load from the log: tiny differences.
     assert np.abs(replay["position_deg"] - window.signals["position_deg"]).max() < 0.02
     assert np.abs(replay["current_a"] - window.signals["current_a"]).mean() < 0.2
@@ -21,7 +22,7 @@ def test_a_clean_window_is_reproduced_by_its_own_scenario():
 
 def test_initial_state_is_read_through_the_noise():
     window = synthetic_window(HealthParams.single(), seed=5, duration_s=0.05)
-    state = initial_state(window)
+    state = initial_state(window, actuator=THESIS.params)
     assert state.position_deg == pytest.approx(0.0, abs=0.02)
     assert state.motor_speed_radps == pytest.approx(0.0, abs=2.0)
     assert isinstance(state, InitialState)
@@ -29,18 +30,25 @@ def test_initial_state_is_read_through_the_noise():
 
 def test_window_noise_is_estimated_against_the_clean_model():
     window = synthetic_window(HealthParams.single(), seed=6, duration_s=0.2)
-    estimated = window_noise(window, scenario_from_window(window), HealthParams.single())
+    estimated = window_noise(
+        window, scenario_from_window(window, actuator=THESIS.params, hinge=THESIS.hinge), HealthParams.single()
+    )
     truth = SensorNoise()
     assert estimated.motor_speed_radps == pytest.approx(truth.motor_speed_radps, rel=0.25)
     assert estimated.current_a == pytest.approx(truth.current_a, rel=0.25)
     assert estimated.hinge_moment_nm == pytest.approx(truth.hinge_moment_nm, rel=0.25)
     clean = synthetic_window(HealthParams.single(), seed=6, duration_s=0.2, noise=NO_NOISE)
-    assert window_noise(clean, scenario_from_window(clean), HealthParams.single()).motor_speed_radps < 0.1
+    assert (
+        window_noise(
+            clean, scenario_from_window(clean, actuator=THESIS.params, hinge=THESIS.hinge), HealthParams.single()
+        ).motor_speed_radps
+        < 0.1
+    )
 
 
 def test_noisy_simulations_are_seeded_and_keep_their_clean_residual():
     window = synthetic_window(HealthParams.single(), seed=7, duration_s=0.05)
-    scenario = scenario_from_window(window)
+    scenario = scenario_from_window(window, actuator=THESIS.params, hinge=THESIS.hinge)
     health = HealthParams(np.full(8, 0.1), np.linspace(0.04, 0.06, 8), np.full(8, 0.85))
     a = simulate_noisy(scenario, health, window, HealthParams.single(), 3, 2)
     b = simulate_noisy(scenario, health, window, HealthParams.single(), 3, 2)

@@ -42,9 +42,11 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, replace
+from typing import Literal
 
 import numpy as np
 
+from sim.actuator import Airframe
 from sim.aircraft import HingeGeometry
 from sim.checks import InputError
 from sim.params import ActuatorParams
@@ -58,7 +60,7 @@ from training.prepare.departures.drive_constants import BESIDE
 from training.prepare.departures.hinge_gain import divided_hinge, free_load_fit
 from training.stats import JACKKNIFE_BLOCKS, jackknife_std
 
-TOLERANCE = 0.1  # how far the spec's C_hδ (a design estimate) may be from an airframe's, relative
+TOLERANCE = Airframe.model_fields["tolerance"].default  # how far the airframe's C_hδ may be off: the document's default
 DEPART_STDS = 2.0  # stds beyond the tolerance by which a ratio departs: the gauge is off by it
 SUSPECT_STDS = 1.0  # stds beyond the tolerance by which a ratio puts the gauge in doubt
 FIT_STDS = 2.0  # a ratio read at another lag fits within the tolerance and this many stds ...
@@ -81,6 +83,8 @@ class AircraftCheck:
     decisive: bool = False  # the window spans ``DECISIVE_SPANS`` of the band's longer span
     factor: float = 1.0  # the moment divided by this before the window's own gain is read: the ratio, where it departs
     spread: dict[str, float] = field(default_factory=dict)  # per target, the std the two ends add
+    skipped: Literal["on_ground", "no_airframe"] | None = None  # why no aircraft model applies
+    tolerance: float = TOLERANCE  # how far the airframe's C_hδ may be from the real one (``sim.actuator.Airframe``)
 
     @property
     def readable(self) -> bool:
@@ -88,7 +92,7 @@ class AircraftCheck:
 
     def beyond(self, stds: float) -> bool:
         """Whether the ratio lies beyond the tolerance by ``stds`` of its stds."""
-        return bool(abs(self.ratio - 1.0) > TOLERANCE + stds * self.ratio_std)
+        return bool(abs(self.ratio - 1.0) > self.tolerance + stds * self.ratio_std)
 
     @property
     def in_doubt(self) -> bool:
@@ -131,22 +135,29 @@ def slope(
     return value, max(white, jackknife) if np.isfinite(jackknife) else math.inf, correlation
 
 
-def check_against_aircraft(window: Window, hinge: HingeGeometry = HingeGeometry()) -> AircraftCheck:
+def check_against_aircraft(
+    window: Window, hinge: HingeGeometry | None, tolerance: float = TOLERANCE
+) -> AircraftCheck:
     """The ratio of ``window``'s moment to the aircraft's, or an InputError naming the moment where it
-    was exported out of step or lies outside ``GROSS`` (module docstring, 1 and 2)."""
-    rate, signals, condition = window.sample_rate_hz, window.signals, window.flight_condition
+    was exported out of step or lies outside ``GROSS`` (module docstring, 1 and 2); ``tolerance``: how far
+    the airframe's C_hδ may be off. Skipped on the ground (the logged moment is the load) and without the
+    airframe's ``hinge`` model, and said so."""
+    condition = window.flight_condition
+    if condition is None or hinge is None:
+        return AircraftCheck(skipped="on_ground" if condition is None else "no_airframe")
+    rate, signals = window.sample_rate_hz, window.signals
     per_deg = hinge.per_deflection_nm_per_rad(condition) * math.pi / 180.0
     bands = (band_part(signals["hinge_moment_nm"], rate), band_part(signals["position_deg"], rate))
     noise_var = band_noise_variance(signals["position_deg"], rate)
     span = kernel_samples(rate, BAND_S[0])
     value, std, correlation = slope(*bands, 0, noise_var, span)
     decisive = window.n_samples / rate >= DECISIVE_SPANS * BAND_S[1]
-    read = AircraftCheck(value / per_deg, std / abs(per_deg), per_deg * 180.0 / math.pi, decisive)
+    read = AircraftCheck(value / per_deg, std / abs(per_deg), per_deg * 180.0 / math.pi, decisive, tolerance=tolerance)
     against = (
         f"its part that follows the deflection is {read.ratio:.3g} ± {read.ratio_std:.2g}x the aircraft's at "
         f"{condition.airspeed_mps:g} m/s, {condition.altitude_m:g} m (q̄·S_e·c_e·C_hδ = {per_deg:.3g} N·m/deg)"
     )
-    shifted = out_of_step(bands, noise_var, per_deg, rate, correlation, span)
+    shifted = out_of_step(bands, noise_var, per_deg, rate, correlation, span, tolerance)
     if shifted is not None:
         lag_s, at_lag, unexplained = shifted
         raise InputError(
@@ -166,7 +177,13 @@ def check_against_aircraft(window: Window, hinge: HingeGeometry = HingeGeometry(
 
 
 def out_of_step(
-    bands: tuple[np.ndarray, np.ndarray], noise_var: float, per_deg: float, rate: float, correlation: float, span: int
+    bands: tuple[np.ndarray, np.ndarray],
+    noise_var: float,
+    per_deg: float,
+    rate: float,
+    correlation: float,
+    span: int,
+    tolerance: float = TOLERANCE,
 ) -> tuple[float, AircraftCheck, float] | None:
     """The lag of ``STEP_LAGS_S`` [s] the moment read that much later fits the aircraft's at (within the
     tolerance and ``FIT_STDS``) leaving the least of what lag 0 leaves unexplained (1 − correlation²),
@@ -177,7 +194,7 @@ def out_of_step(
         if not 0 < abs(lag) < len(bands[0]) // 4:
             continue
         value, std, at_correlation = slope(*bands, lag, noise_var, span)
-        at_lag = AircraftCheck(value / per_deg, std / abs(per_deg))
+        at_lag = AircraftCheck(value / per_deg, std / abs(per_deg), tolerance=tolerance)
         unexplained = (1.0 - at_correlation**2) / max(1.0 - correlation**2, 1e-12)
         best = STEP_UNEXPLAINED if found is None else found[2]
         if at_lag.readable and not at_lag.beyond(FIT_STDS) and unexplained < best:
@@ -193,7 +210,7 @@ def divided_out(read: AircraftCheck) -> AircraftCheck:
 
 
 def banded(
-    read: AircraftCheck, window: Window, gain: float, actuator: ActuatorParams = ActuatorParams()
+    read: AircraftCheck, window: Window, gain: float, actuator: ActuatorParams
 ) -> AircraftCheck:
     """``read`` with the stds it adds to FDJ and η_O of ``window`` (its ratio divided out already, where
     it departs) where the window's own loads read no ``gain`` (``training.prepare.departures.hinge_gain``); as it is
@@ -202,7 +219,7 @@ def banded(
     In doubt, the whole reading moves (``training.prepare.departures.read``)."""
     if gain != 1.0 or read.factor == 1.0 or not read.beyond(SUSPECT_STDS):
         return read
-    band = math.hypot(TOLERANCE, read.ratio_std / read.ratio)
+    band = math.hypot(read.tolerance, read.ratio_std / read.ratio)
     fitted = free_load_fit(window, actuator, BESIDE)
     if fitted is not None:
         own, own_std = float(fitted[0][0]), float(jackknife_std(fitted[0][None, 1:])[0])
@@ -222,13 +239,21 @@ def _moved(window: Window, actuator: ActuatorParams, first: float, second: float
 
 
 def aircraft_note(read: AircraftCheck) -> list[Note]:
-    """The disagreement, for the result's notes."""
+    """The disagreement, or why no aircraft model applied, for the result's notes."""
+    if read.skipped == "on_ground":
+        text = ("logged on the ground (no flight_condition): no aircraft model applies, the logged hinge moment is "
+                "the load, and the strain gauge is not checked against an aircraft")  # fmt: skip
+        return [Note(code="on_ground", text=text)]
+    if read.skipped == "no_airframe":
+        text = ("the actuator's document holds no airframe: the hinge moment's gain is not checked against the "
+                "aircraft model (its loads in Eq. 5.1 still read it)")  # fmt: skip
+        return [Note(code="aircraft_check_skipped", parameter="hinge_moment_nm", text=text)]
     if read.factor == 1.0 and not read.spread:
         return []
     against = (
         f"the hinge moment's part that follows the deflection is {read.ratio:.3f} ± {read.ratio_std:.3f}x the "
         f"aircraft model's at this flight condition (q̄·S_e·c_e·C_hδ = {read.per_rad_nm:.4g} N·m/rad), beyond the "
-        f"model's {100 * TOLERANCE:.0f} % tolerance"
+        f"model's {100 * read.tolerance:.0f} % tolerance"
     )
     if read.factor == 1.0:
         return [Note(code="hinge_vs_aircraft_undecided", parameter="hinge_moment_nm", text=

@@ -83,11 +83,11 @@ KERNEL_FREE_RATE_HZ = 5_000.0
 class DriveConstants:
     """γ and ΔJ read on a window (0: the spec's), and what their stds add to FDJ's and η_O's."""
 
+    spec: ActuatorParams  # the drive's constants the departures are read against
     torque_scale: float = 0.0  # γ: the motor's torque is (1 + γ)·k_T·I
     inertia_kgm2: float = 0.0  # ΔJ beyond the spec's J_M
     stds: dict[str, float] = field(default_factory=dict)  # per field read, its std
     spread: dict[str, float] = field(default_factory=dict)  # per target, the std the constants' uncertainty adds
-    spec: ActuatorParams = ActuatorParams()
     alternative: DriveConstants | None = None  # where the window did not tell ΔJ from this γ: the ΔJ reading
     unit_scale: float = 0.0  # γ fitted alone beyond any motor, its answer's gap in ``spread`` (``unit_story``)
 
@@ -122,7 +122,7 @@ def _fit(window: Window, actuator: ActuatorParams, settings: FitSettings) -> Fri
     return fit_as_read(window.signals, window.sample_rate_hz, actuator, settings)
 
 
-def read_drive_constants(window: Window, actuator: ActuatorParams = ActuatorParams()) -> DriveConstants:
+def read_drive_constants(window: Window, actuator: ActuatorParams) -> DriveConstants:
     """γ or ΔJ where it stands out (module docstring), with FDJ's and η_O's change across it ± its std. Where
     both do, the likelier if the window decides (``DECISIVE``); else γ, with ΔJ beside it as the
     ``alternative`` (``training.prepare.departures.read`` replays both, or widens the stds by their gap)."""
@@ -174,9 +174,11 @@ def no_drive_error(gamma: float, inertia_alone: FrictionFit, spec: ActuatorParam
         return None
     return InputError(
         "signals.current_a",
-        f"Eq. 5.1 balances the window only with the motor's torque {1 + gamma:.3g}x k_T·I (or J_M {1 + inertia:.3g}x "
-        f"the spec's), beyond any drive's (±{PLAUSIBLE['torque_scale']:.0%}, ±{PLAUSIBLE['inertia']:.0%}): the current "
-        "in other units, or a shunt's voltage?",
+        f"Eq. 5.1 balances the window only with the motor giving {1 + gamma:.3g}x the document's k_T·I (a k_T of "
+        f"{(1 + gamma) * spec.torque_constant_nm_per_a:.3g} N·m/A against its {spec.torque_constant_nm_per_a:g}), or "
+        f"with J_M {1 + inertia:.3g}x the document's {spec.inertia_kgm2:g} kg·m², beyond any drive's departure "
+        f"(±{PLAUSIBLE['torque_scale']:.0%}, ±{PLAUSIBLE['inertia']:.0%}): is the actuator's document the right one? "
+        "Else the current is in other units, or a shunt's voltage",
     )
 
 
@@ -250,10 +252,12 @@ def drive_constants_note(read: DriveConstants) -> list[Note]:
     if constants is not None:
         notes.append(Note(code="drive_constants", text=constants))
     if read.unit_scale:
+        kt = read.spec.torque_constant_nm_per_a
         notes.append(Note(code="current_units", parameter="current_a", text=(
-            f"Eq. 5.1 balances the window as well with the motor giving {1 + read.unit_scale:.3g}x the spec's k_T·I, "
-            "which no motor does: a current logged in other units (RMS for amplitude?) would read so, and the stds "
-            "include what that reading would change"
+            f"Eq. 5.1 balances the window as well with the motor giving {1 + read.unit_scale:.3g}x the document's "
+            f"k_T·I (a k_T of {(1 + read.unit_scale) * kt:.3g} N·m/A against its {kt:g}), which no drive departs by: "
+            "the actuator's document may not be this actuator's, or the current is logged in other units (RMS for "
+            "amplitude?); the stds include what that reading would change"
         )))  # fmt: skip
     return notes
 

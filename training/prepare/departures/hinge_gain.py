@@ -111,7 +111,7 @@ def _margin(window: Window, actuator: ActuatorParams, free_rms: float, used: int
     return rms_log_likelihood_ratio(best, free_rms, used, rate)
 
 
-def read_hinge_gain(window: Window, actuator: ActuatorParams = ActuatorParams(), leading: bool = False) -> HingeGain:
+def read_hinge_gain(window: Window, actuator: ActuatorParams, leading: bool = False) -> HingeGain:
     """g where it stands out and is plausible (module docstring), with FDJ's and η_O's change across g ± its
     std; ``leading``: only where it also explains the window ``DECISIVE`` (ln LR) better than γ or ΔJ alone,
     each beside an offset and ΔC, to be read before them (which would each take a part of it)."""

@@ -25,6 +25,7 @@ from functools import cached_property
 
 import numpy as np
 
+from sim.actuator import Actuator
 from sim.checks import InputError
 from sim.noise import SensorNoise
 from sim.params import ActuatorParams
@@ -32,7 +33,7 @@ from sim.window import Window
 from training.documents import Note
 from training.physics.features import fit_as_read
 from training.physics.noise import white_noise_std
-from training.physics.scenario import CLEAR_MARGIN, MAX_RATIO, following_error, inside
+from training.physics.scenario import CLEAR_MARGIN, MAX_RATIO, following_error, inside, scenario_from_window
 from training.prepare.departures.aircraft_check import AircraftCheck, banded, divided_out
 from training.prepare.departures.drive_constants import UNDECIDED_SHARE, DriveConstants, read_drive_constants
 from training.prepare.departures.hinge_gain import HingeGain, read_hinge_gain
@@ -55,9 +56,9 @@ class Known:
 
 @dataclass(frozen=True)
 class Departures:
-    window: Window  # zeroed, its current on the spec's k_T
+    window: Window  # zeroed, its current on the document's k_T
+    drive: DriveConstants  # γ and ΔJ, and the drive's constants they were read against
     offset: ZeroOffset = field(default_factory=ZeroOffset)
-    drive: DriveConstants = field(default_factory=DriveConstants)
     viscosity: Viscosity = field(default_factory=Viscosity)
     hinge: HingeGain = field(default_factory=HingeGain)
     aircraft: AircraftCheck = field(default_factory=AircraftCheck)
@@ -77,7 +78,7 @@ class Departures:
 
 def read_departures(
     window: Window,
-    actuator: ActuatorParams = ActuatorParams(),
+    actuator: Actuator,
     aircraft: AircraftCheck = AircraftCheck(),
     known: Known = Known(),
 ) -> Departures:
@@ -110,21 +111,21 @@ def _doubted(read: Departures, divided: Departures) -> Departures:
     return replace(read, aircraft=replace(read.aircraft, spread=spread))
 
 
-def _read(window: Window, actuator: ActuatorParams, aircraft: AircraftCheck, known: Known) -> Departures:
+def _read(window: Window, actuator: Actuator, aircraft: AircraftCheck, known: Known) -> Departures:
     """``read_departures`` with ``aircraft``'s factor as decided."""
-    zero = known.zero
+    zero, spec = known.zero, actuator.params
     window = aircraft.corrected(window)
-    offset = read_zero_offset(window, actuator, zero)
-    hinge = read_hinge_gain(zeroed(window, offset), actuator, leading=True)
+    offset = read_zero_offset(window, spec, zero)
+    hinge = read_hinge_gain(zeroed(window, offset), spec, leading=True)
     if hinge.gain != 1.0:  # a logged g·H + b: the offset, b/g once the gain is taken off, read again
         window = hinge.corrected(window)
-        offset = read_zero_offset(window, actuator, zero)
-    drive = read_drive_constants(zeroed(window, offset), actuator)
+        offset = read_zero_offset(window, spec, zero)
+    drive = read_drive_constants(zeroed(window, offset), spec)
     read = _along(window, offset, drive, hinge, aircraft, zero)
     if drive.alternative is None:
         return read
     other = _along(window, offset, drive.alternative, hinge, aircraft, zero)
-    told = _told_apart(window, read, other) or _by_history(read, other, known)
+    told = _told_apart(window, read, other, actuator) or _by_history(read, other, known)
     if told is not None:
         return replace(told, drive=replace(told.drive, alternative=None))
     mine, theirs = read.answer, other.answer
@@ -132,7 +133,7 @@ def _read(window: Window, actuator: ActuatorParams, aircraft: AircraftCheck, kno
     return replace(read, drive=replace(drive, spread=spread))
 
 
-def _told_apart(window: Window, scale: Departures, inertia: Departures) -> Departures | None:
+def _told_apart(window: Window, scale: Departures, inertia: Departures, actuator: Actuator) -> Departures | None:
     """The reading whose simulation follows the window's motor speed and current clearly better
     (``CLEAR_MARGIN``), or None: γ as a torque constant or as a current sensor's gain, whichever
     follows better, against ΔJ; each at its own answer, with the viscous coefficient it read. Only
@@ -146,7 +147,9 @@ def _told_apart(window: Window, scale: Departures, inertia: Departures) -> Depar
 
     def error(read: Departures, effect: str, **parameters: float) -> float:
         effects = read.viscosity.effects().with_effect(effect, **parameters)
-        return following_error(window, effects, inside(read.answer["FDJ"], read.answer["eta_O"]), noise)
+        scenario = scenario_from_window(window, actuator.params, actuator.hinge, effects)
+        health = inside(read.answer["FDJ"], read.answer["eta_O"], actuator.nominal.fdj_nm)
+        return following_error(scenario, window, health, noise)
 
     factor = scale.drive.torque_factor
     errors = (
@@ -196,7 +199,7 @@ def _along(
         hinge = read_hinge_gain(window, drive.actuator)
         window = hinge.corrected(window)
     aircraft = banded(aircraft, window, hinge.gain, drive.actuator)
-    return Departures(window, offset, drive, read_viscosity(window, drive.actuator), hinge, aircraft)
+    return Departures(window, drive, offset, read_viscosity(window, drive.actuator), hinge, aircraft)
 
 
 def history_note(read: Departures) -> list[Note]:

@@ -63,17 +63,17 @@ class Viscosity:
     change_nms: float = 0.0  # ΔC [N·m·s/rad] at the motor shaft
     change_std_nms: float = 0.0
     spread: dict[str, float] = field(default_factory=dict)  # per target, the std C's uncertainty adds
-    spec_nms: float = ActuatorParams().viscous_nms  # the C_M it was read against
+    spec_nms: float = 0.0  # the C_M it was read against
     leaning_nms: float = 0.0  # where no change was read: the ΔC the window leans to, weighed into ``spread``
     leaning_weight: float = 0.0  # the posterior weight of "C is off by ``leaning_nms``"
     unseen: bool = False  # the window cannot tell C·|ω| from FDJ: ``spread`` carries a C ``UNSEEN_SHARE`` off
 
     @property
     def factor(self) -> float:
-        """The coefficient read over the spec's."""
-        return 1.0 + self.change_nms / self.spec_nms
+        """The coefficient read over the spec's (1 where none was read, or the spec's is 0)."""
+        return 1.0 + self.change_nms / self.spec_nms if self.change_nms and self.spec_nms > 0 else 1.0
 
-    def actuator(self, spec: ActuatorParams = ActuatorParams()) -> ActuatorParams:
+    def actuator(self, spec: ActuatorParams) -> ActuatorParams:
         """The actuator every fit of the window reads it with."""
         return replace(spec, viscous_nms=spec.viscous_nms + self.change_nms) if self.change_nms else spec
 
@@ -82,7 +82,7 @@ class Viscosity:
         return EffectSet({"viscous": {"coefficient_nms": self.change_nms}}) if self.change_nms else EffectSet()
 
 
-def read_viscosity(window: Window, spec: ActuatorParams = ActuatorParams()) -> Viscosity:
+def read_viscosity(window: Window, spec: ActuatorParams) -> Viscosity:
     """ΔC where it stands out, with FDJ's and η_O's change across C ± its std; elsewhere the spec's C,
     with what the change the window leans to would move them, by its weight (module docstring)."""
     rate = window.sample_rate_hz

@@ -121,7 +121,7 @@ def second_weight(first: FrictionFit, second: FrictionFit, rate: float) -> float
 
 
 def read_zero_offset(
-    window: Window, actuator: ActuatorParams = ActuatorParams(), carried: ZeroOffset | None = None
+    window: Window, actuator: ActuatorParams, carried: ZeroOffset | None = None
 ) -> ZeroOffset:
     """The window's constant torque beyond friction, where the fit with it explains the window ``DECISIVE_Z``
     stds better, and the two readings of it (module docstring) weighed; the zero ``carried`` from a window

@@ -6,6 +6,7 @@ import math
 import numpy as np
 import pytest
 
+from sim.actuator import THESIS
 from sim.checks import InputError
 from sim.window import window_from_dict
 from tests.foreign.careless import SLIPS, exported
@@ -57,7 +58,7 @@ def test_the_std_holds_where_a_filter_correlates_the_noise():
 def test_foreign_windows_agree_with_the_aircraft_within_the_tolerance():
     windows = [draw(s, FAMILIES[s % 5]) for s in SEEDS] + [worn(s, family=FAMILIES[s % 5]) for s in SEEDS]
     windows += [through_filters(draw(s, FAMILIES[s % 5]), {"hinge_moment_nm": 20}) for s in SEEDS[:5]]
-    reads = [check_against_aircraft(window_from_dict(w.document)) for w in windows]
+    reads = [check_against_aircraft(window_from_dict(w.document), hinge=THESIS.hinge) for w in windows]
     assert all(not r.beyond(DEPART_STDS) for r in reads), [(r.ratio, r.ratio_std) for r in reads]
     readable = [r for r in reads if r.readable]
     assert len(readable) >= 20 and np.median([abs(r.ratio - 1.0) for r in readable]) < 0.03
@@ -67,7 +68,7 @@ def test_foreign_windows_agree_with_the_aircraft_within_the_tolerance():
 def test_a_moment_far_from_the_aircraft_is_refused_naming_it(slip):
     for seed in SEEDS[:5]:
         with pytest.raises(InputError) as refused:
-            check_against_aircraft(_window(draw(seed, FAMILIES[seed % 5]).document, slip))
+            check_against_aircraft(_window(draw(seed, FAMILIES[seed % 5]).document, slip), hinge=THESIS.hinge)
         assert refused.value.field == "signals.hinge_moment_nm"
 
 
@@ -75,7 +76,9 @@ def test_a_moment_exported_out_of_step_is_refused_with_its_lag():
     refused = []
     for seed in SEEDS:
         try:
-            check_against_aircraft(_window(draw(seed, FAMILIES[seed % 5]).document, "hinge moment 20 ms out of step"))
+            check_against_aircraft(
+                _window(draw(seed, FAMILIES[seed % 5]).document, "hinge moment 20 ms out of step"), hinge=THESIS.hinge
+            )
         except InputError as error:
             refused.append(error)
     assert len(refused) >= 7 and all(e.field == "signals.hinge_moment_nm" for e in refused)
@@ -89,7 +92,9 @@ def test_a_moment_in_lbf_ft_is_refused_or_its_gain_read():
     caught = 0
     for seed in SEEDS:
         try:
-            slipped = prepare(_window(draw(seed, FAMILIES[seed % 5]).document, "hinge moment in lbf·ft"))
+            slipped = prepare(
+                _window(draw(seed, FAMILIES[seed % 5]).document, "hinge moment in lbf·ft"), actuator=THESIS
+            )
         except InputError as refused:
             caught += refused.field == "signals.hinge_moment_nm"
             continue
@@ -101,33 +106,44 @@ def test_a_moment_in_lbf_ft_is_refused_or_its_gain_read():
 def test_the_aircrafts_gain_is_divided_out_and_its_band_covers_the_true_moments_answer(seed):
     drawn = draw(seed, FAMILIES[seed % 5])
     true, slipped = _window(drawn.document), _window(drawn.document, "hinge moment in lbf·ft")
-    read = divided_out(check_against_aircraft(slipped))
-    assert read.factor == pytest.approx(0.7376, abs=2 * read.ratio_std) and aircraft_note(read)[0].code == "hinge_vs_aircraft"
+    read = divided_out(check_against_aircraft(slipped, hinge=THESIS.hinge))
+    assert (
+        read.factor == pytest.approx(0.7376, abs=2 * read.ratio_std)
+        and aircraft_note(read)[0].code == "hinge_vs_aircraft"
+    )
     corrected = read.corrected(slipped)
-    read = banded(read, corrected, gain=1.0)
-    fitted = fit_as_read(corrected.signals, slipped.sample_rate_hz)
-    answer = fit_as_read(true.signals, true.sample_rate_hz)
+    read = banded(read, corrected, gain=1.0, actuator=THESIS.params)
+    fitted = fit_as_read(corrected.signals, slipped.sample_rate_hz, actuator=THESIS.params)
+    answer = fit_as_read(true.signals, true.sample_rate_hz, actuator=THESIS.params)
     assert abs(fitted.eta_o[0] - answer.eta_o[0]) <= 2 * np.hypot(read.spread["eta_O"], fitted.eta_o_std[0])
     assert abs(fitted.fdj_nm[0] - answer.fdj_nm[0]) <= 2 * np.hypot(read.spread["FDJ"], fitted.fdj_std_nm[0])
-    assert banded(divided_out(check_against_aircraft(slipped)), corrected, gain=0.98).spread == {}  # loads read one
-    assert divided_out(check_against_aircraft(true)).factor == 1.0
+    assert (
+        banded(
+            divided_out(check_against_aircraft(slipped, hinge=THESIS.hinge)),
+            corrected,
+            gain=0.98,
+            actuator=THESIS.params,
+        ).spread
+        == {}
+    )  # loads read one
+    assert divided_out(check_against_aircraft(true, hinge=THESIS.hinge)).factor == 1.0
 
 
 def test_the_ratio_is_reported_where_the_deflection_moves():
-    done = conditioning_done(prepare(window_from_dict(draw(4611, "gust").document)))
+    done = conditioning_done(prepare(window_from_dict(draw(4611, "gust").document), actuator=THESIS))
     assert done["hinge_aircraft_ratio"] == pytest.approx(1.0, abs=TOLERANCE)
 
 
 def test_a_ratio_just_beyond_the_tolerance_leaves_the_moment_as_logged_and_widens_the_stds():
     drawn = draw(4612, "doublet")
-    as_drawn = check_against_aircraft(window_from_dict(drawn.document))
+    as_drawn = check_against_aircraft(window_from_dict(drawn.document), hinge=THESIS.hinge)
     gain = (1.0 - TOLERANCE - 1.5 * as_drawn.ratio_std) / as_drawn.ratio  # beyond by 1.5 stds: in doubt
     window = window_from_dict(with_hinge_gain(drawn, gain).document)
-    read = divided_out(check_against_aircraft(window))
+    read = divided_out(check_against_aircraft(window, hinge=THESIS.hinge))
     assert read.factor == 1.0 and read.in_doubt
-    doubted = read_departures(window, aircraft=read).aircraft
+    doubted = read_departures(window, aircraft=read, actuator=THESIS).aircraft
     assert doubted.spread["eta_O"] > 0.0 and aircraft_note(doubted)[0].code == "hinge_vs_aircraft_undecided"
-    assert read_departures(window_from_dict(drawn.document), aircraft=as_drawn).aircraft.spread == {}
+    assert read_departures(window_from_dict(drawn.document), aircraft=as_drawn, actuator=THESIS).aircraft.spread == {}
 
 
 def test_where_a_short_window_puts_the_gauge_in_doubt_the_stds_reach_the_moment_read_in_newton_metres():
@@ -138,11 +154,11 @@ def test_where_a_short_window_puts_the_gauge_in_doubt_the_stds_reach_the_moment_
     for seed in range(4600, 4630):
         drawn = draw(seed, "gust", duration_s=0.1)
         slipped = _window(drawn.document, "hinge moment in lbf·ft")
-        read = divided_out(check_against_aircraft(slipped))
+        read = divided_out(check_against_aircraft(slipped, hinge=THESIS.hinge))
         assert not read.decisive and read.factor == 1.0
         if not read.in_doubt:
             continue
-        prepared = prepare(slipped)
+        prepared = prepare(slipped, actuator=THESIS)
         fitted = fit_as_read(prepared.departures.window.signals, slipped.sample_rate_hz, prepared.departures.actuator)
         stds = widened({"FDJ": float(fitted.fdj_std_nm[0]), "eta_O": float(fitted.eta_o_std[0])}, prepared)
         answer = prepared.departures.answer

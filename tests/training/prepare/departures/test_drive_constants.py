@@ -3,6 +3,7 @@ sensor gain, fed back through its loop, and inertia)."""
 
 import pytest
 
+from sim.actuator import THESIS
 from sim.checks import InputError
 from sim.window import window_from_dict
 from tests.foreign.windows import Effects, draw
@@ -15,7 +16,7 @@ FAMILIES = ("thesis", "cruise", "gust", "doublet", "steps")
 
 def _read(seed: int, effects: Effects) -> DriveConstants:
     drawn = draw(seed, FAMILIES[seed % 5], effects=effects)
-    return prepare(window_from_dict(drawn.document)).departures.drive
+    return prepare(window_from_dict(drawn.document), actuator=THESIS).departures.drive
 
 
 @pytest.mark.parametrize("gain", [0.96, 1.02, 1.05])
@@ -56,10 +57,10 @@ def test_a_heavier_inertia_the_window_cannot_tell_from_a_weaker_motor_widens_the
 def test_the_specs_constants_are_left_alone():
     """On 420 clean foreign windows of every benchmark group no constant stood MIN_Z stds out; nor do a sensor
     off zero or a viscous coefficient 1.2–2x the spec's pass for one."""
-    assert all(_read(seed, Effects()) == DriveConstants() for seed in range(70, 80))
-    assert _read(80, Effects(hinge_bias_nm=8.0)) == DriveConstants()
-    assert _read(81, Effects(current_bias_a=-0.2)) == DriveConstants()
-    assert _read(82, Effects(viscous_factor=1.8)) == DriveConstants()
+    assert all(_read(seed, Effects()) == DriveConstants(THESIS.params) for seed in range(70, 80))
+    assert _read(80, Effects(hinge_bias_nm=8.0)) == DriveConstants(THESIS.params)
+    assert _read(81, Effects(current_bias_a=-0.2)) == DriveConstants(THESIS.params)
+    assert _read(82, Effects(viscous_factor=1.8)) == DriveConstants(THESIS.params)
 
 
 def _logged_scaled(seed: int, factor: float) -> dict:
@@ -74,21 +75,24 @@ def test_a_current_in_other_units_is_refused_naming_it(factor):
     """Before, FDJ 3–11 ranges off, said weak with stds of hundreds of ranges."""
     for seed in range(100, 105):
         with pytest.raises(InputError) as refused:
-            prepare(window_from_dict(_logged_scaled(seed, factor)))
+            prepare(window_from_dict(_logged_scaled(seed, factor)), actuator=THESIS)
         assert refused.value.field == "signals.current_a" and "other units" in str(refused.value), seed
 
 
 def test_a_heavy_rotor_within_the_plausible_is_read_not_refused():
     """J_M 1.45x reads γ −0.33 to −0.46 fitted alone, past γ's bound: ΔJ, within its own, keeps it a drive."""
     for seed in range(105, 110):
-        prepare(window_from_dict(draw(seed, FAMILIES[seed % 5], effects=Effects(inertia_factor=1.45)).document))
+        prepare(
+            window_from_dict(draw(seed, FAMILIES[seed % 5], effects=Effects(inertia_factor=1.45)).document),
+            actuator=THESIS,
+        )
 
 
 def test_a_current_logged_as_rms_is_weighed_as_the_story_it_may_be():
     """0.71x reads as a motor 1.41x as strong beyond any drive, or as a rotor ~0.7x as heavy: not refused,
     the stds carry the gap; a J_M 1.1x (γ within any motor's) carries none."""
     for seed in range(110, 115):
-        read = prepare(window_from_dict(_logged_scaled(seed, 0.7071))).departures.drive
+        read = prepare(window_from_dict(_logged_scaled(seed, 0.7071)), actuator=THESIS).departures.drive
         assert read.unit_scale == pytest.approx(1 / 0.7071 - 1, abs=0.03) and read.spread["FDJ"] > 0.002, seed
         heavier = _read(seed, Effects(inertia_factor=1.1))
         assert heavier.unit_scale == 0.0, seed
@@ -101,7 +105,7 @@ def test_a_current_logged_as_rms_is_answered_weak_and_within_its_std():
     within = 0
     for seed in range(110, 115):
         truth = draw(seed, FAMILIES[seed % 5]).truth
-        found = estimate_window(window_from_dict(_logged_scaled(seed, 0.7071))).estimates.FDJ
+        found = estimate_window(window_from_dict(_logged_scaled(seed, 0.7071)), actuator=THESIS).estimates.FDJ
         assert found.weakly_determined, seed
         within += abs(found.value - truth["FDJ"]) < 2 * found.std
     assert within >= 4  # the gap to the γ reading's answer, not its truth: a doublet's 1.05 ranges off at 3 std
@@ -112,6 +116,6 @@ def test_a_slow_logs_inertia_reading_carries_the_kernels_bias(family, seed, rate
     """10 s windows logged slowly read J_M 0.4–1.25 % low through the few-sample kernel, at a jackknife std of
     0.03 %: the spec's J_M must lie within the reading's 2 std."""
     drawn = draw(seed, family, duration_s=10.0, sample_rate_hz=rate_hz)
-    read = prepare(window_from_dict(drawn.document)).departures.drive
+    read = prepare(window_from_dict(drawn.document), actuator=THESIS).departures.drive
     std = read.stds.get("inertia_kgm2", 0.0) / read.spec.inertia_kgm2
     assert read.inertia_kgm2 < 0.0 and abs(read.inertia_factor - 1.0) < 2 * std

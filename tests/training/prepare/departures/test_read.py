@@ -2,6 +2,7 @@
 
 import pytest
 
+from sim.actuator import THESIS
 from sim.window import window_from_dict
 from tests.foreign.windows import Effects, draw, of_the_same_flight, worn
 from training.documents import HistoryReadings, InertiaReading
@@ -15,7 +16,7 @@ def test_where_a_scale_and_an_inertia_cannot_be_told_apart_the_stds_reach_both_e
     """A worn gust window, J_M 0.5 % light: read as γ, its viscous coefficient then read 0.63x and FDJ 66 %
     of range off; read as ΔJ, 1.0x and right. The window cannot tell which: the std must reach both."""
     drawn = worn(32057, family="gust", effects=Effects(inertia_factor=0.99465))
-    prepared = prepare(window_from_dict(drawn.document))
+    prepared = prepare(window_from_dict(drawn.document), actuator=THESIS)
     assert prepared.departures.drive.alternative is not None
     w = prepared.window
     fitted = fit_window(as_read(w.signals, w.sample_rate_hz), w.sample_rate_hz, prepared.actuator)
@@ -30,7 +31,7 @@ def test_a_heavier_inertia_is_told_from_a_weaker_motor_where_the_replay_follows_
     """J_M 1.09x on a thesis window: the likelihood ratio does not decide, but simulated with ΔJ the window's
     speed and current are followed within the noise and with γ they are not (2.1 against 15 noise stds)."""
     drawn = draw(85, "thesis", effects=Effects(inertia_factor=1.09))
-    prepared = prepare(window_from_dict(drawn.document))
+    prepared = prepare(window_from_dict(drawn.document), actuator=THESIS)
     assert prepared.departures.drive.alternative is None and prepared.departures.drive.torque_scale == 0.0
     assert prepared.departures.drive.inertia_factor == pytest.approx(1.09, abs=0.003)
 
@@ -40,14 +41,18 @@ UNDECIDED = [(401, "cruise"), (403, "doublet"), (407, "gust"), (419, "steps"), (
 
 
 def _drive(drawn, inertia: InertiaReading | None = None):
-    return prepare(window_from_dict(drawn.document), known=known_from(HistoryReadings(inertia=inertia))).departures
+    return prepare(
+        window_from_dict(drawn.document), known=known_from(HistoryReadings(inertia=inertia)), actuator=THESIS
+    ).departures
 
 
 @pytest.mark.parametrize(("seed", "family"), UNDECIDED)
 def test_the_actuators_j_m_read_by_a_window_that_could_decides_where_this_one_cannot(seed, family):
     heavier = draw(seed, family, effects=Effects(inertia_factor=1.08))
     assert _drive(heavier).drive.alternative is not None  # alone, undecided
-    thesis = prepare(window_from_dict(of_the_same_flight(heavier, seed + 1000, "thesis", 0.5).document)).departures
+    thesis = prepare(
+        window_from_dict(of_the_same_flight(heavier, seed + 1000, "thesis", 0.5).document), actuator=THESIS
+    ).departures
     read = thesis.drive.inertia_factor, thesis.drive.stds["inertia_kgm2"] / thesis.drive.spec.inertia_kgm2
     assert read[0] == pytest.approx(1.08, abs=0.003)  # a thesis window tells them apart (the replay)
     decided = _drive(heavier, InertiaReading(factor=read[0], std=read[1], window_ids=["thesis"]))
@@ -64,7 +69,9 @@ def test_on_a_worn_actuator_too_the_j_m_its_thesis_window_read_decides(seed, fam
     """Worn (FDJ 1.3–2.5x nominal): read alone, FDJ 29 and 65 % of range off; with the thesis window's J_M, right."""
     heavier = worn(seed, family=family, effects=Effects(inertia_factor=factor))
     assert _drive(heavier).drive.alternative is not None
-    thesis = prepare(window_from_dict(of_the_same_flight(heavier, seed + 1000, "thesis", 0.5).document)).departures
+    thesis = prepare(
+        window_from_dict(of_the_same_flight(heavier, seed + 1000, "thesis", 0.5).document), actuator=THESIS
+    ).departures
     std = thesis.drive.stds["inertia_kgm2"] / thesis.drive.spec.inertia_kgm2
     decided = _drive(heavier, InertiaReading(factor=thesis.drive.inertia_factor, std=std, window_ids=["thesis"]))
     assert decided.inertia_from == ("thesis",) and decided.drive.inertia_factor == pytest.approx(factor, abs=0.005)
@@ -76,7 +83,7 @@ def test_a_gauge_gain_in_doubt_that_only_a_drive_no_one_has_explains_does_not_re
     where α_t answers δ): with that ratio divided out first, Eq. 5.1 wants a motor 0.33x as strong, and the
     window was refused as a current in other units. The story is refuted; the window is answered as logged."""
     drawn = draw(4821, "gust", duration_s=0.1)
-    prepared = prepare(window_from_dict(drawn.document))
+    prepared = prepare(window_from_dict(drawn.document), actuator=THESIS)
     aircraft = prepared.departures.aircraft
     assert aircraft.in_doubt and aircraft.spread == {}
     w = prepared.window

@@ -6,6 +6,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+from sim.actuator import THESIS
 from sim.window import window_from_dict
 from tests.foreign.windows import Draw, Effects, draw, of_the_same_flight
 from training.documents import HistoryReadings, SensorZero
@@ -18,7 +19,9 @@ GEAR, TORQUE_CONSTANT = 500.0, 0.0752
 
 
 def _offset(seed: int, effects: Effects) -> ZeroOffset:
-    return prepare(window_from_dict(draw(seed, FAMILIES[seed % 5], effects=effects).document)).departures.offset
+    return prepare(
+        window_from_dict(draw(seed, FAMILIES[seed % 5], effects=effects).document), actuator=THESIS
+    ).departures.offset
 
 
 def _torque_nm(offset: ZeroOffset) -> float:
@@ -77,14 +80,16 @@ def carried_zero(zero: SensorZero):
 def test_a_window_moving_one_way_takes_off_the_zero_its_flight_read(effects, torque_nm):
     for seed, family in ONE_WAY:
         one_way, both = flight(seed, family, effects)
-        read = prepare(window_from_dict(both.document)).departures.offset
+        read = prepare(window_from_dict(both.document), actuator=THESIS).departures.offset
         assert read.read and _torque_nm(read) == pytest.approx(torque_nm, rel=0.05)
         offset = prepare(
-            window_from_dict(one_way.document), known=carried_zero(sensor_zero(read, "w"))
+            window_from_dict(one_way.document), known=carried_zero(sensor_zero(read, "w")), actuator=THESIS
         ).departures.offset
         assert offset.one_way and offset.carried_from == "w"
         assert _torque_nm(offset) == pytest.approx(_torque_nm(read)) and offset.spread["FDJ"] == read.zero_std_nm
-        assert not prepare(window_from_dict(one_way.document)).departures.offset.current_a  # alone: none known
+        assert not prepare(
+            window_from_dict(one_way.document), actuator=THESIS
+        ).departures.offset.current_a  # alone: none known
 
 
 @pytest.mark.parametrize(("seed", "family"), ONE_WAY[:3])
@@ -92,14 +97,18 @@ def test_a_window_moving_both_ways_takes_its_flights_zero_where_it_holds(seed, f
     """A 0.1 s or 0.5 s window moving both ways reads a zero less precisely than a 1 s cruise of its flight."""
     effects = Effects(current_bias_a=0.1)
     both = draw(seed + 2000, family, duration_s=0.1 if family == "gust" else 0.5, effects=effects)
-    cruise = prepare(window_from_dict(of_the_same_flight(both, seed + 1000).document)).departures.offset
-    alone = prepare(window_from_dict(both.document)).departures.offset
+    cruise = prepare(
+        window_from_dict(of_the_same_flight(both, seed + 1000).document), actuator=THESIS
+    ).departures.offset
+    alone = prepare(window_from_dict(both.document), actuator=THESIS).departures.offset
     assert alone.read and cruise.zero_std_nm < alone.zero_std_nm
-    with_flight = prepare(window_from_dict(both.document), known=carried_zero(sensor_zero(cruise, "w"))).departures
+    with_flight = prepare(
+        window_from_dict(both.document), known=carried_zero(sensor_zero(cruise, "w")), actuator=THESIS
+    ).departures
     assert with_flight.offset.carried_from == "w" and not with_flight.offset.read
     assert _torque_nm(with_flight.offset) == pytest.approx(0.1 * TORQUE_CONSTANT, rel=0.05)
     drifted = carried_zero(SensorZero(window_id="w", hinge_nm=0.0, current_a=0.05, torque_std_nm=1e-5))
-    unheld = prepare(window_from_dict(both.document), known=drifted).departures.offset
+    unheld = prepare(window_from_dict(both.document), known=drifted, actuator=THESIS).departures.offset
     assert (
         unheld.unheld_from == "w"
         and unheld.carried_from is None
