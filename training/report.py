@@ -124,10 +124,13 @@ NO_LOAD_SHARE = 0.02  # a load term under this share of the nominal FDJ: the win
 
 
 def carries_load(prepared: Prepared) -> bool:
-    """Whether the window's load can show η_O: its opposing term (1/η_O − 1)·|H/n| at the nominal η_O, its RMS
-    over the samples Eq. 5.1 reads, reaches ``NO_LOAD_SHARE`` of the nominal FDJ. A pre-flight sweep logs only
-    its gauge's noise there; any flight and any bench load carries more."""
+    """Whether a window on the ground carries a load that can show η_O: its opposing term (1/η_O − 1)·|H/n| at
+    the nominal η_O, its RMS over the samples Eq. 5.1 reads, reaches ``NO_LOAD_SHARE`` of the nominal FDJ. A
+    pre-flight sweep logs only its gauge's noise there, a bench load more. In flight the air always loads the
+    surface: a window that holds little of it says η_O is weakly determined instead."""
     document, w = prepared.document, prepared.window
+    if not w.on_ground:
+        return True
     load_nm = denoised_hinge_nm(w.signals["hinge_moment_nm"], w.signals["position_deg"], w.sample_rate_hz)
     sliding = np.abs(w.signals["motor_speed_radps"]) > FitSettings().sliding_speed_radps(document.params)
     if not np.any(sliding):
