@@ -91,6 +91,7 @@ def history(actuator_id: str, url: str, api_key_file: Path | None, plot: Path | 
             as_json: bool) -> None:  # fmt: skip
     """An actuator's stored estimates, their trend and its remaining useful life."""
     from clients.figures import prognosis_figure
+    from clients.printing import print_prognosis
     from clients.replay import request
     from prognosis.documents import History, Prognosis
 
@@ -104,45 +105,7 @@ def history(actuator_id: str, url: str, api_key_file: Path | None, plot: Path | 
         "history": stored.model_dump(mode="json", by_alias=True),
         "prognosis": prognosis.model_dump(mode="json"),
     }
-    emit(document, as_json, lambda _: _print_history(stored, prognosis, plot))
-
-
-def _print_history(stored: Any, prognosis: Any, plot: Path | None) -> None:
-    click.echo(f"{prognosis.actuator_id}: {len(stored.estimates)} window(s), time in {prognosis.time_unit}")
-    for name, trend in prognosis.trends.items():
-        life = prognosis.remaining_life[name]
-        bending = trend.curved is not None and trend.curved.weight >= 0.5
-        bend = (
-            f", bending {trend.curved.curvature_per_unit2:+.3g} per unit² (weight {trend.curved.weight:.2f})"
-            if bending
-            else ""
-        )
-        level, level_std = trend.now()
-        slope = (
-            "no slope yet"
-            if trend.slope_std is None
-            else f"slope {trend.slope_per_unit:+.3g} ± {trend.slope_std:.2g} per unit{bend}"
-        )
-        click.echo(f"{name:<6} now {level:.5g} ± {level_std:.2g}, {slope}; {life.status}", nl=False)
-        if life.rul is not None:
-            high = "open" if life.rul_high is None else f"{life.rul_high:.3g}"
-            click.echo(f": {life.threshold:g} crossed in {life.rul:.3g} (90 %: {life.rul_low:.3g} to {high})")
-        else:
-            click.echo("")
-    for name, trend in prognosis.sensors.items():
-        slope = (
-            "no slope yet"
-            if trend.slope_std is None
-            else f"slope {trend.slope_per_unit:+.3g} ± {trend.slope_std:.2g} per unit"
-        )
-        click.echo(f"{name} now {trend.level:.4g} ± {trend.level_std:.2g}, {slope} ({trend.n} windows)")
-    if prognosis.inertia is not None:
-        inertia = prognosis.inertia
-        click.echo(f"J_M {inertia.factor:.4f} ± {inertia.std:.2g}x the spec's, as windows that could tell it read it")
-    for note in prognosis.notes:
-        click.echo(f"note [{note.code}]: {note.text}")
-    if plot is not None:
-        click.echo(f"figure: {plot}")
+    emit(document, as_json, lambda _: print_prognosis(stored, prognosis, plot))
 
 
 COMMANDS = (replay, history)

@@ -58,7 +58,8 @@ def calibration_figure(calibrator: Any, path: Path) -> Path:
 
 
 def prognosis_figure(prognosis: Any, parameter: str, path: Path) -> Path:
-    """Estimates with ±2 std, the trend and its band, the threshold and the RUL interval."""
+    """Estimates with ±2 std, the line through them, the weighed laws' forecast (median and 90 % band), the
+    threshold and the RUL interval."""
     plt = _pyplot()
     trend, life = prognosis.trends[parameter], prognosis.remaining_life[parameter]
     t = np.array([p.time for p in trend.points])
@@ -71,13 +72,13 @@ def prognosis_figure(prognosis: Any, parameter: str, path: Path) -> Path:
         axis.plot(t[outlier], v[outlier], "x", color="tab:gray", label="outliers (down-weighted)")
     horizon = life.rul_high if life.rul_high is not None else 1.5 * (life.rul or 0.0)
     grid = np.linspace(t.min(), t.max() + horizon, 200)
-    line = trend.level + trend.slope_per_unit * (grid - t.max())
-    band = 2 * np.array([trend.std_at(offset) for offset in grid - t.max()])
-    axis.plot(grid, line, color="tab:orange", label="trend")
-    if trend.curved is not None and trend.curved.weight >= 0.1:
-        axis.plot(grid, trend.curved.value_at(grid - t.max()), color="tab:orange", ls="--",
-                  label=f"bending trend (weight {trend.curved.weight:.2f})")  # fmt: skip
-    axis.fill_between(grid, line - band, line + band, color="tab:orange", alpha=0.2)
+    axis.plot(grid, trend.level + trend.slope_per_unit * (grid - t.max()), color="tab:gray", lw=0.8, label="line")
+    if trend.forecast:
+        at = np.array([p.time for p in trend.forecast])
+        laws = ", ".join(f"{k} {w:.2f}" for k, w in sorted(trend.laws.items(), key=lambda x: -x[1]) if w >= 0.1)
+        axis.plot(at, [p.median for p in trend.forecast], color="tab:orange", label=f"forecast ({laws})")
+        axis.fill_between(at, [p.low for p in trend.forecast], [p.high for p in trend.forecast], color="tab:orange",
+                          alpha=0.2, label="forecast 90 % band")  # fmt: skip
     axis.axhline(life.threshold, color="tab:red", ls="--", label=f"threshold ({life.direction})")
     if life.rul_low is not None:
         high = t.max() + (life.rul_high if life.rul_high is not None else grid[-1] - t.max())

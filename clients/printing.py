@@ -81,3 +81,44 @@ def print_calibration(report: dict[str, Any]) -> None:
         click.echo(line)
     if report["figure"] is not None:
         click.echo(f"figure: {report['figure']}")
+
+
+def _slope(trend: Any) -> str:
+    if trend.slope_std is None:
+        return "no slope yet"
+    return f"slope {trend.slope_per_unit:+.3g} ± {trend.slope_std:.2g} per unit"
+
+
+def _life(life: Any) -> str:
+    if life.rul is None:
+        return life.status
+    high = "open" if life.rul_high is None else f"{life.rul_high:.3g}"
+    faster = "; speeding up" if life.speeding_up else ""
+    return (f"{life.threshold:g} crossed in {life.rul:.3g} (90 %: {life.rul_low:.3g} to {high}; earliest plausible "
+            f"{life.rul_earliest:.3g}){faster}")  # fmt: skip
+
+
+def print_prognosis(stored: Any, prognosis: Any, plot: Path | None) -> None:
+    """An actuator's outlook per parameter, the laws it weighs, its backtest, its sensors' trends and notes."""
+    click.echo(f"{prognosis.actuator_id}: {len(stored.estimates)} window(s), time in {prognosis.time_unit}")
+    for name, trend in prognosis.trends.items():
+        level, level_std = trend.now()
+        laws = ", ".join(f"{law} {w:.2f}" for law, w in sorted(trend.laws.items(), key=lambda x: -x[1]) if w >= 0.05)
+        life = _life(prognosis.remaining_life[name])
+        click.echo(f"{name:<6} now {level:.5g} ± {level_std:.2g}, {_slope(trend)}; {life}")
+        if laws:
+            click.echo(f"       laws weighed by how they predicted later windows: {laws}")
+        for point in prognosis.backtest.get(name, []):
+            inside = "—" if point.later_inside is None else f"{100 * point.later_inside:.0f} %"
+            said = "no crossing" if point.crossing is None else f"crossing at {point.crossing:.4g}"
+            click.echo(f"       backtest at {point.time:.4g} ({point.windows} windows): {said}; of the "
+                       f"{point.later_windows} later windows {inside} inside its 90 % band")  # fmt: skip
+    for name, trend in prognosis.sensors.items():
+        click.echo(f"{name} now {trend.level:.4g} ± {trend.level_std:.2g}, {_slope(trend)} ({trend.n} windows)")
+    if prognosis.inertia is not None:
+        inertia = prognosis.inertia
+        click.echo(f"J_M {inertia.factor:.4f} ± {inertia.std:.2g}x the spec's, as windows that could tell it read it")
+    for note in prognosis.notes:
+        click.echo(f"note [{note.code}]: {note.text}")
+    if plot is not None:
+        click.echo(f"figure: {plot}")

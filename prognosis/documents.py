@@ -59,6 +59,15 @@ class Curved(Document):
         return self.level + self.slope_per_unit * offset + self.curvature_per_unit2 * offset**2
 
 
+class ForecastPoint(Document):
+    """The forecast at one time: the median of the weighed laws' curves and their 90 % band."""
+
+    time: float
+    median: float
+    low: float = Field(description="5 % quantile")
+    high: float = Field(description="95 % quantile")
+
+
 class Trend(Document):
     """value(t) = level + slope·(t − t_last), weighted by each window's std, robust to outliers; beside it
     the curve where the windows bend (``curved``)."""
@@ -77,6 +86,14 @@ class Trend(Document):
     excess_std: float = Field(description="scatter beyond the stated stds, added to every point's (0: none)")
     points: list[Point]
     curved: Curved | None = Field(None, description="the quadratic and its weight (null: too few windows to bend)")
+    laws: dict[str, float] = Field(
+        default_factory=dict,
+        description="each degradation law's weight: how well it predicted the later windows from the earlier ones "
+        "(linear, quadratic, exponential, power, knee); the forecast draws from each in that share",
+    )
+    forecast: list[ForecastPoint] = Field(
+        default_factory=list, description="the weighed laws' median and 90 % band, from the first window on"
+    )
 
     def now(self) -> tuple[float, float]:
         """The value at the last window and its std, the line's and the curve's weighed by the curve's weight."""
@@ -103,7 +120,29 @@ class RemainingLife(Document):
     rul: float | None = Field(description="time from the last window to the crossing, in the time unit")
     rul_low: float | None = Field(description="5 % quantile")
     rul_high: float | None = Field(description="95 % quantile (null: beyond any horizon the data support)")
+    rul_earliest: float | None = Field(
+        None, description="the earliest plausible crossing: the 5 % quantile of the law that crosses soonest of those "
+        "holding some weight (plan for it if the wear is of that kind)"
+    )
+    speeding_up: bool = Field(False, description="the latest windows move towards the threshold faster than the trend")
     probability_degrading: float | None = Field(description="probability that the trend moves towards the threshold")
+
+
+class BacktestPoint(Document):
+    """The prognosis as it stood at an earlier window, from the windows up to it alone, against what came after."""
+
+    window_id: str = Field(description="the last window it saw")
+    time: float
+    windows: int = Field(description="how many windows it saw")
+    status: str
+    rul: float | None
+    rul_low: float | None
+    rul_high: float | None
+    crossing: float | None = Field(description="the crossing time it predicted (time + rul)")
+    later_windows: int
+    later_inside: float | None = Field(
+        description="share of the later windows inside the forecast's 90 % band then (null: beyond its reach)"
+    )
 
 
 class Prognosis(Document):
@@ -123,6 +162,10 @@ class Prognosis(Document):
         "what a window that cannot is read with (null: none read one)",
     )
     notes: Notes = Field(default_factory=list)
+    backtest: dict[str, list[BacktestPoint]] = Field(
+        default_factory=dict,
+        description="per parameter, the prognosis as it would have stood at earlier windows, against what came after",
+    )
 
 
 class History(Document):

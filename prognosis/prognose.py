@@ -4,11 +4,13 @@ from __future__ import annotations
 
 import datetime as dt
 from collections.abc import Sequence
+from dataclasses import replace
 
 import numpy as np
 
+from prognosis.backtest import backtest
 from prognosis.documents import PARAMETERS, Prognosis, Stored, Trend
-from prognosis.rul import remaining_life
+from prognosis.outlook import Outlook, outlook
 from prognosis.trend import fit_trend
 from sim.actuator import Actuator, Airframe
 from training.documents import Note
@@ -38,24 +40,36 @@ def prognose(actuator_id: str, stored: Sequence[Stored], actuator: Actuator) -> 
         return Prognosis(actuator_id=actuator_id, time_unit="days", trends={}, remaining_life={},
                          notes=[Note(code="no_estimates", text="no estimates stored for this actuator")])  # fmt: skip
     times, unit, note = _times(stored)
-    ids = [s.window_id for s in stored]
-    trends, lives = {}, {}
-    for name in PARAMETERS:
-        read = [(t, e, i) for t, e, i in zip(times, (getattr(s.estimates, name) for s in stored), ids, strict=True)
-                if e is not None]  # fmt: skip
-        if not read:
-            continue
-        values = np.array([e.value for _, e, _ in read])
-        stds = np.array([np.nan if e.std is None else e.std for _, e, _ in read])
-        trends[name] = fit_trend(name, np.array([t for t, _, _ in read]), values, stds, [i for _, _, i in read])
-        lives[name] = remaining_life(trends[name], *actuator.threshold(name))
+    outlooks = {name: seen for name in PARAMETERS if (seen := _outlook(name, stored, times, actuator)) is not None}
     tolerance = actuator.airframe.tolerance if actuator.airframe is not None else AIRFRAME_TOLERANCE
     sensors, said = sensor_trends(stored, times, unit, tolerance)
     inertias = [s.window.inertia_read for s in stored if s.window.inertia_read is not None]
-    changed = inertia_change_note(inertias)
-    return Prognosis(actuator_id=actuator_id, time_unit=unit, trends=trends, remaining_life=lives,  # type: ignore[arg-type]
-                     sensors=sensors, inertia=combined_inertia(inertias),
-                     notes=[n for n in (note, *said, changed) if n])  # fmt: skip
+    faster = [speeding_note(name) for name, seen in outlooks.items() if seen.life.speeding_up]
+    notes = [n for n in (note, *faster, *said, inertia_change_note(inertias)) if n]
+    return Prognosis(actuator_id=actuator_id, time_unit=unit, trends={n: o.trend for n, o in outlooks.items()},
+                     remaining_life={n: o.life for n, o in outlooks.items()}, sensors=sensors,
+                     inertia=combined_inertia(inertias), notes=notes,
+                     backtest={n: o.backtest for n, o in outlooks.items()})  # fmt: skip
+
+
+def _outlook(name: str, stored: Sequence[Stored], times: np.ndarray, actuator: Actuator) -> Outlook | None:
+    """``name``'s outlook over the windows that read it, or None where none did."""
+    read = [(t, e, s.window_id) for t, s in zip(times, stored, strict=True) if (e := getattr(s.estimates, name))]
+    if not read:
+        return None
+    values = np.array([e.value for _, e, _ in read])
+    stds = np.array([np.nan if e.std is None else e.std for _, e, _ in read])
+    times_read, ids = np.array([t for t, _, _ in read]), [i for _, _, i in read]
+    seen = outlook(name, times_read, values, stds, ids, *actuator.threshold(name))
+    return replace(seen, backtest=backtest(name, times_read, values, stds, ids, *actuator.threshold(name)))
+
+
+def speeding_note(name: str) -> Note:
+    return Note(code="speeding_up", parameter=name, text=(
+        f"{name}'s latest windows move towards its threshold faster than its whole history does: wear speeding "
+        "up? The remaining life weighs the laws that accelerate by how well they predicted the later windows; "
+        "plan for the earliest plausible crossing"
+    ))  # fmt: skip
 
 
 def sensor_trends(

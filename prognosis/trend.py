@@ -37,7 +37,7 @@ def _wls(x: np.ndarray, y: np.ndarray, w: np.ndarray, degree: int) -> tuple[np.n
     return covariance @ design.T @ (w * y), covariance
 
 
-def _excess_variance(residual: np.ndarray, variance: np.ndarray, robust: np.ndarray, dof: int) -> float:
+def excess_variance(residual: np.ndarray, variance: np.ndarray, robust: np.ndarray, dof: int) -> float:
     """τ² ≥ 0 with Σ h·r²/(σ² + τ²) = Σ h − p (bisection; 0 when the stds already explain the scatter)."""
 
     def excess(tau2: float) -> float:
@@ -60,7 +60,7 @@ def robust_fit(x: np.ndarray, values: np.ndarray, variance: np.ndarray, degree: 
         beta, covariance = _wls(x, values, robust / (variance + tau2 + 1e-300), degree)
         residual = values - np.vander(x, n_coefficients, increasing=True) @ beta
         dof = max(int(robust.sum()) - n_coefficients, 1)
-        tau2 = _excess_variance(residual, variance, robust, dof) if len(x) > n_coefficients else 0.0
+        tau2 = excess_variance(residual, variance, robust, dof) if len(x) > n_coefficients else 0.0
         z = np.abs(residual) / np.sqrt(variance + tau2 + 1e-300)
         robust = np.minimum(1.0, HUBER_C / np.maximum(z, 1e-12))
     return {"beta": beta, "covariance": covariance, "tau2": np.float64(tau2), "z": z, "robust": robust,

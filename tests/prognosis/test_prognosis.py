@@ -3,105 +3,80 @@
 import numpy as np
 import pytest
 
-from prognosis.rul import remaining_life
+from prognosis.backtest import backtest
+from prognosis.outlook import outlook
 from prognosis.trend import fit_trend
 from sim.actuator import THESIS
+from tests.prognosis.histories import History, history
 
 THRESHOLD = 0.075  # FDJ +50 % of nominal
+LAWS_SEEN = ("line", "doubling", "cube", "onset", "sinh")  # tests/prognosis/histories: none is a law of the code
 
 
-def degrading(seed: int, n: int = 200, slope: float = 1e-4, stated: float = 4e-4, actual: float = 4e-4, outliers=0):
-    """FDJ rising linearly over n windows, one per flight hour, with realistic noise (and wild outliers)."""
-    rng = np.random.default_rng(seed)
-    hours = np.sort(rng.uniform(0, 200, n))
-    values = 0.05 + slope * hours + actual * rng.normal(size=n)
-    values[rng.choice(n, outliers, replace=False)] += 0.02
-    return hours, values, np.full(n, stated)
+def _outlook(h: History):
+    return outlook("FDJ", h.hours, h.values, h.stds, [str(i) for i in range(len(h.hours))], THRESHOLD, "above")
 
 
-def truth_rul(hours: np.ndarray, slope: float = 1e-4) -> float:
-    return (THRESHOLD - 0.05) / slope - hours.max()
+def _held(h: History, life) -> bool:
+    return life.status == "crossing predicted" and life.rul_low <= h.true_life <= (life.rul_high or np.inf)
 
 
-def rul_of(hours, values, stds):
-    trend = fit_trend("FDJ", hours, values, stds, [str(i) for i in range(len(hours))])
-    return trend, remaining_life(trend, THRESHOLD, "above")
+@pytest.mark.parametrize("law", LAWS_SEEN)
+def test_the_remaining_life_holds_wear_of_laws_the_code_does_not_have(law):
+    """20 windows over 190 h, crossing 20–60 h after the last, each with its std (tests/prognosis/histories):
+    the 90 % interval holds the true life in most histories of every law, the median within 35 % of it. Of
+    these 60 histories 53 were held and 58 close; a line alone held none of the accelerating ones."""
+    held, close = 0, 0
+    for seed in range(12):
+        h = history(law, 3000 + seed)
+        life = _outlook(h).life
+        held += _held(h, life)
+        close += life.rul is not None and abs(life.rul / h.true_life - 1) <= 0.35
+    assert held >= 8 and close >= 10, (held, close)
 
 
-def test_the_rul_interval_holds_the_truth_as_often_as_it_says():
-    """A 90 % interval over 200 histories: 180 ± 4 expected. Drawn with the level and the slope independent
-    (they correlate ~0.87 where the windows spread evenly before the last), it held 81 % of 300."""
-    early, late = 0, 0
-    for seed in range(200):
-        hours, values, stds = degrading(seed)
-        _, life = rul_of(hours, values, stds)
-        assert life.status == "crossing predicted"
-        early += truth_rul(hours) < life.rul_low
-        late += truth_rul(hours) > life.rul_high
-    assert 170 <= 200 - early - late <= 190, (early, late)
-    assert early >= 2 and late >= 2  # misses on both sides, as an interval's should be (24 and 24 of 400)
+def test_wear_that_speeds_up_is_said_and_its_earliest_crossing_given():
+    h = history("doubling", 3100)
+    seen = _outlook(h)
+    assert seen.life.speeding_up and seen.life.rul_earliest <= seen.life.rul_low <= h.true_life
+    assert seen.trend.laws["exponential"] + seen.trend.laws["power"] > 0.8  # the accelerating laws predicted best
+    assert not _outlook(history("line", 3100)).life.speeding_up
 
 
-def test_outliers_do_not_move_the_trend_and_are_flagged():
-    hours, values, stds = degrading(1, outliers=8)
-    trend, life = rul_of(hours, values, stds)
-    assert trend.slope_per_unit == pytest.approx(1e-4, rel=0.1)
-    assert sum(p.outlier for p in trend.points) >= 6
-    assert life.rul_low <= truth_rul(hours) <= life.rul_high
+def test_steady_actuators_raise_no_alarm():
+    """A degradation is claimed at 95 %: on steady histories of every size, none here."""
+    claims = [
+        _outlook(history("steady", 3200 + seed, n=n, std=std)).life.status
+        for seed in range(10) for n, std in ((10, 3e-4), (20, 1e-3), (60, 3e-4))
+    ]  # fmt: skip
+    assert claims.count("crossing predicted") == 0, claims
 
 
-def test_stds_that_claim_too_much_widen_the_trend_instead_of_narrowing_it():
-    hours, values, stds = degrading(2, stated=1e-4, actual=8e-4)
-    trend, life = rul_of(hours, values, stds)
-    assert trend.excess_std == pytest.approx(8e-4, rel=0.2)
-    assert life.rul_low <= truth_rul(hours) <= life.rul_high
-
-
-def test_a_healthy_actuator_shows_no_degradation():
-    hours, values, stds = degrading(3, slope=0.0)
-    _, life = rul_of(hours, values, stds)
-    assert life.status == "no degradation detected" and life.rul is None
-
-
-def test_healthy_actuators_raise_few_false_alarms():
-    """A degradation is claimed at 95 %: on 100 histories that do not wear, at most a few claims (4), the
-    curve beside the line included."""
-    claims = sum(rul_of(*degrading(seed, slope=0.0))[1].status == "crossing predicted" for seed in range(100, 200))
-    assert claims <= 8
-
-
-def accelerating(seed: int, n: int = 200) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
-    """FDJ reaching its threshold quadratically after 250–500 flight hours (wear that speeds up), and the
-    true remaining life after the last window."""
-    rng = np.random.default_rng(seed)
-    hours = np.sort(rng.uniform(0, 200, n))
-    crossing = rng.uniform(250, 500)
-    values = 0.05 + (THRESHOLD - 0.05) * (hours / crossing) ** 2 + 4e-4 * rng.normal(size=n)
-    return hours, values, np.full(n, 4e-4), crossing - hours.max()
-
-
-def test_wear_that_speeds_up_is_followed_by_the_curve():
-    """A line through bending windows crosses the threshold far too late, surely: its 90 % interval held the
-    true life in none of these; with the curve weighed beside it, in most (52 of 60)."""
-    held, held_by_line, level_held = 0, 0, 0
-    for seed in range(60):
-        hours, values, stds, truth = accelerating(seed)
-        trend, life = rul_of(hours, values, stds)
-        assert trend.curved is not None and trend.curved.weight > 0.5
-        now, now_std = trend.now()  # the line's own level held the truth within 2 std in none
-        level_held += abs(now - (0.05 + (THRESHOLD - 0.05) * (hours.max() / (truth + hours.max())) ** 2)) <= 2 * now_std
-        held += life.status == "crossing predicted" and life.rul_low <= truth <= (life.rul_high or np.inf)
-        line = remaining_life(trend.model_copy(update={"curved": None}), THRESHOLD, "above")
-        held_by_line += line.status == "crossing predicted" and line.rul_low <= truth <= (line.rul_high or np.inf)
-    assert held >= 48 and held_by_line <= 6 and level_held >= 50, (held, held_by_line, level_held)
+def test_outliers_do_not_move_the_outlook():
+    h = history("line", 3300, n=40)
+    values = h.values.copy()
+    values[[5, 17, 29]] += 0.01  # three windows the model could not explain, 30 stds off
+    clean, spoiled = _outlook(h).life, _outlook(History(h.hours, values, h.stds, h.true_life)).life
+    assert spoiled.rul == pytest.approx(clean.rul, rel=0.25) and _held(h, spoiled)
 
 
 def test_too_few_windows_and_a_crossed_threshold():
-    _, few = rul_of(np.array([0.0, 1.0]), np.array([0.05, 0.051]), np.array([1e-4, 1e-4]))
+    few = outlook("FDJ", np.array([0.0, 1.0]), np.array([0.05, 0.051]), np.array([1e-4, 1e-4]), ["a", "b"],
+                  THRESHOLD, "above").life  # fmt: skip
     assert few.status == "too few windows"
-    hours, values, stds = degrading(4)
-    _, crossed = rul_of(hours, values + 0.03, stds)
+    h = history("line", 3400)
+    crossed = _outlook(History(h.hours, h.values + 0.03, h.stds, 0.0)).life
     assert crossed.status == "already crossed" and crossed.rul == 0.0
+
+
+def test_the_backtest_shows_past_forecasts_against_the_windows_since():
+    h = history("cube", 3500, n=40)
+    points = backtest("FDJ", h.hours, h.values, h.stds, [f"w{i}" for i in range(40)], THRESHOLD, "above")
+    assert [p.windows for p in points] == [20, 26, 32] and points[-1].later_windows == 8
+    assert all(p.later_inside is not None and p.later_inside >= 0.7 for p in points)
+    truth = h.hours[-1] + h.true_life  # the crossing dates move in on it as the windows come
+    crossings = [p.crossing for p in points if p.crossing is not None]
+    assert len(crossings) >= 2 and abs(crossings[-1] - truth) < abs(crossings[0] - truth)
 
 
 @pytest.fixture(scope="module")
@@ -187,5 +162,6 @@ def test_windows_at_one_time_are_a_level_with_no_slope(times):
     trend = fit_trend("FDJ", np.array(times), np.full(n, 0.06), np.full(n, 1e-3), [str(i) for i in range(n)])
     assert trend.level == pytest.approx(0.06) and trend.slope_std is None
     assert trend.level_std == pytest.approx(1e-3 / np.sqrt(n))
-    assert remaining_life(trend, THRESHOLD, "above").status == "too few windows"
+    assert outlook("FDJ", np.array(times), np.full(n, 0.06), np.full(n, 1e-3), [str(i) for i in range(n)], THRESHOLD,
+                   "above").life.status == "too few windows"  # fmt: skip
     trend.model_dump_json()  # finite: JSON carries it
