@@ -3,12 +3,15 @@
 from __future__ import annotations
 
 import threading
+from collections import OrderedDict
 from collections.abc import Callable
 from typing import Annotated
 
 from fastapi import Depends, Request
 from starlette.concurrency import run_in_threadpool
 
+from prognosis.documents import Prognosis
+from prognosis.prognose import prognose
 from service.config import Settings
 from service.jobs import CancelledError, JobRunner
 from service.store import EstimateStore
@@ -54,6 +57,38 @@ async def actuator_of(store: EstimateStore, actuator_id: str) -> tuple[Actuator,
     version) where it has none: its windows are then read with the default, and their answers say so."""
     stored = await run_in_threadpool(store.get_actuator, actuator_id)
     return (THESIS, None) if stored is None else (stored.document, stored.version)
+
+
+class Prognoses:
+    """The latest prognoses, each kept until its actuator stores another window or document (a prognosis with its
+    backtest takes seconds; a fleet page asks for every actuator's)."""
+
+    def __init__(self, size: int = 512) -> None:
+        self.size = size
+        self._kept: OrderedDict[tuple[str, int, int | None, int | None], Prognosis] = OrderedDict()
+
+    def get(self, key: tuple[str, int, int | None, int | None]) -> Prognosis | None:
+        found = self._kept.get(key)
+        if found is not None:
+            self._kept.move_to_end(key)
+        return found
+
+    def put(self, key: tuple[str, int, int | None, int | None], prognosis: Prognosis) -> None:
+        self._kept[key] = prognosis
+        while len(self._kept) > self.size:
+            self._kept.popitem(last=False)
+
+
+async def prognosis_of(prognoses: Prognoses, store: EstimateStore, actuator_id: str) -> Prognosis:
+    """The actuator's prognosis over its stored estimates, to its document's thresholds (kept while they stand)."""
+    current, _ = await run_in_threadpool(store.history, actuator_id)
+    document, version = await actuator_of(store, actuator_id)
+    key = (actuator_id, len(current), current[-1].id if current else None, version)
+    found = prognoses.get(key)
+    if found is None:
+        found = await run_in_threadpool(prognose, actuator_id, current, document)
+        prognoses.put(key, found)
+    return found
 
 
 def stopper(cancel: threading.Event) -> Callable[[str], None]:

@@ -6,6 +6,10 @@ from the headers alone, with nothing parsed on the event loop. The key is compar
 constant time (a non-ASCII header is simply wrong, not an error). Without a key, the service only
 answers to a loopback Host: a page on another site cannot reach it through DNS rebinding.
 
+The operator's pages (``/ui``) need the key too: a browser cannot add a header to a link, so there it
+may come as HTTP Basic authentication's password (the browser asks for it once; it never appears in a
+URL, and so in no log).
+
 A write is accepted as ``application/json`` only, and never from a page of another origin: a browser
 sends a ``text/plain`` POST across sites without asking (no CORS preflight), so either check alone
 would let any open web page write into an actuator's history. A body must arrive within
@@ -15,6 +19,8 @@ would let any open web page write into an actuator's history. A body must arrive
 from __future__ import annotations
 
 import asyncio
+import base64
+import binascii
 import hmac
 import json
 import time
@@ -24,6 +30,7 @@ from starlette.types import ASGIApp, Message, Receive, Scope, Send
 from service.config import LOOPBACK_NAMES
 
 WRITES = frozenset({"POST", "PUT", "PATCH", "DELETE"})
+PAGES = "/ui"
 
 
 class BodyTooLargeError(Exception):
@@ -38,8 +45,8 @@ def error_body(loc: list[str], message: str, kind: str) -> bytes:
     return json.dumps({"detail": [{"loc": loc, "msg": message, "type": kind}]}).encode()
 
 
-async def answer(send: Send, status: int, body: bytes) -> None:
-    headers = [(b"content-type", b"application/json"), (b"content-length", str(len(body)).encode())]
+async def answer(send: Send, status: int, body: bytes, extra: list[tuple[bytes, bytes]] | None = None) -> None:
+    headers = [(b"content-type", b"application/json"), (b"content-length", str(len(body)).encode()), *(extra or [])]
     await send({"type": "http.response.start", "status": status, "headers": headers})
     await send({"type": "http.response.body", "body": body})
 
@@ -72,7 +79,9 @@ class Guard:
         headers = dict(scope.get("headers", []))
         refusal = self._refusal(scope["path"], scope["method"], headers)
         if refusal is not None:
-            await answer(send, *refusal)
+            page = scope["path"] == PAGES or scope["path"].startswith(PAGES + "/")
+            challenge = [(b"www-authenticate", b'Basic realm="ema"')] if refusal[0] == 401 and page else None
+            await answer(send, *refusal, challenge)
             return
         received, deadline = 0, time.monotonic() + self.body_timeout_s
 
@@ -99,12 +108,13 @@ class Guard:
         return error_body(["body"], f"exceeds this service's limit of {self.max_body_bytes} bytes", "too_large")
 
     def _refusal(self, path: str, method: str, headers: dict[bytes, bytes]) -> tuple[int, bytes] | None:
-        protected = path == self.prefix or path.startswith(self.prefix + "/")
+        protected = any(path == root or path.startswith(root + "/") for root in (self.prefix, PAGES))
         host = headers.get(b"host", b"localhost")
         if self.key is None and _host_name(host) not in LOOPBACK_NAMES:
             return 400, error_body(["header", "host"], "this service answers loopback hosts only (no key set)", "host")
-        if protected and self.key is not None and not hmac.compare_digest(headers.get(b"x-api-key", b""), self.key):
-            return 401, error_body(["header", "x-api-key"], "missing or wrong X-API-Key", "unauthorized")
+        if protected and self.key is not None and not self._keyed(headers):
+            return 401, error_body(["header", "x-api-key"], "missing or wrong X-API-Key (or the pages' password)",
+                                   "unauthorized")  # fmt: skip
         if protected and method in WRITES:
             refused = self._write_refusal(headers, host)
             if refused is not None:
@@ -113,6 +123,18 @@ class Guard:
         if declared is not None and declared.isdigit() and int(declared) > self.max_body_bytes:
             return 413, self._too_large()
         return None
+
+    def _keyed(self, headers: dict[bytes, bytes]) -> bool:
+        """The key as X-API-Key, or as the password of HTTP Basic authentication (what a browser sends)."""
+        assert self.key is not None
+        given = headers.get(b"x-api-key", b"")
+        scheme, _, encoded = headers.get(b"authorization", b"").partition(b" ")
+        if scheme.lower() == b"basic":
+            try:
+                given = base64.b64decode(encoded, validate=True).partition(b":")[2]
+            except (binascii.Error, ValueError):
+                return False
+        return hmac.compare_digest(given, self.key)
 
     def _write_refusal(self, headers: dict[bytes, bytes], host: bytes) -> tuple[int, bytes] | None:
         """403 for a write from a page of another origin, 415 for a body that does not say it is JSON."""

@@ -15,9 +15,10 @@ from fastapi_offline import FastAPIOffline
 
 from service import errors
 from service.config import Settings
+from service.deps import Prognoses
 from service.guard import Guard
 from service.jobs import JobRunner
-from service.routes import actuators, calibrate, estimate, health
+from service.routes import actuators, calibrate, estimate, health, ui
 from service.schemas import CalibrateIn
 from service.store import EstimateStore
 from service.warmup import warm_up
@@ -76,12 +77,14 @@ def create_app(settings: Settings) -> FastAPI:
     app = FastAPIOffline(title="ema", version=version("ema"), description=DESCRIPTION, lifespan=lifespan)
     app.state.settings = settings
     app.state.warm = threading.Event()
+    app.state.prognoses = Prognoses()
     app.openapi = lambda: _openapi(app)  # type: ignore[method-assign]
     errors.install(app)
     app.add_middleware(Guard, key=settings.key_bytes(), prefix=settings.api_prefix,
                        max_body_bytes=settings.max_body_bytes, body_timeout_s=settings.body_timeout_s,
                        allowed_origins=settings.allowed_origins)  # fmt: skip
     app.include_router(health.router)
+    app.include_router(ui.router)
     for router in (estimate.router, actuators.router, calibrate.router):
         app.include_router(router, prefix=settings.api_prefix)
     return app

@@ -25,6 +25,7 @@ from typing import Any
 
 from pydantic import ValidationError
 
+from calibration.documents import CalibrationReport
 from prognosis.documents import Stored, StoredActuator
 from sim.actuator import Actuator
 from training.documents import Estimate, HistoryReadings, InertiaReading, SensorZero
@@ -43,6 +44,13 @@ CREATE TABLE IF NOT EXISTS estimates (
     UNIQUE (actuator_id, window_id)
 );
 CREATE INDEX IF NOT EXISTS estimates_by_actuator ON estimates (actuator_id, id);
+CREATE TABLE IF NOT EXISTS calibrations (
+    id INTEGER PRIMARY KEY AUTOINCREMENT,
+    actuator_id TEXT NOT NULL,
+    stored_at TEXT NOT NULL,
+    report TEXT NOT NULL
+);
+CREATE INDEX IF NOT EXISTS calibrations_by_actuator ON calibrations (actuator_id, id);
 CREATE TABLE IF NOT EXISTS actuators (
     actuator_id TEXT NOT NULL,
     version INTEGER NOT NULL,
@@ -217,6 +225,21 @@ class EstimateStore:
             return None
         return StoredActuator(actuator_id=actuator_id, version=row[0], stored_at=row[1],
                               document=Actuator.model_validate_json(row[2]))  # fmt: skip
+
+    def add_calibration(self, actuator_id: str, report: CalibrationReport) -> None:
+        """Keep a calibration report of the actuator's windows (the operator's page lists them)."""
+        stored_at = dt.datetime.now(dt.UTC).isoformat(timespec="milliseconds")
+        with self._lock:
+            self._connection.execute("INSERT INTO calibrations (actuator_id, stored_at, report) VALUES (?, ?, ?)",
+                                     (actuator_id, stored_at, report.model_dump_json(by_alias=True)))  # fmt: skip
+
+    def calibrations(self, actuator_id: str) -> list[tuple[str, CalibrationReport]]:
+        """The actuator's calibration reports with when each was stored, latest first."""
+        with self._lock:
+            rows = self._connection.execute(
+                "SELECT stored_at, report FROM calibrations WHERE actuator_id = ? ORDER BY id DESC", (actuator_id,)
+            ).fetchall()
+        return [(stored_at, CalibrationReport.model_validate_json(report)) for stored_at, report in rows]
 
     def actuator_ids(self) -> list[str]:
         """Every actuator with a stored estimate or document, in name order."""

@@ -6,8 +6,7 @@ from fastapi import APIRouter, Request
 from starlette.concurrency import run_in_threadpool
 
 from prognosis.documents import History, Prognosis, StoredActuator
-from prognosis.prognose import prognose
-from service.deps import RunnerDep, StoreDep, actuator_of
+from service.deps import RunnerDep, StoreDep, prognosis_of
 from service.parsing import read_body
 from service.schemas import json_body, responses
 from sim.actuator import Actuator
@@ -23,12 +22,10 @@ async def history(actuator_id: str, store: StoreDep) -> History:
 
 
 @router.get("/{actuator_id:path}/prognosis", response_model=Prognosis, responses=responses(401))
-async def prognosis(actuator_id: str, store: StoreDep) -> Prognosis:
+async def prognosis(actuator_id: str, request: Request, store: StoreDep) -> Prognosis:
     """Trend of FDJ, η_O and η_A and the remaining useful life to the thresholds of the actuator's document
-    (the default actuator's where it has none)."""
-    current, _ = await run_in_threadpool(store.history, actuator_id)
-    document, _ = await actuator_of(store, actuator_id)
-    return await run_in_threadpool(prognose, actuator_id, current, document)
+    (the default actuator's where it has none), with its backtest."""
+    return await prognosis_of(request.app.state.prognoses, store, actuator_id)
 
 
 @router.put(

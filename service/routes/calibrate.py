@@ -1,6 +1,7 @@
 from __future__ import annotations
 
 from fastapi import APIRouter, Request
+from starlette.concurrency import run_in_threadpool
 
 from calibration.calibrate import Calibrator
 from calibration.documents import CalibrationReport
@@ -42,4 +43,6 @@ async def calibrate(request: Request, settings: SettingsDep, store: StoreDep, ru
         def run() -> CalibrationReport:
             return calibrator.fit(windows, truth, on_stage=stop, checkpoint=lambda: stop("")).report_
 
-        return await runner.run(ticket, request.is_disconnected, run)
+        report = await runner.run(ticket, request.is_disconnected, run)
+        await run_in_threadpool(store.add_calibration, windows[0].actuator_id, report)
+        return report

@@ -1,0 +1,30 @@
+"""A small fleet's stored histories for the operator's pages: each actuator's FDJ over flight hours by a law of
+its own (copies of one real estimate with FDJ and η_O replaced), and the truth of what each should show."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from service.store import EstimateStore
+from training.documents import Estimate, parameter
+
+# actuator -> (FDJ at 0 h [N·m], FDJ per flight hour, curvature per h², what its page must say)
+FLEET = {
+    "tail-1/elevator-left": (0.050, 0.0, 0.0, "no degradation detected"),
+    "tail-1/elevator-right": (0.050, 1e-4, 0.0, "crossing predicted"),
+    "tail-2/elevator-left": (0.052, 2e-5, 4e-7, "crossing predicted"),
+    "tail-3/elevator-left": (0.070, 1.5e-4, 0.0, "already crossed"),
+}
+
+
+def store_fleet(store: EstimateStore, base: Estimate, windows: int = 20, seed: int = 0) -> None:
+    """Every actuator of ``FLEET``, ``windows`` windows over 190 flight hours."""
+    rng = np.random.default_rng(seed)
+    hours = np.linspace(0.0, 190.0, windows)
+    for actuator_id, (start, slope, curvature, _) in FLEET.items():
+        for i, h in enumerate(hours):
+            fdj = start + slope * h + curvature * h**2 + 3e-4 * rng.normal()
+            estimates = base.estimates.model_copy(update={"FDJ": parameter(fdj, 3e-4, 0.05)})
+            window = base.window.model_copy(update={"flight_hours": float(h), "content_sha256": f"{actuator_id}-{i}"})
+            store.add(base.model_copy(update={"actuator_id": actuator_id, "window_id": f"w{i:02d}",
+                                              "estimates": estimates, "window": window}))  # fmt: skip

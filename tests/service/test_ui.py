@@ -1,0 +1,59 @@
+"""The operator's pages through TestClient: what they list, in what order, and that they need the key."""
+
+import base64
+
+import pytest
+from fastapi.testclient import TestClient
+
+from service.main import create_app
+from service.store import EstimateStore
+from sim.actuator import THESIS
+from sim.params import HealthParams
+from sim.synthetic import synthetic_window
+from tests.service.conftest import KEY, LOCAL, SMALL, settings_for
+from tests.service.fleet import FLEET, store_fleet
+from training.pipeline import estimate_window
+
+
+@pytest.fixture(scope="module")
+def base():
+    return estimate_window(synthetic_window(HealthParams.single(), seed=1, duration_s=0.1), SMALL, actuator=THESIS)
+
+
+@pytest.fixture
+def fleet_settings(tmp_path, base):
+    settings = settings_for(tmp_path)
+    store = EstimateStore(settings.database)
+    store_fleet(store, base)
+    store.close()
+    return settings
+
+
+def test_the_fleet_page_lists_every_actuator_most_urgent_first(fleet_settings):
+    with TestClient(create_app(fleet_settings), base_url=LOCAL) as client:
+        page = client.get("/ui")
+    assert page.status_code == 200 and page.headers["content-type"].startswith("text/html")
+    order = sorted(FLEET, key=page.text.index)
+    assert order[0] == "tail-3/elevator-left" and order[-1] == "tail-1/elevator-left"  # crossed first, steady last
+    assert page.text.count('class="due"') >= 1 and 'class="healthy"' in page.text
+    assert "no degradation detected" in page.text and "http" not in page.text.replace(LOCAL, "")
+
+
+def test_an_actuator_page_plots_each_parameter_with_its_outlook(fleet_settings):
+    with TestClient(create_app(fleet_settings), base_url=LOCAL) as client:
+        page = client.get("/ui/actuators/tail-1/elevator-right")
+    assert page.status_code == 200 and page.text.count("<svg") == 3  # FDJ, η_O, η_A
+    assert page.text.count('class="estimate"') == 60 and 'class="forecast"' in page.text
+    assert 'class="threshold"' in page.text and 'class="rul"' in page.text and "backtest" in page.text
+
+
+def test_with_a_key_the_pages_ask_for_it_as_a_password(tmp_path, base):
+    settings = settings_for(tmp_path, api_key=KEY)
+    with TestClient(create_app(settings), base_url="http://ema.example") as client:
+        refused = client.get("/ui")
+        assert refused.status_code == 401 and refused.headers["www-authenticate"].startswith("Basic")
+        basic = base64.b64encode(f"operator:{KEY}".encode()).decode()
+        assert client.get("/ui", headers={"authorization": f"Basic {basic}"}).status_code == 200
+        wrong = base64.b64encode(b"operator:wrong").decode()
+        assert client.get("/ui", headers={"authorization": f"Basic {wrong}"}).status_code == 401
+        assert client.post("/ui", json={}, headers={"authorization": f"Basic {basic}"}).status_code == 405  # read only
