@@ -1,6 +1,6 @@
 """The calibration loop on windows our code did not draw: docs/calibration.md.
 
-Every window comes from ``tests.foreign`` (an independent implementation of the spec, thesis
+Every window comes from ``tests.foreign`` (an independent implementation of the model, thesis
 commands, its own noise) with one effect in the foreign implementation's own form
 (``tests.foreign.effects``): a Gaussian friction bump, tanh Stribeck friction, friction drifting
 in time, cogging of 12 periods per revolution, and the rest, at 0.2x, 1x, 5x and 20x of the
@@ -119,7 +119,7 @@ def main() -> None:
         "`tests/foreign` (thesis commands, its own noise), effects in its own forms (`tests/foreign/effects.py`);",
         "sizes relative to those the calibration issue reported. *Right name*: the effect named (clean: none;",
         "drift: none, and described as following time). Errors are |FDJ| + |η_O| relative errors, before",
-        "(the spec's model alone: `ema estimate` without its offset and viscous reads) and after",
+        "(the document's model alone: `ema estimate` without its offset and viscous reads) and after",
         "(re-estimated with what was adopted). Where no name fits,",
         "the base model is kept and the report offers the described curve as a simulator term with its",
         "own estimates (`unexplained.estimates_if_added`): *described, with its term* is their error.",

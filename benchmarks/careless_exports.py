@@ -61,7 +61,7 @@ def main() -> None:
 def report(counts: dict[str, Counter], per_slip: int, seconds: float) -> str:
     lines = [
         f"{per_slip} windows of `tests/foreign`, one of each group of the accuracy table in turn (0.1–2 s,",
-        "1–100 kHz, worn, filtered, off zero, drives unlike the spec's), each exported once more with one",
+        "1–100 kHz, worn, filtered, off zero, drives unlike the document's), each exported once more with one",
         "slip (`tests/foreign/careless.py`) and sent as it is. *Refused, naming it*: the error names the",
         "field the slip is in (`training/consistency.py`); *answered*: the estimate, scored against the",
         f"truth: within the bound if no parameter is past {100 * BOUND:.0f} % of range, or said weak if each",

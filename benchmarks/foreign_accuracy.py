@@ -1,6 +1,6 @@
 """Accuracy and honesty of ``ema estimate`` on windows our own code did not draw: docs/results.md.
 
-Every window comes from ``tests.foreign`` (an independent implementation of the spec, with its
+Every window comes from ``tests.foreign`` (an independent implementation of the model, with its
 own command families, sensor noise and quantization) and goes through the public contract
 (``ema-window/1`` document -> ``estimate_window``). For each group of windows: how many were
 answered, the mean and worst |error| (relative, and in % of the thesis's range: 0.02 N·m for FDJ,
@@ -207,11 +207,11 @@ def report(rows: dict[str, list[dict[str, Any]]], per_group: int, seconds: float
     summaries["all worn windows"] = pooled(rows, worn_only=True)
     return "\n".join([
         f"{per_group} windows per group (3 held positions), drawn by `tests/foreign` (an independent",
-        "implementation of the spec: exact RL step, RK4 aircraft from the instantaneous deflection, trim at",
+        "implementation of the model: exact RL step, RK4 aircraft from the instantaneous deflection, trim at",
         "true airspeed, 100 kHz command table, its own sensor noise and quantization), health uniform in",
         "Table 3.1's ranges (worn: FDJ 1.3–2.5x nominal, η_O 0.45–0.66), random flight condition; default",
-        "pipeline sizes. *Drive unlike the spec's*: the five families, with a loop that departs from the",
-        "spec's and from every simulation the pipeline runs, unlogged (bus ±10 %, position gain ±2 %, up",
+        "pipeline sizes. *Drive unlike the document's*: the five families, with a loop that departs from the",
+        "document's and from every simulation the pipeline runs, unlogged (bus ±10 %, position gain ±2 %, up",
         "to 50 µs of lag, a speed read with up to 0.5 rad/s of noise: `unlike_the_spec`). *Sensors behind",
         "filters*: the five families, each sensor's signal and noise through a causal moving average, as a",
         "real filter passes them (current 2–6 samples, speed and position 2–8, the hinge moment 10–40:",
@@ -225,12 +225,12 @@ def report(rows: dict[str, list[dict[str, Any]]], per_group: int, seconds: float
         "1–5 spikes of 50–500 noise stds on each sensor, one in four two samples long (`with_spikes`).",
         "*Sensors off zero*: the five families with the hinge moment 1–10 N·m or the current 0.04–0.25 A",
         "off zero, in turn (`off_zero`), read and taken off per window (`training.prepare.departures.zero_offset`).",
-        "*Viscous friction 1.2–2x the spec's*: the five families with C above the spec's, as a cold grease",
+        "*Viscous friction 1.2–2x the document's*: the five families with C above the document's, as a cold grease",
         "has it (`viscous`), read per window and used by every estimator",
         "(`training.prepare.departures.viscosity`). The",
         "*worn* groups with these two: a worn transmission's k = 1/η_O − 1 reaches 1.2, and so does the",
         "share of a hinge offset that passes for FDJ where the window cannot tell which sensor is off.",
-        "*k_T, current gain or J_M off*: the five families with, in turn, k_T 0.95–1.05x the spec's (magnets",
+        "*k_T, current gain or J_M off*: the five families with, in turn, k_T 0.95–1.05x the document's (magnets",
         "warm or cold), the current sensor's gain 0.97–1.03 and J_M 0.9–1.1x (`drive_off`), read per window",
         "and corrected (`training.prepare.departures.drive_constants`); and on worn actuators. *Hinge moment",
         "gain*: the five",

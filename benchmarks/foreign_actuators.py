@@ -1,6 +1,6 @@
 """Actuators unlike the thesis's, each read with its own ema-actuator/1 document: docs/results.md.
 
-Windows drawn by ``tests.foreign`` (an independent implementation of the spec) for two drives of the
+Windows drawn by ``tests.foreign`` (an independent implementation of the model) for two drives of the
 architecture with other constants (``tests.foreign.actuators``: gear ratio 320 and 800, k_T 0.12 and
 0.05 N·m/A, their own inertia, gains, backlash and stops) and the thesis's, each in three conditions: in
 flight (thesis-family commands, random flight conditions), on the ground without load (a pre-flight

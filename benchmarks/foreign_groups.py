@@ -41,14 +41,14 @@ def groups() -> dict[str, Callable[..., Draw]]:
     )
     for family in FAMILIES:
         out[f"worn, {family}"] = lambda s, f=family, **kw: worn(s, family=f, **kw)
-    out["drive unlike the spec's"] = lambda s, **kw: draw(s, FAMILIES[s % 5], effects=unlike_the_spec(s), **kw)
+    out["drive unlike the document's"] = lambda s, **kw: draw(s, FAMILIES[s % 5], effects=unlike_the_spec(s), **kw)
     out["sensors behind filters"] = lambda s, **kw: through_filters(draw(s, FAMILIES[s % 5], **kw), filter_widths(s))
     out["noise behind filters, not the signal"] = lambda s, **kw: draw(
         s, FAMILIES[s % 5], filter_samples=filter_widths(s), **kw
     )
     out["sensor glitches"] = lambda s, **kw: with_spikes(draw(s, FAMILIES[s % 5], **kw), s)
     out["sensors off zero"] = lambda s, **kw: draw(s, FAMILIES[s % 5], effects=off_zero(s), **kw)
-    out["viscous friction 1.2-2x the spec's"] = lambda s, **kw: draw(s, FAMILIES[s % 5], effects=viscous(s), **kw)
+    out["viscous friction 1.2-2x the document's"] = lambda s, **kw: draw(s, FAMILIES[s % 5], effects=viscous(s), **kw)
     out["worn, sensors off zero"] = lambda s, **kw: worn(s, family=FAMILIES[s % 5], effects=off_zero(s), **kw)
     out["worn, viscous 1.2-2x"] = lambda s, **kw: worn(s, family=FAMILIES[s % 5], effects=viscous(s), **kw)
     out["held position"] = lambda s, **kw: draw(s, "hold", **kw)
@@ -63,7 +63,7 @@ def groups() -> dict[str, Callable[..., Draw]]:
 
 
 def unlike_the_spec(seed: int) -> Effects:
-    """A drive whose loop departs from the spec's, unlogged: bus ±10 %, position gain ±2 %, the command
+    """A drive whose loop departs from the document's, unlogged: bus ±10 %, position gain ±2 %, the command
     reaching the loop up to 50 µs late, the loop reading a speed as noisy as the logged one (up to 0.5 rad/s)."""
     rng = np.random.default_rng(20_000 + seed)
     return Effects(
@@ -86,12 +86,12 @@ def off_zero(seed: int) -> Effects:
 
 
 def viscous(seed: int) -> Effects:
-    """Viscous friction 1.2–2x the spec's C (a cold grease), unlogged, as a change of temperature is."""
+    """Viscous friction 1.2–2x the document's C (a cold grease), unlogged, as a change of temperature is."""
     return Effects(viscous_factor=float(np.random.default_rng(40_000 + seed).uniform(1.2, 2.0)))
 
 
 def drive_off(seed: int) -> Effects:
-    """A drive constant off the spec's, unlogged: in turn k_T 0.95–1.05x (the magnets warm or cold), the
+    """A drive constant off the document's, unlogged: in turn k_T 0.95–1.05x (the magnets warm or cold), the
     current sensor's gain 0.97–1.03 (fed back to its loop, too) and J_M 0.9–1.1x."""
     value = np.random.default_rng(50_000 + seed).uniform(-1.0, 1.0)
     return (

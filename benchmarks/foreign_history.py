@@ -52,11 +52,11 @@ This checks that remedy end to end. Sixteen actuators wear linearly in flight ho
 1.5–4 times the logged span of 1000 flight hours after the first window. Its windows, at flight hours
 drawn uniformly over the span, come from `tests/foreign` (the independent implementation) as a fleet
 logs them: the five families, half 0.5 s at 10 kHz, a fifth 0.1 s gusts, a fifth 1–2 kHz logs, a
-tenth 2 s cruise; in three of ten a grease 1.2–2x as viscous as the spec's (a cold flight), unlogged.
+tenth 2 s cruise; in three of ten a grease 1.2–2x as viscous as the document's (a cold flight), unlogged.
 Eight more wear as the square of the hours (wear that speeds up: a line through their windows
 crosses the threshold ~3x too late, surely), and eight do not wear at all (a monitor that claims
 degradation there raises a false alarm). Eight more wear linearly with a rotor 1.03–1.1x as heavy as
-the spec's J_M, unlogged: a window whose motor saturates as it accelerates cannot tell that from a
+the document's J_M, unlogged: a window whose motor saturates as it accelerates cannot tell that from a
 weaker motor, and is read with the J_M earlier windows of the actuator read (thesis-like windows can;
 each read alone, `--actuators 0 --speeding 0 --healthy 0 --zeroed 0 --alone`, 143 of their 240 FDJ answers were
 past 10 % of the range, all said weak, the level up to 12 % of range off, and 4 of 8 FDJ lives
@@ -83,7 +83,7 @@ class Wear:
     eta_o_start: float
     eta_o_crossing_h: float
     power: float = 1.0
-    inertia_factor: float = 1.0  # its rotor's J_M over the spec's, unlogged (it stays with the build)
+    inertia_factor: float = 1.0  # its rotor's J_M over the document's, unlogged (it stays with the build)
     zeroed_per_flight: bool = False  # its current sensor keeps a zero off by 0.04–0.2 A, new each flight
 
     def health(self, hours: float, thresholds: Thresholds) -> Health:

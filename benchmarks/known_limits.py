@@ -35,7 +35,7 @@ def _hinge_late(scale: float) -> Callable[[int], Draw]:
 
 
 def _slow_log_viscous(seed: int) -> Draw:
-    """Viscous friction 1.2–2x the spec's on a 1–2 kHz log."""
+    """Viscous friction 1.2–2x the document's on a 1–2 kHz log."""
     return draw(seed, FAMILIES[seed % 5], sample_rate_hz=(1_000.0, 2_000.0)[seed % 2], effects=viscous(seed))
 
 
@@ -45,7 +45,7 @@ def _short_off_zero(seed: int) -> Draw:
 
 
 def _heavier_inertia(seed: int) -> Draw:
-    """J_M 1.04–1.1x the spec's, which a motor k_T·I 0.9–0.96x as strong explains about as well."""
+    """J_M 1.04–1.1x the document's, which a motor k_T·I 0.9–0.96x as strong explains about as well."""
     return draw(seed, FAMILIES[seed % 5], effects=Effects(inertia_factor=1.04 + 0.06 * (seed % 7) / 6))
 
 
@@ -72,14 +72,14 @@ GROUPS: dict[str, Callable[[int], Draw]] = {
     "hinge moment 0-0.15 ms late (1-4 samples)": _hinge_late(0.1),
     "viscous friction 1.2-2x on a 1-2 kHz log": _slow_log_viscous,
     "a sensor off zero in a 0.1 s window": _short_off_zero,
-    "J_M 1.04-1.1x the spec's": _heavier_inertia,
+    "J_M 1.04-1.1x the document's": _heavier_inertia,
     "k_T, current gain or J_M off in a 0.1 s window": _short_drive_off,
 }
 # A group's windows answered again, each after another window of its flight (its family and duration): as the
 # service answers them once it holds others of the actuator and flight_id.
 AFTER_ANOTHER = {
     "the same, a 1 s cruise window of its flight read first": ("a sensor off zero in a 0.1 s window", "cruise", 1.0),
-    "J_M 1.04-1.1x, a 0.5 s thesis window of the actuator read first": ("J_M 1.04-1.1x the spec's", "thesis", 0.5),
+    "J_M 1.04-1.1x, a 0.5 s thesis window of the actuator read first": ("J_M 1.04-1.1x the document's", "thesis", 0.5),
 }
 
 
@@ -100,7 +100,7 @@ trace in the noise (0.70–1.15 of the delay) and the lag the deflection band re
 weigh filtered against on time, and the moment is advanced by the weighted lag, its spread in the
 stds (`training.prepare.hinge_lag`): what is left shows in the heaviest filters. The sensor chain's lag is the
 same in every window of an actuator; read across them, as a calibration term, it could be pinned.
-A sensor off zero and a viscous coefficient above the spec's are read per window (groups of the
+A sensor off zero and a viscous coefficient above the document's are read per window (groups of the
 accuracy table above), but each is a parameter more to read from the window, which a window holding
 little to begin with (a 1–2 kHz log, 0.1 s) often cannot: the answers past 10 % of range are all said
 weak. A C too unclear to read is weighed into the stds by the weight of the change the window leans
@@ -112,7 +112,7 @@ offset is read in 11 and missed in 1. A drive keeps its sensors' zero for a powe
 row answers the same windows as the service answers a flight's (`flight_id`), after a 1 s cruise window
 of their flight (the same actuator, offset and flight condition) was read; its zero is taken off the
 windows moving one way, and off those moving both ways where it is the more precise and holds
-(`training.prepare.departures.zero_offset`). *J_M heavier than the spec's*: where the motor saturates as it
+(`training.prepare.departures.zero_offset`). *J_M heavier than the document's*: where the motor saturates as it
 accelerates, a motor k_T·I a few % weaker explains the window about as well, and the likelihood ratio
 does not decide; a replay of the window with each tells them apart only where it follows the drive
 within the noise (thesis windows), and elsewhere γ is read with FDJ's std widened by 0.6 of what

@@ -32,7 +32,7 @@ def report(rows: dict[str, list[dict[str, Any]]], found: dict[str, int], per_fau
         summaries[label] = summarize(answers)
     return "\n".join([
         f"{per_fault} windows of `tests/foreign`, one of each group of the accuracy table in turn (0.1–10 s,",
-        "1–100 kHz, worn, filtered, off zero, drives unlike the spec's), each logged once more with one fault",
+        "1–100 kHz, worn, filtered, off zero, drives unlike the document's), each logged once more with one fault",
         "(`tests/foreign/faults.py`): a sensor whose logger kept writing its last value after it stopped",
         "updating, or a gap filled with zeros, over 5–25 % of the window somewhere in it, or for 0.5–2 ms",
         "where the motor slews past 300 rad/s. *Found in*: windows where `training.prepare.stale` takes a run of that",

@@ -1,6 +1,6 @@
 """Would reading the whole closed loop beat Eq. 5.1 on short and slow windows? Not on a real loop: docs/results.md.
 
-Eq. 5.1 reads the torque balance alone: k_T, J, n and four sensors. The spec's model says more:
+Eq. 5.1 reads the torque balance alone: k_T, J, n and four sensors. The model says more:
 how the position and speed loops turn the command into a current reference, and how the PWM
 current loop follows it. A reading that simulates that whole loop (the window's start, command
 and flight condition known) and fits all four sensors can also use *when* things happen: the
@@ -15,8 +15,8 @@ range), this computes:
   Timing events make the signals almost discontinuous in the parameters, so read it as a scale;
   and the same with the loop's bus voltage, lag and position gain fitted as unknowns too;
 - its first-order bias b = F⁻¹ Σ_s J_sᵀ Δs / σ_s² when the model it trusts is *our* simulator of
-  the same spec (started where the window starts, fed its command and logged hinge moment: what
-  ``training.simulate.dataset`` simulates), and when the real loop departs from the spec's by less than any
+  the same model (started where the window starts, fed its command and logged hinge moment: what
+  ``training.simulate.dataset`` simulates), and when the real loop departs from the document's by less than any
   log shows: the PWM bus 1 % high, the command reaching the loop 10 µs late, the position gain
   0.1 % high, the loop reading a speed as noisy as the logged one (``tests.foreign.physics.Effects``);
 - how far our Eq. 5.1 fit (``training.physics.friction``) moves on the same departures, noise-free;
@@ -169,27 +169,27 @@ def table(rows: dict[str, list[dict[str, np.ndarray]]]) -> str:
 def report(rows: dict[str, list[dict[str, np.ndarray]]]) -> str:
     where = np.median([r["where"] for found in rows.values() for r in found], axis=0)
     return "\n".join([
-        "The windows of the section above, read through the whole closed loop of the spec instead of",
+        "The windows of the section above, read through the whole closed loop of the model instead of",
         "Eq. 5.1 (module docstring): what that would buy and what it would cost. Errors and biases in",
         "% of the range; biases as median (worst) over the windows.",
         "",
         table(rows),
         "",
-        "Trusted to the microsecond, the spec's loop holds far more than Eq. 5.1 (first column), and",
+        "Trusted to the microsecond, the document's loop holds far more than Eq. 5.1 (first column), and",
         f"in a few instants: at the median window, {100 * where[0]:.0f} % of it lies in the richest "
         f"{100 * FEW:.0f} % of",
         f"the samples, {100 * where[1]:.0f} % of those at slew speed (> {SLEW_RADPS:.0f} rad/s, the speed reference",
         "near its saturation). Fitting the loop's constants as unknowns keeps most of it (second",
-        "column). But that information belongs to one implementation. Our own simulator of the spec, started",
+        "column). But that information belongs to one implementation. Our own simulator of the model, started",
         "where the window starts and fed its command and hinge moment, differs from the independent one",
         "by far more (third column; among the causes, the side of the backlash at the start, the command",
         "between log samples and the ripple of an Euler against an exact current step, all legitimate",
-        "readings of the spec). A departure of the loop smaller than any log shows (a bus 1 % high,",
+        "readings of the model). A departure of the loop smaller than any log shows (a bus 1 % high,",
         "a 10 µs lag, a gain 0.1 % off, a loop that reads the logged speed sensor's noise) moves the",
         "reading by more than its std. Eq. 5.1 uses none of the loop's constants, and our fit moves by",
         "the last column's amounts under the same departures (at 1 kHz the 3-sample reconstruction",
         "feels the slightly changed motion). So the product reads Eq. 5.1 and says when a window is",
-        "weak; `benchmarks.foreign_accuracy`'s drives unlike the spec's are read as well as the others.",
+        "weak; `benchmarks.foreign_accuracy`'s drives unlike the document's are read as well as the others.",
     ])  # fmt: skip
 
 

@@ -4,7 +4,7 @@
 checks them and runs the stages once each, in order, and leaves ``report_`` (the
 ``ema-calibration/1`` document) and the residuals a figure needs:
 
-1. ``training.pipeline`` estimates each window with the base model, the spec's alone (the answer before;
+1. ``training.pipeline`` estimates each window with the base model, the document's alone (the answer before;
    ``ema estimate`` also takes a sensor's offset off and reads the viscous coefficient);
 2. ``calibration.equations`` turns the windows into their equation-error problem;
 3. ``calibration.noise_floor`` builds the same problem on noise-only copies;

@@ -1,4 +1,4 @@
-"""``ema-calibration/1``: the one definition of a calibration report (shared/spec/interfaces.md).
+"""``ema-calibration/1``: the one definition of a calibration report (``docs/calibration.md``).
 
 The loop returns it, ``POST /v1/calibrate`` declares it, ``ema calibrate`` prints it, the study
 in benchmarks/ reads it; docs/schemas/ema-calibration-1.json is exported from it.

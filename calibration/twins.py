@@ -3,7 +3,7 @@
 A torque constant g and a current-sensor gain s both leave a term in k_T·I in the residual
 torque; only the first also changes the back-EMF (k_e = k_T), hence how much voltage is left to
 drive current near top speed, hence how the motor speed and current evolve. An inertia off the
-spec's leaves a term in dω/dt, which k_T·I mostly is, and moves how fast the speed follows the
+document's leaves a term in dω/dt, which k_T·I mostly is, and moves how fast the speed follows the
 current. Each twin is added
 to the simulator in turn, the window simulated at the estimates, and the one whose speed and
 current stay closer to the measured ones (in units of their noise) is named; the other is

@@ -117,7 +117,9 @@ def print_prognosis(stored: Any, prognosis: Any, plot: Path | None) -> None:
         click.echo(f"{name} now {trend.level:.4g} ± {trend.level_std:.2g}, {_slope(trend)} ({trend.n} windows)")
     if prognosis.inertia is not None:
         inertia = prognosis.inertia
-        click.echo(f"J_M {inertia.factor:.4f} ± {inertia.std:.2g}x the spec's, as windows that could tell it read it")
+        click.echo(
+            f"J_M {inertia.factor:.4f} ± {inertia.std:.2g}x the document's, as windows that could tell it read it"
+        )
     for note in prognosis.notes:
         click.echo(f"note [{note.code}]: {note.text}")
     if plot is not None:

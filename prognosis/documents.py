@@ -1,4 +1,4 @@
-"""The history and prognosis documents (shared/spec/interfaces.md): one definition each.
+"""The history and prognosis documents (``docs/prognosis.md``): one definition each.
 
 ``GET /v1/actuators/{id}/estimates`` answers :class:`History`, ``.../prognosis`` answers
 :class:`Prognosis`, ``ema history`` prints and plots them, and docs/schemas/ holds their JSON

@@ -17,7 +17,8 @@ from prognosis.documents import RemainingLife
 from prognosis.forecast import PLAUSIBLE_WEIGHT, Forecast
 
 MIN_PROBABILITY = 0.95
-MIN_LINE_PROBABILITY = 0.99  # the whole history's line towards the threshold: a steady one passes 95 % in 1 of 20
+MIN_LINE_PROBABILITY = 0.99  # the whole history's line towards the threshold (at 0.95 a steady one passes by chance
+# one time in twenty)
 MIN_WINDOWS = 3
 
 

@@ -7,11 +7,10 @@ and a Huber weight (c = 2.5) keeps a window the model could not explain from pul
 The level is quoted at the last window, where it is best known and where the remaining life starts.
 
 Wear need not be linear: friction that grows faster as the transmission wears bends the windows
-upwards, and a line through them crosses its threshold far too late, surely (on histories that
-reach the threshold quadratically, the line's 90 % interval held the true life in none of 10, at
-~3x the truth). So the quadratic is fitted beside the line (the same weights, its own τ) and weighed
-against it by BIC with the quadratic's scatter: ln odds = ½(χ²_line − χ²_curve) − ½ ln n. The
-remaining life draws from both by that weight (``prognosis.rul``).
+upwards, and a line through them would cross its threshold far too late, and surely. So the
+quadratic is fitted beside the line (the same weights, its own τ) and weighed against it by BIC with
+the quadratic's scatter: ln odds = ½(χ²_line − χ²_curve) − ½ ln n, which says whether the history
+bends. Which law to extrapolate is ``prognosis.weigh``'s question.
 """
 
 from __future__ import annotations

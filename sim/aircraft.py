@@ -1,6 +1,6 @@
 """F-16 linear longitudinal dynamics, its scaling over the envelope, exact discretization, hinge moment.
 
-Numbers and scaling rules: ``shared/spec/aircraft.md`` (Stevens & Lewis Example 4.4-1, SI).
+Numbers and scaling rules: ``docs/model.md`` (Stevens & Lewis Example 4.4-1, SI).
 The kernel sees the aircraft only through a :class:`LoadModel`: a discrete linear system advanced
 once per log interval plus the hinge-moment output, so the on-ground case (a prescribed load) and
 a load taken from a log are the same structure with the dynamics switched off.
@@ -45,7 +45,7 @@ TRIM_TABLE = np.array(
 
 @dataclass(frozen=True)
 class HingeGeometry:
-    """Elevator hinge-moment model, sized to this EMA (aircraft.md)."""
+    """Elevator hinge-moment model, sized to the thesis's EMA (``docs/model.md``)."""
 
     area_m2: float = 0.34  # S_e [m²], one elevator half
     chord_m: float = 0.25  # c_e [m]
@@ -120,7 +120,7 @@ class LoadModel(NamedTuple):
 
 
 def state_space(condition: FlightCondition) -> tuple[np.ndarray, np.ndarray]:
-    """(A, B) at ``condition``, scaled from the default linearization as aircraft.md prescribes."""
+    """(A, B) at ``condition``, scaled from the default linearization as ``docs/model.md`` sets out."""
     k_rho = condition.density_kgpm3 / SEA_LEVEL_DENSITY_KGPM3
     k_v = k_rho * condition.airspeed_mps / DEFAULT_AIRSPEED_MPS
     k_q = k_rho * (condition.airspeed_mps / DEFAULT_AIRSPEED_MPS) ** 2
@@ -259,7 +259,7 @@ Load = FlightCondition | GroundLoad | LoggedLoad
 
 
 def load_model(load: Load, interval_s: float, hinge: HingeGeometry | None = None) -> LoadModel:
-    """Dispatch on the kind of load: in flight (the airframe's ``hinge`` model, the spec's elevator by
+    """Dispatch on the kind of load: in flight (the airframe's ``hinge`` model, the thesis's elevator by
     default), on ground, or as logged."""
     if isinstance(load, FlightCondition):
         return flight_load_model(load, interval_s, hinge or HingeGeometry())

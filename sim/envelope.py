@@ -1,4 +1,4 @@
-"""The flight envelope the model accepts (shared/spec/aircraft.md), as plain numbers.
+"""The flight envelope the model accepts (``docs/model.md``, the aircraft), as plain numbers.
 
 Kept free of numpy so that the CLI's help can show them without importing the simulator.
 """

@@ -9,7 +9,7 @@ current sensor's noise does.
 
 So the moment is split along the measured deflection, whose sensor is ~15x quieter in N·m:
 b is the least-squares slope of the fast part of H_e on the fast part of δ (each minus its
-``HINGE_SMOOTHING_S`` mean; measured, so nothing assumes the aircraft matches the spec), and
+``HINGE_SMOOTHING_S`` mean; measured, so nothing assumes the aircraft matches its model), and
 
     H_read = mean(H_e) + b·(δ − mean(δ))        (means over the ``HINGE_SMOOTHING_S`` around each
                                                   sample; near an end, a line through the nearest)
@@ -18,8 +18,9 @@ i.e. the slow part averaged over the window, the fast part as the deflection dra
 does not move fast, b·(δ − mean δ) vanishes and H_read is the plain mean. The position sensor's
 own noise passes through b (~12 N·m/deg · 0.01° ≈ 0.12 N·m a sample at 153 m/s, sea level),
 so the hinge noise drops ~10x per sample at 10 kHz. The estimates respond mostly to the noise's
-low frequencies, which no filter removes: their error falls 5–20 % (docs/pipeline.md). Measured
-and simulated windows go through this one function, and simulations draw position noise for it.
+low frequencies, which no filter removes, so their error falls far less than the noise per sample.
+Measured and simulated windows go through this one function, and simulations draw position noise
+for it.
 """
 
 from __future__ import annotations

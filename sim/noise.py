@@ -5,9 +5,8 @@ correlation time τ, so that consecutive samples correlate by ρ = exp(−1 / (�
 white noise. A real sensor's noise is rarely white: an anti-aliasing filter, an averaging ADC or a
 resolver's tracking loop correlates it over a few samples, a strain-gauge amplifier over many.
 The estimates feel the noise's low frequencies, where AR(1) noise of the same σ carries
-(1 + ρ) / (1 − ρ) times the power of white noise. Drawn white into the simulations, such noise
-made the stds of foreign windows ~3x too wide (the equation error then looked like missing physics)
-or, from the hinge moment's, too narrow, and the static friction 40–60 % low at 7–10 std.
+(1 + ρ) / (1 − ρ) times the power of white noise. Simulations that draw such noise white train
+the network and set the stds on data quieter or louder than the window, where it counts.
 """
 
 from __future__ import annotations

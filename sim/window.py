@@ -1,6 +1,6 @@
 """``ema-window/1``, the flight-log window every layer reads: one definition, one validation.
 
-:class:`WindowDocument` is the JSON contract (shared/spec/ema-model.md §5): the service takes it
+:class:`WindowDocument` is the JSON contract (``docs/model.md``, the window format): the service takes it
 as its request body, the CLI and the replay client read files through it, and its JSON Schema
 is exported to docs/schemas/. Types are strict (a boolean or a string is not a number), every
 number finite, every bound stated in the schema. :class:`Window` is what the layers below

@@ -2,7 +2,7 @@
 
 The pipeline returns it, the service declares it as its response model, the CLI prints it, the
 history stores it and the tests construct it; ``docs/schemas/ema-estimate-1.json`` is exported
-from it. Fields may be added; those of interfaces.md are never renamed or removed.
+from it. Fields may be added; those of a published version are never renamed or removed.
 """
 
 from __future__ import annotations
@@ -147,7 +147,7 @@ class InertiaReading(Document):
     (``training.prepare.departures.drive_constants``): a window that cannot is read with it (J_M stays with
     the build)."""
 
-    factor: float = Field(description="the inertia at the motor shaft over the spec's J_M")
+    factor: float = Field(description="the inertia at the motor shaft over the document's J_M")
     std: float = Field(ge=0, description="its std")
     window_ids: list[str] = Field(description="the windows that read it")
 
@@ -199,11 +199,12 @@ class WindowInfo(Document):
     )
     inertia_factor: float = Field(
         default=1.0,
-        description="the inertia at the motor shaft over the spec's J_M as read; the current carries the difference",
+        description="the inertia at the motor shaft over the document's J_M as read; "
+        "the current carries the difference",
     )
     viscous_factor: float = Field(
         default=1.0,
-        description="the viscous coefficient every estimator used over the spec's C_M (read where it departs)",
+        description="the viscous coefficient every estimator used over the document's C_M (read where it departs)",
     )
     hinge_gain: float = Field(
         default=1.0,
@@ -228,7 +229,7 @@ class WindowInfo(Document):
     sensor_zero: SensorZero | None = Field(
         default=None,
         description="the sensors' zero as this window read it, for the windows of its flight that move one way "
-        "(null: it moves one way itself, took its flight's instead (sensor_zero_from), or was read with the spec's "
+        "(null: it moves one way itself, took its flight's instead (sensor_zero_from), or was read with the document's "
         "model alone)",
     )
     sensor_zero_from: str | None = Field(

@@ -87,7 +87,8 @@ def inertia_change_note(readings: Sequence[InertiaReading]) -> Note | None:
     if len(used) < len(readings):
         before = _weighted(readings[: len(readings) - len(used)])[0]
         return Note(code="inertia_changed", text=(
-            f"J_M read {before:.3f}x the spec's before window {used[0].window_ids[0]} and {_weighted(used)[0]:.3f}x "
+            f"J_M read {before:.3f}x the document's before window {used[0].window_ids[0]} "
+            f"and {_weighted(used)[0]:.3f}x "
             f"since ({len(used)} windows): a rotor, screw or gear replaced? The actuator's J_M is read since"
         ))
     mean, _, birge = _weighted(readings)
@@ -95,7 +96,8 @@ def inertia_change_note(readings: Sequence[InertiaReading]) -> Note | None:
         return None
     low, high = min(r.factor for r in readings), max(r.factor for r in readings)
     return Note(code="inertia_scatter", text=(
-        f"the {len(readings)} windows that read J_M read {low:.3f}–{high:.3f}x the spec's, {birge:.1f} times as far "
+        f"the {len(readings)} windows that read J_M read {low:.3f}–{high:.3f}x the document's, "
+        f"{birge:.1f} times as far "
         f"apart as their stds allow (a part replaced, or readings gone wrong?): the actuator's J_M ({mean:.3f}) is "
         "said with its std widened as much"
     ))

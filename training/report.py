@@ -71,9 +71,8 @@ def _estimates(
     if fsj.value_nm is not None and fsj.std_nm is not None:
         relative = np.hypot(fsj.std_nm / fsj.value_nm, answer.stds["FDJ"] / fdj)
         ratio = RatioEstimate(value=fsj.value_nm / fdj, std=fsj.value_nm / fdj * relative)
-    # η_A is η_O's through Eq. 3.4, and as weak; a bound of the search is no value, whatever its std (a 0.1 s
-    # window with its current logged 0.71x read η_O 0.999 ± 0.009 at the bound, the truth 0.70; a cruise
-    # window's moment in lbf·ft put η_O there and FDJ 15 % of its range off at 3.3 std)
+    # η_A is η_O's through Eq. 3.4, and as weak; a bound of the search is no value, whatever its std: the fit
+    # stops there for a reason it does not know (a unit, a departure), and FDJ with it where the window is loaded
     weak_eta = weakly_determined("eta_O", eta_o_std, ranges) or eta_o_bound
     weak_fdj = weakly_determined("FDJ", answer.stds["FDJ"], ranges) or (eta_o_bound and loaded)
     eta_a = parameter(float(actuator.eta_a(eta_o)), abs(slope) * eta_o_std, float(actuator.eta_a(nominal.eta_o)),
@@ -147,7 +146,7 @@ def _window_info(prepared: Prepared, data: Data, digest: str) -> WindowInfo:
     )
     inertia = None
     # told apart from γ by the window itself, and moving both ways: a window moving one way holds too little to
-    # read J_M for the actuator (a one-way 0.5 s cruise read 0.61x, the spec's J_M true), and the history keeps it;
+    # read J_M for the actuator (a one-way window reads it poorly), and the history keeps it;
     # and processed fast enough that the kernel reads no bias every window would share (``KERNEL_FREE_RATE_HZ``)
     unbiased = w.sample_rate_hz >= KERNEL_FREE_RATE_HZ
     if drive.inertia_kgm2 and not prepared.departures.inertia_from and not offset.one_way and unbiased:

@@ -8,7 +8,7 @@ import numpy as np
 from sim.residual import DEFAULT_DERIVATIVE_WINDOW_S, kernel_samples
 
 JACKKNIFE_BLOCKS = 10
-DECISIVE_Z = 4.0  # stds by which a reading must explain a window better than the spec's before it is taken
+DECISIVE_Z = 4.0  # stds by which a reading must explain a window better than the document's before it is taken
 
 
 def jackknife_std(estimates: np.ndarray) -> np.ndarray:
@@ -18,7 +18,7 @@ def jackknife_std(estimates: np.ndarray) -> np.ndarray:
 
 
 # A departure a window leans to without showing it (a hinge moment out of step, a viscous coefficient off the
-# spec's) is weighed against the spec's reading with these prior odds (which also pay for trying several: ten
+# document's) is weighed against the document's reading with these prior odds (which also pay for trying several: ten
 # lags, one C), into the stds only; a note says so from this weight.
 UNDECIDED_PRIOR_LOG_ODDS = -4.0
 UNDECIDED_NOTE_WEIGHT = 0.1

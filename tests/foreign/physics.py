@@ -1,4 +1,4 @@
-"""The EMA of ``shared/spec/ema-model.md`` written again, independently of ``sim/``, for tests only.
+"""The EMA of ``docs/model.md`` written again, independently of ``sim/``, for tests only.
 
 Deliberate differences in form from ``sim.kernels`` (each one a legitimate reading of the spec):
 
@@ -128,7 +128,7 @@ def _density(altitude_m: float) -> float:
 
 
 def aircraft_matrices(flight: Flight) -> tuple[np.ndarray, np.ndarray]:
-    """A and B of aircraft.md, scaled to the flight condition as it prescribes."""
+    """A and B of the aircraft (``docs/model.md``), scaled to the flight condition as it prescribes."""
     a = np.array([[-1.9311e-2, 2.68703, -9.80542, -0.175257],
                   [-8.3297e-4, -1.0189, 0.0, 0.90506],
                   [0.0, 0.0, 0.0, 1.0],

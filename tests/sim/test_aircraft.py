@@ -86,7 +86,7 @@ def test_hinge_moment_scales_with_dynamic_pressure():
         expected = condition.dynamic_pressure_pa * geometry.area_m2 * geometry.chord_m * geometry.ch_delta_per_rad
         assert load.hinge_delta_nm == pytest.approx(expected)
         assert geometry.per_deflection_nm_per_rad(condition) == pytest.approx(expected)
-    # aircraft.md's default: q̄0 ≈ 14 340 Pa, so 25° of deflection alone gives ≈ 290 N·m
+    # the aircraft's default: q̄0 ≈ 14 340 Pa, so 25° of deflection alone gives ≈ 290 N·m
     per_rad = HingeGeometry().per_deflection_nm_per_rad(FlightCondition())
     assert per_rad * np.radians(25.0) == pytest.approx(-292.5, abs=1)
 

@@ -6,17 +6,15 @@ bias on this scenario (the 2 ms reconstruction blurs the reversals, the motor sa
 subtracted as far as those K simulations resolve it (James–Stein shrinkage). The errors then give
 each parameter's MSE-optimal blend (``training.assess.blend``) and an in-distribution std. The network
 joins the answer only where the blend cuts the physics fit's error there by ``1 − NETWORK_MARGIN``
-or more: a weight fitted on 24 simulations overstates what the network adds on data the simulator
-did not draw (on 1980 foreign windows in three seed blocks, the plain blend and the full bias made
-the mean error 1–4 % worse in every block, FDJ and η_O alike). Those simulations cannot
+or more: a weight fitted on a few dozen simulations overstates what the network adds on data the
+simulator did not draw, and so does the full bias. Those simulations cannot
 see a mismatch between the model and the measured window, so two checks on the window follow:
 
 - **Consistency.** The network reads the window's residual torque, the physics fit reads it
   too, through Eq. 5.1. On held-out simulations their difference has a known spread; on the
   window it must fall inside it (|z| ≤ ``MAX_DISAGREEMENT_Z``), and the network's answer must
   lie in the box it was trained on. Otherwise the network is extrapolating from a trace the
-  simulator does not produce, and only the physics fit is kept (a doublet's network answer was
-  17 % off with a 0.3 % std that way).
+  simulator does not produce, and only the physics fit is kept.
 - **Equation error.** The window's Eq. 5.1 residual RMS over the simulations' (the same noise,
   no missing physics): ≈ 1 when the model explains the window. Above, the stds are scaled by it
   (the Birge ratio): structure the model lacks widens the uncertainty instead of hiding in it.

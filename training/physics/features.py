@@ -4,7 +4,7 @@ denoised, ``sim.hinge``), residual torque, then resampling.
 Measured and simulated data must go through the very same function (thesis §5.7); this module
 is that function. Resampling to K timesteps takes the mean over K equal bins rather than
 interpolating: with sensor noise, a bin mean keeps every sample's information and averages its
-noise down, where point interpolation would throw 4 of 5 samples away.
+noise down, where point interpolation would throw most samples away.
 """
 
 from __future__ import annotations
@@ -63,8 +63,7 @@ def sliding_features(residual_nm: np.ndarray, sliding: np.ndarray, n_timesteps: 
     ``sliding`` is the measured window's mask (Eq. 5.1's samples), applied to every simulation of
     its dataset alike. Outside it the shaft rests or hunts in the backlash, a limit cycle that no
     two implementations of the model reproduce sample for sample: a network that reads it learns
-    the simulator's hunting, not the transmission's friction (a doublet, mostly holds, was read
-    64 % off that way).
+    the simulator's hunting, not the transmission's friction.
     """
     weight = sliding.astype(np.float64)
     counts = bin_means(weight[None], n_timesteps)

@@ -53,7 +53,7 @@ class FitSettings:
     derivative_window_s: float = DEFAULT_DERIVATIVE_WINDOW_S
     blocks: int = JACKKNIFE_BLOCKS
     offset: bool = False  # also fit a constant torque at the shaft (a current or hinge sensor off zero)
-    viscous: bool = False  # also fit a change ΔC of the viscous coefficient (C·|ω| beyond the spec's)
+    viscous: bool = False  # also fit a change ΔC of the viscous coefficient (C·|ω| beyond the document's)
     torque_scale: bool = False  # also fit γ, the motor torque per logged k_T·I beyond 1 (k_T or a current gain off)
     inertia: bool = False  # also fit ΔJ, the inertia at the motor shaft beyond the actuator's J_M
 

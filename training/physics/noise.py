@@ -18,10 +18,9 @@ between 7 and 8 times ΣR(k) for any correlation shape, so T is read from it wit
 (summed over the lags before S first reaches ``1 − DIP`` of its plateau), on the fewest lags over
 which S levels off (``noise_structure``).
 The simulations then draw AR(1) noise of the same per-sample std and the same T:
-ρ = (T − 1) / (T + 1): a W-sample moving average's noise (T = W) is read with T within 25 %
-(tests/training/test_noise_level.py). Fitting an AR(1)'s shape to S instead read the hinge noise
-behind a 32-sample moving average with 4–15x its low-frequency density, and the bias correction
-drawn from it moved η_O by 13 %.
+ρ = (T − 1) / (T + 1) (a W-sample moving average's noise has T = W; a test pins the read). Fitting
+an AR(1)'s shape to S instead would assume the shape the area rule does not need, and a moving
+average is far from that shape.
 """
 
 from __future__ import annotations
@@ -39,13 +38,12 @@ from sim.params import MAX_CORRELATION_S
 # against its own 40 ms reading, and a strain-gauge amplifier correlates its noise for longer.
 MAX_LAG = {"position_deg": 16, "motor_speed_radps": 16, "current_a": 16, "hinge_moment_nm": 64}
 AREA_PER_COVARIANCE = 7.5  # Σ(6R(0) − S(L)) / ΣR(k): 8 for a lag-1 correlation, 7 for a smooth one
-# A correlation shows as a dip of S below its plateau; the mismatch's shallow rise over many lags (5–25 %
-# by 16 samples on white foreign windows) does not, and counted as area it read white noise as T ≈ 2.
+# A correlation shows as a dip of S below its plateau; the mismatch's shallow rise over many lags does not,
+# and counted as area it would read white noise as correlated.
 DIP = 0.1
 # Noise's S is flat past its correlation; the mismatch's grows as L⁴. A span of lags is the noise's when
 # S rises by at most ``RISE`` of its plateau across the span's upper half (a least-squares line: a
-# correlation longer than the span rises ~0.67 there). On 0.1 s gust windows, all 16 lags read the
-# current's white noise with a median 1.8x its √(low-frequency density); the fewest flat lags, 1.3x.
+# correlation longer than the span rises ~0.67 there). The fewest flat lags keep the mismatch's rise out.
 RISE = 0.25
 MIN_SPAN = 8
 

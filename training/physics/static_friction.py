@@ -6,12 +6,9 @@ end of a rest, minus the load part, is FSJ. Only a *quasi-static* break-away sho
 counts as one only if
 
 - the drive *crept* into the break-away: after a pilot's step the current reference saturates
-  within microseconds and the drive jumps past the static level inside one log interval (a
-  doublet read 0.037 N·m against a true 0.094 that way);
+  within microseconds and the drive jumps past the static level inside one log interval;
 - the drive did not jump *as the shaft let go* either: a shaft held still against the hinge load
-  and then stepped away shows a drive that is only a lower bound of the static level (read as
-  values, 18 of 25 FSJ readings of independently drawn windows, most of them such holds, lay
-  outside their ±2 std, up to 53 % low);
+  and then stepped away shows a drive that is only a lower bound of the static level;
 - the shaft was stuck, not creeping: its mean speed over the rest is zero within the noise (a
   shaft creeping at 0.3 rad/s under dynamic friction passes for resting in a noisy log);
 - it was clear of the end stops, where the drive is the stop's reaction, not friction;
@@ -22,8 +19,7 @@ break-away is sought over the last ``LOOKBACK_RUNS`` ms of the rest. The answer 
 the events with a std from their spread, or no value with the reason. The log holds interval means:
 where the drive itself scatters before the break-away (a loop that dithers the current on its own
 noisy speed reading), the peak that let the shaft go hides inside an interval, up to two of the
-scatter's stds above the ramp, so no event is read closer than that (with the sensor noise's std
-alone, 6 of 14 foreign windows whose loop read 0.4 rad/s of speed noise were read 2.3–8.8 std low).
+scatter's stds above the ramp, so no event is read closer than that.
 """
 
 from __future__ import annotations
@@ -131,8 +127,7 @@ def _scatter(drive_nm: np.ndarray, begin: int, peak: int) -> float:
 def _traces(signals: Mapping[str, np.ndarray], rate: float, actuator: ActuatorParams, noise: SensorNoise) -> _Traces:
     """The drive and speed with the per-sample std that *white* noise would need to scatter their means as
     much as this window's does: a sensor filter correlates the noise, and its means scatter more. Read
-    white, a drive's noise looked like build-ups: 40 foreign windows with filtered sensors gave 3 FSJ, 2 of
-    them 41 and 50 % low at 7 and 10 std; with AR(1)-filtered sensors, 8 FSJ, none within ±2 std."""
+    white, a filtered drive's noise looks like build-ups, and each reads as a low FSJ."""
     drive = actuator.torque_constant_nm_per_a * signals["current_a"] + signals["hinge_moment_nm"] / actuator.gear_ratio
     speed = signals["motor_speed_radps"]
     drive_noise = max(white_noise_std(drive), actuator.torque_constant_nm_per_a * noise.current_a)

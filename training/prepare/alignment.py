@@ -3,17 +3,14 @@
 Eq. 5.1 sets the motor torque k_T·I against the inertia's J·dω/dt at each instant; at the shaft's
 accelerations both are far larger than the friction read from their difference, so a current
 logged a fraction of a millisecond after the speed (an anti-aliasing filter, an averaging ADC, a
-speed read through a filtered resolver) leaves a residual that no friction explains. On foreign
-windows whose current or speed passed through a 2–8 sample moving average (0.05–0.35 ms of delay),
-FDJ and η_O were 7–19 % of the range off on average (up to 59 %), every answer weakly determined.
+speed read through a filtered resolver) leaves a residual that no friction explains.
 
 The lag is read as the shift of the current, to half a sample within ``MAX_LAG_S``, that minimizes
 the equation error of the physics fit: batched fits of the window with the current shifted each way
-(the sliding samples, set by the speed, stay the same). It is sharp: on those windows the minimum
-fell exactly on the filter's delay, the equation error 32–88 % below the unshifted one, and on
-windows without filters exactly on zero. A lag is applied only
-where it lowers the equation error by ``MIN_GAIN``; then the later of the two signals is advanced
-(a filter only delays), by linear interpolation, the end held.
+(the sliding samples, set by the speed, stay the same). The minimum is sharp, because the
+accelerations are large. A lag is applied only where it lowers the equation error by ``MIN_GAIN``;
+then the later of the two signals is advanced (a filter only delays), by linear interpolation, the
+end held.
 
 The hinge moment's lag barely shows in the equation error; it is read from its filter's trace in
 its noise, the deflection and Eq. 5.1 together (``training.prepare.hinge_lag``), and advanced by it.

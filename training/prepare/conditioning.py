@@ -1,38 +1,30 @@
 """A logged window made ready for the pipeline: isolated glitches repaired, a bounded number of
-samples, its signals checked to tell one story (``training.prepare.consistency``: a sign, unit or sample
-rate the log got wrong is refused, naming the field), its sensors on one clock
-(``training.prepare.alignment``), what it shows beyond the spec's model read and undone
-(``training.prepare.departures.read``: a sensor off zero, the drive's k_T and J_M, the hinge moment's gain, the
-viscous coefficient), how likely its hinge moment is out of step (``training.prepare.step_lag``), and what
-was done to it.
+samples, its signals checked to tell one story (``training.prepare.consistency``: a sign, unit or
+sample rate the log got wrong is refused, naming the field), its sensors on one clock
+(``training.prepare.alignment``), what it shows beyond the actuator document's model read and undone
+(``training.prepare.departures.read``: a sensor off zero, the drive's k_T and J_M, the hinge moment's
+gain, the viscous coefficient), how likely its hinge moment is out of step
+(``training.prepare.step_lag``), and what was done to it.
 
 A sensor's sample that jumps away from both neighbours and straight back (an EMI spike, a bit
-error) is no measurement, nor is a burst of a few of them (``MAX_GLITCH_RUN``, ``MAX_GLITCH_S``:
-at 1 kHz, a current pulse as the motion reverses looks like a 2–3 sample burst). Two such samples of
-500–1000 noise stds on each sensor of foreign 0.5 s windows made every answer weakly determined and
-7–11 % of range off on average. A run is a glitch when all its samples stand more than
-``GLITCH_STDS`` noise stds beyond both flanking samples, which agree with each other, and more than
-``GLITCH_ACTIVITY`` times the median step around them and the steps into them: a 1 kHz log's
-fastest legitimate turns reach 36 noise stds, but not those. On 280 foreign windows (1–100 kHz,
-0.1–0.5 s, filtered sensors, worn actuators) no sample is taken for a glitch, and 1892 of 1920
-spikes of 100–1000 noise stds drawn into them are found. It is replaced by the line
-between its flanks, before the averaging below would smear it, and counted in the result. (A
-sample beyond the window format's plausible range is refused before this, naming it.)
+error) is no measurement, nor is a burst of a few of them (``MAX_GLITCH_RUN``, ``MAX_GLITCH_S``: at
+1 kHz, a current pulse as the motion reverses looks like a 2–3 sample burst), and a few of them
+move every answer. A run is a glitch when all its samples stand more than ``GLITCH_STDS`` noise stds
+beyond both flanking samples, which agree with each other, and more than ``GLITCH_ACTIVITY`` times
+the median step around them and the steps into them: a 1 kHz log's fastest legitimate turns stand
+far out in noise stds, but not against the steps around them. It is replaced by the line between
+its flanks, before the averaging below would smear it, and counted in the result. (A sample beyond
+the window format's plausible range is refused before this, naming it.)
 
 Logs come at 1–100 kHz and last 0.1–10 s. The simulator runs at 1 µs whatever the log rate, but
-every later stage (reconstruction, features, the friction fit) costs per logged sample, and a
-batch of simulations records every sample of every simulation. So the window is averaged over
-f adjacent samples first: interval means of interval means are the interval means of the longer
-intervals, exactly, which is also what the simulations record at the lower rate. ``f`` keeps the
-rate at or below ``MAX_RATE_HZ`` (the 2 ms reconstruction needs no more) and the samples at or
-below ``MAX_SAMPLES``: memory and time grow at most linearly with the duration, and are bounded.
-A window of up to 10 s is kept at ``KERNEL_FREE_RATE_HZ`` or more where it was logged so: below it the
-2 ms kernel spans few samples and reads J_M low (``training.prepare.departures.drive_constants``), and a long window's
-stds are small enough to show it: processed at 1 kHz, a 10 s cruise logged at
-100 kHz read J_M 0.9885 ± 0.0003 (the spec's true), and of 30 foreign 10 s windows logged at 10 kHz
-7 held η_O's truth outside their ±2 std (to 4.3 std), 2 FDJ's; at 5 kHz 0 and 1, for 1.6x the time
-(``benchmarks.foreign_accuracy``'s 10 s group). Memory grows with the samples too (~1.2 GB at the
-default sizes for 10 s at 5 kHz): within what the service already admits for a 1 s window at 10 kHz.
+every later stage costs per logged sample, and a batch of simulations records every sample of every
+simulation. So the window is averaged over f adjacent samples first: interval means of interval
+means are the interval means of the longer intervals, exactly, which is also what the simulations
+record at the lower rate. ``f`` keeps the rate at or below ``MAX_RATE_HZ`` (the 2 ms reconstruction
+needs no more) and the samples at or below ``MAX_SAMPLES``: memory and time grow at most linearly
+with the duration, and are bounded. A window of up to 10 s is kept at ``KERNEL_FREE_RATE_HZ`` or more
+where it was logged so: below it the 2 ms kernel spans few samples and reads J_M low
+(``training.prepare.departures.drive_constants``), and a long window's stds are small enough to show it.
 """
 
 from __future__ import annotations
@@ -80,7 +72,7 @@ class Prepared:
     glitches: dict[str, int]  # per sensor, samples of glitches replaced by the line between their flanks
     consistency: Consistency  # how its signals relate: the kinematic gain, the loop, Eq. 5.1's readings
     lags: Lags  # how late the current (behind the speed) and the hinge moment were logged, undone
-    departures: Departures  # what it shows beyond the spec's model (an offset, k_T and J_M, g, C), undone
+    departures: Departures  # what it shows beyond the document's model (an offset, k_T and J_M, g, C), undone
     step: StepLag  # how likely its hinge moment is out of step, where that is too unclear to refuse it
     stale: Stale = field(default_factory=Stale)  # sensors that repeated one value while the shaft slid: cut out
 
@@ -91,7 +83,7 @@ class Prepared:
 
     @property
     def actuator(self) -> ActuatorParams:
-        """What every reconstruction and fit of the window reads it with: the spec's, J_M and C as read."""
+        """What every reconstruction and fit of the window reads it with: the document's, J_M and C as read."""
         return self.departures.actuator
 
 
@@ -154,7 +146,7 @@ def prepare(window: Window, actuator: Actuator, spec_only: bool = False, known: 
     naming the field), put its sensors on one clock (``training.prepare.alignment``), read what it shows beyond
     ``actuator`` (``training.prepare.departures.read``) and weigh whether its hinge moment is out of step
     (``training.prepare.step_lag``); say what it found. ``spec_only`` skips the departures and the step:
-    ``calibration`` reads the spec's model alone and names what departs. ``known``: what other windows of
+    ``calibration`` reads the document's model alone and names what departs. ``known``: what other windows of
     the actuator read (``departures.read_departures``)."""
     logged, spec = window.n_samples, actuator.params
     window, stale = without_stale(window, spec)
@@ -176,7 +168,7 @@ def prepare(window: Window, actuator: Actuator, spec_only: bool = False, known: 
         else read_departures(window, actuator, aircraft, known or Known())
     )
     rate = read.window.sample_rate_hz * factor
-    # with the departures left in, a lag fits what they leave (an offset: ln LR 105): the story is no test there
+    # with the departures left in, a lag fits what they leave (an offset above all): the story is no test there
     step = StepLag() if spec_only else step_lag(read.window, read.actuator)
     return Prepared(actuator, factor, logged, rate, clipped, glitches, consistent, lags, read, step, stale)
 

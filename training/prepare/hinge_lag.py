@@ -1,26 +1,23 @@
 """How late the hinge moment is logged: its filter's trace in the noise, the deflection and Eq. 5.1,
 weighed together.
 
-The hinge moment's lag barely shows in Eq. 5.1's equation error (on most windows lags of 0–3 ms fit
-it as well as none), yet through a 1–4 ms strain-gauge filter it put FDJ outside its ±2 std on 18 of
-20 windows. It shows in the noise: the filter that delays the signal correlates the noise it passes,
-and ``noise_level`` reads that correlation as a filter's delay D (``filter_delay_samples``; behind
-10–40 sample moving averages 0.70–1.15 of it, and 0 on white noise). But noise correlated after the
-signal (an amplifier's own noise behind its output filter) reads the same, and advancing an
-unfiltered moment by it put FDJ up to 13 % of the range off; and now and then the read misses a
-filter (0.1 ms read behind a 2 ms one). So where the noise shows a filter, the lag is a model
-average over three stories (``PRIOR``): the filter delays the moment too (D within
-``HINGE_LAG_UNCERTAINTY``), it filters only the noise (on time), or the moment is late by another
-amount up to ``MAX_HINGE_LAG_S``. Each lag of the grid is weighed by
+The hinge moment's lag barely shows in Eq. 5.1's equation error (lags of a few ms fit it about as
+well as none), yet a strain-gauge filter's delay of 1–4 ms moves FDJ beyond its std. It shows in the
+noise: the filter that delays the signal correlates the noise it passes, and ``training.physics.noise`` reads
+that correlation as a filter's delay D (``filter_delay_samples``; 0 on white noise). But noise
+correlated after the signal (an amplifier's own noise behind its output filter) reads the same, and
+advancing an unfiltered moment by it would move FDJ as much the other way; and now and then the read
+misses a filter. So where the noise shows a filter, the lag is a model average over three stories
+(``PRIOR``): the filter delays the moment too (D within ``HINGE_LAG_UNCERTAINTY``), it filters only
+the noise (on time), or the moment is late by another amount up to ``MAX_HINGE_LAG_S``. Each lag of
+the grid is weighed by
 - the deflection: in the aircraft's band the moment follows it at once, so the lag read there
   (``aircraft_band.band_lag_s``, relative to the position's own filter) is the moment's; Student's t
-  on its jackknife std, widened by ``BAND_LAG_UNCERTAINTY`` of the lag (behind filters the band reads
-  0.6–1.1 of it);
-- Eq. 5.1's equation error at that lag (``preprocess.rms_log_likelihood_ratio``; weak).
+  on its jackknife std, widened by ``BAND_LAG_UNCERTAINTY`` of the lag;
+- Eq. 5.1's equation error at that lag (``training.stats.rms_log_likelihood_ratio``; weak).
 The moment is advanced by the posterior mean lag, and FDJ's and η_O's stds grow by their posterior
-spread over the lags (the two stories' gap where neither decides). On 24 foreign windows each, the
-posterior put 0.88 on "late" where the filter delays the moment, and 0.36 where it filters only its
-noise (a slow window's band reads too little to decide: there the stds carry both).
+spread over the lags (the two stories' gap where neither decides; a slow window's band reads too
+little to decide, and there the stds carry both).
 """
 
 from __future__ import annotations
@@ -38,16 +35,15 @@ from training.prepare.departures.aircraft_band import band_lag_s
 from training.stats import JACKKNIFE_BLOCKS, rms_log_likelihood_ratio
 
 MAX_HINGE_LAG_S = 3e-3
-# The filter's delay as read from the noise is 0.70–1.15 of the true one (RMS 12 % off on 20 windows): one std.
+# How far the filter's delay as read from the noise may be off the true one, in shares of it: one std.
 HINGE_LAG_UNCERTAINTY = 0.15
-# The deflection's band reads a filtered moment's lag at 0.6–1.1 of the filter's delay: one std, in shares of it.
+# How far the deflection's band may read a filtered moment's lag off the filter's delay: one std, in shares of it.
 BAND_LAG_UNCERTAINTY = 0.25
 PRIOR = {"filter": 0.45, "on_time": 0.45, "other": 0.1}  # where the noise shows a filter
 OTHER_LAGS = 40  # grid points over (0, MAX_HINGE_LAG_S]
 FILTER_LAGS = np.linspace(-2.0, 2.0, 9)  # D·(1 + HINGE_LAG_UNCERTAINTY·z)
 # Eq. 5.1's evidence on the lag is read with a sensor's offset and C free: the window's departures are read
-# after its lags, and a grease 1.2–2x the spec's, left in, fitted best with a clean moment read 2–3 ms late
-# (2 in 150 slow foreign windows, one of them then refused as out of step with the deflection).
+# after its lags, and a thick grease left in fits best with a clean moment read a few ms late.
 DEPARTURES_FREE = FitSettings(offset=True, viscous=True)
 
 

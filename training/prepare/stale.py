@@ -2,43 +2,32 @@
 a gap it filled in. A short run is bridged by the line between its flanks; past a kernel's span, the window
 is read from the stretch without such runs that holds the most sliding motion.
 
-A working sensor shows its noise: over the 1735 windows of ``benchmarks.foreign_accuracy`` and
-``careless_exports`` (every group: 1–100 kHz, quantized, filtered, held positions), one repeated a value
-over 8 successive samples at most where its noise spans its resolution (a position quantized at a quarter
-of its noise, whose neighbours are equal 7 % of the time), 19 behind a filter, where it does not.
-Two faults of real flight logs leave such a run in an otherwise noisy signal: a sensor or bus that stops
-updating while the logger keeps writing its last value, and a gap the logger fills with zeros. Left in,
-they are read as physics: on 5 foreign windows with the speed frozen over a fifth of them, FDJ came out
-0.3–7 ranges off (said weak, but the window's four good fifths were lost with it), with the current
-dropping to zero over a tenth, 0.2–2 ranges; and a current dropping to zero for 1.8 ms at slew moved FDJ
-by a median 4 of its stds (15 foreign windows, up to 84).
+Two faults of real flight logs leave such a run in an otherwise noisy signal: a sensor or bus that
+stops updating while the logger keeps writing its last value, and a gap the logger fills with zeros.
+Left in, they are read as physics: a frozen speed or a current at zero is friction to Eq. 5.1.
 
 A run of ``r`` repeats (``r + 1`` equal samples, at least ``MIN_STALE_SAMPLES``) is stale where
 
 1. the sensor's noise spans its resolution (its white noise std, read outside the runs, at least its
    smallest step): a sensor quantized coarser than its noise sits on one level wherever its signal is
-   flat, as a frozen one does (a current logged in 0.5 A steps, 10x its noise, held one value for
-   25–62 ms of sliding in 5 foreign windows), and there the two cannot be told apart;
+   flat, as a frozen one does, and there the two cannot be told apart;
 2. the signal's own repeats elsewhere make it improbable: m·pʳ < ``STALE_CHANCE``, m the pairs of
-   neighbours, p the share of them equal outside the run (Laplace's rule: at 1e-3 chance runs of that
-   position were taken in 3 of those windows); or it stands off both flanking samples by ``DROPOUT_STDS``
-   noise stds: a gap filled with zeros. Of 29 foreign currents dropping to 0 for 5 samples at slew (3–495
-   noise stds), the repeats alone found none, standing 30 stds off 19, 10 stds 28 (not the one 3 stds
-   off). A glitch (``conditioning.repaired``) is 3 samples at most, and one sample 30 stds off is the
-   evidence there; a flat run of four is already rare;
+   neighbours, p the share of them equal outside the run (Laplace's rule); or it stands off both
+   flanking samples by ``DROPOUT_STDS`` noise stds: a gap filled with zeros, which repeats alone
+   would rarely find. A glitch (``conditioning.repaired``) is 3 samples at most, and one sample far
+   off is the evidence there; a flat run of four is already rare;
 3. for a motion sensor, the shaft slides during it by the other one (the speed for the position; the
    position's travel, or the frozen value itself, for the speed): a speed derived from an encoder may
    read 0 at rest, a resolver one count through a hold. A torque sensor that shows its noise never
    repeats a value, at rest or not, and the simulations replay the logged load through the holds too.
 
-A stale run inside the window and no longer than the reconstruction kernel (2 ms) is replaced by the line
-between its flanking samples, as a glitch is (``conditioning.repaired``): the kernel averages over as
-much (30 foreign windows, the current or the speed frozen or at 0 for 0.6–2 ms at slew: the answer moved
-by a median 0.1 of its std, 1.0 at most, where cutting the window there moved it 0.6, up to 3.1). A
-longer one cuts the window to the stretch between such runs with the most sliding samples
-(``window.read_span``); both are counted (``window.stale_samples``) and said in a note. Where that stretch
-holds fewer than ``baseline.MIN_SLIDING_KERNELS`` kernel widths of sliding samples, the window is refused
-naming the sensor and its run. A sensor that repeats one value over the whole window is left to
+A stale run inside the window and no longer than the reconstruction kernel (2 ms) is replaced by the
+line between its flanking samples, as a glitch is: the kernel averages over as much, and cutting
+the window there would lose more than the bridge costs. A longer one cuts the window to the stretch
+between such runs with the most sliding samples (``window.read_span``); both are counted
+(``window.stale_samples``) and said in a note. Where that stretch holds fewer than
+``training.physics.friction.MIN_SLIDING_KERNELS`` kernel widths of sliding samples, the window is refused naming the
+sensor and its run. A sensor that repeats one value over the whole window is left to
 ``consistency.check_logged``, which names it as not logged.
 """
 

@@ -1,39 +1,28 @@
 """A hinge moment that may be out of step with the other channels, where Eq. 5.1 leans that way
 without deciding.
 
-``training.prepare.consistency`` refuses a window whose hinge moment, read 3–50 ms away (``STEP_LAGS_S``),
-fits Eq. 5.1 ``MIN_BETTER`` times better: exported on another clock. Below that it was answered as
-logged, and where the deflection moves slowly Eq. 5.1 hardly feels 20 ms: a cruise window so
-exported was answered FDJ 13 % of the range off at 2.7 std, not said weak. Once the window's
-departures are taken off (an offset, a gain, C), the moment read at any of those lags fits a
-window in step worse than as logged, or barely better: on 208 foreign windows of every group ln of
-the likelihood ratio of the best lag against none was under 0.25 in 99 %, 4.3 at most. Out of step,
-it fits better at about the lag the export shifted it by, by 0.5–8 (5 ms out of step), 1.3–6.7
-(10 ms) and 0.3–36 (20 ms), on the windows ``training.prepare.consistency`` answers (12, 6 and 14 of 104,
-104 and 208); and those answers erred by what reading the moment at that lag changes.
+``training.prepare.consistency`` refuses a window whose hinge moment, read 3–50 ms away
+(``STEP_LAGS_S``), fits Eq. 5.1 ``MIN_BETTER`` times better: exported on another clock. Below that
+the window is answered as logged, yet where the deflection moves slowly Eq. 5.1 hardly feels 20 ms,
+and an answer read at the wrong lag is off by what reading the moment at the right one changes.
+Once the window's departures are taken off (an offset, a gain, C), the moment read at any of those
+lags fits a window in step worse than as logged, or barely better; out of step, it fits better at
+about the lag the export shifted it by.
 
 So the window is still read as logged, and the story "out of step by the best of those lags" is
 weighed against it by the likelihood ratio of their equation errors
-(``preprocess.rms_log_likelihood_ratio``) and a small prior (``PRIOR_LOG_ODDS``, which also pays for
-trying ten lags): its weight w. Each target's std grows by √w·|gap|, the RMS distance of the logged
-reading from the mixture's (gap: what reading the moment at that lag changes), and a note says so
-from ``NOTE_WEIGHT``. On those windows the answers past 10 % of the range not said weak went from 5
-to 2 (5 ms), 3 to 1 (10 ms) and 2 to 0 (20 ms); on the 208 in step FDJ's std grew by a median 0.7 %
-(by over half in 6), and ±2 std held the truth as often as before. A prior of e⁻³ would catch one
-more 5 ms window and grow 26 in-step stds by over half.
+(``training.stats.rms_log_likelihood_ratio``) and a small prior (``PRIOR_LOG_ODDS``, which also pays
+for trying ten lags): its weight w. Each target's std grows by √w·|gap|, the RMS distance of the
+logged reading from the mixture's (gap: what reading the moment at that lag changes), and a note says
+so from ``NOTE_WEIGHT``. The prior trades the out-of-step windows caught against in-step stds grown.
 
 The deflection weighs in too: in the aircraft's band the moment follows it at once, so the lag the
 band reads (``hinge_lag.band_log_likelihood``, as for a filter's lag) is the moment's, and its
-likelihood at the best lag against none joins the ratio. Of 2 kHz foreign windows logged 5 ms
-early, Eq. 5.1 alone left 24 of 48 under weight 0.1; the band put 19 of them over 0.9, and it weighs
-against any lag where the moment is in step. Careless exports 5 ms out of step: confidently wrong
-3 → 1 of 104 (``docs/results.md``, "Careless exports"); where the deflection moves too slowly for the
-band, the ratio alone stays the limit. In step, the stds lose what the story lent them: FDJ's ±2 std
-coverage went 100 → 98 / 97 % on the thesis and doublet groups of the accuracy table, 100 → 95 % behind
-the heaviest hinge filters, where the story had covered for the filter's lag.
+likelihood at the best lag against none joins the ratio; it weighs against any lag where the moment
+is in step. Where the deflection moves too slowly for the band, the ratio alone stays the limit.
 
-The current needs no such reading: its lag breaks Eq. 5.1 at every acceleration, and of 104 foreign
-windows exported with it 20 ms out of step 101 were refused, the rest answered within 10 % of range.
+The current needs no such reading: its lag breaks Eq. 5.1 at every acceleration, and
+``training.prepare.consistency`` refuses it.
 """
 
 from __future__ import annotations
@@ -50,7 +39,7 @@ from training.prepare.consistency import step_lags
 from training.prepare.hinge_lag import band_log_likelihood
 from training.stats import UNDECIDED_NOTE_WEIGHT, UNDECIDED_PRIOR_LOG_ODDS, odds_weight, rms_log_likelihood_ratio
 
-# the prior odds of "out of step" against "in step", and the note's weight (in-step windows: 1 of 208 reached it)
+# the prior odds of "out of step" against "in step", and the weight from which a note says so
 PRIOR_LOG_ODDS, NOTE_WEIGHT = UNDECIDED_PRIOR_LOG_ODDS, UNDECIDED_NOTE_WEIGHT
 
 

@@ -1,8 +1,8 @@
 """Where a window's dataset is drawn: around the physics estimate, as wide as its uncertainty says.
 
 The thesis samples fixed ranges (FDJ 0.04–0.06 N·m, η_O 0.68–0.98), and a network trained there
-cannot answer outside them: a worn actuator at 2.4x nominal friction was read at 1.4x, with a
-std that did not notice. Here every window gets its own box, centred on the Eq. 5.1 estimate
+cannot answer outside them: a worn actuator's friction is read near the edge of the box, with a
+std that does not notice. Here every window gets its own box, centred on the Eq. 5.1 estimate
 (``training.physics.friction``), ±``SPAN_SIGMAS`` of its jackknife std wide but never narrower than
 ``MIN_HALF_SPAN``, and clipped only to what is physical (``PHYSICAL``): FDJ from a tenth of
 nominal to ten times it, η_O down into Case 1C's irreversible range, FSJ ≥ FDJ. The points fill

@@ -1,41 +1,34 @@
 """The logged hinge moment against the aircraft's: the part of it that follows the deflection, which
 the flight condition alone gives (analytical redundancy for the strain gauge).
 
-H_e = q̄·S_e·c_e·(C_h0 + C_hα·α_t + C_hδ·δ) (aircraft.md). Between 10 and 400 Hz (``BAND_S``: each
-signal's local line over 2.5 ms minus that over 100 ms) the aircraft's own part hardly moves (α_t's
-response to δ adds under 1 % there) and the sensors' noise is mostly averaged away, so the logged
-moment and the logged deflection stand in the ratio b = q̄·S_e·c_e·C_hδ in that band. Their
-least-squares slope over b, the *ratio*, reads the strain gauge's gain where Eq. 5.1 cannot: there
-a gain is η_O's twin wherever the load is small (``training.prepare.departures.hinge_gain``), here it needs only a
-deflection that moves. What the position sensor's noise keeps in the band is taken out of the
-deflection's spread (it would attenuate the slope: a 40 ms band without it read a clean cruise
-window 0.49); the std is the larger of the white-noise one and a jackknife over
-``JACKKNIFE_BLOCKS`` (which sees a filter's correlated noise). On 364 foreign windows of every group
-of ``benchmarks.foreign_accuracy`` the ratio read 0.95–1.07 (median std 0.008); with the moment in
-lbf·ft (0.74x) 0.70–0.79, beyond ``TOLERANCE`` by 2 stds in all of 104; in kN·m or of the other sign
-far outside ``GROSS``; exported 20 ms out of step it collapses as logged and comes back to ~1 read
-at the lag the export shifted it by.
+H_e = q̄·S_e·c_e·(C_h0 + C_hα·α_t + C_hδ·δ) (``docs/model.md``, the airframe). Between 10 and
+400 Hz (``BAND_S``: each signal's local line over 2.5 ms minus that over 100 ms) the aircraft's own
+part hardly moves (α_t's response to δ adds under 1 % there) and the sensors' noise is mostly
+averaged away, so the logged moment and the logged deflection stand in the ratio
+b = q̄·S_e·c_e·C_hδ in that band. Their least-squares slope over b, the *ratio*, reads the strain
+gauge's gain where Eq. 5.1 cannot: there a gain is η_O's twin wherever the load is small
+(``training.prepare.departures.hinge_gain``), here it needs only a deflection that moves. What the
+position sensor's noise keeps in the band is taken out of the deflection's spread (it would
+attenuate the slope); the std is the larger of the white-noise one and a jackknife over
+``JACKKNIFE_BLOCKS`` (which sees a filter's correlated noise).
 
 In turn:
 1. Where the moment read ``STEP_LAGS_S`` away fits the aircraft's (within the tolerance) and the
    band clearly better (``STEP_UNEXPLAINED``): it was exported out of step, refused naming it and
-   the lag (95 of 104 foreign windows 20 ms out of step; none of the 364 clean ones).
+   the lag.
 2. Outside ``GROSS`` by ``GROSS_STDS``: no strain gauge's calibration nor hinge coefficient is that
    far off: refused naming it (a unit, a sign, or the flight condition).
-3. Departing from 1 by more than ``TOLERANCE`` + ``DEPART_STDS`` stds: the model's C_hδ is
-   trusted within ``TOLERANCE`` (it is the airframe's model every simulation of the product runs;
-   one further off shows the same ratio in every window of the aircraft,
-   ``window.hinge_aircraft_ratio``: a model to calibrate), so the gauge is off by the ratio, where the
-   window spans ``DECISIVE_SPANS`` of the band (shorter, it only widens the stds, below). It is
-   divided out first (``divided_out``): a gain seen later passes in part for an offset (a moment
-   in lbf·ft read as 10 N·m off zero, then divided by its gain, put FDJ 3.9 ranges off). Where
-   the window's loads then read no gain more precisely (``training.prepare.departures.hinge_gain``; a small load, where
-   the gain is η_O's twin), the stds grow by half of what the ends of the ratio's band (the
-   tolerance and its std) move FDJ and η_O (``banded``): 10 % moves FDJ by up to its range on a
-   steady load. Beyond the tolerance by ``SUSPECT_STDS`` only, or in a shorter window, the gauge is
-   in doubt (``in_doubt``): the moment is read as logged and the stds grow by ``UNDECIDED_SHARE`` of
-   what reading the window with the ratio divided out first would move (``training.prepare.departures.read``; 1 of
-   the 364 clean foreign windows, a 0.1 s one).
+3. Departing from 1 by more than the airframe's tolerance + ``DEPART_STDS`` stds: the model's C_hδ
+   is trusted within the tolerance (one further off shows the same ratio in every window of the
+   aircraft, ``window.hinge_aircraft_ratio``: a model to calibrate), so the gauge is off by the
+   ratio, where the window spans ``DECISIVE_SPANS`` of the band (shorter, it only widens the stds).
+   It is divided out first (``divided_out``): a gain seen later passes in part for an offset. Where
+   the window's loads then read no gain more precisely (a small load, where the gain is η_O's twin),
+   the stds grow by half of what the ends of the ratio's band (the tolerance and its std) move FDJ
+   and η_O (``banded``). Beyond the tolerance by ``SUSPECT_STDS`` only, or in a shorter window, the
+   gauge is in doubt (``in_doubt``): the moment is read as logged and the stds grow by
+   ``UNDECIDED_SHARE`` of what reading the window with the ratio divided out first would move
+   (``training.prepare.departures.read``).
 """
 
 from __future__ import annotations
@@ -64,12 +57,12 @@ TOLERANCE = Airframe.model_fields["tolerance"].default  # how far the airframe's
 DEPART_STDS = 2.0  # stds beyond the tolerance by which a ratio departs: the gauge is off by it
 SUSPECT_STDS = 1.0  # stds beyond the tolerance by which a ratio puts the gauge in doubt
 FIT_STDS = 2.0  # a ratio read at another lag fits within the tolerance and this many stds ...
-STEP_UNEXPLAINED = 0.75  # ... and leaves under this share of what lag 0 leaves unexplained (clean: ≥ 0.98)
+STEP_UNEXPLAINED = 0.75  # ... and leaves under this share of what lag 0 leaves unexplained
 GROSS = (0.5, 2.0)  # no gauge's calibration nor hinge coefficient is off beyond these
 GROSS_STDS = 4.0
 MAX_NOISE_SHARE = 0.5  # of the deflection's fast spread its sensor noise may make for the slope to be read
 DECISIVE_SPANS = 2.0  # a shorter window's band is its deviation from one line: curvature, where α_t
-# answers δ (a clean 0.1 s gust window read 1.17, with noise 1.6 ± 0.24): it only widens the stds
+# answers δ, reads as a gain there: it only widens the stds
 READABLE_STD = 0.25  # a ratio read less precisely is not reported (a deflection that hardly moves fast)
 
 

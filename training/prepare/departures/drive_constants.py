@@ -1,37 +1,28 @@
-"""The drive's k_T and J_M as a window shows them, read where they depart from the spec's.
+"""The drive's k_T and J_M as a window shows them, read where they depart from the document's.
 
-T_R = k_T·I − J_M·dω/dt + H_e/n takes both constants from the spec, and a real drive has neither
-exactly. A magnet's k_T falls about 0.1 %/K as the motor warms (NdFeB; SmCo a third of that) and a
-Hall current sensor carries a gain error of about 1 %: T_R then misses γ·k_T·I, with γ the motor's
-torque per spec k_T·I less one. A rotor, screw and gear train reflect an inertia the spec rounds:
-T_R then holds ΔJ·dω/dt too much. k_T·I is mostly the hinge load and the inertia, and dω/dt reaches
-6·10⁴ rad/s²: on foreign windows, k_T 0.95–1.05x the spec's put FDJ a mean 53 % of its range off (up
-to 258 %, at up to 14 stds), J_M 0.92–1.06x a mean 21 %, 7 of 10 outside ±2 std.
+T_R = k_T·I − J_M·dω/dt + H_e/n takes both constants from the actuator document, and a real drive
+has neither exactly: a magnet's k_T falls about 0.1 %/K as the motor warms and a Hall current
+sensor carries a gain error of about 1 % (T_R then misses γ·k_T·I); a rotor, screw and gear train
+reflect an inertia the document rounds (T_R then holds ΔJ·dω/dt too much). Both terms are large
+beside friction, so a small error in either moves FDJ by much of its range.
 
-Friction follows the direction and |T_ext|; k_T·I follows the signed load and the acceleration, dω/dt
-the acceleration alone. So each is fitted beside FDJ (``baseline.nuisance_columns``), the offset and
-ΔC free too (either might pass for them), and read where the fit with it explains the window
-``DECISIVE_Z`` stds better than the fit without it (``zero_offset.equation_z``). Not together: γ and
-ΔJ/J_M equal make a gain of the hinge moment's term, and the sensor noise the two columns share
-with the target read one on clean foreign cruise windows (up to 12 stds). Where both stand out
-alone, the likelihood ratio of the two readings decides if it can (``DECISIVE``); where it cannot
-(mostly a heavier J_M in a window where the motor saturates as it accelerates, which a weaker motor
-explains as well), γ is read and the stds carry what ΔJ would change instead (``UNDECIDED_SHARE``).
-The current carries γ (I' = (1 + γ)·I, refitted until nothing is left, ``ITERATIONS``: where k_T·I
-meets the motor's peak torque the model cuts it, the drive's too), the window's actuator ΔJ
-(``DriveConstants.actuator``: every reconstruction of the window's T_R uses it; the simulations
-keep the spec's they are drawn with). FDJ's and η_O's stds grow by what each constant's std moves
-them.
+Friction follows the direction and |T_ext|; k_T·I follows the signed load and the acceleration,
+dω/dt the acceleration alone. So each constant is fitted beside FDJ, with the offset and ΔC free,
+and read where the fit with it explains the window ``DECISIVE_Z`` stds better than the fit without
+(``zero_offset.equation_z``). Never both together: γ and ΔJ/J_M equal make a gain of the hinge
+moment's term, and the noise the two columns share with the target would read one. Where both
+stand out alone, the likelihood ratio of the two readings decides if it can (``DECISIVE``); where it
+cannot (a heavier rotor in a window where the motor saturates as it accelerates, which a weaker
+motor explains as well), γ is read and the stds carry what ΔJ would change (``UNDECIDED_SHARE``).
+The current carries γ (I' = (1 + γ)·I, refitted up to ``ITERATIONS`` times, as the motor's peak
+torque cuts k_T·I), the window's actuator carries ΔJ; FDJ's and η_O's stds grow by what each
+constant's std moves them.
 
-A current logged in other units (a tenth of it, a shunt's voltage) passed every check and was answered
-FDJ 3–11 ranges off, said weak with stds of hundreds of ranges. Fitted alone, γ then reads 9 and ΔJ
-−0.82 to −0.89 of J_M: no drive has either, and the window is refused naming the current
-(``no_drive_error``): on foreign windows of every group, a current a tenth in 104 of 104, a hundredth
-in 51 of 52, half in 3 of 52; none of 104 logged in amperes, nor of 120 with J_M 0.6x or 1.45x, a short
-window's k_T off or a slow log's viscosity. A current off by 1.4x or 0.7x (logged as RMS or as
-amplitude) is not: it reads as γ −0.29 or +0.41, but a J_M 1.3–1.45x, within ``PLAUSIBLE``, reads γ
-−0.23 to −0.46 too, and on a cruise window the likelihood ratio favoured γ by up to e⁶⁵; such answers
-stay said weak.
+A current logged in other units (a tenth of it, a shunt's voltage) reads as a γ or a ΔJ no drive
+has (``PLAUSIBLE``), and the window is refused naming the current (``no_drive_error``). A current
+off by 1.4x or 0.7x (RMS against amplitude) is not refused: a heavy rotor reads alike, so the stds
+carry both stories (``unit_story``). The measurements that set these bounds are in
+``docs/evidence.md``.
 """
 
 from __future__ import annotations
@@ -54,38 +45,32 @@ SETTLED = 0.01  # of the constant's std: what a refit may leave
 BESIDE = FitSettings(offset=True, viscous=True)  # what each constant is fitted beside
 FIELDS = {"torque_scale": "torque_scale", "inertia": "inertia_kgm2"}  # the fit's nuisance -> the field it reads
 # Beyond these no drive runs (γ: k_T from −55 to 125 °C and a sensor's gain; ΔJ: of J_M): a read past them
-# is something else the model lacks (a 0.1 s foreign window read J_M 0.27x), which the fit check reports.
+# is something else the model lacks, which the fit check reports.
 PLAUSIBLE = {"torque_scale": 0.2, "inertia": 0.5}
 # Stds of its own by which a γ fitted alone must pass PLAUSIBLE for the current to be refused (``no_drive_error``):
-# on 104 clean foreign windows γ stayed within 0.05, and a J_M up to 1.45x read γ down to −0.46 but ΔJ within its
-# bound; a steps window with a current a tenth read γ 9.0 ± 2.9 (its blocks split the accelerations unevenly).
+# a window whose blocks split the accelerations unevenly reads γ loosely, and must not be refused on that.
 SCALE_STDS = 2.0
-# Where both stand out, the log-likelihood ratio of the two readings that decides for each: on 110 foreign
-# windows where both did (k_T, the current gain or J_M off, healthy and worn), none with γ off read past 6
-# for ΔJ (the sensor noise sits in both columns as in the target, and favours one), but a J_M 3–10 % heavier,
-# which saturates the motor as a weaker one would, read down to −18 for γ. Short of these, the window
-# cannot tell them apart.
+# Where both stand out, the log-likelihood ratio of the two readings that decides for each. The bounds are
+# asymmetric: the sensor noise sits in both columns as in the target and favours one, and a heavier rotor that
+# saturates the motor as a weaker one would leans far towards γ. Short of these, the window cannot tell them apart.
 DECISIVE = {"inertia": 12.0, "torque_scale": -30.0}
 # Undecided, γ is read (k_T moves with temperature from flight to flight, J_M stays with the build), and the
-# stds grow by this share of what reading ΔJ instead would change (``training.prepare.departures.read``): on 7 such
-# foreign windows with J_M off, the truth lay 0.87–1.07 of that change from γ's answer.
+# stds grow by this share of what reading ΔJ instead would change (``training.prepare.departures.read``).
 UNDECIDED_SHARE = 0.6
-# The 2 ms reconstruction reads J_M low where its kernel spans few samples, as h² shrinks. On foreign windows with
-# the spec's J_M (cruise, gust, steps; 2 and 10 s, two seeds): 0.4–1.25 % low at 1 kHz at a jackknife std of
-# 0.03 %, 0.15–0.45 % at 2 kHz, none read at 5 kHz. ΔJ's std carries this share of J_M at 1 kHz, scaled by
-# (1 kHz / rate)²: each such window's J_M within 1.8 std. The bias is systematic, so averaging windows does not
-# shrink it: the history keeps J_M only from windows processed at KERNEL_FREE_RATE_HZ or more (``training.report``).
+# The 2 ms reconstruction reads J_M low where its kernel spans few samples (the bias shrinks as h²). ΔJ's std
+# carries this share of J_M at 1 kHz, scaled by (1 kHz / rate)². The bias is systematic, so averaging windows does
+# not shrink it: the history keeps J_M only from windows processed at KERNEL_FREE_RATE_HZ or more (``training.report``).
 KERNEL_INERTIA_SHARE = 0.01
 KERNEL_FREE_RATE_HZ = 5_000.0
 
 
 @dataclass(frozen=True)
 class DriveConstants:
-    """γ and ΔJ read on a window (0: the spec's), and what their stds add to FDJ's and η_O's."""
+    """γ and ΔJ read on a window (0: the document's), and what their stds add to FDJ's and η_O's."""
 
     spec: ActuatorParams  # the drive's constants the departures are read against
     torque_scale: float = 0.0  # γ: the motor's torque is (1 + γ)·k_T·I
-    inertia_kgm2: float = 0.0  # ΔJ beyond the spec's J_M
+    inertia_kgm2: float = 0.0  # ΔJ beyond the document's J_M
     stds: dict[str, float] = field(default_factory=dict)  # per field read, its std
     spread: dict[str, float] = field(default_factory=dict)  # per target, the std the constants' uncertainty adds
     alternative: DriveConstants | None = None  # where the window did not tell ΔJ from this γ: the ΔJ reading
@@ -98,12 +83,12 @@ class DriveConstants:
 
     @property
     def inertia_factor(self) -> float:
-        """The inertia at the motor shaft over the spec's J_M."""
+        """The inertia at the motor shaft over the document's J_M."""
         return 1.0 + self.inertia_kgm2 / self.spec.inertia_kgm2
 
     @property
     def actuator(self) -> ActuatorParams:
-        """The actuator the window's T_R is reconstructed with: the spec's, its J_M as read."""
+        """The actuator the window's T_R is reconstructed with: the document's, its J_M as read."""
         return replace(self.spec, inertia_kgm2=self.spec.inertia_kgm2 + self.inertia_kgm2)
 
     def added(self, left: FrictionFit) -> DriveConstants:
@@ -112,7 +97,7 @@ class DriveConstants:
         return replace(self, torque_scale=scale, inertia_kgm2=self.inertia_kgm2 + float(left.term("inertia")[0]))
 
     def corrected(self, window: Window) -> Window:
-        """``window`` with its current on the spec's k_T: I' = (1 + γ)·I."""
+        """``window`` with its current on the document's k_T: I' = (1 + γ)·I."""
         if not self.torque_scale:
             return window
         return replace(window, signals=dict(window.signals, current_a=self.torque_factor * window.signals["current_a"]))
@@ -187,9 +172,7 @@ def unit_story(read: DriveConstants, gamma: float, plain: FrictionFit, alone: di
     motor (``gamma`` from ``beyond_any_motor``) and yet ΔJ reads a drive: a current logged 0.71x (RMS for
     amplitude) reads as a rotor ~0.7x as heavy with other friction, and a rotor 1.3–1.45x as heavy as a
     current logged 1.41x, alike. Each target's std grows by the full gap between the γ reading's answer
-    and ``read``'s (on 104 foreign windows logged 0.71x, 7 answers past 10 % of the range were not said
-    weak, FDJ up to 1.4 ranges off; with the gap none, ±2 std holding the truth in 96 %; a J_M 1.1x reads
-    γ within any motor's and keeps its stds)."""
+    and ``read``'s: neither story can be ruled out, so the answer must cover both."""
     if not gamma:
         return read
     reference = (alone["inertia"] if read.inertia_kgm2 else plain).values()
@@ -203,7 +186,7 @@ def _stands_out(plain: FrictionFit, alone: FrictionFit, name: str, rate: float, 
     relative = float(alone.term(name)[0]) / (spec.inertia_kgm2 if name == "inertia" else 1.0)
     return bool(
         np.isfinite(relative)
-        and alone.term_std(name)[0] > 0  # else the window cannot tell it from FDJ (``baseline._fitted``)
+        and alone.term_std(name)[0] > 0  # else the window cannot tell it from FDJ (``friction._fitted``)
         and abs(relative) < PLAUSIBLE[name]
         and equation_z(plain, alone, rate) > DECISIVE_Z
     )
@@ -266,24 +249,25 @@ def _constants_note(read: DriveConstants) -> str | None:
     found = []
     if read.torque_scale:
         found.append(
-            f"the motor gives {read.torque_factor:.4f} ± {read.stds['torque_scale']:.4f} times the spec's k_T·I (k_T "
+            f"the motor gives {read.torque_factor:.4f} ± {read.stds['torque_scale']:.4f} times "
+            "the document's k_T·I (k_T "
             "moves with the magnets' temperature, a current sensor has a gain error)"
         )
     if read.inertia_kgm2:
         found.append(
             f"the inertia at the motor is {read.inertia_factor:.4f} ± "
-            f"{read.stds['inertia_kgm2'] / read.spec.inertia_kgm2:.4f} times the spec's J_M"
+            f"{read.stds['inertia_kgm2'] / read.spec.inertia_kgm2:.4f} times the document's J_M"
         )
     if not found:
         return None
     if read.alternative is not None:
         found.append(
             f"or, about as likely, the inertia at the motor is {read.alternative.inertia_factor:.3f} times the "
-            "spec's J_M (the window tells the two apart too little: the stds include what reading that instead "
+            "document's J_M (the window tells the two apart too little: the stds include what reading that instead "
             "would change)"
         )
     used = "the first" if read.alternative is not None else "it"
     return (
         "; ".join(found) + f". Every estimator read the window with {used}, and the stds include its "
-        "uncertainty; read with the spec's constants, the load and inertia it moves would have passed for friction"
+        "uncertainty; read with the document's constants, the load and inertia it moves would have passed for friction"
     )

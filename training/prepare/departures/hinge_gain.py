@@ -2,30 +2,23 @@
 calibrated off, or a log in lbf·ft taken for N·m.
 
 Eq. 5.1 reads the load as t = FDJ + k_aid·a + k_opp·o, with k_aid = 1 − η_A and k_opp = 1/η_O − 1
-over the aiding and opposing |T_ext| (``training.physics.friction``), η_A tied to η_O by Eq. 3.4. A hinge
-moment logged g times the true one puts (g − 1)·H/n into T_R and g into a and o, so the window
+over the aiding and opposing |T_ext| (``training.physics.friction``), η_A tied to η_O by Eq. 3.4. A
+hinge moment logged g times the true one puts (g − 1)·H/n into T_R and g into a and o, so the window
 holds c_aid = 1 − η_A/g and c_opp = 1/(g·η_O) − 1 instead. Fitted freely (both are linear), they
-give η_A·η_O = (1 − c_aid)/(1 + c_opp), whence η_O by Eq. 3.4 (a quadratic), and g = 1/((1 + c_opp)·η_O).
-On ten foreign windows logged 0.74, 0.9, 1.0 and 1.1 times the true moment g was read within 1 %,
-η_O within 0.01, as well as the fit that knows g = 1.
+give η_A·η_O = (1 − c_aid)/(1 + c_opp), whence η_O by Eq. 3.4 (a quadratic), and
+g = 1/((1 + c_opp)·η_O). Read with g = 1, a gain is η_O's twin in the constrained fit.
 
-Read with g = 1, a moment 0.95–1.05x put 2 of 60 foreign windows past 10 % of range, and one in
-lbf·ft (0.74x) answered 4 of 104 confidently wrong (``benchmarks.careless_exports``): it is η_O's
-twin in the constrained fit. So g is read where the free fit explains the window ``DECISIVE_Z`` stds
-better (the likelihood ratio of the two equation errors, as for the offset) and lies in
-``PLAUSIBLE``; the hinge moment is then divided by it before every estimator, and FDJ's and η_O's
-stds grow by what g's jackknife std moves them (``spread``).
+So g is read where the free fit explains the window ``DECISIVE_Z`` stds better (the likelihood ratio
+of the two equation errors, as for the offset) and lies in ``PLAUSIBLE``; the hinge moment is then
+divided by it before every estimator, and FDJ's and η_O's stds grow by what g's jackknife std moves
+them (``spread``).
 
-A k_T or J_M off (``training.prepare.departures.drive_constants``) and g each take a part of the other: read after
-them, a moment logged 0.8x was read 0.84–1.0x (FDJ up to 54 % off); read first, k_T and J_M
-windows were read as hinge gains (η_O 9 % of range off on worn ones, against 0.3 %). So g is read
-before them only where it explains the window decisively better than γ or ΔJ alone (``leading``, as
-ΔJ must beat γ), and after them otherwise: 0.8x was then read 0.795–0.806x on ten foreign windows,
-every answer as with the true moment, and 60 windows with k_T, a current gain or J_M off were
-answered as before. Every fit of g sits beside a sensor offset and a change of C, and leads on the
-window the offset stage zeroed: a hinge moment off zero bends |H − b| as a gain would, and C·|ω|
-grows with the load's speeds; without them worn windows 5 N·m off were read as gains 0.73–1.25
-(FDJ up to 69 % of range off), and worn windows with C 1.2–2x as 0.89 and 1.08 (52 and 22 %).
+A k_T or J_M off (``training.prepare.departures.drive_constants``) and g each take a part of the
+other, whichever is read first. So g is read before them only where it explains the window
+decisively better than γ or ΔJ alone (``leading``, as ΔJ must beat γ), and after them otherwise.
+Every fit of g sits beside a sensor offset and a change of C, and leads on the window the offset
+stage zeroed: a hinge moment off zero bends |H − b| as a gain would, and C·|ω| grows with the load's
+speeds.
 """
 
 from __future__ import annotations
@@ -43,7 +36,7 @@ from training.physics.friction import MIN_SLIDING_KERNELS, FitSettings, nuisance
 from training.prepare.departures.drive_constants import BESIDE, FIELDS
 from training.stats import DECISIVE_Z, JACKKNIFE_BLOCKS, jackknife_std, rms_log_likelihood_ratio
 
-PLAUSIBLE = (0.7, 1.35)  # lbf·ft for N·m is 0.74; outside, no sensor's (a 0.1 s window read 1.47): not taken
+PLAUSIBLE = (0.7, 1.35)  # lbf·ft for N·m is 0.74; outside, no sensor's: not taken
 MIN_CHANGE = 0.01  # a gain nearer 1 than this changes nothing worth a note
 DECISIVE = 12.0  # ln LR by which g must beat γ and ΔJ to be read before them (as ΔJ must beat γ)
 

@@ -1,21 +1,19 @@
-"""What a window shows beyond the spec's model, read in turn, each on the window the last corrected: the
-hinge moment's gain against the aircraft's (``training.prepare.departures.aircraft_check``), a sensor off zero
+"""What a window shows beyond the actuator document's model, read in turn, each on the window the
+last corrected: the hinge moment's gain against the aircraft's
+(``training.prepare.departures.aircraft_check``), a sensor off zero
 (``training.prepare.departures.zero_offset``), the drive's k_T and J_M
-(``training.prepare.departures.drive_constants``), the hinge moment's gain
-its loads show (``training.prepare.departures.hinge_gain``), the viscous coefficient
+(``training.prepare.departures.drive_constants``), the hinge moment's gain its loads show
+(``training.prepare.departures.hinge_gain``), the viscous coefficient
 (``training.prepare.departures.viscosity``).
 
-A drive constant, seen before it is read, passes in part for an offset (a thesis window's current logged
-1.5 % low read as 2.2 mN·m off zero, which left FDJ 11 % of range off once the scale was read too), so
-where one is read the offset is read again on the corrected window (the logged current is s·I + i₀:
-corrected, then zeroed). Where the window's equation error cannot tell γ from ΔJ, both are read to the
-end and the window simulated with each: the one whose replay follows the motor speed and current
-clearly better, and within twice the noise, is taken (``_told_apart``). Where neither does, both ends
-stand: what is read after them moves with the choice (a worn gust window read γ where J_M was 0.5 %
-light, then its viscous coefficient 0.63x, FDJ 66 % of range off; read with ΔJ instead, 1.0x and
-right), so the stds grow by ``UNDECIDED_SHARE`` of how far the two ends lie apart. So too where the
-aircraft only puts the strain gauge's gain in doubt: the window is read as logged and with the aircraft's
-ratio divided out first (``_doubted``).
+A drive constant, seen before it is read, passes in part for an offset, so where one is read the
+offset is read again on the corrected window (the logged current is s·I + i₀: corrected, then
+zeroed). Where the window's equation error cannot tell γ from ΔJ, both are read to the end and the
+window simulated with each: the one whose replay follows the motor speed and current clearly
+better, and within twice the noise, is taken (``_told_apart``). Where neither does, both ends
+stand: what is read after them moves with the choice, so the stds grow by ``UNDECIDED_SHARE`` of
+how far the two ends lie apart. So too where the aircraft only puts the strain gauge's gain in
+doubt: the window is read as logged and with the aircraft's ratio divided out first (``_doubted``).
 """
 
 from __future__ import annotations
@@ -49,7 +47,7 @@ class Known:
     """What other windows of the actuator read that this one may not (``documents.HistoryReadings``)."""
 
     zero: ZeroOffset | None = None  # the sensor zero of its flight
-    inertia_factor: float | None = None  # its J_M over the spec's ...
+    inertia_factor: float | None = None  # its J_M over the document's ...
     inertia_std: float = 0.0
     inertia_from: tuple[str, ...] = ()  # ... and the windows that read it
 
@@ -66,7 +64,7 @@ class Departures:
 
     @property
     def actuator(self) -> ActuatorParams:
-        """What every reconstruction and fit of the window reads it with: the spec's, J_M and C as read."""
+        """What every reconstruction and fit of the window reads it with: the document's, J_M and C as read."""
         return self.viscosity.actuator(self.drive.actuator)
 
     @cached_property
@@ -96,7 +94,7 @@ def read_departures(
         divided = _read(window, actuator, replace(aircraft, factor=aircraft.ratio), known)
     except InputError:
         # the gain explains the window only with a motor no drive has: a refuted story, not a refusal of the
-        # window (2 of 60 clean foreign 0.1 s gusts, their band reading 1.34 and 1.6x, were refused so)
+        # window, which the doubt alone never justifies
         return read
     return _doubted(read, divided)
 
@@ -139,7 +137,7 @@ def _told_apart(window: Window, scale: Departures, inertia: Departures, actuator
     follows better, against ΔJ; each at its own answer, with the viscous coefficient it read. Only
     where the better one follows within twice the noise: a replay that drifts from the drive (after a
     pilot's step, or where the loop saturates) drifts by tens of noise stds whichever constant it
-    carries, and on foreign doublets then preferred ΔJ to a current gain that was the truth."""
+    carries, and its preference is noise."""
     signals = window.signals
     noise = SensorNoise(
         motor_speed_radps=white_noise_std(signals["motor_speed_radps"]), current_a=white_noise_std(signals["current_a"])

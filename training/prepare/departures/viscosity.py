@@ -1,30 +1,24 @@
-"""The viscous coefficient a window shows, read where it departs from the spec's.
+"""The viscous coefficient a window shows, read where it departs from the document's.
 
-The spec fixes C_M; a grease's viscosity is not fixed (it grows several-fold in the cold). With C
-1.2–2x the spec's, foreign windows were read 92 % of range off in FDJ on average, none within its
-±2 std: the excess ΔC·|ω| is read as friction. Where a window slides at one speed the two are twins,
-but most windows slide across 100–600 rad/s (the accelerations to and from slew), and there ΔC is
-fitted beside FDJ (``FitSettings(viscous=True)``): on 10 foreign windows with C 1.6x the spec's it
-was read 1.52–1.61x, 15–66 jackknife stds from the spec's.
+The document fixes C_M; a grease's viscosity is not fixed (it grows several-fold in the cold), and
+an excess ΔC·|ω| left in the residual is read as friction. Where a window slides at one speed the
+two are twins, but most windows slide across 100–600 rad/s (the accelerations to and from slew),
+and there ΔC is fitted beside FDJ (``FitSettings(viscous=True)``).
 
-Freeing C costs FDJ where C is right (on 10 clean windows FDJ erred up to 12 % of range with C free,
-2.5 % without), so a change is read only where it stands ``DECISIVE_Z`` stds out and is ``MIN_CHANGE`` of
-the spec's C or more (a 10 % change at slew is 15 % of FDJ's range). Then every estimator of the
-window uses the read C, the fits and the simulations alike, and the stds of FDJ and η_O grow by what
-C's own std moves them (``spread``; its floor, ``READ_ERROR_OF_C``).
+Freeing C costs FDJ precision where C is right, so a change is read only where it stands
+``DECISIVE_Z`` stds out and is ``MIN_CHANGE`` of the document's C or more. Then every estimator of
+the window uses the read C, the fits and the simulations alike, and the stds of FDJ and η_O grow by
+what C's own std moves them (``spread``; its floor, ``READ_ERROR_OF_C``, as the reconstruction's
+bias follows the speed a little).
 
 Where the speed hardly varies (one way, at slew), ΔC cannot be fitted at all, and the stds carry a C
-``UNSEEN_SHARE`` off the spec's either way, as the offset stage carries an unseen sensor offset there.
-Where the change does not stand out, the window is read with the spec's C, but not as if it had
-shown C to be the spec's: on 1–2 kHz logs with C 1.2–2x, 6 of 40 changes stood 1.3–3.7 stds out, too
-few to read, and FDJ was read 40–95 % of the range high at 6–20 % std (FDJ moves by ~1.4 ranges per
-C_M of ΔC). As for a hinge moment out of step (``training.prepare.step_lag``), the story "C is off by the
-change the window leans to" is weighed against the spec's by the likelihood ratio of the nested fit
-(z²/2, z over the std with its floor) and a prior of e⁻⁴: its weight w. Each target's std grows by
-√w·|gap|, the gap what reading C so would change, and a note says so from ``NOTE_WEIGHT``. On those
-40 windows FDJ's ±2 std then held the truth in 93 % instead of 82 %; on 170 foreign windows with the
-spec's C (thesis, cruise, doublet, 0.1 s and 1–2 kHz) FDJ's std grew by a median 0.03 % of the
-range, 3.5 % at most.
+``UNSEEN_SHARE`` off the document's either way, as the offset stage carries an unseen sensor offset.
+Where the change does not stand out, the window is read with the document's C, but not as if it had
+shown C to be right: as for a hinge moment out of step (``training.prepare.step_lag``), the story
+"C is off by the change the window leans to" is weighed against the document's by the likelihood
+ratio of the nested fit (z²/2, z over the std with its floor) and a prior of e⁻⁴: its weight w.
+Each target's std grows by √w·|gap|, the gap what reading C so would change, and a note says so
+from ``NOTE_WEIGHT``.
 """
 
 from __future__ import annotations
@@ -41,14 +35,12 @@ from training.physics.features import as_read
 from training.physics.friction import FitSettings, fit_friction
 from training.stats import DECISIVE_Z, UNDECIDED_NOTE_WEIGHT, UNDECIDED_PRIOR_LOG_ODDS, odds_weight
 
-MIN_CHANGE = 0.1  # of the spec's C
-# On 20 foreign windows with C 1.2–2x the spec's the read erred by 2.2 % of the spec's C (RMS; up to 7 %,
-# mostly low), beyond what its jackknife std, often 0.5 %, said: the reconstruction's bias follows the speed
-# a little. Taken as a floor of C's std, FDJ's ±2 std held the truth in 19 of 20 instead of 16.
+MIN_CHANGE = 0.1  # of the document's C
+# A floor of C's std, of the document's C: the reconstruction's bias follows the speed a little, beyond what the
+# jackknife sees.
 READ_ERROR_OF_C = 0.025
 # Where the speed hardly varies (one way at slew) C·|ω| is FDJ's twin and ΔC cannot be fitted: the stds then
-# carry a C this share of the spec's off, either way (the spread of C over foreign windows a third of them cold,
-# 1.2–2x: 0.30). A one-way 0.1 s gust, C 1.24x, was read FDJ 40 % of range high at 3.8 % std without it.
+# carry a C this share of the document's off, either way (the spread of C over a fleet a third of it cold).
 UNSEEN_SHARE = 0.3
 CHANGE_BOUNDS_NMS = (-5e-5, 5e-3)  # what the simulator's viscous effect accepts (``sim.effects``)
 VISCOUS_FIT = FitSettings(offset=True, viscous=True)
@@ -58,7 +50,7 @@ PRIOR_LOG_ODDS, NOTE_WEIGHT = UNDECIDED_PRIOR_LOG_ODDS, UNDECIDED_NOTE_WEIGHT
 
 @dataclass(frozen=True)
 class Viscosity:
-    """The change of the viscous coefficient read on a window (0: the spec's), and what its std adds."""
+    """The change of the viscous coefficient read on a window (0: the document's), and what its std adds."""
 
     change_nms: float = 0.0  # ΔC [N·m·s/rad] at the motor shaft
     change_std_nms: float = 0.0
@@ -70,7 +62,7 @@ class Viscosity:
 
     @property
     def factor(self) -> float:
-        """The coefficient read over the spec's (1 where none was read, or the spec's is 0)."""
+        """The coefficient read over the document's (1 where none was read, or the document's is 0)."""
         return 1.0 + self.change_nms / self.spec_nms if self.change_nms and self.spec_nms > 0 else 1.0
 
     def actuator(self, spec: ActuatorParams) -> ActuatorParams:
@@ -78,12 +70,12 @@ class Viscosity:
         return replace(spec, viscous_nms=spec.viscous_nms + self.change_nms) if self.change_nms else spec
 
     def effects(self) -> EffectSet:
-        """What every simulation of the window adds to the spec's model."""
+        """What every simulation of the window adds to the document's model."""
         return EffectSet({"viscous": {"coefficient_nms": self.change_nms}}) if self.change_nms else EffectSet()
 
 
 def read_viscosity(window: Window, spec: ActuatorParams) -> Viscosity:
-    """ΔC where it stands out, with FDJ's and η_O's change across C ± its std; elsewhere the spec's C,
+    """ΔC where it stands out, with FDJ's and η_O's change across C ± its std; elsewhere the document's C,
     with what the change the window leans to would move them, by its weight (module docstring)."""
     rate = window.sample_rate_hz
     seen = as_read(window.signals, rate)
@@ -102,7 +94,7 @@ def read_viscosity(window: Window, spec: ActuatorParams) -> Viscosity:
 def _targets_at(
     seen: dict[str, np.ndarray], rate: float, spec: ActuatorParams, changes: tuple[float, ...]
 ) -> list[dict[str, float]]:
-    """FDJ and η_O read with the spec's C plus each change."""
+    """FDJ and η_O read with the document's C plus each change."""
     fits = (fit_friction(seen, rate, replace(spec, viscous_nms=spec.viscous_nms + d)) for d in changes)
     return [{name: float(value) for name, value in fit.values().items()} for fit in fits]
 
@@ -110,13 +102,13 @@ def _targets_at(
 def _half_change(
     seen: dict[str, np.ndarray], rate: float, spec: ActuatorParams, change: float, std: float
 ) -> dict[str, float]:
-    """Per target, half its change across the spec's C plus ``change`` ± ``std``: the std that uncertainty adds."""
+    """Per target, half its change across the document's C plus ``change`` ± ``std``: the std that uncertainty adds."""
     low, high = _targets_at(seen, rate, spec, (change - std, change + std))
     return {name: abs(high[name] - low[name]) / 2 for name in low}
 
 
 def _unseen(seen: dict[str, np.ndarray], rate: float, spec: ActuatorParams) -> Viscosity:
-    """The spec's C where the window cannot tell C·|ω| from FDJ, with the stds carrying a change of
+    """The document's C where the window cannot tell C·|ω| from FDJ, with the stds carrying a change of
     ``UNSEEN_SHARE`` of it either way (module docstring)."""
     spread = _half_change(seen, rate, spec, 0.0, UNSEEN_SHARE * spec.viscous_nms)
     if not all(np.isfinite(v) for v in spread.values()):
@@ -125,7 +117,7 @@ def _unseen(seen: dict[str, np.ndarray], rate: float, spec: ActuatorParams) -> V
 
 
 def _leaning(seen: dict[str, np.ndarray], rate: float, spec: ActuatorParams, change: float, std: float) -> Viscosity:
-    """The spec's C, with the story "off by ``change``" weighed into the stds (module docstring)."""
+    """The document's C, with the story "off by ``change``" weighed into the stds (module docstring)."""
     weight = odds_weight((change / std) ** 2 / 2 + PRIOR_LOG_ODDS)
     change = float(np.clip(change, *CHANGE_BOUNDS_NMS))
     spec_read, off_read = _targets_at(seen, rate, spec, (0.0, change))
@@ -139,15 +131,15 @@ def viscosity_note(viscosity: Viscosity) -> list[Note]:
     """The change, or what the window could not tell of it, for the result's notes."""
     if viscosity.unseen:
         return [Note(code="viscosity_unseen", text=
-            "the speed hardly varies: a viscous coefficient off the spec's (a cold grease) would read as FDJ here, "
+            "the speed hardly varies: a viscous coefficient off the document's (a cold grease) would read as FDJ here, "
             f"and cannot be told from it (the stds include a coefficient {100 * UNSEEN_SHARE:.0f} % off either way)"
         )]
     if not viscosity.change_nms:
         return _leaning_note(viscosity)
     return [Note(code="viscosity", text=
         f"the viscous coefficient reads {viscosity.factor:.2f} ± {viscosity.change_std_nms / viscosity.spec_nms:.2f} "
-        "times the spec's (a cold or aged grease): every estimator of this window used it, and the stds include "
-        "its uncertainty; read with the spec's, C·|ω| would have passed for friction"
+        "times the document's (a cold or aged grease): every estimator of this window used it, and the stds include "
+        "its uncertainty; read with the document's, C·|ω| would have passed for friction"
     )]
 
 
@@ -155,7 +147,8 @@ def _leaning_note(viscosity: Viscosity) -> list[Note]:
     if viscosity.leaning_weight < NOTE_WEIGHT:
         return []
     return [Note(code="viscosity_leaning", text=
-        f"the viscous coefficient leans to {1 + viscosity.leaning_nms / viscosity.spec_nms:.2f} times the spec's, too "
-        f"unclear to read (weight {viscosity.leaning_weight:.2f}); read with the spec's, the stds include what that "
+        f"the viscous coefficient leans to {1 + viscosity.leaning_nms / viscosity.spec_nms:.2f} times the document's, "
+        f"too unclear to read (weight {viscosity.leaning_weight:.2f}); read with the document's, the stds include "
+        "what that "
         "coefficient would change"
     )]

@@ -1,34 +1,29 @@
 """A sensor off zero: the current or the hinge moment logged with a constant added, read and removed.
 
 A strain gauge drifts with temperature, a Hall current sensor has an offset; either leaves T_R a
-constant c beyond friction (k_T·i₀ from the current, b/n from the hinge moment), which Eq. 5.1's t =
-sgn(ω)(T_R − C·ω) reads as c·sgn(ω): on foreign windows with the hinge moment 1–10 N·m off, FDJ and
-η_O were 14 and 13 % of the range off on average, every answer weakly determined.
+constant c beyond friction (k_T·i₀ from the current, b/n from the hinge moment), which Eq. 5.1's
+t = sgn(ω)(T_R − C·ω) reads as c·sgn(ω): friction, unless it is taken off.
 
 With motion both ways c·sgn(ω) is told from FDJ, so it is fitted beside it (``FitSettings(offset=
-True)``) and read as an offset where the fit with it explains the window ``DECISIVE_Z`` stds better than
-the fit without (the likelihood ratio of their equation errors, ``equation_z``): on 570 clean
-foreign windows of every group it reached 1.6 at most, on 60 with a sensor off zero it passed 4 in
-59. (The offset's own jackknife std is no test: where one direction's samples gather in a few time
-blocks, leaving those out leaves c unread, and on worn windows a third of the offsets stood under 4
-of it.) Which sensor is off matters: a hinge moment off by b also shifts |T_ext|, whose k·|T_ext|
-term then moves FDJ by about k·b/n (up to 18 % of the range at 10 N·m). The two readings differ in
-the fit only where |T_ext| comes near zero or varies, so both are made: the current corrected by i₀,
-or the hinge moment by b, each refitted until no constant is left (|H − b| is not linear in b, and
-k_T·I is cut at the motor's peak torque). Their likelihoods (the equation errors' RSS, over about
-one independent value per reconstruction kernel) weigh them: on 20 foreign windows each, the true
-sensor was never the less likely one, and was favoured more than 9:1 on 11 of the hinge's and 15 of
-the current's. The window is corrected by the weighted mix (the hinge moment by w·b, the current by
-(1 − w)·c/k_T), which puts the answer between the readings, and each target's std grows by their
-disagreement (``conditioning.widened``): an offset the window cannot place is an uncertainty, said
-as one. Where the motion goes one way, no offset can be read. A drive keeps its sensors' zero for
-a power-on, so such a window is read with the zero a window of the same flight read moving both
-ways (``carried``: what it took off, FDJ's std carrying that reading's ``zero_std_nm``); where the
-flight has none, FDJ's std carries an offset a sensor may keep unseen (``UNSEEN_CURRENT_OFFSET_A``).
-A short window moving both ways reads its zero less precisely than a long one of its flight: it takes
-the flight's where that holds on it (``flight_zero``: on foreign 0.1 s gusts FDJ 12 % of range off
-became 1 %, an η_O 2.5 std off 0.1); where it does not, a sensor drifted or the drive was powered up
-again, and the window's own reading stands. A note says which.
+True)``) and read where the fit with it explains the window ``DECISIVE_Z`` stds better than the fit
+without (the likelihood ratio of their equation errors, ``equation_z``). The offset's own jackknife
+std is no test: where one direction's samples gather in a few time blocks, leaving those out leaves
+c unread. Which sensor is off matters: a hinge moment off by b also shifts |T_ext|, whose k·|T_ext|
+term then moves FDJ by about k·b/n. The two readings differ only where |T_ext| comes near zero or
+varies, so both are made: the current corrected by i₀, or the hinge moment by b, each refitted until
+no constant is left (|H − b| is not linear in b, and k_T·I is cut at the motor's peak torque). Their
+likelihoods (the equation errors' RSS, over about one independent value per reconstruction kernel)
+weigh them; the window is corrected by the weighted mix, which puts the answer between the readings,
+and each target's std grows by their disagreement (``conditioning.widened``): an offset the window
+cannot place is an uncertainty, said as one.
+
+Where the motion goes one way, no offset can be read. A drive keeps its sensors' zero for a power-on,
+so such a window is read with the zero a window of the same flight read moving both ways
+(``carried``, FDJ's std carrying that reading's ``zero_std_nm``); where the flight has none, FDJ's std
+carries an offset a sensor may keep unseen (``UNSEEN_CURRENT_OFFSET_A``). A short window moving both
+ways takes its flight's zero where that holds on it (``flight_zero``, more precise than its own);
+where it does not, a sensor drifted or the drive was powered up again, and the window's own reading
+stands. A note says which.
 """
 
 from __future__ import annotations
@@ -49,11 +44,10 @@ from training.stats import DECISIVE_Z, odds_weight, rms_log_likelihood_ratio
 HOLDS_Z = 3.0
 # Where the motion goes one way, an offset is FDJ's twin and cannot be read: FDJ then rests on the sensors
 # being on zero, and its std carries the offset a Hall sensor keeps after its power-up zeroing (~0.2 % of
-# the drive's 22.5 A). One foreign window in fifty is so; one 0.075 A off was read 24 % of range off at 1.9 % std.
+# the thesis drive's 22.5 A).
 UNSEEN_CURRENT_OFFSET_A = 0.05
 # Refits of a sensor's offset: the hinge moment's moves |H − b| (each refit cuts what is left by ~k), the
-# current's is lost where k_T·I meets the motor's peak torque (on worn foreign windows, which saturate more,
-# one read 7 % low, FDJ 4.7 % of range off at 2.9 std).
+# current's is lost where k_T·I meets the motor's peak torque (worn windows saturate more, and need more refits).
 ITERATIONS = 4
 OFFSET_FIT = FitSettings(offset=True)
 
@@ -129,7 +123,7 @@ def read_zero_offset(
     one way, the carried zero, or the note that none is known."""
     rate, signals = window.sample_rate_hz, dict(window.signals)
     found = fit_as_read(signals, rate, actuator, OFFSET_FIT)
-    if float(found.term_std("offset")[0]) == 0.0:  # too little motion the other way (``baseline.MIN_OFFSET_BALANCE``)
+    if float(found.term_std("offset")[0]) == 0.0:  # too little motion the other way (``friction.MIN_OFFSET_BALANCE``)
         unseen = UNSEEN_CURRENT_OFFSET_A * actuator.torque_constant_nm_per_a
         known = carried or ZeroOffset(zero_std_nm=unseen)
         return replace(known, one_way=True, spread={"FDJ": known.zero_std_nm})
