@@ -5,7 +5,9 @@ whole pipeline on fresh synthetic windows with a known truth and realistic noise
 command, health drawn in Table 3.1's ranges), and record every stage's time, the real-time factor
 (pipeline seconds per second of window) and the error reached. With ``--under-load N`` the same
 windows are timed again while N CPU-bound processes run beside (an onboard computer is shared).
-Figures from one run are compared as ratios: this machine's speed drifts ~2x from day to day.
+Figures from one run are compared as ratios: this machine's speed drifts ~2x from day to day. So the
+same run times the simulation kernel alone (ns per simulation-step) and a yardstick, an independent
+16-lane kernel of the same EMA (``clients.yardstick``), and states each latency as a share of it.
 """
 
 from __future__ import annotations
@@ -13,6 +15,7 @@ from __future__ import annotations
 import json
 import subprocess
 import sys
+import time
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -21,7 +24,10 @@ from typing import Any
 import numpy as np
 
 from clients.report import BENCHMARKS_MD, write_section
+from clients.yardstick import DURATION_S, SIMS, yardstick_seconds
 from sim.actuator import THESIS
+from sim.batch import simulate_batch
+from sim.commands import random_command_knots
 from sim.params import DEFAULT_RANGES, HealthParams
 from sim.synthetic import synthetic_window
 from training import runtime
@@ -30,6 +36,7 @@ from training.pipeline import estimate_window
 from training.report import share_of_range
 
 STAGES = ("prepare", "physics", "simulate", "train", "predict", "check", "total")  # predict: the assess stage
+TARGET_SHARE = 0.128  # a 0.5 s window's idle p95 as a share of the yardstick: the latency target
 BUSY = "import itertools\nfor _ in itertools.count(): pass"
 
 
@@ -71,7 +78,54 @@ def time_windows(config: PipelineConfig, duration_s: float, repeats: int, seed: 
     }
 
 
-def markdown(rows: list[dict[str, Any]], config: PipelineConfig) -> str:
+def references() -> dict[str, float]:
+    """The yardstick's seconds and our kernel's ns per simulation-step on the same ``SIMS`` × 0.5 s, this run."""
+    rate_hz, steps_per_sample = 10_000.0, 100
+    samples = round(DURATION_S * rate_hz)
+    rng = np.random.default_rng(0)
+    health = HealthParams.uniform(SIMS, DEFAULT_RANGES, rng)
+    knots = random_command_knots(samples, rate_hz, rng)[0]
+    simulate_batch(knots[:11], health, actuator=THESIS.params)  # compiled or loaded outside the timing
+    best = np.inf
+    for _ in range(2):
+        started = time.perf_counter()
+        simulate_batch(knots, health, actuator=THESIS.params)
+        best = min(best, time.perf_counter() - started)
+    steps = SIMS * samples * steps_per_sample
+    return {"yardstick_s": yardstick_seconds(), "kernel_s": float(best), "kernel_ns_per_step": 1e9 * best / steps}
+
+
+def reference_lines(rows: list[dict[str, Any]], refs: dict[str, float]) -> list[str]:
+    """The kernel's and the yardstick's figures, and each latency as a share of the yardstick."""
+    lines = [
+        f"Same run: our kernel simulates {SIMS} x {DURATION_S:g} s in {refs['kernel_s']:.3f} s "
+        f"({refs['kernel_ns_per_step']:.2f} ns per simulation-step, 64 lanes, every thread of the budget); "
+        f"the yardstick (`clients/yardstick.py`, an independent 16-lane kernel) in {refs['yardstick_s']:.3f} s.",
+        "",
+        "| load | window | total p50 / yardstick | total p95 / yardstick | target (0.5 s, idle p95) |",
+        "|---|---:|---:|---:|---:|",
+    ]
+    for r in rows:
+        target = f"≤ {TARGET_SHARE}" if r["duration_s"] == DURATION_S and r["load"] == "idle" else ""
+        lines.append(f"| {r['load']} | {r['duration_s']:g} s | {r['p50_s']['total'] / refs['yardstick_s']:.3f} "
+                     f"| {r['p95_s']['total'] / refs['yardstick_s']:.3f} | {target} |")  # fmt: skip
+    return lines
+
+
+def stage_factors(rows: list[dict[str, Any]]) -> list[str]:
+    """Each stage's real-time factor (its seconds per second of window), p50 (p95)."""
+    lines = [
+        "| load | window | " + " | ".join(STAGES).replace("predict", "assess") + " |",
+        "|---|---:|" + "---:|" * len(STAGES),
+    ]
+    for r in rows:
+        d = r["duration_s"]
+        cells = " | ".join(f"{r['p50_s'][s] / d:.3f} ({r['p95_s'][s] / d:.3f})" for s in STAGES)
+        lines.append(f"| {r['load']} | {d:g} s | {cells} |")
+    return lines
+
+
+def markdown(rows: list[dict[str, Any]], config: PipelineConfig, refs: dict[str, float] | None = None) -> str:
     lines = [
         "One synthetic window (§5.6 command, realistic sensor noise, health uniform in Table 3.1's ranges) ->",
         f"estimates, in-process (`training.pipeline.estimate_window`, what the service runs), "
@@ -88,6 +142,9 @@ def markdown(rows: list[dict[str, Any]], config: PipelineConfig) -> str:
         error = f"{r['error_pct_of_range']['FDJ']:.2f} % / {r['error_pct_of_range']['eta_O']:.2f} %"
         rtf = f"{r['real_time_factor_p50']:.2f} ({r['real_time_factor_p95']:.2f})"
         lines.append(f"| {r['load']} | {r['duration_s']:g} s | {cells} | {rtf} | {error} |")
+    lines += ["", "Real-time factor per stage, p50 (p95):", "", *stage_factors(rows)]
+    if refs:
+        lines += ["", *reference_lines(rows, refs)]
     return "\n".join(lines)
 
 
@@ -101,11 +158,13 @@ def run_bench(config: PipelineConfig, durations: list[float], repeats: int, unde
         with load(under_load):
             rows += [{**time_windows(config, d, repeats, seed=100), "load": f"{under_load} busy processes"}
                      for d in durations]  # fmt: skip
+    print("timing the kernel and the yardstick…", file=sys.stderr)
+    refs = references()
     out.mkdir(parents=True, exist_ok=True)
-    (out / "bench.json").write_text(json.dumps(rows, indent=2))
-    table = markdown(rows, config)
+    (out / "bench.json").write_text(json.dumps({"rows": rows, "references": refs}, indent=2))
+    table = markdown(rows, config, refs)
     if docs:
         command = f"ema bench --repeats {repeats} --durations {','.join(f'{d:g}' for d in durations)}"
         write_section("Pipeline latency", command + (f" --under-load {under_load}" if under_load else "") + " --docs",
                       table, BENCHMARKS_MD)  # fmt: skip
-    return {"rows": rows, "json": str(out / "bench.json"), "table": table}
+    return {"rows": rows, "references": refs, "json": str(out / "bench.json"), "table": table}
