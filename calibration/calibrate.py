@@ -28,7 +28,7 @@ from calibration.documents import CalibrationReport, Step
 from calibration.equations import Equations, equations
 from calibration.families import COGGING_ORDERS, Family, generic_families, named_families
 from calibration.noise_floor import COPIES, clean_replicas, noise_copies
-from calibration.refit import corrected, fit_with, held_out_rss
+from calibration.refit import MIN_HELD_OUT_GAIN, corrected, fit_with, held_out_rss
 from calibration.selection import MAX_EFFECTS, Chosen, Decision, Evidence, decide, evidence
 from calibration.twins import TWINS, tell_apart
 from sim.actuator import Actuator
@@ -39,8 +39,6 @@ from training.config import PipelineConfig
 from training.documents import TARGETS, Estimate
 from training.pipeline import estimate_window
 from training.prepare.conditioning import prepare
-
-MIN_HELD_OUT_GAIN = 0.01  # the model with the effect must cut the held-out residual by at least 1 %
 
 
 def combined(results: Sequence[Estimate], actuator: Actuator) -> dict[str, float]:
@@ -116,13 +114,15 @@ class Calibrator:
         stage(f"scoring {len(families)} candidate families against the noise floor")
         chosen, steps, first_round, unnamed = self._select(measured, copies, families, prepared, before, noise, check)
         held, chosen = self._held_out(measured, chosen)
-        after = corrected(fit_with(measured, chosen).values, bias) if chosen else before
-        self.measured_, self.chosen_ = measured, chosen
-        backlash = read_backlash(measured, copies, chosen)
+        found = reporting.Found(measured, copies, first_round, chosen, steps, unnamed,
+                                read_backlash(measured, copies, chosen))  # fmt: skip
+        found, held = reporting.adopt_described(found, held)
+        adopted = found.adopted
+        after = corrected(fit_with(measured, adopted).values, bias) if adopted else before
+        self.measured_, self.chosen_ = measured, adopted
         self.report_: CalibrationReport = reporting.assemble(
-            reporting.Found(measured, copies, first_round, chosen, steps, unnamed, backlash),
-            before, after, bias, held, truth, time.perf_counter() - started,
-        )  # fmt: skip
+            found, before, after, bias, held, truth, time.perf_counter() - started
+        )
         return self
 
     def _select(
@@ -141,7 +141,7 @@ class Calibrator:
         steps: list[Step] = []
         first_round: list[Evidence] = []
         while len(chosen) < self.max_effects:
-            taken = {c.family.name for c in chosen} | {TWINS.get(c.family.name) for c in chosen}
+            taken = {c.family.name for c in chosen} | {t for c in chosen for t in TWINS.get(c.family.name, ())}
             found = []
             for family in (f for f in families if f.name not in taken):
                 check()
@@ -171,7 +171,8 @@ class Calibrator:
         if not twins:
             return pick, Step(selected=pick.family.name, reason=decision.reason, indistinguishable_from=decision.alike)
         options = [pick, *twins]
-        pick, errors, clear = tell_apart(windows, before, options, noise, self.actuator)
+        simulated, errors, clear = tell_apart(windows, before, options, noise, self.actuator)
+        pick = simulated if clear else pick  # a narrow call is noise: the held-out equations' choice stands
         others = [o.family.name for o in options if o is not pick]
         runner = min(others, key=errors.__getitem__)
         reason = f"{decision.reason}; told from {' and '.join(others)} by the motor speed and current it predicts"

@@ -34,6 +34,8 @@ class Step(Document):
 class Unexplained(Document):
     """Structure no named effect fits, described rather than named."""
 
+    adopted: bool = Field(False, description="the term is in the estimates after (it predicts held-out folds "
+                          "better and its estimates are identified), as a named effect would be")
     variables: list[str] = Field(description="what the residual follows (several: the windows cannot tell which)")
     description: str
     shape: dict[str, float] = Field(description="extra friction [N·m] at grid points of the first variable")

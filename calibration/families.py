@@ -151,6 +151,24 @@ def _torque_shift(e: Equations, true_over_logged: np.ndarray, actuator: Actuator
     return shift * e.variables["direction"][:, None]
 
 
+CURRENT_OFFSETS_A = tuple(float(o) for o in np.round(np.arange(-1.5, 1.5025, 0.005), 3))
+
+
+def _offset_term(offset_a: float) -> EffectSet | None:
+    return EffectSet({"current_sensor_offset": {"offset_a": offset_a}}) if abs(offset_a) <= 5.0 else None
+
+
+def _offset_shift(e: Equations, offsets_a: np.ndarray, actuator: ActuatorParams) -> np.ndarray:
+    """(m, G): what T_R takes for friction when the current sensor reads o too high, for each o of a grid, as t
+    sees it (times sgn ω): the true current is the logged one less o, and the motor's torque is cut at its
+    peak (the loop holds the *logged* current at I_max)."""
+    limit, k_t = actuator.max_motor_torque_nm, actuator.torque_constant_nm_per_a
+    current = e.variables["current_unsigned_a"][:, None]
+    true = current - offsets_a[None, :]
+    shift = np.clip(k_t * current, -limit, limit) - np.clip(k_t * true, -limit, limit)
+    return shift * e.variables["direction"][:, None]
+
+
 HINGE_BIASES_NM = tuple(float(b) for b in np.arange(-150.0, 152.5, 2.5))
 
 
@@ -211,6 +229,11 @@ def named_families(measured: Equations, actuator: ActuatorParams) -> list[Family
                lambda e, g: _torque_shift(e, np.array([1.0 / g]), actuator),
                lambda b, g: {"gain": g}, lambda b, g: _gain_term("current_sensor_gain", g),
                GAINS, stacked=lambda e: _torque_shift(e, 1.0 / np.array(GAINS), actuator)[..., None], offset=True),
+        Family("current_sensor_offset", "direction", True,
+               lambda e, g: _offset_shift(e, np.array([g]), actuator),
+               lambda b, g: {"offset_a": g}, lambda b, g: _offset_term(g),
+               CURRENT_OFFSETS_A, stacked=lambda e: _offset_shift(e, np.array(CURRENT_OFFSETS_A), actuator)[..., None],
+               offset=True),
         Family("inertia", "acceleration_radps2", True, lambda e, g: e.variables["acceleration_radps2"][:, None],
                lambda b, g: {"factor": 1.0 + float(b[0]) / actuator.inertia_kgm2},
                lambda b, g: EffectSet({"inertia": {"factor": float(np.clip(1.0 + b[0] / actuator.inertia_kgm2,

@@ -3,14 +3,14 @@
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 
 import numpy as np
 
 from calibration.backlash import BacklashReading
 from calibration.documents import CalibrationReport, Candidate, HeldOut, NoiseFloor, Step, Unexplained
 from calibration.equations import Equations
-from calibration.refit import corrected, fit_with
+from calibration.refit import MIN_HELD_OUT_GAIN, corrected, fit_with, held_out_rss
 from calibration.selection import Chosen, Evidence, floor_rms, residual_rms
 from sim.effects import EffectSet
 from training.documents import TARGETS
@@ -30,6 +30,12 @@ class Found:
     steps: Sequence[Step]
     unnamed: Sequence[Evidence]
     backlash: BacklashReading
+    described: Chosen | None = None  # the generic term adopted where no name fits (``adopt_described``)
+
+    @property
+    def adopted(self) -> list[Chosen]:
+        """Every term the estimates after are fitted with: the named effects, then the described one."""
+        return [*self.chosen, *([self.described] if self.described else [])]
 
 
 @dataclass(frozen=True)
@@ -71,6 +77,10 @@ def adopted_effects(found: Found) -> EffectSet:
         if term is not None:
             values.update({name: dict(p) for name, p in term.values.items()})
             table = table or term.table
+    if found.described is not None:
+        lead = found.unnamed[0]
+        term = lead.family.term(lead.beta, lead.grid)
+        table = table or (term.table if term is not None else None)
     if found.backlash.significant:
         values["backlash"] = {"extra_rad": float(np.clip(found.backlash.extra_rad, -5e-3, 0.1))}
     return EffectSet(values, table)
@@ -106,6 +116,29 @@ def withheld(found: Found, with_it: Sequence[Chosen], estimates: Mapping[str, fl
     return None
 
 
+def adopt_described(found: Found, held: HeldOutCheck) -> tuple[Found, HeldOutCheck]:
+    """``found`` with the lead described term adopted, and the held-out check with it, where the simulator
+    can add the term, the estimates with it are identified (``withheld``) and the model with it predicts
+    held-out folds better than without it, as a named effect must; else both unchanged. Never where the
+    windows cannot tell which variable the residual follows: a curve over the wrong one trades with FDJ
+    and η_O (a current offset described as time or direction, adopted as a time curve, went 8x worse)."""
+    if len({e.family.follows for e in found.unnamed}) != 1:
+        return found, held
+    lead = found.unnamed[0]
+    term = lead.family.term(lead.beta, lead.grid)
+    described = Chosen(lead.family, lead.grid)
+    with_it = [*found.chosen, described]
+    if withheld(found, with_it, fit_with(found.measured, with_it).values, term is not None and term.table is not None):
+        return found, held
+    current = held.rss_after if held.adopted else held.rss_before
+    trial = held_out_rss(found.measured, with_it)
+    if trial >= (1.0 - MIN_HELD_OUT_GAIN) * current:
+        return found, held
+    note = f"{held.note}; the described term ({lead.family.name}) adopted: held-out folds "
+    note += f"{100 * (1 - trial / current):.0f} % better with it"
+    return replace(found, described=described), HeldOutCheck(held.rss_before, trial, True, note)
+
+
 def unexplained(found: Found, bias: Mapping[str, float], truth: Mapping[str, float] | None) -> Unexplained | None:
     if not found.unnamed:
         return None
@@ -122,6 +155,7 @@ def unexplained(found: Found, bias: Mapping[str, float], truth: Mapping[str, flo
     else:
         described = f"the residual torque follows {' or '.join(variables)}: these windows cannot tell which"
     return Unexplained(
+        adopted=found.described is not None,
         variables=variables,
         description=described,
         shape=lead.family.parameters(lead.beta, lead.grid),
@@ -152,7 +186,7 @@ def assemble(
         n_windows=int(found.measured.window.max()) + 1,
         noise_floor=NoiseFloor(copies=len(found.copies), equation_error_ratio=residual_rms(found.measured, []) / floor),
         residual_rms_before={"residual_torque": residual_rms(found.measured, [])},
-        residual_rms_after={"residual_torque": residual_rms(found.measured, found.chosen)},
+        residual_rms_after={"residual_torque": residual_rms(found.measured, found.adopted)},
         candidates=[*(_candidate(e) for e in found.evidence), _backlash_candidate(found.backlash)],
         selected_effect=names[0] if names else None,
         selected_effects=names,

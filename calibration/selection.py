@@ -170,6 +170,12 @@ def decide(
     if named is None:
         return Decision(None, [best], f"the residual follows {best.family.follows} in a way no named effect describes")
     named, alike = simplest(named, [best, *close], measured, copies, chosen)
+    drift = _step_in_time(named, found)
+    if drift is not None:
+        share = drift.improvement / named.improvement
+        return Decision(None, [drift, named], f"friction drifting in time explains {share:.0%} of what "
+                                              f"{named.family.name} does: where the motion mostly goes one way and "
+                                              "then the other, sgn(ω) is a step in time")  # fmt: skip
     rivals = [e for e in [best, *close] if not e.family.named and e.family.exogenous]
     rivals = [e for e in rivals if e.family.follows != named.family.follows]
     for rival in rivals:
@@ -183,6 +189,18 @@ def decide(
     if alike:
         reason += f"; {', '.join(alike)} explains the same samples (one trace over the range visited): simpler named"
     return Decision(named, [], reason, alike)
+
+
+def _step_in_time(named: Evidence, found: Sequence[Evidence]) -> Evidence | None:
+    """The curve over time that explains within ``NAME_MARGIN`` as much as a family following the direction
+    (a sensor off zero leaves sgn(ω)·c), or None. A curve over another variable is set aside when the named
+    family explains held-out samples beyond it (``settle``); a step in time is not, as the few reversals that
+    tell a step from a drift are the very samples both fit."""
+    if named.family.follows != "direction":
+        return None
+    timed = [e for e in found if not e.family.named and e.family.follows == "time_s" and e.z >= MIN_Z]
+    close = [e for e in timed if e.improvement >= (1 - NAME_MARGIN) * named.improvement]
+    return close[0] if close else None
 
 
 def _ambiguous(best: Evidence, rivals: Sequence[Evidence]) -> str:

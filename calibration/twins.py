@@ -1,13 +1,13 @@
 """Twins: effects that leave the same trace in the residual torque, told apart by simulation.
 
-A torque constant g and a current-sensor gain s both leave a term in k_T·I in the residual
-torque; only the first also changes the back-EMF (k_e = k_T), hence how much voltage is left to
-drive current near top speed, hence how the motor speed and current evolve. An inertia off the
-document's leaves a term in dω/dt, which k_T·I mostly is, and moves how fast the speed follows the
-current. Each twin is added
-to the simulator in turn, the window simulated at the estimates, and the one whose speed and
-current stay closer to the measured ones (in units of their noise) is named; the other is
-reported as indistinguishable when the difference is small.
+A torque constant g and a current-sensor gain s both leave a term in k_T·I in the residual torque;
+only the first also changes the back-EMF (k_e = k_T), hence how much voltage is left to drive current
+near top speed, hence how the motor speed and current evolve. An inertia off the document's leaves a
+term in dω/dt, which k_T·I mostly is, and moves how fast the speed follows the current. A current
+sensor and a hinge-moment sensor off zero both leave a constant in T_R; only the first is felt by the
+loop, which regulates the logged current. Each twin is added to the simulator in turn, the window
+simulated at the estimates, and the one whose speed and current stay closer to the measured ones (in
+units of their noise) is named; the other is reported as indistinguishable when the difference is small.
 """
 
 from __future__ import annotations
@@ -23,9 +23,11 @@ from sim.window import Window
 from training.physics.scenario import CLEAR_MARGIN, following_error, inside, scenario_from_window
 
 # Look-alikes, each with the others of its group. An inertia ΔJ leaves ΔJ·dω/dt, which a gain of k_T·I
-# (mostly the load and J_M·dω/dt) nearly matches; only its simulation moves the speed otherwise.
-GROUP = ("torque_constant", "current_sensor_gain", "inertia")
-TWINS = {name: tuple(other for other in GROUP if other != name) for name in GROUP}
+# (mostly the load and J_M·dω/dt) nearly matches; only its simulation moves the speed otherwise. A current
+# sensor off zero and a hinge-moment sensor off zero both leave a constant in T_R, sgn(ω)·c in t; only the
+# first is felt by the loop (it regulates the logged current), and only the second moves the load columns.
+GROUPS = (("torque_constant", "current_sensor_gain", "inertia"), ("hinge_moment_bias", "current_sensor_offset"))
+TWINS = {name: tuple(other for other in group if other != name) for group in GROUPS for name in group}
 
 
 def output_error(

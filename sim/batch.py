@@ -80,6 +80,8 @@ def kernel_constants(actuator: ActuatorParams, effects: EffectSet) -> kernels.Ke
         half_backlash=0.5 * (actuator.backlash_rad + effects.get("backlash", "extra_rad")),
         end_stop=float(np.radians(actuator.end_stop_deg)),
         current_sensor_gain=sensor_gain,
+        current_sensor_offset=effects.get("current_sensor_offset", "offset_a"),
+        current_ref_shift=effects.get("current_sensor_offset", "offset_a") / sensor_gain,
         hinge_sensor_bias=effects.get("hinge_moment_bias", "bias_nm"),
         stribeck_amplitude=effects.get("stribeck", "amplitude_nm"),
         stribeck_inverse_speed=1.0 / stribeck_speed,

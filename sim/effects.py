@@ -52,6 +52,10 @@ EFFECTS: Mapping[str, Effect] = MappingProxyType(
                 {"gain": (1.0, 0.7, 1.3)},  # measured current over true current [-] (the loop sees it)
             ),
             Effect(
+                "current_sensor_offset",
+                {"offset_a": (0.0, -5.0, 5.0)},  # measured − gain × true current [A] (the loop sees it)
+            ),
+            Effect(
                 "position_friction",
                 {"amplitude_nm": (0.0, -0.05, 1.0)},  # extra dry friction at full deflection [N·m], ∝ |θ_u|
             ),

@@ -54,6 +54,8 @@ class KernelConstants(NamedTuple):
     half_backlash: float  # BLK / 2 [rad], elevator side
     end_stop: float  # θ_stop [rad]
     current_sensor_gain: float  # measured / true current [-]
+    current_sensor_offset: float  # measured − gain·true current [A]
+    current_ref_shift: float  # the offset in true amperes (offset / gain) [A]: the loop regulates the measured current
     hinge_sensor_bias: float  # measured − true hinge moment [N·m]
     stribeck_amplitude: float  # extra dry friction at zero speed [N·m]
     stribeck_inverse_speed: float  # 1 / ω_s [s/rad]
@@ -98,6 +100,7 @@ def advance(
     # Controller: P position loop -> speed reference, P speed loop -> current reference.
     speed_ref = min(max(c.position_gain * (command_rad - position), -c.max_speed_ref), c.max_speed_ref)
     current_ref = min(max(c.speed_gain_over_kt * (speed_ref - speed), -c.max_current), c.max_current)
+    current_ref -= c.current_ref_shift
     # PWM-like bang-bang on the measured current; explicit Euler on L·dI/dt = V − R·I − k_e·ω.
     voltage_step = c.voltage_step if current_ref > current else (-c.voltage_step if current_ref < current else 0.0)
     current = c.current_decay * current + voltage_step - c.back_emf_step * speed
@@ -285,7 +288,7 @@ def _record(c, load, lane, first, k, steps, out):
         mean_position = lane[SUM_POSITION, s] / steps
         out[POSITION, first + s, k] = mean_position
         out[SPEED, first + s, k] = lane[SUM_SPEED, s] / steps
-        out[CURRENT, first + s, k] = c.current_sensor_gain * lane[SUM_CURRENT, s] / steps
+        out[CURRENT, first + s, k] = c.current_sensor_gain * lane[SUM_CURRENT, s] / steps + c.current_sensor_offset
         out[LOSS, first + s, k] = lane[SUM_LOSS, s] / steps
         # H_e is affine in θ_u within an interval, so its mean follows from the mean position.
         hinge = lane[LOAD_SLOW, s] * c.gear + load.hinge_delta_nm * mean_position

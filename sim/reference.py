@@ -34,6 +34,7 @@ def _step(
     current, speed, angle, position, _ = state
     speed_ref = np.minimum(np.maximum(c.position_gain * (command - position), -c.max_speed_ref), c.max_speed_ref)
     current_ref = np.minimum(np.maximum(c.speed_gain_over_kt * (speed_ref - speed), -c.max_current), c.max_current)
+    current_ref = current_ref - c.current_ref_shift
     voltage_step = np.where(
         current_ref > current, c.voltage_step, np.where(current_ref < current, -c.voltage_step, 0.0)
     )
@@ -88,7 +89,7 @@ def simulate_numpy(
             sums += (state[3], state[1], state[0], state[4])
         mean_position = sums[0] / steps
         out[0, :, k], out[1, :, k] = mean_position, sums[1] / steps
-        out[2, :, k] = c.current_sensor_gain * sums[2] / steps
+        out[2, :, k] = c.current_sensor_gain * sums[2] / steps + c.current_sensor_offset
         out[5, :, k] = sums[3] / steps
         out[3, :, k] = load_slow * c.gear + load.hinge_delta_nm * mean_position + c.hinge_sensor_bias
         out[4, :, k] = command0 + command_step * (steps - 1) / 2

@@ -32,6 +32,8 @@ CASES: dict[str, Case] = {
         current_sensor_gain=_gain(rng.choice([rng.uniform(0.94, 0.97), rng.uniform(1.04, 1.10)]), k)
     ),
     "hinge_moment_bias": lambda rng, k: Effects(hinge_bias_nm=k * rng.choice([-1, 1]) * rng.uniform(20.0, 35.0)),
+    # a Hall sensor off zero by a few tenths of an ampere, which the loop feeds back as it logs
+    "current_sensor_offset": lambda rng, k: Effects(current_bias_a=k * rng.choice([-1, 1]) * rng.uniform(0.2, 0.5)),
     "position_friction": lambda rng, k: Effects(
         bump_nm=k * rng.uniform(0.03, 0.05),
         bump_centre_deg=rng.uniform(-8.0, 8.0),

@@ -98,13 +98,18 @@ def test_one_command_per_simulation_case_2():
         np.testing.assert_array_equal(batch.signals["position_deg"][i], single.signals["position_deg"][0])
 
 
-def test_kernel_matches_the_plain_numpy_model():
+SENSOR_FAULTS = EffectSet({"current_sensor_offset": {"offset_a": 0.3}, "current_sensor_gain": {"gain": 1.05},
+                           "hinge_moment_bias": {"bias_nm": 5.0}})  # fmt: skip
+
+
+@pytest.mark.parametrize("effects", [EffectSet(), SENSOR_FAULTS], ids=["base", "sensor faults"])
+def test_kernel_matches_the_plain_numpy_model(effects):
     rng = np.random.default_rng(9)
     health = HealthParams.uniform(4, DEFAULT_RANGES, rng)
     knots = random_command_knots(30, RATE, rng)[0]
     initial = InitialState(position_deg=0.3, motor_speed_radps=50.0, current_a=2.0)
-    fast = simulate_batch(knots, health, initial=initial, actuator=THESIS.params)
-    c = kernel_constants(ActuatorParams(), EffectSet())
+    fast = simulate_batch(knots, health, initial=initial, effects=effects, actuator=THESIS.params)
+    c = kernel_constants(ActuatorParams(), effects)
     eta_a = health.eta_a(500.0)
     per_sim = np.stack([health.fdj_nm, health.fsj_nm, 1 - eta_a, 1 / health.eta_o - 1])
     start = np.repeat(np.array([[np.radians(0.3)], [50.0], [2.0]]), 4, axis=1)

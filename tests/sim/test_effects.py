@@ -76,6 +76,29 @@ def test_current_scale_effects_scale_the_logged_current(base, effect):
     assert ratio == pytest.approx(expected, rel=0.01)
 
 
+def test_a_current_sensor_offset_shifts_the_log_and_not_the_torque_that_slides(base):
+    """Sliding needs the same true current, which the loop reaches through the sensor: the log reads it plus
+    the offset, and the motion is the same within the loop's own chatter."""
+    result = run(EffectSet({"current_sensor_offset": {"offset_a": 0.4}}))
+    shift = result.signals["current_a"][0, STEADY] - base.signals["current_a"][0, STEADY]
+    assert shift.mean() == pytest.approx(0.4, abs=0.01)
+    np.testing.assert_allclose(result.loss_torque_nm[0, STEADY], base.loss_torque_nm[0, STEADY], atol=2e-3)
+
+
+def test_a_current_sensor_offset_is_held_by_a_stuck_shaft():
+    """At rest on its command, unloaded, the loop holds the *measured* current near zero: the true current
+    is −offset, and the stuck shaft's friction holds exactly that torque, k_T·offset."""
+    still = ramp_knots(0.0, 0.0, 2000)
+    offset = 0.5
+    result = simulate_batch(still, NOMINAL, GroundLoad(0.0), effects=EffectSet({"current_sensor_offset": {
+        "offset_a": offset}}), actuator=THESIS.params)  # fmt: skip
+    late = slice(1000, 2000)
+    assert abs(result.signals["current_a"][0, late].mean()) < 0.02  # the loop's view
+    assert np.abs(result.signals["motor_speed_radps"][0, late]).max() == 0.0  # never slips: k_T·0.5 < FSJ
+    torque = THESIS.params.torque_constant_nm_per_a * offset
+    assert np.abs(result.loss_torque_nm[0, late]).mean() == pytest.approx(torque, rel=0.02)
+
+
 def test_backlash_delays_the_elevator_at_a_reversal():
     knots = np.concatenate([ramp_knots(0.0, 10.0, 1500), ramp_knots(1.5, -10.0, 1500)[1:]])
     base = simulate_batch(knots, NOMINAL, LOAD, actuator=THESIS.params)
