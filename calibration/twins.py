@@ -26,14 +26,8 @@ from training.physics.scenario import CLEAR_MARGIN, following_error, inside, sce
 # (mostly the load and J_M·dω/dt) nearly matches; only its simulation moves the speed otherwise. A current
 # sensor off zero and a hinge-moment sensor off zero both leave a constant in T_R, sgn(ω)·c in t; only the
 # first is felt by the loop (it regulates the logged current), and only the second moves the load columns.
-# Each group with the margin by which one twin's replay must follow the window better to override the held-out
-# equations' choice. The offsets' replays differ only by the small share of the current the loop shifts, while
-# the hinge bias also moves the load columns, which the equations see; so between the offsets a replay must be
-# far better (half again) before it outvotes the equations (docs/calibration.md has the study).
-GROUPS = {("torque_constant", "current_sensor_gain", "inertia"): CLEAR_MARGIN,
-          ("hinge_moment_bias", "current_sensor_offset"): 0.5}  # fmt: skip
+GROUPS = (("torque_constant", "current_sensor_gain", "inertia"), ("hinge_moment_bias", "current_sensor_offset"))
 TWINS = {name: tuple(other for other in group if other != name) for group in GROUPS for name in group}
-MARGIN = {name: margin for group, margin in GROUPS.items() for name in group}
 
 
 def output_error(
@@ -66,4 +60,4 @@ def tell_apart(
     errors = {o.family.name: output_error(windows, estimates, o, noise, actuator) for o in options}
     ranked = sorted(options, key=lambda o: errors[o.family.name])
     best, runner = errors[ranked[0].family.name], errors[ranked[1].family.name]
-    return ranked[0], errors, runner > (1 + MARGIN[ranked[0].family.name]) * best
+    return ranked[0], errors, runner > (1 + CLEAR_MARGIN) * best
