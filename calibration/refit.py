@@ -18,7 +18,7 @@ import numpy as np
 from calibration.equations import FOLDS, Equations
 from calibration.selection import Chosen
 from sim.params import eta_a_from_eta_o
-from training.physics.friction import ETA_O_SEARCH, GRID_POINTS, REFINEMENTS
+from training.physics.eta_search import ETA_O_SEARCH, GRID_POINTS, REFINEMENTS
 
 MIN_HELD_OUT_GAIN = 0.01  # a model with an effect must cut the held-out residual by at least 1 % to be adopted
 

@@ -14,7 +14,7 @@ from calibration.refit import MIN_HELD_OUT_GAIN, corrected, fit_with, held_out_r
 from calibration.selection import Chosen, Evidence, floor_rms, residual_rms
 from sim.effects import EffectSet
 from training.documents import TARGETS
-from training.physics.friction import ETA_O_SEARCH
+from training.physics.eta_search import ETA_O_SEARCH
 
 # How much further noise alone may move FDJ or η_O with a described term than without it before the
 # estimates with it are withheld: a time drift inflates them 1–2.5x, a ramp over deflection 13–32x.

@@ -26,6 +26,7 @@ for it.
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 
 from sim.checks import InputError
 from sim.residual import kernel_samples
@@ -37,27 +38,21 @@ HINGE_SMOOTHING_S = 0.04
 def local_line(values: np.ndarray, width: int) -> np.ndarray:
     """At each sample, the least-squares line through the ``width`` samples nearest it, there (last axis).
 
-    Inside the array that window is centred and the line's value is the plain mean (O(n) by
-    cumulative sums); within width/2 of an end the window stops at the end and the line through
+    Inside the array that window is centred and the line's value is the plain mean (O(n) by a
+    running sum); within width/2 of an end the window stops at the end and the line through
     it is evaluated off-centre. A straight line passes unchanged, and no output leans on fewer
     than ``width`` samples (a reflected pad would: at the edge sample it returns that sample).
     """
+    values = np.asarray(values, dtype=np.float64)
     n = values.shape[-1]
-    width = min(width, n - (1 - n % 2))  # odd, at most n
-    half = width // 2
-    if half < 1:
-        return values.astype(np.float64, copy=True)
-    sums = np.cumsum(values, axis=-1, dtype=np.float64)
-    sums = np.concatenate([np.zeros_like(sums[..., :1]), sums], axis=-1)
-    out = np.empty(values.shape)
-    out[..., half : n - half] = (sums[..., width:] - sums[..., : n - width + 1]) / width
-    offsets = np.arange(width) - half
-    for ends, at in ((slice(0, width), slice(0, half)), (slice(n - width, n), slice(width - half, width))):
-        block = values[..., ends]
-        mean = block.mean(axis=-1, keepdims=True)
-        slope = block @ offsets / np.sum(offsets**2)
-        out[..., at.start + ends.start : at.stop + ends.start] = mean + slope[..., None] * offsets[at]
-    return out
+    width = min(width - (1 - width % 2), n - (1 - n % 2))  # odd, at most n
+    if width < 3:
+        return values.copy()
+    rows = np.ascontiguousarray(values.reshape(-1, n))
+    out = np.empty_like(rows)
+    for r in range(rows.shape[0]):
+        _local_line(rows[r], width, out[r])
+    return out.reshape(values.shape)
 
 
 def denoised_hinge_nm(
@@ -71,10 +66,54 @@ def denoised_hinge_nm(
     position = np.asarray(position_deg, dtype=np.float64)
     if hinge.shape != position.shape:
         raise InputError("signals", f"shapes differ: hinge {hinge.shape}, position {position.shape}")
-    width = kernel_samples(sample_rate_hz, window_s)
-    slow_hinge = local_line(hinge, width)
-    fast_position = position - local_line(position, width)
-    spread = np.sum(fast_position**2, axis=-1, keepdims=True)
-    covariance = np.sum((hinge - slow_hinge) * fast_position, axis=-1, keepdims=True)
-    slope = np.divide(covariance, spread, out=np.zeros_like(spread), where=spread > 0)
-    return slow_hinge + slope * fast_position
+    n = hinge.shape[-1]
+    width = min(kernel_samples(sample_rate_hz, window_s), n - (1 - n % 2))
+    hinge_rows, position_rows = (np.ascontiguousarray(x.reshape(-1, n)) for x in (hinge, position))
+    out = np.empty(hinge_rows.shape)
+    _denoise_rows(hinge_rows, position_rows, max(width, 1), out)
+    return out.reshape(hinge.shape)
+
+
+@njit(cache=True, nogil=True)
+def _local_line(values, width, out):
+    """out (n,) = the local line of ``values`` (n,) over ``width`` (odd, 3 ≤ width ≤ n) samples."""
+    n, half = values.shape[0], width // 2
+    total = 0.0
+    for k in range(width):
+        total += values[k]
+    for i in range(half, n - half):
+        out[i] = total / width
+        if i + half + 1 < n:
+            total += values[i + half + 1] - values[i - half]
+    denominator = 0.0
+    for j in range(width):
+        denominator += (j - half) ** 2
+    for start, first_out, last_out in ((0, 0, half), (n - width, n - half, n)):
+        mean, moment = 0.0, 0.0
+        for j in range(width):
+            mean += values[start + j]
+            moment += values[start + j] * (j - half)
+        mean /= width
+        for i in range(first_out, last_out):
+            out[i] = mean + moment / denominator * (i - start - half)
+
+
+@njit(cache=True, nogil=True)
+def _denoise_rows(hinge, position, width, out):
+    """out (R, n) = H_read of hinge and position (R, n) over ``width`` samples (1: the hinge as logged)."""
+    n = hinge.shape[1]
+    fast = np.empty(n)
+    for r in range(hinge.shape[0]):
+        if width < 3:
+            out[r] = hinge[r]
+            continue
+        _local_line(hinge[r], width, out[r])
+        _local_line(position[r], width, fast)
+        spread, covariance = 0.0, 0.0
+        for k in range(n):
+            fast[k] = position[r, k] - fast[k]
+            spread += fast[k] * fast[k]
+            covariance += (hinge[r, k] - out[r, k]) * fast[k]
+        slope = covariance / spread if spread > 0 else 0.0
+        for k in range(n):
+            out[r, k] += slope * fast[k]

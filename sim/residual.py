@@ -102,15 +102,27 @@ def above_throughout(values: np.ndarray, threshold: float, width: int) -> np.nda
     """Whether every sample of a centred window of ``width`` samples exceeds ``threshold`` (last axis),
     by a running count: O(n). False where the window runs past either end: the reconstruction's
     kernel is padded there, leaning on the last few samples (noise ~4x, the samples erring together)."""
-    half = width // 2
-    low = (values <= threshold).astype(np.int64)
-    counts = np.cumsum(np.pad(low, [(0, 0)] * (values.ndim - 1) + [(1, 0)]), axis=-1)
+    values = np.asarray(values, dtype=np.float64)
     n = values.shape[-1]
-    index = np.arange(n)
-    upper = np.minimum(index + half + 1, n)
-    lower = np.maximum(index - half, 0)
-    whole = (index >= half) & (index < n - half)
-    return ((counts[..., upper] - counts[..., lower]) == 0) & whole
+    rows = np.ascontiguousarray(values.reshape(-1, n))
+    out = np.empty(rows.shape, dtype=np.bool_)
+    _above_rows(rows, float(threshold), width // 2, out)
+    return out.reshape(values.shape)
+
+
+@njit(cache=True, nogil=True)
+def _above_rows(rows, threshold, half, out):
+    """out[r, i] = all(rows[r, i − half : i + half + 1] > threshold), False within ``half`` of an end."""
+    n = rows.shape[1]
+    for r in range(rows.shape[0]):
+        out[r, :] = False
+        low = 0  # samples ≤ threshold in the window around i
+        for k in range(min(2 * half, n)):
+            low += rows[r, k] <= threshold
+        for i in range(half, n - half):
+            low += rows[r, i + half] <= threshold
+            out[r, i] = low == 0
+            low -= rows[r, i - half] <= threshold
 
 
 def residual_torque_nm(

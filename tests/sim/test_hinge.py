@@ -27,6 +27,16 @@ def test_the_local_line_equals_its_definition_and_keeps_a_line():
     np.testing.assert_allclose(local_line(line, 31), line, atol=1e-9)
 
 
+def test_the_compiled_reading_equals_its_formula_written_plainly():
+    rng = np.random.default_rng(8)
+    hinge, position = rng.normal(50.0, 3.0, 300), np.cumsum(rng.normal(0.0, 0.05, 300))
+    width = 41  # 4 ms at 10 kHz
+    slow = _plain_local_line(hinge, width)
+    fast = position - _plain_local_line(position, width)
+    want = slow + np.sum((hinge - slow) * fast) / np.sum(fast**2) * fast
+    np.testing.assert_allclose(denoised_hinge_nm(hinge, position, RATE_HZ, window_s=0.004), want, atol=1e-9)
+
+
 def test_a_fast_deflection_term_is_kept_and_its_slope_is_measured():
     t = np.arange(2_000) / RATE_HZ
     position_deg = 2.0 * np.sign(np.sin(2 * np.pi * 15 * t)) * (1 - np.exp(-t / 0.003))  # steps, 15 Hz

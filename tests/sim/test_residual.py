@@ -85,3 +85,14 @@ def test_sliding_mask_leaves_out_the_edges_where_the_kernel_is_padded():
     assert not kept[: kernel_samples(RATE) // 2].any() and not kept[-(kernel_samples(RATE) // 2) :].any()
     assert spread[kept].max() < 1.15 * np.median(spread)
     assert spread[~kept].max() > 3 * np.median(spread)
+
+
+def test_above_throughout_equals_its_definition():
+    rng = np.random.default_rng(1)
+    for shape, width in [((300,), 21), ((4, 300), 7), ((4, 300), 1), ((5,), 21)]:
+        values = rng.normal(1.0, 1.0, shape)
+        half = width // 2
+        want = np.zeros(shape, dtype=bool)
+        for i in range(half, shape[-1] - half):
+            want[..., i] = np.all(values[..., i - half : i + half + 1] > 0.2, axis=-1)
+        np.testing.assert_array_equal(above_throughout(values, 0.2, width), want)

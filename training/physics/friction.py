@@ -5,10 +5,11 @@ the load aids the motion and 1/η_O − 1 when it opposes it (T_ext = H_e / n). 
 through the same smoothing kernel as the reconstruction (``sim.residual``), which keeps the
 model linear in FDJ and k: with t = sgn(ω)·(T_R − C·ω), a and o the smoothed aiding and opposing
 |T_ext|, t = FDJ + k_aid·a + k_opp·o. η_A is tied to η_O by Eq. 3.4, so the fit is a search over
-η_O with FDJ in closed form at each point. Where asked, nuisances join FDJ in that closed form
-(``nuisance_columns``): a constant torque c (a sensor off zero, ``training.prepare.departures.zero_offset``), a change
-ΔC of the viscous coefficient (``training.prepare.departures.viscosity``), a scale γ of the motor torque and a change
-ΔJ of the inertia (k_T, a current sensor's gain or J_M off, ``training.prepare.departures.drive_constants``).
+η_O with FDJ in closed form at each point (``training.physics.eta_search``). Where asked, nuisances
+join FDJ in that closed form (``nuisance_columns``): a constant torque c (a sensor off zero,
+``training.prepare.departures.zero_offset``), a change ΔC of the viscous coefficient
+(``training.prepare.departures.viscosity``), a scale γ of the motor torque and a change ΔJ of the
+inertia (k_T, a current sensor's gain or J_M off, ``training.prepare.departures.drive_constants``).
 
 Everything the search needs is the matrix of sums Σ z·zᵀ per window, z = (t, a, o, nuisances…, 1)
 (ten numbers without nuisances), so a batch of simulated windows is fitted at the cost of one pass
@@ -26,7 +27,7 @@ import numpy as np
 from numba import njit
 
 from sim.checks import InputError
-from sim.params import ActuatorParams, eta_a_from_eta_o
+from sim.params import ActuatorParams
 from sim.residual import (
     DEFAULT_DERIVATIVE_WINDOW_S,
     END_STOP_MARGIN_DEG,
@@ -36,11 +37,9 @@ from sim.residual import (
     smooth_derivative,
     smoothed,
 )
+from training.physics.eta_search import ETA_O_SEARCH, solve
 from training.stats import JACKKNIFE_BLOCKS, jackknife_std
 
-ETA_O_SEARCH = (0.20, 0.999)  # η_O searched over; Case 1C reaches 0.44
-GRID_POINTS = 41
-REFINEMENTS = 3  # coarse-to-fine passes: η_O to ~1e-5 (the SSE is smooth and unimodal in η_O)
 MIN_SLIDING_KERNELS = 10  # fewer sliding samples than 10 kernel widths: too little motion to fit
 NUISANCES = ("offset", "viscous", "torque_scale", "inertia")  # the terms a fit may carry beside FDJ, in this order
 
@@ -178,72 +177,6 @@ def _block_sums(columns, mask, edges, out):
                             out[r, b, i, j] += x * columns[j][r, k]
                         out[r, b, i, k_cols] += x
                     out[r, b, k_cols, k_cols] += 1.0
-
-
-# An offset needs motion both ways: with fewer than this share of the samples in the rarer direction,
-# it cannot be told from FDJ and is not fitted. ΔC, γ and ΔJ need columns that vary: a coefficient of
-# variation below this, and they cannot be told from FDJ either.
-MIN_OFFSET_BALANCE = 0.05
-MIN_VARIATION = 0.05
-
-
-def _fitted(stats: np.ndarray, nuisances: tuple[str, ...]) -> np.ndarray:
-    """(R, F) which of (FDJ, *nuisances) each row's window can tell apart (FDJ always; the rest by their
-    column's balance or variation; ``stats`` (R, P, P))."""
-    m = stats[:, -1, -1]
-    used = [m > 0]
-    for i, name in enumerate(nuisances, start=3):
-        total, square = stats[:, i, -1], stats[:, i, i]
-        if name == "offset":
-            used.append((m > 0) & (m - np.abs(total) >= 2 * MIN_OFFSET_BALANCE * m))  # 2 × the rarer direction's
-        else:
-            used.append((m > 0) & (square * m - total**2 > (MIN_VARIATION * total) ** 2))
-    return np.stack(used, axis=-1)
-
-
-def _profile(stats: np.ndarray, eta_o: np.ndarray, gear: float, nuisances: tuple[str, ...]) -> tuple[np.ndarray, ...]:
-    """For stats (R, P, P) and a grid per row (R, G): the coefficients (R, G, F) of FDJ and each nuisance
-    in closed form, and the SSE (R, G). With u = t − k_aid·a − k_opp·o, FDJ is u's mean, or with the
-    nuisances, the regression of u on (1, nuisances…); a term this window cannot tell (``_fitted``) gets
-    an identity row, so its coefficient is 0."""
-    k_opp = 1.0 / eta_o - 1.0
-    k_aid = 1.0 - eta_a_from_eta_o(eta_o, gear)
-    s = stats[:, None]  # (R, 1, P, P)
-    uu = (
-        s[..., 0, 0] + k_aid**2 * s[..., 1, 1] + k_opp**2 * s[..., 2, 2]
-        - 2 * k_aid * s[..., 0, 1] - 2 * k_opp * s[..., 0, 2] + 2 * k_aid * k_opp * s[..., 1, 2]
-    )  # fmt: skip
-    free = [-1, *range(3, 3 + len(nuisances))]  # the constant (FDJ) first
-    cross = s[..., 0, free] - k_aid[..., None] * s[..., 1, free] - k_opp[..., None] * s[..., 2, free]
-    if not nuisances:  # the batches of simulations: the plain mean, no solve
-        fdj = cross[..., 0] / np.maximum(s[..., -1, -1], 1.0)
-        return fdj[..., None], uu - fdj * cross[..., 0]
-    used = _fitted(stats, nuisances)[:, None, :]  # (R, 1, F)
-    both = used[..., :, None] & used[..., None, :]
-    gram = np.where(both, stats[:, free][:, :, free][:, None], 0.0)
-    # Two nuisances nearly dependent (speeds set by the direction): a ridge keeps the solve regular.
-    diagonal = np.where(used, np.diagonal(gram, axis1=-2, axis2=-1) * (1.0 + 1e-12), 1.0)
-    gram = gram * ~np.eye(len(free), dtype=bool) + diagonal[..., None] * np.eye(len(free))
-    rhs = np.where(used, cross, 0.0)
-    beta = np.linalg.solve(np.broadcast_to(gram, (*rhs.shape, len(free))), rhs[..., None])[..., 0]
-    return beta, uu - np.sum(beta * rhs, axis=-1)
-
-
-def solve(stats: np.ndarray, gear: float, nuisances: tuple[str, ...] = ()) -> tuple[np.ndarray, ...]:
-    """(coefficients (R, F): FDJ then the nuisances', η_O, SSE) per row of ``stats`` (R, P, P): a
-    coarse-to-fine grid over η_O, vectorized."""
-    rows = np.arange(len(stats))
-    low = np.full(len(stats), ETA_O_SEARCH[0])
-    high = np.full(len(stats), ETA_O_SEARCH[1])
-    for _ in range(REFINEMENTS):
-        grid = low[:, None] + (high - low)[:, None] * np.linspace(0.0, 1.0, GRID_POINTS)
-        beta, sse = _profile(stats, grid, gear, nuisances)
-        best = np.argmin(sse, axis=1)
-        step = grid[:, 1] - grid[:, 0]
-        centre = grid[rows, best]
-        low = np.maximum(centre - step, ETA_O_SEARCH[0])
-        high = np.minimum(centre + step, ETA_O_SEARCH[1])
-    return beta[rows, best], centre, sse[rows, best]
 
 
 def fit_friction(

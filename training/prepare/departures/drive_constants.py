@@ -186,7 +186,7 @@ def _stands_out(plain: FrictionFit, alone: FrictionFit, name: str, rate: float, 
     relative = float(alone.term(name)[0]) / (spec.inertia_kgm2 if name == "inertia" else 1.0)
     return bool(
         np.isfinite(relative)
-        and alone.term_std(name)[0] > 0  # else the window cannot tell it from FDJ (``friction._fitted``)
+        and alone.term_std(name)[0] > 0  # else the window cannot tell it from FDJ (``eta_search.fitted_terms``)
         and abs(relative) < PLAUSIBLE[name]
         and equation_z(plain, alone, rate) > DECISIVE_Z
     )

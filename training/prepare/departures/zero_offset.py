@@ -123,7 +123,7 @@ def read_zero_offset(
     one way, the carried zero, or the note that none is known."""
     rate, signals = window.sample_rate_hz, dict(window.signals)
     found = fit_as_read(signals, rate, actuator, OFFSET_FIT)
-    if float(found.term_std("offset")[0]) == 0.0:  # too little motion the other way (``friction.MIN_OFFSET_BALANCE``)
+    if float(found.term_std("offset")[0]) == 0.0:  # too little motion the other way (``eta_search.MIN_OFFSET_BALANCE``)
         unseen = UNSEEN_CURRENT_OFFSET_A * actuator.torque_constant_nm_per_a
         known = carried or ZeroOffset(zero_std_nm=unseen)
         return replace(known, one_way=True, spread={"FDJ": known.zero_std_nm})
