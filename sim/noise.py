@@ -11,6 +11,7 @@ the network and set the stds on data quieter or louder than the window, where it
 
 from __future__ import annotations
 
+import functools
 from dataclasses import asdict, dataclass
 
 import numpy as np
@@ -88,17 +89,62 @@ def add_sensor_noise(
     added in place: no temporaries the size of the batch.
     """
     levels = noise.as_dict()
+    drawn = [name for name in signals if levels.get(name, 0.0) > 0]
+    unit = {name: rng.standard_normal(signals[name].shape, dtype=np.float32) for name in drawn}
+    return _scaled(signals, noise, unit, sample_rate_hz)
+
+
+def add_seeded_noise(
+    signals: dict[str, np.ndarray], noise: SensorNoise, seed: int, sample_rate_hz: float | None = None
+) -> dict[str, np.ndarray]:
+    """``add_sensor_noise`` with ``np.random.default_rng(seed)``, equal to it value for value.
+
+    The unit draws depend only on the seed, the signals drawn and their shape, not on the noise's
+    levels: a monitor answers window after window of one shape with one seed, so they are drawn once
+    and kept (``_unit_draws``), and each window pays only for scaling them.
+    """
+    levels = noise.as_dict()
+    drawn = tuple((name, signals[name].shape) for name in signals if levels.get(name, 0.0) > 0)
+    unit = {name: draw for (name, _), draw in zip(drawn, _unit_draws(seed, drawn), strict=True)}
+    return _scaled(signals, noise, unit, sample_rate_hz)
+
+
+@functools.lru_cache(maxsize=4)
+def _unit_draws(seed: int, drawn: tuple[tuple[str, tuple[int, ...]], ...]) -> tuple[np.ndarray, ...]:
+    """Unit-variance float32 draws for each (signal, shape) in order, read-only (they are shared)."""
+    rng = np.random.default_rng(seed)
+    draws = tuple(rng.standard_normal(shape, dtype=np.float32) for _, shape in drawn)
+    for draw in draws:
+        draw.flags.writeable = False
+    return draws
+
+
+def _scaled(
+    signals: dict[str, np.ndarray], noise: SensorNoise, unit: dict[str, np.ndarray], sample_rate_hz: float | None
+) -> dict[str, np.ndarray]:
+    """Each signal plus its unit draws (correlated at its ρ where it has one) times its std; a copy of the rest."""
+    levels = noise.as_dict()
     out = {}
     for name, values in signals.items():
-        if levels.get(name, 0.0) > 0:
-            noisy = rng.standard_normal(values.shape, dtype=np.float32).astype(np.float64)
-            if levels.get(f"{name}_corr_s", 0.0) > 0:
-                if sample_rate_hz is None:
-                    raise ValueError(f"correlated {name} noise needs the sample rate")
-                _correlate(noisy.reshape(-1, values.shape[-1]), noise.correlation(name, sample_rate_hz))
+        if name not in unit:
+            out[name] = values.copy()
+            continue
+        if levels.get(f"{name}_corr_s", 0.0) > 0:
+            if sample_rate_hz is None:
+                raise ValueError(f"correlated {name} noise needs the sample rate")
+            noisy = unit[name].astype(np.float64)
+            _correlate(noisy.reshape(-1, values.shape[-1]), noise.correlation(name, sample_rate_hz))
             noisy *= levels[name]
             noisy += values
-            out[name] = noisy
         else:
-            out[name] = values.copy()
+            noisy = np.empty(values.shape)
+            _add_scaled(values.reshape(-1), unit[name].reshape(-1), levels[name], noisy.reshape(-1))
+        out[name] = noisy
     return out
+
+
+@njit(cache=True, nogil=True)
+def _add_scaled(values, unit, level, out):
+    """out = values + level·unit, in one pass (flat arrays of one length; ``unit`` float32)."""
+    for k in range(out.shape[0]):
+        out[k] = values[k] + level * np.float64(unit[k])

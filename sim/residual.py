@@ -57,28 +57,33 @@ def _half_width(values: np.ndarray, sample_rate_hz: float, window_s: float) -> i
 
 def _correlate(values: np.ndarray, weights: np.ndarray, odd_extension: bool) -> np.ndarray:
     """Centred correlation along the last axis, the ends padded by reflection (point reflection if odd)."""
-    half = len(weights) // 2
-    head = values[..., half:0:-1]
-    tail = values[..., -2 : -half - 2 : -1]
-    if odd_extension:  # 2·x₀ − x keeps the end slope, so a derivative has no edge transient
-        head, tail = 2 * values[..., :1] - head, 2 * values[..., -1:] - tail
-    padded = np.ascontiguousarray(np.concatenate([head, values, tail], axis=-1))
-    rows = padded.reshape(-1, padded.shape[-1])
-    out = np.empty((rows.shape[0], values.shape[-1]))
-    _correlate_rows(rows, np.ascontiguousarray(weights, dtype=np.float64), out)
+    values = np.asarray(values, dtype=np.float64)
+    rows = np.ascontiguousarray(values.reshape(-1, values.shape[-1]))
+    out = np.empty(rows.shape)
+    _correlate_rows(rows, np.ascontiguousarray(weights, dtype=np.float64), odd_extension, out)
     return out.reshape(values.shape)
 
 
 @njit(cache=True, nogil=True)
-def _correlate_rows(padded, weights, out):
-    """out[r, i] = Σ_j weights[j] · padded[r, i + j]; padded (R, n + w − 1), weights (w,), out (R, n)."""
-    n = out.shape[1]
-    for r in range(out.shape[0]):
+def _correlate_rows(rows, weights, odd_extension, out):
+    """out[r, i] = Σ_j weights[j] · x[r, i + j − h], h = len(weights) // 2, rows (R, n), out (R, n), x the
+    row reflected about its end samples (x[−k] = x[k]; with ``odd_extension``, 2·x[0] − x[k])."""
+    n, half = rows.shape[1], weights.shape[0] // 2
+    padded = np.empty(n + 2 * half)
+    for r in range(rows.shape[0]):
+        row = rows[r]
+        padded[half : half + n] = row
+        for k in range(1, half + 1):
+            head, tail = row[k], row[n - 1 - k]
+            if odd_extension:
+                head, tail = 2 * row[0] - head, 2 * row[n - 1] - tail
+            padded[half - k] = head
+            padded[half + n - 1 + k] = tail
         out[r, :] = 0.0
         for j in range(weights.shape[0]):  # tap-outer: the inner loop runs along the row and vectorizes
             w = weights[j]
             for i in range(n):
-                out[r, i] += w * padded[r, i + j]
+                out[r, i] += w * padded[i + j]
 
 
 def smoothed(values: np.ndarray, sample_rate_hz: float, window_s: float = DEFAULT_DERIVATIVE_WINDOW_S) -> np.ndarray:

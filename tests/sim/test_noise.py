@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from sim.noise import SensorNoise, _correlate, add_sensor_noise, ar1_mean_variance
+from sim.noise import SensorNoise, _correlate, add_seeded_noise, add_sensor_noise, ar1_mean_variance
 
 RATE = 10_000.0
 
@@ -41,3 +41,16 @@ def test_correlated_noise_has_its_std_its_lag_one_correlation_and_the_scatter_of
 def test_correlated_noise_without_a_rate_is_refused():
     with pytest.raises(ValueError, match="sample rate"):
         add_sensor_noise({"current_a": np.zeros(10)}, SensorNoise(current_a_corr_s=1e-3), np.random.default_rng(0))
+
+
+@pytest.mark.parametrize("noise", [SensorNoise(), SensorNoise(current_a=0.0, hinge_moment_nm_corr_s=0.002)])
+def test_seeded_noise_equals_a_fresh_generator_of_that_seed_every_time(noise):
+    rng = np.random.default_rng(3)
+    signals = {name: rng.normal(size=(5, 300)) for name in ("position_deg", "current_a", "hinge_moment_nm")}
+    want = add_sensor_noise(signals, noise, np.random.default_rng(12), 10_000.0)
+    for _ in range(2):  # the second call reads the kept draws: still equal, and they were not scaled in place
+        got = add_seeded_noise(signals, noise, 12, 10_000.0)
+        for name in signals:
+            np.testing.assert_array_equal(got[name], want[name])
+    other = add_seeded_noise({k: v[:, :200] for k, v in signals.items()}, noise, 12, 10_000.0)
+    assert other["position_deg"].shape == (5, 200)

@@ -8,7 +8,15 @@ from sim.checks import InputError
 from sim.commands import random_command_knots
 from sim.noise import SensorNoise, add_sensor_noise
 from sim.params import HealthParams
-from sim.residual import above_throughout, kernel_samples, residual_torque_nm, smooth_derivative, smoothed
+from sim.residual import (
+    above_throughout,
+    derivative_weights,
+    kernel_samples,
+    residual_torque_nm,
+    smooth_derivative,
+    smoothed,
+    smoothing_weights,
+)
 
 RATE = 10_000.0
 
@@ -24,6 +32,20 @@ def test_derivative_is_exact_for_a_parabola_inside_and_for_a_line_everywhere():
 def test_smoothing_keeps_a_line_and_a_constant():
     t = np.arange(300) / RATE
     np.testing.assert_allclose(smoothed(1.5 + 4.0 * t, RATE)[30:-30], 1.5 + 4.0 * t[30:-30], atol=1e-12)
+
+
+def test_the_compiled_filters_equal_a_plain_correlation_of_the_reflected_rows():
+    values = np.random.default_rng(2).normal(size=(3, 200))
+    half = kernel_samples(RATE) // 2
+    head, tail = values[:, half:0:-1], values[:, -2 : -half - 2 : -1]
+    for got, weights, pad in (
+        (smoothed(values, RATE), smoothing_weights(half), (head, tail)),
+        (smooth_derivative(values, RATE), derivative_weights(half, RATE),
+         (2 * values[:, :1] - head, 2 * values[:, -1:] - tail)),
+    ):  # fmt: skip
+        padded = np.concatenate([pad[0], values, pad[1]], axis=1)
+        want = np.stack([np.correlate(row, weights, "valid") for row in padded])
+        np.testing.assert_allclose(got, want, rtol=1e-12, atol=1e-9)
 
 
 def test_residual_torque_reconstructs_the_true_loss_on_clean_data():

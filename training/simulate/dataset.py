@@ -9,7 +9,7 @@ import numpy as np
 
 from sim.actuator import Actuator
 from sim.effects import EffectSet
-from sim.noise import SensorNoise, add_sensor_noise
+from sim.noise import SensorNoise, add_seeded_noise
 from sim.params import ActuatorParams, HealthParams
 from sim.residual import residual_torque_nm
 from sim.window import Window
@@ -52,8 +52,7 @@ def simulate_noisy(
     rate = scenario.sample_rate_hz
     noise = excess_noise(window.signals, {name: values[-1] for name, values in result.signals.items()}, rate)
     clean = {name: result.signals[name][:-1] for name in SIGNALS_READ}
-    rng = np.random.default_rng(seed)
-    noisy = add_sensor_noise(clean, noise, rng, rate)
+    noisy = add_seeded_noise(clean, noise, seed, rate)
 
     def residual(s: dict[str, np.ndarray]) -> np.ndarray:
         return residual_torque_nm(s["current_a"], s["motor_speed_radps"], s["hinge_moment_nm"], rate, scenario.actuator)
