@@ -10,6 +10,7 @@ same kernel, and the thesis's Simulink figure (100-150 ms per 0.5 s simulation).
 from __future__ import annotations
 
 import argparse
+import functools
 import time
 
 import numpy as np
@@ -36,6 +37,22 @@ def best_of(repeats: int, run) -> float:
         run()
         times.append(time.perf_counter() - start)
     return min(times)
+
+LANE_SWEEP = (1, 8, 16, 24, 32, 48, 64)
+
+
+def lane_sweep(health: HealthParams, knots: np.ndarray, samples: int, repeats: int) -> list[str]:
+    """Lines of a table: ns per simulation-step with one group of each of ``LANE_SWEEP`` lanes, one thread."""
+    lines = ["", f"Cost per simulation-step by lanes per group (one group on one thread, {samples} samples): below",
+             "`sim.batch.MIN_VECTOR_LANES` the lane loop runs its scalar path.", "",
+             "| lanes per group | ns / sim-step |", "|---:|---:|"]  # fmt: skip
+    for lanes in LANE_SWEEP:
+        one = HealthParams(*(getattr(health, name)[:lanes] for name in ("fsj_nm", "fdj_nm", "eta_o")))
+        simulate_batch(knots[:11], one, lanes=lanes, actuator=THESIS.params)
+        run = functools.partial(simulate_batch, knots[: samples + 1], one, lanes=lanes, actuator=THESIS.params)
+        seconds = best_of(repeats, run)
+        lines.append(f"| {lanes} | {seconds / (lanes * samples * STEPS_PER_SAMPLE) * 1e9:.3g} |")
+    return lines
 
 
 def main() -> None:
@@ -89,6 +106,7 @@ def main() -> None:
     ]
     for name, seconds, note in rows:
         lines.append(f"| {name} | {seconds:.3g} | {seconds / steps * 1e9:.3g} | {seconds / fast_s:.3g}x | {note} |")
+    lines += lane_sweep(health, knots, short, args.repeats)
     body = "\n".join(lines)
     print(body)
     if args.docs:

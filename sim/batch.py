@@ -16,6 +16,7 @@ DEFAULT_SAMPLE_RATE_HZ = 10_000.0
 SAMPLE_RATE_RANGE_HZ = (1_000.0, 100_000.0)
 MAX_LANES = 64  # simulations advanced in lock-step; fewer lanes pay more per-step loop overhead
 LANE_MULTIPLE = 8  # one AVX-512 register of float64
+MIN_VECTOR_LANES = 24  # fewer lanes take the lane loop's scalar path: ~3x the cost per lane (benchmarks.sim_speed)
 # Past the end stops a command only saturates the speed reference: ω_ref = sat(G_P·(θ_cmd − θ_u)) is
 # already ±ω_max once θ_cmd is ω_max/G_P ≈ 0.37° beyond them, so clipping there changes nothing.
 COMMAND_MARGIN_DEG = 1.0
@@ -133,9 +134,18 @@ def _checked_initial(initial: InitialState, actuator: ActuatorParams) -> Initial
 
 
 def default_lanes(n_sims: int) -> int:
-    """Lanes per group: every thread gets a group, groups are whole registers, at most MAX_LANES."""
-    per_thread = -(-n_sims // runtime.threads())
-    return min(MAX_LANES, -(-per_thread // LANE_MULTIPLE) * LANE_MULTIPLE)
+    """Lanes per group: groups of whole registers, at most MAX_LANES, at least MIN_VECTOR_LANES (fewer run
+    scalar, ~3x the cost per lane), as many per thread as the others where there are enough simulations,
+    and as little padding as that allows (89 simulations on one thread: two groups of 48, not 64 + 64).
+    Below one register the lanes run scalar anyway: no padding."""
+    if n_sims < LANE_MULTIPLE:
+        return max(n_sims, 1)
+    threads = runtime.threads()
+    groups = max(-(-n_sims // MAX_LANES), min(threads, -(-n_sims // MIN_VECTOR_LANES)))
+    if groups >= threads:
+        groups = -(-groups // threads) * threads
+    per_group = max(-(-n_sims // groups), MIN_VECTOR_LANES)
+    return min(MAX_LANES, -(-per_group // LANE_MULTIPLE) * LANE_MULTIPLE)
 
 
 def run_groups(inputs: tuple, out: np.ndarray, lanes: int) -> None:

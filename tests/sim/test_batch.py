@@ -3,10 +3,19 @@
 import numpy as np
 import pytest
 
-from sim import kernels
+from sim import kernels, runtime
 from sim.actuator import THESIS
 from sim.aircraft import FlightCondition, GroundLoad, LoggedLoad, load_model
-from sim.batch import InitialState, interval_steps, kernel_constants, simulate_batch
+from sim.batch import (
+    LANE_MULTIPLE,
+    MAX_LANES,
+    MIN_VECTOR_LANES,
+    InitialState,
+    default_lanes,
+    interval_steps,
+    kernel_constants,
+    simulate_batch,
+)
 from sim.checks import InputError
 from sim.commands import random_command_knots
 from sim.effects import EffectSet
@@ -262,3 +271,20 @@ def test_an_interrupted_batch_runs_none_of_its_queued_groups(monkeypatch):
     settled = len(ran)
     time.sleep(0.2)
     assert settled < 50 and len(ran) <= settled + 2
+
+
+@pytest.mark.parametrize("threads", [1, 2, 4])
+def test_default_lanes_fill_the_threads_with_vector_groups_and_little_padding(threads):
+    before = runtime.threads()
+    runtime.set_threads(threads)
+    try:
+        assert default_lanes(1) == 1 and default_lanes(5) == 5  # scalar anyway: no padding
+        for n in range(LANE_MULTIPLE, 1200, 7):
+            lanes = default_lanes(n)
+            groups = -(-n // lanes)
+            assert lanes % LANE_MULTIPLE == 0 and MIN_VECTOR_LANES <= lanes <= MAX_LANES
+            assert groups * lanes - n < max(LANE_MULTIPLE * groups, MIN_VECTOR_LANES)  # padding: < a register a group
+            if n >= threads * MIN_VECTOR_LANES:
+                assert groups >= threads  # every thread has a group
+    finally:
+        runtime.set_threads(before)
