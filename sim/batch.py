@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import threading
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -178,6 +179,24 @@ def _padded(values: np.ndarray, multiple: int) -> np.ndarray:
     return np.concatenate([values, np.repeat(values[..., -1:], missing, axis=-1)], axis=-1)
 
 
+_KEPT = threading.local()
+
+
+def _recording(shape: tuple[int, int, int], reuse: bool) -> np.ndarray:
+    """The kernel's output array: fresh, or with ``reuse`` this thread's kept one of that shape.
+
+    The kernel writes each log interval's means across every simulation's row, pages apart: into
+    fresh memory every one of those writes first faults its page in, which costs a 0.5 s batch of
+    89 simulations a third more than the same batch recorded into memory it has written before.
+    """
+    if not reuse:
+        return np.empty(shape)
+    kept = getattr(_KEPT, "out", None)
+    if kept is None or kept.shape != shape:
+        kept = _KEPT.out = np.empty(shape)
+    return kept
+
+
 def simulate_batch(
     command_knots_deg: np.ndarray,
     health: HealthParams,
@@ -189,6 +208,7 @@ def simulate_batch(
     actuator: ActuatorParams,
     hinge: HingeGeometry | None = None,
     lanes: int | None = None,
+    reuse_output: bool = False,
 ) -> BatchResult:
     """Simulate one simulation per entry of ``health`` and record interval means at ``sample_rate_hz``.
 
@@ -198,6 +218,8 @@ def simulate_batch(
     flight condition (the thesis's elevator by default). The 1 µs trajectory is never stored.
     Deterministic: the same inputs give the same output, whatever ``lanes`` (simulations per lock-step
     group; by default as many as keep every thread busy, up to 64) and whatever the thread budget.
+    ``reuse_output``: record into this thread's kept buffer (``_recording``), for a caller that copies
+    what it keeps: the result's arrays are overwritten by the next such call on the thread.
     """
     if not isinstance(health, HealthParams):
         raise InputError("health", f"must be HealthParams, got {type(health).__name__}")
@@ -219,7 +241,7 @@ def simulate_batch(
     per_sim = _padded(np.stack([health.fdj_nm, health.fsj_nm, 1.0 - eta_a, 1.0 / health.eta_o - 1.0]), lanes)
     start = [np.radians(initial.position_deg), initial.motor_speed_radps, initial.current_a]
     initial_rows = np.repeat(np.array(start)[:, None], per_sim.shape[1], axis=1)
-    out = np.empty((kernels.N_RECORDED, per_sim.shape[1], n_samples))
+    out = _recording((kernels.N_RECORDED, per_sim.shape[1], n_samples), reuse_output)
     constants = kernel_constants(actuator, effects)
     knots_rad = np.ascontiguousarray(np.radians(knots))
     table_nm = np.zeros(2) if effects.table is None else np.array(effects.table.values_nm)

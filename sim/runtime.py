@@ -5,7 +5,9 @@
   process its idle workers spun while the other computed (a 0.7 s training took 21 s), and a
   static split of the batch waits for its slowest thread, which on a shared computer is the one
   the OS has parked. A pool of our own takes groups from one queue: a parked thread delays only
-  its group. The budget is shared with torch (``training.runtime``), which trains on one thread.
+  its group. The budget is shared with torch (``training.runtime``), which trains on one thread,
+  and with NumPy's BLAS, which gets one too: its small solves gain nothing from a team, and
+  OpenBLAS's idle worker spins after each call, on a core a simulation group needs.
 - **Vector width.** LLVM tunes AVX-512 CPUs to prefer 256-bit vectors; the lane loop is
   instruction-bound and measured ~1.5x faster with 512-bit ones (docs/benchmarks.md). Numba reads
   this when it first compiles or loads a kernel, so :func:`configure` must run before that; a
@@ -87,7 +89,17 @@ def prefer_wide_vectors() -> None:
 
 
 def configure(threads: int | None = None) -> int:
-    """The entry points' one call: vector width, then the thread budget (default: the usable cores)."""
+    """The entry points' one call: vector width, BLAS on one thread, then the thread budget (default: the
+    usable cores)."""
     prefer_wide_vectors()
+    single_threaded_blas()
     set_threads(threads or available_cores())
     return _BUDGET.threads
+
+
+def single_threaded_blas() -> None:
+    """Limit every BLAS NumPy has loaded to one thread, for the rest of the process (threadpoolctl finds
+    OpenBLAS, MKL or BLIS whatever their symbol names; a per-build ``ctypes`` call would not)."""
+    from threadpoolctl import threadpool_limits
+
+    threadpool_limits(limits=1, user_api="blas")

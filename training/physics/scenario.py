@@ -50,9 +50,9 @@ class Scenario:
     def n_samples(self) -> int:
         return self.command_knots_deg.shape[-1] - 1
 
-    def simulate(self, health: HealthParams, lanes: int | None = None) -> BatchResult:
+    def simulate(self, health: HealthParams, lanes: int | None = None, reuse_output: bool = False) -> BatchResult:
         return simulate_batch(self.command_knots_deg, health, self.load, self.initial, self.sample_rate_hz,
-                              self.effects, actuator=self.actuator, lanes=lanes)  # fmt: skip
+                              self.effects, actuator=self.actuator, lanes=lanes, reuse_output=reuse_output)  # fmt: skip
 
 
 def initial_state(window: Window, actuator: ActuatorParams) -> InitialState:

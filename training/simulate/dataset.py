@@ -48,7 +48,7 @@ def simulate_noisy(
     together = HealthParams(
         *(np.concatenate([getattr(health, name), getattr(reference, name)]) for name in ("fsj_nm", "fdj_nm", "eta_o"))
     )
-    result = scenario.simulate(together)
+    result = scenario.simulate(together, reuse_output=True)  # nothing below keeps a view of it
     rate = scenario.sample_rate_hz
     noise = excess_noise(window.signals, {name: values[-1] for name, values in result.signals.items()}, rate)
     clean = {name: result.signals[name][:-1] for name in SIGNALS_READ}

@@ -1,0 +1,17 @@
+"""The process's one thread budget: the simulator's pool, and NumPy's BLAS on one thread."""
+
+import subprocess
+import sys
+
+
+def test_configure_puts_every_blas_numpy_loaded_on_one_thread():
+    # A fresh interpreter: the limit is process-wide and lasts, so it is not set inside the test run.
+    script = (
+        "import numpy as np; from threadpoolctl import threadpool_info; from sim import runtime; "
+        "np.linalg.lstsq(np.eye(3), np.ones(3), rcond=None); "
+        "runtime.configure(2); "
+        "blas = [p for p in threadpool_info() if p['user_api'] == 'blas']; "
+        "print(len(blas), max(p['num_threads'] for p in blas), runtime.threads())"
+    )
+    found = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, check=True).stdout.split()
+    assert int(found[0]) >= 1 and found[1:] == ["1", "2"]  # a BLAS found, on one thread; the pool on two
