@@ -201,6 +201,16 @@ def test_thread_budget_does_not_change_results(nominal):
     np.testing.assert_array_equal(one.signals["current_a"], two.signals["current_a"])
 
 
+def test_a_kept_recording_buffer_gives_the_fresh_results_and_is_reused():
+    knots = random_command_knots(200, RATE, np.random.default_rng(3))[0]
+    first, second = (HealthParams.uniform(30, DEFAULT_RANGES, np.random.default_rng(seed)) for seed in (4, 5))
+    kept = simulate_batch(knots, first, actuator=THESIS.params, reuse_output=True).signals["current_a"].copy()
+    np.testing.assert_array_equal(kept, simulate_batch(knots, first, actuator=THESIS.params).signals["current_a"])
+    a = simulate_batch(knots, first, actuator=THESIS.params, reuse_output=True).signals["current_a"]
+    b = simulate_batch(knots, second, actuator=THESIS.params, reuse_output=True).signals["current_a"]
+    assert np.shares_memory(a, b)  # the documented contract: the next such call overwrites the last
+
+
 def test_simulation_is_deterministic(nominal):
     knots = random_command_knots(200, RATE, np.random.default_rng(3))[0]
     a, b = (
