@@ -17,7 +17,7 @@ DEFAULT_SAMPLE_RATE_HZ = 10_000.0
 SAMPLE_RATE_RANGE_HZ = (1_000.0, 100_000.0)
 MAX_LANES = 64  # simulations advanced in lock-step; fewer lanes pay more per-step loop overhead
 LANE_MULTIPLE = 8  # one AVX-512 register of float64
-MIN_VECTOR_LANES = 24  # fewer lanes take the lane loop's scalar path: ~3x the cost per lane (benchmarks.sim_speed)
+MIN_VECTOR_LANES = 24  # fewer lanes take the lane loop's scalar path, several times the cost per lane
 # Past the end stops a command only saturates the speed reference: ω_ref = sat(G_P·(θ_cmd − θ_u)) is
 # already ±ω_max once θ_cmd is ω_max/G_P ≈ 0.37° beyond them, so clipping there changes nothing.
 COMMAND_MARGIN_DEG = 1.0
@@ -186,8 +186,8 @@ def _recording(shape: tuple[int, int, int], reuse: bool) -> np.ndarray:
     """The kernel's output array: fresh, or with ``reuse`` this thread's kept one of that shape.
 
     The kernel writes each log interval's means across every simulation's row, pages apart: into
-    fresh memory every one of those writes first faults its page in, which costs a 0.5 s batch of
-    89 simulations a third more than the same batch recorded into memory it has written before.
+    fresh memory every one of those writes first faults its page in, which a batch recorded into
+    memory it has written before does not pay (docs/benchmarks.md has the cost).
     """
     if not reuse:
         return np.empty(shape)
