@@ -18,7 +18,6 @@ trains on the raw inputs, as the thesis did).
 
 from __future__ import annotations
 
-import copy
 import time
 from dataclasses import dataclass, field
 
@@ -152,6 +151,12 @@ def _optimizer(model: ShallowNet, config: TrainConfig) -> torch.optim.Optimizer:
     )
 
 
+def _snapshot(model: nn.Module) -> dict[str, torch.Tensor]:
+    """A copy of the model's parameters and buffers: a clone per tensor (deepcopy walks each object in
+    Python, and the best state is copied at every epoch that improves)."""
+    return {name: value.detach().clone() for name, value in model.state_dict().items()}
+
+
 def fit(inputs: np.ndarray, targets: np.ndarray, config: TrainConfig) -> FitResult:
     """Train one network on (N, F) inputs and (N, T) targets in [0, 1]; seeded end to end."""
     start = time.perf_counter()
@@ -173,7 +178,7 @@ def fit(inputs: np.ndarray, targets: np.ndarray, config: TrainConfig) -> FitResu
         loss.backward()
         return loss
 
-    best_val, best_state, failures, stop_reason = float("inf"), copy.deepcopy(model.state_dict()), 0, "max_epochs"
+    best_val, best_state, failures, stop_reason = float("inf"), _snapshot(model), 0, "max_epochs"
     history: list[tuple[float, float]] = []
     for _ in range(config.max_epochs):
         optimizer.step(closure)  # type: ignore[arg-type]  # torch types the closure as returning float
@@ -181,7 +186,7 @@ def fit(inputs: np.ndarray, targets: np.ndarray, config: TrainConfig) -> FitResu
         val_mse = _mse(model, z[parts["val"]], y[parts["val"]])
         history.append((train_mse, val_mse))
         if val_mse < best_val:
-            best_val, best_state, failures = val_mse, copy.deepcopy(model.state_dict()), 0
+            best_val, best_state, failures = val_mse, _snapshot(model), 0
         else:
             failures += 1
         if failures >= config.max_validation_failures:
