@@ -121,7 +121,7 @@ def adopt_described(found: Found, held: HeldOutCheck) -> tuple[Found, HeldOutChe
     can add the term, the estimates with it are identified (``withheld``) and the model with it predicts
     held-out folds better than without it, as a named effect must; else both unchanged. Never where the
     windows cannot tell which variable the residual follows: a curve over the wrong one trades with FDJ
-    and η_O (a current offset described as time or direction, adopted as a time curve, went 8x worse)."""
+    and η_O (docs/calibration.md, step 5)."""
     if len({e.family.follows for e in found.unnamed}) != 1:
         return found, held
     lead = found.unnamed[0]

@@ -136,7 +136,7 @@ def _checked_initial(initial: InitialState, actuator: ActuatorParams) -> Initial
 
 def default_lanes(n_sims: int) -> int:
     """Lanes per group: groups of whole registers, at most MAX_LANES, at least MIN_VECTOR_LANES (fewer run
-    scalar, ~3x the cost per lane), as many per thread as the others where there are enough simulations,
+    scalar, at several times the cost per lane), as many per thread as the others where there are enough simulations,
     and as little padding as that allows (89 simulations on one thread: two groups of 48, not 64 + 64).
     Below one register the lanes run scalar anyway: no padding."""
     if n_sims < LANE_MULTIPLE:
