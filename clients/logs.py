@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 
 from sim.actuator import Actuator, actuator_from_dict
-from sim.checks import InputError
+from sim.checks import InputError, load_json
 from sim.envelope import DEFAULT_AIRSPEED_MPS
 from sim.window import SIGNALS, Window, window_from_dict
 
@@ -181,10 +181,7 @@ def read_actuators(folder: Path) -> dict[str, Actuator]:
     path = Path(folder) / ACTUATORS_FILE
     if not Path(folder).is_dir() or not path.exists():
         return {}
-    try:
-        documents = json.loads(path.read_bytes())
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise InputError(str(path), f"cannot be read as JSON ({exc})") from None
+    documents = load_json(path)
     if not isinstance(documents, dict):
         raise InputError(str(path), "must map each actuator_id to its ema-actuator/1 document")
     read = {}

@@ -10,7 +10,6 @@ elevator EMA (Table 3.1), the default wherever a user names none; ``examples/act
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any, Literal
 
@@ -18,7 +17,7 @@ import numpy as np
 from pydantic import AllowInfNan, BaseModel, ConfigDict, Field, Strict, ValidationError, model_validator
 
 from sim.aircraft import HingeGeometry
-from sim.checks import InputError, from_validation
+from sim.checks import InputError, from_validation, read_document
 from sim.params import MAX_CORRELATION_S, ActuatorParams, HealthRanges, eta_a_from_eta_o
 
 if TYPE_CHECKING:
@@ -207,12 +206,4 @@ def actuator_from_dict(document: Any) -> Actuator:
 
 def read_actuator(path: str | Path) -> Actuator:
     """Read an ``ema-actuator/1`` JSON file; a bad file raises InputError naming it and the field."""
-    path = Path(path)
-    try:
-        document = json.loads(path.read_bytes())
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise InputError(str(path), f"cannot be read as JSON ({exc})") from None
-    try:
-        return actuator_from_dict(document)
-    except InputError as exc:
-        raise InputError(f"{path}: {exc.field}", exc.message) from None
+    return read_document(path, actuator_from_dict)

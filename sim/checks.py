@@ -2,8 +2,11 @@
 
 from __future__ import annotations
 
+import json
 import math
-from typing import Any
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any, TypeVar
 
 import numpy as np
 
@@ -15,6 +18,26 @@ class InputError(ValueError):
         super().__init__(f"{field}: {message}")
         self.field = field
         self.message = message
+
+
+Parsed = TypeVar("Parsed")
+
+
+def load_json(path: str | Path) -> Any:
+    """The JSON value in the file at ``path``; one that cannot be read or parsed is an InputError naming it."""
+    try:
+        return json.loads(Path(path).read_bytes())
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise InputError(str(path), f"cannot be read as JSON ({exc})") from None
+
+
+def read_document(path: str | Path, parse: Callable[[Any], Parsed]) -> Parsed:
+    """``parse`` of the JSON in the file at ``path``; its errors name the file before the field."""
+    document = load_json(path)
+    try:
+        return parse(document)
+    except InputError as exc:
+        raise InputError(f"{path}: {exc.field}", exc.message) from None
 
 
 def finite_array(field: str, values: object, ndim: int | None = None) -> np.ndarray:

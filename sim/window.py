@@ -19,7 +19,7 @@ import numpy as np
 from pydantic import AllowInfNan, AwareDatetime, BaseModel, ConfigDict, Field, Strict, ValidationError, field_validator
 
 from sim.aircraft import AIRSPEED_RANGE_MPS, ALTITUDE_RANGE_M, FlightCondition
-from sim.checks import InputError, from_validation
+from sim.checks import InputError, from_validation, read_document
 
 SCHEMA = "ema-window/1"
 SIGNALS = ("command_deg", "position_deg", "motor_speed_radps", "current_a", "hinge_moment_nm")
@@ -191,15 +191,7 @@ def window_to_dict(window: Window) -> dict[str, Any]:
 
 def read_window(path: str | Path) -> Window:
     """Read one window from a JSON file; a bad file raises InputError naming it (and the field)."""
-    path = Path(path)
-    try:
-        document = json.loads(path.read_bytes())
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise InputError(str(path), f"cannot be read as JSON ({exc})") from None
-    try:
-        return window_from_dict(document)
-    except InputError as exc:
-        raise InputError(f"{path}: {exc.field}", exc.message) from None
+    return read_document(path, window_from_dict)
 
 
 def write_window(window: Window, path: str | Path) -> None:
