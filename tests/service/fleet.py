@@ -3,10 +3,20 @@ its own (copies of one real estimate with FDJ and η_O replaced), and the truth 
 
 from __future__ import annotations
 
+import contextlib
+from collections.abc import Iterator
+from pathlib import Path
+
 import numpy as np
 
 from service.store import EstimateStore
+from sim.actuator import THESIS
+from sim.params import HealthParams
+from sim.synthetic import synthetic_window
+from tests.clients.test_replay import _free_port, _start_server
+from tests.service.conftest import SMALL
 from training.documents import Estimate, parameter
+from training.pipeline import estimate_window
 
 # actuator -> (FDJ at 0 h [N·m], FDJ per flight hour, curvature per h², what its page must say)
 FLEET = {
@@ -28,3 +38,20 @@ def store_fleet(store: EstimateStore, base: Estimate, windows: int = 20, seed: i
             window = base.window.model_copy(update={"flight_hours": float(h), "content_sha256": f"{actuator_id}-{i}"})
             store.add(base.model_copy(update={"actuator_id": actuator_id, "window_id": f"w{i:02d}",
                                               "estimates": estimates, "window": window}))  # fmt: skip
+
+
+@contextlib.contextmanager
+def served_fleet(database: Path) -> Iterator[str]:
+    """The URL of a service on a free port whose store (``database``) holds the fleet, copies of one small real
+    estimate; the service is stopped on leaving."""
+    base = estimate_window(synthetic_window(HealthParams.single(), seed=1, duration_s=0.1), SMALL, actuator=THESIS)
+    store = EstimateStore(database)
+    store_fleet(store, base)
+    store.close()
+    port = _free_port()
+    server = _start_server(port, database)
+    try:
+        yield f"http://127.0.0.1:{port}"
+    finally:
+        server.terminate()
+        server.wait(timeout=30)

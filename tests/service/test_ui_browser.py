@@ -6,14 +6,7 @@ import shutil
 
 import pytest
 
-from service.store import EstimateStore
-from sim.actuator import THESIS
-from sim.params import HealthParams
-from sim.synthetic import synthetic_window
-from tests.clients.test_replay import _free_port, _start_server
-from tests.service.conftest import SMALL
-from tests.service.fleet import FLEET, store_fleet
-from training.pipeline import estimate_window
+from tests.service.fleet import FLEET, served_fleet
 
 CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
 ARGS = ["--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run", "--disable-background-networking",
@@ -24,16 +17,8 @@ pytestmark = pytest.mark.skipif(CHROMIUM is None, reason="no chromium on this ma
 
 @pytest.fixture(scope="module")
 def served(tmp_path_factory):
-    database = tmp_path_factory.mktemp("ui") / "history.sqlite3"
-    base = estimate_window(synthetic_window(HealthParams.single(), seed=1, duration_s=0.1), SMALL, actuator=THESIS)
-    store = EstimateStore(database)
-    store_fleet(store, base)
-    store.close()
-    port = _free_port()
-    server = _start_server(port, database)
-    yield f"http://127.0.0.1:{port}"
-    server.terminate()
-    server.wait(timeout=30)
+    with served_fleet(tmp_path_factory.mktemp("ui") / "history.sqlite3") as url:
+        yield url
 
 
 def visit(url: str, path: str, screenshot=None) -> tuple[str, list[str], set[str], int]:
