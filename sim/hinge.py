@@ -50,8 +50,7 @@ def local_line(values: np.ndarray, width: int) -> np.ndarray:
         return values.copy()
     rows = np.ascontiguousarray(values.reshape(-1, n))
     out = np.empty_like(rows)
-    for r in range(rows.shape[0]):
-        _local_line(rows[r], width, out[r])
+    _local_line_rows(rows, width, out)
     return out.reshape(values.shape)
 
 
@@ -96,6 +95,13 @@ def _local_line(values, width, out):
         mean /= width
         for i in range(first_out, last_out):
             out[i] = mean + moment / denominator * (i - start - half)
+
+
+@njit(cache=True, nogil=True)
+def _local_line_rows(rows, width, out):
+    """out (R, n) = the local line of each row of ``rows`` (R, n) over ``width`` samples."""
+    for r in range(rows.shape[0]):
+        _local_line(rows[r], width, out[r])
 
 
 @njit(cache=True, nogil=True)

@@ -37,6 +37,7 @@ class _Budget:
         self.lock = threading.Lock()
         self.threads = available_cores()
         self.pool: ThreadPoolExecutor | None = None
+        self.blas_limited = False  # the limit lasts for the process: set once (a fleet worker configures per window)
 
 
 _BUDGET = _Budget()
@@ -99,7 +100,12 @@ def configure(threads: int | None = None) -> int:
 
 def single_threaded_blas() -> None:
     """Limit every BLAS NumPy has loaded to one thread, for the rest of the process (threadpoolctl finds
-    OpenBLAS, MKL or BLIS whatever their symbol names; a per-build ``ctypes`` call would not)."""
-    from threadpoolctl import threadpool_limits
+    OpenBLAS, MKL or BLIS whatever their symbol names; a per-build ``ctypes`` call would not). Once per
+    process: the search through the loaded libraries costs about a millisecond."""
+    with _BUDGET.lock:
+        if _BUDGET.blas_limited:
+            return
+        from threadpoolctl import threadpool_limits
 
-    threadpool_limits(limits=1, user_api="blas")
+        threadpool_limits(limits=1, user_api="blas")
+        _BUDGET.blas_limited = True
