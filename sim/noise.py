@@ -12,7 +12,9 @@ the network and set the stds on data quieter or louder than the window, where it
 from __future__ import annotations
 
 import functools
+from collections.abc import Mapping
 from dataclasses import asdict, dataclass
+from types import MappingProxyType
 
 import numpy as np
 from numba import njit
@@ -88,10 +90,7 @@ def add_sensor_noise(
     The draws are float32 (a third faster than float64; noise needs no more digits), scaled and
     added in place: no temporaries the size of the batch.
     """
-    levels = noise.as_dict()
-    drawn = [name for name in signals if levels.get(name, 0.0) > 0]
-    unit = {name: rng.standard_normal(signals[name].shape, dtype=np.float32) for name in drawn}
-    return _scaled(signals, noise, unit, sample_rate_hz)
+    return _scaled(signals, noise, _draw(rng, _drawn(signals, noise)), sample_rate_hz)
 
 
 def add_seeded_noise(
@@ -103,24 +102,33 @@ def add_seeded_noise(
     levels: a monitor answers window after window of one shape with one seed, so they are drawn once
     and kept (``_unit_draws``), and each window pays only for scaling them.
     """
-    levels = noise.as_dict()
-    drawn = tuple((name, signals[name].shape) for name in signals if levels.get(name, 0.0) > 0)
-    unit = {name: draw for (name, _), draw in zip(drawn, _unit_draws(seed, drawn), strict=True)}
-    return _scaled(signals, noise, unit, sample_rate_hz)
+    return _scaled(signals, noise, _unit_draws(seed, _drawn(signals, noise)), sample_rate_hz)
+
+
+Drawn = tuple[tuple[str, tuple[int, ...]], ...]
+
+
+def _drawn(signals: dict[str, np.ndarray], noise: SensorNoise) -> Drawn:
+    """(name, shape) of each signal that gets noise (a level above 0), in the signals' order."""
+    return tuple((name, values.shape) for name, values in signals.items() if getattr(noise, name, 0.0) > 0)
+
+
+def _draw(rng: np.random.Generator, drawn: Drawn) -> dict[str, np.ndarray]:
+    """Unit-variance float32 draws for each (signal, shape), in order: the one sequence both entries share."""
+    return {name: rng.standard_normal(shape, dtype=np.float32) for name, shape in drawn}
 
 
 @functools.lru_cache(maxsize=4)
-def _unit_draws(seed: int, drawn: tuple[tuple[str, tuple[int, ...]], ...]) -> tuple[np.ndarray, ...]:
-    """Unit-variance float32 draws for each (signal, shape) in order, read-only (they are shared)."""
-    rng = np.random.default_rng(seed)
-    draws = tuple(rng.standard_normal(shape, dtype=np.float32) for _, shape in drawn)
-    for draw in draws:
+def _unit_draws(seed: int, drawn: Drawn) -> Mapping[str, np.ndarray]:
+    """``_draw`` of a fresh generator of ``seed``, kept read-only (the draws are shared between calls)."""
+    draws = _draw(np.random.default_rng(seed), drawn)
+    for draw in draws.values():
         draw.flags.writeable = False
-    return draws
+    return MappingProxyType(draws)
 
 
 def _scaled(
-    signals: dict[str, np.ndarray], noise: SensorNoise, unit: dict[str, np.ndarray], sample_rate_hz: float | None
+    signals: dict[str, np.ndarray], noise: SensorNoise, unit: Mapping[str, np.ndarray], sample_rate_hz: float | None
 ) -> dict[str, np.ndarray]:
     """Each signal plus its unit draws (correlated at its ρ where it has one) times its std; a copy of the rest."""
     levels = noise.as_dict()
