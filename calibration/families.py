@@ -32,12 +32,13 @@ KNOTS = 9  # piecewise-linear curves: 8 segments over the visited range
 # bend. Eight free segments would spend their freedom on noise, and lose on held-out samples to any
 # one-column shape that merely correlates with time (the direction, when the elevator turns once).
 TIME_KNOTS = 3
-# A Stribeck curve exp(−(|ω|/ω_s)^δ): Tustin's δ = 1, the Gaussian δ = 2, and a slower δ = ½. With
-# only the scale free (steps of 2), a decay of another form was matched by the wrong tail, and what
-# the tail missed at speed went into FDJ; scales a quarter-octave apart and three exponents follow
-# any monotone decay closely enough that FDJ stays put.
+# A Stribeck curve exp(−(|ω|/ω_s)^δ): Tustin's δ = 1, the Gaussian δ = 2, a slower δ = ½ and the
+# shapes between. A decay of another form matched by the wrong tail leaves friction at speed that goes
+# into FDJ: with scales an octave apart it moved FDJ several times its noise, and a 1 − tanh decay
+# lies between δ = 1 and δ = 1.5 (either alone leaves ~1 % of FDJ). Scales a quarter-octave apart and
+# exponents a quarter apart follow a monotone decay closely enough that FDJ stays put.
 STRIBECK_GRID = tuple(
-    (float(w), d) for d in (0.5, 1.0, 2.0) for w in np.round(np.geomspace(10.0, 640.0, 25), 1)
+    (float(w), d) for d in (0.5, 0.75, 1.0, 1.25, 1.5, 2.0) for w in np.round(np.geomspace(10.0, 640.0, 25), 1)
 )  # (ω_s [rad/s], δ)
 COGGING_ORDERS = tuple(float(p) for p in range(1, 49))
 BUMP_WIDTHS_DEG = (0.75, 1.5, 3.0, 6.0)  # a spall's half-width, as a Gaussian's std
