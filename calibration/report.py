@@ -120,9 +120,9 @@ def adopt_described(found: Found, held: HeldOutCheck) -> tuple[Found, HeldOutChe
     """``found`` with the lead described term adopted, and the held-out check with it, where the simulator
     can add the term, the estimates with it are identified (``withheld``) and the model with it predicts
     held-out folds better than without it, as a named effect must; else both unchanged. Never where the
-    windows cannot tell which variable the residual follows: a curve over the wrong one trades with FDJ
-    and η_O (docs/calibration.md, step 5)."""
-    if len({e.family.follows for e in found.unnamed}) != 1:
+    windows cannot tell which variable the residual follows, or which of two named effects: a curve over
+    the wrong one trades with FDJ and η_O (docs/calibration.md, step 5)."""
+    if len({e.family.follows for e in found.unnamed}) != 1 or found.unnamed[0].family.named:
         return found, held
     lead = found.unnamed[0]
     term = lead.family.term(lead.beta, lead.grid)
@@ -150,7 +150,10 @@ def unexplained(found: Found, bias: Mapping[str, float], truth: Mapping[str, flo
     raw = fit_with(found.measured, with_it).values
     reason = withheld(found, with_it, raw, table is not None)
     estimates = None if reason else corrected(raw, bias)
-    if len(variables) == 1:
+    if lead.family.named:
+        names = " or ".join(dict.fromkeys(e.family.name for e in found.unnamed))
+        described = f"the residual torque follows {variables[0]} as {names} would: these windows cannot tell which"
+    elif len(variables) == 1:
         described = f"the residual torque follows {variables[0]} in a shape no named effect has (table below)"
     else:
         described = f"the residual torque follows {' or '.join(variables)}: these windows cannot tell which"

@@ -170,6 +170,11 @@ def decide(
     if named is None:
         return Decision(None, [best], f"the residual follows {best.family.follows} in a way no named effect describes")
     named, alike = simplest(named, [best, *close], measured, copies, chosen)
+    if _falls_with_speed(named):
+        decays = [e for e in found if e.family.name == "stribeck" and e.z >= MIN_Z]
+        return Decision(None, [named, *decays], "friction falls with speed over the speeds visited: a viscous "
+                                                "coefficient below the document's, or a Stribeck decay; FDJ "
+                                                "depends on which, and these windows cannot tell")  # fmt: skip
     drift = _step_in_time(named, found)
     if drift is not None:
         share = drift.improvement / named.improvement
@@ -189,6 +194,14 @@ def decide(
     if alike:
         reason += f"; {', '.join(alike)} explains the same samples (one trace over the range visited): simpler named"
     return Decision(named, [], reason, alike)
+
+
+def _falls_with_speed(named: Evidence) -> bool:
+    """A viscous term below the document's: friction falling with speed is also what a Stribeck decay
+    leaves over the speeds a window visits, and the two put different constants into FDJ (a decay's
+    level at rest is friction, a line's intercept is not). Named, a small decay read as a negative
+    viscous coefficient moved FDJ by its amplitude."""
+    return named.family.name == "viscous" and float(named.beta[0]) < 0.0
 
 
 def _step_in_time(named: Evidence, found: Sequence[Evidence]) -> Evidence | None:

@@ -207,3 +207,13 @@ def test_a_sensor_offset_in_a_window_that_reverses_as_a_drift_would_is_described
     assert report.selected_effect is None
     assert report.unexplained is not None and set(report.unexplained.variables) == {"time_s", "direction"}
     assert not report.unexplained.adopted and report.estimates_after == report.estimates_before
+
+
+@pytest.mark.slow
+def test_a_small_stribeck_decay_read_as_a_viscous_term_below_the_documents_is_described_not_named():
+    # 8 mN·m decaying over 120-300 rad/s: over the speeds visited a line of negative slope fits it as
+    # well, and named viscous it put the decay's level into FDJ (0.003 -> 0.064).
+    report, _ = calibrate("stribeck", 5901, scale=0.2)
+    assert report.selected_effect is None, report.selection_steps[0].reason
+    assert report.unexplained is not None and "viscous or stribeck" in report.unexplained.description
+    assert not report.unexplained.adopted and report.estimates_after == report.estimates_before
