@@ -161,14 +161,7 @@ def run_groups(inputs: tuple, out: np.ndarray, lanes: int) -> None:
         for first in firsts:
             run(first)
         return
-    futures = [runtime.pool().submit(run, first) for first in firsts]
-    try:
-        for future in futures:
-            future.result()
-    except BaseException:  # an interrupt, or a group that failed: the rest of the batch is not wanted
-        for future in futures:
-            future.cancel()
-        raise
+    runtime.wait_all([runtime.pool().submit(run, first) for first in firsts])
 
 
 def _padded(values: np.ndarray, multiple: int) -> np.ndarray:

@@ -17,6 +17,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from sim import runtime
 from sim.checks import InputError, finite_array, in_range
 from sim.params import ActuatorParams
 
@@ -60,30 +61,65 @@ def _correlate(values: np.ndarray, weights: np.ndarray, odd_extension: bool) -> 
     values = np.asarray(values, dtype=np.float64)
     rows = np.ascontiguousarray(values.reshape(-1, values.shape[-1]))
     out = np.empty(rows.shape)
-    _correlate_rows(rows, np.ascontiguousarray(weights, dtype=np.float64), odd_extension, out)
+    weights = np.ascontiguousarray(weights, dtype=np.float64)
+    runtime.run_rows(lambda a, b: _correlate_rows(rows[a:b], weights, odd_extension, out[a:b]), len(rows))
     return out.reshape(values.shape)
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _pad(row, half, odd_extension, padded):
+    """padded (n + 2·half,) = ``row`` reflected about its end samples (x[−k] = x[k]; with ``odd_extension``,
+    2·x[0] − x[k])."""
+    n = row.shape[0]
+    padded[half : half + n] = row
+    for k in range(1, half + 1):
+        head, tail = row[k], row[n - 1 - k]
+        if odd_extension:
+            head, tail = 2 * row[0] - head, 2 * row[n - 1] - tail
+        padded[half - k] = head
+        padded[half + n - 1 + k] = tail
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _correlate_padded(padded, weights, out):
+    """out[i] = Σ_j weights[j] · padded[i + j], tap-outer: the inner loop runs along the row and vectorizes."""
+    out[:] = 0.0
+    for j in range(weights.shape[0]):
+        w = weights[j]
+        for i in range(out.shape[0]):
+            out[i] += w * padded[i + j]
 
 
 @njit(cache=True, nogil=True)
 def _correlate_rows(rows, weights, odd_extension, out):
     """out[r, i] = Σ_j weights[j] · x[r, i + j − h], h = len(weights) // 2, rows (R, n), out (R, n), x the
-    row reflected about its end samples (x[−k] = x[k]; with ``odd_extension``, 2·x[0] − x[k])."""
-    n, half = rows.shape[1], weights.shape[0] // 2
-    padded = np.empty(n + 2 * half)
+    row reflected about its end samples (``_pad``)."""
+    half = weights.shape[0] // 2
+    padded = np.empty(rows.shape[1] + 2 * half)
     for r in range(rows.shape[0]):
-        row = rows[r]
-        padded[half : half + n] = row
-        for k in range(1, half + 1):
-            head, tail = row[k], row[n - 1 - k]
-            if odd_extension:
-                head, tail = 2 * row[0] - head, 2 * row[n - 1] - tail
-            padded[half - k] = head
-            padded[half + n - 1 + k] = tail
-        out[r, :] = 0.0
-        for j in range(weights.shape[0]):  # tap-outer: the inner loop runs along the row and vectorizes
-            w = weights[j]
-            for i in range(n):
-                out[r, i] += w * padded[i + j]
+        _pad(rows[r], half, odd_extension, padded)
+        _correlate_padded(padded, weights, out[r])
+
+
+@njit(cache=True, nogil=True)
+def _residual_rows(current, speed, hinge, smoothing, derivative, constants, out):
+    """out[r] = smoothing ⋆ (clip(k_T·I, ±T_M,max) + H_e / n) − J_M · (derivative ⋆ ω), rows (R, n), ⋆ the
+    padded correlation of ``_correlate_rows`` (even for the torques, odd for the speed); ``constants``
+    = (k_T, T_M,max, n, J_M). The same operations in the same order as the separate steps, in one pass
+    per row and without the batch-sized temporaries."""
+    torque_constant, max_torque, gear, inertia = constants
+    n, half = current.shape[1], smoothing.shape[0] // 2
+    driving, padded = np.empty(n), np.empty(n + 2 * half)
+    smooth, slope = np.empty(n), np.empty(n)
+    for r in range(current.shape[0]):
+        for i in range(n):
+            driving[i] = min(max(torque_constant * current[r, i], -max_torque), max_torque) + hinge[r, i] / gear
+        _pad(driving, half, False, padded)
+        _correlate_padded(padded, smoothing, smooth)
+        _pad(speed[r], half, True, padded)
+        _correlate_padded(padded, derivative, slope)
+        for i in range(n):
+            out[r, i] = smooth[i] - inertia * slope[i]
 
 
 def smoothed(values: np.ndarray, sample_rate_hz: float, window_s: float = DEFAULT_DERIVATIVE_WINDOW_S) -> np.ndarray:
@@ -143,15 +179,19 @@ def residual_torque_nm(
     speed = finite_array("motor_speed_radps", motor_speed_radps)
     hinge = finite_array("hinge_moment_nm", hinge_moment_nm)
     try:  # one window, a batch, or a batch of one signal against one window of the others
-        np.broadcast_shapes(current.shape, speed.shape, hinge.shape)
+        shape = np.broadcast_shapes(current.shape, speed.shape, hinge.shape)
     except ValueError:
         raise InputError(
             "signals", f"shapes differ: current {current.shape}, speed {speed.shape}, hinge {hinge.shape}"
         ) from None
     rate = in_range("sample_rate_hz", sample_rate_hz, 100.0, 1e6, "Hz")
-    acceleration = smooth_derivative(speed, rate, derivative_window_s)
-    motor = np.clip(
-        actuator.torque_constant_nm_per_a * current, -actuator.max_motor_torque_nm, actuator.max_motor_torque_nm
+    half = _half_width(speed, rate, derivative_window_s)
+    i, w, h = (np.ascontiguousarray(np.broadcast_to(x, shape).reshape(-1, shape[-1])) for x in (current, speed, hinge))
+    a = actuator
+    constants = (a.torque_constant_nm_per_a, a.max_motor_torque_nm, a.gear_ratio, a.inertia_kgm2)
+    smoothing, derivative = smoothing_weights(half), derivative_weights(half, rate)
+    out = np.empty(i.shape)
+    runtime.run_rows(
+        lambda r, s: _residual_rows(i[r:s], w[r:s], h[r:s], smoothing, derivative, constants, out[r:s]), len(out)
     )
-    driving = motor + hinge / actuator.gear_ratio
-    return smoothed(driving, rate, derivative_window_s) - actuator.inertia_kgm2 * acceleration
+    return out.reshape(shape)

@@ -1,7 +1,16 @@
 import numpy as np
 import pytest
 
+from sim import runtime
 from sim.params import HealthParams
+
+
+@pytest.fixture
+def threads():
+    """``runtime.set_threads`` for the test, the budget restored after it."""
+    before = runtime.threads()
+    yield runtime.set_threads
+    runtime.set_threads(before)
 
 
 @pytest.fixture

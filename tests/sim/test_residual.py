@@ -85,6 +85,19 @@ def test_batch_and_single_reconstruction_agree():
     )
 
 
+def test_the_one_pass_reconstruction_equals_its_steps_on_a_batch_split_over_threads(threads):
+    threads(2)
+    rng = np.random.default_rng(5)
+    current, speed, hinge = 8.0 * rng.normal(size=(3, 40, 700))  # some currents past the torque's saturation
+    a = THESIS.params
+    motor = np.clip(a.torque_constant_nm_per_a * current, -a.max_motor_torque_nm, a.max_motor_torque_nm)
+    plain = smoothed(motor + hinge / a.gear_ratio, RATE) - a.inertia_kgm2 * smooth_derivative(speed, RATE)
+    np.testing.assert_array_equal(residual_torque_nm(current, speed, hinge, RATE, actuator=a), plain)
+    # one signal of a batch against one window of the others
+    np.testing.assert_array_equal(residual_torque_nm(current, speed[0], hinge[0], RATE, actuator=a)[3],
+                                  residual_torque_nm(current[3], speed[0], hinge[0], RATE, actuator=a))  # fmt: skip
+
+
 def test_bad_inputs_are_named():
     with pytest.raises(InputError, match="motor_speed_radps"):
         residual_torque_nm(np.zeros(100), np.full(100, np.nan), np.zeros(100), RATE, actuator=THESIS.params)
