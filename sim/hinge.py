@@ -28,6 +28,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from sim import runtime
 from sim.checks import InputError
 from sim.residual import kernel_samples
 
@@ -69,7 +70,8 @@ def denoised_hinge_nm(
     width = min(kernel_samples(sample_rate_hz, window_s), n - (1 - n % 2))
     hinge_rows, position_rows = (np.ascontiguousarray(x.reshape(-1, n)) for x in (hinge, position))
     out = np.empty(hinge_rows.shape)
-    _denoise_rows(hinge_rows, position_rows, max(width, 1), out)
+    width = max(width, 1)
+    runtime.run_rows(lambda a, b: _denoise_rows(hinge_rows[a:b], position_rows[a:b], width, out[a:b]), len(out))
     return out.reshape(hinge.shape)
 
 

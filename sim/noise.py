@@ -19,6 +19,7 @@ from types import MappingProxyType
 import numpy as np
 from numba import njit
 
+from sim import runtime
 from sim.checks import in_range
 from sim.params import MAX_CORRELATION_S
 
@@ -145,14 +146,22 @@ def _scaled(
             noisy *= levels[name]
             noisy += values
         else:
-            noisy = np.empty(values.shape)
-            _add_scaled(values.reshape(-1), unit[name].reshape(-1), levels[name], noisy.reshape(-1))
+            noisy = _plus_scaled(values, unit[name], levels[name])
         out[name] = noisy
     return out
 
 
+def _plus_scaled(values: np.ndarray, unit: np.ndarray, level: float) -> np.ndarray:
+    """values + level·unit (``unit`` float32, of ``values``'s shape), its rows split over the simulator's threads."""
+    rows = np.ascontiguousarray(values).reshape(-1, values.shape[-1])
+    draws, out = unit.reshape(rows.shape), np.empty(rows.shape)
+    runtime.run_rows(lambda a, b: _add_scaled(rows[a:b], draws[a:b], level, out[a:b]), len(rows))
+    return out.reshape(values.shape)
+
+
 @njit(cache=True, nogil=True)
 def _add_scaled(values, unit, level, out):
-    """out = values + level·unit, in one pass (flat arrays of one length; ``unit`` float32)."""
-    for k in range(out.shape[0]):
-        out[k] = values[k] + level * np.float64(unit[k])
+    """out = values + level·unit, in one pass (rows (R, n); ``unit`` float32)."""
+    for r in range(out.shape[0]):
+        for k in range(out.shape[1]):
+            out[r, k] = values[r, k] + level * np.float64(unit[r, k])
