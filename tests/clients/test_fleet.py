@@ -106,7 +106,7 @@ def test_history_plots_a_prognosis_whose_interval_holds_the_truth(tmp_path, caps
     import numpy as np
 
     from service.store import EstimateStore
-    from tests.clients.test_replay import _free_port, _start_server
+    from tests.servers import free_port, start_server
     from training.config import PipelineConfig
     from training.documents import parameter
     from training.pipeline import estimate_window
@@ -122,8 +122,8 @@ def test_history_plots_a_prognosis_whose_interval_holds_the_truth(tmp_path, caps
         store.add(base.model_copy(update={"estimates": estimates, "window": window, "actuator_id": "tail-9",
                                           "window_id": f"w{i}"}))  # fmt: skip
     store.close()
-    port = _free_port()
-    server = _start_server(port, tmp_path / "history.sqlite3")
+    port = free_port()
+    server = start_server(port, tmp_path / "history.sqlite3")
     try:
         plot = tmp_path / "fdj.png"
         arguments = ["history", "tail-9", "--url", f"http://127.0.0.1:{port}", "--plot", str(plot), "--json"]

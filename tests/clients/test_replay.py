@@ -1,13 +1,8 @@
 """The replay client against a real uvicorn server on 127.0.0.1, and the history across a kill -9."""
 
 import json
-import os
 import signal
-import socket
-import subprocess
-import sys
 import threading
-import time
 import urllib.request
 from dataclasses import replace
 from http.server import BaseHTTPRequestHandler, HTTPServer
@@ -22,42 +17,13 @@ from sim.checks import InputError
 from sim.params import HealthParams
 from sim.synthetic import synthetic_window
 from sim.window import SIGNALS, window_to_dict
+from tests.servers import free_port, start_server
 
 ANSWER = {
     "estimates": {name: {"value": 0.85, "std": 0.01} for name in ("FDJ", "eta_O", "eta_A")} | {"FSJ": None},
     "timings_s": {"simulate": 0.1, "train": 0.1, "predict": 0.1, "total": 0.3},
     "fit_check": {"reproduced": True},
 }
-SMALL_ENV = {
-    "EMA_PIPELINE__N_SIMULATIONS": "16",
-    "EMA_PIPELINE__CHECK_WINDOWS": "8",
-    "EMA_PIPELINE__N_TIMESTEPS": "50",
-    "EMA_PIPELINE__HIDDEN_UNITS": "8",
-}
-
-
-def _free_port() -> int:
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        return probe.getsockname()[1]
-
-
-def _start_server(port: int, database) -> subprocess.Popen:
-    env = {**os.environ, **SMALL_ENV}
-    command = [sys.executable, "-m", "clients.cli", "serve", "--port", str(port), "--database", str(database)]
-    server = subprocess.Popen(command, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    deadline = time.monotonic() + 180
-    while time.monotonic() < deadline:
-        try:
-            with urllib.request.urlopen(f"http://127.0.0.1:{port}/healthz", timeout=2) as response:
-                if json.loads(response.read())["warm"]:
-                    return server
-        except OSError:
-            time.sleep(0.3)
-    server.kill()
-    raise RuntimeError("the server did not become warm in 180 s")
-
-
 @pytest.fixture
 def log_folder(tmp_path):
     """A folder with a 0.3 s JSON recording (3 windows), a CSV and an NPZ window."""
@@ -93,10 +59,10 @@ def test_a_bad_file_in_a_folder_is_skipped_and_named_alone_it_is_an_error(log_fo
 
 
 def test_replay_end_to_end_resume_and_kill_9(tmp_path, log_folder, capsys):
-    port, database, out = _free_port(), tmp_path / "history.sqlite3", tmp_path / "estimates.csv"
+    port, database, out = free_port(), tmp_path / "history.sqlite3", tmp_path / "estimates.csv"
     url = f"http://127.0.0.1:{port}"
     (log_folder / "d_broken.json").write_text('{"schema": "ema-window/1"')  # skipped and said so
-    server = _start_server(port, database)
+    server = start_server(port, database)
     try:
         assert main(["replay", str(log_folder), "--url", url, "--out", str(out), "--window-s", "0.1"]) == EXIT_OK
         printed = capsys.readouterr()
@@ -119,7 +85,7 @@ def test_replay_end_to_end_resume_and_kill_9(tmp_path, log_folder, capsys):
     finally:
         server.send_signal(signal.SIGKILL)
         server.wait()
-    server = _start_server(port, database)
+    server = start_server(port, database)
     try:
         with urllib.request.urlopen(f"{url}/v1/actuators/ac-7/estimates", timeout=10) as response:
             history = json.loads(response.read())

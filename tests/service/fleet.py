@@ -13,7 +13,7 @@ from service.store import EstimateStore
 from sim.actuator import THESIS
 from sim.params import HealthParams
 from sim.synthetic import synthetic_window
-from tests.clients.test_replay import _free_port, _start_server
+from tests.servers import free_port, start_server
 from tests.service.conftest import SMALL
 from training.documents import Estimate, parameter
 from training.pipeline import estimate_window
@@ -48,8 +48,8 @@ def served_fleet(database: Path) -> Iterator[str]:
     store = EstimateStore(database)
     store_fleet(store, base)
     store.close()
-    port = _free_port()
-    server = _start_server(port, database)
+    port = free_port()
+    server = start_server(port, database)
     try:
         yield f"http://127.0.0.1:{port}"
     finally:

@@ -12,6 +12,7 @@ import time
 import httpx
 import pytest
 
+from tests.servers import SMALL_ENV, free_port
 from tests.service.conftest import KEY
 
 SERVER = """
@@ -22,25 +23,16 @@ uvicorn.run(create_app(Settings()), host="127.0.0.1", port={port}, log_level="wa
 """
 
 
-def _free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
 @pytest.fixture(scope="module")
 def server(tmp_path_factory):
-    port = _free_port()
+    port = free_port()
     env = {
         **os.environ,
         "EMA_API_KEY": KEY,
         "EMA_DATABASE": str(tmp_path_factory.mktemp("live") / "history.sqlite3"),
         "EMA_MAX_QUEUE": "2",
         "EMA_WARM_UP": "false",
-        "EMA_PIPELINE__N_SIMULATIONS": "16",
-        "EMA_PIPELINE__CHECK_WINDOWS": "8",
-        "EMA_PIPELINE__N_TIMESTEPS": "50",
-        "EMA_PIPELINE__HIDDEN_UNITS": "8",
+        **SMALL_ENV,
         "EMA_BODY_TIMEOUT_S": "4",
     }
     log = (tmp_path_factory.mktemp("log") / "server.log").open("w")
