@@ -217,3 +217,12 @@ def test_a_small_stribeck_decay_read_as_a_viscous_term_below_the_documents_is_de
     assert report.selected_effect is None, report.selection_steps[0].reason
     assert report.unexplained is not None and "viscous or stribeck" in report.unexplained.description
     assert not report.unexplained.adopted and report.estimates_after == report.estimates_before
+
+
+@pytest.mark.slow
+def test_a_large_hinge_moment_bias_is_simulated_against_the_load_the_drive_feels():
+    # -104 N·m: simulated, the bias hypothesis used to push the drive against the logged (biased) moment,
+    # so a current offset followed the window better and was named (0.39 -> 0.58).
+    report, _ = calibrate("hinge_moment_bias", 5402, scale=5.0)
+    assert report.selected_effect == "hinge_moment_bias", report.selection_steps[0].reason
+    assert combined_error(report, "after") <= max(0.5 * combined_error(report, "before"), 0.01)

@@ -76,13 +76,14 @@ def initial_state(window: Window, actuator: ActuatorParams) -> InitialState:
     )  # fmt: skip
 
 
-def logged_load(window: Window, hinge: HingeGeometry | None) -> LoggedLoad:
-    """The window's own hinge moment (smoothed of sensor noise) as the load its simulations feel; with the
-    airframe's ``hinge`` model in flight, corrected for the simulation's own deflection."""
+def logged_load(window: Window, hinge: HingeGeometry | None, sensor_bias_nm: float = 0.0) -> LoggedLoad:
+    """The window's own hinge moment (smoothed of sensor noise) as the load its simulations feel, less the
+    sensor's bias where one is supposed (the drive feels the moment, the sensor adds its bias to it); with
+    the airframe's ``hinge`` model in flight, corrected for the simulation's own deflection."""
     rate = window.sample_rate_hz
     return LoggedLoad(
         window.flight_condition,
-        smoothed(window.signals["hinge_moment_nm"], rate),
+        smoothed(window.signals["hinge_moment_nm"], rate) - sensor_bias_nm,
         smoothed(window.signals["position_deg"], rate),
         hinge,
     )
@@ -95,7 +96,7 @@ def scenario_from_window(
     return Scenario(
         actuator=actuator,
         command_knots_deg=knots_from_samples(window.signals["command_deg"])[0],
-        load=logged_load(window, hinge),
+        load=logged_load(window, hinge, effects.get("hinge_moment_bias", "bias_nm")),
         initial=initial_state(window, actuator),
         sample_rate_hz=window.sample_rate_hz,
         effects=effects,
