@@ -105,22 +105,17 @@ def table(rows: dict[tuple[str, float], list[dict[str, Any]]]) -> str:
     return "\n".join(lines)
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--seeds", type=int, default=5)
-    parser.add_argument("--scales", default="0.2,1,5,20")
-    parser.add_argument("--docs", action="store_true")
-    args = parser.parse_args()
-    runtime.configure()
-    scales = [float(s) for s in args.scales.split(",")]
-    rows: dict[tuple[str, float], list[dict[str, Any]]] = {}
-    if args.docs:
-        (DOCS / "figures").mkdir(parents=True, exist_ok=True)
+Rows = dict[tuple[str, float], list[dict[str, Any]]]
+
+
+def study(scales: list[float], seeds: int, figures: bool) -> Rows:
+    """Every case at every scale (clean at 1x only), ``seeds`` windows each; a figure per case at 1x."""
+    rows: Rows = {}
     for c, case in enumerate(CASES):
         for scale in [1.0] if case == "clean" else scales:
             rows[case, scale] = []
-            for s in range(args.seeds):
-                first = args.docs and scale == 1.0 and s == 0
+            for s in range(seeds):
+                first = figures and scale == 1.0 and s == 0
                 figure = DOCS / "figures" / f"calibration_{case}.png" if first else None
                 try:
                     rows[case, scale].append(one(case, scale, 5000 + 100 * c + s, figure))
@@ -130,12 +125,16 @@ def main() -> None:
                                               "if_added": np.nan, "without": np.nan, "seconds": np.nan})  # fmt: skip
             print(case, scale, [(r["named"], round(r["before"], 3), round(r["after"], 3)) for r in rows[case, scale]],
                   flush=True)  # fmt: skip
+    return rows
+
+
+def summary(rows: Rows, seeds: int, seconds: list[float]) -> str:
+    """The results section: what the table counts, the table, and the tally at the issue's sizes (1x)."""
     at_one = [r for (case, scale), runs in rows.items() if scale == 1.0 and case != "clean" for r in runs]
     missed = [r for r in at_one if not r["better"]]
     at_own_floor = sum(r["after"] <= OWN_FLOOR * r["without"] for r in missed)
-    seconds = [r["seconds"] for runs in rows.values() for r in runs if np.isfinite(r["seconds"])]
-    body = "\n".join([
-        f"{args.seeds} windows per effect and size, one window per calibration, 0.5 s at 10 kHz from",
+    return "\n".join([
+        f"{seeds} windows per effect and size, one window per calibration, 0.5 s at 10 kHz from",
         "`tests/foreign` (thesis commands, its own noise), effects in its own forms (`tests/foreign/effects.py`);",
         "sizes relative to those the calibration issue reported. *Right name*: the effect named (clean: none;",
         "drift: none, and described as following time). Errors are |FDJ| + |η_O| relative errors, before",
@@ -157,6 +156,20 @@ def main() -> None:
         f"max {max(seconds):.1f} s on this machine (2 cores). Figures: `docs/figures/calibration_<effect>.png`",
         "(the equation error before and after, against the variable the effect follows).",
     ])  # fmt: skip
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--seeds", type=int, default=5)
+    parser.add_argument("--scales", default="0.2,1,5,20")
+    parser.add_argument("--docs", action="store_true")
+    args = parser.parse_args()
+    runtime.configure()
+    if args.docs:
+        (DOCS / "figures").mkdir(parents=True, exist_ok=True)
+    rows = study([float(s) for s in args.scales.split(",")], args.seeds, args.docs)
+    seconds = [r["seconds"] for runs in rows.values() for r in runs if np.isfinite(r["seconds"])]
+    body = summary(rows, args.seeds, seconds)
     print(body)
     if args.docs:
         command = "python -m benchmarks.calibration_study --docs"
