@@ -46,13 +46,18 @@ def local_line(values: np.ndarray, width: int) -> np.ndarray:
     """
     values = np.asarray(values, dtype=np.float64)
     n = values.shape[-1]
-    width = min(width - (1 - width % 2), n - (1 - n % 2))  # odd, at most n
+    width = _line_width(width, n)
     if width < 3:
         return values.copy()
     rows = np.ascontiguousarray(values.reshape(-1, n))
     out = np.empty_like(rows)
-    _local_line_rows(rows, width, out)
+    runtime.run_rows(lambda a, b: _local_line_rows(rows[a:b], width, out[a:b]), len(out))
     return out.reshape(values.shape)
+
+
+def _line_width(width: int, n: int) -> int:
+    """The samples a local line spans: ``width`` made odd (rounded down), at most ``n`` (odd)."""
+    return min(width - (1 - width % 2), n - (1 - n % 2))
 
 
 def denoised_hinge_nm(
@@ -67,10 +72,9 @@ def denoised_hinge_nm(
     if hinge.shape != position.shape:
         raise InputError("signals", f"shapes differ: hinge {hinge.shape}, position {position.shape}")
     n = hinge.shape[-1]
-    width = min(kernel_samples(sample_rate_hz, window_s), n - (1 - n % 2))
+    width = _line_width(kernel_samples(sample_rate_hz, window_s), n)
     hinge_rows, position_rows = (np.ascontiguousarray(x.reshape(-1, n)) for x in (hinge, position))
     out = np.empty(hinge_rows.shape)
-    width = max(width, 1)
     runtime.run_rows(lambda a, b: _denoise_rows(hinge_rows[a:b], position_rows[a:b], width, out[a:b]), len(out))
     return out.reshape(hinge.shape)
 
