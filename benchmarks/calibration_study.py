@@ -15,6 +15,7 @@ right effect is named (for the drift: never named, described as following time),
 from __future__ import annotations
 
 import argparse
+import functools
 import time
 from pathlib import Path
 from typing import Any
@@ -43,9 +44,11 @@ def relative_error(estimates: dict[str, float], truth: dict[str, float]) -> floa
     return sum(abs(estimates[n] / truth[n] - 1) for n in ("FDJ", "eta_O"))
 
 
+@functools.cache
 def without_effect(seed: int) -> float:
     """The base model's error on the same window (health, command, noise) drawn without the effect: what
-    a calibration that took the effect out exactly would be left with."""
+    a calibration that took the effect out exactly would be left with. One per seed: every size of an
+    effect shares its seeds' windows."""
     drawn = draw(seed, "thesis")
     base = estimate_window(window_from_dict(drawn.document), PipelineConfig(), actuator=THESIS, spec_only=True)
     return relative_error(combined([base], THESIS), drawn.truth)
