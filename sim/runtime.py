@@ -22,10 +22,13 @@ import os
 import threading
 from collections.abc import Callable, Sequence
 from concurrent.futures import Future, ThreadPoolExecutor
+from typing import TypeVar
 
 from sim.checks import InputError
 
 MAX_THREADS = 256
+T = TypeVar("T")
+R = TypeVar("R")
 
 
 def available_cores() -> int:
@@ -94,6 +97,16 @@ def run_rows(work: Callable[[int, int], None], n_rows: int) -> None:
         return
     edges = [round(n_rows * k / parts) for k in range(parts + 1)]
     wait_all([pool().submit(work, a, b) for a, b in itertools.pairwise(edges)])
+
+
+def map_on_pool(work: Callable[[T], R], items: Sequence[T]) -> list[R]:
+    """``work`` of each item, in order, the items spread over the pool (inline with one thread or one item):
+    for independent pieces of work whose compiled loops release the GIL."""
+    if threads() == 1 or len(items) <= 1:
+        return [work(item) for item in items]
+    futures = [pool().submit(work, item) for item in items]
+    wait_all(futures)
+    return [future.result() for future in futures]
 
 
 def wait_all(futures: Sequence[Future]) -> None:

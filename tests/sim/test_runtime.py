@@ -15,3 +15,26 @@ def test_configure_puts_every_blas_numpy_loaded_on_one_thread():
     )
     found = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, check=True).stdout.split()
     assert int(found[0]) >= 1 and found[1:] == ["1", "2"]  # a BLAS found, on one thread; the pool on two
+
+
+def test_map_on_pool_keeps_the_items_order_and_raises_a_pieces_error():
+    import pytest
+
+    from sim import runtime
+    from sim.checks import InputError
+
+    before = runtime.threads()
+    try:
+        for threads in (1, 2):
+            runtime.set_threads(threads)
+            assert runtime.map_on_pool(lambda x: x * x, list(range(7))) == [x * x for x in range(7)]
+
+            def fails_on_three(x: int) -> int:
+                if x == 3:
+                    raise InputError("x", "three")
+                return x
+
+            with pytest.raises(InputError, match="three"):
+                runtime.map_on_pool(fails_on_three, [1, 2, 3, 4])
+    finally:
+        runtime.set_threads(before)
