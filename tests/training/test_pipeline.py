@@ -346,3 +346,30 @@ def test_a_torque_constant_current_gain_or_inertia_off_the_specs_is_read_and_the
     assert "drive_constants" in _codes(result)
     for name, (of_range, z) in _errors(result, drawn.truth).items():
         assert of_range < 3.0 and z < 2.5, name
+
+
+@pytest.mark.parametrize("expected_right", [True, False])
+def test_the_check_simulated_beside_the_training_is_used_only_at_the_answer(monkeypatch, expected_right):
+    """With two threads the check's simulation starts at the physics-only answer while the network trains
+    (``simulate_ahead``); with one it runs after. Where the answer is that value the early simulation is
+    used, where it is not (here: expected 0.01 N·m off) a new one runs: the check is the same either way."""
+    from sim import runtime
+    from training import pipeline
+
+    drawn, before = draw(35, "gust"), runtime.threads()
+    try:
+        runtime.set_threads(1)
+        after = _estimate(drawn)
+        runtime.set_threads(2)
+        if not expected_right:
+            physics_only = pipeline.HeldOut.physics_only
+
+            def off(self, physics):
+                return {name: v + (0.01 if name == "FDJ" else 0.0) for name, v in physics_only(self, physics).items()}
+
+            monkeypatch.setattr(pipeline.HeldOut, "physics_only", off)
+        beside = _estimate(drawn)
+    finally:
+        runtime.set_threads(before)
+    assert beside.fit_check.output_error_ratio == after.fit_check.output_error_ratio
+    assert beside.estimates == after.estimates
