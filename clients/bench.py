@@ -26,7 +26,7 @@ import numpy as np
 from clients.report import BENCHMARKS_MD, write_section
 from clients.yardstick import DURATION_S, SIMS, yardstick_seconds
 from sim.actuator import THESIS
-from sim.batch import simulate_batch
+from sim.batch import default_lanes, simulate_batch
 from sim.commands import random_command_knots
 from sim.params import DEFAULT_RANGES, HealthParams
 from sim.synthetic import synthetic_window
@@ -99,7 +99,8 @@ def reference_lines(rows: list[dict[str, Any]], refs: dict[str, float]) -> list[
     """The kernel's and the yardstick's figures, and each latency as a share of the yardstick."""
     lines = [
         f"Same run: our kernel simulates {SIMS} x {DURATION_S:g} s in {refs['kernel_s']:.3f} s "
-        f"({refs['kernel_ns_per_step']:.2f} ns per simulation-step, 64 lanes, every thread of the budget); "
+        f"({refs['kernel_ns_per_step']:.2f} ns per simulation-step, {default_lanes(SIMS)} lanes a group, every thread "
+        "of the budget); "
         f"the yardstick (`clients/yardstick.py`, an independent 16-lane kernel) in {refs['yardstick_s']:.3f} s.",
         "",
         "| load | window | total p50 / yardstick | total p95 / yardstick | target (0.5 s, idle p95) |",

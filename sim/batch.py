@@ -17,9 +17,10 @@ from sim.params import ActuatorParams, HealthParams
 
 DEFAULT_SAMPLE_RATE_HZ = 10_000.0
 SAMPLE_RATE_RANGE_HZ = (1_000.0, 100_000.0)
-MAX_LANES = 64  # simulations advanced in lock-step; fewer lanes pay more per-step loop overhead
-LANE_MULTIPLE = 8  # one AVX-512 register of float64
-MIN_VECTOR_LANES = 24  # fewer lanes take the lane loop's scalar path, several times the cost per lane
+VECTOR_LANES = 8  # float64 in one AVX-512 register
+LANE_MULTIPLE = VECTOR_LANES * runtime.INTERLEAVE  # one iteration of the vectorized lane loop
+MAX_LANES = 3 * LANE_MULTIPLE  # simulations advanced in lock-step; fewer lanes pay more per-step loop overhead
+MIN_VECTOR_LANES = LANE_MULTIPLE  # fewer lanes take the lane loop's scalar path, several times the cost per lane
 # Past the end stops a command only saturates the speed reference: ω_ref = sat(G_P·(θ_cmd − θ_u)) is
 # already ±ω_max once θ_cmd is ω_max/G_P ≈ 0.37° beyond them, so clipping there changes nothing.
 COMMAND_MARGIN_DEG = 1.0
@@ -150,18 +151,21 @@ def _checked_initial(initial: InitialState, actuator: ActuatorParams) -> Initial
 
 
 def default_lanes(n_sims: int) -> int:
-    """Lanes per group: groups of whole registers, at most MAX_LANES, at least MIN_VECTOR_LANES (fewer run
-    scalar, at several times the cost per lane), as many per thread as the others where there are enough simulations,
-    and as little padding as that allows (89 simulations on one thread: two groups of 48, not 64 + 64).
-    Below one register the lanes run scalar anyway: no padding."""
-    if n_sims < LANE_MULTIPLE:
+    """Lanes per group: of the sizes the vectorized lane loop runs whole (multiples of ``LANE_MULTIPLE`` from
+    MIN_VECTOR_LANES to MAX_LANES; fewer lanes run scalar, at several times the cost per lane), the one that
+    leaves the fewest lanes on the busiest thread, then the largest (fewer groups, each cheaper per lane: 65
+    simulations on two threads are two groups of 48, not three of 24, one thread running two). Below one
+    register the lanes run scalar anyway: no padding."""
+    if n_sims < VECTOR_LANES:
         return max(n_sims, 1)
     threads = runtime.threads()
-    groups = max(-(-n_sims // MAX_LANES), min(threads, -(-n_sims // MIN_VECTOR_LANES)))
-    if groups >= threads:
-        groups = -(-groups // threads) * threads
-    per_group = max(-(-n_sims // groups), MIN_VECTOR_LANES)
-    return min(MAX_LANES, -(-per_group // LANE_MULTIPLE) * LANE_MULTIPLE)
+
+    def cost(lanes: int) -> tuple[int, int]:
+        groups = -(-n_sims // lanes)
+        rounds = -(-groups // threads)  # groups the busiest thread runs
+        return rounds * lanes, -lanes
+
+    return min(range(MIN_VECTOR_LANES, MAX_LANES + 1, LANE_MULTIPLE), key=cost)
 
 
 def start_groups(inputs: tuple, out: np.ndarray, lanes: int, background: bool = False) -> list[Future]:

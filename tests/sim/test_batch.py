@@ -289,12 +289,12 @@ def test_default_lanes_fill_the_threads_with_vector_groups_and_little_padding(th
     runtime.set_threads(threads)
     try:
         assert default_lanes(1) == 1 and default_lanes(5) == 5  # scalar anyway: no padding
-        for n in range(LANE_MULTIPLE, 1200, 7):
+        for n in range(8, 1200, 7):
             lanes = default_lanes(n)
             groups = -(-n // lanes)
             assert lanes % LANE_MULTIPLE == 0 and MIN_VECTOR_LANES <= lanes <= MAX_LANES
-            assert groups * lanes - n < max(LANE_MULTIPLE * groups, MIN_VECTOR_LANES)  # padding: < a register a group
-            if n >= threads * MIN_VECTOR_LANES:
-                assert groups >= threads  # every thread has a group
+            assert groups * lanes - n < max(LANE_MULTIPLE * groups, MIN_VECTOR_LANES)  # padding: < an iteration a group
+            busiest, fair = -(-groups // threads) * lanes, -(-n // threads)  # lanes on the busiest thread
+            assert busiest < max(fair, MIN_VECTOR_LANES) + LANE_MULTIPLE  # within one loop iteration of a fair share
     finally:
         runtime.set_threads(before)

@@ -2,6 +2,9 @@
 
 import subprocess
 import sys
+import tempfile
+
+import pytest
 
 
 def test_configure_puts_every_blas_numpy_loaded_on_one_thread():
@@ -18,8 +21,6 @@ def test_configure_puts_every_blas_numpy_loaded_on_one_thread():
 
 
 def test_map_on_pool_keeps_the_items_order_and_raises_a_pieces_error():
-    import pytest
-
     from sim import runtime
     from sim.checks import InputError
 
@@ -38,3 +39,28 @@ def test_map_on_pool_keeps_the_items_order_and_raises_a_pieces_error():
                 runtime.map_on_pool(fails_on_three, [1, 2, 3, 4])
     finally:
         runtime.set_threads(before)
+
+
+@pytest.mark.slow
+def test_the_interleaved_lane_loop_computes_what_the_plain_one_does():
+    """``configure`` has LLVM interleave three vectors of lanes an iteration: the same arithmetic per lane, so
+    48 lanes record what one lane at a time records, and what a process that never configured records."""
+    script = (
+        "import sys, numpy as np; from sim import runtime; from sim.actuator import THESIS; "
+        "from sim.batch import simulate_batch; from sim.commands import random_command_knots; "
+        "from sim.params import DEFAULT_RANGES, HealthParams; "
+        "runtime.configure(1) if sys.argv[1] == 'configured' else None; "
+        "rng = np.random.default_rng(5); health = HealthParams.uniform(48, DEFAULT_RANGES, rng); "
+        "knots = random_command_knots(300, 10_000.0, rng)[0]; "
+        "runs = [simulate_batch(knots, health, lanes=k, actuator=THESIS.params) for k in (48, 1)]; "
+        "np.save(sys.argv[2], np.stack([np.stack([r.loss_torque_nm, *r.signals.values()]) for r in runs]))"
+    )
+    import numpy as np
+
+    recorded = {}
+    for mode in ("configured", "plain"):
+        path = f"{tempfile.mkdtemp()}/{mode}.npy"
+        subprocess.run([sys.executable, "-c", script, mode, path], check=True)
+        recorded[mode] = np.load(path)
+    assert np.array_equal(recorded["configured"][0], recorded["configured"][1])  # 48 lanes == 1 lane at a time
+    assert np.array_equal(recorded["configured"], recorded["plain"])
