@@ -21,6 +21,8 @@ VECTOR_LANES = 8  # float64 in one AVX-512 register
 LANE_MULTIPLE = VECTOR_LANES * runtime.INTERLEAVE  # one iteration of the vectorized lane loop
 MAX_LANES = 3 * LANE_MULTIPLE  # simulations advanced in lock-step; fewer lanes pay more per-step loop overhead
 MIN_VECTOR_LANES = LANE_MULTIPLE  # fewer lanes take the lane loop's scalar path, several times the cost per lane
+# A group's fixed cost per step, in lanes' worth: one thread, 24 lanes cost 3.0-3.4 ns a lane-step, 48 and 72 2.8.
+GROUP_OVERHEAD_LANES = 6
 # Past the end stops a command only saturates the speed reference: ω_ref = sat(G_P·(θ_cmd − θ_u)) is
 # already ±ω_max once θ_cmd is ω_max/G_P ≈ 0.37° beyond them, so clipping there changes nothing.
 COMMAND_MARGIN_DEG = 1.0
@@ -153,19 +155,19 @@ def _checked_initial(initial: InitialState, actuator: ActuatorParams) -> Initial
 def default_lanes(n_sims: int) -> int:
     """Lanes per group: of the sizes the vectorized lane loop runs whole (multiples of ``LANE_MULTIPLE`` from
     MIN_VECTOR_LANES to MAX_LANES; fewer lanes run scalar, at several times the cost per lane), the one that
-    leaves the fewest lanes on the busiest thread, then the largest (fewer groups, each cheaper per lane: 65
-    simulations on two threads are two groups of 48, not three of 24, one thread running two). Below one
-    register the lanes run scalar anyway: no padding."""
+    leaves the least work on the busiest thread, each group counted with its fixed cost
+    (``GROUP_OVERHEAD_LANES``): 89 simulations on two threads run as two groups of 48, 500 as seven of 72.
+    Below one register the lanes run scalar anyway: no padding."""
     if n_sims < VECTOR_LANES:
         return max(n_sims, 1)
     threads = runtime.threads()
 
-    def cost(lanes: int) -> tuple[int, int]:
+    def busiest(lanes: int) -> tuple[int, int]:
         groups = -(-n_sims // lanes)
         rounds = -(-groups // threads)  # groups the busiest thread runs
-        return rounds * lanes, -lanes
+        return rounds * (lanes + GROUP_OVERHEAD_LANES), -lanes
 
-    return min(range(MIN_VECTOR_LANES, MAX_LANES + 1, LANE_MULTIPLE), key=cost)
+    return min(range(MIN_VECTOR_LANES, MAX_LANES + 1, LANE_MULTIPLE), key=busiest)
 
 
 def start_groups(inputs: tuple, out: np.ndarray, lanes: int, background: bool = False) -> list[Future]:
