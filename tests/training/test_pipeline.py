@@ -355,11 +355,28 @@ def test_the_check_simulated_beside_the_training_is_used_only_at_the_answer(monk
     used, where it is not (here: expected 0.01 N·m off) a new one runs: the check is the same either way."""
     from sim import runtime
     from training import pipeline
+    from training.physics.scenario import Scenario
 
+    trained, simulated_after_training = [False], []  # 1-lane simulations started after the network trained
+    real_simulate, real_train = Scenario.simulate, pipeline.train_network
+
+    def counted(self, health, lanes=None, reuse_output=False):
+        simulated_after_training.append(lanes == 1 and trained[0])
+        return real_simulate(self, health, lanes, reuse_output)
+
+    def train(data, config):
+        network = real_train(data, config)
+        trained[0] = True
+        return network
+
+    monkeypatch.setattr(Scenario, "simulate", counted)
+    monkeypatch.setattr(pipeline, "train_network", train)
     drawn, before = draw(35, "gust"), runtime.threads()
     try:
         runtime.set_threads(1)
         after = _estimate(drawn)
+        assert sum(simulated_after_training) == 1  # the check, after the training
+        trained[0], simulated_after_training[:] = False, []
         runtime.set_threads(2)
         if not expected_right:
             physics_only = pipeline.HeldOut.physics_only
@@ -371,5 +388,6 @@ def test_the_check_simulated_beside_the_training_is_used_only_at_the_answer(monk
         beside = _estimate(drawn)
     finally:
         runtime.set_threads(before)
+    assert sum(simulated_after_training) == (0 if expected_right else 1)  # the early one used, or a new one
     assert beside.fit_check.output_error_ratio == after.fit_check.output_error_ratio
     assert beside.estimates == after.estimates
