@@ -3,8 +3,6 @@
 from __future__ import annotations
 
 import threading
-from collections.abc import Callable
-from concurrent.futures import Future
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -36,19 +34,6 @@ class InitialState:
     position_deg: float = 0.0  # elevator deflection θ_u [deg]
     motor_speed_radps: float = 0.0  # ω_m [rad/s]
     current_a: float = 0.0  # phase current I [A]
-
-
-@dataclass(frozen=True)
-class PendingBatch:
-    """A batch whose groups run on the simulator's pool: ``result`` waits for them (raising what a group
-    raised) and returns the ``BatchResult``, built on the caller's thread."""
-
-    groups: list[Future]
-    finish: Callable[[], BatchResult]
-
-    def result(self) -> BatchResult:
-        runtime.wait_all(self.groups)
-        return self.finish()
 
 
 @dataclass(frozen=True)
@@ -170,20 +155,19 @@ def default_lanes(n_sims: int) -> int:
     return min(range(MIN_VECTOR_LANES, MAX_LANES + 1, LANE_MULTIPLE), key=busiest)
 
 
-def start_groups(inputs: tuple, out: np.ndarray, lanes: int, background: bool = False) -> list[Future]:
-    """``kernels.run_group`` for every group of ``lanes`` simulations, on the simulator's thread pool; inline
-    with one thread, or one group unless ``background`` (then the caller's thread goes on meanwhile).
-    ``inputs`` are the kernel's arguments before ``first``. Returns the groups' futures (none: all done)."""
+def run_groups(inputs: tuple, out: np.ndarray, lanes: int) -> None:
+    """``kernels.run_group`` for every group of ``lanes`` simulations, on the simulator's thread pool
+    (inline with one thread). ``inputs`` are the kernel's arguments before ``first``."""
     firsts = range(0, out.shape[1], lanes)
 
     def run(first: int) -> None:
         kernels.run_group(*inputs, first, lanes, out)  # type: ignore[call-arg]  # numba's Dispatcher
 
-    if runtime.threads() == 1 or (len(firsts) == 1 and not background):
+    if runtime.threads() == 1 or len(firsts) == 1:
         for first in firsts:
             run(first)
-        return []
-    return [runtime.pool().submit(run, first) for first in firsts]
+        return
+    runtime.wait_all([runtime.pool().submit(run, first) for first in firsts])
 
 
 def _padded(values: np.ndarray, multiple: int) -> np.ndarray:
@@ -236,29 +220,6 @@ def simulate_batch(
     ``reuse_output``: record into this thread's kept buffer (``_recording``), for a caller that copies
     what it keeps: the result's arrays are overwritten by the next such call on the thread.
     """
-    return start_batch(
-        command_knots_deg, health, load, initial, sample_rate_hz, effects,
-        actuator=actuator, hinge=hinge, lanes=lanes, reuse_output=reuse_output,
-    ).result()  # fmt: skip
-
-
-def start_batch(
-    command_knots_deg: np.ndarray,
-    health: HealthParams,
-    load: Load = FlightCondition(),
-    initial: InitialState = InitialState(),
-    sample_rate_hz: float = DEFAULT_SAMPLE_RATE_HZ,
-    effects: EffectSet = EffectSet(),
-    *,
-    actuator: ActuatorParams,
-    hinge: HingeGeometry | None = None,
-    lanes: int | None = None,
-    reuse_output: bool = False,
-    background: bool = False,
-) -> PendingBatch:
-    """``simulate_batch``'s inputs checked and its groups started: with ``background``, all of them on the
-    pool (with a thread budget above one), so that the caller's thread may do other work meanwhile and
-    take the result when it needs it."""
     if not isinstance(health, HealthParams):
         raise InputError("health", f"must be HealthParams, got {type(health).__name__}")
     n_sims = len(health)
@@ -283,17 +244,13 @@ def start_batch(
     constants = kernel_constants(actuator, effects)
     knots_rad = np.ascontiguousarray(np.radians(knots))
     table_nm = np.zeros(2) if effects.table is None else np.array(effects.table.values_nm)
-    groups = start_groups((constants, table_nm, loads, per_sim, knots_rad, steps, initial_rows), out, lanes, background)
-
-    def finish() -> BatchResult:
-        kept = out[:, :n_sims]
-        signals = {
-            "position_deg": np.degrees(kept[kernels.POSITION]),
-            "motor_speed_radps": kept[kernels.SPEED],
-            "current_a": kept[kernels.CURRENT],
-            "hinge_moment_nm": kept[kernels.HINGE],
-            "command_deg": np.degrees(kept[kernels.COMMAND]),
-        }
-        return BatchResult(sample_rate_hz, signals, kept[kernels.LOSS], health, effects)
-
-    return PendingBatch(groups, finish)
+    run_groups((constants, table_nm, loads, per_sim, knots_rad, steps, initial_rows), out, lanes)
+    out = out[:, :n_sims]
+    signals = {
+        "position_deg": np.degrees(out[kernels.POSITION]),
+        "motor_speed_radps": out[kernels.SPEED],
+        "current_a": out[kernels.CURRENT],
+        "hinge_moment_nm": out[kernels.HINGE],
+        "command_deg": np.degrees(out[kernels.COMMAND]),
+    }
+    return BatchResult(sample_rate_hz, signals, out[kernels.LOSS], health, effects)

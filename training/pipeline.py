@@ -11,9 +11,7 @@ The thesis's §6.3 proposal, made to hold on data our simulator did not draw:
 4. **train**: the shallow network on the residual torque of the sliding samples;
 5. **assess**: both estimators scored on held-out simulations, blended per parameter, checked
    against the window itself (``training.assess.weighing``) and by simulating it at the answer
-   (``training.assess.reproduction``). The held-out physics fits come before the training: they give
-   the physics-only answer (the answer wherever the network does not join), and the check's
-   simulation starts there on the core the training leaves idle;
+   (``training.assess.reproduction``);
 6. **FSJ** where the window shows a quasi-static break-away (``training.physics.static_friction``).
 """
 
@@ -22,16 +20,14 @@ from __future__ import annotations
 import contextlib
 import time
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass, replace
+from dataclasses import replace
 
 import numpy as np
 
-from sim import runtime as sim_runtime
 from sim.actuator import THESIS, Actuator
-from sim.batch import PendingBatch
 from sim.window import Window
 from training.assess.reproduction import output_error_ratios
-from training.assess.weighing import Assessed, Candidates, assess, physics_only
+from training.assess.weighing import Assessed, Candidates, assess
 from training.config import PipelineConfig
 from training.documents import ActuatorRead, Estimate, FitCheck, HistoryReadings, Note, Timings
 from training.history import known_from
@@ -58,87 +54,38 @@ def train_network(data: Data, config: PipelineConfig) -> NetworkEstimator:
     return NetworkEstimator(train, config.members).fit(data.inputs[:n], health.fdj_nm[:n], health.eta_o[:n], data.box)
 
 
-@dataclass(frozen=True)
-class HeldOut:
-    """The physics fit of the held-out simulations that could slide, and their truths."""
-
-    fit: FrictionFit
-    scored: np.ndarray  # (K,) which held-out simulations slid long enough to have a physics answer
-    truth: dict[str, np.ndarray]  # per target, of the scored ones
-
-    def physics_only(self, physics: FrictionFit) -> dict[str, float]:
-        """The answer wherever the network does not join (``training.assess.weighing.physics_only``)."""
-        return physics_only(window_values(physics), self.fit.values(slice(None)), self.truth)
-
-
-def window_values(physics: FrictionFit) -> dict[str, float]:
-    return {k: float(v) for k, v in physics.values().items()}
-
-
-def held_out_physics(window: Window, data: Data, n: int) -> HeldOut:
-    """The physics fit of the held-out simulations (one that never slides long enough has no physics
-    answer: left out, not poisoning the scores)."""
+def candidates(
+    window: Window, physics: FrictionFit, data: Data, network: NetworkEstimator, n: int
+) -> tuple[Candidates, FrictionFit]:
+    """Physics and network on the window and on the held-out simulations (and the physics fit of those)."""
     held = {name: values[n:] for name, values in data.sims.signals.items()}
-    fitted = fit_friction(held, window.sample_rate_hz, data.actuator, residual_nm=data.sims.residual_nm[n:])
-    ok = np.isfinite(fitted.fdj_nm) & np.isfinite(fitted.eta_o)
-    health = data.sims.health
-    truth = {"FDJ": health.fdj_nm[n:][ok], "eta_O": health.eta_o[n:][ok]}
-    return HeldOut(replace(fitted, **{k: getattr(fitted, k)[ok] for k in FIT_ARRAYS}), ok, truth)
-
-
-def candidates(physics: FrictionFit, data: Data, network: NetworkEstimator, n: int, held: HeldOut) -> Candidates:
-    """Physics and network on the window and on the held-out simulations."""
+    check_physics = fit_friction(held, window.sample_rate_hz, data.actuator, residual_nm=data.sims.residual_nm[n:])
     unit = network.predict_unit(np.vstack([data.inputs[n:], data.window_inputs]))
     fdj, eta_o = data.box.denormalize(unit)
+    health = data.sims.health
+    # A held-out simulation that never slides long enough has no physics answer: left out, not poisoning the scores.
+    ok = np.isfinite(check_physics.fdj_nm) & np.isfinite(check_physics.eta_o)
+    check_physics = replace(check_physics, **{k: getattr(check_physics, k)[ok] for k in FIT_ARRAYS})
+    fdj_check, eta_check = fdj[:-1][ok], eta_o[:-1][ok]
+    truth_fdj, truth_eta = health.fdj_nm[n:][ok], health.eta_o[n:][ok]
     return Candidates(
-        physics=window_values(physics),
+        physics={k: float(v) for k, v in physics.values().items()},
         physics_std={"FDJ": float(physics.fdj_std_nm[0]), "eta_O": float(physics.eta_o_std[0])},
         network={"FDJ": float(fdj[-1]), "eta_O": float(eta_o[-1])},
         network_unit=unit[-1],
-        check_truth=held.truth,
-        check_physics=held.fit.values(slice(None)),
-        check_network={"FDJ": fdj[:-1][held.scored], "eta_O": eta_o[:-1][held.scored]},
-    )
-
-
-@dataclass(frozen=True)
-class Ahead:
-    """The window's simulation at the answer expected (``values``), running on the simulator's pool."""
-
-    values: dict[str, float]
-    simulation: PendingBatch
-
-
-def simulate_ahead(data: Data, values: dict[str, float], nominal_fdj_nm: float) -> Ahead | None:
-    """Start the check's simulation at ``values`` (the physics-only answer: the answer on most windows) on the
-    pool, to run on the core the network's training leaves idle; None with a one-thread budget (a second
-    thread would oversubscribe it). Only the compiled kernel runs there: the Python around it would take the
-    GIL from the training. Its 1-lane simulation cannot vectorize: this hides it, not shortens it."""
-    if sim_runtime.threads() == 1:
-        return None
-    health = inside(values["FDJ"], values["eta_O"], nominal_fdj_nm)
-    return Ahead(values, data.scenario.start(health, lanes=1, background=True))
+        check_truth={"FDJ": truth_fdj, "eta_O": truth_eta},
+        check_physics=check_physics.values(slice(None)),
+        check_network={"FDJ": fdj_check, "eta_O": eta_check},
+    ), check_physics
 
 
 def fit_check(
-    window: Window,
-    data: Data,
-    answer: Assessed,
-    equation_ratio: float,
-    n: int,
-    nominal_fdj_nm: float,
-    ahead: Ahead | None = None,
+    window: Window, data: Data, answer: Assessed, equation_ratio: float, n: int, nominal_fdj_nm: float
 ) -> FitCheck:
-    """Simulate the window at the answer and compare (``training.assess.reproduction``): ``ahead``'s simulation
-    when it was started at exactly the answer's values, else one now."""
-    if ahead is not None and ahead.values == answer.values:
-        simulation = ahead.simulation.result()
-    else:
-        simulation = data.scenario.simulate(
-            inside(answer.values["FDJ"], answer.values["eta_O"], nominal_fdj_nm), lanes=1
-        )
+    """Simulate the window at the answer and compare (``training.assess.reproduction``)."""
+    health = inside(answer.values["FDJ"], answer.values["eta_O"], nominal_fdj_nm)
     floor = float(np.sqrt(np.mean((data.sims.residual_nm[n:] - data.sims.clean_residual_nm)[:, data.sliding] ** 2)))
-    ratios = output_error_ratios(window, data.scenario, simulation, data.noise, floor, data.sliding, data.actuator)
+    ratios = output_error_ratios(window, data.scenario, health, data.noise, floor, data.sliding, data.actuator)
     reproduced = ratios["residual_torque"] <= MAX_RATIO
     notes = list(answer.notes)
     if not reproduced:
@@ -156,8 +103,7 @@ def fit_check(
 
 
 class Stopwatch:
-    """Each stage's seconds (summed over its parts), announced to ``on_stage`` as it starts (which may raise to
-    stop the job there)."""
+    """Each stage's seconds, announced to ``on_stage`` as it starts (which may raise to stop the job there)."""
 
     def __init__(self, on_stage: Callable[[str], None] | None) -> None:
         self.on_stage = on_stage or (lambda _: None)
@@ -168,7 +114,7 @@ class Stopwatch:
         self.on_stage(announcement)
         started = time.perf_counter()
         yield
-        self.seconds[name] = self.seconds.get(name, 0.0) + time.perf_counter() - started
+        self.seconds[name] = time.perf_counter() - started
 
     def timings(self) -> Timings:
         s = self.seconds
@@ -207,20 +153,16 @@ def estimate_window(
     with watch("simulate", f"simulating {config.total_simulations} windows around the physics estimate"):
         effects = prepared.departures.viscosity.effects()
         data = simulate_dataset(w, seen, physics, config, actuator, prepared.actuator, effects)
-    with watch("assess", "fitting Eq. 5.1 to the held-out simulations"):
-        held = held_out_physics(w, data, n)
     with watch("train", f"training {config.members} network(s) of {config.hidden_units} neurons"):
-        ahead = simulate_ahead(data, held.physics_only(physics), actuator.nominal.fdj_nm)
         network = train_network(data, config)
     with watch("assess", "weighing the estimators on held-out simulations"):
-        found = candidates(physics, data, network, n, held)
-        residuals = held.fit.residual_rms_nm
-        floor = np.median(residuals) if len(residuals) else np.nan
+        found, check_physics = candidates(w, physics, data, network, n)
+        floor = np.median(check_physics.residual_rms_nm) if len(check_physics.residual_rms_nm) else np.nan
         equation_ratio = float(physics.residual_rms_nm[0] / floor) if np.isfinite(floor) else 1.0
         answer = assess(found, equation_ratio)
         answer = replace(answer, stds=widened(answer.stds, prepared))
     with watch("check", "checking the answer against the window"):
-        check = fit_check(seen, data, answer, equation_ratio, n, actuator.nominal.fdj_nm, ahead)
+        check = fit_check(seen, data, answer, equation_ratio, n, actuator.nominal.fdj_nm)
         fsj = read_static_friction(
             seen.signals, w.sample_rate_hz, answer.values["FDJ"], answer.values["eta_O"], data.actuator, data.noise
         )

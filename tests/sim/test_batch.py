@@ -276,7 +276,7 @@ def test_an_interrupted_batch_runs_none_of_its_queued_groups(monkeypatch):
     timer = threading.Timer(0.1, _thread.interrupt_main)
     timer.start()
     with pytest.raises(KeyboardInterrupt):
-        runtime.wait_all(batch.start_groups((), np.empty((1, 400 * 8, 1)), 8))  # 400 groups: 4 s on two threads
+        batch.run_groups((), np.empty((1, 400 * 8, 1)), 8)  # 400 groups: 4 s on two threads
     runtime.shutdown()
     settled = len(ran)
     time.sleep(0.2)

@@ -16,9 +16,8 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from sim.batch import BatchResult
 from sim.noise import SensorNoise
-from sim.params import ActuatorParams
+from sim.params import ActuatorParams, HealthParams
 from sim.residual import residual_torque_nm
 from sim.window import Window
 from training.physics.features import as_read
@@ -28,17 +27,16 @@ from training.physics.scenario import SETTLE_S, Scenario, rms
 def output_error_ratios(
     window: Window,
     scenario: Scenario,
-    simulation: BatchResult,
+    health: HealthParams,
     noise: SensorNoise,
     residual_floor_nm: float,
     sliding: np.ndarray,
     actuator: ActuatorParams,
 ) -> dict[str, float]:
-    """Per signal, RMS(measured − ``simulation``) over its noise-only floor, ``simulation`` the window's own in
-    ``scenario`` (``Scenario.start``); the measured T_R reconstructed with ``actuator`` (as the window is read),
-    the simulated with the drive it is drawn with."""
+    """Per signal, RMS(measured − simulated at ``health``) over its noise-only floor; the measured T_R
+    reconstructed with ``actuator`` (as the window is read), the simulated with the drive it is drawn with."""
     rate = window.sample_rate_hz
-    simulated = as_read(simulation.simulation(0), rate)
+    simulated = as_read(scenario.simulate(health, lanes=1).simulation(0), rate)
     measured = window.signals
     keep = np.arange(window.n_samples) >= round(SETTLE_S * rate)
     floors = {

@@ -87,14 +87,6 @@ def bias_corrected(physics: np.ndarray, truth: np.ndarray) -> tuple[float, np.nd
     return shrink * bias, physics - shrink * left_out
 
 
-def physics_only(
-    physics: dict[str, float], check_physics: dict[str, np.ndarray], check_truth: dict[str, np.ndarray]
-) -> dict[str, float]:
-    """Each target's bias-corrected physics fit: the answer wherever the network does not join (known
-    before the network is trained, so the answer's check can start beside the training)."""
-    return {name: physics[name] - bias_corrected(check_physics[name], check_truth[name])[0] for name in TARGETS}
-
-
 def network_note(c: Candidates, name: str) -> Note | None:
     """Why the network's answer for ``name`` cannot be used on this window, or None."""
     if c.network is None or c.check_network is None or c.network_unit is None:

@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from sim.aircraft import FlightCondition, HingeGeometry, Load, LoggedLoad
-from sim.batch import BatchResult, InitialState, PendingBatch, start_batch
+from sim.batch import BatchResult, InitialState, simulate_batch
 from sim.commands import knots_from_samples
 from sim.effects import EffectSet
 from sim.noise import SensorNoise
@@ -51,16 +51,8 @@ class Scenario:
         return self.command_knots_deg.shape[-1] - 1
 
     def simulate(self, health: HealthParams, lanes: int | None = None, reuse_output: bool = False) -> BatchResult:
-        return self.start(health, lanes, reuse_output).result()
-
-    def start(
-        self, health: HealthParams, lanes: int | None = None, reuse_output: bool = False, background: bool = False
-    ) -> PendingBatch:
-        """``simulate``, its groups started (``sim.batch.start_batch``: with ``background``, all on the pool)."""
-        return start_batch(
-            self.command_knots_deg, health, self.load, self.initial, self.sample_rate_hz, self.effects,
-            actuator=self.actuator, lanes=lanes, reuse_output=reuse_output, background=background,
-        )  # fmt: skip
+        return simulate_batch(self.command_knots_deg, health, self.load, self.initial, self.sample_rate_hz,
+                              self.effects, actuator=self.actuator, lanes=lanes, reuse_output=reuse_output)  # fmt: skip
 
 
 def initial_state(window: Window, actuator: ActuatorParams) -> InitialState:
