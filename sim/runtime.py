@@ -54,6 +54,7 @@ class _Budget:
         self.threads = available_cores()
         self.pool: ThreadPoolExecutor | None = None
         self.blas_limited = False  # the limit lasts for the process: set once (a fleet worker configures per window)
+        self.interleaved = False  # LLVM's option, likewise
 
 
 _BUDGET = _Budget()
@@ -168,7 +169,11 @@ def single_threaded_blas() -> None:
 
 def interleave_vector_loops() -> None:
     """Have LLVM put ``INTERLEAVE`` independent vectors in each iteration of the loops it vectorizes from now
-    on (see the module docstring)."""
-    import llvmlite.binding as llvm
+    on (see the module docstring). Once per process."""
+    with _BUDGET.lock:
+        if _BUDGET.interleaved:
+            return
+        import llvmlite.binding as llvm
 
-    llvm.set_option("ema", f"-force-vector-interleave={INTERLEAVE}")
+        llvm.set_option("ema", f"-force-vector-interleave={INTERLEAVE}")
+        _BUDGET.interleaved = True
