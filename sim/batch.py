@@ -157,17 +157,13 @@ def default_lanes(n_sims: int) -> int:
 
 def run_groups(inputs: tuple, out: np.ndarray, lanes: int) -> None:
     """``kernels.run_group`` for every group of ``lanes`` simulations, on the simulator's thread pool
-    (inline with one thread). ``inputs`` are the kernel's arguments before ``first``."""
-    firsts = range(0, out.shape[1], lanes)
+    (``runtime.map_on_pool``: inline with one thread or one group). ``inputs`` are the kernel's arguments
+    before ``first``."""
 
     def run(first: int) -> None:
         kernels.run_group(*inputs, first, lanes, out)  # type: ignore[call-arg]  # numba's Dispatcher
 
-    if runtime.threads() == 1 or len(firsts) == 1:
-        for first in firsts:
-            run(first)
-        return
-    runtime.wait_all([runtime.pool().submit(run, first) for first in firsts])
+    runtime.map_on_pool(run, range(0, out.shape[1], lanes))
 
 
 def _padded(values: np.ndarray, multiple: int) -> np.ndarray:
