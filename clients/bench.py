@@ -92,24 +92,30 @@ def references() -> dict[str, float]:
         simulate_batch(knots, health, actuator=THESIS.params)
         best = min(best, time.perf_counter() - started)
     steps = SIMS * samples * steps_per_sample
-    return {"yardstick_s": yardstick_seconds(), "kernel_s": float(best), "kernel_ns_per_step": 1e9 * best / steps}
+    return {"yardstick_s": yardstick_seconds(threads=1), "yardstick_every_thread_s": yardstick_seconds(),
+            "kernel_s": float(best), "kernel_ns_per_step": 1e9 * best / steps}
 
 
 def reference_lines(rows: list[dict[str, Any]], refs: dict[str, float]) -> list[str]:
-    """The kernel's and the yardstick's figures, and each latency as a share of the yardstick."""
+    """The kernel's and the yardstick's figures, and each latency as a share of the yardstick: on one thread
+    (the target's measure) and on every thread (twice as fast on two cores, so a share twice as strict)."""
     lines = [
         f"Same run: our kernel simulates {SIMS} x {DURATION_S:g} s in {refs['kernel_s']:.3f} s "
         f"({refs['kernel_ns_per_step']:.2f} ns per simulation-step, {default_lanes(SIMS)} lanes a group, every thread "
         "of the budget); "
-        f"the yardstick (`clients/yardstick.py`, an independent 16-lane kernel) in {refs['yardstick_s']:.3f} s.",
+        f"the yardstick (`clients/yardstick.py`, an independent 16-lane kernel) in {refs['yardstick_s']:.3f} s on one "
+        f"thread, {refs['yardstick_every_thread_s']:.3f} s on every thread.",
         "",
-        "| load | window | total p50 / yardstick | total p95 / yardstick | target (0.5 s, idle p95) |",
-        "|---|---:|---:|---:|---:|",
+        "| load | window | total p50 / yardstick | total p95 / yardstick | p95 / yardstick on every thread "
+        "| target (0.5 s, idle p95) |",
+        "|---|---:|---:|---:|---:|---:|",
     ]
     for r in rows:
         target = f"≤ {TARGET_SHARE}" if r["duration_s"] == DURATION_S and r["load"] == "idle" else ""
-        lines.append(f"| {r['load']} | {r['duration_s']:g} s | {r['p50_s']['total'] / refs['yardstick_s']:.3f} "
-                     f"| {r['p95_s']['total'] / refs['yardstick_s']:.3f} | {target} |")  # fmt: skip
+        p50, p95 = r["p50_s"]["total"], r["p95_s"]["total"]
+        lines.append(f"| {r['load']} | {r['duration_s']:g} s | {p50 / refs['yardstick_s']:.3f} "
+                     f"| {p95 / refs['yardstick_s']:.3f} | {p95 / refs['yardstick_every_thread_s']:.3f} "
+                     f"| {target} |")  # fmt: skip
     return lines
 
 

@@ -1,0 +1,119 @@
+"""Real time as an operator meets it: a warm ``ema serve`` answering hidden 0.5 s windows, idle and shared.
+
+Windows are drawn by ``tests.foreign`` (its own simulator, noise and commands, five command
+families in turn), each posted once under a fresh ``window_id``, one after another, to a service
+started and warmed for the run. The same windows are posted again under new ids while N CPU-bound
+processes run beside the service (an onboard computer is shared), idle and loaded passes
+alternating in blocks. The figure is the client's wall
+time of ``POST /v1/estimate``: parsing, validation, the pipeline, storage and the answer.
+
+This machine's speed drifts ~2x from day to day, so the same run times the yardstick
+(``clients.yardstick``, an independent 16-lane kernel simulating 500 x 0.5 s) on one thread and on
+every thread, and states each latency as a share of it. The target: the idle p95 at most 0.128 of
+the yardstick, and the p95 beside two busy processes at most twice the idle one.
+
+    python -m benchmarks.real_time [--windows 40] [--under-load 2] [--blocks 4] [--docs]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import tempfile
+import time
+from pathlib import Path
+
+import httpx
+import numpy as np
+
+from benchmarks.service_overhead import free_port, quiet_collector, serve
+from clients.bench import TARGET_SHARE, load
+from clients.report import write_section
+from clients.yardstick import yardstick_seconds
+from tests.foreign.windows import draw
+
+SECTION = "Real time on a warm service"
+FAMILIES = ("thesis", "cruise", "gust", "doublet", "steps")
+LOADED_LIMIT = 2.0  # the p95 beside two busy processes, as a multiple of the idle p95
+
+
+def documents(count: int, seed: int) -> list[dict]:
+    """``count`` hidden 0.5 s windows at 10 kHz, the command families in turn."""
+    return [draw(seed + i, FAMILIES[i % len(FAMILIES)]).document for i in range(count)]
+
+
+def post_all(windows: list[dict], port: int, tag: str) -> list[float]:
+    """Wall seconds of each ``POST /v1/estimate``, every window under a new id (``tag``: this pass)."""
+    wall = []
+    quiet_collector()
+    with httpx.Client(base_url=f"http://127.0.0.1:{port}", timeout=120.0) as client:
+        for document in windows:
+            body = json.dumps({**document, "window_id": f"{document['window_id']}-{tag}"}).encode()
+            started = time.perf_counter()
+            answer = client.post("/v1/estimate", content=body, headers={"Content-Type": "application/json"})
+            wall.append(time.perf_counter() - started)
+            answer.raise_for_status()
+    return wall
+
+
+def measure(windows: list[dict], under_load: int, blocks: int) -> dict[str, list[float]]:
+    """Wall seconds per window idle and beside ``under_load`` busy processes, on one warm service. The
+    windows go in ``blocks``, each posted idle and then loaded, so the machine's drift meets both alike."""
+    walls: dict[str, list[float]] = {"idle": [], f"{under_load} busy processes": []}
+    with tempfile.TemporaryDirectory() as folder:
+        port = free_port()
+        process = serve(Path(folder) / "history.sqlite3", port)
+        try:
+            post_all(windows[:3], port, "warm")
+            for block in np.array_split(np.arange(len(windows)), blocks):
+                part = [windows[i] for i in block]
+                walls["idle"] += post_all(part, port, "idle")
+                with load(under_load):
+                    walls[f"{under_load} busy processes"] += post_all(part, port, "loaded")
+        finally:
+            process.terminate()
+            process.wait()
+    return walls
+
+
+def report(walls: dict[str, list[float]], yardsticks: dict[str, float], count: int) -> str:
+    idle_p95 = float(np.quantile(walls["idle"], 0.95))
+    lines = [
+        f"{count} hidden 0.5 s windows at 10 kHz (`tests.foreign`: {', '.join(FAMILIES)} commands in turn), "
+        "posted one after another to a warm `ema serve` on loopback, each under a new `window_id`; the "
+        "figure is the client's wall time of `POST /v1/estimate`. Same run: the yardstick "
+        f"(`clients/yardstick.py`, 500 x 0.5 s on a 16-lane kernel) takes {yardsticks['one thread']:.3f} s on one "
+        f"thread and {yardsticks['every thread']:.3f} s on every thread.",
+        "",
+        "| load | p50 [s] | p95 [s] | p95 / idle p95 | p95 / yardstick, one thread | p95 / yardstick, every thread |",
+        "|---|---:|---:|---:|---:|---:|",
+    ]
+    for name, wall in walls.items():
+        p50, p95 = float(np.median(wall)), float(np.quantile(wall, 0.95))
+        lines.append(f"| {name} | {p50:.3f} | {p95:.3f} | {p95 / idle_p95:.2f} | "
+                     f"{p95 / yardsticks['one thread']:.3f} | {p95 / yardsticks['every thread']:.3f} |")  # fmt: skip
+    lines += ["", f"Target: idle p95 ≤ {TARGET_SHARE} of the yardstick; loaded p95 ≤ {LOADED_LIMIT:g}x the idle p95."]
+    return "\n".join(lines)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--windows", type=int, default=40)
+    parser.add_argument("--under-load", type=int, default=2, help="CPU-bound processes beside the service")
+    parser.add_argument("--blocks", type=int, default=4, help="idle and loaded passes alternate this many times")
+    parser.add_argument("--seed", type=int, default=390_000)
+    parser.add_argument("--docs", action="store_true", help="rewrite the section of docs/benchmarks.md")
+    args = parser.parse_args()
+    windows = documents(args.windows, args.seed)
+    walls = measure(windows, args.under_load, args.blocks)
+    yardsticks = {"one thread": yardstick_seconds(threads=1), "every thread": yardstick_seconds()}
+    body = report(walls, yardsticks, args.windows)
+    print(body)
+    if args.docs:
+        command = (f"python -m benchmarks.real_time --windows {args.windows} --under-load {args.under_load} "
+                   f"--blocks {args.blocks} --docs")  # fmt: skip
+        write_section(SECTION, command, body)
+
+
+if __name__ == "__main__":
+    main()
