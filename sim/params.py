@@ -93,6 +93,10 @@ class HealthParams:
     def __len__(self) -> int:
         return len(self.fdj_nm)
 
+    def identical(self, other: HealthParams) -> bool:
+        """Whether ``other`` holds exactly these values: the same simulations, to the bit."""
+        return all(np.array_equal(getattr(self, name), getattr(other, name)) for name in ("fsj_nm", "fdj_nm", "eta_o"))
+
     def eta_a(self, gear_ratio: float) -> np.ndarray:
         """η_A by Eq. 3.4."""
         return eta_a_from_eta_o(self.eta_o, gear_ratio)

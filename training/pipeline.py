@@ -82,10 +82,13 @@ def candidates(
 def fit_check(
     window: Window, data: Data, answer: Assessed, equation_ratio: float, n: int, nominal_fdj_nm: float
 ) -> FitCheck:
-    """Simulate the window at the answer and compare (``training.assess.reproduction``)."""
+    """Simulate the window at the answer and compare (``training.assess.reproduction``). Where the answer is the
+    point the noise was measured at (the physics estimate, when it carries the answer), that simulation is
+    the one: a lane of the dataset's batch, the same numbers as a run of its own."""
     health = inside(answer.values["FDJ"], answer.values["eta_O"], nominal_fdj_nm)
     floor = float(np.sqrt(np.mean((data.sims.residual_nm[n:] - data.sims.clean_residual_nm)[:, data.sliding] ** 2)))
-    ratios = output_error_ratios(window, data.scenario, health, data.noise, floor, data.sliding, data.actuator)
+    known = data.sims.reference_signals if health.identical(data.sims.reference) else None
+    ratios = output_error_ratios(window, data.scenario, health, data.noise, floor, data.sliding, data.actuator, known)
     reproduced = ratios["residual_torque"] <= MAX_RATIO
     notes = list(answer.notes)
     if not reproduced:

@@ -346,3 +346,25 @@ def test_a_torque_constant_current_gain_or_inertia_off_the_specs_is_read_and_the
     assert "drive_constants" in _codes(result)
     for name, (of_range, z) in _errors(result, drawn.truth).items():
         assert of_range < 3.0 and z < 2.5, name
+
+
+def test_the_check_reuses_the_simulation_at_the_physics_answer_with_the_same_result(monkeypatch):
+    """Where the physics estimate carries the answer, the dataset's batch simulated it already (the lane the
+    noise is measured against): the check runs no simulation of its own and reads the same ratios."""
+    from training.physics.scenario import Scenario
+
+    own_runs = []
+    simulate = Scenario.simulate
+
+    def counted(self, health, lanes=None, reuse_output=False):
+        own_runs.extend([lanes] if lanes == 1 else [])
+        return simulate(self, health, lanes, reuse_output)
+
+    monkeypatch.setattr(Scenario, "simulate", counted)
+    drawn = draw(6, "cruise")
+    reused = _estimate(drawn)
+    assert own_runs == []
+    monkeypatch.setattr(HealthParams, "identical", lambda self, other: False)
+    alone = _estimate(drawn)
+    assert own_runs == [1]
+    assert reused.fit_check == alone.fit_check and reused.estimates == alone.estimates

@@ -32,11 +32,15 @@ def output_error_ratios(
     residual_floor_nm: float,
     sliding: np.ndarray,
     actuator: ActuatorParams,
+    simulated_at_health: Mapping[str, np.ndarray] | None = None,
 ) -> dict[str, float]:
     """Per signal, RMS(measured − simulated at ``health``) over its noise-only floor; the measured T_R
-    reconstructed with ``actuator`` (as the window is read), the simulated with the drive it is drawn with."""
+    reconstructed with ``actuator`` (as the window is read), the simulated with the drive it is drawn with.
+    ``simulated_at_health``: the scenario's clean simulation at ``health`` where one was run already."""
     rate = window.sample_rate_hz
-    simulated = as_read(scenario.simulate(health, lanes=1).simulation(0), rate)
+    if simulated_at_health is None:
+        simulated_at_health = scenario.simulate(health, lanes=1).simulation(0)
+    simulated = as_read(simulated_at_health, rate)
     measured = window.signals
     keep = np.arange(window.n_samples) >= round(SETTLE_S * rate)
     floors = {

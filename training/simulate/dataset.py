@@ -34,6 +34,8 @@ class Simulated:
     signals: dict[str, np.ndarray]  # SIGNALS_READ, (n, n_samples), sensor noise added, then as_read
     residual_nm: np.ndarray  # (n, n_samples) T_R of the noisy signals
     clean_residual_nm: np.ndarray  # (k, n_samples) T_R without sensor noise, of the last k: the noise floor's reference
+    reference: HealthParams  # the one point simulated clean to measure the noise against
+    reference_signals: dict[str, np.ndarray]  # its five signals, as simulated (no noise, not read)
 
 
 def simulate_noisy(
@@ -43,14 +45,16 @@ def simulate_noisy(
     is read (``as_read``) and reconstruct T_R (and without noise for the last ``clean_last`` simulations).
 
     The noise is measured against a clean simulation of the window at ``reference`` (one point),
-    run in the same batch: it takes a lane the batch would have padded anyway.
+    run in the same batch: it takes a lane the batch would have padded anyway. Its signals are kept: where
+    the answer is that point, the answer's check needs no simulation of its own.
     """
     together = HealthParams(
         *(np.concatenate([getattr(health, name), getattr(reference, name)]) for name in ("fsj_nm", "fdj_nm", "eta_o"))
     )
     result = scenario.simulate(together, reuse_output=True)  # nothing below keeps a view of it
     rate = scenario.sample_rate_hz
-    noise = excess_noise(window.signals, {name: values[-1] for name, values in result.signals.items()}, rate)
+    at_reference = {name: values[-1].copy() for name, values in result.signals.items()}
+    noise = excess_noise(window.signals, at_reference, rate)
     clean = {name: result.signals[name][:-1] for name in SIGNALS_READ}
     noisy = add_seeded_noise(clean, noise, seed, rate)
 
@@ -59,7 +63,7 @@ def simulate_noisy(
 
     seen = as_read(noisy, rate)
     tail = as_read({name: values[len(health) - clean_last :] for name, values in clean.items()}, rate)
-    return Simulated(health, noise, seen, residual(seen), residual(tail))
+    return Simulated(health, noise, seen, residual(seen), residual(tail), reference, at_reference)
 
 
 def window_noise(window: Window, scenario: Scenario, health: HealthParams) -> SensorNoise:

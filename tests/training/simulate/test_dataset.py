@@ -6,6 +6,8 @@ from sim.batch import InitialState
 from sim.noise import NO_NOISE, SensorNoise
 from sim.params import HealthParams
 from sim.synthetic import synthetic_window
+from sim.window import window_from_dict
+from tests.foreign.windows import draw
 from training.physics.scenario import initial_state, scenario_from_window
 from training.simulate.dataset import simulate_noisy, window_noise
 
@@ -56,3 +58,19 @@ def test_noisy_simulations_are_seeded_and_keep_their_clean_residual():
     assert a.noise.current_a == pytest.approx(SensorNoise().current_a, rel=0.3)  # the window's own, measured
     np.testing.assert_array_equal(a.residual_nm, b.residual_nm)
     assert not np.array_equal(a.residual_nm[-2:], a.clean_residual_nm)
+
+
+def test_the_reference_lane_is_its_own_one_lane_run_to_the_bit():
+    """What lets the answer's check reuse it: a lane of the batch equals a run of its own (a foreign window)."""
+    window = window_from_dict(draw(11, "gust").document)
+    scenario = scenario_from_window(window, actuator=THESIS.params, hinge=THESIS.hinge)
+    health = HealthParams(np.full(40, 0.1), np.linspace(0.04, 0.06, 40), np.linspace(0.7, 0.95, 40))
+    reference = HealthParams.single(0.1, 0.052, 0.83)
+    kept = simulate_noisy(scenario, health, window, reference, 3, 2)
+    alone = scenario.simulate(reference, lanes=1).simulation(0)
+    assert kept.reference.identical(reference) and not kept.reference.identical(HealthParams.single(0.1, 0.052, 0.84))
+    assert kept.reference_signals.keys() == alone.keys()
+    for name, values in alone.items():
+        np.testing.assert_array_equal(kept.reference_signals[name], values, err_msg=name)
+    simulate_noisy(scenario, health, window, HealthParams.single(0.1, 0.05, 0.9), 3, 2)  # the kept buffer written over
+    np.testing.assert_array_equal(kept.reference_signals["current_a"], alone["current_a"])
