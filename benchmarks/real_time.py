@@ -79,11 +79,11 @@ def measure(windows: list[dict], under_load: int, blocks: int) -> dict[str, list
 def report(walls: dict[str, list[float]], yardsticks: dict[str, float], count: int) -> str:
     idle_p95 = float(np.quantile(walls["idle"], 0.95))
     lines = [
-        f"{count} hidden 0.5 s windows at 10 kHz (`tests.foreign`: {', '.join(FAMILIES)} commands in turn), "
-        "posted one after another to a warm `ema serve` on loopback, each under a new `window_id`; the "
-        "figure is the client's wall time of `POST /v1/estimate`. Same run: the yardstick "
-        f"(`clients/yardstick.py`, 500 x 0.5 s on a 16-lane kernel) takes {yardsticks['one thread']:.3f} s on one "
-        f"thread and {yardsticks['every thread']:.3f} s on every thread.",
+        f"{count} hidden 0.5 s windows at 10 kHz (`tests.foreign`: {', '.join(FAMILIES)} commands in turn),",
+        "posted one after another to a warm `ema serve` on loopback, each under a new `window_id`, idle and",
+        "loaded passes alternating in blocks; the figure is the client's wall time of `POST /v1/estimate`.",
+        f"Same run: the yardstick (`clients/yardstick.py`, 500 x 0.5 s on a 16-lane kernel) takes "
+        f"{yardsticks['one thread']:.3f} s on one thread and {yardsticks['every thread']:.3f} s on every thread.",
         "",
         "| load | p50 [s] | p95 [s] | p95 / idle p95 | p95 / yardstick, one thread | p95 / yardstick, every thread |",
         "|---|---:|---:|---:|---:|---:|",
