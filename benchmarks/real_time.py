@@ -4,8 +4,8 @@ Windows are drawn by ``tests.foreign`` (its own simulator, noise and commands, f
 families in turn), each posted once under a fresh ``window_id``, one after another, to a service
 started and warmed for the run. The same windows are posted again under new ids while N CPU-bound
 processes run beside the service (an onboard computer is shared), idle and loaded passes
-alternating in blocks. The figure is the client's wall
-time of ``POST /v1/estimate``: parsing, validation, the pipeline, storage and the answer.
+alternating in blocks. The figure is the client's wall time of ``POST /v1/estimate``: parsing,
+validation, the pipeline, storage and the answer.
 
 This machine's speed drifts ~2x from day to day, so the same run times the yardstick
 (``clients.yardstick``, an independent 16-lane kernel simulating 500 x 0.5 s) on one thread and on
