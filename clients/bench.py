@@ -140,7 +140,7 @@ def markdown(rows: list[dict[str, Any]], config: PipelineConfig, refs: dict[str,
         "p50 (p95) seconds per stage; real-time factor = pipeline seconds per second of window (≤ 1: real time);",
         "error = mean |error| in % of the thesis's range (0.02 N·m for FDJ, 0.30 for η_O).",
         "Windows run back to back, so beside busy processes this loop keeps a core of its own; a service",
-        "waiting between requests does not, and reads ~2x (*Real time on a warm service*).",
+        "waiting between requests does not (*Real time on a warm service* measures one).",
         "",
         "| load | window | prepare | physics | simulate | train | assess | check | total | real-time factor p50 (p95) "
         "| error FDJ / η_O |",
