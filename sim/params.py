@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 
 import numpy as np
 
@@ -95,7 +95,7 @@ class HealthParams:
 
     def identical(self, other: HealthParams) -> bool:
         """Whether ``other`` holds exactly these values: the same simulations, to the bit."""
-        return all(np.array_equal(getattr(self, name), getattr(other, name)) for name in ("fsj_nm", "fdj_nm", "eta_o"))
+        return all(np.array_equal(getattr(self, f.name), getattr(other, f.name)) for f in fields(self))
 
     def eta_a(self, gear_ratio: float) -> np.ndarray:
         """η_A by Eq. 3.4."""
