@@ -66,12 +66,6 @@ def simulate_noisy(
     return Simulated(health, noise, seen, residual(seen), residual(tail), reference, at_reference)
 
 
-def window_noise(window: Window, scenario: Scenario, health: HealthParams) -> SensorNoise:
-    """The window's sensor noise, measured against a clean simulation of its own command at ``health``."""
-    clean = scenario.simulate(health, lanes=1).simulation(0)
-    return excess_noise(window.signals, clean, window.sample_rate_hz)
-
-
 @dataclass(frozen=True)
 class Data:
     """Everything simulated for one window."""

@@ -12,7 +12,7 @@ from training.physics.features import as_read
 from training.physics.friction import fit_window
 from training.physics.noise import noise_of, robust_variance, second_difference_variances
 from training.physics.scenario import scenario_from_window
-from training.simulate.dataset import window_noise
+from training.simulate.dataset import simulate_noisy
 
 RATE = 10_000.0
 SENSORS = ("position_deg", "motor_speed_radps", "current_a", "hinge_moment_nm")
@@ -23,7 +23,8 @@ def _measured_and_realized(seed: int, family: str, widths: dict[str, int]):
     window = window_from_dict(d.document)
     physics = fit_window(as_read(window.signals, RATE), RATE, actuator=THESIS.params)
     at = HealthParams.single(fdj_nm=float(physics.fdj_nm[0]), eta_o=float(physics.eta_o[0]))
-    measured = window_noise(window, scenario_from_window(window, actuator=THESIS.params, hinge=THESIS.hinge), at)
+    scenario = scenario_from_window(window, actuator=THESIS.params, hinge=THESIS.hinge)
+    measured = simulate_noisy(scenario, at, window, at, seed=0, clean_last=1).noise  # read against the clean lane
     clean = d.clean_signals()
     return measured, {name: window.signals[name] - clean[name] for name in SENSORS}
 

@@ -9,7 +9,7 @@ from sim.synthetic import synthetic_window
 from sim.window import window_from_dict
 from tests.foreign.windows import draw
 from training.physics.scenario import initial_state, scenario_from_window
-from training.simulate.dataset import simulate_noisy, window_noise
+from training.simulate.dataset import simulate_noisy
 
 
 def test_a_clean_window_is_reproduced_by_its_own_scenario():
@@ -30,22 +30,21 @@ def test_initial_state_is_read_through_the_noise():
     assert isinstance(state, InitialState)
 
 
+def _noise_read_at(window, health: HealthParams) -> SensorNoise:
+    """The window's noise as the dataset reads it: against the batch's clean lane at ``health``."""
+    scenario = scenario_from_window(window, actuator=THESIS.params, hinge=THESIS.hinge)
+    return simulate_noisy(scenario, health, window, health, seed=0, clean_last=1).noise
+
+
 def test_window_noise_is_estimated_against_the_clean_model():
     window = synthetic_window(HealthParams.single(), seed=6, duration_s=0.2)
-    estimated = window_noise(
-        window, scenario_from_window(window, actuator=THESIS.params, hinge=THESIS.hinge), HealthParams.single()
-    )
+    estimated = _noise_read_at(window, HealthParams.single())
     truth = SensorNoise()
     assert estimated.motor_speed_radps == pytest.approx(truth.motor_speed_radps, rel=0.25)
     assert estimated.current_a == pytest.approx(truth.current_a, rel=0.25)
     assert estimated.hinge_moment_nm == pytest.approx(truth.hinge_moment_nm, rel=0.25)
     clean = synthetic_window(HealthParams.single(), seed=6, duration_s=0.2, noise=NO_NOISE)
-    assert (
-        window_noise(
-            clean, scenario_from_window(clean, actuator=THESIS.params, hinge=THESIS.hinge), HealthParams.single()
-        ).motor_speed_radps
-        < 0.1
-    )
+    assert _noise_read_at(clean, HealthParams.single()).motor_speed_radps < 0.1
 
 
 def test_noisy_simulations_are_seeded_and_keep_their_clean_residual():
