@@ -57,26 +57,38 @@ def _loads(e: Equations, chosen: Sequence[Chosen]) -> np.ndarray:
     return loads
 
 
+def _load_factors(eta_o: np.ndarray | float, gear_ratio: float) -> tuple[np.ndarray, np.ndarray]:
+    """(k_aid, k_opp) at η_O (η_A by Eq. 3.4): the load-dependent friction's share of a and o."""
+    return 1.0 - eta_a_from_eta_o(eta_o, gear_ratio), 1.0 / np.asarray(eta_o, dtype=np.float64) - 1.0
+
+
 def _target(y: np.ndarray, eta_o: float, loads: np.ndarray, gear_ratio: float) -> np.ndarray:
-    """t minus the load-dependent friction at η_O (η_A by Eq. 3.4): what FDJ and the effect must explain."""
-    k_aid, k_opp = 1.0 - float(eta_a_from_eta_o(eta_o, gear_ratio)), 1.0 / eta_o - 1.0
+    """t minus the load-dependent friction at η_O: what FDJ and the effect must explain."""
+    k_aid, k_opp = _load_factors(eta_o, gear_ratio)
     return y - k_aid * loads[:, 0] - k_opp * loads[:, 1]
 
 
 def fit_with(e: Equations, chosen: Sequence[Chosen], rows: np.ndarray | None = None) -> TiedFit:
-    """The base model plus ``chosen``'s columns, η_O searched coarse to fine, on ``rows`` (all by default)."""
+    """The base model plus ``chosen``'s columns, η_O searched coarse to fine, on ``rows`` (all by default).
+
+    The target at η_O is y − k_aid·a − k_opp·o, and least squares is linear in its target: one solve for
+    y, a and o together gives the coefficients and the residual at every η_O of the grid as a mix of
+    three (the same minimum-norm solution a solve per grid point finds, without the solves).
+    """
     rows = np.arange(e.m) if rows is None else rows
     design, loads, y = _extra(e, chosen)[rows], _loads(e, chosen)[rows], (e.y - _offset(e, chosen))[rows]
+    parts = np.column_stack([y, loads])  # (m, 3): y, a, o
+    coefficients = np.linalg.lstsq(design, parts, rcond=None)[0]  # (k, 3)
+    residuals = parts - design @ coefficients
     low, high = ETA_O_SEARCH
     for _ in range(REFINEMENTS):
         grid = np.linspace(low, high, GRID_POINTS)
-        targets = [_target(y, eta, loads, e.gear_ratio) for eta in grid]
-        betas = [np.linalg.lstsq(design, t, rcond=None)[0] for t in targets]
-        sse = [float(np.sum((t - design @ b) ** 2)) for t, b in zip(targets, betas, strict=True)]
-        best = int(np.argmin(sse))
+        mixes = np.vstack([np.ones(GRID_POINTS), *(-k for k in _load_factors(grid, e.gear_ratio))])  # (3, G)
+        best = int(np.argmin(np.sum((residuals @ mixes) ** 2, axis=0)))
         step = grid[1] - grid[0]
         low, high = max(grid[best] - step, ETA_O_SEARCH[0]), min(grid[best] + step, ETA_O_SEARCH[1])
-    return TiedFit(float(betas[best][0]), float(grid[best]), betas[best])
+    beta = coefficients @ mixes[:, best]
+    return TiedFit(float(beta[0]), float(grid[best]), beta)
 
 
 def held_out_rss(e: Equations, chosen: Sequence[Chosen]) -> float:
