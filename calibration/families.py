@@ -148,8 +148,10 @@ def _torque_shift(e: Equations, true_over_logged: np.ndarray, actuator: Actuator
     *logged* current at I_max: the true one is above it)."""
     limit, k_t = actuator.max_motor_torque_nm, actuator.torque_constant_nm_per_a
     drive = k_t * e.variables["current_unsigned_a"][:, None]
-    shift = np.clip(drive, -limit, limit) - np.clip(drive * true_over_logged[None, :], -limit, limit)
-    return shift * e.variables["direction"][:, None]
+    shift = drive * true_over_logged[None, :]  # the true torque, then the shift: one (m, G) array
+    np.clip(shift, -limit, limit, out=shift)
+    np.subtract(np.clip(drive, -limit, limit), shift, out=shift)
+    return np.multiply(shift, e.variables["direction"][:, None], out=shift)
 
 
 CURRENT_OFFSETS_A = tuple(float(o) for o in np.round(np.arange(-1.5, 1.5025, 0.005), 3))
@@ -165,9 +167,11 @@ def _offset_shift(e: Equations, offsets_a: np.ndarray, actuator: ActuatorParams)
     peak (the loop holds the *logged* current at I_max)."""
     limit, k_t = actuator.max_motor_torque_nm, actuator.torque_constant_nm_per_a
     current = e.variables["current_unsigned_a"][:, None]
-    true = current - offsets_a[None, :]
-    shift = np.clip(k_t * current, -limit, limit) - np.clip(k_t * true, -limit, limit)
-    return shift * e.variables["direction"][:, None]
+    shift = current - offsets_a[None, :]  # the true current, then its torque, then the shift: one (m, G) array
+    np.multiply(k_t, shift, out=shift)
+    np.clip(shift, -limit, limit, out=shift)
+    np.subtract(np.clip(k_t * current, -limit, limit), shift, out=shift)
+    return np.multiply(shift, e.variables["direction"][:, None], out=shift)
 
 
 HINGE_BIASES_NM = tuple(float(b) for b in np.arange(-150.0, 152.5, 2.5))
