@@ -5,7 +5,8 @@ families in turn), each posted once under a fresh ``window_id``, one after anoth
 started and warmed for the run. The same windows are posted again under new ids while N CPU-bound
 processes run beside the service (an onboard computer is shared), idle and loaded passes
 alternating in blocks. The figure is the client's wall time of ``POST /v1/estimate``: parsing,
-validation, the pipeline, storage and the answer.
+validation, the pipeline, storage and the answer. Beside it, the service process's CPU time over
+each pass (``/proc``): the CPU a request costs, and how many cores the service had while it worked.
 
 This machine's speed drifts ~2x from day to day, so the same run times the yardstick
 (``clients.yardstick``, an independent 16-lane kernel simulating 500 x 0.5 s) on one thread and on
@@ -19,9 +20,11 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import tempfile
 import time
 from pathlib import Path
+from typing import NamedTuple
 
 import httpx
 import numpy as np
@@ -56,10 +59,27 @@ def post_all(windows: list[dict], port: int, tag: str) -> list[float]:
     return wall
 
 
-def measure(windows: list[dict], under_load: int, blocks: int) -> dict[str, list[float]]:
-    """Wall seconds per window idle and beside ``under_load`` busy processes, on one warm service. The
+def cpu_seconds(pid: int) -> float:
+    """User + system CPU seconds of process ``pid`` so far, every thread (``/proc/<pid>/stat``)."""
+    fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")  # utime, stime: fields 14, 15
+
+
+class Pass(NamedTuple):
+    walls: list[float]  # each POST [s]
+    cpu_s: float  # the service's CPU over the pass
+
+
+def timed_pass(windows: list[dict], port: int, tag: str, pid: int) -> Pass:
+    before = cpu_seconds(pid)
+    walls = post_all(windows, port, tag)
+    return Pass(walls, cpu_seconds(pid) - before)
+
+
+def measure(windows: list[dict], under_load: int, blocks: int) -> dict[str, list[Pass]]:
+    """Each pass over the windows idle and beside ``under_load`` busy processes, on one warm service. The
     windows go in ``blocks``, each posted idle and then loaded, so the machine's drift meets both alike."""
-    walls: dict[str, list[float]] = {"idle": [], f"{under_load} busy processes": []}
+    passes: dict[str, list[Pass]] = {"idle": [], f"{under_load} busy processes": []}
     with tempfile.TemporaryDirectory() as folder:
         port = free_port()
         process = serve(Path(folder) / "history.sqlite3", port)
@@ -67,16 +87,18 @@ def measure(windows: list[dict], under_load: int, blocks: int) -> dict[str, list
             post_all(windows[:3], port, "warm")
             for block in np.array_split(np.arange(len(windows)), blocks):
                 part = [windows[i] for i in block]
-                walls["idle"] += post_all(part, port, "idle")
+                passes["idle"].append(timed_pass(part, port, "idle", process.pid))
                 with load(under_load):
-                    walls[f"{under_load} busy processes"] += post_all(part, port, "loaded")
+                    passes[f"{under_load} busy processes"].append(timed_pass(part, port, "loaded", process.pid))
         finally:
             process.terminate()
             process.wait()
-    return walls
+    return passes
 
 
-def report(walls: dict[str, list[float]], yardsticks: dict[str, float], count: int) -> str:
+def report(passes: dict[str, list[Pass]], yardsticks: dict[str, float], count: int) -> str:
+    walls = {name: [w for p in runs for w in p.walls] for name, runs in passes.items()}
+    cpu = {name: sum(p.cpu_s for p in runs) for name, runs in passes.items()}
     idle_p95 = float(np.quantile(walls["idle"], 0.95))
     lines = [
         f"{count} hidden 0.5 s windows at 10 kHz (`tests.foreign`: {', '.join(FAMILIES)} commands in turn),",
@@ -85,14 +107,22 @@ def report(walls: dict[str, list[float]], yardsticks: dict[str, float], count: i
         f"Same run: the yardstick (`clients/yardstick.py`, 500 x 0.5 s on a 16-lane kernel) takes "
         f"{yardsticks['one thread']:.3f} s on one thread and {yardsticks['every thread']:.3f} s on every thread.",
         "",
-        "| load | p50 [s] | p95 [s] | p95 / idle p95 | p95 / yardstick, one thread | p95 / yardstick, every thread |",
-        "|---|---:|---:|---:|---:|---:|",
+        "| load | p50 [s] | p95 [s] | p95 / idle p95 | p95 / yardstick, one thread | p95 / yardstick, every thread "
+        "| CPU per request [s] | cores the service had |",
+        "|---|---:|---:|---:|---:|---:|---:|---:|",
     ]
     for name, wall in walls.items():
         p50, p95 = float(np.median(wall)), float(np.quantile(wall, 0.95))
         lines.append(f"| {name} | {p50:.3f} | {p95:.3f} | {p95 / idle_p95:.2f} | "
-                     f"{p95 / yardsticks['one thread']:.3f} | {p95 / yardsticks['every thread']:.3f} |")  # fmt: skip
-    lines += ["", f"Target: idle p95 ≤ {TARGET_SHARE} of the yardstick; loaded p95 ≤ {LOADED_LIMIT:g}x the idle p95."]
+                     f"{p95 / yardsticks['one thread']:.3f} | {p95 / yardsticks['every thread']:.3f} | "
+                     f"{cpu[name] / len(wall):.3f} | {cpu[name] / sum(wall):.2f} |")  # fmt: skip
+    lines += [
+        "",
+        f"Target: idle p95 ≤ {TARGET_SHARE} of the yardstick; loaded p95 ≤ {LOADED_LIMIT:g}x the idle p95.",
+        "*Cores the service had*: its CPU seconds over the passes (every thread, `/proc`) per second of",
+        "POST wall time. Where a request costs the same CPU idle and loaded, its wall time grows by the",
+        "ratio of the cores the service had: beside busy processes it works on its share of them.",
+    ]
     return "\n".join(lines)
 
 
@@ -105,9 +135,9 @@ def main() -> None:
     parser.add_argument("--docs", action="store_true", help="rewrite the section of docs/benchmarks.md")
     args = parser.parse_args()
     windows = documents(args.windows, args.seed)
-    walls = measure(windows, args.under_load, args.blocks)
+    passes = measure(windows, args.under_load, args.blocks)
     yardsticks = {"one thread": yardstick_seconds(threads=1), "every thread": yardstick_seconds()}
-    body = report(walls, yardsticks, args.windows)
+    body = report(passes, yardsticks, args.windows)
     print(body)
     if args.docs:
         command = (f"python -m benchmarks.real_time --windows {args.windows} --under-load {args.under_load} "

@@ -1,18 +1,42 @@
-"""The real-time benchmark's report: shares of the idle p95 and of both yardstick readings."""
+"""The real-time benchmark's report: shares of the idle p95 and of both yardstick readings, and the CPU the
+service spent; its CPU reading against a process of known work."""
+
+import os
+import subprocess
+import sys
+import time
 
 import numpy as np
+import pytest
 
-from benchmarks.real_time import FAMILIES, LOADED_LIMIT, documents, report
+from benchmarks.real_time import FAMILIES, LOADED_LIMIT, Pass, cpu_seconds, documents, report
 
 
 def test_each_row_is_its_p95_over_the_idle_one_and_over_each_yardstick() -> None:
-    idle = list(np.linspace(0.1, 0.2, 21))  # p95 0.195
+    idle = list(np.linspace(0.1, 0.2, 21))  # p95 0.195, 3.15 s in all
     loaded = [2 * x for x in idle]
-    text = report({"idle": idle, "2 busy processes": loaded}, {"one thread": 1.95, "every thread": 0.975}, 21)
+    passes = {"idle": [Pass(idle[:10], 2.0), Pass(idle[10:], 2.5)], "2 busy processes": [Pass(loaded, 4.41)]}
+    text = report(passes, {"one thread": 1.95, "every thread": 0.975}, 21)
     rows = [line for line in text.splitlines() if line.startswith(("| idle", "| 2 busy"))]
-    assert rows[0] == "| idle | 0.150 | 0.195 | 1.00 | 0.100 | 0.200 |"
-    assert rows[1] == "| 2 busy processes | 0.300 | 0.390 | 2.00 | 0.200 | 0.400 |"
+    assert rows[0] == "| idle | 0.150 | 0.195 | 1.00 | 0.100 | 0.200 | 0.214 | 1.43 |"
+    assert rows[1] == "| 2 busy processes | 0.300 | 0.390 | 2.00 | 0.200 | 0.400 | 0.210 | 0.70 |"
     assert f"≤ {LOADED_LIMIT:g}x the idle p95" in text
+
+
+def test_a_process_cpu_is_read_from_proc_and_a_sleeping_one_spends_none() -> None:
+    spin = ("import time\nt = time.process_time()\nwhile time.process_time() - t < 0.5: pass\n"
+            "print('spun', flush=True)\ntime.sleep(30)")  # fmt: skip
+    child = subprocess.Popen([sys.executable, "-c", spin], stdout=subprocess.PIPE, text=True)
+    try:
+        assert child.stdout is not None and child.stdout.readline() == "spun\n"
+        first = cpu_seconds(child.pid)
+        time.sleep(0.3)
+        assert first == pytest.approx(0.5, abs=0.25)  # the interpreter's start-up on top of the spin
+        assert cpu_seconds(child.pid) - first < 0.02
+    finally:
+        child.kill()
+        child.wait()
+    assert cpu_seconds(os.getpid()) > 0
 
 
 def test_windows_are_foreign_and_take_the_families_in_turn() -> None:
