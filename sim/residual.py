@@ -14,6 +14,8 @@ where a fast transient meets a filter on one term only.
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 from numba import njit
 
@@ -40,7 +42,13 @@ def acceleration_weights(half_width: int) -> np.ndarray:
 
 
 def smoothing_weights(half_width: int) -> np.ndarray:
-    """2h + 1 weights that average a signal as the slope averages the acceleration (sums to 1)."""
+    """2h + 1 weights that average a signal as the slope averages the acceleration (sums to 1): a copy of
+    the width's one computation (a window's reads smooth ~100 times at one width)."""
+    return _smoothing_weights(half_width).copy()
+
+
+@functools.cache
+def _smoothing_weights(half_width: int) -> np.ndarray:
     return np.convolve(acceleration_weights(half_width), [0.5, 0.5])
 
 
