@@ -86,12 +86,26 @@ def shutdown() -> None:
             _BUDGET.pool = None
 
 
+_THREAD = threading.local()  # ``on_pool``: set in the pool's own threads
+
+
+def _mark_pool_thread() -> None:
+    _THREAD.on_pool = True
+
+
 def pool() -> ThreadPoolExecutor:
     """The shared pool, created on first use."""
     with _BUDGET.lock:
         if _BUDGET.pool is None:
-            _BUDGET.pool = ThreadPoolExecutor(_BUDGET.threads, thread_name_prefix="ema-sim")
+            _BUDGET.pool = ThreadPoolExecutor(_BUDGET.threads, thread_name_prefix="ema-sim",
+                                              initializer=_mark_pool_thread)  # fmt: skip
         return _BUDGET.pool
+
+
+def _inline() -> bool:
+    """Whether work must run in the calling thread: one thread, or a pool thread itself (waiting there for
+    the pool's other threads could wait for ever: each of them may be waiting too)."""
+    return threads() == 1 or getattr(_THREAD, "on_pool", False)
 
 
 # Rows of a signal batch per thread below which a split costs more than it saves (a 5000-sample row: ~30 µs).
@@ -101,9 +115,10 @@ MIN_ROWS_PER_THREAD = 8
 def run_rows(work: Callable[[int, int], None], n_rows: int) -> None:
     """``work(start, stop)`` over the rows [0, n_rows) of a signal batch, in one contiguous part per thread
     of the budget (none below ``MIN_ROWS_PER_THREAD`` rows), on the pool, inline when one part: for
-    compiled loops over independent rows that release the GIL. Waits for every part (``wait_all``)."""
+    compiled loops over independent rows that release the GIL. Waits for every part (``wait_all``); inline
+    in a pool thread."""
     parts = max(1, min(threads(), n_rows // MIN_ROWS_PER_THREAD))
-    if parts == 1:
+    if parts == 1 or _inline():
         work(0, n_rows)
         return
     edges = [round(n_rows * k / parts) for k in range(parts + 1)]
@@ -112,8 +127,8 @@ def run_rows(work: Callable[[int, int], None], n_rows: int) -> None:
 
 def map_on_pool(work: Callable[[T], R], items: Sequence[T]) -> list[R]:
     """``work`` of each item, in order, the items spread over the pool (inline with one thread or one item):
-    for independent pieces of work whose compiled loops release the GIL."""
-    if threads() == 1 or len(items) <= 1:
+    for independent pieces of work whose compiled loops release the GIL; inline in a pool thread."""
+    if _inline() or len(items) <= 1:
         return [work(item) for item in items]
     futures = [pool().submit(work, item) for item in items]
     wait_all(futures)

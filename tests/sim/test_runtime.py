@@ -41,6 +41,30 @@ def test_map_on_pool_keeps_the_items_order_and_raises_a_pieces_error():
         runtime.set_threads(before)
 
 
+NESTED = """
+from sim import runtime
+
+def rows_squared(n):
+    out = [0] * n
+    runtime.run_rows(lambda a, b: out.__setitem__(slice(a, b), [i * i for i in range(a, b)]), n)
+    return out
+
+runtime.set_threads(2)
+found = runtime.map_on_pool(lambda x: runtime.map_on_pool(rows_squared, [x, x + 20]), [16, 32, 48])
+assert found == [[[i * i for i in range(n)] for n in (x, x + 20)] for x in (16, 32, 48)], found
+"""
+
+
+def test_work_the_pool_runs_may_use_the_pool_again_without_waiting_for_ever():
+    """Each of the two pool threads maps (and splits rows) again: done in the pool thread itself, not queued
+    behind the two threads that wait for it. In a process of its own, so that a deadlock fails the test."""
+    try:
+        done = subprocess.run([sys.executable, "-c", NESTED], capture_output=True, text=True, timeout=60)
+    except subprocess.TimeoutExpired:
+        pytest.fail("the nested map waited for ever")
+    assert done.returncode == 0, done.stderr
+
+
 @pytest.mark.slow
 def test_the_interleaved_lane_loop_computes_what_the_plain_one_does():
     """``configure`` has LLVM interleave three vectors of lanes an iteration: the same arithmetic per lane, so
