@@ -4,8 +4,8 @@ The windows are the real-time benchmark's (``tests.foreign``: its own simulator,
 families), estimated in-process one after another, warm, idle. Each step is timed by wrapping the
 function the stage calls (``PARTS``: the stage, where the stage looks the function up, and what it
 does), counted only while its stage runs (a step called from two stages is two parts); what a
-stage spends outside its listed steps is its *rest*. The wrappers cost ~1 µs a call. Steps on the
-simulator's threads (the kernel, the row loops) are wall time on every thread of the budget.
+stage spends outside its listed steps is its *rest*. A wrapper adds two clock reads to a call. Steps
+on the simulator's threads (the kernel, the row loops) are wall time on every thread of the budget.
 
     python -m benchmarks.request_parts [--windows 40] [--docs]
 """

@@ -43,7 +43,7 @@ def acceleration_weights(half_width: int) -> np.ndarray:
 
 def smoothing_weights(half_width: int) -> np.ndarray:
     """2h + 1 weights that average a signal as the slope averages the acceleration (sums to 1): a copy of
-    the width's one computation (a window's reads smooth ~100 times at one width)."""
+    the width's one computation (a window's reads smooth many times at one width)."""
     return _smoothing_weights(half_width).copy()
 
 
