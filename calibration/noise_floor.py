@@ -16,6 +16,7 @@ from collections.abc import Callable, Mapping, Sequence
 import numpy as np
 
 from calibration.equations import Equations, equations
+from sim import runtime
 from sim.actuator import Actuator
 from sim.noise import SensorNoise, add_sensor_noise
 from sim.params import ActuatorParams
@@ -45,12 +46,12 @@ def noise_copies(
     on_copy: Callable[[], None] | None = None,
 ) -> list[Equations]:
     """``copies`` noisy versions of the clean replicas, each as the selection sees a window set; ``on_copy`` is
-    called before each (and may raise to stop there)."""
+    called before each draw (and may raise to stop there). The draws come from one generator in turn; their
+    equations, independent, are built on the simulator's threads."""
     rng = np.random.default_rng(seed)
-    out = []
+    drawn = []
     for _ in range(copies):
         if on_copy is not None:
             on_copy()
-        noisy = [add_sensor_noise(signals, level, rng, rate) for signals, level in zip(clean, noise, strict=True)]
-        out.append(equations(noisy, rate, orders, actuator))
-    return out
+        drawn.append([add_sensor_noise(signals, level, rng, rate) for signals, level in zip(clean, noise, strict=True)])
+    return runtime.map_on_pool(lambda noisy: equations(noisy, rate, orders, actuator), drawn)
