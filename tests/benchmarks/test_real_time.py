@@ -16,11 +16,12 @@ def test_each_row_is_its_p95_over_the_idle_one_and_over_each_yardstick() -> None
     idle = list(np.linspace(0.1, 0.2, 21))  # p95 0.195, 3.15 s in all
     loaded = [2 * x for x in idle]
     passes = {"idle": [Pass(idle[:10], 2.0), Pass(idle[10:], 2.5)], "2 busy processes": [Pass(loaded, 4.41)]}
-    text = report(passes, {"one thread": 1.95, "every thread": 0.975}, 21)
+    text = report(passes, {"one thread": 1.95, "every thread": 0.975, "every thread, loaded": 1.95}, 21)
     rows = [line for line in text.splitlines() if line.startswith(("| idle", "| 2 busy"))]
     assert rows[0] == "| idle | 0.150 | 0.195 | 1.00 | 0.100 | 0.200 | 0.214 | 1.43 |"
     assert rows[1] == "| 2 busy processes | 0.300 | 0.390 | 2.00 | 0.200 | 0.400 | 0.210 | 0.70 |"
     assert f"≤ {LOADED_LIMIT:g}x the idle p95" in text
+    assert "busy processes 1.950 s on every thread, 2.00x" in text
 
 
 def test_a_process_cpu_is_read_from_proc_and_a_sleeping_one_spends_none() -> None:
