@@ -15,7 +15,6 @@ from __future__ import annotations
 import argparse
 import contextlib
 import functools
-import gc
 import importlib
 import time
 from collections import defaultdict
@@ -23,6 +22,7 @@ from collections.abc import Callable, Iterator
 from typing import Any
 
 from benchmarks.real_time import documents
+from benchmarks.service_overhead import quiet_collector
 from clients.report import write_section
 from sim.actuator import THESIS
 from sim.window import WindowDocument
@@ -86,6 +86,17 @@ class Clock:
         return wrapper
 
 
+def resolve(key: str) -> tuple[Any, str]:
+    """(the module or class that holds it, its name) of a ``PARTS`` key, "module:function" or
+    "module:Class.method"."""
+    module_name, path = key.split(":")
+    owner: Any = importlib.import_module(module_name)
+    *classes, name = path.split(".")
+    for cls in classes:
+        owner = getattr(owner, cls)
+    return owner, name
+
+
 @contextlib.contextmanager
 def instrumented(clock: Clock) -> Iterator[None]:
     """Every function of ``PARTS`` wrapped where its stage looks it up, restored on exit."""
@@ -94,11 +105,7 @@ def instrumented(clock: Clock) -> Iterator[None]:
         stages[key].add(stage)
     originals = []
     for key, where in stages.items():
-        module_name, path = key.split(":")
-        owner: Any = importlib.import_module(module_name)
-        *classes, name = path.split(".")
-        for cls in classes:
-            owner = getattr(owner, cls)
+        owner, name = resolve(key)
         originals.append((owner, name, getattr(owner, name)))
         setattr(owner, name, clock.timed(key, where, getattr(owner, name)))
     try:
@@ -114,8 +121,7 @@ def measure(count: int, seed: int) -> tuple[dict[tuple[str, str], float], dict[s
     windows = [WindowDocument.model_validate(d).to_window() for d in documents(count, seed)]
     for window in windows[:3]:
         estimate_window(window, actuator=THESIS)
-    gc.collect()
-    gc.freeze()  # the collector's full passes over the loaded modules are not the request's
+    quiet_collector()  # the collector's full passes over the loaded modules are not the request's
     clock, stages = Clock(), defaultdict[str, float](float)
     with instrumented(clock):
         for window in windows:

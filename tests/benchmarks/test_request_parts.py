@@ -1,29 +1,18 @@
 """The request's parts: each step is found where its stage calls it, its wrapper comes off, the table adds up."""
 
-import importlib
-
 import pytest
 
-from benchmarks.request_parts import PARTS, STAGES, Clock, instrumented, measure, report
-
-
-def _owner_and_name(key: str):
-    module_name, path = key.split(":")
-    owner = importlib.import_module(module_name)
-    *classes, name = path.split(".")
-    for cls in classes:
-        owner = getattr(owner, cls)
-    return owner, name
+from benchmarks.request_parts import PARTS, STAGES, Clock, instrumented, measure, report, resolve
 
 
 def test_every_step_is_a_function_of_its_module_and_comes_off_after():
     keys = {key for _, key, _ in PARTS}
-    before = {key: getattr(*_owner_and_name(key)) for key in keys}
+    before = {key: getattr(*resolve(key)) for key in keys}
     assert all(callable(function) for function in before.values())
     assert {stage for stage, _, _ in PARTS} == set(STAGES)
     with instrumented(Clock()):
-        assert all(getattr(*_owner_and_name(key)) is not before[key] for key in keys)
-    assert all(getattr(*_owner_and_name(key)) is before[key] for key in keys)
+        assert all(getattr(*resolve(key)) is not before[key] for key in keys)
+    assert all(getattr(*resolve(key)) is before[key] for key in keys)
 
 
 def test_a_step_counts_only_while_its_stage_runs():
