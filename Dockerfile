@@ -23,19 +23,14 @@ print('\n'.join(x for x in d if not x.startswith('torch')))" > /tmp/requirements
     && pip install -r /tmp/requirements.txt
 
 # The code, installed into site-packages; the sources are not kept beside it.
-COPY sim /tmp/ema/sim
-COPY training /tmp/ema/training
-COPY calibration /tmp/ema/calibration
-COPY prognosis /tmp/ema/prognosis
-COPY service /tmp/ema/service
-COPY clients /tmp/ema/clients
+COPY ema /tmp/ema/ema
 RUN pip install --no-deps /tmp/ema && rm -rf /tmp/ema
 
 USER ema
 WORKDIR /data
 # Compile the kernels at build time, from the installed package (Numba keys its cache on the source
 # path: a warm-up of another copy would leave the service to compile at every start).
-RUN python -c "from training import runtime; runtime.configure(); from service.warmup import warm_up; warm_up()"
+RUN python -c "from ema.estimate import runtime; runtime.configure(); from ema.service.warmup import warm_up; warm_up()"
 
 VOLUME ["/data"]
 EXPOSE 8000

@@ -22,17 +22,17 @@ from typing import Any
 
 import numpy as np
 
-from calibration.calibrate import Calibrator, combined
-from clients.figures import calibration_figure
-from clients.report import write_section
-from sim.actuator import THESIS
-from sim.checks import InputError
-from sim.window import window_from_dict
+from ema.calibration.calibrate import Calibrator, combined
+from ema.cli.figures import calibration_figure
+from ema.cli.report import write_section
+from ema.estimate import runtime
+from ema.estimate.config import PipelineConfig
+from ema.estimate.pipeline import estimate_window
+from ema.model.actuator import THESIS
+from ema.model.checks import InputError
+from ema.model.window import window_from_dict
 from tests.foreign.effects import CASES
 from tests.foreign.windows import draw
-from training import runtime
-from training.config import PipelineConfig
-from training.pipeline import estimate_window
 
 DOCS = Path(__file__).resolve().parent.parent / "docs"
 FLOOR = 0.01  # |FDJ| + |η_O| relative error of clean windows: the noise floor of one window
@@ -81,10 +81,17 @@ def one(case: str, scale: float, seed: int, figure: Path | None) -> dict[str, An
     added = report.unexplained.estimates_if_added if report.unexplained else None
     if_added = relative_error(added, drawn.truth) if added else np.nan
     return {
-        "named": named, "unexplained": unexplained, "right": right, "before": before, "after": after,
-        "if_added": if_added, "without": without_effect(seed),
-        "better": after <= max(0.5 * before, FLOOR), "worse": after > max(before, FLOOR), "seconds": seconds,
-    }  # fmt: skip
+        "named": named,
+        "unexplained": unexplained,
+        "right": right,
+        "before": before,
+        "after": after,
+        "if_added": if_added,
+        "without": without_effect(seed),
+        "better": after <= max(0.5 * before, FLOOR),
+        "worse": after > max(before, FLOOR),
+        "seconds": seconds,
+    }
 
 
 def table(rows: dict[tuple[str, float], list[dict[str, Any]]]) -> str:
@@ -123,11 +130,26 @@ def study(scales: list[float], seeds: int, figures: bool) -> Rows:
                 try:
                     rows[case, scale].append(one(case, scale, 5000 + 100 * c + s, figure))
                 except InputError as exc:  # a window the pipeline refuses (no sliding at all): counted as a miss
-                    rows[case, scale].append({"named": f"refused: {exc.field}", "unexplained": [], "right": False,
-                                              "before": np.nan, "after": np.nan, "better": False, "worse": False,
-                                              "if_added": np.nan, "without": np.nan, "seconds": np.nan})  # fmt: skip
-            print(case, scale, [(r["named"], round(r["before"], 3), round(r["after"], 3)) for r in rows[case, scale]],
-                  flush=True)  # fmt: skip
+                    rows[case, scale].append(
+                        {
+                            "named": f"refused: {exc.field}",
+                            "unexplained": [],
+                            "right": False,
+                            "before": np.nan,
+                            "after": np.nan,
+                            "better": False,
+                            "worse": False,
+                            "if_added": np.nan,
+                            "without": np.nan,
+                            "seconds": np.nan,
+                        }
+                    )
+            print(
+                case,
+                scale,
+                [(r["named"], round(r["before"], 3), round(r["after"], 3)) for r in rows[case, scale]],
+                flush=True,
+            )
     return rows
 
 
@@ -136,29 +158,33 @@ def summary(rows: Rows, seeds: int, seconds: list[float]) -> str:
     at_one = [r for (case, scale), runs in rows.items() if scale == 1.0 and case != "clean" for r in runs]
     missed = [r for r in at_one if not r["better"]]
     at_own_floor = sum(r["after"] <= OWN_FLOOR * r["without"] for r in missed)
-    return "\n".join([
-        f"{seeds} windows per effect and size, one window per calibration, 0.5 s at 10 kHz from",
-        "`tests/foreign` (thesis commands, its own noise), effects in its own forms (`tests/foreign/effects.py`);",
-        "sizes relative to those the calibration issue reported. *Right name*: the effect named (clean: none;",
-        "drift: none, and described as following time). Errors are |FDJ| + |η_O| relative errors, before",
-        "(the document's model alone: `ema estimate` without its offset and viscous reads) and after",
-        "(re-estimated with what was adopted). Where no name fits and the residual follows one variable, the",
-        "described curve is adopted as a named effect would be (a simulator term, re-estimated, held-out folds",
-        "better); where the windows cannot tell which variable it follows, the base model is kept and the",
-        "report only offers the curve (`unexplained.estimates_if_added`): *described, with its term* is the",
-        "error of those estimates. A current sensor off zero is a sensor fault, not wear: *right name* is",
-        "`current_sensor_offset`.",
-        "",
-        table(rows),
-        "",
-        f"At 1x, over all effects: right name {sum(r['right'] for r in at_one)}/{len(at_one)}, error halved or",
-        f"at the floor {sum(r['better'] for r in at_one)}/{len(at_one)}, made worse {sum(r['worse'] for r in at_one)}/"
-        f"{len(at_one)}; of the {len(missed)} not halved, {at_own_floor} end within {OWN_FLOOR - 1:.0%} of the same",
-        "window's error without the effect (its command and noise, the base model): the effect is out, and",
-        f"what is left is that window's own floor. One calibration: median {np.median(seconds):.1f} s,",
-        f"max {max(seconds):.1f} s on this machine (2 cores). Figures: `docs/figures/calibration_<effect>.png`",
-        "(the equation error before and after, against the variable the effect follows).",
-    ])  # fmt: skip
+    return "\n".join(
+        [
+            f"{seeds} windows per effect and size, one window per calibration, 0.5 s at 10 kHz from",
+            "`tests/foreign` (thesis commands, its own noise), effects in its own forms (`tests/foreign/effects.py`);",
+            "sizes relative to those the calibration issue reported. *Right name*: the effect named (clean: none;",
+            "drift: none, and described as following time). Errors are |FDJ| + |η_O| relative errors, before",
+            "(the document's model alone: `ema estimate` without its offset and viscous reads) and after",
+            "(re-estimated with what was adopted). Where no name fits and the residual follows one variable, the",
+            "described curve is adopted as a named effect would be (a simulator term, re-estimated, held-out folds",
+            "better); where the windows cannot tell which variable it follows, the base model is kept and the",
+            "report only offers the curve (`unexplained.estimates_if_added`): *described, with its term* is the",
+            "error of those estimates. A current sensor off zero is a sensor fault, not wear: *right name* is",
+            "`current_sensor_offset`.",
+            "",
+            table(rows),
+            "",
+            f"At 1x, over all effects: right name {sum(r['right'] for r in at_one)}/{len(at_one)}, error halved or",
+            f"at the floor {sum(r['better'] for r in at_one)}/{len(at_one)}, "
+            f"made worse {sum(r['worse'] for r in at_one)}/"
+            f"{len(at_one)}; of the {len(missed)} not halved, {at_own_floor} end within {OWN_FLOOR - 1:.0%} of the "
+            f"same",
+            "window's error without the effect (its command and noise, the base model): the effect is out, and",
+            f"what is left is that window's own floor. One calibration: median {np.median(seconds):.1f} s,",
+            f"max {max(seconds):.1f} s on this machine (2 cores). Figures: `docs/figures/calibration_<effect>.png`",
+            "(the equation error before and after, against the variable the effect follows).",
+        ]
+    )
 
 
 def main() -> None:

@@ -15,8 +15,8 @@ from dataclasses import replace
 from benchmarks.foreign_accuracy import RESULTS_MD, run_one
 from benchmarks.foreign_groups import group_seed, groups
 from benchmarks.tails import BOUND
-from clients.report import write_section
-from sim import runtime
+from ema.cli.report import write_section
+from ema.model import runtime
 from tests.foreign.careless import SLIPS, Slip, exported
 from tests.foreign.windows import Draw
 
@@ -68,28 +68,28 @@ def report(counts: dict[str, Counter], per_slip: int, seconds: float) -> str:
         "past it says so; *confidently wrong* if one past it does not. A hinge moment in lbf·ft (0.74x) is",
         "much what η_O 0.74x as high would read in Eq. 5.1; the part of it that follows the deflection is",
         "0.74x the aircraft model's at the window's flight condition",
-        "(`training.prepare.departures.aircraft_check`), which",
+        "(`ema.estimate.prepare.departures.aircraft_check`), which",
         "reads the gauge's gain, and a moment out of step by its lag, unless its deflection moves slowly. There",
         "Eq. 5.1 fits the moment read at its lag a few % better at most, too little to refuse the window; that",
         "story is weighed by the likelihood ratio and its gap goes into the stds",
-        "(`training.prepare.step_lag`): a 20 ms",
+        "(`ema.estimate.prepare.step_lag`): a 20 ms",
         "slip was answered FDJ 13 % of range off at 2.7 std before. At 5 ms the ratio often cannot tell it from",
         "the noise; the lag the deflection's band reads decides most of those (3 confidently wrong before it).",
         "A window too short to divide the aircraft's ratio out is read as logged and with it divided out first,",
-        "the stds carrying the gap (`training.prepare.departures.read`; 2 confidently wrong 0.1 s gusts before).",
+        "the stds carrying the gap (`ema.estimate.prepare.departures.read`; 2 confidently wrong 0.1 s gusts before).",
         "A current a tenth reads as a motor 10x stronger and a rotor 0.1x as heavy, which no drive",
-        "has (`training.prepare.departures.drive_constants`); one 0.71x (RMS for amplitude) reads as a motor",
+        "has (`ema.estimate.prepare.departures.drive_constants`); one 0.71x (RMS for amplitude) reads as a motor",
         "1.41x as strong, or as",
         "well as a rotor ~0.7x as heavy with other friction: the window cannot tell them apart, and the stds carry",
         "the gap between the two readings (7 answers were confidently wrong before). Where Eq. 5.1 then puts η_O",
-        "at its search bound, η_O and FDJ are said weak (`training.report`; a 0.1 s gust read η_O 0.999 ± 0.009,",
+        "at its search bound, η_O and FDJ are said weak (`ema.estimate.report`; a 0.1 s gust read η_O 0.999 ± 0.009,",
         "the truth 0.70, before).",
         f"Total {seconds:.0f} s.",
         "",
         "| export | refused, naming it | refused, naming another field | answered: within the bound or said weak "
         "| answered, confidently wrong |",
         "|---|---:|---:|---:|---:|",
-    ]  # fmt: skip
+    ]
     for slip, seen in counts.items():
         other = sum(n for key, n in seen.items() if key.startswith("other"))
         fields = ", ".join(sorted({key.split(": ")[1] for key in seen if key.startswith("other")}))

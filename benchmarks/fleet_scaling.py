@@ -1,7 +1,7 @@
 """ema fleet's throughput against Ray workers, the overhead per task, and the cluster a fleet-day needs.
 
 An archive of 40 windows from 4 actuators (0.5 s, 10 kHz, realistic noise) goes through
-``clients.fleet.run_fleet`` with 1 and then 2 workers, each a fresh local Ray started inside the
+``ema.cli.fleet.run_fleet`` with 1 and then 2 workers, each a fresh local Ray started inside the
 timing (start-up included, as ``ema fleet`` pays it), in one run. The overhead per task is a
 no-op task's round trip on the same Ray. The projection: 100 aircraft x 2 elevator EMAs x a
 window every 20 s over 10 flight hours = 360 000 windows a day.
@@ -16,13 +16,13 @@ import tempfile
 import time
 from pathlib import Path
 
-from clients.fleet import run_fleet
-from clients.report import write_section
-from sim.params import HealthParams
-from sim.runtime import available_cores
-from sim.synthetic import synthetic_window
-from sim.window import Window
-from training.config import PipelineConfig
+from ema.cli.fleet import run_fleet
+from ema.cli.report import write_section
+from ema.estimate.config import PipelineConfig
+from ema.model.params import HealthParams
+from ema.model.runtime import available_cores
+from ema.model.synthetic import synthetic_window
+from ema.model.window import Window
 
 FLEET_DAY = 100 * 2 * (10 * 3600 // 20)  # windows a day
 
@@ -71,24 +71,27 @@ def main() -> None:
     cores = available_cores()
     per_core = two / cores
     needed = FLEET_DAY / 86_400 / per_core
-    body = "\n".join([
-        f"{args.windows} windows from 4 actuators (0.5 s at 10 kHz, realistic noise), default pipeline sizes, a",
-        f"fresh local Ray per row (start-up included), on {cores} cores; each worker is one core (a task reserves",
-        "and pins one thread).",
-        "",
-        "| workers | windows/s | vs 1 worker | no-op task overhead |",
-        "|---:|---:|---:|---:|",
-        f"| 1 | {one:.2f} | 1.00x | {1e3 * overhead_1:.1f} ms |",
-        f"| 2 | {two:.2f} | {two / one:.2f}x | {1e3 * overhead_2:.1f} ms |",
-        "",
-        f"Projection: a fleet-day of {FLEET_DAY:,} windows (100 aircraft x 2 EMAs x a window every 20 s over",
-        f"10 flight hours) needs {FLEET_DAY / 86_400:.1f} windows/s; at {per_core:.2f} windows/s per core (2 workers",
-        f"here) that is **{needed:.0f} cores** working around the clock. What stops linear scaling: on this",
-        "machine, the two cores are all there is (and Ray's own processes take a little of them); on a",
-        "cluster each worker brings its own core, and the limits are the driver reading the archive and",
-        "streaming results into one CSV (a few ms per task against ~1 s of work) and, past that, the archive's",
-        "I/O: shard the archive across drivers well before that.",
-    ])  # fmt: skip
+    body = "\n".join(
+        [
+            f"{args.windows} windows from 4 actuators (0.5 s at 10 kHz, realistic noise), default pipeline sizes, a",
+            f"fresh local Ray per row (start-up included), on {cores} cores; each worker is one core (a task reserves",
+            "and pins one thread).",
+            "",
+            "| workers | windows/s | vs 1 worker | no-op task overhead |",
+            "|---:|---:|---:|---:|",
+            f"| 1 | {one:.2f} | 1.00x | {1e3 * overhead_1:.1f} ms |",
+            f"| 2 | {two:.2f} | {two / one:.2f}x | {1e3 * overhead_2:.1f} ms |",
+            "",
+            f"Projection: a fleet-day of {FLEET_DAY:,} windows (100 aircraft x 2 EMAs x a window every 20 s over",
+            f"10 flight hours) needs {FLEET_DAY / 86_400:.1f} windows/s; at {per_core:.2f} windows/s per core (2 "
+            f"workers",
+            f"here) that is **{needed:.0f} cores** working around the clock. What stops linear scaling: on this",
+            "machine, the two cores are all there is (and Ray's own processes take a little of them); on a",
+            "cluster each worker brings its own core, and the limits are the driver reading the archive and",
+            "streaming results into one CSV (a few ms per task against ~1 s of work) and, past that, the archive's",
+            "I/O: shard the archive across drivers well before that.",
+        ]
+    )
     print(body)
     if args.docs:
         write_section("Fleet throughput (Ray)", "python -m benchmarks.fleet_scaling --docs", body)

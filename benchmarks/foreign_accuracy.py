@@ -22,15 +22,15 @@ import numpy as np
 
 from benchmarks.foreign_groups import group_seed, groups
 from benchmarks.tails import BOUND, FIRST_NOISE_SEED, expected_over
-from clients.report import write_section
-from sim import runtime
-from sim.actuator import THESIS
-from sim.checks import InputError
-from sim.window import window_from_dict
+from ema.cli.report import write_section
+from ema.estimate.documents import HistoryReadings
+from ema.estimate.pipeline import estimate_window
+from ema.estimate.report import WEAK_SHARE_OF_RANGE, share_of_range
+from ema.model import runtime
+from ema.model.actuator import THESIS
+from ema.model.checks import InputError
+from ema.model.window import window_from_dict
 from tests.foreign.windows import Draw
-from training.documents import HistoryReadings
-from training.pipeline import estimate_window
-from training.report import WEAK_SHARE_OF_RANGE, share_of_range
 
 RESULTS_MD = Path(__file__).resolve().parent.parent / "docs" / "results.md"
 
@@ -49,8 +49,13 @@ def run_one(window: Draw, history: HistoryReadings | None = None) -> dict[str, A
         if entry is None or entry["std"] is None:
             continue
         error = entry["value"] - window.truth[name]
-        row[name] = {"relative": error / window.truth[name], "z": error / entry["std"], "truth": window.truth[name],
-                     "value": entry["value"], "std": entry["std"]}  # fmt: skip
+        row[name] = {
+            "relative": error / window.truth[name],
+            "z": error / entry["std"],
+            "truth": window.truth[name],
+            "value": entry["value"],
+            "std": entry["std"],
+        }
         if name in ("FDJ", "eta_O"):
             row[name]["of_range"] = share_of_range(name, error, ranges=THESIS.ranges)
             row[name]["weak"] = entry["weakly_determined"]
@@ -99,9 +104,11 @@ def _expected(s: dict[str, Any]) -> str:
 
 def table(summaries: dict[str, dict[str, Any]]) -> str:
     header = "| windows | answered | FDJ mean / worst error | η_O mean / worst error | ±2 std coverage FDJ / η_O "
-    lines = [header + f"| over {100 * BOUND:.0f} % of range FDJ / η_O (said weak) "
-             "| expected from the stds FDJ / η_O (not weak) | FSJ given: coverage |",
-             "|---|---:|---:|---:|---:|---:|---:|---:|"]  # fmt: skip
+    lines = [
+        header + f"| over {100 * BOUND:.0f} % of range FDJ / η_O (said weak) "
+        "| expected from the stds FDJ / η_O (not weak) | FSJ given: coverage |",
+        "|---|---:|---:|---:|---:|---:|---:|---:|",
+    ]
     for name, s in summaries.items():
         if "FDJ" not in s:
             lines.append(f"| {name} | {s['answered']}/{s['n']} (refused: too little motion) | — | — | — | — | — | — |")
@@ -140,12 +147,16 @@ def redrawn_tails(rows: dict[str, list[dict[str, Any]]], seed: int, count: int) 
 
 
 def tails_table(found: list[dict[str, Any]], count: int) -> str:
-    lines = [f"| window | parameter | z as logged | {count} fresh draws of its noise: RMS z / worst abs(z) |",
-             "|---|---|---:|---:|"]  # fmt: skip
+    lines = [
+        f"| window | parameter | z as logged | {count} fresh draws of its noise: RMS z / worst abs(z) |",
+        "|---|---|---:|---:|",
+    ]
     for f in found:
         z = f["redrawn"]
-        lines.append(f"| {f['window']} | {f['parameter'].replace('eta_O', 'η_O')} | {f['z']:+.1f} "
-                     f"| {np.sqrt(np.mean(z**2)):.2f} / {np.abs(z).max():.2f} |")  # fmt: skip
+        lines.append(
+            f"| {f['window']} | {f['parameter'].replace('eta_O', 'η_O')} | {f['z']:+.1f} "
+            f"| {np.sqrt(np.mean(z**2)):.2f} / {np.abs(z).max():.2f} |"
+        )
     return "\n".join(lines)
 
 
@@ -159,8 +170,10 @@ WEAR_BINS = ((0.8, 1.2), (1.3, 1.7), (1.7, 2.1), (2.1, 2.5))  # FDJ / nominal
 
 def wear_table(rows: dict[str, list[dict[str, Any]]]) -> str:
     """Error and coverage against wear: windows grouped by FDJ over its nominal 0.05 N·m."""
-    lines = ["| FDJ / nominal | windows | FDJ mean / worst | η_O mean / worst | ±2 std coverage FDJ / η_O |",
-             "|---|---:|---:|---:|---:|"]  # fmt: skip
+    lines = [
+        "| FDJ / nominal | windows | FDJ mean / worst | η_O mean / worst | ±2 std coverage FDJ / η_O |",
+        "|---|---:|---:|---:|---:|",
+    ]
     every = [r for rs in rows.values() for r in rs if "FDJ" in r]
     for low, high in WEAR_BINS:
         found = [r for r in every if low <= r["FDJ"]["truth"] / 0.05 < high]
@@ -185,11 +198,20 @@ def wear_figure(rows: dict[str, list[dict[str, Any]]], path: Path) -> None:
     figure, axes = plt.subplots(1, 2, figsize=(10, 4.5))
     for axis, name, label in zip(axes, ("FDJ", "eta_O"), ("FDJ [N·m]", "η_O"), strict=True):
         for group, colour in (("worn", "tab:red"), ("healthy", "tab:blue")):
-            found = [r[name] for g, rs in rows.items() for r in rs
-                     if name in r and g.startswith("worn") == (group == "worn")]  # fmt: skip
+            found = [
+                r[name] for g, rs in rows.items() for r in rs if name in r and g.startswith("worn") == (group == "worn")
+            ]
             truth = np.array([f["truth"] for f in found])
-            axis.errorbar(truth, [f["value"] for f in found], yerr=2 * np.array([f["std"] for f in found]),
-                          fmt="o", ms=3, lw=0.8, color=colour, label=f"{group} ({len(found)})")  # fmt: skip
+            axis.errorbar(
+                truth,
+                [f["value"] for f in found],
+                yerr=2 * np.array([f["std"] for f in found]),
+                fmt="o",
+                ms=3,
+                lw=0.8,
+                color=colour,
+                label=f"{group} ({len(found)})",
+            )
         low, high = axis.get_xlim()
         axis.plot([low, high], [low, high], color="grey", lw=1)
         axis.set(xlabel=f"true {label}", ylabel=f"estimated {label} (± 2 std)")
@@ -201,41 +223,44 @@ def wear_figure(rows: dict[str, list[dict[str, Any]]], path: Path) -> None:
 
 
 # What each group of the accuracy table holds, for the docs section.
-GROUPS_TEXT = "\n".join([
-    "windows per group (3 held positions), drawn by `tests/foreign` (an independent",
-    "implementation of the model: exact RL step, RK4 aircraft from the instantaneous deflection, trim at",
-    "true airspeed, 100 kHz command table, its own sensor noise and quantization), health uniform in",
-    "Table 3.1's ranges (worn: FDJ 1.3–2.5x nominal, η_O 0.45–0.66), random flight condition; default",
-    "pipeline sizes. *Drive unlike the document's*: the five families, with a loop that departs from the",
-    "document's and from every simulation the pipeline runs, unlogged (bus ±10 %, position gain ±2 %, up",
-    "to 50 µs of lag, a speed read with up to 0.5 rad/s of noise: `unlike_the_spec`). *Sensors behind",
-    "filters*: the five families, each sensor's signal and noise through a causal moving average, as a",
-    "real filter passes them (current 2–6 samples, speed and position 2–8, the hinge moment 10–40:",
-    "`through_filters`, `filter_widths`): logged up to 2 ms late, the noise's low frequencies carrying",
-    "up to 40x the power of white noise of the same std. *Noise behind filters, not the signal*: the",
-    "same filters on the noise alone (`draw(filter_samples=...)`), as an amplifier's own noise behind its",
-    "output filter would be: the noise reads as a filter's delay either way, and the product weighs the two",
-    "readings by the lag the deflection shows in the aircraft's band and by the equation error",
-    "(`training.prepare.alignment`), its stds carrying both where neither decides.",
-    "*Sensor glitches*: the five families with",
-    "1–5 spikes of 50–500 noise stds on each sensor, one in four two samples long (`with_spikes`).",
-    "*Sensors off zero*: the five families with the hinge moment 1–10 N·m or the current 0.04–0.25 A",
-    "off zero, in turn (`off_zero`), read and taken off per window (`training.prepare.departures.zero_offset`).",
-    "*Viscous friction 1.2–2x the document's*: the five families with C above the document's, as a cold grease",
-    "has it (`viscous`), read per window and used by every estimator",
-    "(`training.prepare.departures.viscosity`). The",
-    "*worn* groups with these two: a worn transmission's k = 1/η_O − 1 reaches 1.2, and so does the",
-    "share of a hinge offset that passes for FDJ where the window cannot tell which sensor is off.",
-    "*k_T, current gain or J_M off*: the five families with, in turn, k_T 0.95–1.05x the document's (magnets",
-    "warm or cold), the current sensor's gain 0.97–1.03 and J_M 0.9–1.1x (`drive_off`), read per window",
-    "and corrected (`training.prepare.departures.drive_constants`); and on worn actuators. *Hinge moment",
-    "gain*: the five",
-    "families with the hinge moment logged 0.95–1.05x the true one (`with_hinge_gain`), read per window",
-    "from Eq. 5.1's aiding and opposing load terms with Eq. 3.4 and corrected",
-    "(`training.prepare.departures.hinge_gain`).",
-    "*Longest window*: the five families over 10 s, the longest the issue names, processed at 5 kHz (the",
-    "pipeline averages a long log down, not below 5 kHz up to 10 s: `training.prepare.conditioning`).",
-])  # fmt: skip
+GROUPS_TEXT = "\n".join(
+    [
+        "windows per group (3 held positions), drawn by `tests/foreign` (an independent",
+        "implementation of the model: exact RL step, RK4 aircraft from the instantaneous deflection, trim at",
+        "true airspeed, 100 kHz command table, its own sensor noise and quantization), health uniform in",
+        "Table 3.1's ranges (worn: FDJ 1.3–2.5x nominal, η_O 0.45–0.66), random flight condition; default",
+        "pipeline sizes. *Drive unlike the document's*: the five families, with a loop that departs from the",
+        "document's and from every simulation the pipeline runs, unlogged (bus ±10 %, position gain ±2 %, up",
+        "to 50 µs of lag, a speed read with up to 0.5 rad/s of noise: `unlike_the_spec`). *Sensors behind",
+        "filters*: the five families, each sensor's signal and noise through a causal moving average, as a",
+        "real filter passes them (current 2–6 samples, speed and position 2–8, the hinge moment 10–40:",
+        "`through_filters`, `filter_widths`): logged up to 2 ms late, the noise's low frequencies carrying",
+        "up to 40x the power of white noise of the same std. *Noise behind filters, not the signal*: the",
+        "same filters on the noise alone (`draw(filter_samples=...)`), as an amplifier's own noise behind its",
+        "output filter would be: the noise reads as a filter's delay either way, and the product weighs the two",
+        "readings by the lag the deflection shows in the aircraft's band and by the equation error",
+        "(`ema.estimate.prepare.alignment`), its stds carrying both where neither decides.",
+        "*Sensor glitches*: the five families with",
+        "1–5 spikes of 50–500 noise stds on each sensor, one in four two samples long (`with_spikes`).",
+        "*Sensors off zero*: the five families with the hinge moment 1–10 N·m or the current 0.04–0.25 A",
+        "off zero, in turn (`off_zero`), read and taken off per window "
+        "(`ema.estimate.prepare.departures.zero_offset`).",
+        "*Viscous friction 1.2–2x the document's*: the five families with C above the document's, as a cold grease",
+        "has it (`viscous`), read per window and used by every estimator",
+        "(`ema.estimate.prepare.departures.viscosity`). The",
+        "*worn* groups with these two: a worn transmission's k = 1/η_O − 1 reaches 1.2, and so does the",
+        "share of a hinge offset that passes for FDJ where the window cannot tell which sensor is off.",
+        "*k_T, current gain or J_M off*: the five families with, in turn, k_T 0.95–1.05x the document's (magnets",
+        "warm or cold), the current sensor's gain 0.97–1.03 and J_M 0.9–1.1x (`drive_off`), read per window",
+        "and corrected (`ema.estimate.prepare.departures.drive_constants`); and on worn actuators. *Hinge moment",
+        "gain*: the five",
+        "families with the hinge moment logged 0.95–1.05x the true one (`with_hinge_gain`), read per window",
+        "from Eq. 5.1's aiding and opposing load terms with Eq. 3.4 and corrected",
+        "(`ema.estimate.prepare.departures.hinge_gain`).",
+        "*Longest window*: the five families over 10 s, the longest the issue names, processed at 5 kHz (the",
+        "pipeline averages a long log down, not below 5 kHz up to 10 s: `ema.estimate.prepare.conditioning`).",
+    ]
+)
 
 
 def report(rows: dict[str, list[dict[str, Any]]], per_group: int, seconds: float, tails: str) -> str:
@@ -243,37 +268,40 @@ def report(rows: dict[str, list[dict[str, Any]]], per_group: int, seconds: float
     summaries = {name: summarize(r) for name, r in rows.items()}
     summaries["all flight windows (not worn)"] = pooled(rows, worn_only=False)
     summaries["all worn windows"] = pooled(rows, worn_only=True)
-    return "\n".join([
-        f"{per_group} {GROUPS_TEXT}",
-        f"Total {seconds:.0f} s.",
-        "",
-        table(summaries),
-        "",
-        f"*Over {100 * BOUND:.0f} % of range*: answers whose error passes that share of the thesis's range, and in",
-        f"brackets how many of them said so themselves: their ±2 std spans more than {100 * WEAK_SHARE_OF_RANGE:.0f} %"
-        " of the range and",
-        "a note calls the parameter weakly determined by the window. A 0.1 s window, a 1–2 kHz log or a",
-        "hinge moment of a few N·m (the load term then a few tenths of a mN·m) holds little of η_O, and",
-        "extrapolating the friction line to zero load from a high, steady load holds little of FDJ.",
-        "*Expected from the stds*: how many errors past 10 % of the range the answers' own stds promise",
-        "(Σ erfc(10 % / (std·√2)) over the group's answers, in brackets over those not said weak:",
-        "`benchmarks.tails`); more observed than expected would mean stds too narrow in the tails.",
-        "How many such errors the sensor noise alone makes unavoidable: `benchmarks.information_limit`",
-        "(next section).",
-        "",
-        "The answers past 10 % of range not said weak, each answered again with fresh realizations of its",
-        "window's sensor noise (the same motion, noise levels and filters: `draw(noise_seed=...)`): a tail",
-        "of the noise reads |z| about 1 again, a bias the window carries keeps its z.",
-        "",
-        tails,
-        "",
-        "Against wear (every answered window, grouped by its true FDJ over the nominal 0.05 N·m; the worn",
-        "windows reach η_O 0.45, Case 1C's irreversible range, where η_A < 0):",
-        "",
-        wear_table(rows),
-        "",
-        "![estimate against truth over the wear range](figures/wear_parity.png)",
-    ])  # fmt: skip
+    return "\n".join(
+        [
+            f"{per_group} {GROUPS_TEXT}",
+            f"Total {seconds:.0f} s.",
+            "",
+            table(summaries),
+            "",
+            f"*Over {100 * BOUND:.0f} % of range*: answers whose error passes that share of the thesis's range, and in",
+            "brackets how many of them said so themselves: their ±2 std spans more than "
+            f"{100 * WEAK_SHARE_OF_RANGE:.0f} %"
+            " of the range and",
+            "a note calls the parameter weakly determined by the window. A 0.1 s window, a 1–2 kHz log or a",
+            "hinge moment of a few N·m (the load term then a few tenths of a mN·m) holds little of η_O, and",
+            "extrapolating the friction line to zero load from a high, steady load holds little of FDJ.",
+            "*Expected from the stds*: how many errors past 10 % of the range the answers' own stds promise",
+            "(Σ erfc(10 % / (std·√2)) over the group's answers, in brackets over those not said weak:",
+            "`benchmarks.tails`); more observed than expected would mean stds too narrow in the tails.",
+            "How many such errors the sensor noise alone makes unavoidable: `benchmarks.information_limit`",
+            "(next section).",
+            "",
+            "The answers past 10 % of range not said weak, each answered again with fresh realizations of its",
+            "window's sensor noise (the same motion, noise levels and filters: `draw(noise_seed=...)`): a tail",
+            "of the noise reads |z| about 1 again, a bias the window carries keeps its z.",
+            "",
+            tails,
+            "",
+            "Against wear (every answered window, grouped by its true FDJ over the nominal 0.05 N·m; the worn",
+            "windows reach η_O 0.45, Case 1C's irreversible range, where η_A < 0):",
+            "",
+            wear_table(rows),
+            "",
+            "![estimate against truth over the wear range](figures/wear_parity.png)",
+        ]
+    )
 
 
 def main() -> None:
@@ -297,8 +325,12 @@ def main() -> None:
     print(body)
     if args.docs:
         wear_figure(rows, RESULTS_MD.parent / "figures" / "wear_parity.png")
-        write_section("Accuracy on windows our code did not draw", "python -m benchmarks.foreign_accuracy --docs",
-                      body, RESULTS_MD)  # fmt: skip
+        write_section(
+            "Accuracy on windows our code did not draw",
+            "python -m benchmarks.foreign_accuracy --docs",
+            body,
+            RESULTS_MD,
+        )
 
 
 if __name__ == "__main__":

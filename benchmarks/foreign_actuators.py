@@ -20,14 +20,14 @@ from typing import Any
 
 import numpy as np
 
-from clients.report import write_section
-from sim import runtime
-from sim.actuator import THESIS, actuator_from_dict
-from sim.checks import InputError
-from sim.window import window_from_dict
+from ema.cli.report import write_section
+from ema.estimate.pipeline import estimate_window
+from ema.model import runtime
+from ema.model.actuator import THESIS, actuator_from_dict
+from ema.model.checks import InputError
+from ema.model.window import window_from_dict
 from tests.foreign.actuators import DRIVES, NOMINAL, document
 from tests.foreign.windows import Ground, draw
-from training.pipeline import estimate_window
 
 RESULTS_MD = Path(__file__).resolve().parent.parent / "docs" / "results.md"
 # Per block: what the hidden set holds of each actuator (6 in flight, 2 sweeps, 2 bench runs).
@@ -55,8 +55,11 @@ def run_one(name: str, condition: str, seed: int) -> dict[str, Any]:
         return {"refused": str(exc)}
     fdj, eta_o = result.estimates.FDJ, result.estimates.eta_O
     fdj_error = fdj.value - drawn.truth["FDJ"]
-    row: dict[str, Any] = {"fdj_relative": fdj_error / drawn.truth["FDJ"], "fdj_z": fdj_error / fdj.std,
-                           "eta_read": eta_o is not None}  # fmt: skip
+    row: dict[str, Any] = {
+        "fdj_relative": fdj_error / drawn.truth["FDJ"],
+        "fdj_z": fdj_error / fdj.std,
+        "eta_read": eta_o is not None,
+    }
     if eta_o is not None and eta_o.std:
         eta_error = eta_o.value - drawn.truth["eta_O"]
         row |= {"eta_error": eta_error, "eta_z": eta_error / eta_o.std}
@@ -73,12 +76,17 @@ def summary(rows: list[dict[str, Any]]) -> dict[str, Any]:
         return float(np.mean(values <= 2.0)) if len(values) else np.nan
 
     return {
-        "n": len(rows), "answered": len(answered), "eta_read": sum(r["eta_read"] for r in answered),
-        "fdj_mean": float(fdj.mean()) if len(fdj) else np.nan, "fdj_worst": float(fdj.max()) if len(fdj) else np.nan,
-        "eta_mean": float(eta.mean()) if len(eta) else np.nan, "eta_worst": float(eta.max()) if len(eta) else np.nan,
-        "fdj_cover": cover("fdj_z"), "eta_cover": cover("eta_z"),
+        "n": len(rows),
+        "answered": len(answered),
+        "eta_read": sum(r["eta_read"] for r in answered),
+        "fdj_mean": float(fdj.mean()) if len(fdj) else np.nan,
+        "fdj_worst": float(fdj.max()) if len(fdj) else np.nan,
+        "eta_mean": float(eta.mean()) if len(eta) else np.nan,
+        "eta_worst": float(eta.max()) if len(eta) else np.nan,
+        "fdj_cover": cover("fdj_z"),
+        "eta_cover": cover("eta_z"),
         "refusals": [r["refused"] for r in rows if "refused" in r][:3],
-    }  # fmt: skip
+    }
 
 
 def markdown(table: dict[tuple[str, str], dict[str, Any]], blocks: int, seconds: float) -> str:
@@ -98,8 +106,10 @@ def markdown(table: dict[tuple[str, str], dict[str, Any]], blocks: int, seconds:
         eta = "—" if np.isnan(s["eta_mean"]) else f"{s['eta_mean']:.4f} / {s['eta_worst']:.4f}"
         eta_cover = "—" if np.isnan(s["eta_cover"]) else f"{100 * s['eta_cover']:.0f} %"
         fdj = f"{100 * s['fdj_mean']:.2f} % / {100 * s['fdj_worst']:.2f} %"
-        lines.append(f"| {name} | {condition} | {s['answered']}/{s['n']} | {s['eta_read']} | {fdj} | {eta} | "
-                     f"{100 * s['fdj_cover']:.0f} % / {eta_cover} |")  # fmt: skip
+        lines.append(
+            f"| {name} | {condition} | {s['answered']}/{s['n']} | {s['eta_read']} | {fdj} | {eta} | "
+            f"{100 * s['fdj_cover']:.0f} % / {eta_cover} |"
+        )
     return "\n".join(lines)
 
 

@@ -22,17 +22,17 @@ import numpy as np
 
 from benchmarks.foreign_groups import FAMILIES
 from benchmarks.tails import BOUND
-from clients.report import write_section
-from prognosis.documents import Prognosis, Stored
-from prognosis.prognose import Thresholds, prognose
-from sim import runtime
-from sim.actuator import THESIS
-from sim.checks import InputError
-from sim.window import window_from_dict
+from ema.cli.report import write_section
+from ema.estimate.history import readings_of
+from ema.estimate.pipeline import estimate_window
+from ema.estimate.report import share_of_range
+from ema.model import runtime
+from ema.model.actuator import THESIS
+from ema.model.checks import InputError
+from ema.model.window import window_from_dict
+from ema.prognosis.documents import Prognosis, Stored
+from ema.prognosis.prognose import Thresholds, prognose
 from tests.foreign.windows import Draw, Effects, Health, draw
-from training.history import readings_of
-from training.pipeline import estimate_window
-from training.report import share_of_range
 
 PROGNOSIS_MD = Path(__file__).resolve().parent.parent / "docs" / "prognosis.md"
 FIRST_SEED = 200_000  # apart from every other benchmark's and the tests'
@@ -65,7 +65,7 @@ three windows a flight, 0.3 h apart, their current sensor 0.04–0.2 A off zero,
 (`flight_id`): a window moving one way cannot read that, and is read with the zero an earlier window
 of its flight read.
 Every window goes through `estimate_window` with what the actuator's earlier windows read
-(`training.history`), and the history through `prognose`, as the service does
+(`ema.estimate.history`), and the history through `prognose`, as the service does
 (`benchmarks/foreign_history.py`). Per actuator: its windows' FDJ
 answers said weak, past 10 % of the range, and past it without saying so; the trend's level at the
 last window against the truth there (error in % of the range and in the trend's stds); the true
@@ -100,8 +100,12 @@ WINDOWS_PER_FLIGHT = 3  # of an actuator whose sensor's zero changes by flight, 
 def wear(actuator: int, kind: str = "linear") -> Wear:
     """A wearing actuator's (``KINDS_OF_WEAR``), or a healthy one's (the same start, no wear)."""
     rng = np.random.default_rng(FIRST_SEED + actuator)
-    fdj, fdj_h, eta_o, eta_o_h = (rng.uniform(0.045, 0.055), SPAN_H * rng.uniform(1.5, 4.0), rng.uniform(0.85, 0.95),
-                                  SPAN_H * rng.uniform(1.5, 4.0))  # fmt: skip
+    fdj, fdj_h, eta_o, eta_o_h = (
+        rng.uniform(0.045, 0.055),
+        SPAN_H * rng.uniform(1.5, 4.0),
+        rng.uniform(0.85, 0.95),
+        SPAN_H * rng.uniform(1.5, 4.0),
+    )
     if kind == "healthy":
         return Wear(fdj, math.inf, eta_o, math.inf)
     inertia = float(rng.uniform(1.03, 1.1)) if kind == "linear, heavier rotor" else 1.0
@@ -138,8 +142,14 @@ def logged_window(
         truth.health(hours, thresholds),
         Effects(viscous_factor=viscous, inertia_factor=truth.inertia_factor, current_bias_a=offset_a),
     )
-    drawn = draw(seed, family or FAMILIES[j % 5], health=health, effects=effects, duration_s=duration,
-                 sample_rate_hz=float(rng.choice(rates)))  # fmt: skip
+    drawn = draw(
+        seed,
+        family or FAMILIES[j % 5],
+        health=health,
+        effects=effects,
+        duration_s=duration,
+        sample_rate_hz=float(rng.choice(rates)),
+    )
     drawn.document.update(actuator_id=f"foreign/history-{actuator}", window_id=f"w{j:03d}", flight_hours=hours)
     return drawn
 
@@ -169,8 +179,15 @@ def history(
         undecided, decided = undecided + result.window.inertia_undecided, decided + bool(result.window.inertia_from)
         zeroed += result.window.sensor_zero_from is not None
         stored.append(Stored(**result.model_dump(), id=j, stored_at="2026-01-01T00:00:00+00:00"))
-    fared = {"weak": weak, "over": over, "unsaid": unsaid, "refused": refused, "undecided": undecided,
-             "decided": decided, "zeroed": zeroed}  # fmt: skip
+    fared = {
+        "weak": weak,
+        "over": over,
+        "unsaid": unsaid,
+        "refused": refused,
+        "undecided": undecided,
+        "decided": decided,
+        "zeroed": zeroed,
+    }
     return prognose(f"foreign/history-{actuator}", stored, thresholds), fared
 
 
@@ -210,10 +227,12 @@ def _life(score: dict[str, Any]) -> str:
 
 
 def table(rows: list[dict[str, Any]]) -> str:
-    lines = ["| actuator | windows answered: FDJ weak / past 10 % of range / past it, not said weak "
-             "| FDJ level error: % of range (stds) | FDJ life: true: RUL [90 %] "
-             "| η_O level error: % of range (stds) | η_O life: true: RUL [90 %] |",
-             "|---|---:|---:|---:|---:|---:|"]  # fmt: skip
+    lines = [
+        "| actuator | windows answered: FDJ weak / past 10 % of range / past it, not said weak "
+        "| FDJ level error: % of range (stds) | FDJ life: true: RUL [90 %] "
+        "| η_O level error: % of range (stds) | η_O life: true: RUL [90 %] |",
+        "|---|---:|---:|---:|---:|---:|",
+    ]
     for row in rows:
         f, e = row["scores"]["FDJ"], row["scores"]["eta_O"]
         lines.append(
@@ -235,21 +254,28 @@ def summary(rows: list[dict[str, Any]]) -> str:
             chosen = [r["scores"][name]["held"] for r in rows if r["kind"] == kind]
             what = "no degradation claimed" if kind == "healthy" else "the true life inside the 90 % interval"
             lives.append(f"{kind}: {what} in {sum(chosen)} of {len(chosen)}")
-        parts.append(f"{label}: level within ±2 std in {level} of {len(rows)} (worst {100 * worst:.1f} % of range); "
-                     + "; ".join(lives))  # fmt: skip
+        parts.append(
+            f"{label}: level within ±2 std in {level} of {len(rows)} (worst {100 * worst:.1f} % of range); "
+            + "; ".join(lives)
+        )
     windows = sum(r["n"] for r in rows)
     over, unsaid = sum(r["over"] for r in rows), sum(r["unsaid"] for r in rows)
     heavier = [r for r in rows if r["kind"] == "linear, heavier rotor"]
-    parts.append(f"Heavier rotors: of their {sum(r['n'] for r in heavier)} windows, "
-                 f"{sum(r['decided'] + r['undecided'] for r in heavier)} could not tell J_M from k_T alone; the "
-                 f"actuator's J_M read by earlier windows decided {sum(r['decided'] for r in heavier)}")  # fmt: skip
+    parts.append(
+        f"Heavier rotors: of their {sum(r['n'] for r in heavier)} windows, "
+        f"{sum(r['decided'] + r['undecided'] for r in heavier)} could not tell J_M from k_T alone; the "
+        f"actuator's J_M read by earlier windows decided {sum(r['decided'] for r in heavier)}"
+    )
     zeroed = [r for r in rows if r["kind"] == "linear, zero off by flight"]
     carried = sum(r["zeroed"] for r in zeroed)
-    parts.append(f"Zero off by flight: of their {sum(r['n'] for r in zeroed)} windows, {carried} were read with "
-                 "the zero an earlier window of their flight read")  # fmt: skip
+    parts.append(
+        f"Zero off by flight: of their {sum(r['n'] for r in zeroed)} windows, {carried} were read with "
+        "the zero an earlier window of their flight read"
+    )
     refused = [f for r in rows for f in r["refused"]]
-    head = (f"{windows} windows, {len(refused)} refused, {over} answered FDJ past 10 % of range ({unsaid} not said "
-            "weak). ")  # fmt: skip
+    head = (
+        f"{windows} windows, {len(refused)} refused, {over} answered FDJ past 10 % of range ({unsaid} not said weak). "
+    )
     tail = "".join(f"\n\nRefused: {f}" for f in refused)
     return head + ". ".join(parts) + "." + tail
 
@@ -273,16 +299,24 @@ def main() -> None:
         for actuator in range(offset, offset + counts[kind]):
             truth = wear(actuator, kind)
             prognosis, fared = history(actuator, truth, args.windows, thresholds, args.alone)
-            rows.append({"actuator": f"{actuator} ({kind})", "kind": kind, "n": args.windows, **fared,
-                         "scores": scored(prognosis, truth, thresholds)})  # fmt: skip
+            rows.append(
+                {
+                    "actuator": f"{actuator} ({kind})",
+                    "kind": kind,
+                    "n": args.windows,
+                    **fared,
+                    "scores": scored(prognosis, truth, thresholds),
+                }
+            )
             print(table(rows[-1:]).splitlines()[-1], flush=True)
-    body = "\n".join([PROSE, f"Total {time.perf_counter() - started:.0f} s.",
-                      "", table(rows), "", summary(rows)])  # fmt: skip
+    body = "\n".join([PROSE, f"Total {time.perf_counter() - started:.0f} s.", "", table(rows), "", summary(rows)])
     print(body)
     if args.docs and not args.alone:
-        command = (f"python -m benchmarks.foreign_history --actuators {args.actuators} --speeding {args.speeding} "
-                   f"--healthy {args.healthy} --heavier {args.heavier} --zeroed {args.zeroed} --windows {args.windows} "
-                   "--docs")  # fmt: skip
+        command = (
+            f"python -m benchmarks.foreign_history --actuators {args.actuators} --speeding {args.speeding} "
+            f"--healthy {args.healthy} --heavier {args.heavier} --zeroed {args.zeroed} --windows {args.windows} "
+            "--docs"
+        )
         write_section("On windows our code did not draw", command, body, PROGNOSIS_MD)
 
 

@@ -9,7 +9,7 @@ twin, linearized at the true health, Eq. 5.1 on raw samples reads
     y_k = sgn(ω_k)·(k_T·I_k + H_k/n − J·(ω_{k+1} − ω_{k−1})/2h) = FDJ + k(η_O)·|H_k/n|    (sliding k)
 
 and each sensor's noise enters y through a known linear map A_s (current: diagonal; speed: the
-central difference; hinge and position: through the hinge reading of ``sim.hinge``, its measured
+central difference; hinge and position: through the hinge reading of ``ema.model.hinge``, its measured
 slope b included). With Σ = Σ_s σ_s² A_s A_sᵀ, generalized least squares has covariance
 (Xᵀ Σ⁻¹ X)⁻¹ (X: ∂y/∂(FDJ, η_O)): the smallest any linear unbiased reading of these equations
 reaches, because it weighs every sample by what the noise leaves of it. *Current sensor alone*
@@ -36,17 +36,17 @@ import numpy as np
 from benchmarks.foreign_accuracy import RESULTS_MD
 from benchmarks.foreign_groups import group_seed, groups
 from benchmarks.tails import expected_over
-from clients.report import write_section
-from sim import runtime
-from sim.actuator import THESIS
-from sim.hinge import HINGE_SMOOTHING_S, local_line
-from sim.params import ActuatorParams, eta_a_from_eta_o
-from sim.residual import kernel_samples
-from sim.window import Window, window_from_dict
-from training.physics.features import as_read
-from training.physics.friction import FitSettings, fit_friction, regressors
-from training.prepare.conditioning import prepare
-from training.report import healthy_range
+from ema.cli.report import write_section
+from ema.estimate.physics.features import as_read
+from ema.estimate.physics.friction import FitSettings, fit_friction, regressors
+from ema.estimate.prepare.conditioning import prepare
+from ema.estimate.report import healthy_range
+from ema.model import runtime
+from ema.model.actuator import THESIS
+from ema.model.hinge import HINGE_SMOOTHING_S, local_line
+from ema.model.params import ActuatorParams, eta_a_from_eta_o
+from ema.model.residual import kernel_samples
+from ema.model.window import Window, window_from_dict
 
 GROUPS = ("short window (0.1 s, gust)", "low log rate (1-2 kHz)")  # the groups with errors past 10 % of range
 SENSORS = ("current_a", "motor_speed_radps", "hinge_moment_nm", "position_deg")
@@ -100,7 +100,7 @@ def linearized(clean: Window, truth: dict[str, float]) -> tuple[np.ndarray, np.n
 
 
 def _hinge_read_maps(signals: dict[str, np.ndarray], rate: float) -> tuple[np.ndarray, np.ndarray]:
-    """∂H_read/∂H_e and ∂H_read/∂δ (n, n) of ``sim.hinge`` at these signals, the slope b's own
+    """∂H_read/∂H_e and ∂H_read/∂δ (n, n) of ``ema.model.hinge`` at these signals, the slope b's own
     response to the noise included (to first order)."""
     n = len(signals["hinge_moment_nm"])
     line = local_line(np.eye(n), kernel_samples(rate, HINGE_SMOOTHING_S)).T  # [i, j] = ∂(line at i)/∂(sample j)
@@ -129,7 +129,7 @@ def efficient_std(
 
 
 def our_rms(clean: Window, truth: dict[str, float], levels: dict[str, float], draws: int, seed: int) -> np.ndarray:
-    """(2,) RMS error (share of range) of ``training.physics.friction`` on ``draws`` Gaussian noise draws at
+    """(2,) RMS error (share of range) of ``ema.estimate.physics.friction`` on ``draws`` Gaussian noise draws at
     ``levels``."""
     rng = np.random.default_rng(seed)
     signals = {name: np.repeat(values[None], draws, axis=0) for name, values in clean.signals.items()}
@@ -166,33 +166,37 @@ def table(rows: dict[str, list[dict[str, np.ndarray]]]) -> str:
                 stds = np.array([r[kind][p] for r in found])
                 cells.append(f"{100 * math.sqrt(2 / math.pi) * stds.mean():.1f} % / {expected_over(stds):.1f}")
             ratio = np.array([r["ours"][p] / r["efficient"][p] for r in found])
-            lines.append(f"| {group} ({len(found)}) | {name} | {cells[0]} | {cells[1]} "
-                         f"| {np.median(ratio):.2f} ({ratio.max():.2f}) |")  # fmt: skip
+            lines.append(
+                f"| {group} ({len(found)}) | {name} | {cells[0]} | {cells[1]} "
+                f"| {np.median(ratio):.2f} ({ratio.max():.2f}) |"
+            )
     return "\n".join(lines)
 
 
 def report(rows: dict[str, list[dict[str, np.ndarray]]], draws: int) -> str:
-    return "\n".join([
-        "The limit the sensor noise sets on windows of `benchmarks.foreign_accuracy`'s seeds (module",
-        "docstring: GLS on Eq. 5.1's raw samples, each sensor's realized noise, linearized at the true",
-        f"health). Mean error in % of the range; *ours*: `training/baseline.py` over {draws} fresh noise",
-        "draws on each clean twin.",
-        "",
-        table(rows),
-        "",
-        "Read beside the accuracy table above. *Efficient* is the least std of any unbiased estimator",
-        "linear in Eq. 5.1's samples (Gauss–Markov); ours, a nonlinear least squares, comes within a few %",
-        "of it at the median (the worst, at 1 kHz: the 3-sample reconstruction kernel's bias, which the",
-        "product measures on its simulations and subtracts). *Current sensor alone* is",
-        "the Cramér–Rao bound with speed, hinge and position noise-free: the model is then linear in",
-        "(FDJ, k) with white noise, and least squares is efficient. Where these expect windows past 10 %",
-        "of the range, no reading of Eq. 5.1 avoids them. A reading of the whole closed loop would hold",
-        "more, but only for a loop known to the microsecond (next section). The remedy is more window",
-        "(a longer or faster log) or the actuator's history (`ema history` weighs each window by its std:",
-        "on 16 foreign histories of 30 windows, a fifth of them 0.1 s and a fifth 1–2 kHz, with 18 answers",
-        "past 10 % of range, every trend's level at the last window stood within 1 % of the range of the",
-        "truth: docs/prognosis.md).",
-    ])  # fmt: skip
+    return "\n".join(
+        [
+            "The limit the sensor noise sets on windows of `benchmarks.foreign_accuracy`'s seeds (module",
+            "docstring: GLS on Eq. 5.1's raw samples, each sensor's realized noise, linearized at the true",
+            f"health). Mean error in % of the range; *ours*: `training/baseline.py` over {draws} fresh noise",
+            "draws on each clean twin.",
+            "",
+            table(rows),
+            "",
+            "Read beside the accuracy table above. *Efficient* is the least std of any unbiased estimator",
+            "linear in Eq. 5.1's samples (Gauss–Markov); ours, a nonlinear least squares, comes within a few %",
+            "of it at the median (the worst, at 1 kHz: the 3-sample reconstruction kernel's bias, which the",
+            "product measures on its simulations and subtracts). *Current sensor alone* is",
+            "the Cramér–Rao bound with speed, hinge and position noise-free: the model is then linear in",
+            "(FDJ, k) with white noise, and least squares is efficient. Where these expect windows past 10 %",
+            "of the range, no reading of Eq. 5.1 avoids them. A reading of the whole closed loop would hold",
+            "more, but only for a loop known to the microsecond (next section). The remedy is more window",
+            "(a longer or faster log) or the actuator's history (`ema history` weighs each window by its std:",
+            "on 16 foreign histories of 30 windows, a fifth of them 0.1 s and a fifth 1–2 kHz, with 18 answers",
+            "past 10 % of range, every trend's level at the last window stood within 1 % of the range of the",
+            "truth: docs/prognosis.md).",
+        ]
+    )
 
 
 def main() -> None:
@@ -206,8 +210,12 @@ def main() -> None:
     body = report(rows, args.draws)
     print(body)
     if args.docs:
-        write_section("The information limit of short and slow windows",
-                      "python -m benchmarks.information_limit --docs", body, RESULTS_MD)  # fmt: skip
+        write_section(
+            "The information limit of short and slow windows",
+            "python -m benchmarks.information_limit --docs",
+            body,
+            RESULTS_MD,
+        )
 
 
 if __name__ == "__main__":

@@ -13,13 +13,13 @@ from typing import Any
 
 from benchmarks.foreign_accuracy import RESULTS_MD, run_one, summarize, table
 from benchmarks.foreign_groups import FAMILIES, drive_off, off_zero, viscous
-from clients.report import write_section
-from sim import runtime
-from sim.actuator import THESIS
-from sim.window import window_from_dict
+from ema.cli.report import write_section
+from ema.estimate.history import readings_of
+from ema.estimate.pipeline import estimate_window
+from ema.model import runtime
+from ema.model.actuator import THESIS
+from ema.model.window import window_from_dict
 from tests.foreign.windows import Draw, Effects, draw, filter_widths, of_the_same_flight, through_filters
-from training.history import readings_of
-from training.pipeline import estimate_window
 
 FIRST_SEED = 60_000  # apart from foreign_accuracy's 7000–26000 and the tests'
 
@@ -56,7 +56,7 @@ def _short_drive_off(seed: int) -> Draw:
 
 def _after_another(make: Callable[[int], Draw], seed: int, family: str, duration_s: float) -> dict[str, Any]:
     """The answer for the window ``make`` draws, after a window of ``family`` of its flight (the same actuator,
-    sensors and flight condition) was read: with what that read (``training.history``), as the service
+    sensors and flight condition) was read: with what that read (``ema.estimate.history``), as the service
     answers a window after others of its actuator and flight_id."""
     drawn = make(seed)
     other = of_the_same_flight(drawn, seed + 500_000, family, duration_s)
@@ -98,13 +98,14 @@ strain-gauge amplifier's filter delays the load the fit reads (signal and noise 
 moving average: `through_filters`). The window's equation error barely feels that lag; the filter's
 trace in the noise (0.70–1.15 of the delay) and the lag the deflection band reads from the moment
 weigh filtered against on time, and the moment is advanced by the weighted lag, its spread in the
-stds (`training.prepare.hinge_lag`): what is left shows in the heaviest filters. The sensor chain's lag is the
+stds (`ema.estimate.prepare.hinge_lag`): what is left shows in the heaviest filters. The sensor chain's lag is the
 same in every window of an actuator; read across them, as a calibration term, it could be pinned.
 A sensor off zero and a viscous coefficient above the document's are read per window (groups of the
 accuracy table above), but each is a parameter more to read from the window, which a window holding
 little to begin with (a 1–2 kHz log, 0.1 s) often cannot: the answers past 10 % of range are all said
 weak. A C too unclear to read is weighed into the stds by the weight of the change the window leans
-to (`training.prepare.departures.viscosity`: FDJ's ±2 std held the truth in 85 % of the slow logs without). An offset
+to (`ema.estimate.prepare.departures.viscosity`: FDJ's ±2 std held the truth in 85 % of the slow logs
+without). An offset
 leaves a short window nothing to lean on, and there FDJ's ±2 std holds the truth less often than
 90 %. Of the 20 short windows 8 move (almost) one way,
 where no offset can be read and FDJ's std carries only one of 0.05 A (these are up to 0.25 A); the
@@ -112,13 +113,13 @@ offset is read in 11 and missed in 1. A drive keeps its sensors' zero for a powe
 row answers the same windows as the service answers a flight's (`flight_id`), after a 1 s cruise window
 of their flight (the same actuator, offset and flight condition) was read; its zero is taken off the
 windows moving one way, and off those moving both ways where it is the more precise and holds
-(`training.prepare.departures.zero_offset`). *J_M heavier than the document's*: where the motor saturates as it
+(`ema.estimate.prepare.departures.zero_offset`). *J_M heavier than the document's*: where the motor saturates as it
 accelerates, a motor k_T·I a few % weaker explains the window about as well, and the likelihood ratio
 does not decide; a replay of the window with each tells them apart only where it follows the drive
 within the noise (thesis windows), and elsewhere γ is read with FDJ's std widened by 0.6 of what
-reading ΔJ would change (`training.prepare.departures.read`): honest, but often weak. J_M stays with the build: the
+reading ΔJ would change (`ema.estimate.prepare.departures.read`): honest, but often weak. J_M stays with the build: the
 last row answers the same windows after a 0.5 s thesis window of the actuator (a pre-flight check) read
-it, which decides between the two readings where one agrees with it (`training.history`)."""
+it, which decides between the two readings where one agrees with it (`ema.estimate.history`)."""
 
 
 def main() -> None:
@@ -132,12 +133,14 @@ def main() -> None:
     for name in [*GROUPS, *AFTER_ANOTHER]:
         summaries[name] = summarize(_rows(name, args.per_group))
         print(f"{name}: {summaries[name]}", flush=True)
-    body = "\n".join([
-        f"{args.per_group} windows per group, the five families in turn. {PROSE} "
-        f"Total {time.perf_counter() - started:.0f} s.",
-        "",
-        table(summaries),
-    ])  # fmt: skip
+    body = "\n".join(
+        [
+            f"{args.per_group} windows per group, the five families in turn. {PROSE} "
+            f"Total {time.perf_counter() - started:.0f} s.",
+            "",
+            table(summaries),
+        ]
+    )
     print(body)
     if args.docs:
         write_section("Where it is still wrong", "python -m benchmarks.known_limits --docs", body, RESULTS_MD)

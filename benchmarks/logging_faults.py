@@ -14,12 +14,12 @@ from typing import Any
 
 from benchmarks.foreign_accuracy import RESULTS_MD, run_one, summarize, table
 from benchmarks.foreign_groups import group_seed, groups
-from clients.report import write_section
-from sim import runtime
-from sim.actuator import THESIS
-from sim.window import window_from_dict
+from ema.cli.report import write_section
+from ema.estimate.prepare.stale import stale_runs
+from ema.model import runtime
+from ema.model.actuator import THESIS
+from ema.model.window import window_from_dict
 from tests.foreign.faults import FAULTS, with_fault
-from training.prepare.stale import stale_runs
 
 FIRST_SEED = 1_000_000  # apart from every other benchmark's (foreign_history's reach ~610 000) and the tests'
 CLEAN = "none: the windows as drawn"
@@ -30,26 +30,29 @@ def report(rows: dict[str, list[dict[str, Any]]], found: dict[str, int], per_fau
     for name, answers in rows.items():
         label = name if name == CLEAN else f"{name} (found in {found[name]})"
         summaries[label] = summarize(answers)
-    return "\n".join([
-        f"{per_fault} windows of `tests/foreign`, one of each group of the accuracy table in turn (0.1–10 s,",
-        "1–100 kHz, worn, filtered, off zero, drives unlike the document's), each logged once more with one fault",
-        "(`tests/foreign/faults.py`): a sensor whose logger kept writing its last value after it stopped",
-        "updating, or a gap filled with zeros, over 5–25 % of the window somewhere in it, or for 0.5–2 ms",
-        "where the motor slews past 300 rad/s. *Found in*: windows where `training.prepare.stale` takes a run of that",
-        "sensor for one (a sensor quantized coarser than its noise, or a speed or position at rest, is left",
-        "alone; a current at 0 a few noise stds from its flanks matters little). A run of up to 2 ms is",
-        "bridged by the line between its flanks, a longer one cuts the window to the stretch with the most",
-        "sliding motion (`window.read_span`). Columns as in the accuracy table above; the first row is the",
-        "same windows as drawn. A long gap costs what the window loses with it: the stretch read is a shorter",
-        "window, and one sliding one way cannot tell a sensor off zero or a cold grease from friction (drawn",
-        "from other seeds, a worn doublet's gap left two such pieces: the one read was 8 ranges off, said weak,",
-        "the other read 1.5 %).",
-        "At 1 kHz a 0.5 ms dropout is 2 samples: neither a run (4 samples) nor a glitch (1 sample at that rate,",
-        "where a current pulse at a reversal lasts 2–3), and it is read as logged.",
-        f"Total {seconds:.0f} s.",
-        "",
-        table(summaries),
-    ])  # fmt: skip
+    return "\n".join(
+        [
+            f"{per_fault} windows of `tests/foreign`, one of each group of the accuracy table in turn (0.1–10 s,",
+            "1–100 kHz, worn, filtered, off zero, drives unlike the document's), each logged once more with one fault",
+            "(`tests/foreign/faults.py`): a sensor whose logger kept writing its last value after it stopped",
+            "updating, or a gap filled with zeros, over 5–25 % of the window somewhere in it, or for 0.5–2 ms",
+            "where the motor slews past 300 rad/s. *Found in*: windows where `ema.estimate.prepare.stale` takes a run "
+            "of that",
+            "sensor for one (a sensor quantized coarser than its noise, or a speed or position at rest, is left",
+            "alone; a current at 0 a few noise stds from its flanks matters little). A run of up to 2 ms is",
+            "bridged by the line between its flanks, a longer one cuts the window to the stretch with the most",
+            "sliding motion (`window.read_span`). Columns as in the accuracy table above; the first row is the",
+            "same windows as drawn. A long gap costs what the window loses with it: the stretch read is a shorter",
+            "window, and one sliding one way cannot tell a sensor off zero or a cold grease from friction (drawn",
+            "from other seeds, a worn doublet's gap left two such pieces: the one read was 8 ranges off, said weak,",
+            "the other read 1.5 %).",
+            "At 1 kHz a 0.5 ms dropout is 2 samples: neither a run (4 samples) nor a glitch (1 sample at that rate,",
+            "where a current pulse at a reversal lasts 2–3), and it is read as logged.",
+            f"Total {seconds:.0f} s.",
+            "",
+            table(summaries),
+        ]
+    )
 
 
 def main() -> None:

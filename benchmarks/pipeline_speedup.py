@@ -19,21 +19,21 @@ from pathlib import Path
 
 import numpy as np
 
-from clients.report import write_section
-from sim.actuator import THESIS
-from sim.params import DEFAULT_RANGES, HealthParams
-from sim.synthetic import synthetic_window
-from sim.window import read_window, write_window
-from training import runtime
-from training.pipeline import estimate_window
-from training.report import share_of_range
+from ema.cli.report import write_section
+from ema.estimate import runtime
+from ema.estimate.pipeline import estimate_window
+from ema.estimate.report import share_of_range
+from ema.model.actuator import THESIS
+from ema.model.params import DEFAULT_RANGES, HealthParams
+from ema.model.synthetic import synthetic_window
+from ema.model.window import read_window, write_window
 
 LEGACY = "b8987e4"  # the last commit of round 1
 ROOT = Path(__file__).resolve().parent.parent
 LEGACY_RUN = """
 import json, sys, time
-from sim.window import read_window
-from training.pipeline import estimate_window
+from ema.model.window import read_window
+from ema.estimate.pipeline import estimate_window
 paths = sys.argv[1:]
 estimate_window(read_window(paths[0]))  # warm
 out = []
@@ -58,12 +58,19 @@ def windows(folder: Path, n: int) -> tuple[list[Path], list[dict[str, float]]]:
 
 
 def legacy(paths: list[Path], checkout: Path) -> list[dict[str, float]]:
-    subprocess.run(["git", "-C", str(ROOT), "worktree", "add", "--force", str(checkout), LEGACY],
-                   check=True, capture_output=True)  # fmt: skip
+    subprocess.run(
+        ["git", "-C", str(ROOT), "worktree", "add", "--force", str(checkout), LEGACY], check=True, capture_output=True
+    )
     try:
         env = {"PYTHONPATH": str(checkout), "PATH": "/usr/bin:/bin"}
-        done = subprocess.run([sys.executable, "-c", LEGACY_RUN, *map(str, paths)], env=env, check=True,
-                              capture_output=True, text=True, cwd=checkout)  # fmt: skip
+        done = subprocess.run(
+            [sys.executable, "-c", LEGACY_RUN, *map(str, paths)],
+            env=env,
+            check=True,
+            capture_output=True,
+            text=True,
+            cwd=checkout,
+        )
         return json.loads(done.stdout.strip().splitlines()[-1])
     finally:
         subprocess.run(["git", "-C", str(ROOT), "worktree", "remove", "--force", str(checkout)], capture_output=True)
@@ -75,8 +82,9 @@ def today(paths: list[Path]) -> list[dict[str, float]]:
     out = []
     for path in paths:
         result = estimate_window(read_window(path), actuator=THESIS)
-        out.append({"total": result.timings_s.total, "FDJ": result.estimates.FDJ.value,
-                    "eta_O": result.estimates.eta_O.value})  # fmt: skip
+        out.append(
+            {"total": result.timings_s.total, "FDJ": result.estimates.FDJ.value, "eta_O": result.estimates.eta_O.value}
+        )
     return out
 
 
@@ -87,8 +95,10 @@ def row(name: str, runs: list[dict[str, float]], truths: list[dict[str, float]])
         * np.mean([share_of_range(k, abs(r[k] - t[k]), THESIS.ranges) for r, t in zip(runs, truths, strict=True)])
         for k in ("FDJ", "eta_O")
     }
-    return (f"| {name} | {np.median(totals):.2f} | {np.percentile(totals, 95):.2f} | {np.median(totals) / 0.5:.2f} "
-            f"| {errors['FDJ']:.2f} % / {errors['eta_O']:.2f} % |")  # fmt: skip
+    return (
+        f"| {name} | {np.median(totals):.2f} | {np.percentile(totals, 95):.2f} | {np.median(totals) / 0.5:.2f} "
+        f"| {errors['FDJ']:.2f} % / {errors['eta_O']:.2f} % |"
+    )
 
 
 def main() -> None:
@@ -101,18 +111,20 @@ def main() -> None:
         old = legacy(paths, Path(folder) / "legacy")
         new = today(paths)
     speedup = np.median([r["total"] for r in old]) / np.median([r["total"] for r in new])
-    body = "\n".join([
-        f"The same {args.windows} synthetic 0.5 s windows (realistic noise, §5.6 commands, health uniform in",
-        f"Table 3.1's ranges) through round 1's pipeline (commit {LEGACY}, 500 + 16 simulations, run from a",
-        "git worktree in a subprocess) and today's, one after the other in one run, both warm.",
-        "",
-        "| pipeline | p50 [s] | p95 [s] | real-time factor p50 | error FDJ / η_O (% of range) |",
-        "|---|---:|---:|---:|---:|",
-        row(f"round 1 ({LEGACY})", old, truths),
-        row("today", new, truths),
-        "",
-        f"Speed-up at the median: **{speedup:.1f}x**.",
-    ])  # fmt: skip
+    body = "\n".join(
+        [
+            f"The same {args.windows} synthetic 0.5 s windows (realistic noise, §5.6 commands, health uniform in",
+            f"Table 3.1's ranges) through round 1's pipeline (commit {LEGACY}, 500 + 16 simulations, run from a",
+            "git worktree in a subprocess) and today's, one after the other in one run, both warm.",
+            "",
+            "| pipeline | p50 [s] | p95 [s] | real-time factor p50 | error FDJ / η_O (% of range) |",
+            "|---|---:|---:|---:|---:|",
+            row(f"round 1 ({LEGACY})", old, truths),
+            row("today", new, truths),
+            "",
+            f"Speed-up at the median: **{speedup:.1f}x**.",
+        ]
+    )
     print(body)
     if args.docs:
         write_section("Speed-up over round 1, side by side", "python -m benchmarks.pipeline_speedup --docs", body)

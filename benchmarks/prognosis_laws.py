@@ -18,13 +18,17 @@ from pathlib import Path
 
 import numpy as np
 
-from clients.report import write_section
-from prognosis.outlook import outlook
+from ema.cli.report import write_section
+from ema.prognosis.outlook import outlook
 from tests.prognosis.histories import LAWS, THRESHOLD, history
 
 PROGNOSIS_MD = Path(__file__).resolve().parent.parent / "docs" / "prognosis.md"
-KINDS = {"20 windows, std 0.3 mN·m": (20, 3e-4), "20 windows, std 1 mN·m": (20, 1e-3),
-         "60 windows, std 0.3 mN·m": (60, 3e-4), "10 windows, std 0.3 mN·m": (10, 3e-4)}  # fmt: skip
+KINDS = {
+    "20 windows, std 0.3 mN·m": (20, 3e-4),
+    "20 windows, std 1 mN·m": (20, 1e-3),
+    "60 windows, std 0.3 mN·m": (60, 3e-4),
+    "10 windows, std 0.3 mN·m": (10, 3e-4),
+}
 
 
 def score(law: str, n: int, std: float, histories: int) -> dict[str, float]:

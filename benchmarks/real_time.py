@@ -9,7 +9,7 @@ validation, the pipeline, storage and the answer. Beside it, the service process
 each pass (``/proc``): the CPU a request costs, and how many cores the service had while it worked.
 
 This machine's speed drifts ~2x from day to day, so the same run times the yardstick
-(``clients.yardstick``, an independent 16-lane kernel simulating 500 x 0.5 s) on one thread and on
+(``ema.cli.yardstick``, an independent 16-lane kernel simulating 500 x 0.5 s) on one thread and on
 every thread, and states each latency as a share of it; and on every thread beside the same busy
 processes, what a program that keeps every core busy meets there. The target: the idle p95 at most
 0.128 of the yardstick, and the p95 beside two busy processes at most twice the idle one.
@@ -31,9 +31,9 @@ import httpx
 import numpy as np
 
 from benchmarks.service_overhead import free_port, quiet_collector, serve
-from clients.bench import TARGET_SHARE, load
-from clients.report import write_section
-from clients.yardstick import yardstick_seconds
+from ema.cli.bench import TARGET_SHARE, load
+from ema.cli.report import write_section
+from ema.cli.yardstick import yardstick_seconds
 from tests.foreign.windows import draw
 
 SECTION = "Real time on a warm service"
@@ -117,9 +117,11 @@ def report(passes: dict[str, list[Pass]], yardsticks: dict[str, float], count: i
     ]
     for name, wall in walls.items():
         p50, p95 = float(np.median(wall)), float(np.quantile(wall, 0.95))
-        lines.append(f"| {name} | {p50:.3f} | {p95:.3f} | {p95 / idle_p95:.2f} | "
-                     f"{p95 / yardsticks['one thread']:.3f} | {p95 / yardsticks['every thread']:.3f} | "
-                     f"{cpu[name] / len(wall):.3f} | {cpu[name] / sum(wall):.2f} |")  # fmt: skip
+        lines.append(
+            f"| {name} | {p50:.3f} | {p95:.3f} | {p95 / idle_p95:.2f} | "
+            f"{p95 / yardsticks['one thread']:.3f} | {p95 / yardsticks['every thread']:.3f} | "
+            f"{cpu[name] / len(wall):.3f} | {cpu[name] / sum(wall):.2f} |"
+        )
     lines += [
         "",
         f"Target: idle p95 ≤ {TARGET_SHARE} of the yardstick; loaded p95 ≤ {LOADED_LIMIT:g}x the idle p95.",
@@ -146,8 +148,10 @@ def main() -> None:
     body = report(passes, yardsticks, args.windows)
     print(body)
     if args.docs:
-        command = (f"python -m benchmarks.real_time --windows {args.windows} --under-load {args.under_load} "
-                   f"--blocks {args.blocks} --docs")  # fmt: skip
+        command = (
+            f"python -m benchmarks.real_time --windows {args.windows} --under-load {args.under_load} "
+            f"--blocks {args.blocks} --docs"
+        )
         write_section(SECTION, command, body)
 
 

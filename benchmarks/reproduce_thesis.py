@@ -14,24 +14,24 @@ from pathlib import Path
 
 import matplotlib
 
-from sim.actuator import THESIS
+from ema.model.actuator import THESIS
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
-from clients.report import write_section
-from sim import runtime
-from sim.aircraft import FlightCondition, GroundLoad
-from sim.commands import random_command_knots
-from sim.noise import NO_NOISE, SensorNoise, add_sensor_noise
-from sim.params import DEFAULT_RANGES, IRREVERSIBLE_RANGES, HealthParams, HealthRanges
-from sim.synthetic import synthetic_window
-from training.learn.network import TrainConfig, fit, predict
-from training.physics.features import features
-from training.physics.friction import fit_window
-from training.physics.scenario import Scenario
-from training.simulate.design import Box
+from ema.cli.report import write_section
+from ema.estimate.learn.network import TrainConfig, fit, predict
+from ema.estimate.physics.features import features
+from ema.estimate.physics.friction import fit_window
+from ema.estimate.physics.scenario import Scenario
+from ema.estimate.simulate.design import Box
+from ema.model import runtime
+from ema.model.aircraft import FlightCondition, GroundLoad
+from ema.model.commands import random_command_knots
+from ema.model.noise import NO_NOISE, SensorNoise, add_sensor_noise
+from ema.model.params import DEFAULT_RANGES, IRREVERSIBLE_RANGES, HealthParams, HealthRanges
+from ema.model.synthetic import synthetic_window
 
 DOCS = Path(__file__).resolve().parent.parent / "docs"
 RATE_HZ, SAMPLES = 10_000.0, 5000
@@ -62,17 +62,44 @@ def cases(quick: bool) -> list[Case]:
     ]
     others = [
         Case("1B noisy", 1000, 500, 100, "(not in the thesis: realistic sensor noise)", noise=SensorNoise()),
-        Case("1B noisy, raw inputs", 1000, 500, 100, "(thesis architecture on noisy data)", noise=SensorNoise(),
-             train=TrainConfig(components=None)),
-        Case("1B noisy, Adam", 1000, 500, 100, "(optimizer comparison)", noise=SensorNoise(),
-             train=TrainConfig(optimizer="adam", learning_rate=3e-3)),
-        Case("1A constant load", 2000, 1000, 100, "test 2.39e-4 (FDJ only; η_O not learned)",
-             load=GroundLoad(-100.0, 0.0)),
+        Case(
+            "1B noisy, raw inputs",
+            1000,
+            500,
+            100,
+            "(thesis architecture on noisy data)",
+            noise=SensorNoise(),
+            train=TrainConfig(components=None),
+        ),
+        Case(
+            "1B noisy, Adam",
+            1000,
+            500,
+            100,
+            "(optimizer comparison)",
+            noise=SensorNoise(),
+            train=TrainConfig(optimizer="adam", learning_rate=3e-3),
+        ),
+        Case(
+            "1A constant load",
+            2000,
+            1000,
+            100,
+            "test 2.39e-4 (FDJ only; η_O not learned)",
+            load=GroundLoad(-100.0, 0.0),
+        ),
         Case("1A ramp load", 2000, 1000, 100, "between 1A constant and 1B", load=GroundLoad(-50.0, -300.0)),
         Case("1C irreversible", 2000, 1000, 100, "30 s, 318 ep, test 3.44e-6", ranges=IRREVERSIBLE_RANGES),
-        Case("2 random commands", 2000, 1000, 100, "failed: best test 2.30e-2 (η_O only, 5000 sims)",
-             per_sim_command=True, inputs="input_map"),
-    ]  # fmt: skip
+        Case(
+            "2 random commands",
+            2000,
+            1000,
+            100,
+            "failed: best test 2.30e-2 (η_O only, 5000 sims)",
+            per_sim_command=True,
+            inputs="input_map",
+        ),
+    ]
     if quick:
         return [replace(c, sims=min(c.sims, 300), timesteps=min(c.timesteps, 500)) for c in (table_6_4[0], others[0])]
     return table_6_4 + others
@@ -130,7 +157,7 @@ def plot_parity(case: Case, index: int, prediction: np.ndarray, truth: np.ndarra
 
 def baseline_comparison(n_windows: int) -> list[str]:
     """Network pipeline vs the least-squares baseline on the same noisy windows (physical errors)."""
-    from training.pipeline import estimate_window
+    from ema.estimate.pipeline import estimate_window
 
     rows = []
     rng = np.random.default_rng(7)
@@ -227,8 +254,11 @@ def main() -> None:
     for index, case in enumerate(cases(args.quick)):
         results.append(run_case(case, index))
         f = results[-1]["fit"]
-        print(f"{case.name:>22} {case.timesteps}/{case.sims}/{case.neurons}: train {f.seconds:.2f} s, "
-              f"test {f.test_mse:.2e}, reserved {results[-1]['reserved_mse']:.2e}", flush=True)  # fmt: skip
+        print(
+            f"{case.name:>22} {case.timesteps}/{case.sims}/{case.neurons}: train {f.seconds:.2f} s, "
+            f"test {f.test_mse:.2e}, reserved {results[-1]['reserved_mse']:.2e}",
+            flush=True,
+        )
     comparison = baseline_comparison(3 if args.quick else args.windows)
     print("\n".join(comparison))
     if args.docs:

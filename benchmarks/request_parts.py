@@ -23,40 +23,40 @@ from typing import Any
 
 from benchmarks.real_time import documents
 from benchmarks.service_overhead import quiet_collector
-from clients.report import write_section
-from sim.actuator import THESIS
-from sim.window import WindowDocument
-from training import runtime
-from training.config import PipelineConfig
-from training.pipeline import estimate_window
+from ema.cli.report import write_section
+from ema.estimate import runtime
+from ema.estimate.config import PipelineConfig
+from ema.estimate.pipeline import estimate_window
+from ema.model.actuator import THESIS
+from ema.model.window import WindowDocument
 
 SECTION = "A warm request, step by step"
 STAGES = ("prepare", "physics", "simulate", "train", "assess", "check")  # in the order the pipeline runs them
 SIMULATIONS = PipelineConfig().total_simulations
 TIMING_FIELDS = {"assess": "predict"}  # the stage's field in ``timings_s`` where it is named otherwise
 PARTS = (  # (stage, "module:function" as the stage calls it, what the step does)
-    ("prepare", "training.prepare.conditioning:without_stale", "cut to the stretch the sensors kept updating"),
-    ("prepare", "training.prepare.conditioning:repaired", "glitches repaired"),
-    ("prepare", "training.prepare.conditioning:check_consistency", "the signals checked against each other"),
-    ("prepare", "training.prepare.conditioning:aligned", "the sensors put on one clock"),
-    ("prepare", "training.prepare.conditioning:check_against_aircraft", "the hinge moment against the airframe"),
-    ("prepare", "training.prepare.conditioning:read_departures", "departures from the actuator document"),
-    ("prepare", "training.prepare.conditioning:step_lag", "the hinge moment's step lag"),
-    ("physics", "training.pipeline:fit_window", "Eq. 5.1 on the window"),
-    ("simulate", "sim.batch:run_groups", f"the kernel: {SIMULATIONS} simulations and the clean lane"),
-    ("simulate", "training.simulate.dataset:excess_noise", "the window's noise, read against the clean lane"),
-    ("simulate", "training.simulate.dataset:add_seeded_noise", "that noise added to the simulations"),
-    ("simulate", "training.simulate.dataset:as_read", "the simulations read as the window is"),
-    ("simulate", "training.simulate.dataset:residual_torque_nm", "T_R of the simulations and the window"),
-    ("simulate", "training.simulate.dataset:sliding_features", "the network's inputs"),
-    ("train", "training.pipeline:train_network", "the network trained"),
-    ("assess", "training.pipeline:fit_friction", "Eq. 5.1 on the held-out simulations"),
-    ("assess", "training.learn.estimator:NetworkEstimator.predict_unit", "the network on them and the window"),
-    ("assess", "training.pipeline:assess", "the estimators weighed and blended"),
-    ("check", "sim.batch:run_groups", "the window simulated at the answer (where not reused)"),
-    ("check", "training.assess.reproduction:as_read", "that simulation read as the window is"),
-    ("check", "training.assess.reproduction:residual_torque_nm", "T_R of both"),
-    ("check", "training.pipeline:read_static_friction", "FSJ read where the window shows one"),
+    ("prepare", "ema.estimate.prepare.conditioning:without_stale", "cut to the stretch the sensors kept updating"),
+    ("prepare", "ema.estimate.prepare.conditioning:repaired", "glitches repaired"),
+    ("prepare", "ema.estimate.prepare.conditioning:check_consistency", "the signals checked against each other"),
+    ("prepare", "ema.estimate.prepare.conditioning:aligned", "the sensors put on one clock"),
+    ("prepare", "ema.estimate.prepare.conditioning:check_against_aircraft", "the hinge moment against the airframe"),
+    ("prepare", "ema.estimate.prepare.conditioning:read_departures", "departures from the actuator document"),
+    ("prepare", "ema.estimate.prepare.conditioning:step_lag", "the hinge moment's step lag"),
+    ("physics", "ema.estimate.pipeline:fit_window", "Eq. 5.1 on the window"),
+    ("simulate", "ema.model.batch:run_groups", f"the kernel: {SIMULATIONS} simulations and the clean lane"),
+    ("simulate", "ema.estimate.simulate.dataset:excess_noise", "the window's noise, read against the clean lane"),
+    ("simulate", "ema.estimate.simulate.dataset:add_seeded_noise", "that noise added to the simulations"),
+    ("simulate", "ema.estimate.simulate.dataset:as_read", "the simulations read as the window is"),
+    ("simulate", "ema.estimate.simulate.dataset:residual_torque_nm", "T_R of the simulations and the window"),
+    ("simulate", "ema.estimate.simulate.dataset:sliding_features", "the network's inputs"),
+    ("train", "ema.estimate.pipeline:train_network", "the network trained"),
+    ("assess", "ema.estimate.pipeline:fit_friction", "Eq. 5.1 on the held-out simulations"),
+    ("assess", "ema.estimate.learn.estimator:NetworkEstimator.predict_unit", "the network on them and the window"),
+    ("assess", "ema.estimate.pipeline:assess", "the estimators weighed and blended"),
+    ("check", "ema.model.batch:run_groups", "the window simulated at the answer (where not reused)"),
+    ("check", "ema.estimate.assess.reproduction:as_read", "that simulation read as the window is"),
+    ("check", "ema.estimate.assess.reproduction:residual_torque_nm", "T_R of both"),
+    ("check", "ema.estimate.pipeline:read_static_friction", "FSJ read where the window shows one"),
 )
 
 

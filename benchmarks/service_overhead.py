@@ -26,12 +26,12 @@ from pathlib import Path
 import httpx
 import numpy as np
 
-from clients.report import write_section
-from service.store import EstimateStore
-from sim.actuator import THESIS
-from sim.window import WindowDocument
+from ema.cli.report import write_section
+from ema.estimate.pipeline import estimate_window
+from ema.model.actuator import THESIS
+from ema.model.window import WindowDocument
+from ema.service.store import EstimateStore
 from tests.foreign.windows import draw
-from training.pipeline import estimate_window
 
 SECTION = "Service overhead"
 
@@ -53,8 +53,12 @@ def bodies(count: int, seed: int) -> list[bytes]:
 
 def serve(database: Path, port: int) -> subprocess.Popen[bytes]:
     environment = {**os.environ, "EMA_DATABASE": str(database), "EMA_PORT": str(port)}
-    process = subprocess.Popen([sys.executable, "-m", "clients.cli", "serve", "--port", str(port)], env=environment,
-                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)  # fmt: skip
+    process = subprocess.Popen(
+        [sys.executable, "-m", "ema.cli.main", "serve", "--port", str(port)],
+        env=environment,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
     for _ in range(600):
         try:
             if httpx.get(f"http://127.0.0.1:{port}/healthz", timeout=1.0).status_code == 200:
@@ -126,7 +130,7 @@ def report(http: dict[str, list[float]], parts: dict[str, float], size_bytes: in
         f"| the service's overhead | {cells(overhead)} |",
         "",
         "In-process, one body, median of 20: " + ", ".join(f"{name} {ms:.1f} ms" for name, ms in parts.items()) + ".",
-    ]  # fmt: skip
+    ]
     return "\n".join(lines)
 
 

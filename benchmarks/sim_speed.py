@@ -15,15 +15,15 @@ import time
 
 import numpy as np
 
-from clients.report import write_section
-from sim import runtime
-from sim.actuator import THESIS
-from sim.aircraft import FlightCondition, load_model
-from sim.batch import default_lanes, kernel_constants, simulate_batch
-from sim.commands import random_command_knots
-from sim.effects import EffectSet
-from sim.params import DEFAULT_RANGES, ActuatorParams, HealthParams
-from sim.reference import simulate_numpy
+from ema.cli.report import write_section
+from ema.model import runtime
+from ema.model.actuator import THESIS
+from ema.model.aircraft import FlightCondition, load_model
+from ema.model.batch import default_lanes, kernel_constants, simulate_batch
+from ema.model.commands import random_command_knots
+from ema.model.effects import EffectSet
+from ema.model.params import DEFAULT_RANGES, ActuatorParams, HealthParams
+from ema.model.reference import simulate_numpy
 
 RATE_HZ = 10_000.0
 STEPS_PER_SAMPLE = 100
@@ -38,14 +38,20 @@ def best_of(repeats: int, run) -> float:
         times.append(time.perf_counter() - start)
     return min(times)
 
+
 LANE_SWEEP = (1, 8, 16, 24, 32, 48, 72)
 
 
 def lane_sweep(health: HealthParams, knots: np.ndarray, samples: int, repeats: int) -> list[str]:
     """Lines of a table: ns per simulation-step with one group of each of ``LANE_SWEEP`` lanes, one thread."""
-    lines = ["", f"Cost per simulation-step by lanes per group (one group on one thread, {samples} samples): below",
-             "`sim.batch.MIN_VECTOR_LANES` the lane loop runs its scalar path.", "",
-             "| lanes per group | ns / sim-step |", "|---:|---:|"]  # fmt: skip
+    lines = [
+        "",
+        f"Cost per simulation-step by lanes per group (one group on one thread, {samples} samples): below",
+        "`ema.model.batch.MIN_VECTOR_LANES` the lane loop runs its scalar path.",
+        "",
+        "| lanes per group | ns / sim-step |",
+        "|---:|---:|",
+    ]
     for lanes in LANE_SWEEP:
         one = HealthParams(*(getattr(health, name)[:lanes] for name in ("fsj_nm", "fdj_nm", "eta_o")))
         simulate_batch(knots[:11], one, lanes=lanes, actuator=THESIS.params)

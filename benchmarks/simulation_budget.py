@@ -18,18 +18,28 @@ from typing import Any
 import numpy as np
 
 from benchmarks.foreign_groups import group_seed, groups
-from clients.report import write_section
-from sim import runtime
-from sim.actuator import THESIS
-from sim.checks import InputError
-from sim.window import window_from_dict
-from training.config import PipelineConfig
-from training.pipeline import estimate_window
-from training.report import share_of_range
+from ema.cli.report import write_section
+from ema.estimate.config import PipelineConfig
+from ema.estimate.pipeline import estimate_window
+from ema.estimate.report import share_of_range
+from ema.model import runtime
+from ema.model.actuator import THESIS
+from ema.model.checks import InputError
+from ema.model.window import window_from_dict
 
 RESULTS_MD = Path(__file__).resolve().parent.parent / "docs" / "results.md"
-GROUPS = ("thesis", "cruise", "gust", "doublet", "steps", "short window (0.1 s, gust)", "low log rate (1-2 kHz)",
-          "worn, gust", "sensors behind filters", "k_T, current gain or J_M off")  # fmt: skip
+GROUPS = (
+    "thesis",
+    "cruise",
+    "gust",
+    "doublet",
+    "steps",
+    "short window (0.1 s, gust)",
+    "low log rate (1-2 kHz)",
+    "worn, gust",
+    "sensors behind filters",
+    "k_T, current gain or J_M off",
+)
 BOUND = 0.10  # of the range: an error past it, not said weak, is confidently wrong
 
 
@@ -96,13 +106,15 @@ def main() -> None:
         config = PipelineConfig(n_simulations=train, check_windows=held)
         results[budget] = scored(config, windows)
         print(budget, results[budget], flush=True)
-    body = "\n".join([
-        f"{len(windows)} windows from `tests/foreign` ({args.per_group} per group: {', '.join(GROUPS)}), each",
-        "answered with every budget in one run, one budget after another; the times compare as ratios.",
-        f"Total {time.perf_counter() - started:.0f} s.",
-        "",
-        table(results, len(windows)),
-    ])  # fmt: skip
+    body = "\n".join(
+        [
+            f"{len(windows)} windows from `tests/foreign` ({args.per_group} per group: {', '.join(GROUPS)}), each",
+            "answered with every budget in one run, one budget after another; the times compare as ratios.",
+            f"Total {time.perf_counter() - started:.0f} s.",
+            "",
+            table(results, len(windows)),
+        ]
+    )
     print(body)
     if args.docs:
         command = f"python -m benchmarks.simulation_budget --per-group {args.per_group} --budgets {args.budgets} --docs"

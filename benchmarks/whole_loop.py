@@ -16,10 +16,10 @@ range), this computes:
   and the same with the loop's bus voltage, lag and position gain fitted as unknowns too;
 - its first-order bias b = F⁻¹ Σ_s J_sᵀ Δs / σ_s² when the model it trusts is *our* simulator of
   the same model (started where the window starts, fed its command and logged hinge moment: what
-  ``training.simulate.dataset`` simulates), and when the real loop departs from the document's by less than any
+  ``ema.estimate.simulate.dataset`` simulates), and when the real loop departs from the document's by less than any
   log shows: the PWM bus 1 % high, the command reaching the loop 10 µs late, the position gain
   0.1 % high, the loop reading a speed as noisy as the logged one (``tests.foreign.physics.Effects``);
-- how far our Eq. 5.1 fit (``training.physics.friction``) moves on the same departures, noise-free;
+- how far our Eq. 5.1 fit (``ema.estimate.physics.friction``) moves on the same departures, noise-free;
 - where the whole-loop information lies: its share in the richest 2 % of the samples.
 
     python -m benchmarks.whole_loop [--per-group 60] [--docs]
@@ -37,18 +37,18 @@ from benchmarks.foreign_accuracy import RESULTS_MD
 from benchmarks.foreign_groups import group_seed, groups
 from benchmarks.information_limit import GROUPS, SENSORS, noise_levels
 from benchmarks.tails import expected_over
-from clients.report import write_section
-from sim import runtime
-from sim.actuator import THESIS
-from sim.params import HealthParams
-from sim.window import Window, window_from_dict
+from ema.cli.report import write_section
+from ema.estimate.physics.features import as_read
+from ema.estimate.physics.friction import fit_friction
+from ema.estimate.physics.scenario import scenario_from_window
+from ema.estimate.prepare.conditioning import prepare
+from ema.estimate.report import healthy_range
+from ema.model import runtime
+from ema.model.actuator import THESIS
+from ema.model.params import HealthParams
+from ema.model.window import Window, window_from_dict
 from tests.foreign.physics import Effects
 from tests.foreign.windows import Draw
-from training.physics.features import as_read
-from training.physics.friction import fit_friction
-from training.physics.scenario import scenario_from_window
-from training.prepare.conditioning import prepare
-from training.report import healthy_range
 
 WIDTH = np.array(
     [np.ptp(healthy_range("FDJ", THESIS.ranges)), np.ptp(healthy_range("eta_O", THESIS.ranges))]
@@ -87,7 +87,7 @@ def _as_window(window: Draw, signals: dict[str, np.ndarray]) -> Window:
 
 def our_simulator_bias(window: Draw, clean: dict[str, np.ndarray], levels: dict[str, float]) -> np.ndarray:
     """(2,) first-order bias of a whole-loop reading that simulates the window with *our* simulator
-    (``training.simulate.dataset``'s scenario of the noise-free window: its command, start and logged load)."""
+    (``ema.estimate.simulate.dataset``'s scenario of the noise-free window: its command, start and logged load)."""
     scenario = scenario_from_window(_as_window(window, clean), actuator=THESIS.params, hinge=THESIS.hinge)
     truth, (d_fdj, d_eta) = window.truth, STEP * WIDTH
     fdj, eta_o = truth["FDJ"] + np.array([0, d_fdj, -d_fdj, 0, 0]), truth["eta_O"] + np.array([0, 0, 0, d_eta, -d_eta])
@@ -168,29 +168,32 @@ def table(rows: dict[str, list[dict[str, np.ndarray]]]) -> str:
 
 def report(rows: dict[str, list[dict[str, np.ndarray]]]) -> str:
     where = np.median([r["where"] for found in rows.values() for r in found], axis=0)
-    return "\n".join([
-        "The windows of the section above, read through the whole closed loop of the model instead of",
-        "Eq. 5.1 (module docstring): what that would buy and what it would cost. Errors and biases in",
-        "% of the range; biases as median (worst) over the windows.",
-        "",
-        table(rows),
-        "",
-        "Trusted to the microsecond, the document's loop holds far more than Eq. 5.1 (first column), and",
-        f"in a few instants: at the median window, {100 * where[0]:.0f} % of it lies in the richest "
-        f"{100 * FEW:.0f} % of",
-        f"the samples, {100 * where[1]:.0f} % of those at slew speed (> {SLEW_RADPS:.0f} rad/s, the speed reference",
-        "near its saturation). Fitting the loop's constants as unknowns keeps most of it (second",
-        "column). But that information belongs to one implementation. Our own simulator of the model, started",
-        "where the window starts and fed its command and hinge moment, differs from the independent one",
-        "by far more (third column; among the causes, the side of the backlash at the start, the command",
-        "between log samples and the ripple of an Euler against an exact current step, all legitimate",
-        "readings of the model). A departure of the loop smaller than any log shows (a bus 1 % high,",
-        "a 10 µs lag, a gain 0.1 % off, a loop that reads the logged speed sensor's noise) moves the",
-        "reading by more than its std. Eq. 5.1 uses none of the loop's constants, and our fit moves by",
-        "the last column's amounts under the same departures (at 1 kHz the 3-sample reconstruction",
-        "feels the slightly changed motion). So the product reads Eq. 5.1 and says when a window is",
-        "weak; `benchmarks.foreign_accuracy`'s drives unlike the document's are read as well as the others.",
-    ])  # fmt: skip
+    return "\n".join(
+        [
+            "The windows of the section above, read through the whole closed loop of the model instead of",
+            "Eq. 5.1 (module docstring): what that would buy and what it would cost. Errors and biases in",
+            "% of the range; biases as median (worst) over the windows.",
+            "",
+            table(rows),
+            "",
+            "Trusted to the microsecond, the document's loop holds far more than Eq. 5.1 (first column), and",
+            f"in a few instants: at the median window, {100 * where[0]:.0f} % of it lies in the richest "
+            f"{100 * FEW:.0f} % of",
+            f"the samples, {100 * where[1]:.0f} % of those at slew speed (> {SLEW_RADPS:.0f} rad/s, the speed "
+            f"reference",
+            "near its saturation). Fitting the loop's constants as unknowns keeps most of it (second",
+            "column). But that information belongs to one implementation. Our own simulator of the model, started",
+            "where the window starts and fed its command and hinge moment, differs from the independent one",
+            "by far more (third column; among the causes, the side of the backlash at the start, the command",
+            "between log samples and the ripple of an Euler against an exact current step, all legitimate",
+            "readings of the model). A departure of the loop smaller than any log shows (a bus 1 % high,",
+            "a 10 µs lag, a gain 0.1 % off, a loop that reads the logged speed sensor's noise) moves the",
+            "reading by more than its std. Eq. 5.1 uses none of the loop's constants, and our fit moves by",
+            "the last column's amounts under the same departures (at 1 kHz the 3-sample reconstruction",
+            "feels the slightly changed motion). So the product reads Eq. 5.1 and says when a window is",
+            "weak; `benchmarks.foreign_accuracy`'s drives unlike the document's are read as well as the others.",
+        ]
+    )
 
 
 def main() -> None:

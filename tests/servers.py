@@ -30,7 +30,7 @@ def free_port() -> int:
 def start_server(port: int, database: Path) -> subprocess.Popen:
     """``ema serve`` on ``port`` with ``database`` and ``SMALL_ENV``, returned once /healthz says warm."""
     env = {**os.environ, **SMALL_ENV}
-    command = [sys.executable, "-m", "clients.cli", "serve", "--port", str(port), "--database", str(database)]
+    command = [sys.executable, "-m", "ema.cli.main", "serve", "--port", str(port), "--database", str(database)]
     server = subprocess.Popen(command, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     deadline = time.monotonic() + 180
     while time.monotonic() < deadline:

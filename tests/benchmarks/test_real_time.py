@@ -25,8 +25,10 @@ def test_each_row_is_its_p95_over_the_idle_one_and_over_each_yardstick() -> None
 
 
 def test_a_process_cpu_is_read_from_proc_and_a_sleeping_one_spends_none() -> None:
-    spin = ("import time\nt = time.process_time()\nwhile time.process_time() - t < 0.5: pass\n"
-            "print('spun', flush=True)\ntime.sleep(30)")  # fmt: skip
+    spin = (
+        "import time\nt = time.process_time()\nwhile time.process_time() - t < 0.5: pass\n"
+        "print('spun', flush=True)\ntime.sleep(30)"
+    )
     child = subprocess.Popen([sys.executable, "-c", spin], stdout=subprocess.PIPE, text=True)
     try:
         assert child.stdout is not None and child.stdout.readline() == "spun\n"

@@ -40,7 +40,10 @@ def test_each_stage_is_its_steps_and_its_rest():
 def test_every_step_is_reached_on_foreign_windows():
     parts, stages = measure(4, seed=390_000)
     reached = {key for key, seconds in parts.items() if seconds > 0}
-    maybe = {("check", "sim.batch:run_groups"), ("check", "training.assess.reproduction:as_read")}  # reused lane
+    maybe = {
+        ("check", "ema.model.batch:run_groups"),
+        ("check", "ema.estimate.assess.reproduction:as_read"),
+    }  # reused lane
     assert {(stage, key) for stage, key, _ in PARTS} - maybe <= reached
     for stage in STAGES:
         listed = sum(seconds for (s, _), seconds in parts.items() if s == stage)

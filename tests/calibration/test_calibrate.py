@@ -3,14 +3,14 @@
 import numpy as np
 import pytest
 
-from calibration.calibrate import Calibrator
-from calibration.documents import CalibrationReport
-from sim.actuator import THESIS
-from sim.checks import InputError
-from sim.window import window_from_dict
+from ema.calibration.calibrate import Calibrator
+from ema.calibration.documents import CalibrationReport
+from ema.estimate.config import PipelineConfig
+from ema.model.actuator import THESIS
+from ema.model.checks import InputError
+from ema.model.window import window_from_dict
 from tests.foreign.effects import CASES
 from tests.foreign.windows import Effects, draw, filter_widths
-from training.config import PipelineConfig
 
 SMALL = PipelineConfig(n_simulations=32, check_windows=16, n_timesteps=100, hidden_units=20)
 
@@ -39,8 +39,13 @@ def test_clean_windows_select_nothing(seed):
 def test_a_drive_whose_loop_departs_from_the_spec_is_no_effect():
     # Bus 8 % high, G_P 1.5 % low, 30 µs of lag and a loop dithering on a noisy speed reading: the
     # torque balance the calibration reads is untouched, so nothing may be named or described.
-    loop = Effects(supply_voltage_factor=1.08, position_gain_factor=0.985, loop_delay_s=3e-5,
-                   loop_noise_radps=0.4, loop_noise_seed=5)  # fmt: skip
+    loop = Effects(
+        supply_voltage_factor=1.08,
+        position_gain_factor=0.985,
+        loop_delay_s=3e-5,
+        loop_noise_radps=0.4,
+        loop_noise_seed=5,
+    )
     drawn = draw(903, "doublet", effects=loop)
     report = Calibrator(SMALL, copies=16, actuator=THESIS).fit([window_from_dict(drawn.document)], drawn.truth).report_
     assert report.selected_effect is None and report.unexplained is None
@@ -97,8 +102,10 @@ def test_a_current_scale_names_one_twin_and_reports_the_others():
     assert report.selected_effect in ("current_sensor_gain", "torque_constant")
     step = report.selection_steps[0]
     assert step.tie_break_output_error is not None and set(step.tie_break_output_error) == {
-        "current_sensor_gain", "torque_constant", "inertia"
-    }  # fmt: skip
+        "current_sensor_gain",
+        "torque_constant",
+        "inertia",
+    }
     assert combined_error(report, "after") <= 0.5 * combined_error(report, "before")
 
 
@@ -132,8 +139,9 @@ def test_friction_drifting_in_time_is_described_never_named_and_adopted():
     assert report.effects["table"]["variable"] == "time"
 
 
-@pytest.mark.parametrize("seed", [3801, 3802, pytest.param(3803, marks=pytest.mark.slow),
-                                  pytest.param(3805, marks=pytest.mark.slow)])  # fmt: skip
+@pytest.mark.parametrize(
+    "seed", [3801, 3802, pytest.param(3803, marks=pytest.mark.slow), pytest.param(3805, marks=pytest.mark.slow)]
+)
 def test_a_current_sensor_off_zero_is_named_as_such_and_the_estimates_recover(seed):
     """A current offset and a hinge-moment bias both leave a constant in T_R; with no family of its own the
     offset was named a hinge-moment bias, and one such window's estimates got worse (0.29 -> 0.72)."""

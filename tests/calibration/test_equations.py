@@ -3,12 +3,12 @@
 import numpy as np
 import pytest
 
-from calibration.backlash import width_rad
-from calibration.equations import cogging_columns, equations, motor_angle_rad
-from sim.actuator import THESIS
-from sim.noise import NO_NOISE
-from sim.params import HealthParams
-from sim.synthetic import synthetic_window
+from ema.calibration.backlash import width_rad
+from ema.calibration.equations import cogging_columns, equations, motor_angle_rad
+from ema.model.actuator import THESIS
+from ema.model.noise import NO_NOISE
+from ema.model.params import HealthParams
+from ema.model.synthetic import synthetic_window
 
 
 def test_motor_angle_integrates_the_interval_mean_speed():
@@ -24,7 +24,7 @@ def test_a_cogging_column_carries_the_logs_interval_mean_attenuation():
     # The interval mean of sin(pθ) over an interval where θ advances by ω/f is sinc(pω/2f) times the centre value.
     exact = np.array([np.mean(np.sin(order * speed * (k / rate + np.arange(1000) / 1000 / rate))) for k in range(4000)])
     middle = slice(100, 3900)  # the 2 ms smoothing attenuates further; compare after it, away from the ends
-    from sim.residual import smoothed
+    from ema.model.residual import smoothed
 
     np.testing.assert_allclose(columns[middle, 0], smoothed(exact, rate)[middle], atol=2e-3)
 
@@ -33,5 +33,5 @@ def test_the_dead_band_width_is_read_from_the_windows_own_angles():
     window = synthetic_window(HealthParams.single(), seed=3, noise=NO_NOISE)
     problem = equations([window.signals], window.sample_rate_hz, [], actuator=THESIS.params)
     # BLK of Table 3.1, within the few % that smoothing over the reversals takes (the noise floor's
-    # copies carry the same, so calibration.backlash reads extra width against them, not against BLK)
+    # copies carry the same, so ema.calibration.backlash reads extra width against them, not against BLK)
     assert width_rad(problem) == pytest.approx(5e-3, rel=0.1)

@@ -3,16 +3,16 @@
 import numpy as np
 import pytest
 
-from calibration.equations import FOLDS, Equations, equations
-from calibration.families import generic_families, named_families
-from calibration.refit import fit_with
-from calibration.selection import Chosen
-from sim.actuator import THESIS
-from sim.params import eta_a_from_eta_o
-from sim.window import window_from_dict
+from ema.calibration.equations import FOLDS, Equations, equations
+from ema.calibration.families import generic_families, named_families
+from ema.calibration.refit import fit_with
+from ema.calibration.selection import Chosen
+from ema.estimate.physics.eta_search import ETA_O_SEARCH, GRID_POINTS, REFINEMENTS
+from ema.model.actuator import THESIS
+from ema.model.params import eta_a_from_eta_o
+from ema.model.window import window_from_dict
 from tests.foreign.effects import CASES
 from tests.foreign.windows import draw
-from training.physics.eta_search import ETA_O_SEARCH, GRID_POINTS, REFINEMENTS
 
 GEAR = THESIS.params.gear_ratio
 
@@ -40,8 +40,9 @@ def _measured(case: str, seed: int) -> Equations:
     return equations([window.signals], window.sample_rate_hz, [], actuator=THESIS.params)
 
 
-@pytest.mark.parametrize(("case", "family"), [("position_friction", "position_friction"),
-                                              ("stribeck", "friction vs speed_radps")])  # fmt: skip
+@pytest.mark.parametrize(
+    ("case", "family"), [("position_friction", "position_friction"), ("stribeck", "friction vs speed_radps")]
+)
 def test_one_solve_for_the_grid_equals_a_solve_per_point(case, family):
     e = _measured(case, 5_601)
     found = {f.name: f for f in [*named_families(e, THESIS.params), *generic_families(e)]}[family]
@@ -60,8 +61,16 @@ def test_a_known_fdj_and_eta_o_come_back():
     loads = np.abs(rng.normal(0.0, 0.4, size=(m, 2))) * (rng.random((m, 1)) < 0.5)
     k_aid, k_opp = 1 - float(eta_a_from_eta_o(eta_o, GEAR)), 1 / eta_o - 1
     y = fdj + k_aid * loads[:, 0] + k_opp * loads[:, 1] + rng.normal(0.0, 2e-3, m)
-    e = Equations(y=y, base=np.column_stack([np.ones(m), loads]), variables={}, cogging={}, kinematic=np.zeros(m),
-                  folds=np.sort(np.arange(m) % FOLDS), window=np.zeros(m, dtype=int), gear_ratio=GEAR)  # fmt: skip
+    e = Equations(
+        y=y,
+        base=np.column_stack([np.ones(m), loads]),
+        variables={},
+        cogging={},
+        kinematic=np.zeros(m),
+        folds=np.sort(np.arange(m) % FOLDS),
+        window=np.zeros(m, dtype=int),
+        gear_ratio=GEAR,
+    )
     fitted = fit_with(e, [])
     assert fitted.fdj_nm == pytest.approx(fdj, rel=0.02)
     assert fitted.eta_o == pytest.approx(eta_o, abs=0.01)

@@ -1,4 +1,4 @@
-"""Command families of real flight windows, drawn independently of ``sim.commands`` (test-only).
+"""Command families of real flight windows, drawn independently of ``ema.model.commands`` (test-only).
 
 Each family returns ``command(t)``, a vectorized function of time [s] (t may start before 0: a
 window cut from a longer flight), and is what a pilot, an autopilot or the thesis would send.
@@ -76,6 +76,11 @@ def hold(rng: np.random.Generator, duration_s: float) -> Command:
 
 
 BY_NAME: dict[str, Callable[[np.random.Generator, float], Command]] = {
-    "thesis": thesis, "cruise": cruise, "gust": gust, "doublet": doublet, "steps": steps, "hold": hold,
+    "thesis": thesis,
+    "cruise": cruise,
+    "gust": gust,
+    "doublet": doublet,
+    "steps": steps,
+    "hold": hold,
     "sweep": sweep,
-}  # fmt: skip
+}

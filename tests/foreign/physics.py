@@ -1,6 +1,6 @@
 """The EMA of ``docs/model.md`` written again, independently of ``sim/``, for tests only.
 
-Deliberate differences in form from ``sim.kernels`` (each one a legitimate reading of the spec):
+Deliberate differences in form from ``ema.model.kernels`` (each one a legitimate reading of the spec):
 
 - one scalar loop per window, branches and all, no lock-step lanes;
 - the RL phase integrated exactly over each 1 µs step (exponential), not by explicit Euler;
@@ -9,7 +9,7 @@ Deliberate differences in form from ``sim.kernels`` (each one a legitimate readi
   moment evaluated at every step, trim interpolated at the *true* airspeed;
 - the command held in a 100 kHz table, linearly interpolated;
 - log intervals of any length (a 3 kHz log has 333 or 334 steps per interval);
-- effects in forms ``sim.effects`` does not have: a Gaussian friction bump over elevator position,
+- effects in forms ``ema.model.effects`` does not have: a Gaussian friction bump over elevator position,
   a tanh Stribeck curve, dynamic friction drifting in time, cogging as a cosine of any order;
 - a loop that may depart from the spec's, unlogged: bus voltage, position gain, a lag between the
   logged command and the one the loop follows, a noisy speed reading;
@@ -30,11 +30,54 @@ COMMAND_TABLE_HZ = 100_000.0
 AIRCRAFT_EVERY = 100  # steps between RK4 steps of the aircraft
 LOOP_SAMPLE_STEPS = 100  # the loop's sensors are read at 10 kHz
 # Indices of the parameter vector the loop reads.
-(P_GP, P_GAP, P_R, P_L, P_KT, P_KE, P_TMAX, P_VMAX, P_IMAX, P_J, P_C, P_BLK, P_STOP,
- P_FSJ, P_FDJ, P_ASYM, P_KAID, P_KOPP, P_ISENSE, P_IBIAS, P_HBIAS,
- P_BUMP_A, P_BUMP_C, P_BUMP_W, P_STRIB_A, P_STRIB_W, P_DRIFT, P_COG_A, P_COG_P, P_COG_PHI,
- P_QSC, P_CHA, P_CHD, P_DWN, P_LT, P_V, P_ALPHA_TRIM, P_DELTA_TRIM, P_ALPHA_LIM, P_VBUS,
- P_GEAR, P_KT_LOOP, P_GROUND, P_LOAD0, P_LOAD_RAMP, N_P) = range(46)  # fmt: skip
+(
+    P_GP,
+    P_GAP,
+    P_R,
+    P_L,
+    P_KT,
+    P_KE,
+    P_TMAX,
+    P_VMAX,
+    P_IMAX,
+    P_J,
+    P_C,
+    P_BLK,
+    P_STOP,
+    P_FSJ,
+    P_FDJ,
+    P_ASYM,
+    P_KAID,
+    P_KOPP,
+    P_ISENSE,
+    P_IBIAS,
+    P_HBIAS,
+    P_BUMP_A,
+    P_BUMP_C,
+    P_BUMP_W,
+    P_STRIB_A,
+    P_STRIB_W,
+    P_DRIFT,
+    P_COG_A,
+    P_COG_P,
+    P_COG_PHI,
+    P_QSC,
+    P_CHA,
+    P_CHD,
+    P_DWN,
+    P_LT,
+    P_V,
+    P_ALPHA_TRIM,
+    P_DELTA_TRIM,
+    P_ALPHA_LIM,
+    P_VBUS,
+    P_GEAR,
+    P_KT_LOOP,
+    P_GROUND,
+    P_LOAD0,
+    P_LOAD_RAMP,
+    N_P,
+) = range(46)
 
 
 @dataclass(frozen=True)
@@ -129,10 +172,14 @@ def _density(altitude_m: float) -> float:
 
 def aircraft_matrices(flight: Flight) -> tuple[np.ndarray, np.ndarray]:
     """A and B of the aircraft (``docs/model.md``), scaled to the flight condition as it prescribes."""
-    a = np.array([[-1.9311e-2, 2.68703, -9.80542, -0.175257],
-                  [-8.3297e-4, -1.0189, 0.0, 0.90506],
-                  [0.0, 0.0, 0.0, 1.0],
-                  [0.0, 0.82225, 0.0, -1.0774]])  # fmt: skip
+    a = np.array(
+        [
+            [-1.9311e-2, 2.68703, -9.80542, -0.175257],
+            [-8.3297e-4, -1.0189, 0.0, 0.90506],
+            [0.0, 0.0, 0.0, 1.0],
+            [0.0, 0.82225, 0.0, -1.0774],
+        ]
+    )
     b = np.array([3.03345, -0.123180, 0.0, -10.0583])
     v0 = 502 * 0.3048
     k_rho = _density(flight.altitude_m) / 1.225
@@ -149,11 +196,14 @@ def aircraft_matrices(flight: Flight) -> tuple[np.ndarray, np.ndarray]:
 
 def trim_rad(flight: Flight) -> tuple[float, float]:
     """Trim α and δe interpolated in the spec's table at the true airspeed."""
-    table = np.array([[300, 8.49, -0.591], [400, 4.16, -0.591], [500, 2.14, -0.756],
-                      [600, 1.04, -0.846], [700, 0.382, -0.900]])  # fmt: skip
+    table = np.array(
+        [[300, 8.49, -0.591], [400, 4.16, -0.591], [500, 2.14, -0.756], [600, 1.04, -0.846], [700, 0.382, -0.900]]
+    )
     v_ftps = flight.airspeed_mps / 0.3048
-    return (np.radians(np.interp(v_ftps, table[:, 0], table[:, 1])),
-            np.radians(np.interp(v_ftps, table[:, 0], table[:, 2])))  # fmt: skip
+    return (
+        np.radians(np.interp(v_ftps, table[:, 0], table[:, 1])),
+        np.radians(np.interp(v_ftps, table[:, 0], table[:, 2])),
+    )
 
 
 def parameters(setup: Setup) -> np.ndarray:
@@ -320,8 +370,19 @@ def simulate(setup: Setup, command_deg, duration_s: float, preroll_s: float = 0.
     first, last = -round(preroll_s / STEP_S), round(duration_s / STEP_S) + 10
     stop = np.radians(setup.drive.end_stop_deg)
     start = float(np.clip(command_rad[0], -stop, stop))
-    _run(parameters(setup), a, b, command_rad, logged_rad, _loop_noise(setup.effects, last - first), first, last, rate,
-         start, out)  # fmt: skip
+    _run(
+        parameters(setup),
+        a,
+        b,
+        command_rad,
+        logged_rad,
+        _loop_noise(setup.effects, last - first),
+        first,
+        last,
+        rate,
+        start,
+        out,
+    )
     names = ("position_deg", "motor_speed_radps", "current_a", "hinge_moment_nm", "command_deg")
     signals = dict(zip(names, out, strict=True))
     signals["position_deg"] = np.degrees(signals["position_deg"])

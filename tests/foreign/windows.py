@@ -39,7 +39,7 @@ class Draw:
 
 def filtered(white: np.ndarray, width: int) -> np.ndarray:
     """Unit-variance noise behind a ``width``-sample moving average (an averaging ADC, a FIR anti-aliasing
-    filter): correlated over ``width`` samples, then not at all (``sim.noise`` draws AR(1) instead)."""
+    filter): correlated over ``width`` samples, then not at all (``ema.model.noise`` draws AR(1) instead)."""
     if width <= 1:
         return white
     return np.convolve(white, np.ones(width) / np.sqrt(width), mode="valid")
@@ -139,8 +139,11 @@ def draw(
     condition and its hinge moment is the load cell's."""
     rng = np.random.default_rng(seed)
     if health is None:
-        health = Health(fdj_nm=nominal.fdj_nm * rng.uniform(0.8, 1.2), fsj_nm=nominal.fsj_nm * rng.uniform(0.8, 1.2),
-                        eta_o=rng.uniform(0.68, 0.98))  # fmt: skip
+        health = Health(
+            fdj_nm=nominal.fdj_nm * rng.uniform(0.8, 1.2),
+            fsj_nm=nominal.fsj_nm * rng.uniform(0.8, 1.2),
+            eta_o=rng.uniform(0.68, 0.98),
+        )
     if flight is None:
         flight = Flight(airspeed_mps=rng.uniform(100.0, 210.0), altitude_m=rng.uniform(0.0, 9000.0))
     if preroll_s is None:
@@ -154,10 +157,11 @@ def draw(
         "actuator_id": f"foreign/{family}",
         "window_id": f"{family}-{seed}",
         "sample_rate_hz": sample_rate_hz,
-        "flight_condition": None if isinstance(flight, Ground) else
-        {"airspeed_mps": flight.airspeed_mps, "altitude_m": flight.altitude_m},
+        "flight_condition": None
+        if isinstance(flight, Ground)
+        else {"airspeed_mps": flight.airspeed_mps, "altitude_m": flight.altitude_m},
         "signals": {name: values.tolist() for name, values in signals.items()},
-    }  # fmt: skip
+    }
     truth = {"FDJ": health.fdj_nm, "eta_O": health.eta_o, "eta_A": health.eta_a(drive.gear_ratio), "FSJ": health.fsj_nm}
     return Draw(document, truth, family, setup, command, duration_s, preroll_s)
 
@@ -174,8 +178,9 @@ def of_the_same_flight(drawn: Draw, seed: int, family: str = "cruise", duration_
     """Another window of ``drawn``'s flight: the same actuator (health, effects, its sensors' offsets),
     flight condition and logger, a command of ``family``."""
     setup = drawn.setup
-    other = draw(seed, family, setup.health, setup.effects, setup.flight, duration_s, setup.sample_rate_hz,
-                 drive=setup.drive)  # fmt: skip
+    other = draw(
+        seed, family, setup.health, setup.effects, setup.flight, duration_s, setup.sample_rate_hz, drive=setup.drive
+    )
     other.document["actuator_id"] = drawn.document["actuator_id"]
     return other
 

@@ -1,4 +1,4 @@
-"""Wear histories drawn with laws only the tests implement (none of them is a law of ``prognosis.laws``), with
+"""Wear histories drawn with laws only the tests implement (none of them is a law of ``ema.prognosis.laws``), with
 the truth of when each crosses its threshold: FDJ rising from 0.05 N·m to the thesis's 0.075."""
 
 from __future__ import annotations
@@ -50,9 +50,14 @@ def _steady(crossing: float) -> Callable[[np.ndarray], np.ndarray]:
 
 
 LAWS: dict[str, Callable[[float], Callable[[np.ndarray], np.ndarray]]] = {
-    "line": _line, "doubling": _doubling, "cube": _cube_plus, "onset": _onset, "crack": _blow_up, "sinh": _sinh,
+    "line": _line,
+    "doubling": _doubling,
+    "cube": _cube_plus,
+    "onset": _onset,
+    "crack": _blow_up,
+    "sinh": _sinh,
     "steady": _steady,
-}  # fmt: skip
+}
 
 
 @dataclass(frozen=True)

@@ -3,10 +3,10 @@
 import numpy as np
 import pytest
 
-from prognosis.backtest import backtest
-from prognosis.outlook import outlook
-from prognosis.trend import fit_trend
-from sim.actuator import THESIS
+from ema.model.actuator import THESIS
+from ema.prognosis.backtest import backtest
+from ema.prognosis.outlook import outlook
+from ema.prognosis.trend import fit_trend
 from tests.prognosis.histories import History, history
 
 THRESHOLD = 0.075  # FDJ +50 % of nominal
@@ -47,8 +47,9 @@ def test_steady_actuators_raise_no_alarm():
     """A degradation is claimed at 95 %: on steady histories of every size, none here."""
     claims = [
         _outlook(history("steady", 3200 + seed, n=n, std=std)).life.status
-        for seed in range(10) for n, std in ((10, 3e-4), (20, 1e-3), (60, 3e-4))
-    ]  # fmt: skip
+        for seed in range(10)
+        for n, std in ((10, 3e-4), (20, 1e-3), (60, 3e-4))
+    ]
     assert claims.count("crossing predicted") == 0, claims
 
 
@@ -61,8 +62,9 @@ def test_outliers_do_not_move_the_outlook():
 
 
 def test_too_few_windows_and_a_crossed_threshold():
-    few = outlook("FDJ", np.array([0.0, 1.0]), np.array([0.05, 0.051]), np.array([1e-4, 1e-4]), ["a", "b"],
-                  THRESHOLD, "above").life  # fmt: skip
+    few = outlook(
+        "FDJ", np.array([0.0, 1.0]), np.array([0.05, 0.051]), np.array([1e-4, 1e-4]), ["a", "b"], THRESHOLD, "above"
+    ).life
     assert few.status == "too few windows"
     h = history("line", 3400)
     crossed = _outlook(History(h.hours, h.values + 0.03, h.stds, 0.0)).life
@@ -81,17 +83,17 @@ def test_the_backtest_shows_past_forecasts_against_the_windows_since():
 
 @pytest.fixture(scope="module")
 def one_estimate():
-    from sim.params import HealthParams
-    from sim.synthetic import synthetic_window
-    from training.config import PipelineConfig
-    from training.pipeline import estimate_window
+    from ema.estimate.config import PipelineConfig
+    from ema.estimate.pipeline import estimate_window
+    from ema.model.params import HealthParams
+    from ema.model.synthetic import synthetic_window
 
     small = PipelineConfig(n_simulations=16, check_windows=8, n_timesteps=50, hidden_units=8)
     return estimate_window(synthetic_window(HealthParams.single(), seed=1, duration_s=0.1), small, actuator=THESIS)
 
 
 def _history(estimate, ratios, stds, hours):
-    from prognosis.documents import Stored
+    from ema.prognosis.documents import Stored
 
     return [
         Stored(
@@ -111,7 +113,7 @@ def _history(estimate, ratios, stds, hours):
 
 
 def test_a_strain_gauge_drifting_against_the_aircraft_is_trended_and_said(one_estimate):
-    from prognosis.prognose import prognose
+    from ema.prognosis.prognose import prognose
 
     rng = np.random.default_rng(5)
     hours = np.sort(rng.uniform(0, 200, 60))
@@ -129,8 +131,8 @@ def test_a_strain_gauge_drifting_against_the_aircraft_is_trended_and_said(one_es
 
 
 def test_the_actuators_j_m_is_its_windows_readings_and_a_replaced_part_is_said(one_estimate):
-    from prognosis.prognose import prognose
-    from training.documents import InertiaReading
+    from ema.estimate.documents import InertiaReading
+    from ema.prognosis.prognose import prognose
 
     def with_reads(factors):
         n = len(factors)
@@ -162,6 +164,10 @@ def test_windows_at_one_time_are_a_level_with_no_slope(times):
     trend = fit_trend("FDJ", np.array(times), np.full(n, 0.06), np.full(n, 1e-3), [str(i) for i in range(n)])
     assert trend.level == pytest.approx(0.06) and trend.slope_std is None
     assert trend.level_std == pytest.approx(1e-3 / np.sqrt(n))
-    assert outlook("FDJ", np.array(times), np.full(n, 0.06), np.full(n, 1e-3), [str(i) for i in range(n)], THRESHOLD,
-                   "above").life.status == "too few windows"  # fmt: skip
+    assert (
+        outlook(
+            "FDJ", np.array(times), np.full(n, 0.06), np.full(n, 1e-3), [str(i) for i in range(n)], THRESHOLD, "above"
+        ).life.status
+        == "too few windows"
+    )
     trend.model_dump_json()  # finite: JSON carries it

@@ -3,12 +3,12 @@ import copy
 import pytest
 from fastapi.testclient import TestClient
 
-from service.config import Settings
-from service.main import create_app
-from sim.params import HealthParams
-from sim.synthetic import synthetic_window
-from sim.window import window_to_dict
-from training.config import PipelineConfig
+from ema.estimate.config import PipelineConfig
+from ema.model.params import HealthParams
+from ema.model.synthetic import synthetic_window
+from ema.model.window import window_to_dict
+from ema.service.config import Settings
+from ema.service.main import create_app
 
 SMALL = PipelineConfig(n_simulations=16, check_windows=8, n_timesteps=50, hidden_units=8)
 KEY = "a-key-of-sixteen-characters"

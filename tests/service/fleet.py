@@ -9,14 +9,14 @@ from pathlib import Path
 
 import numpy as np
 
-from service.store import EstimateStore
-from sim.actuator import THESIS
-from sim.params import HealthParams
-from sim.synthetic import synthetic_window
+from ema.estimate.documents import Estimate, parameter
+from ema.estimate.pipeline import estimate_window
+from ema.model.actuator import THESIS
+from ema.model.params import HealthParams
+from ema.model.synthetic import synthetic_window
+from ema.service.store import EstimateStore
 from tests.servers import free_port, start_server
 from tests.service.conftest import SMALL
-from training.documents import Estimate, parameter
-from training.pipeline import estimate_window
 
 # actuator -> (FDJ at 0 h [N·m], FDJ per flight hour, curvature per h², what its page must say)
 FLEET = {
@@ -36,8 +36,16 @@ def store_fleet(store: EstimateStore, base: Estimate, windows: int = 20, seed: i
             fdj = start + slope * h + curvature * h**2 + 3e-4 * rng.normal()
             estimates = base.estimates.model_copy(update={"FDJ": parameter(fdj, 3e-4, 0.05)})
             window = base.window.model_copy(update={"flight_hours": float(h), "content_sha256": f"{actuator_id}-{i}"})
-            store.add(base.model_copy(update={"actuator_id": actuator_id, "window_id": f"w{i:02d}",
-                                              "estimates": estimates, "window": window}))  # fmt: skip
+            store.add(
+                base.model_copy(
+                    update={
+                        "actuator_id": actuator_id,
+                        "window_id": f"w{i:02d}",
+                        "estimates": estimates,
+                        "window": window,
+                    }
+                )
+            )
 
 
 @contextlib.contextmanager

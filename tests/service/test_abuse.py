@@ -17,8 +17,8 @@ from tests.service.conftest import KEY
 
 SERVER = """
 import uvicorn
-from service.config import Settings
-from service.main import create_app
+from ema.service.config import Settings
+from ema.service.main import create_app
 uvicorn.run(create_app(Settings()), host="127.0.0.1", port={port}, log_level="warning")
 """
 
@@ -118,8 +118,10 @@ def _trickle(url: str, stop: threading.Event) -> None:
     """A body announced at 100 kB that arrives a byte every 0.3 s (on a raw socket: no client library waits)."""
     host, port = url.removeprefix("http://").split(":")
     with socket.create_connection((host, int(port))) as connection:
-        head = (f"POST /v1/estimate HTTP/1.1\r\nHost: 127.0.0.1\r\nX-API-Key: {KEY}\r\n"
-                "Content-Type: application/json\r\nContent-Length: 100000\r\n\r\n")  # fmt: skip
+        head = (
+            f"POST /v1/estimate HTTP/1.1\r\nHost: 127.0.0.1\r\nX-API-Key: {KEY}\r\n"
+            "Content-Type: application/json\r\nContent-Length: 100000\r\n\r\n"
+        )
         connection.sendall(head.encode())
         while not stop.wait(0.3):
             try:
@@ -147,8 +149,10 @@ def test_slow_uploads_hold_their_connections_not_the_queue(live, window_document
 def test_a_body_that_does_not_arrive_in_time_is_a_408_and_an_abandoned_one_leaves_no_traceback(server):
     url, log_path = server
     host, port = url.removeprefix("http://").split(":")
-    head = (f"POST /v1/estimate HTTP/1.1\r\nHost: 127.0.0.1\r\nX-API-Key: {KEY}\r\n"
-            "Content-Type: application/json\r\nContent-Length: 1000\r\n\r\n{")  # fmt: skip
+    head = (
+        f"POST /v1/estimate HTTP/1.1\r\nHost: 127.0.0.1\r\nX-API-Key: {KEY}\r\n"
+        "Content-Type: application/json\r\nContent-Length: 1000\r\n\r\n{"
+    )
     with socket.create_connection((host, int(port)), timeout=30) as connection:
         connection.sendall(head.encode())
         assert b" 408 " in connection.recv(4096).split(b"\r\n")[0] + b" "

@@ -6,7 +6,7 @@ import time
 import pytest
 from fastapi.testclient import TestClient
 
-from service.main import create_app
+from ema.service.main import create_app
 from tests.foreign.windows import Effects, draw, of_the_same_flight
 from tests.service.conftest import KEY, LOCAL, SMALL, settings_for
 
@@ -260,7 +260,7 @@ def test_a_ground_station_fans_out_to_ray(tmp_path, document):
         hold = {**document, "window_id": "hold", "signals": {k: [0.0] * 1000 for k in document["signals"]}}
         refused = client.post("/v1/estimate", json=hold)
     assert first.status_code == second.status_code == 200
-    # all zeros: no sensor logged anything (training.prepare.consistency), named before any motion is looked for
+    # all zeros: no sensor logged anything (ema.estimate.prepare.consistency), named before any motion is looked for
     assert refused.status_code == 422 and refused.json()["detail"][0]["loc"] == ["body", "signals", "position_deg"]
 
 

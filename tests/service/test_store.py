@@ -6,13 +6,13 @@ import stat
 
 import pytest
 
-from service.store import EstimateStore, StorageError
-from sim.actuator import THESIS
-from sim.params import HealthParams
-from sim.synthetic import synthetic_window
+from ema.estimate.documents import SensorZero
+from ema.estimate.pipeline import estimate_window
+from ema.model.actuator import THESIS
+from ema.model.params import HealthParams
+from ema.model.synthetic import synthetic_window
+from ema.service.store import EstimateStore, StorageError
 from tests.service.conftest import SMALL
-from training.documents import SensorZero
-from training.pipeline import estimate_window
 
 
 @pytest.fixture(scope="module")
@@ -43,7 +43,7 @@ def test_a_file_others_could_read_is_made_private_with_a_warning(tmp_path, resul
 
 
 def test_another_window_under_a_stored_key_is_a_conflict_and_an_old_row_a_replay(tmp_path, result):
-    from service.store import ConflictError
+    from ema.service.store import ConflictError
 
     store = EstimateStore(tmp_path / "h.sqlite3")
     store.add(result)
@@ -94,8 +94,14 @@ def test_the_sensor_zero_is_the_most_precise_of_the_actuators_flight(tmp_path, r
         window = result.window.model_copy(update={"flight_id": flight_id, "sensor_zero": zero})
         store.add(result.model_copy(update={"actuator_id": actuator_id, "window_id": window_id, "window": window}))
 
-    for args in [("a", "w1", "f", 3e-4), ("a", "w2", "f", 1e-4), ("a", "w3", "f", None), ("a", "w4", "g", 1e-5),
-                 ("b", "w5", "f", 1e-6), ("a", "w6", None, 1e-6)]:  # fmt: skip
+    for args in [
+        ("a", "w1", "f", 3e-4),
+        ("a", "w2", "f", 1e-4),
+        ("a", "w3", "f", None),
+        ("a", "w4", "g", 1e-5),
+        ("b", "w5", "f", 1e-6),
+        ("a", "w6", None, 1e-6),
+    ]:
         stored(*args)
     assert store.readings("a", "f").sensor_zero.window_id == "w2"
     assert store.readings("a", "g").sensor_zero.window_id == "w4"

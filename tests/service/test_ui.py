@@ -5,14 +5,14 @@ import base64
 import pytest
 from fastapi.testclient import TestClient
 
-from service.main import create_app
-from service.store import EstimateStore
-from sim.actuator import THESIS
-from sim.params import HealthParams
-from sim.synthetic import synthetic_window
+from ema.estimate.pipeline import estimate_window
+from ema.model.actuator import THESIS
+from ema.model.params import HealthParams
+from ema.model.synthetic import synthetic_window
+from ema.service.main import create_app
+from ema.service.store import EstimateStore
 from tests.service.conftest import KEY, LOCAL, SMALL, settings_for
 from tests.service.fleet import FLEET, store_fleet
-from training.pipeline import estimate_window
 
 
 @pytest.fixture(scope="module")

@@ -1,0 +1,59 @@
+"""Stage 2, noise floor: what the equation error of *these* windows looks like when nothing is missing.
+
+Each window is simulated once, clean, with its own command, logged load and first state at the
+estimates the base model gives it; then ``COPIES`` independent draws of the window's own
+estimated sensor noise are added. Every statistic the selection computes on the measured
+windows is computed on each copy too: the copies carry the same trajectory, the same 2 ms
+reconstruction and its approximation error, the same correlated noise, and none of the missing
+physics. A candidate is evidence only where the measured statistic stands far outside their
+spread (no effective-sample-size guess, no BIC on correlated samples).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping, Sequence
+
+import numpy as np
+
+from ema.calibration.equations import Equations, equations
+from ema.estimate.physics.scenario import inside, scenario_from_window
+from ema.model import runtime
+from ema.model.actuator import Actuator
+from ema.model.noise import SensorNoise, add_sensor_noise
+from ema.model.params import ActuatorParams
+from ema.model.window import Window
+
+COPIES = 30
+
+
+def clean_replicas(
+    windows: Sequence[Window], estimates: Mapping[str, float], actuator: Actuator
+) -> list[dict[str, np.ndarray]]:
+    """Each window simulated at ``estimates`` (FSJ at twice FDJ), without noise."""
+    health = inside(estimates["FDJ"], estimates["eta_O"], actuator.nominal.fdj_nm)
+    return [
+        scenario_from_window(w, actuator.params, actuator.hinge).simulate(health, lanes=1).simulation(0)
+        for w in windows
+    ]
+
+
+def noise_copies(
+    clean: Sequence[dict[str, np.ndarray]],
+    noise: Sequence[SensorNoise],
+    rate: float,
+    orders: Sequence[float],
+    seed: int,
+    actuator: ActuatorParams,
+    copies: int = COPIES,
+    on_copy: Callable[[], None] | None = None,
+) -> list[Equations]:
+    """``copies`` noisy versions of the clean replicas, each as the selection sees a window set; ``on_copy`` is
+    called before each draw (and may raise to stop there). The draws come from one generator in turn; their
+    equations, independent, are built on the simulator's threads."""
+    rng = np.random.default_rng(seed)
+    drawn = []
+    for _ in range(copies):
+        if on_copy is not None:
+            on_copy()
+        drawn.append([add_sensor_noise(signals, level, rng, rate) for signals, level in zip(clean, noise, strict=True)])
+    return runtime.map_on_pool(lambda noisy: equations(noisy, rate, orders, actuator), drawn)

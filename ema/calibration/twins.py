@@ -1,0 +1,63 @@
+"""Twins: effects that leave the same trace in the residual torque, told apart by simulation.
+
+A torque constant g and a current-sensor gain s both leave a term in k_T·I in the residual torque;
+only the first also changes the back-EMF (k_e = k_T), hence how much voltage is left to drive current
+near top speed, hence how the motor speed and current evolve. An inertia off the document's leaves a
+term in dω/dt, which k_T·I mostly is, and moves how fast the speed follows the current. A current
+sensor and a hinge-moment sensor off zero both leave a constant in T_R; only the first is felt by the
+loop, which regulates the logged current. Each twin is added to the simulator in turn, the window
+simulated at the estimates, and the one whose speed and current stay closer to the measured ones (in
+units of their noise) is named; the other is reported as indistinguishable when the difference is small.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+
+from ema.calibration.selection import Evidence
+from ema.estimate.physics.scenario import CLEAR_MARGIN, following_error, inside, scenario_from_window
+from ema.model.actuator import Actuator
+from ema.model.noise import SensorNoise
+from ema.model.window import Window
+
+# Look-alikes, each with the others of its group. An inertia ΔJ leaves ΔJ·dω/dt, which a gain of k_T·I
+# (mostly the load and J_M·dω/dt) nearly matches; only its simulation moves the speed otherwise. A current
+# sensor off zero and a hinge-moment sensor off zero both leave a constant in T_R, sgn(ω)·c in t; only the
+# first is felt by the loop (it regulates the logged current), and only the second moves the load columns.
+GROUPS = (("torque_constant", "current_sensor_gain", "inertia"), ("hinge_moment_bias", "current_sensor_offset"))
+TWINS = {name: tuple(other for other in group if other != name) for group in GROUPS for name in group}
+
+
+def output_error(
+    windows: Sequence[Window],
+    estimates: Mapping[str, float],
+    option: Evidence,
+    noise: Sequence[SensorNoise],
+    actuator: Actuator,
+) -> float:
+    """Mean over windows of RMS(speed)/σ_speed + RMS(current)/σ_current, simulated with ``option`` added."""
+    effects = option.family.term(option.beta, option.grid)
+    if effects is None:
+        return float("inf")  # a gain outside what the simulator admits: not this twin
+    health = inside(estimates["FDJ"], estimates["eta_O"], actuator.nominal.fdj_nm)
+    errors = [
+        following_error(scenario_from_window(w, actuator.params, actuator.hinge, effects), w, health, level)
+        for w, level in zip(windows, noise, strict=True)
+    ]
+    return float(np.mean(errors))
+
+
+def tell_apart(
+    windows: Sequence[Window],
+    estimates: Mapping[str, float],
+    options: Sequence[Evidence],
+    noise: Sequence[SensorNoise],
+    actuator: Actuator,
+) -> tuple[Evidence, dict[str, float], bool]:
+    """The twin whose simulation follows the windows best, each one's output error, and whether the call is clear."""
+    errors = {o.family.name: output_error(windows, estimates, o, noise, actuator) for o in options}
+    ranked = sorted(options, key=lambda o: errors[o.family.name])
+    best, runner = errors[ranked[0].family.name], errors[ranked[1].family.name]
+    return ranked[0], errors, runner > (1 + CLEAR_MARGIN) * best

@@ -1,0 +1,116 @@
+"""Commands for the ground and the bench: an archive across Ray workers, and the latency benchmark."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import click
+
+from ema.cli.options import NothingAnsweredError, actuator, as_json, emit, pipeline_config, sizes
+
+ARCHIVE = click.Path(exists=True, path_type=Path)
+
+
+@click.command()
+@click.argument("archive", type=ARCHIVE)
+@click.option(
+    "--out",
+    required=True,
+    type=click.Path(dir_okay=False, path_type=Path),
+    help="results CSV, one row per window (a rerun resumes from it)",
+)
+@click.option("--workers", type=click.IntRange(1, 4096), default=2, help="Ray workers (windows at a time)")
+@click.option("--threads", type=click.IntRange(1, 256), default=1, help="threads (CPUs) each worker reserves")
+@click.option("--ray-address", default=None, help="'auto' or HOST:PORT of a cluster [default: a local Ray]")
+@click.option("--window-s", type=click.FloatRange(0.1, 10.0), default=0.5, help="cut recordings into windows [s]")
+@click.option(
+    "--database",
+    type=click.Path(dir_okay=False, path_type=Path),
+    default=None,
+    help="also store every answer in this SQLite history (the service's)",
+)
+@actuator
+@sizes
+@as_json
+def fleet(
+    archive: Path,
+    out: Path,
+    workers: int,
+    threads: int,
+    ray_address: str | None,
+    window_s: float,
+    database: Path | None,
+    actuator_file: Path | None,
+    as_json: bool,
+    **size_values: int,
+) -> None:
+    """Reprocess an archive (folder, NPZ, CSV or JSON logs) on Ray workers; one CSV row per window.
+
+    Each window is read with its actuator's document: the archive folder's actuators.json maps actuator_ids to
+    ema-actuator/1 documents; the others take --actuator (the thesis's where none is given). Without Ray
+    (``pip install 'ema[fleet]'``) one worker runs in this process. Exit status 2 when no window was
+    answered; a folder's unreadable files are skipped and listed."""
+    from ema.cli.commands_remote import report_log
+    from ema.cli.fleet import Documents, check_engine, run_fleet
+    from ema.cli.logs import read_actuators, read_log
+    from ema.model.actuator import read_actuator
+
+    config = pipeline_config(size_values)
+    check_engine(workers, ray_address)
+    documents = Documents(read_actuators(archive), None if actuator_file is None else read_actuator(actuator_file))
+    read = read_log(archive, window_s)
+    report_log(read)
+    print(f"ema fleet: {len(read.windows)} window(s) from {archive}, {workers} worker(s)", file=sys.stderr)
+    result = {
+        **run_fleet(read.windows, out, config, workers, ray_address, threads, database, documents),
+        "bad_files": read.bad_files,
+    }
+    emit(result, as_json, _print_fleet)
+    if result["answered"] + result["skipped"] == 0 and result["refused"]:
+        raise NothingAnsweredError(f"none of the {result['refused']} window(s) was answered (see {out})")
+
+
+def _print_fleet(result: dict) -> None:
+    skipped = f", {len(result['bad_files'])} unreadable file(s) skipped" if result["bad_files"] else ""
+    click.echo(
+        f"{result['answered']} answered, {result['refused']} refused, {result['skipped']} already in "
+        f"{result['csv']}{skipped}; {result['windows_per_s']:.2f} windows/s on {result['workers']} worker(s) "
+        f"({result['engine']})"
+    )
+
+
+@click.command()
+@click.option(
+    "--out",
+    type=click.Path(file_okay=False, path_type=Path),
+    default=Path("bench-out"),
+    help="folder for bench.json and bench.png",
+)
+@click.option("--repeats", type=click.IntRange(1, 1000), default=10, help="windows per duration")
+@click.option("--durations", default="0.5,2", help="window durations [s], comma-separated")
+@click.option(
+    "--under-load",
+    type=click.IntRange(0, 64),
+    default=0,
+    help="also time with this many CPU-bound processes running beside",
+)
+@click.option("--docs", is_flag=True, help="rewrite the section of docs/benchmarks.md")
+@sizes
+@as_json
+def bench(
+    out: Path, repeats: int, durations: str, under_load: int, docs: bool, as_json: bool, **size_values: int
+) -> None:
+    """Latency of one window -> estimates: p50/p95 per stage, real-time factor, accuracy (idle, and under load)."""
+    from ema.cli.bench import run_bench
+    from ema.model.checks import InputError
+
+    try:
+        seconds = [float(d) for d in durations.split(",")]
+    except ValueError:
+        raise InputError("--durations", f"must be numbers separated by commas, got {durations!r}") from None
+    result = run_bench(pipeline_config(size_values), seconds, repeats, under_load, out, docs)
+    emit(result, as_json, lambda r: click.echo(r["table"]))
+
+
+COMMANDS = (fleet, bench)

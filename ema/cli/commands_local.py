@@ -1,0 +1,240 @@
+"""Commands that run in this process: estimate, simulate, calibrate, serve, schemas."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import click
+
+from ema.cli.options import (
+    actuator,
+    actuator_document,
+    as_json,
+    emit,
+    flags_named,
+    pipeline_config,
+    progress,
+    sizes,
+    threads,
+)
+from ema.model.envelope import DEFAULT_AIRSPEED_MPS
+
+FAMILIES = ("thesis", "cruise", "gust", "doublet", "steps")  # ema.model.commands.FAMILIES, without importing numpy here
+EXISTING = click.Path(exists=True, dir_okay=False, path_type=Path)
+SIMULATE_FLAGS = {
+    "flight_condition.airspeed_mps": "--airspeed",
+    "flight_condition.altitude_m": "--altitude",
+    "fsj_nm": "--fsj",
+    "fdj_nm": "--fdj",
+    "eta_o": "--eta-o",
+    "sample_rate_hz": "--rate",
+    "command": "--command",
+    "effects": "--effect",
+    "ground_load.constant_nm": "--load",
+    "ground_load.ramp_nmps": "--load-ramp",
+}
+
+
+def history_of(window: Any, paths: tuple[Path, ...]) -> Any:
+    """What the ema-estimate/1 results in ``paths``, of other windows of ``window``'s actuator, read that it may
+    not (``ema.estimate.history``); InputError naming --history."""
+    from pydantic import ValidationError
+
+    from ema.estimate.documents import Estimate
+    from ema.estimate.history import readings_of
+    from ema.model.checks import InputError
+
+    results = []
+    for path in paths:
+        try:
+            result = Estimate.model_validate_json(path.read_bytes())
+        except (OSError, ValidationError) as exc:
+            first = str(exc).splitlines()[0]
+            raise InputError("--history", f"{path} is not an ema-estimate/1 result ({first})") from None
+        if result.actuator_id != window.actuator_id:
+            raise InputError(
+                "--history", f"{path} is of actuator {result.actuator_id}, the window of {window.actuator_id}"
+            )
+        results.append(result)
+    return readings_of([result.window for result in results], window.flight_id)
+
+
+@click.command()
+@click.argument("window", type=EXISTING)
+@click.option(
+    "--history",
+    "history",
+    type=EXISTING,
+    multiple=True,
+    metavar="RESULT.json",
+    help="the ema-estimate/1 result of another window of the actuator (repeatable): J_M where it read one, "
+    "its sensors' zero where it is of the window's flight_id",
+)
+@actuator
+@sizes
+@threads
+@as_json
+def estimate(
+    window: Path,
+    history: tuple[Path, ...],
+    actuator_file: Path | None,
+    threads: int | None,
+    as_json: bool,
+    **size_values: int,
+) -> None:
+    """Estimate FDJ, η_O, η_A (FSJ where it shows) of one ema-window/1 JSON file, in-process."""
+    from ema.cli.printing import print_estimate
+    from ema.estimate import runtime
+    from ema.estimate.pipeline import estimate_window
+    from ema.model.window import read_window
+
+    config = pipeline_config(size_values)
+    document = actuator_document(actuator_file)
+    read = read_window(window)
+    known = history_of(read, history) if history else None
+    runtime.configure(threads)
+    result = estimate_window(read, config, actuator=document, on_stage=progress, history=known)
+    emit(result, as_json, print_estimate)
+
+
+@click.command()
+@click.option("--out", required=True, type=click.Path(dir_okay=False, path_type=Path), help="window JSON to write")
+@click.option("--fdj", type=float, default=None, help="dynamic friction FDJ [N·m]  [default: the actuator's nominal]")
+@click.option("--eta-o", "eta_o", type=float, default=None, help="opposing efficiency η_O  [default: nominal]")
+@click.option("--fsj", type=float, default=None, help="static friction FSJ [N·m]  [default: nominal]")
+@click.option("--airspeed", type=float, default=DEFAULT_AIRSPEED_MPS, help="true airspeed [m/s], 90–215")
+@click.option("--altitude", type=float, default=0.0, help="altitude [m], 0–10000")
+@click.option("--ground", is_flag=True, help="on the ground: a load cell's load (--load, --load-ramp), no aircraft")
+@click.option("--load", "load_nm", type=float, default=0.0, help="with --ground: the hinge moment at t = 0 [N·m]")
+@click.option("--load-ramp", "load_ramp_nmps", type=float, default=0.0, help="with --ground: its rate [N·m/s]")
+@click.option("--command", type=click.Choice(FAMILIES), default="thesis", help="the command's family")
+@click.option("--seed", type=int, default=0, help="seed of the command and the noise")
+@click.option("--duration", type=click.FloatRange(0.01, 60.0), default=0.5, help="window length [s]")
+@click.option("--rate", type=float, default=10_000.0, help="log rate [Hz], 1000–100000")
+@click.option("--clean", is_flag=True, help="no sensor noise")
+@click.option(
+    "--effect",
+    "effect",
+    multiple=True,
+    metavar="NAME[:KEY=VALUE,...]",
+    help="an effect the base model lacks, e.g. cogging:amplitude_nm=0.02 (repeatable)",
+)
+@click.option("--actuator-id", default="synthetic/elevator", help="actuator_id written to the window")
+@click.option("--truth-out", type=click.Path(dir_okay=False, path_type=Path), help="also write the truth as JSON")
+@actuator
+@as_json
+def simulate(as_json: bool, **options: Any) -> None:
+    """Write a synthetic ema-window/1 file from the model (sensor noise unless --clean)."""
+    from ema.cli.printing import print_simulate
+    from ema.cli.synthesis import synthesize
+
+    with flags_named(SIMULATE_FLAGS):
+        result = synthesize(**options)
+    emit(result, as_json, print_simulate)
+
+
+@click.command()
+@click.argument("windows", type=EXISTING, nargs=-1, required=True)
+@click.option("--truth", type=EXISTING, help='JSON {"FDJ": ..., "eta_O": ...} of synthetic windows')
+@click.option(
+    "--figure",
+    type=click.Path(dir_okay=False, path_type=Path),
+    default=None,
+    help="also write a PNG of the residual before and after",
+)
+@click.option("--copies", type=click.IntRange(8, 500), default=30, help="noise-only copies behind the noise floor")
+@actuator
+@sizes
+@threads
+@as_json
+def calibrate(
+    windows: tuple[Path, ...],
+    truth: Path | None,
+    figure: Path | None,
+    copies: int,
+    actuator_file: Path | None,
+    threads: int | None,
+    as_json: bool,
+    **size_values: int,
+) -> None:
+    """Trace what the model misses in windows of one actuator to an effect, add it, re-estimate."""
+    from ema.calibration.calibrate import Calibrator
+    from ema.cli.figures import calibration_figure
+    from ema.cli.printing import print_calibration, read_truth
+    from ema.estimate import runtime
+    from ema.model.window import read_window
+
+    config = pipeline_config(size_values)
+    runtime.configure(threads)
+    loaded = [read_window(path) for path in windows]
+    calibrator = Calibrator(config, copies=copies, seed=config.seed, actuator=actuator_document(actuator_file))
+    calibrator.fit(loaded, read_truth(truth), on_stage=progress)
+    written = None if figure is None else str(calibration_figure(calibrator, figure))
+    emit({**calibrator.report_.model_dump(mode="json", by_alias=True), "figure": written}, as_json, print_calibration)
+
+
+@click.command()
+@click.option("--host", default=None, help="bind address [default: EMA_HOST, else 127.0.0.1]")
+@click.option("--port", type=click.IntRange(1, 65535), default=None, help="port [default: EMA_PORT, else 8000]")
+@click.option(
+    "--database",
+    type=click.Path(dir_okay=False, path_type=Path),
+    default=None,
+    help="SQLite history file [default: EMA_DATABASE, else $XDG_DATA_HOME/ema/history.sqlite3]",
+)
+@click.option("--api-key-file", type=EXISTING, default=None, help="a file holding the API key (or EMA_API_KEY)")
+def serve(**flags: Any) -> None:
+    """Run the HTTP service (all settings: EMA_* environment variables; the flags win)."""
+    import uvicorn
+    from pydantic import ValidationError
+
+    from ema.model.checks import InputError, from_validation
+    from ema.service.config import Settings
+    from ema.service.main import create_app
+    from ema.service.store import EstimateStore
+
+    try:
+        settings = Settings(**{k: v for k, v in flags.items() if v is not None})
+    except ValidationError as exc:
+        error = from_validation(exc)
+        field = "host" if error.field == "document" else error.field  # the one check across fields: host vs key
+        raise InputError(f"--{field.replace('_', '-')} / EMA_{field.upper()}", error.message) from None
+    EstimateStore(settings.database).close()  # refused here, naming the file, before the server starts
+    _check_port_free(settings.host, settings.port)
+    uvicorn.run(create_app(settings), host=settings.host, port=settings.port, log_level="info")
+
+
+def _check_port_free(host: str, port: int) -> None:
+    """InputError naming --port where the address is taken (uvicorn would exit 3 after loading everything)."""
+    import socket
+
+    from ema.model.checks import InputError
+
+    try:
+        with socket.create_server((host, port)):
+            pass
+    except OSError as exc:
+        raise InputError("--port / EMA_PORT", f"{host}:{port} cannot be bound ({exc.strerror})") from None
+
+
+@click.command()
+@click.option(
+    "--out",
+    type=click.Path(file_okay=False, path_type=Path),
+    required=True,
+    help="folder for the JSON Schemas (the repository keeps them in docs/schemas)",
+)
+@click.option("--check", is_flag=True, help="exit 1 if the files there differ from the code")
+def schemas(out: Path, check: bool) -> None:
+    """Export the JSON Schema of every public document (or check the exported ones)."""
+    from ema.cli.schemas import export
+
+    stale = export(out, check=check)
+    if check and stale:
+        raise click.ClickException(f"stale or missing in {out}: {', '.join(stale)} (run: ema schemas --out {out})")
+    click.echo(json.dumps({"folder": str(out), "checked" if check else "written": "all"}))
+
+
+COMMANDS = (estimate, simulate, calibrate, serve, schemas)

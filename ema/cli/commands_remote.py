@@ -1,0 +1,135 @@
+"""Commands that talk to a running service: replay a log into it, read an actuator's history back."""
+
+from __future__ import annotations
+
+import os
+import sys
+import urllib.parse
+from pathlib import Path
+from typing import Any
+
+import click
+
+from ema.cli.options import NothingAnsweredError, as_json, emit, flags_named
+from ema.model.envelope import DEFAULT_AIRSPEED_MPS
+
+URL = "http://127.0.0.1:8000"
+LOG = click.Path(exists=True, path_type=Path)
+KEY_FILE = click.Path(exists=True, dir_okay=False, path_type=Path)
+
+
+def api_key(path: Path | None) -> str | None:
+    """The key from --api-key-file, else EMA_API_KEY (never a flag: ``ps`` would show it)."""
+    if path is not None:
+        return path.read_text().strip()
+    return os.environ.get("EMA_API_KEY")
+
+
+@click.command()
+@click.argument("log", type=LOG)
+@click.option("--url", default=URL, help="the service")
+@click.option(
+    "--out",
+    type=click.Path(dir_okay=False, path_type=Path),
+    default=Path("estimates.csv"),
+    help="CSV the answers are appended to (a rerun resumes from it)",
+)
+@click.option("--window-s", type=click.FloatRange(0.1, 10.0), default=0.5, help="cut recordings into windows [s]")
+@click.option("--api-key-file", type=KEY_FILE, default=None, help="file holding the API key [default: EMA_API_KEY]")
+@click.option("--actuator-id", default="unknown", help="for CSV/NPZ logs that carry none")
+@click.option("--rate", type=float, default=10_000.0, help="sample rate [Hz] for CSV/NPZ logs that carry none")
+@click.option("--airspeed", type=float, default=DEFAULT_AIRSPEED_MPS, help="[m/s] for CSV/NPZ logs that carry none")
+@click.option("--altitude", type=float, default=0.0, help="[m] for CSV/NPZ logs that carry none")
+@as_json
+def replay(
+    log: Path,
+    url: str,
+    out: Path,
+    window_s: float,
+    api_key_file: Path | None,
+    actuator_id: str,
+    rate: float,
+    airspeed: float,
+    altitude: float,
+    as_json: bool,
+) -> None:
+    """Post a recorded log (JSON window(s), CSV, NPZ or a folder) to the service, window by window.
+
+    Exit status 2 when no window was answered; a folder's unreadable files are skipped and listed."""
+    from ema.cli.logs import Defaults, read_log
+    from ema.cli.replay import replay as post_all
+
+    defaults = Defaults(actuator_id, rate, airspeed, altitude)
+    with flags_named({"sample_rate_hz": "--rate", "airspeed_mps": "--airspeed", "altitude_m": "--altitude"}):
+        read = read_log(log, window_s, defaults)
+    report_log(read)
+    print(f"replaying {len(read.windows)} window(s) from {log} to {url}", file=sys.stderr)
+    rows = post_all(read.windows, url, out, api_key(api_key_file))
+    refused = [row for row in rows if row.get("error")]
+    result = {
+        "csv": str(out),
+        "posted": len(rows),
+        "answered": len(rows) - len(refused),
+        "refused": len(refused),
+        "bad_files": read.bad_files,
+        "rows": rows,
+    }
+    emit(result, as_json, _print_replay)
+    if rows and not result["answered"]:
+        raise NothingAnsweredError(f"none of the {len(rows)} window(s) posted was answered (see {out})")
+
+
+def report_log(read: Any) -> None:
+    """What reading a log left out, on standard error: each skipped file and each dropped tail."""
+    for file, reason in read.bad_files.items():
+        print(f"skipped {file}: {reason}", file=sys.stderr)
+    for window_id, dropped in read.dropped.items():
+        print(f"{window_id}: the last {dropped} sample(s) after it do not fill a window", file=sys.stderr)
+
+
+def _print_replay(result: dict[str, Any]) -> None:
+    click.echo(f"{'window':<36}{'FDJ [N·m]':>12}{'η_O':>9}{'η_A':>9}{'total [s]':>11}")
+    for row in result["rows"]:
+        if row.get("error"):
+            click.echo(f"{row['window_id']:<36}  refused: {row['error']}")
+            continue
+        click.echo(
+            f"{row['window_id']:<36}{row['FDJ']:>12.5f}{row['eta_O']:>9.4f}{row['eta_A']:>9.4f}{row['total_s']:>11.2f}"
+        )
+    skipped = f", {len(result['bad_files'])} unreadable file(s) skipped" if result["bad_files"] else ""
+    click.echo(
+        f"{result['posted']} window(s) posted: {result['answered']} answered, {result['refused']} refused"
+        f"{skipped}; all answers in {result['csv']}"
+    )
+
+
+@click.command()
+@click.argument("actuator_id")
+@click.option("--url", default=URL, help="the service")
+@click.option("--api-key-file", type=KEY_FILE, default=None, help="file holding the API key [default: EMA_API_KEY]")
+@click.option("--plot", type=click.Path(dir_okay=False, path_type=Path), default=None, help="PNG of the prognosis")
+@click.option("--parameter", type=click.Choice(["FDJ", "eta_O", "eta_A"]), default="FDJ", help="what --plot draws")
+@as_json
+def history(
+    actuator_id: str, url: str, api_key_file: Path | None, plot: Path | None, parameter: str, as_json: bool
+) -> None:
+    """An actuator's stored estimates, their trend and its remaining useful life."""
+    from ema.cli.figures import prognosis_figure
+    from ema.cli.printing import print_prognosis
+    from ema.cli.replay import request
+    from ema.prognosis.documents import History, Prognosis
+
+    key = api_key(api_key_file)
+    base = f"{url.rstrip('/')}/v1/actuators/{urllib.parse.quote(actuator_id, safe='/')}"
+    stored = History.model_validate(request(f"{base}/estimates", key, timeout=60))
+    prognosis = Prognosis.model_validate(request(f"{base}/prognosis", key, timeout=60))
+    if plot is not None and parameter in prognosis.trends:
+        prognosis_figure(prognosis, parameter, plot)
+    document = {
+        "history": stored.model_dump(mode="json", by_alias=True),
+        "prognosis": prognosis.model_dump(mode="json"),
+    }
+    emit(document, as_json, lambda _: print_prognosis(stored, prognosis, plot))
+
+
+COMMANDS = (replay, history)

@@ -1,0 +1,94 @@
+"""The ``ema`` command line: one click group, heavy imports inside the commands (``ema --help`` stays fast).
+
+Exit status: 0 success, 2 bad input (the message names the flag or file given), 1 internal error,
+130 interrupted. With ``--json`` standard output holds exactly one JSON document; progress and
+warnings go to standard error. A closed pipe (``ema simulate ... | head``) ends quietly.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+from collections.abc import Sequence
+
+import click
+
+from ema.cli import commands_fleet, commands_local, commands_remote
+from ema.cli.options import NothingAnsweredError, PipeClosedError
+
+EXIT_OK, EXIT_INTERNAL, EXIT_BAD_INPUT, EXIT_INTERRUPTED = 0, 1, 2, 130
+
+
+@click.group(context_settings={"help_option_names": ["-h", "--help"], "show_default": True})
+@click.version_option(package_name="ema", message="%(prog)s %(version)s")
+def ema() -> None:
+    """Onboard health monitor for an elevator electromechanical actuator (EMA)."""
+
+
+for module in (commands_local, commands_remote, commands_fleet):
+    for command in module.COMMANDS:
+        ema.add_command(command)
+
+
+def _bad_input(exc: BaseException) -> str | None:
+    """The message for an error that is the user's input (named field, flag or file), else None."""
+    from ema.model.checks import InputError
+    from ema.service.store import StorageError
+
+    if isinstance(exc, InputError):
+        return f"bad input: {exc}"
+    if isinstance(exc, StorageError):
+        return f"bad input: {exc}"
+    if isinstance(exc, OSError) and exc.filename is not None:
+        return f"{exc.filename}: {exc.strerror}"
+    return None
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run ``ema`` and return its exit status (never a traceback for input errors or interruptions); the
+    simulator's threads end with it, however it ends."""
+    try:
+        return _run(list(sys.argv[1:] if argv is None else argv))
+    finally:
+        simulator = sys.modules.get("ema.model.runtime")
+        if simulator is not None:
+            simulator.shutdown()
+
+
+def _run(arguments: list[str]) -> int:
+    name = next((a for a in arguments if not a.startswith("-")), "")
+    try:
+        ema.main(args=arguments, prog_name="ema", standalone_mode=False)
+        return EXIT_OK
+    except click.exceptions.Abort:
+        print("\nema: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    except click.ClickException as exc:
+        exc.show()
+        return exc.exit_code
+    except KeyboardInterrupt:
+        print("\nema: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    except NothingAnsweredError as exc:
+        print(f"ema {name}: {exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except PipeClosedError:
+        # The reader stopped reading (| head): nothing left to say, and Python must not try at exit.
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return EXIT_OK
+    except Exception as exc:
+        from ema.cli.replay import ServiceError
+
+        message = _bad_input(exc)
+        if message is not None:
+            print(f"ema {name}: {message}", file=sys.stderr)
+            return EXIT_BAD_INPUT
+        if isinstance(exc, ServiceError):
+            print(f"ema {name}: {exc}", file=sys.stderr)
+            return EXIT_INTERNAL
+        print(f"ema {name}: internal error: {type(exc).__name__}: {exc}", file=sys.stderr)
+        return EXIT_INTERNAL
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,109 @@
+"""Options shared by several commands, their defaults read from the one config (never restated)."""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import sys
+from collections.abc import Callable, Iterator, Mapping
+from pathlib import Path
+from typing import Any, TypeVar
+
+import click
+
+from ema.estimate.sizes import SIZES as PIPELINE_SIZES
+
+F = TypeVar("F", bound=Callable[..., Any])
+SIZES = {  # flag -> PipelineConfig field
+    "--sims": "n_simulations",
+    "--checks": "check_windows",
+    "--timesteps": "n_timesteps",
+    "--hidden": "hidden_units",
+    "--members": "members",
+    "--seed": "seed",
+}
+SIZE_FLAGS = {f"{field}": flag for flag, field in SIZES.items()}  # an InputError's field -> the flag typed
+
+
+def sizes(function: F) -> F:
+    """--sims, --checks, --timesteps, --hidden, --members, --seed with PipelineConfig's defaults."""
+    for flag, field in reversed(SIZES.items()):
+        size = PIPELINE_SIZES[field]
+        kind = click.IntRange(size.low, size.high)
+        function = click.option(flag, field, type=kind, default=size.default, help=size.description)(function)
+    return function
+
+
+def actuator(function: F) -> F:
+    return click.option(
+        "--actuator",
+        "actuator_file",
+        type=click.Path(exists=True, dir_okay=False, path_type=Path),
+        default=None,
+        metavar="A.json",
+        help="the actuator's ema-actuator/1 document [default: the thesis's, examples/actuator.json]",
+    )(function)
+
+
+def actuator_document(path: Path | None) -> Any:
+    """The document in ``path``, or the default (``ema.model.actuator.THESIS``) where none was given."""
+    from ema.model.actuator import THESIS, read_actuator
+
+    return THESIS if path is None else read_actuator(path)
+
+
+def as_json(function: F) -> F:
+    return click.option("--json", "as_json", is_flag=True, help="print one JSON document")(function)
+
+
+def threads(function: F) -> F:
+    return click.option(
+        "--threads", type=click.IntRange(1, 256), default=None, help="thread budget [default: EMA_THREADS, else cores]"
+    )(function)
+
+
+def pipeline_config(values: Mapping[str, Any]) -> Any:
+    """The PipelineConfig from a command's size options; a bad value names its flag."""
+    from ema.estimate.config import PipelineConfig, validated
+
+    with flags_named(SIZE_FLAGS):
+        return validated(PipelineConfig, {field: values[field] for field in SIZES.values()})
+
+
+@contextlib.contextmanager
+def flags_named(flags: Mapping[str, str]) -> Iterator[None]:
+    """Re-raise an InputError about an internal field as one about the flag the user typed."""
+    from ema.model.checks import InputError
+
+    try:
+        yield
+    except InputError as exc:
+        flag = flags.get(exc.field) or next((f for field, f in flags.items() if exc.field.endswith(field)), None)
+        if flag is None:
+            raise
+        raise InputError(flag, exc.message) from None
+
+
+def progress(text: str) -> None:
+    print(f"ema: {text}…", file=sys.stderr, flush=True)
+
+
+class NothingAnsweredError(Exception):
+    """A batch command ran, but no window of its input was answered: exit 2 after its report."""
+
+
+class PipeClosedError(Exception):
+    """The reader of our output went away (``| head``): not an OSError, so that click leaves it to us."""
+
+
+def emit(result: Any, as_json_flag: bool, show: Callable[[Any], None]) -> None:
+    """One JSON document on stdout with --json, else the human table."""
+    try:
+        if as_json_flag:
+            document = result.model_dump(mode="json", by_alias=True) if hasattr(result, "model_dump") else result
+            click.echo(json.dumps(document))
+        else:
+            show(result)
+        sys.stdout.flush()
+    except BrokenPipeError:
+        raise PipeClosedError from None

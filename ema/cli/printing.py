@@ -1,0 +1,139 @@
+"""What the commands print for a human (``--json`` prints the documents themselves)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import click
+
+from ema.model.checks import InputError
+
+
+def read_truth(path: Path | None) -> dict[str, float] | None:
+    """``{"FDJ": 0.05, "eta_O": 0.85, "FSJ": 0.1}`` (FSJ optional); errors name the file."""
+    if path is None:
+        return None
+    try:
+        truth = json.loads(Path(path).read_text())
+        return {key: float(truth[key]) for key in ("FDJ", "eta_O")}
+    except (OSError, ValueError, KeyError, TypeError) as exc:
+        raise InputError(str(path), f"is not a truth file with FDJ and eta_O ({exc!r})") from None
+
+
+def _std(std: float | None) -> str:
+    return "—" if std is None else f"{std:.2g}"
+
+
+def print_estimate(result: Any) -> None:
+    click.echo(f"{result.actuator_id}  window {result.window_id}")
+    click.echo(f"{'parameter':<10}{'value':>12}{'± std':>12}{'nominal':>12}{'drift':>10}")
+    for name in ("FDJ", "eta_O", "eta_A", "FSJ"):
+        entry = getattr(result.estimates, name)
+        if entry is None:
+            continue
+        weak = "  weakly determined" if entry.weakly_determined else ""
+        click.echo(
+            f"{name:<10}{entry.value:>12.5g}{_std(entry.std):>12}{entry.nominal:>12.4g}{entry.drift_pct:>9.2f}%{weak}"
+        )
+    if result.estimates.FSJ is None:
+        click.echo(f"FSJ: not estimated: {result.fsj_note.text}")
+    check = result.fit_check
+    click.echo(
+        f"check: the model {'reproduces' if check.reproduced else 'does NOT reproduce'} the window "
+        f"(residual torque {check.output_error_ratio['residual_torque']:.2f}x its noise floor)"
+    )
+    for note in result.notes:
+        click.echo(f"note [{note.code}]: {note.text}")
+    click.echo("time: " + "  ".join(f"{stage} {seconds:.2f} s" for stage, seconds in result.timings_s))
+
+
+def print_simulate(result: dict[str, Any]) -> None:
+    summary = result["summary"]
+    click.echo(
+        f"wrote {result['window']}: {summary['n_samples']} samples, {summary['duration_s']:g} s at "
+        f"{summary['sample_rate_hz']:g} Hz, {result['command']} command"
+    )
+    truth = result["truth"]
+    click.echo(
+        f"truth: FDJ {truth['FDJ']:.4f} N·m  η_O {truth['eta_O']:.4f}  η_A {truth['eta_A']:.4f}  "
+        f"FSJ {truth['FSJ']:.4f} N·m"
+    )
+    click.echo(
+        f"effects: {result['effects'] or 'none'}   noise: {'none' if result['noise'] == 'none' else 'realistic'}"
+    )
+    click.echo(f"{'signal':<22}{'min':>12}{'max':>12}")
+    for name, (low, high) in summary["ranges"].items():
+        click.echo(f"{name:<22}{low:>12.4g}{high:>12.4g}")
+    click.echo(f"moving {summary['moving_fraction']:.0%} of the window")
+
+
+def print_calibration(report: dict[str, Any]) -> None:
+    click.echo(
+        f"noise floor: the base model's residual is {report['noise_floor']['equation_error_ratio']:.2f}x "
+        f"what noise alone leaves ({report['noise_floor']['copies']} copies)"
+    )
+    click.echo(f"{'candidate':<28}{'z':>9}{'held-out drop':>15}  parameters")
+    for c in sorted(report["candidates"], key=lambda c: -c["score"])[:8]:
+        parameters = ", ".join(f"{k}={v:.4g}" for k, v in list(c["parameters"].items())[:4])
+        click.echo(f"{c['effect']:<28}{c['score']:>9.1f}{c['held_out_drop']:>14.1%}  {parameters}")
+    for step in report["selection_steps"]:
+        click.echo(f"step: {step['selected'] or '—'}: {step['reason']}")
+    if report["unexplained"]:
+        click.echo(f"unexplained: {report['unexplained']['description']}")
+    click.echo(f"held out: {report['held_out']['note']}")
+    for name in ("FDJ", "eta_O"):
+        line = f"{name}: {report['estimates_before'][name]:.5g} -> {report['estimates_after'][name]:.5g}"
+        if report.get("error_pct_before"):
+            line += f"   error {report['error_pct_before'][name]:.2f} % -> {report['error_pct_after'][name]:.2f} %"
+        click.echo(line)
+    if report["figure"] is not None:
+        click.echo(f"figure: {report['figure']}")
+
+
+def _slope(trend: Any) -> str:
+    if trend.slope_std is None:
+        return "no slope yet"
+    return f"slope {trend.slope_per_unit:+.3g} ± {trend.slope_std:.2g} per unit"
+
+
+def _life(life: Any) -> str:
+    if life.rul is None:
+        return life.status
+    high = "open" if life.rul_high is None else f"{life.rul_high:.3g}"
+    faster = "; speeding up" if life.speeding_up else ""
+    return (
+        f"{life.threshold:g} crossed in {life.rul:.3g} (90 %: {life.rul_low:.3g} to {high}; earliest plausible "
+        f"{life.rul_earliest:.3g}){faster}"
+    )
+
+
+def print_prognosis(stored: Any, prognosis: Any, plot: Path | None) -> None:
+    """An actuator's outlook per parameter, the laws it weighs, its backtest, its sensors' trends and notes."""
+    click.echo(f"{prognosis.actuator_id}: {len(stored.estimates)} window(s), time in {prognosis.time_unit}")
+    for name, trend in prognosis.trends.items():
+        level, level_std = trend.now()
+        laws = ", ".join(f"{law} {w:.2f}" for law, w in sorted(trend.laws.items(), key=lambda x: -x[1]) if w >= 0.05)
+        life = _life(prognosis.remaining_life[name])
+        click.echo(f"{name:<6} now {level:.5g} ± {level_std:.2g}, {_slope(trend)}; {life}")
+        if laws:
+            click.echo(f"       laws weighed by how they predicted later windows: {laws}")
+        for point in prognosis.backtest.get(name, []):
+            inside = "—" if point.later_inside is None else f"{100 * point.later_inside:.0f} %"
+            said = "no crossing" if point.crossing is None else f"crossing at {point.crossing:.4g}"
+            click.echo(
+                f"       backtest at {point.time:.4g} ({point.windows} windows): {said}; of the "
+                f"{point.later_windows} later windows {inside} inside its 90 % band"
+            )
+    for name, trend in prognosis.sensors.items():
+        click.echo(f"{name} now {trend.level:.4g} ± {trend.level_std:.2g}, {_slope(trend)} ({trend.n} windows)")
+    if prognosis.inertia is not None:
+        inertia = prognosis.inertia
+        click.echo(
+            f"J_M {inertia.factor:.4f} ± {inertia.std:.2g}x the document's, as windows that could tell it read it"
+        )
+    for note in prognosis.notes:
+        click.echo(f"note [{note.code}]: {note.text}")
+    if plot is not None:
+        click.echo(f"figure: {plot}")

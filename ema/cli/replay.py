@@ -1,0 +1,94 @@
+"""``ema replay``: post a recorded log to the service window by window, in order, and keep the answers.
+
+Answers are appended to a CSV as they arrive (``ema.cli.results``); a rerun skips the windows the CSV
+holds answered and posts the refused ones again (a refusal may be the service's, such as a budget an
+operator has since raised). A 503 is waited out (Retry-After) and the same window retried. A refusal
+(422, or 409 for another window under a stored window_id) is kept as its fields and messages. The
+API key comes from a file or EMA_API_KEY, never from the command line (where ``ps`` shows it).
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+import time
+import urllib.error
+import urllib.request
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+from ema.cli.results import ResultsWriter, done_windows, row_of
+from ema.model.window import Window, window_to_dict
+
+MAX_WAIT_S = 600.0
+
+
+class ServiceError(Exception):
+    """The service could not be reached or failed; not the window's fault."""
+
+
+def request(url: str, api_key: str | None, data: bytes | None = None, timeout: float = 900) -> dict[str, Any]:
+    """One HTTP request to the service; the JSON answer, or HTTPError / ServiceError."""
+    headers = {"content-type": "application/json", **({"x-api-key": api_key} if api_key else {})}
+    try:
+        with urllib.request.urlopen(urllib.request.Request(url, data=data, headers=headers), timeout=timeout) as r:
+            return json.loads(r.read())
+    except urllib.error.HTTPError:
+        raise
+    except urllib.error.URLError as error:
+        raise ServiceError(f"cannot reach {url}: {error.reason}") from None
+
+
+def post_window(url: str, window: Window, api_key: str | None, sleep: Callable[[float], None] = time.sleep) -> dict:
+    """POST one window; wait out 503s. Returns the estimate, or {"error": ...} for a 422 about this window."""
+    body = json.dumps(window_to_dict(window)).encode()
+    waited = 0.0
+    while True:
+        try:
+            return request(f"{url.rstrip('/')}/v1/estimate", api_key, body)
+        except urllib.error.HTTPError as error:
+            detail = error.read().decode(errors="replace")
+            if error.code == 503 and waited < MAX_WAIT_S:
+                pause = float(error.headers.get("Retry-After", "1"))
+                print(f"  service busy, retrying {window.window_id} in {pause:g} s", file=sys.stderr)
+                sleep(pause)
+                waited += pause
+                continue
+            if error.code in (409, 422):
+                return {"error": refusal_text(error.code, detail)}
+            raise ServiceError(f"HTTP {error.code} for {window.window_id}: {detail[:300]}") from None
+
+
+def refusal_text(status: int, body: str) -> str:
+    """A 422 or 409 answer as a person reads it: each ``field: message`` (the body as is if it is not ours)."""
+    try:
+        items = json.loads(body)["detail"]
+        parts = [f"{'.'.join(str(p) for p in item['loc'] if p != 'body')}: {item['msg']}" for item in items]
+    except (ValueError, KeyError, TypeError):
+        return f"HTTP {status}: {body}"
+    return ("conflict: " if status == 409 else "") + "; ".join(parts)
+
+
+def replay(windows: list[Window], url: str, out: Path, api_key: str | None = None) -> list[dict[str, Any]]:
+    """Post every window not yet in ``out``, appending each answer as it comes; returns the new rows."""
+    done = done_windows(out, answered_only=True)
+    todo = [w for w in windows if (w.actuator_id, w.window_id) not in done]
+    if done:
+        print(f"resuming: {len(windows) - len(todo)} window(s) already in {out}", file=sys.stderr)
+    rows = []
+    started = time.perf_counter()
+    with ResultsWriter(out) as writer:
+        for index, window in enumerate(todo, 1):
+            row = row_of(window.actuator_id, window.window_id, post_window(url, window, api_key))
+            writer.write(row)
+            rows.append(row)
+            status = f"refused: {row['error']}" if row.get("error") else f"FDJ {row['FDJ']:.5f}  η_O {row['eta_O']:.4f}"
+            elapsed = time.perf_counter() - started
+            eta = elapsed / index * (len(todo) - index)
+            print(
+                f"[{index}/{len(todo)}] {window.window_id}: {status}  ({index / elapsed:.2f} windows/s, "
+                f"{eta:.0f} s left)",
+                file=sys.stderr,
+            )
+    return rows

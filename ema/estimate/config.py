@@ -1,0 +1,52 @@
+"""The pipeline's one configuration object, built from ``ema.estimate.sizes`` (the defaults and bounds).
+
+The service's settings, the CLI's flags and their help, and every result (which carries the
+config it ran with) read this model; nothing restates a default or a bound.
+"""
+
+from __future__ import annotations
+
+from typing import Any, TypeVar
+
+from pydantic import BaseModel, ConfigDict, Field, ValidationError
+
+from ema.estimate.sizes import SIZES
+
+Model = TypeVar("Model", bound=BaseModel)
+
+
+def _field(name: str) -> Any:
+    size = SIZES[name]
+    return Field(size.default, ge=size.low, le=size.high, description=size.description)
+
+
+class PipelineConfig(BaseModel):
+    """One window -> estimates: how much to simulate and train (``ema.estimate.sizes`` holds the numbers)."""
+
+    model_config = ConfigDict(frozen=True, extra="forbid")
+
+    n_simulations: int = _field("n_simulations")
+    check_windows: int = _field("check_windows")
+    n_timesteps: int = _field("n_timesteps")
+    hidden_units: int = _field("hidden_units")
+    members: int = _field("members")
+    seed: int = _field("seed")
+
+    @property
+    def total_simulations(self) -> int:
+        return self.n_simulations + self.check_windows
+
+
+def validated(model: type[Model], values: dict[str, Any], prefix: str = "") -> Model:
+    """``model(**values)``, its first error as an InputError naming the field (``prefix`` + name)."""
+    from ema.model.checks import from_validation  # numpy: kept out of this module's import (the CLI's help reads it)
+
+    try:
+        return model(**values)
+    except ValidationError as exc:
+        raise from_validation(exc, prefix) from None
+
+
+def bounds(name: str) -> tuple[int, int]:
+    """(low, high) of a pipeline size, for the service's query parameters."""
+    return SIZES[name].low, SIZES[name].high

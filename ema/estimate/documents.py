@@ -1,0 +1,343 @@
+"""``ema-estimate/1``: the one definition of an estimate result.
+
+The pipeline returns it, the service declares it as its response model, the CLI prints it, the
+history stores it and the tests construct it; ``docs/schemas/ema-estimate-1.json`` is exported
+from it. Fields may be added; those of a published version are never renamed or removed.
+"""
+
+from __future__ import annotations
+
+from typing import Annotated, Any, Literal
+
+from pydantic import BaseModel, BeforeValidator, ConfigDict, Field
+
+from ema.estimate.config import PipelineConfig
+
+TARGETS = ("FDJ", "eta_O")  # what the estimators fit; η_A follows by Eq. 3.4, FSD from FSJ
+
+NoteCode = Literal[
+    # what preparation did to the window, or found in it
+    "command_clipped",
+    "current_lag",
+    "hinge_lag",
+    "glitches_repaired",
+    "stale_sensor",
+    "kinematic_gain",
+    "sensor_offset",
+    "sensor_zero_carried",
+    "sensor_zero_unheld",
+    "sensor_zero_unseen",
+    "drive_constants",
+    "current_units",
+    "inertia_from_history",
+    "hinge_gain",
+    "hinge_vs_aircraft",
+    "hinge_vs_aircraft_undecided",
+    "aircraft_check_skipped",
+    "viscosity",
+    "viscosity_unseen",
+    "viscosity_leaning",
+    "hinge_out_of_step",
+    "default_actuator",
+    "on_ground",
+    "no_load",
+    # how the answer was reached, and how far to trust it
+    "network_absent",
+    "network_too_few_checks",
+    "network_out_of_box",
+    "network_disagrees",
+    "network_not_better",
+    "physics_only",
+    "model_misfit",
+    "not_reproduced",
+    "weakly_determined",
+    "eta_o_at_bound",
+    "eta_o_unread",
+    "fdj_not_friction",
+    "irreversible",
+    "fsj_read",
+    "fsj_no_break_away",
+    "fsj_below_fdj",
+    # the prognosis
+    "no_estimates",
+    "time_from_storage",
+    "gauge_off_model",
+    "gauge_drift",
+    "inertia_changed",
+    "inertia_scatter",
+    "speeding_up",
+    # a note stored by an earlier version, as a sentence only
+    "unspecified",
+]
+
+
+class Document(BaseModel):
+    """A public document: immutable, strict about unknown fields."""
+
+    model_config = ConfigDict(frozen=True, extra="forbid", populate_by_name=True)
+
+
+class Note(Document):
+    """Something a reader of a document should know: a stable ``code`` a client or a test matches, and the
+    same in words."""
+
+    code: NoteCode
+    text: str
+    parameter: str | None = Field(None, description="the parameter or signal it concerns, where it is one")
+
+
+def _sentences_as_notes(value: Any) -> Any:
+    """A note stored as a sentence (before notes had codes) is read as ``unspecified``."""
+    if isinstance(value, str):
+        return {"code": "unspecified", "text": value}
+    if isinstance(value, list):
+        return [_sentences_as_notes(item) for item in value]
+    return value
+
+
+Notes = Annotated[list[Note], BeforeValidator(_sentences_as_notes)]
+OptionalNote = Annotated[Note | None, BeforeValidator(_sentences_as_notes)]
+
+
+class ParameterEstimate(Document):
+    value: float
+    std: float | None = Field(description="one standard deviation, in the parameter's unit; null: not assessed")
+    nominal: float
+    drift_pct: float = Field(description="100 · (value − nominal) / nominal")
+    weakly_determined: bool = Field(
+        default=False,
+        description="the window holds little of this parameter: its ±2 std spans more than 10 % of the healthy "
+        "range (a short window, a slow log, a hinge load that barely varies), or Eq. 5.1 put η_O at an end of the "
+        "physical search range (a bound rather than a value, FDJ read with it held there); the notes say so in words",
+    )
+
+
+class RatioEstimate(Document):
+    value: float
+    std: float | None = None
+
+
+class Estimates(Document):
+    FDJ: ParameterEstimate
+    eta_O: ParameterEstimate | None = Field(description="null: the window carries no load (the notes say why)")
+    eta_A: ParameterEstimate | None = Field(description="null with eta_O")
+    FSJ: ParameterEstimate | None
+    FSD: RatioEstimate | None = None
+
+
+class Timings(Document):
+    """Seconds of each stage of ``ema.estimate.pipeline``, in order."""
+
+    prepare: float = Field(0.0, description="the window checked, repaired, aligned, its departures read")
+    physics: float = Field(0.0, description="Eq. 5.1 fitted by least squares")
+    simulate: float = Field(description="the window's own dataset simulated")
+    train: float = Field(description="the network trained")
+    predict: float = Field(description="assess: both estimators on held-out simulations, blended")
+    check: float = Field(0.0, description="the window simulated at the answer, and FSJ read")
+    total: float
+
+
+class MethodReport(Document):
+    """How one parameter's value was reached: each estimator, its error on held-out simulations, the blend."""
+
+    physics: float = Field(description="Eq. 5.1 least squares on the window")
+    physics_bias: float = Field(
+        description="its mean error on held-out simulations, shrunk by how well they resolve it (James–Stein); "
+        "subtracted"
+    )
+    physics_std: float = Field(description="its block-jackknife std on the window")
+    network: float | None = Field(description="the window's own network; null if it was not used")
+    weight_network: float
+    rms_error_physics: float = Field(description="on held-out simulations of this window")
+    rms_error_network: float | None
+    rms_error_blend: float
+    network_note: OptionalNote = Field(None, description="why the network's answer was not used, or not alone")
+
+
+class FitCheck(Document):
+    """The answer checked against the measured window itself."""
+
+    reproduced: bool = Field(description="the model at these estimates reproduces the window within its noise")
+    equation_error_ratio: float = Field(
+        description="RMS of the window's Eq. 5.1 residual over what sensor noise alone leaves in simulations (≈ 1)"
+    )
+    output_error_ratio: dict[str, float] = Field(
+        description="per signal: RMS(measured − simulated at the estimates) over the noise-only floor"
+    )
+    uncertainty_inflation: float = Field(description="factor applied to the stds for what the model did not reproduce")
+    notes: Notes = Field(default_factory=list)
+
+
+class SensorZero(Document):
+    """The sensors' zero as a window moving both ways read it (``ema.estimate.prepare.departures.zero_offset``):
+    what a window of
+    the same flight that moves one way, and so cannot read it, is read with."""
+
+    window_id: str = Field(description="the window that read it")
+    hinge_nm: float = Field(description="taken off the logged hinge moment")
+    current_a: float = Field(description="taken off the logged current")
+    torque_std_nm: float = Field(ge=0, description="its std, as a constant torque at the motor shaft")
+
+
+class InertiaReading(Document):
+    """J_M as windows of an actuator read it where each told a heavier rotor from a weaker motor itself
+    (``ema.estimate.prepare.departures.drive_constants``): a window that cannot is read with it (J_M stays with
+    the build)."""
+
+    factor: float = Field(description="the inertia at the motor shaft over the document's J_M")
+    std: float = Field(ge=0, description="its std")
+    window_ids: list[str] = Field(description="the windows that read it")
+
+
+class HistoryReadings(Document):
+    """What other windows of an actuator read that one window may not: the sensor zero of its flight
+    (``flight_id``) and the actuator's J_M. The service takes them from its history."""
+
+    sensor_zero: SensorZero | None = None
+    inertia: InertiaReading | None = None
+
+
+class WindowInfo(Document):
+    content_sha256: str | None = Field(
+        default=None,
+        description="SHA-256 of the window as posted, but its actuator_id and window_id (ema.model.window): another "
+        "body under the same key is another window",
+    )
+    n_samples: int
+    duration_s: float
+    sample_rate_hz: float
+    processed_rate_hz: float = Field(description="after averaging adjacent samples (exact for interval means)")
+    command_clipped_fraction: float = Field(description="share of command samples past the end stops, saturating")
+    glitches_repaired: dict[str, int] = Field(
+        default_factory=dict,
+        description="per sensor, samples of glitches (short runs far off both flanks, which agree), "
+        "replaced by the line between the flanks",
+    )
+    stale_samples: dict[str, int] = Field(
+        default_factory=dict,
+        description="per sensor, samples of runs that repeated one value exactly where a working sensor shows its "
+        "noise (it stopped updating, or a logging gap was filled in): a run up to the 2 ms reconstruction kernel "
+        "bridged by the line between its flanks, a longer one cut out with the window read from read_span",
+    )
+    read_span: list[int] | None = Field(
+        default=None,
+        description="[first, one past the last] logged sample read, where stale runs cut the window (null: all)",
+    )
+    current_lag_s: float = Field(
+        default=0.0, description="how late the current is logged behind the speed (negative: the speed), undone"
+    )
+    hinge_lag_s: float = Field(default=0.0, description="how late the hinge moment is logged (its filter), undone")
+    hinge_offset_nm: float = Field(default=0.0, description="taken off the logged hinge moment (a sensor off zero)")
+    current_offset_a: float = Field(default=0.0, description="taken off the logged current (a sensor off zero)")
+    torque_scale: float = Field(
+        default=1.0,
+        description="the motor's torque per spec k_T·I as read (k_T warm or cold, a current sensor's gain); "
+        "the current was multiplied by it before every estimator",
+    )
+    inertia_factor: float = Field(
+        default=1.0,
+        description="the inertia at the motor shaft over the document's J_M as read; "
+        "the current carries the difference",
+    )
+    viscous_factor: float = Field(
+        default=1.0,
+        description="the viscous coefficient every estimator used over the document's C_M (read where it departs)",
+    )
+    hinge_gain: float = Field(
+        default=1.0,
+        description="the logged hinge moment over the load it shows (a strain gauge calibrated off, other units); "
+        "the moment was divided by it before every estimator",
+    )
+    hinge_aircraft_ratio: float | None = Field(
+        default=None,
+        description="the logged hinge moment's part that follows the deflection over the aircraft model's "
+        "q̄·S_e·c_e·C_hδ at the flight condition (1 where gauge and model agree; null: too little fast motion)",
+    )
+    hinge_aircraft_ratio_std: float | None = Field(default=None, description="the std of hinge_aircraft_ratio")
+    kinematic_gain: float | None = Field(
+        default=None,
+        description="the position's travel over the speed's integral / gear ratio through the dead band (1 in a "
+        "consistent log; 0.9-1.1 accepted; null: too little motion to tell)",
+    )
+    sliding_fraction: float = Field(description="share of samples the friction fit could use")
+    recorded_at: str | None = None
+    flight_hours: float | None = None
+    flight_id: str | None = None
+    sensor_zero: SensorZero | None = Field(
+        default=None,
+        description="the sensors' zero as this window read it, for the windows of its flight that move one way "
+        "(null: it moves one way itself, took its flight's instead (sensor_zero_from), or was read with the document's "
+        "model alone)",
+    )
+    sensor_zero_from: str | None = Field(
+        default=None, description="the window of its flight whose sensor_zero it was read with (null: its own)"
+    )
+    inertia_read: InertiaReading | None = Field(
+        default=None,
+        description="J_M as this window read it, where it told a heavier rotor from a weaker motor itself (null: "
+        "it read none, or could not tell)",
+    )
+    inertia_undecided: bool = Field(
+        default=False,
+        description="it could not tell a heavier rotor from a weaker motor, nor did a J_M read by other windows of "
+        "the actuator decide: its stds carry both readings",
+    )
+    inertia_from: list[str] | None = Field(
+        default=None,
+        description="it could not tell a heavier rotor from a weaker motor: the windows whose J_M (history) decided",
+    )
+
+
+class DatasetInfo(Document):
+    n_simulations: int
+    n_timesteps: int
+    inputs: list[str]
+    check_windows: int
+    noise_estimated: dict[str, float]
+    box: dict[str, tuple[float, float]] = Field(description="the FDJ and η_O intervals the simulations were drawn in")
+
+
+class TrainingInfo(Document):
+    epochs: int
+    stop_reason: str
+    val_mse: float
+    test_mse: float
+    members: int
+    hidden_units: int
+
+
+class ActuatorRead(Document):
+    """The ``ema-actuator/1`` document a window was read with."""
+
+    name: str
+    version: int | None = Field(None, description="the service's stored version (null: given in-process)")
+    default: bool = Field(False, description="no document was given for the actuator: the thesis's was used")
+
+
+class Estimate(Document):
+    """``ema-estimate/1``."""
+
+    schema_: Literal["ema-estimate/1"] = Field("ema-estimate/1", alias="schema")
+    actuator_id: str
+    window_id: str
+    actuator: ActuatorRead = Field(
+        default_factory=lambda: ActuatorRead(name="thesis elevator EMA (Table 3.1)", default=True),
+        description="the actuator's document it was read with (results stored before documents: the thesis's)",
+    )
+    estimates: Estimates
+    fsj_note: Annotated[Note, BeforeValidator(_sentences_as_notes)] = Field(description="how FSJ was read, or why not")
+    irreversible: bool = Field(description="η_A < 0: the load can never back-drive the transmission (thesis Case 1C)")
+    notes: Notes = Field(default_factory=list, description="what a reader of this answer should know")
+    timings_s: Timings
+    dataset: DatasetInfo
+    training: TrainingInfo
+    methods: dict[str, MethodReport]
+    fit_check: FitCheck
+    window: WindowInfo
+    config: PipelineConfig
+
+
+def parameter(value: float, std: float | None, nominal: float, weak: bool = False) -> ParameterEstimate:
+    return ParameterEstimate(
+        value=value, std=std, nominal=nominal, drift_pct=100.0 * (value - nominal) / nominal, weakly_determined=weak
+    )

@@ -1,0 +1,46 @@
+"""Networks trained on a dataset, as an estimator of FDJ and η_O (η_A derived).
+
+With several members (independently seeded, each with its own split) the prediction is their
+mean. Targets are FDJ and η_O in the units of the dataset's box (``ema.estimate.simulate.design``): 0 and 1
+at its edges. Predictions are returned unclipped in those units too, so that the caller sees
+when the network leaves the region it was trained on.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+import torch
+
+from ema.estimate.learn.network import FitResult, TrainConfig, fit
+from ema.estimate.simulate.design import Box
+from ema.model.checks import InputError
+
+
+class NetworkEstimator:
+    """scikit-learn shape: settings in ``__init__``, ``fit`` returns self, learned values end in ``_``."""
+
+    def __init__(self, train: TrainConfig = TrainConfig(), members: int = 1) -> None:
+        self.train = train
+        self.members = members
+
+    def fit(self, inputs: np.ndarray, fdj_nm: np.ndarray, eta_o: np.ndarray, box: Box) -> NetworkEstimator:
+        if not 1 <= self.members <= 20:
+            raise InputError("members", f"must be in [1, 20], got {self.members}")
+        targets = box.normalize(fdj_nm, eta_o)
+        self.fits_: list[FitResult] = [
+            fit(inputs, targets, replace(self.train, seed=self.train.seed + member)) for member in range(self.members)
+        ]
+        self.box_ = box
+        return self
+
+    def predict_unit(self, inputs: np.ndarray) -> np.ndarray:
+        """(N, 2) FDJ, η_O in box units, the members' mean, unclipped."""
+        x = torch.as_tensor(np.atleast_2d(inputs), dtype=torch.float64)
+        with torch.no_grad():
+            return np.mean([f.model.eval()(x).numpy() for f in self.fits_], axis=0)
+
+    def predict(self, inputs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """FDJ [N·m] and η_O for each row of ``inputs`` (N, F)."""
+        return self.box_.denormalize(self.predict_unit(inputs))

@@ -1,0 +1,45 @@
+"""A signal read later than logged, and Eq. 5.1's fit of the window so: what every reading of a
+sensor's lag compares (``ema.estimate.prepare.alignment``, ``ema.estimate.prepare.hinge_lag``,
+``ema.estimate.prepare.consistency``,
+``ema.estimate.prepare.step_lag``)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ema.estimate.physics.features import as_read
+from ema.estimate.physics.friction import FitSettings, FrictionFit, fit_friction
+from ema.model.params import ActuatorParams
+
+
+def advanced(values: np.ndarray, samples: float) -> np.ndarray:
+    """``values`` read ``samples`` later (linear interpolation; past the end, the last value)."""
+    index = np.arange(len(values), dtype=np.float64)
+    return np.interp(index + samples, index, values)
+
+
+def shifted_fits(
+    signals: dict[str, np.ndarray],
+    sample_rate_hz: float,
+    lags: np.ndarray,
+    actuator: ActuatorParams,
+    name: str = "current_a",
+    settings: FitSettings = FitSettings(),
+) -> FrictionFit:
+    """The physics fit with signal ``name`` read ``lags`` samples later, one row per lag, one batched fit."""
+    batch = dict(signals, **{name: np.stack([advanced(signals[name], lag) for lag in lags])})
+    if name == "hinge_moment_nm":  # its reading leans on the deflection, row by row
+        batch["position_deg"] = np.broadcast_to(signals["position_deg"], batch[name].shape)
+    read = dict(as_read(batch, sample_rate_hz), position_deg=signals["position_deg"])
+    return fit_friction(read, sample_rate_hz, actuator, settings)
+
+
+def equation_errors(
+    signals: dict[str, np.ndarray],
+    sample_rate_hz: float,
+    lags: np.ndarray,
+    actuator: ActuatorParams,
+    name: str = "current_a",
+) -> np.ndarray:
+    """The physics fit's equation error with signal ``name`` read ``lags`` samples later."""
+    return shifted_fits(signals, sample_rate_hz, lags, actuator, name).residual_rms_nm

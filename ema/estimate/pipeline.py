@@ -1,0 +1,187 @@
+"""Window -> ``ema-estimate/1``: what ``ema estimate``, the service and the fleet call.
+
+The thesis's §6.3 proposal, made to hold on data our simulator did not draw:
+
+1. **prepare**: repair, average, align and zero the window's sensors, read its viscous coefficient
+   (``ema.estimate.prepare.conditioning``);
+2. **physics**: fit Eq. 5.1 by least squares (``ema.estimate.physics.friction``), a block-jackknife std beside;
+3. **simulate**: a Case-1B dataset of the window's own command, logged load and first state, its
+   health drawn in a box around the physics estimate (``ema.estimate.simulate.design``: no fixed range, so no
+   cap on a worn actuator), with the window's own sensor noise;
+4. **train**: the shallow network on the residual torque of the sliding samples;
+5. **assess**: both estimators scored on held-out simulations, blended per parameter, checked
+   against the window itself (``ema.estimate.assess.weighing``) and by simulating it at the answer
+   (``ema.estimate.assess.reproduction``);
+6. **FSJ** where the window shows a quasi-static break-away (``ema.estimate.physics.static_friction``).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import time
+from collections.abc import Callable, Iterator
+from dataclasses import replace
+
+import numpy as np
+
+from ema.estimate.assess.reproduction import output_error_ratios
+from ema.estimate.assess.weighing import Assessed, Candidates, assess
+from ema.estimate.config import PipelineConfig
+from ema.estimate.documents import ActuatorRead, Estimate, FitCheck, HistoryReadings, Note, Timings
+from ema.estimate.history import known_from
+from ema.estimate.learn.estimator import NetworkEstimator
+from ema.estimate.learn.network import TrainConfig
+from ema.estimate.physics.features import as_read
+from ema.estimate.physics.friction import FIT_ARRAYS, FrictionFit, fit_friction, fit_window
+from ema.estimate.physics.scenario import MAX_RATIO, inside
+from ema.estimate.physics.static_friction import read_static_friction
+from ema.estimate.prepare.conditioning import prepare, widened
+from ema.estimate.report import estimate_document
+from ema.estimate.simulate.dataset import Data, simulate_dataset
+from ema.model.actuator import THESIS, Actuator
+from ema.model.window import Window
+
+# On a few dozen noisy simulations the network stops improving within a few epochs, and the physics fit
+# carries most of the answer (ema.estimate.assess.weighing): the thesis's 12 failures and 1000 epochs made its time
+# the pipeline's least predictable.
+PIPELINE_TRAINING = TrainConfig(max_epochs=60, max_validation_failures=6)
+
+
+def train_network(data: Data, config: PipelineConfig) -> NetworkEstimator:
+    n = config.n_simulations
+    train = replace(PIPELINE_TRAINING, hidden=config.hidden_units, seed=config.seed)
+    health = data.sims.health
+    return NetworkEstimator(train, config.members).fit(data.inputs[:n], health.fdj_nm[:n], health.eta_o[:n], data.box)
+
+
+def candidates(
+    window: Window, physics: FrictionFit, data: Data, network: NetworkEstimator, n: int
+) -> tuple[Candidates, FrictionFit]:
+    """Physics and network on the window and on the held-out simulations (and the physics fit of those)."""
+    held = {name: values[n:] for name, values in data.sims.signals.items()}
+    check_physics = fit_friction(held, window.sample_rate_hz, data.actuator, residual_nm=data.sims.residual_nm[n:])
+    unit = network.predict_unit(np.vstack([data.inputs[n:], data.window_inputs]))
+    fdj, eta_o = data.box.denormalize(unit)
+    health = data.sims.health
+    # A held-out simulation that never slides long enough has no physics answer: left out, not poisoning the scores.
+    ok = np.isfinite(check_physics.fdj_nm) & np.isfinite(check_physics.eta_o)
+    check_physics = replace(check_physics, **{k: getattr(check_physics, k)[ok] for k in FIT_ARRAYS})
+    fdj_check, eta_check = fdj[:-1][ok], eta_o[:-1][ok]
+    truth_fdj, truth_eta = health.fdj_nm[n:][ok], health.eta_o[n:][ok]
+    return Candidates(
+        physics={k: float(v) for k, v in physics.values().items()},
+        physics_std={"FDJ": float(physics.fdj_std_nm[0]), "eta_O": float(physics.eta_o_std[0])},
+        network={"FDJ": float(fdj[-1]), "eta_O": float(eta_o[-1])},
+        network_unit=unit[-1],
+        check_truth={"FDJ": truth_fdj, "eta_O": truth_eta},
+        check_physics=check_physics.values(slice(None)),
+        check_network={"FDJ": fdj_check, "eta_O": eta_check},
+    ), check_physics
+
+
+def fit_check(
+    window: Window, data: Data, answer: Assessed, equation_ratio: float, n: int, nominal_fdj_nm: float
+) -> FitCheck:
+    """Simulate the window at the answer and compare (``ema.estimate.assess.reproduction``). Where the answer is the
+    point the noise was measured at (the physics estimate, when it carries the answer), that simulation is
+    the one: a lane of the dataset's batch, the same numbers as a run of its own."""
+    health = inside(answer.values["FDJ"], answer.values["eta_O"], nominal_fdj_nm)
+    floor = float(np.sqrt(np.mean((data.sims.residual_nm[n:] - data.sims.clean_residual_nm)[:, data.sliding] ** 2)))
+    known = data.sims.reference_signals if health.identical(data.sims.reference) else None
+    ratios = output_error_ratios(window, data.scenario, health, data.noise, floor, data.sliding, data.actuator, known)
+    reproduced = ratios["residual_torque"] <= MAX_RATIO
+    notes = list(answer.notes)
+    if not reproduced:
+        notes.append(
+            Note(
+                code="not_reproduced",
+                text=(
+                    f"simulated at these estimates, the window's residual torque differs by "
+                    f"{ratios['residual_torque']:.1f}x "
+                    "its noise floor: the model does not reproduce this window"
+                ),
+            )
+        )
+    return FitCheck(
+        reproduced=reproduced,
+        equation_error_ratio=equation_ratio,
+        output_error_ratio=ratios,
+        uncertainty_inflation=answer.inflation,
+        notes=notes,
+    )
+
+
+class Stopwatch:
+    """Each stage's seconds, announced to ``on_stage`` as it starts (which may raise to stop the job there)."""
+
+    def __init__(self, on_stage: Callable[[str], None] | None) -> None:
+        self.on_stage = on_stage or (lambda _: None)
+        self.seconds: dict[str, float] = {}
+
+    @contextlib.contextmanager
+    def __call__(self, name: str, announcement: str) -> Iterator[None]:
+        self.on_stage(announcement)
+        started = time.perf_counter()
+        yield
+        self.seconds[name] = time.perf_counter() - started
+
+    def timings(self) -> Timings:
+        s = self.seconds
+        return Timings(
+            prepare=s["prepare"],
+            physics=s["physics"],
+            simulate=s["simulate"],
+            train=s["train"],
+            predict=s["assess"],
+            check=s["check"],
+            total=sum(s.values()),
+        )
+
+
+def estimate_window(
+    window: Window,
+    config: PipelineConfig = PipelineConfig(),
+    *,
+    actuator: Actuator,
+    version: int | None = None,
+    on_stage: Callable[[str], None] | None = None,
+    spec_only: bool = False,
+    history: HistoryReadings | None = None,
+) -> Estimate:
+    """The ``ema-estimate/1`` result for one window, its stages timed.
+
+    ``actuator``: the document every stage reads its constants from (``ema.model.actuator.THESIS`` itself is the
+    default a caller chose for a user who gave none, and the answer says so), ``version`` its stored
+    version; ``on_stage`` hears each stage as it starts (and may raise to stop the job there);
+    ``spec_only`` reads the window with the document's model alone, no departures taken off (calibration's
+    base); ``history``: what other windows of the actuator lend this one (``ema.estimate.history``). Raises
+    InputError naming the field for a window that cannot be read.
+    """
+    watch = Stopwatch(on_stage)
+    read_with = ActuatorRead(name=actuator.name, version=version, default=actuator is THESIS)
+    with watch("prepare", "preparing the window"):
+        digest = window.content_sha256()
+        prepared = prepare(window, actuator, spec_only=spec_only, known=known_from(history))
+        w, n = prepared.window, config.n_simulations
+        seen = replace(w, signals=as_read(w.signals, w.sample_rate_hz))
+    with watch("physics", "fitting Eq. 5.1"):
+        physics = fit_window(seen.signals, w.sample_rate_hz, prepared.actuator)
+    with watch("simulate", f"simulating {config.total_simulations} windows around the physics estimate"):
+        effects = prepared.departures.viscosity.effects()
+        data = simulate_dataset(w, seen, physics, config, actuator, prepared.actuator, effects)
+    with watch("train", f"training {config.members} network(s) of {config.hidden_units} neurons"):
+        network = train_network(data, config)
+    with watch("assess", "weighing the estimators on held-out simulations"):
+        found, check_physics = candidates(w, physics, data, network, n)
+        floor = np.median(check_physics.residual_rms_nm) if len(check_physics.residual_rms_nm) else np.nan
+        equation_ratio = float(physics.residual_rms_nm[0] / floor) if np.isfinite(floor) else 1.0
+        answer = assess(found, equation_ratio)
+        answer = replace(answer, stds=widened(answer.stds, prepared))
+    with watch("check", "checking the answer against the window"):
+        check = fit_check(seen, data, answer, equation_ratio, n, actuator.nominal.fdj_nm)
+        fsj = read_static_friction(
+            seen.signals, w.sample_rate_hz, answer.values["FDJ"], answer.values["eta_O"], data.actuator, data.noise
+        )
+    return estimate_document(
+        prepared, physics, data, network, answer, check, fsj, config, watch.timings(), digest, read_with
+    )

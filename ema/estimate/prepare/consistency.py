@@ -1,0 +1,306 @@
+"""Whether a window's signals tell one story: a sign convention, a unit or a sample rate the log got
+wrong, found and named before anything is read from the window.
+
+A careless export (a speed or current of the other sign, a sample rate twice the log's, a hinge
+moment in kN·m) otherwise gets an answer ranges off, said weak but an answer. Three relations hold
+in every window of a working drive, whatever its health:
+
+1. Kinematics: the surface turns as the motor does, θ_u = θ_m / n behind the backlash's dead band.
+   The position is ``g`` times the speed's integral over n carried through a dead band
+   (``ema.model.dead_band``, its width fitted: a worn band as well); a working drive reads g within a
+   percent of 1. A speed of the other sign gives g = −1, a sample rate stated twice the log's g = 2,
+   a position in radians 1/57.3.
+   Refused outside ``TRAVEL_GAIN``: a position sensor's gain a few % off is no unit error.
+2. The closed loop: the surface moves toward the command whenever it is over ``FOLLOW_GAP_DEG`` away.
+   Over 2 ms steps, begun on the side of the command the surface has been on for the drive's reaction
+   time (``reaction_s``: the thesis's needs ~20 ms to turn from full speed), a working loop does so in
+   nearly every step; a position of the other sign or a command in radians fails it in many. Judged
+   over ``MIN_FOLLOW_S`` of such steps.
+3. Eq. 5.1: the current drives the motion against friction and load. Read with the current's sign
+   flipped, the hinge moment's, both (which is the motion's sign flipped), or the hinge moment read
+   from kN·m, lbf·in or lbf·ft, the window's fit (a sensor offset free) is ``MIN_BETTER`` times
+   better only if that field is wrong. A load 0.74x (lbf·ft) is much what η_O 0.74x as high reads
+   (Eq. 5.1's load term), and seldom told; what is missed, the fit check still flags.
+
+4. One clock: a sensor's filter logs it up to ~1 ms late (``ema.estimate.prepare.alignment`` reads
+   that), but a channel exported out of step by 5–20 ms puts FDJ ranges off. Where Eq. 5.1 fits
+   ``MIN_BETTER`` times better with the current or the hinge moment read ``STEP_LAGS_S`` away, the
+   window is refused naming it and the lag.
+
+Before these, every sensor must show that it logs: a working one shows at least ``MIN_LEVELS``
+values over a window (its noise, its quantization). A hinge moment logged as zeros (an aircraft
+without the strain gauge) or stuck at one value would be read as a load of nothing. The command
+may hold still.
+
+Which field is named follows from which relations fail together (``check_consistency``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ema.estimate.documents import Note
+from ema.estimate.physics.features import as_read
+from ema.estimate.physics.friction import fit_friction
+from ema.estimate.physics.shifts import equation_errors
+from ema.estimate.prepare.departures.zero_offset import OFFSET_FIT
+from ema.model.checks import InputError
+from ema.model.dead_band import dead_band_paths
+from ema.model.params import ActuatorParams
+from ema.model.window import Window
+
+TRAVEL_GAIN = (0.9, 1.1)  # g accepted
+NOTED_GAIN = (0.98, 1.02)  # g accepted without a note: a working drive's position and speed agree within it
+BAND_GRID = 40  # dead band widths tried: 0, then geometric from 5 % of the document's to the whole travel
+MIN_EXPLAINED = 0.9  # share of the position's variance the speed's travel must explain for g to be judged
+FOLLOW_GAP_DEG = 1.0
+FOLLOW_STEP_S = 2e-3
+FOLLOW_MIN_STEP_DEG = 0.05  # a step that moves: 5 position-noise stds
+REACTION_MARGIN = 1.3  # a drive turns from full speed one way to the other in J_M·2ω_max / T_M,max: this once more
+MIN_FOLLOW_S = 0.01  # of steps over the gap, to judge the loop by
+MIN_FOLLOWING = 0.8  # share of those steps toward the command, accepted
+UNIT_SLIPS = (  # a travel gain of about (factor): the field, and the slip it points to
+    (1.0 / np.degrees(1.0), "signals.position_deg", "in radians (or motor_speed_radps in deg/s)?"),
+    (np.pi / 30.0, "signals.motor_speed_radps", "in rpm?"),
+)
+UNIT_SLIP_TOLERANCE = 0.1
+# A sample rate stated off by a factor a logger's settings make (a decimation, a base rate, kHz for Hz) is taken
+# for the cause; a travel gain of any other factor is an actuator of another gear ratio than its document's.
+RATE_SLIPS = (2.0, 0.5, 4.0, 0.25, 5.0, 0.2, 10.0, 0.1, 1.024, 1 / 1.024, 1e3, 1e-3)
+RATE_SLIP_TOLERANCE = 0.02
+AGAINST_THE_MOTION = ("current sign", "torque signs")  # readings that say the motor's motion runs backwards
+MIN_LEVELS = 3  # distinct values a logged sensor shows over a window
+STEP_LAGS_S = np.array([-50, -20, -10, -5, -3, 3, 5, 10, 20, 50]) * 1e-3  # channel lags tried, beyond any filter
+MIN_BETTER = 3.0  # how many times better a reading of a field must fit Eq. 5.1 to call the field wrong
+READINGS = {  # fields read otherwise: ({signal: factor}, the field named, what it would mean)
+    "current sign": (
+        {"current_a": -1.0},
+        "current_a",
+        "its sign is the other one: it opposes the torque the motion needs",
+    ),
+    "hinge sign": (
+        {"hinge_moment_nm": -1.0},
+        "hinge_moment_nm",
+        "its sign is the other one: the load aids where it opposes",
+    ),
+    "hinge in kN·m": ({"hinge_moment_nm": 1e3}, "hinge_moment_nm", "it is 1000x too small: in kN·m?"),
+    "hinge in lbf·in": ({"hinge_moment_nm": 0.11298}, "hinge_moment_nm", "it is 8.85x too large: in lbf·in?"),
+    "hinge in lbf·ft": ({"hinge_moment_nm": 1.35582}, "hinge_moment_nm", "it is 0.738x too small: in lbf·ft?"),
+    # Eq. 5.1 is odd in (I, H) against (ω, θ): both torques flipped is the motion flipped, which the command tells
+    "torque signs": (
+        {"current_a": -1.0, "hinge_moment_nm": -1.0},
+        "current_a",
+        "and hinge_moment_nm both have the other sign: they oppose the motion",
+    ),
+}
+
+
+@dataclass(frozen=True)
+class Consistency:
+    """How a window's signals relate (None: too little motion to judge that relation)."""
+
+    travel_gain: float | None  # the position's travel over the speed's integral / n (1: consistent)
+    following: float | None  # share of the steps over the gap that move toward the command
+    better_reading: tuple[str, float] | None  # a field read otherwise (``READINGS``), and how many times better
+
+
+def _best_band(travel: np.ndarray, y: np.ndarray, halves: np.ndarray) -> tuple[float, float, int]:
+    """Over dead bands of ``halves`` (each begun at either face or the middle), the one whose path best
+    explains ``y`` (centred): (explained sum of squares, slope, its index in ``halves``)."""
+    starts = np.repeat([-1.0, 0.0, 1.0], len(halves))
+    paths = dead_band_paths(travel, np.tile(halves, 3), starts)
+    paths -= paths.mean(axis=1, keepdims=True)
+    spread, covariance = np.einsum("ij,ij->i", paths, paths), paths @ y
+    explained = np.divide(covariance**2, spread, out=np.zeros_like(spread), where=spread > 0.0)
+    best = int(np.argmax(explained))
+    slope = covariance[best] / spread[best] if spread[best] > 0.0 else 0.0
+    return float(explained[best]), float(slope), best % len(halves)
+
+
+def travel_gain(window: Window, actuator: ActuatorParams) -> float | None:
+    """The drive's kinematic gain g: the least-squares slope (with an intercept) of the position (rad) on
+    the speed's integral / n carried through a dead band (``ema.model.dead_band``) whose width (any the travel
+    shows: a worn band too; a coarse grid, then a fine one about the best) and start the least squares
+    choose; None where that explains under ``MIN_EXPLAINED`` of the position's variance (a surface that
+    hardly moves, or not with the motor)."""
+    rate, position = window.sample_rate_hz, np.radians(window.signals["position_deg"])
+    travel = np.cumsum(window.signals["motor_speed_radps"]) / rate / actuator.gear_ratio
+    y = position - position.mean()
+    widest = max(np.ptp(travel), actuator.backlash_rad)
+    coarse = np.concatenate([[0.0], np.geomspace(0.05 * actuator.backlash_rad, widest, BAND_GRID - 1)]) / 2
+    at = _best_band(travel, y, coarse)[2]
+    fine = np.linspace(coarse[max(0, at - 1)], coarse[min(len(coarse) - 1, at + 1)], BAND_GRID)
+    explained, gain, _ = _best_band(travel, y, fine)
+    return gain if explained >= MIN_EXPLAINED * (y @ y) > 0.0 else None
+
+
+def reaction_s(actuator: ActuatorParams) -> float:
+    """How long the drive takes to turn from full speed one way to full speed the other, with a margin (the
+    thesis's: 19 ms, taken as 25)."""
+    turn = actuator.inertia_kgm2 * 2 * actuator.max_motor_speed_radps / actuator.max_motor_torque_nm
+    return REACTION_MARGIN * turn
+
+
+def following(window: Window, actuator: ActuatorParams) -> float | None:
+    """The share of ``FOLLOW_STEP_S`` steps, begun over ``FOLLOW_GAP_DEG`` from the command (clipped to the
+    end stops) on the side it has stood for the drive's reaction time (``reaction_s``) and moving, that move
+    toward it; None where they
+    last under ``MIN_FOLLOW_S`` in all."""
+    position, rate = window.signals["position_deg"], window.sample_rate_hz
+    command = np.clip(window.signals["command_deg"], -actuator.end_stop_deg, actuator.end_stop_deg)
+    lag = max(1, round(FOLLOW_STEP_S * rate))
+    step, gap = position[lag:] - position[:-lag], (command - position)[:-lag]
+    side, at = np.sign(gap), np.arange(len(gap))
+    since = at - np.maximum.accumulate(np.where(np.diff(side, prepend=side[0]) != 0, at, 0))  # on this side
+    judged = (
+        (np.abs(gap) > FOLLOW_GAP_DEG) & (np.abs(step) > FOLLOW_MIN_STEP_DEG) & (since >= reaction_s(actuator) * rate)
+    )
+    if judged.sum() < MIN_FOLLOW_S * rate:
+        return None
+    return float(np.mean(np.sign(step[judged]) == side[judged]))
+
+
+def better_reading(window: Window, actuator: ActuatorParams) -> tuple[str, float] | None:
+    """The reading of ``READINGS`` that fits Eq. 5.1 best, with how many times its equation error is below
+    the window's as logged, if by ``MIN_BETTER``; one batched fit of the window and its readings."""
+    signals, rate = window.signals, window.sample_rate_hz
+    batch = {name: np.stack([signals[name]] * (1 + len(READINGS))) for name in ("current_a", "hinge_moment_nm")}
+    for row, (factors, _, _) in enumerate(READINGS.values(), start=1):
+        for name, factor in factors.items():
+            batch[name][row] = signals[name] * factor
+    batch["position_deg"] = np.broadcast_to(signals["position_deg"], batch["current_a"].shape)
+    read = dict(as_read(dict(signals, **batch), rate), position_deg=signals["position_deg"])
+    errors = fit_friction(read, rate, actuator, OFFSET_FIT).residual_rms_nm
+    gains = errors[0] / errors[1:]
+    best = int(np.nanargmax(gains)) if np.any(np.isfinite(gains)) else -1
+    if best < 0 or not gains[best] >= MIN_BETTER:
+        return None
+    return list(READINGS)[best], float(gains[best])
+
+
+def step_lags(window: Window) -> np.ndarray:
+    """``STEP_LAGS_S`` in samples of ``window``, those under a quarter of it (the rest must overlap)."""
+    lags = STEP_LAGS_S * window.sample_rate_hz
+    return lags[np.abs(lags) < window.n_samples / 4]
+
+
+def out_of_step(window: Window, actuator: ActuatorParams) -> tuple[str, float, float] | None:
+    """The channel (current or hinge moment), its lag [s] and how many times better Eq. 5.1 fits with it,
+    where a lag of ``STEP_LAGS_S`` fits ``MIN_BETTER`` times better than none; else None."""
+    signals, rate, lags = window.signals, window.sample_rate_hz, step_lags(window)
+    if not len(lags):
+        return None
+    logged = float(fit_friction(as_read(signals, rate), rate, actuator).residual_rms_nm[0])
+    for name in ("current_a", "hinge_moment_nm"):
+        errors = equation_errors(dict(signals), rate, lags, actuator, name)
+        best = int(np.nanargmin(errors)) if np.any(np.isfinite(errors)) else -1
+        if best >= 0 and logged >= MIN_BETTER * errors[best]:
+            return name, float(lags[best] / rate), logged / float(errors[best])
+    return None
+
+
+def check_logged(window: Window) -> None:
+    """An InputError naming the first sensor with fewer than ``MIN_LEVELS`` distinct values over ``window``."""
+    for name in ("position_deg", "motor_speed_radps", "current_a", "hinge_moment_nm"):
+        levels = np.unique(window.signals[name])
+        if len(levels) < MIN_LEVELS:
+            values = ", ".join(f"{v:g}" for v in levels)
+            raise InputError(
+                f"signals.{name}",
+                f"takes only {values} over the window: a sensor not logged or stuck (a working one shows its noise); "
+                "nothing can be read through it",
+            )
+
+
+def consistency(window: Window, actuator: ActuatorParams) -> Consistency:
+    """The three relations of the module docstring, read off ``window``."""
+    return Consistency(travel_gain(window, actuator), following(window, actuator), better_reading(window, actuator))
+
+
+def kinematics_note(found: Consistency) -> list[Note]:
+    """What a kinematic gain outside ``NOTED_GAIN`` may mean, for the result's notes."""
+    gain = found.travel_gain
+    if gain is None or NOTED_GAIN[0] <= gain <= NOTED_GAIN[1]:
+        return []
+    text = (
+        f"the position travels {gain:.3f}x the speed's integral / gear ratio (1 in a consistent log): the sample "
+        "rate, the speed's or the position's gain is that far off; read as logged (a time base off puts J·dω/dt off "
+        "as much)"
+    )
+    return [Note(code="kinematic_gain", text=text)]
+
+
+def _travel_error(
+    gain: float, reading: tuple[str, float] | None, loop: str, window: Window, actuator: ActuatorParams
+) -> InputError:
+    """The error for a travel gain outside ``TRAVEL_GAIN``, naming the field it points to: for a sign, the
+    speed where Eq. 5.1 reads the torques against the motion (24–940x better flipped), else the position
+    (a command near 0° is followed by either sign: it cannot tell); otherwise a known unit slip, or the
+    sample rate."""
+    travel = (
+        f"the position's travel is {gain:.3g}x the speed's integral over the window / gear ratio "
+        f"{actuator.gear_ratio:g} (1 in a working drive){loop}"
+    )
+    if gain < 0 and reading is not None and reading[0] in AGAINST_THE_MOTION:
+        return InputError("signals.motor_speed_radps", f"runs against position_deg and the torques: {travel}: a sign?")
+    if gain < 0:
+        return InputError("signals.position_deg", f"runs against motor_speed_radps: {travel}: a sign?")
+    for factor, field, slip in UNIT_SLIPS:
+        if abs(gain / factor - 1.0) < UNIT_SLIP_TOLERANCE:
+            return InputError(field, f"{slip} {travel}")
+    rate = window.sample_rate_hz
+    if any(abs(gain / factor - 1.0) < RATE_SLIP_TOLERANCE for factor in RATE_SLIPS):
+        return InputError(
+            "sample_rate_hz",
+            f"{travel}: at {rate * gain:.6g} Hz instead of {rate:.6g} it would be 1 (a rate stated "
+            f"{1 / gain:.3g}x the log's?); or is motor_speed_radps in other units, or the document's gear ratio off?",
+        )
+    return InputError(
+        "actuator.drive.gear_ratio",
+        f"{travel}: the drive that logged this window turns as a gear ratio of {actuator.gear_ratio / gain:.4g} "
+        f"would; is the actuator's document the right one (its gear ratio, k_T, end stops)? Else the sample rate "
+        f"is off (at {rate * gain:.6g} Hz instead of {rate:.6g} it would be 1) or motor_speed_radps is in other "
+        "units",
+    )
+
+
+def check_consistency(window: Window, actuator: ActuatorParams) -> Consistency:
+    """``window``'s relations, or an InputError naming the field the failing ones point to."""
+    check_logged(window)
+    found = consistency(window, actuator)
+    gain, follows, reading = found.travel_gain, found.following, found.better_reading
+    lost = follows is not None and follows < MIN_FOLLOWING
+    loop = (
+        ""
+        if follows is None
+        else f"; the position moves toward the command in {100 * follows:.0f} % of the {FOLLOW_STEP_S * 1e3:g} ms "
+        f"steps begun over {FOLLOW_GAP_DEG:g}° from it (97–100 % in a working closed loop)"
+    )
+    if gain is not None and not TRAVEL_GAIN[0] <= gain <= TRAVEL_GAIN[1]:
+        raise _travel_error(gain, reading, loop, window, actuator)
+    if lost and reading is not None and reading[0] in AGAINST_THE_MOTION:
+        raise InputError(
+            "signals.position_deg",
+            f"and motor_speed_radps both run against the command and the current{loop}: a sign convention?",
+        )
+    if lost:
+        raise InputError(
+            "signals.command_deg",
+            f"the position does not follow it{loop}: a command in other units, of the other sign or of another window?",
+        )
+    shifted = out_of_step(window, actuator)
+    if shifted is not None:
+        name, lag_s, better = shifted
+        raise InputError(
+            f"signals.{name}",
+            f"is out of step with the other channels: Eq. 5.1 fits the window {better:.3g}x better with it read "
+            f"{1e3 * lag_s:+g} ms later (a sensor's filter delays ~1 ms at most): exported on another clock?",
+        )
+    if reading is not None:
+        _, name, meaning = READINGS[reading[0]]
+        unseen = " (or position_deg and motor_speed_radps have: the command moves too little to tell which)"
+        meaning += unseen if follows is None and reading[0] == "torque signs" else ""
+        raise InputError(f"signals.{name}", f"{meaning}: Eq. 5.1 fits the window {reading[1]:.3g}x better so")
+    return found

@@ -1,0 +1,43 @@
+"""The process's one thread budget, set by the program that starts (the CLI, the service, a worker).
+
+The simulator runs its groups on ``threads`` threads of its own (``ema.model.runtime``). torch trains a
+16-input, 100-neuron network on a hundred examples: its OpenMP team only adds waiting, and on a
+shared computer a team whose member the OS has parked stalls at every barrier (training went
+from 0.7 s to 19 s beside another CPU-bound job). So torch gets one intra-op and one inter-op
+thread, and the budget goes to the simulator.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+
+from ema.model import runtime as sim_runtime
+
+ENVIRONMENT = "EMA_THREADS"
+
+
+def budget(threads: int | None = None) -> int | None:
+    """The budget asked for: the argument, else EMA_THREADS, else None (the usable cores)."""
+    if threads is not None:
+        return threads
+    text = os.environ.get(ENVIRONMENT)
+    if text:
+        from ema.model.checks import InputError
+
+        if not text.isdigit() or int(text) < 1:
+            raise InputError(ENVIRONMENT, f"must be a positive integer, got {text!r}")
+        return int(text)
+    return None
+
+
+def configure(threads: int | None = None) -> int:
+    """Set the budget for this process; returns the simulator's thread count."""
+    import torch
+
+    count = sim_runtime.configure(budget(threads))
+    if torch.get_num_threads() != 1:
+        torch.set_num_threads(1)
+    with contextlib.suppress(RuntimeError):  # set once already: torch allows it only before any parallel work
+        torch.set_num_interop_threads(1)
+    return count

@@ -1,0 +1,36 @@
+"""Statistics every stage shares: block-jackknife stds, likelihood ratios of two fits, posterior weights of two
+stories, and how decisive a difference must be."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ema.model.residual import DEFAULT_DERIVATIVE_WINDOW_S, kernel_samples
+
+JACKKNIFE_BLOCKS = 10
+DECISIVE_Z = 4.0  # stds by which a reading must explain a window better than the document's before it is taken
+
+
+def jackknife_std(estimates: np.ndarray) -> np.ndarray:
+    """Std of the full-sample estimate from (N, B, …) leave-one-block-out estimates."""
+    b = estimates.shape[1]
+    return np.sqrt((b - 1) / b * np.sum((estimates - estimates.mean(axis=1, keepdims=True)) ** 2, axis=1))
+
+
+# A departure a window leans to without showing it (a hinge moment out of step, a viscous coefficient off the
+# document's) is weighed against the document's reading with these prior odds (which also pay for trying several: ten
+# lags, one C), into the stds only; a note says so from this weight.
+UNDECIDED_PRIOR_LOG_ODDS = -4.0
+UNDECIDED_NOTE_WEIGHT = 0.1
+
+
+def odds_weight(log_odds: float) -> float:
+    """The posterior weight of a story whose ln posterior odds against its rival are ``log_odds`` (clipped
+    where exp would overflow)."""
+    return float(1.0 / (1.0 + np.exp(-np.clip(log_odds, -50.0, 50.0))))
+
+
+def rms_log_likelihood_ratio(worse_rms: float, better_rms: float, n_sliding: float, rate: float) -> float:
+    """ln of the likelihood ratio of two fits of one window's ``n_sliding`` samples by their RMS equation
+    errors, with one independent value per reconstruction kernel (the kernel smooths both sides of Eq. 5.1)."""
+    return n_sliding / kernel_samples(rate, DEFAULT_DERIVATIVE_WINDOW_S) * float(np.log(worse_rms / better_rms))

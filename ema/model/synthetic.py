@@ -1,0 +1,52 @@
+"""Synthetic windows: the model standing in for an actuator's log (for demos, tests and calibration)."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from ema.model.actuator import THESIS, Actuator
+from ema.model.aircraft import FlightCondition, GroundLoad
+from ema.model.batch import InitialState, simulate_batch
+from ema.model.commands import family_knots
+from ema.model.effects import EffectSet
+from ema.model.noise import SensorNoise, add_sensor_noise
+from ema.model.params import HealthParams
+from ema.model.window import Window
+
+
+def synthetic_window(
+    health: HealthParams,
+    condition: FlightCondition | GroundLoad = FlightCondition(),
+    seed: int = 0,
+    duration_s: float = 0.5,
+    sample_rate_hz: float = 10_000.0,
+    noise: SensorNoise = SensorNoise(),
+    effects: EffectSet = EffectSet(),
+    actuator_id: str = "synthetic/elevator",
+    window_id: str | None = None,
+    command: str = "thesis",
+    actuator: Actuator = THESIS,
+) -> Window:
+    """One window logged from the model of ``actuator``: a command of ``command``'s family
+    (``ema.model.commands.FAMILIES``), the actuator at rest where the command starts, sensor noise; in flight at
+    ``condition``, or on the ground under a load cell's ``GroundLoad`` (the window then names no flight
+    condition).
+
+    ``seed`` fixes the command and the noise; ``health`` must hold one simulation. Without a ``window_id``
+    the window is named by its content (``synthetic-`` and its digest), so two different windows never
+    share a name.
+    """
+    rng = np.random.default_rng(seed)
+    n_samples = round(duration_s * sample_rate_hz)
+    knots = family_knots(command, n_samples, sample_rate_hz, rng)
+    stop = actuator.drive.end_stop_deg - 1.0
+    start = InitialState(position_deg=float(np.clip(knots[0], -stop, stop)))
+    result = simulate_batch(
+        knots, health, condition, start, sample_rate_hz, effects, actuator=actuator.params, hinge=actuator.hinge
+    )
+    signals = add_sensor_noise(result.simulation(0), noise, rng)
+    flight = condition if isinstance(condition, FlightCondition) else None
+    window = Window(signals, sample_rate_hz, flight, actuator_id, window_id or "synthetic")
+    return window if window_id else replace(window, window_id=f"synthetic-{window.content_sha256()[:16]}")

@@ -1,0 +1,204 @@
+"""``ema-window/1``, the flight-log window every layer reads: one definition, one validation.
+
+:class:`WindowDocument` is the JSON contract (``docs/model.md``, the window format): the service takes it
+as its request body, the CLI and the replay client read files through it, and its JSON Schema
+is exported to docs/schemas/. Types are strict (a boolean or a string is not a number), every
+number finite, every bound stated in the schema. :class:`Window` is what the layers below
+compute with: numpy arrays, built from a validated document or by our own code.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Annotated, Any, Literal
+
+import numpy as np
+from pydantic import AllowInfNan, AwareDatetime, BaseModel, ConfigDict, Field, Strict, ValidationError, field_validator
+
+from ema.model.aircraft import AIRSPEED_RANGE_MPS, ALTITUDE_RANGE_M, FlightCondition
+from ema.model.checks import InputError, from_validation, read_document
+
+SCHEMA = "ema-window/1"
+SIGNALS = ("command_deg", "position_deg", "motor_speed_radps", "current_a", "hinge_moment_nm")
+MIN_SAMPLES = 100
+MAX_SAMPLES = 1_000_000
+WINDOW_RATE_RANGE_HZ = (1_000.0, 100_000.0)
+# Physical plausibility: beyond these a sample is a sensor fault or a unit error, not a state.
+SIGNAL_LIMITS = {
+    "command_deg": (-90.0, 90.0),  # a reference, not a measurement: only a unit error is refused
+    "position_deg": (-35.0, 35.0),
+    "motor_speed_radps": (-2_000.0, 2_000.0),
+    "current_a": (-60.0, 60.0),
+    "hinge_moment_nm": (-5_000.0, 5_000.0),
+}
+IDENTIFIER = r"^[!-~](?:[ -~]{0,198}[!-~])?$"  # printable ASCII, no surrounding blanks: safe in a URL and a CSV
+
+Number = Annotated[float, Strict(), AllowInfNan(False)]
+Samples = Annotated[list[Number], Field(min_length=MIN_SAMPLES, max_length=MAX_SAMPLES)]
+
+
+class _Contract(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True, populate_by_name=True)
+
+
+class FlightConditionDocument(_Contract):
+    airspeed_mps: Number = Field(ge=AIRSPEED_RANGE_MPS[0], le=AIRSPEED_RANGE_MPS[1], description="true airspeed")
+    altitude_m: Number = Field(ge=ALTITUDE_RANGE_M[0], le=ALTITUDE_RANGE_M[1], description="pressure altitude, ISA")
+
+
+class SignalsDocument(_Contract):
+    """Five signals of one length, uniformly sampled from t = 0, each sample the mean over its interval."""
+
+    command_deg: Samples = Field(description=f"elevator command; any value within {SIGNAL_LIMITS['command_deg']}")
+    position_deg: Samples = Field(description=f"elevator deflection θ_u, within {SIGNAL_LIMITS['position_deg']}")
+    motor_speed_radps: Samples = Field(description=f"motor speed ω_m, within {SIGNAL_LIMITS['motor_speed_radps']}")
+    current_a: Samples = Field(description=f"phase current I, within {SIGNAL_LIMITS['current_a']}")
+    hinge_moment_nm: Samples = Field(description=f"hinge moment H_e, within {SIGNAL_LIMITS['hinge_moment_nm']}")
+
+    @field_validator(*SIGNALS)
+    @classmethod
+    def _plausible(cls, values: list[float], info: Any) -> list[float]:
+        low, high = SIGNAL_LIMITS[info.field_name]
+        array = np.asarray(values)
+        outside = np.flatnonzero((array < low) | (array > high))
+        if len(outside):
+            index = int(outside[0])
+            raise ValueError(f"sample {index} = {array[index]:g} is outside [{low:g}, {high:g}]")
+        return values
+
+
+class WindowDocument(_Contract):
+    """``ema-window/1``."""
+
+    schema_: Literal["ema-window/1"] = Field(alias="schema")
+    actuator_id: str = Field(min_length=1, max_length=200, pattern=IDENTIFIER, examples=["tail-123/elevator-left"])
+    window_id: str = Field(min_length=1, max_length=200, pattern=IDENTIFIER, examples=["2026-11-21T10:00:00Z#17"])
+    sample_rate_hz: Number = Field(ge=WINDOW_RATE_RANGE_HZ[0], le=WINDOW_RATE_RANGE_HZ[1])
+    flight_condition: FlightConditionDocument | None = Field(
+        None,
+        description="where the aircraft flew; null or absent: logged on the ground (a pre-flight test or a "
+        "bench), where no aircraft model applies and the logged hinge moment is the load",
+    )
+    signals: SignalsDocument
+    recorded_at: AwareDatetime | None = Field(None, description="when the window began (for trends)")
+    flight_hours: Number | None = Field(None, ge=0, description="the airframe's flight hours then (for trends)")
+    flight_id: str | None = Field(
+        None,
+        min_length=1,
+        max_length=200,
+        pattern=IDENTIFIER,
+        description="the flight (one power-on of the drive) it was logged in: a window moving one way, which "
+        "cannot read its sensors' zero, is read with the zero of one of the same flight that moves both ways",
+        examples=["tail-123/2026-11-21T10:00:00Z"],
+    )
+
+    def to_window(self) -> Window:
+        """The arrays; signals of unequal lengths are refused naming the first one that differs."""
+        arrays = {name: np.asarray(getattr(self.signals, name), dtype=np.float64) for name in SIGNALS}
+        length = len(arrays["command_deg"])
+        for name, array in arrays.items():
+            if len(array) != length:
+                raise InputError(f"signals.{name}", f"has {len(array)} samples, command_deg has {length}")
+        flight = self.flight_condition
+        condition = None if flight is None else FlightCondition(flight.airspeed_mps, flight.altitude_m)
+        recorded = None if self.recorded_at is None else self.recorded_at.isoformat()
+        return Window(
+            arrays,
+            self.sample_rate_hz,
+            condition,
+            self.actuator_id,
+            self.window_id,
+            recorded_at=recorded,
+            flight_hours=self.flight_hours,
+            flight_id=self.flight_id,
+        )
+
+
+@dataclass(frozen=True)
+class Window:
+    """A logged window as arrays: five uniformly sampled signals from t = 0 and where the aircraft flew (None:
+    on the ground)."""
+
+    signals: dict[str, np.ndarray]
+    sample_rate_hz: float = 10_000.0
+    flight_condition: FlightCondition | None = field(default_factory=FlightCondition)
+    actuator_id: str = "unknown"
+    window_id: str = "unknown"
+    recorded_at: str | None = None  # ISO 8601 with a time zone
+    flight_hours: float | None = None
+    flight_id: str | None = None  # one power-on of the drive: its sensors keep one zero
+
+    def __post_init__(self) -> None:
+        lengths = {name: len(self.signals[name]) for name in SIGNALS}
+        if len(set(lengths.values())) != 1:
+            raise InputError("signals", f"signals differ in length: {lengths}")
+
+    @property
+    def n_samples(self) -> int:
+        return len(self.signals["command_deg"])
+
+    def content_sha256(self) -> str:
+        """SHA-256 of everything the window says but its key (actuator_id, window_id): two bodies posted
+        under one key are the same window exactly when their digests agree."""
+        digest = hashlib.sha256()
+        meta = window_to_dict(replace(self, signals={name: self.signals[name][:0] for name in SIGNALS}))
+        for key in ("actuator_id", "window_id", "signals"):
+            meta.pop(key)
+        digest.update(json.dumps(meta, sort_keys=True).encode())
+        for name in SIGNALS:
+            digest.update(np.ascontiguousarray(self.signals[name], dtype="<f8").tobytes())
+        return digest.hexdigest()
+
+    @property
+    def duration_s(self) -> float:
+        return self.n_samples / self.sample_rate_hz
+
+    @property
+    def on_ground(self) -> bool:
+        return self.flight_condition is None
+
+
+def window_from_dict(document: Any) -> Window:
+    """Parse and validate an ``ema-window/1`` document (a dict); errors name the field."""
+    if not isinstance(document, dict):
+        raise InputError("window", f"must be a JSON object, got {type(document).__name__}")
+    try:
+        return WindowDocument.model_validate(document).to_window()
+    except ValidationError as exc:
+        raise from_validation(exc) from None
+
+
+def window_to_dict(window: Window) -> dict[str, Any]:
+    """The ``ema-window/1`` document of ``window``."""
+    return {
+        "schema": SCHEMA,
+        "actuator_id": window.actuator_id,
+        "window_id": window.window_id,
+        "sample_rate_hz": float(window.sample_rate_hz),
+        "flight_condition": None
+        if window.flight_condition is None
+        else {
+            "airspeed_mps": float(window.flight_condition.airspeed_mps),
+            "altitude_m": float(window.flight_condition.altitude_m),
+        },
+        "signals": {name: window.signals[name].tolist() for name in SIGNALS},
+        **({"recorded_at": window.recorded_at} if window.recorded_at is not None else {}),
+        **({"flight_hours": window.flight_hours} if window.flight_hours is not None else {}),
+        **({"flight_id": window.flight_id} if window.flight_id is not None else {}),
+    }
+
+
+def read_window(path: str | Path) -> Window:
+    """Read one window from a JSON file; a bad file raises InputError naming it (and the field)."""
+    return read_document(path, window_from_dict)
+
+
+def write_window(window: Window, path: str | Path) -> None:
+    """Write ``window`` as JSON, atomically (a reader never sees half a file)."""
+    path = Path(path)
+    temporary = path.with_name(path.name + ".tmp")
+    temporary.write_text(json.dumps(window_to_dict(window)))
+    temporary.replace(path)

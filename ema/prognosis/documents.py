@@ -1,0 +1,177 @@
+"""The history and prognosis documents (``docs/prognosis.md``): one definition each.
+
+``GET /v1/actuators/{id}/estimates`` answers :class:`History`, ``.../prognosis`` answers
+:class:`Prognosis`, ``ema history`` prints and plots them, and docs/schemas/ holds their JSON
+Schemas.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Literal
+
+import numpy as np
+from pydantic import Field
+
+from ema.estimate.documents import Document, Estimate, InertiaReading, Notes
+from ema.model.actuator import Actuator
+
+PARAMETERS = ("FDJ", "eta_O", "eta_A")
+
+
+class Stored(Estimate):
+    """An ``ema-estimate/1`` result as the history keeps it."""
+
+    id: int
+    stored_at: str = Field(description="when the service stored it (UTC, ISO 8601)")
+    replay: bool = Field(False, description="this window was posted before: the stored answer, not recomputed")
+
+
+class StoredActuator(Document):
+    """An actuator's ``ema-actuator/1`` document as the service keeps it: one version of several."""
+
+    actuator_id: str
+    version: int = Field(ge=1, description="1 for the first document PUT, then one more for each that differs")
+    stored_at: str = Field(description="when this version was stored (UTC, ISO 8601)")
+    document: Actuator
+
+
+class Point(Document):
+    """One window's estimate of one parameter, at its time."""
+
+    window_id: str
+    time: float = Field(description="in the prognosis's time unit")
+    value: float
+    std: float | None
+    outlier: bool = False
+
+
+class Curved(Document):
+    """The quadratic beside the line, value(t) = level + slope·dt + curvature·dt² (dt = t − t_last), and the
+    weight the windows give it against the line: wear that speeds up."""
+
+    level: float
+    slope_per_unit: float
+    curvature_per_unit2: float
+    covariance: list[list[float]] = Field(description="of (level, slope, curvature), 3 x 3")
+    weight: float = Field(ge=0, le=1, description="posterior weight of the curve against the line (BIC)")
+
+    def value_at(self, offset: float | np.ndarray) -> float | np.ndarray:
+        return self.level + self.slope_per_unit * offset + self.curvature_per_unit2 * offset**2
+
+
+class ForecastPoint(Document):
+    """The forecast at one time: the median of the weighed laws' curves and their 90 % band."""
+
+    time: float
+    median: float
+    low: float = Field(description="5 % quantile")
+    high: float = Field(description="95 % quantile")
+
+
+class Trend(Document):
+    """value(t) = level + slope·(t − t_last), weighted by each window's std, robust to outliers; beside it
+    the curve where the windows bend (``curved``)."""
+
+    parameter: str
+    n: int
+    level: float = Field(description="the line's value at the last window (with the curve weighed in: now())")
+    level_std: float
+    slope_per_unit: float = Field(description="0 where the windows span no time (slope_std null)")
+    slope_std: float | None = Field(
+        description="null: the windows span no time (one window, or all at one time): a level with no slope"
+    )
+    level_slope_correlation: float = Field(
+        0.0, ge=-1, le=1, description="of the level's and the slope's errors (the level is quoted at the last window)"
+    )
+    excess_std: float = Field(description="scatter beyond the stated stds, added to every point's (0: none)")
+    points: list[Point]
+    curved: Curved | None = Field(None, description="the quadratic and its weight (null: too few windows to bend)")
+    laws: dict[str, float] = Field(
+        default_factory=dict,
+        description="each degradation law's weight: how well it predicted the later windows from the earlier ones "
+        "(linear, quadratic, exponential, power, knee); the forecast draws from each in that share",
+    )
+    forecast: list[ForecastPoint] = Field(
+        default_factory=list, description="the weighed laws' median and 90 % band, from the first window on"
+    )
+
+    def now(self) -> tuple[float, float]:
+        """The value at the last window and its std, the line's and the curve's weighed by the curve's weight."""
+        if self.curved is None:
+            return self.level, self.level_std
+        w, curve_std = self.curved.weight, float(np.sqrt(max(self.curved.covariance[0][0], 0.0)))
+        value = (1 - w) * self.level + w * self.curved.level
+        spread = (1 - w) * self.level_std**2 + w * curve_std**2 + w * (1 - w) * (self.curved.level - self.level) ** 2
+        return float(value), float(np.sqrt(spread))
+
+    def std_at(self, offset: float) -> float:
+        """The std of the trend's value ``offset`` time units after the last window (level and slope correlated)."""
+        if self.slope_std is None:
+            return self.level_std if offset == 0 else float("inf")
+        level, slope = self.level_std, self.slope_std * offset
+        return float(np.sqrt(max(level**2 + 2 * self.level_slope_correlation * level * slope + slope**2, 0.0)))
+
+
+class RemainingLife(Document):
+    parameter: str
+    threshold: float
+    direction: Literal["above", "below"]
+    status: Literal["crossing predicted", "already crossed", "no degradation detected", "too few windows"]
+    rul: float | None = Field(description="time from the last window to the crossing, in the time unit")
+    rul_low: float | None = Field(description="5 % quantile")
+    rul_high: float | None = Field(description="95 % quantile (null: beyond any horizon the data support)")
+    rul_earliest: float | None = Field(
+        None,
+        description="the earliest plausible crossing: the 5 % quantile of the law that crosses soonest of those "
+        "holding some weight (plan for it if the wear is of that kind)",
+    )
+    speeding_up: bool = Field(False, description="the latest windows move towards the threshold faster than the trend")
+    probability_degrading: float | None = Field(description="probability that the trend moves towards the threshold")
+
+
+class BacktestPoint(Document):
+    """The prognosis as it stood at an earlier window, from the windows up to it alone, against what came after."""
+
+    window_id: str = Field(description="the last window it saw")
+    time: float
+    windows: int = Field(description="how many windows it saw")
+    status: str
+    rul: float | None
+    rul_low: float | None
+    rul_high: float | None
+    crossing: float | None = Field(description="the crossing time it predicted (time + rul)")
+    later_windows: int
+    later_inside: float | None = Field(
+        description="share of the later windows inside the forecast's 90 % band then (null: beyond its reach)"
+    )
+
+
+class Prognosis(Document):
+    actuator_id: str
+    time_unit: Literal["flight_hours", "days"]
+    trends: dict[str, Trend]
+    remaining_life: dict[str, RemainingLife]
+    sensors: dict[str, Trend] = Field(
+        default_factory=dict,
+        description="trends of what the windows read of the sensors: hinge_aircraft_ratio, the strain gauge's gain "
+        "against the aircraft model (1 where they agree; a level off 1 in every window is the gauge's calibration or "
+        "the airframe's C_hδ, a slope the gauge drifting)",
+    )
+    inertia: InertiaReading | None = Field(
+        None,
+        description="the actuator's J_M as its windows that told a heavier rotor from a weaker motor read it: "
+        "what a window that cannot is read with (null: none read one)",
+    )
+    notes: Notes = Field(default_factory=list)
+    backtest: dict[str, list[BacktestPoint]] = Field(
+        default_factory=dict,
+        description="per parameter, the prognosis as it would have stood at earlier windows, against what came after",
+    )
+
+
+class History(Document):
+    actuator_id: str
+    estimates: list[Stored] = Field(description="oldest first; one per (actuator_id, window_id)")
+    legacy: list[dict[str, Any]] = Field(
+        default_factory=list, description="results an earlier version stored, in their own format, as stored"
+    )

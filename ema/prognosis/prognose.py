@@ -1,0 +1,128 @@
+"""An actuator's stored estimates -> its ``Prognosis``: a trend per parameter and a remaining life each."""
+
+from __future__ import annotations
+
+import datetime as dt
+from collections.abc import Sequence
+from dataclasses import replace
+
+import numpy as np
+
+from ema.estimate.documents import Note
+from ema.estimate.history import combined_inertia, inertia_change_note
+from ema.model.actuator import Actuator, Airframe
+from ema.prognosis.backtest import backtest
+from ema.prognosis.documents import PARAMETERS, Prognosis, Stored, Trend
+from ema.prognosis.outlook import Outlook, outlook
+from ema.prognosis.trend import fit_trend
+
+AIRFRAME_TOLERANCE = Airframe.model_fields["tolerance"].default
+SENSOR_STDS = 3.0  # stds by which a sensor's level or drift must stand out to be said
+
+
+def _times(stored: Sequence[Stored]) -> tuple[np.ndarray, str, Note | None]:
+    """Flight hours where every window has them, else days from the windows' or the storage's dates."""
+    if all(s.window.flight_hours is not None for s in stored):
+        return np.array([s.window.flight_hours for s in stored], dtype=float), "flight_hours", None
+    if all(s.window.recorded_at is not None for s in stored):
+        stamps, note = [s.window.recorded_at for s in stored], None
+    else:
+        text = "windows carry no recorded_at: time is when they were stored"
+        stamps, note = [s.stored_at for s in stored], Note(code="time_from_storage", text=text)
+    seconds = np.array([dt.datetime.fromisoformat(str(t)).timestamp() for t in stamps])
+    return (seconds - seconds.min()) / 86_400.0, "days", note
+
+
+def prognose(actuator_id: str, stored: Sequence[Stored], actuator: Actuator) -> Prognosis:
+    """Trends and remaining lives of FDJ, η_O and η_A over ``stored`` (any order), to ``actuator``'s
+    thresholds; a parameter a window did not read (η_O without a load) is left out of its trend."""
+    if not stored:
+        return Prognosis(
+            actuator_id=actuator_id,
+            time_unit="days",
+            trends={},
+            remaining_life={},
+            notes=[Note(code="no_estimates", text="no estimates stored for this actuator")],
+        )
+    times, unit, note = _times(stored)
+    outlooks = {name: seen for name in PARAMETERS if (seen := _outlook(name, stored, times, actuator)) is not None}
+    tolerance = actuator.airframe.tolerance if actuator.airframe is not None else AIRFRAME_TOLERANCE
+    sensors, said = sensor_trends(stored, times, unit, tolerance)
+    inertias = [s.window.inertia_read for s in stored if s.window.inertia_read is not None]
+    faster = [speeding_note(name) for name, seen in outlooks.items() if seen.life.speeding_up]
+    notes = [n for n in (note, *faster, *said, inertia_change_note(inertias)) if n]
+    return Prognosis(
+        actuator_id=actuator_id,
+        time_unit=unit,
+        trends={n: o.trend for n, o in outlooks.items()},
+        remaining_life={n: o.life for n, o in outlooks.items()},
+        sensors=sensors,
+        inertia=combined_inertia(inertias),
+        notes=notes,
+        backtest={n: o.backtest for n, o in outlooks.items()},
+    )
+
+
+def _outlook(name: str, stored: Sequence[Stored], times: np.ndarray, actuator: Actuator) -> Outlook | None:
+    """``name``'s outlook over the windows that read it, or None where none did."""
+    read = [(t, e, s.window_id) for t, s in zip(times, stored, strict=True) if (e := getattr(s.estimates, name))]
+    if not read:
+        return None
+    values = np.array([e.value for _, e, _ in read])
+    stds = np.array([np.nan if e.std is None else e.std for _, e, _ in read])
+    times_read, ids = np.array([t for t, _, _ in read]), [i for _, _, i in read]
+    seen = outlook(name, times_read, values, stds, ids, *actuator.threshold(name))
+    return replace(seen, backtest=backtest(name, times_read, values, stds, ids, *actuator.threshold(name)))
+
+
+def speeding_note(name: str) -> Note:
+    return Note(
+        code="speeding_up",
+        parameter=name,
+        text=(
+            f"{name}'s latest windows move towards its threshold faster than its whole history does: wear speeding "
+            "up? The remaining life weighs the laws that accelerate by how well they predicted the later windows; "
+            "plan for the earliest plausible crossing"
+        ),
+    )
+
+
+def sensor_trends(
+    stored: Sequence[Stored], times: np.ndarray, unit: str, tolerance: float
+) -> tuple[dict[str, Trend], list[Note]]:
+    """The trend of the strain gauge's gain against the aircraft model over the windows that read it (two
+    at least), and notes where its level stands off 1 beyond the airframe model's ``tolerance`` or it drifts
+    (``SENSOR_STDS`` stds)."""
+    read = [
+        (t, s.window.hinge_aircraft_ratio, s.window.hinge_aircraft_ratio_std, s.window_id)
+        for t, s in zip(times, stored, strict=True)
+        if s.window.hinge_aircraft_ratio is not None
+    ]
+    if len(read) < 2:
+        return {}, []
+    t, values, stds, ids = zip(*read, strict=True)
+    trend = fit_trend("hinge_aircraft_ratio", np.array(t), np.array(values), np.array(stds, dtype=float), list(ids))
+    notes = []
+    if abs(trend.level - 1.0) > tolerance + SENSOR_STDS * trend.level_std:
+        notes.append(
+            Note(
+                code="gauge_off_model",
+                parameter="hinge_moment_nm",
+                text=f"the hinge moment's strain gauge reads {trend.level:.3f} ± {trend.level_std:.3f}x the aircraft "
+                f"model over "
+                f"{trend.n} windows, beyond the model's {100 * tolerance:.0f} % tolerance: recalibrate the gauge, or "
+                f"the "
+                "airframe's C_hδ is off (each estimate divides the gauge's gain out where its window is long enough)",
+            )
+        )
+    if trend.slope_std is not None and abs(trend.slope_per_unit) > SENSOR_STDS * trend.slope_std:
+        notes.append(
+            Note(
+                code="gauge_drift",
+                parameter="hinge_moment_nm",
+                text=f"the hinge moment's strain gauge drifts against the aircraft model by "
+                f"{trend.slope_per_unit:+.2g} "
+                f"± {trend.slope_std:.2g} per {unit.replace('_', ' ').rstrip('s')}",
+            )
+        )
+    return {"hinge_aircraft_ratio": trend}, notes

@@ -1,1 +1,0 @@
-"""The HTTP service: a thin FastAPI shell over ``training.pipeline``."""

@@ -1,0 +1,197 @@
+"""ema fleet on a small archive: every window answered once, resumable; and ema history's prognosis plot."""
+
+import csv
+import json
+
+import pytest
+
+from ema.cli.main import EXIT_BAD_INPUT, EXIT_OK, main
+from ema.model.actuator import THESIS
+from ema.model.params import HealthParams
+from ema.model.synthetic import synthetic_window
+from ema.model.window import window_to_dict
+
+SIZES = ["--sims", "16", "--checks", "8", "--timesteps", "50", "--hidden", "8"]
+
+
+@pytest.fixture
+def archive(tmp_path):
+    folder = tmp_path / "archive"
+    folder.mkdir()
+    for a in range(2):
+        for w in range(3):
+            window = synthetic_window(HealthParams.single(), seed=10 * a + w, duration_s=0.1, actuator_id=f"tail-{a}")
+            (folder / f"{a}-{w}.json").write_text(json.dumps({**window_to_dict(window), "window_id": f"w{w}"}))
+    (folder / "9-hold.json").write_text(
+        json.dumps(
+            {**window_to_dict(window), "window_id": "hold", "signals": {k: [0.0] * 1000 for k in window.signals}}
+        )
+    )
+    return folder
+
+
+def _rows(path):
+    with path.open() as handle:
+        return list(csv.DictReader(handle))
+
+
+@pytest.mark.slow
+def test_a_local_ray_run_answers_every_window_once_and_resumes(archive, tmp_path, capsys):
+    out, database = tmp_path / "results.csv", tmp_path / "history.sqlite3"
+    arguments = ["fleet", str(archive), "--out", str(out), "--workers", "2", "--database", str(database), *SIZES]
+    assert main([*arguments, "--json"]) == EXIT_OK
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["engine"] == "ray" and summary["answered"] == 6 and summary["refused"] == 1
+    rows = _rows(out)
+    assert len(rows) == 7 and len({(r["actuator_id"], r["window_id"]) for r in rows}) == 7
+    assert main([*arguments, "--json"]) == EXIT_OK  # rerun: nothing twice
+    assert json.loads(capsys.readouterr().out)["skipped"] == 7 and len(_rows(out)) == 7
+
+
+def test_one_worker_without_ray_runs_in_process_and_skips_a_bad_file(archive, tmp_path, capsys, monkeypatch):
+    from ema.cli import fleet
+
+    monkeypatch.setattr(fleet, "ray_installed", lambda: False)
+    (archive / "5-broken.json").write_text("{not json")
+    out = tmp_path / "results.csv"
+    assert main(["fleet", str(archive), "--out", str(out), "--workers", "1", "--json", *SIZES]) == EXIT_OK
+    captured = capsys.readouterr()
+    summary = json.loads(captured.out)
+    assert summary["engine"] == "in-process" and summary["answered"] == 6
+    assert list(summary["bad_files"]) == [str(archive / "5-broken.json")] and "5-broken.json" in captured.err
+    assert "[7/7]" in captured.err and "windows/s" in captured.err  # progress: done, rate, time left
+
+
+def test_more_workers_without_ray_say_how_to_install_it_and_write_nothing(archive, tmp_path, capsys, monkeypatch):
+    from ema.cli import fleet
+
+    monkeypatch.setattr(fleet, "ray_installed", lambda: False)
+    out = tmp_path / "results.csv"
+    assert main(["fleet", str(archive), "--out", str(out), "--workers", "2"]) == EXIT_BAD_INPUT
+    assert "--workers" in (err := capsys.readouterr().err) and "pip install 'ema[fleet]'" in err
+    assert not out.exists()
+
+
+def test_windows_wanting_what_others_read_are_answered_with_it(tmp_path, capsys, monkeypatch):
+    """Their files first in the archive: a 0.1 s gust moving one way (current 0.2 A off) waits for the cruise
+    window of its flight (a window of another flight does not take that zero), and so does one moving both ways
+    that reads the zero less precisely (0.10 A alone), as the service answers it; a doublet that cannot tell
+    J_M 1.08x from a weaker motor waits for the thesis window of its actuator."""
+    from ema.cli import fleet
+    from ema.service.store import EstimateStore
+    from tests.foreign.windows import Effects, draw, of_the_same_flight
+
+    monkeypatch.setattr(fleet, "ray_installed", lambda: False)
+    folder, database = tmp_path / "archive", tmp_path / "history.sqlite3"
+    folder.mkdir()
+    one_way = draw(318, "gust", duration_s=0.1, effects=Effects(current_bias_a=0.2))
+    cruise, both_ways = of_the_same_flight(one_way, 1318), of_the_same_flight(one_way, 2318, "gust", 0.1)
+    flights = (("a", one_way, "f-1"), ("a2", both_ways, "f-1"), ("b", cruise, "f-1"), ("c", one_way, "f-2"))
+    for name, drawn, flight_id in flights:
+        document = {**drawn.document, "actuator_id": "tail-9", "flight_id": flight_id, "window_id": name}
+        (folder / f"{name}.json").write_text(json.dumps(document))
+    heavier = draw(403, "doublet", effects=Effects(inertia_factor=1.08))
+    for name, drawn in (("d", heavier), ("e", of_the_same_flight(heavier, 1403, "thesis", 0.5))):
+        (folder / f"{name}.json").write_text(json.dumps({**drawn.document, "actuator_id": "tail-8", "window_id": name}))
+    arguments = ["fleet", str(folder), "--out", str(tmp_path / "r.csv"), "--workers", "1", "--database", str(database)]
+    assert main([*arguments, *SIZES, "--json"]) == EXIT_OK
+    answers = {s.window_id: s.window for s in EstimateStore(database).history("tail-9")[0]}
+    cruise_pieces = {name for name in answers if name.startswith("b#")}  # the archive's windows are cut
+    assert answers["a"].sensor_zero_from in cruise_pieces and answers["c"].sensor_zero_from is None
+    assert answers["a2"].sensor_zero_from in cruise_pieces and answers["a2"].sensor_zero is None
+    drive = {s.window_id: s.window for s in EstimateStore(database).history("tail-8")[0]}
+    assert drive["d"].inertia_from == ["e"] and not drive["d"].inertia_undecided
+    count = len(answers) + len(drive)
+    assert f"[{count}/{count}]" in capsys.readouterr().err
+
+
+def test_history_plots_a_prognosis_whose_interval_holds_the_truth(tmp_path, capsys):
+    import numpy as np
+
+    from ema.estimate.config import PipelineConfig
+    from ema.estimate.documents import parameter
+    from ema.estimate.pipeline import estimate_window
+    from ema.service.store import EstimateStore
+    from tests.servers import free_port, start_server
+
+    small = PipelineConfig(n_simulations=16, check_windows=8, n_timesteps=50, hidden_units=8)
+    base = estimate_window(synthetic_window(HealthParams.single(), seed=1, duration_s=0.1), small, actuator=THESIS)
+    rng, store = np.random.default_rng(0), EstimateStore(tmp_path / "history.sqlite3")
+    hours = np.sort(rng.uniform(0, 200, 200))
+    for i, h in enumerate(hours):  # FDJ rising 1e-4 N·m per flight hour: crosses 0.075 at 250 h
+        fdj = 0.05 + 1e-4 * h + 4e-4 * rng.normal()
+        estimates = base.estimates.model_copy(update={"FDJ": parameter(fdj, 4e-4, 0.05)})
+        window = base.window.model_copy(update={"flight_hours": float(h)})
+        store.add(
+            base.model_copy(
+                update={"estimates": estimates, "window": window, "actuator_id": "tail-9", "window_id": f"w{i}"}
+            )
+        )
+    store.close()
+    port = free_port()
+    server = start_server(port, tmp_path / "history.sqlite3")
+    try:
+        plot = tmp_path / "fdj.png"
+        arguments = ["history", "tail-9", "--url", f"http://127.0.0.1:{port}", "--plot", str(plot), "--json"]
+        assert main(arguments) == EXIT_OK
+    finally:
+        server.terminate()
+        server.wait(timeout=30)
+    life = json.loads(capsys.readouterr().out)["prognosis"]["remaining_life"]["FDJ"]
+    assert life["status"] == "crossing predicted"
+    assert life["rul_low"] <= 250 - hours.max() <= life["rul_high"]
+    assert plot.stat().st_size > 10_000
+
+
+def test_a_flights_windows_are_given_out_once_the_flight_is_answered_not_at_the_runs_end(monkeypatch):
+    """The results CSV is the checkpoint: a window waits for its flight's other windows, not for the run."""
+    from dataclasses import replace
+
+    from ema.cli import fleet
+
+    monkeypatch.setattr(fleet._Readings, "add", lambda self, window, answer: None)
+    monkeypatch.setattr(fleet._Readings, "lacked", lambda self, window, answer: None)
+    base = synthetic_window(HealthParams.single(), seed=1, duration_s=0.05)
+    flights = [("f-1", "a"), ("f-1", "b"), (None, "c"), ("f-2", "d"), ("f-2", "e")]
+    windows = [replace(base, flight_id=flight, window_id=name) for flight, name in flights]
+    consumed: list[str] = []
+
+    def first():
+        for window in windows:
+            consumed.append(window.window_id)
+            yield window, {"window": {}}
+
+    given = [(w.window_id, list(consumed)) for w, _ in fleet._with_history(windows, first(), lambda jobs: iter(()))]
+    assert given == [
+        ("a", ["a", "b"]),
+        ("b", ["a", "b"]),
+        ("c", ["a", "b", "c"]),
+        ("d", ["a", "b", "c", "d", "e"]),
+        ("e", ["a", "b", "c", "d", "e"]),
+    ]
+
+
+def test_an_archive_carries_its_actuators_documents(tmp_path, capsys, monkeypatch):
+    """actuators.json maps an actuator to its document: its windows are read with it (and the history stores
+    it, versioned); an actuator it does not list is read with the default, and said so."""
+    from ema.cli import fleet
+    from ema.service.store import EstimateStore
+    from tests.foreign.actuators import DRIVES, NOMINAL, document
+    from tests.foreign.windows import Ground, draw
+
+    monkeypatch.setattr(fleet, "ray_installed", lambda: False)
+    folder, database = tmp_path / "archive", tmp_path / "history.sqlite3"
+    folder.mkdir()
+    bench = draw(31, "sweep", drive=DRIVES["smaller"], nominal=NOMINAL["smaller"], flight=Ground(-100.0, 500.0))
+    (folder / "a.json").write_text(json.dumps({**bench.document, "actuator_id": "small-1", "window_id": "b"}))
+    thesis = synthetic_window(HealthParams.single(), seed=4, duration_s=0.1, actuator_id="thesis-1")
+    (folder / "t.json").write_text(json.dumps(window_to_dict(thesis)))
+    (folder / "actuators.json").write_text(json.dumps({"small-1": document("smaller")}))
+    arguments = ["fleet", str(folder), "--out", str(tmp_path / "r.csv"), "--workers", "1", "--database", str(database)]
+    assert main([*arguments, *SIZES, "--json"]) == EXIT_OK
+    assert json.loads(capsys.readouterr().out)["answered"] == 2
+    store = EstimateStore(database)
+    small = store.history("small-1")[0][0]
+    assert small.actuator.version == 1 and store.get_actuator("small-1").document.drive.gear_ratio == 800.0
+    assert abs(small.estimates.FDJ.value / bench.truth["FDJ"] - 1) < 0.03
+    assert store.history("thesis-1")[0][0].actuator.default and store.get_actuator("thesis-1") is None

@@ -1,0 +1,64 @@
+"""The ema-actuator/1 document: validated naming the field, the thesis's the default, what stages read of it."""
+
+import json
+from pathlib import Path
+
+import pytest
+
+from ema.model.actuator import THESIS, actuator_from_dict, read_actuator
+from ema.model.checks import InputError
+from ema.model.params import DEFAULT_RANGES, ActuatorParams, eta_a_from_eta_o
+
+EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "actuator.json"
+
+
+def test_the_thesis_actuator_ships_as_the_example_and_is_table_3_1():
+    assert read_actuator(EXAMPLE) == THESIS
+    assert THESIS.params == ActuatorParams()
+    for name in ("fdj_nm", "fsj_nm", "eta_o"):  # the healthy range: Table 3.1's, ±20 % of nominal
+        assert getattr(THESIS.ranges, name) == pytest.approx(getattr(DEFAULT_RANGES, name))
+    assert THESIS.threshold("FDJ") == (0.075, "above") and THESIS.threshold("eta_O") == (0.70, "below")
+
+
+def test_eq_3_4_and_the_thresholds_follow_the_documents_gear_ratio_and_nominal():
+    document = json.loads(EXAMPLE.read_text())
+    document["drive"]["gear_ratio"] = 320.0
+    document["nominal"] = {"fdj_nm": 0.08, "fsj_nm": 0.16, "eta_o": 0.9}
+    del document["thresholds"]
+    heavier = actuator_from_dict(document)
+    assert heavier.eta_a(0.9) == pytest.approx(eta_a_from_eta_o(0.9, 320.0))
+    assert heavier.eta_a(0.9) != pytest.approx(eta_a_from_eta_o(0.9, 500.0), rel=1e-6)
+    assert heavier.threshold("FDJ") == (pytest.approx(0.12), "above")  # 1.5x its own nominal
+    assert heavier.threshold("eta_A")[0] == pytest.approx(eta_a_from_eta_o(0.70, 320.0))
+    assert heavier.ranges.fdj_nm == pytest.approx((0.064, 0.096)) and heavier.ranges.eta_o[1] == pytest.approx(0.98)
+
+
+@pytest.mark.parametrize(
+    ("change", "field"),
+    [
+        (("drive", "gear_ratio", 0.5), "drive.gear_ratio"),
+        (("drive", "torque_constant_nm_per_a", -0.1), "drive.torque_constant_nm_per_a"),
+        (("drive", "inductance_h", 1e-8), "drive.inductance_h"),  # R/L beyond what a 1 µs step integrates
+        (("drive", "end_stop_deg", "30"), "drive.end_stop_deg"),  # strict: a string is not a number
+        (("nominal", "fsj_nm", 0.01), "nominal.fsj_nm"),  # static below dynamic friction
+        (("nominal", "eta_o", 1.2), "nominal.eta_o"),
+        (("thresholds", "fdj_above_nm", 0.04), "thresholds.fdj_above_nm"),  # not past the nominal
+        (("drive", "unknown_constant", 1.0), "drive.unknown_constant"),
+    ],
+)
+def test_an_impossible_value_is_refused_naming_the_field(change, field):
+    document = json.loads(EXAMPLE.read_text())
+    part, name, value = change
+    document[part][name] = value
+    with pytest.raises(InputError) as refused:
+        actuator_from_dict(document)
+    assert refused.value.field == field
+
+
+def test_a_document_without_its_airframe_is_valid_and_checks_no_aircraft():
+    document = json.loads(EXAMPLE.read_text())
+    del document["airframe"]
+    assert actuator_from_dict(document).hinge is None and THESIS.hinge is not None
+    with pytest.raises(InputError) as refused:
+        actuator_from_dict({**document, "schema": "ema-actuator/2"})
+    assert refused.value.field == "schema"

@@ -1,0 +1,73 @@
+import copy
+
+import numpy as np
+import pytest
+
+from ema.model.checks import InputError
+from ema.model.params import HealthParams
+from ema.model.synthetic import synthetic_window
+from ema.model.window import read_window, window_from_dict, window_to_dict, write_window
+
+
+@pytest.fixture(scope="module")
+def document():
+    return window_to_dict(synthetic_window(HealthParams.single(), seed=1, duration_s=0.05))
+
+
+def test_round_trip_through_a_file(tmp_path, document):
+    window = window_from_dict(document)
+    write_window(window, tmp_path / "w.json")
+    again = read_window(tmp_path / "w.json")
+    for name, values in window.signals.items():
+        np.testing.assert_array_equal(again.signals[name], values)
+    assert again.flight_condition == window.flight_condition
+    assert not list(tmp_path.glob("*.tmp"))
+
+
+def test_synthetic_windows_are_seeded(document):
+    again = window_to_dict(synthetic_window(HealthParams.single(), seed=1, duration_s=0.05))
+    assert again == document
+
+
+def _broken(document, path, value):
+    broken = copy.deepcopy(document)
+    target = broken
+    for key in path[:-1]:
+        target = target[key]
+    if value is KeyError:
+        del target[path[-1]]
+    else:
+        target[path[-1]] = value
+    return broken
+
+
+@pytest.mark.parametrize(
+    ("path", "value", "field"),
+    [
+        (("schema",), "ema-window/2", "schema"),
+        (("sample_rate_hz",), 50.0, "sample_rate_hz"),
+        (("sample_rate_hz",), "fast", "sample_rate_hz"),
+        (("flight_condition", "airspeed_mps"), 400.0, "flight_condition.airspeed_mps"),
+        (("flight_condition", "altitude_m"), KeyError, "flight_condition.altitude_m"),
+        (("signals", "current_a"), KeyError, "signals.current_a"),
+        (("signals", "current_a"), [0.0] * 10, "signals.current_a"),
+        (("signals", "position_deg"), [float("nan")] * 500, "signals.position_deg"),
+        (("signals", "position_deg"), [90.0] * 500, "signals.position_deg"),
+        (("signals", "extra"), [0.0] * 500, "signals.extra"),
+        (("actuator_id",), 5, "actuator_id"),
+    ],
+)
+def test_bad_windows_name_the_field(document, path, value, field):
+    with pytest.raises(InputError) as error:
+        window_from_dict(_broken(document, path, value))
+    assert error.value.field == field
+
+
+def test_too_short_and_unreadable(tmp_path, document):
+    short = copy.deepcopy(document)
+    short["signals"] = {name: values[:50] for name, values in document["signals"].items()}
+    with pytest.raises(InputError, match="signals"):
+        window_from_dict(short)
+    (tmp_path / "bad.json").write_text("{not json")
+    with pytest.raises(InputError, match=r"bad\.json"):
+        read_window(tmp_path / "bad.json")
