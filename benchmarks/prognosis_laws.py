@@ -36,7 +36,9 @@ def score(law: str, n: int, std: float, histories: int) -> dict[str, float]:
     errors = []
     for seed in range(histories):
         h = history(law, 9000 + seed, n=n, std=std)
-        life = outlook("FDJ", h.hours, h.values, h.stds, [str(i) for i in range(n)], THRESHOLD, "above").life
+        life = outlook(
+            "FDJ", h.hours, h.values, h.stds, [str(i) for i in range(n)], threshold=THRESHOLD, direction="above"
+        ).life
         if law == "steady":
             alarms += life.status == "crossing predicted"
             continue

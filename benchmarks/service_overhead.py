@@ -28,9 +28,9 @@ import numpy as np
 
 from ema.cli.report import write_section
 from ema.estimate.pipeline import estimate_window
+from ema.history.open import open_history
 from ema.model.actuator import THESIS
 from ema.model.window import WindowDocument
-from ema.service.store import EstimateStore
 from tests.foreign.windows import draw
 
 SECTION = "Service overhead"
@@ -95,7 +95,7 @@ def in_process(body: bytes, database: Path) -> dict[str, float]:
     """Milliseconds of each step the service takes around the pipeline, on one body (median of 20)."""
     steps: dict[str, list[float]] = {"parse and validate": [], "to arrays": [], "store": []}
     result = None
-    store = EstimateStore(database)
+    store = open_history(database)
     for i in range(20):
         started = time.perf_counter()
         document = WindowDocument.model_validate_json(body)

@@ -180,9 +180,9 @@ def calibrate(
 @click.option("--port", type=click.IntRange(1, 65535), default=None, help="port [default: EMA_PORT, else 8000]")
 @click.option(
     "--database",
-    type=click.Path(dir_okay=False, path_type=Path),
     default=None,
-    help="SQLite history file [default: EMA_DATABASE, else $XDG_DATA_HOME/ema/history.sqlite3]",
+    help="the history: an SQLite file, or a postgresql://user@host:port/db address [default: EMA_DATABASE, else "
+    "$XDG_DATA_HOME/ema/history.sqlite3]",
 )
 @click.option("--api-key-file", type=EXISTING, default=None, help="a file holding the API key (or EMA_API_KEY)")
 def serve(**flags: Any) -> None:
@@ -193,7 +193,6 @@ def serve(**flags: Any) -> None:
     from ema.model.checks import InputError, from_validation
     from ema.service.config import Settings
     from ema.service.main import create_app
-    from ema.service.store import EstimateStore
 
     try:
         settings = Settings(**{k: v for k, v in flags.items() if v is not None})
@@ -201,9 +200,26 @@ def serve(**flags: Any) -> None:
         error = from_validation(exc)
         field = "host" if error.field == "document" else error.field  # the one check across fields: host vs key
         raise InputError(f"--{field.replace('_', '-')} / EMA_{field.upper()}", error.message) from None
-    EstimateStore(settings.database).close()  # refused here, naming the file, before the server starts
-    _check_port_free(settings.host, settings.port)
+    _check_port_free(settings.host, settings.port)  # before the history: a busy port creates no file
+    with flags_named({"database": "--database / EMA_DATABASE"}):
+        _check_history(settings.database, settings.min_free_bytes)
     uvicorn.run(create_app(settings), host=settings.host, port=settings.port, log_level="info")
+
+
+def _check_history(database: str, min_free_bytes: int) -> None:
+    """InputError naming --database where the history cannot be opened or cannot take a write now."""
+    from ema.history.errors import StorageError
+    from ema.history.open import open_history
+    from ema.model.checks import InputError
+
+    try:
+        history = open_history(database, min_free_bytes)
+        try:
+            history.probe()
+        finally:
+            history.close()
+    except StorageError as exc:
+        raise InputError("--database / EMA_DATABASE", str(exc)) from None
 
 
 def _check_port_free(host: str, port: int) -> None:
@@ -223,14 +239,19 @@ def _check_port_free(host: str, port: int) -> None:
 @click.option(
     "--out",
     type=click.Path(file_okay=False, path_type=Path),
-    required=True,
-    help="folder for the JSON Schemas (the repository keeps them in docs/schemas)",
+    default=None,
+    help="folder to write the JSON Schemas to (with --check: to compare; default docs/schemas, where the "
+    "repository keeps them)",
 )
-@click.option("--check", is_flag=True, help="exit 1 if the files there differ from the code")
-def schemas(out: Path, check: bool) -> None:
+@click.option("--check", is_flag=True, help="exit 1 if the files there differ from the code (writes nothing)")
+def schemas(out: Path | None, check: bool) -> None:
     """Export the JSON Schema of every public document (or check the exported ones)."""
     from ema.cli.schemas import export
+    from ema.model.checks import InputError
 
+    if out is None and not check:
+        raise InputError("--out", "name the folder to write the schemas to (the repository's: --out docs/schemas)")
+    out = out or Path("docs/schemas")
     stale = export(out, check=check)
     if check and stale:
         raise click.ClickException(f"stale or missing in {out}: {', '.join(stale)} (run: ema schemas --out {out})")

@@ -242,9 +242,9 @@ def ray_installed() -> bool:
 
 def _stored(store: Any, row: dict[str, Any], answer: dict[str, Any]) -> dict[str, Any]:
     """``row`` once its answer is in the history, or refused where the history holds another window's content
-    under its window_id (``ema.service.store.ConflictError``)."""
+    under its window_id (``ema.history.errors.ConflictError``)."""
     from ema.estimate.documents import Estimate
-    from ema.service.store import ConflictError
+    from ema.history.errors import ConflictError
 
     try:
         store.add(Estimate.model_validate(answer))
@@ -267,6 +267,6 @@ def _stored_documents(store: Any, documents: Documents, actuator_ids: set[str]) 
 def _store(database: Path | None) -> Any:
     if database is None:
         return None
-    from ema.service.store import EstimateStore
+    from ema.history.open import open_history
 
-    return EstimateStore(database)
+    return open_history(database)

@@ -32,8 +32,8 @@ for module in (commands_local, commands_remote, commands_fleet):
 
 def _bad_input(exc: BaseException) -> str | None:
     """The message for an error that is the user's input (named field, flag or file), else None."""
+    from ema.history.errors import StorageError
     from ema.model.checks import InputError
-    from ema.service.store import StorageError
 
     if isinstance(exc, InputError):
         return f"bad input: {exc}"

@@ -9,6 +9,7 @@ API key comes from a file or EMA_API_KEY, never from the command line (where ``p
 
 from __future__ import annotations
 
+import http.client
 import json
 import sys
 import time
@@ -37,7 +38,12 @@ def request(url: str, api_key: str | None, data: bytes | None = None, timeout: f
     except urllib.error.HTTPError:
         raise
     except urllib.error.URLError as error:
-        raise ServiceError(f"cannot reach {url}: {error.reason}") from None
+        raise ServiceError(f"cannot reach the service at {url}: {error.reason}") from None
+    except (ConnectionError, http.client.HTTPException, TimeoutError) as error:
+        reason = str(error) or type(error).__name__
+        raise ServiceError(
+            f"the service at {url} stopped answering mid-request ({reason}): is it still running?"
+        ) from None
 
 
 def post_window(url: str, window: Window, api_key: str | None, sleep: Callable[[float], None] = time.sleep) -> dict:
@@ -49,8 +55,8 @@ def post_window(url: str, window: Window, api_key: str | None, sleep: Callable[[
             return request(f"{url.rstrip('/')}/v1/estimate", api_key, body)
         except urllib.error.HTTPError as error:
             detail = error.read().decode(errors="replace")
-            if error.code == 503 and waited < MAX_WAIT_S:
-                pause = float(error.headers.get("Retry-After", "1"))
+            if error.code == 503 and error.headers.get("Retry-After") is not None and waited < MAX_WAIT_S:
+                pause = float(error.headers["Retry-After"])
                 print(f"  service busy, retrying {window.window_id} in {pause:g} s", file=sys.stderr)
                 sleep(pause)
                 waited += pause

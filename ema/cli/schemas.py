@@ -14,7 +14,7 @@ def documents() -> dict[str, type[BaseModel]]:
     from ema.estimate.documents import Estimate
     from ema.model.actuator import Actuator
     from ema.model.window import WindowDocument
-    from ema.prognosis.documents import History, Prognosis, StoredActuator
+    from ema.prognosis.documents import ActuatorSummary, History, Prognosis, StoredActuator, Withdrawal
 
     return {
         "ema-actuator-1": Actuator,
@@ -24,6 +24,8 @@ def documents() -> dict[str, type[BaseModel]]:
         "ema-calibration-1": CalibrationReport,
         "history": History,
         "prognosis": Prognosis,
+        "actuator-summary": ActuatorSummary,
+        "withdrawal": Withdrawal,
     }
 
 

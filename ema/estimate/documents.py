@@ -61,6 +61,8 @@ NoteCode = Literal[
     # the prognosis
     "no_estimates",
     "time_from_storage",
+    "time_by_window_order",
+    "prognosis_failed",
     "gauge_off_model",
     "gauge_drift",
     "inertia_changed",

@@ -9,6 +9,7 @@ compute with: numpy arrays, built from a validated document or by our own code.
 
 from __future__ import annotations
 
+import datetime as dt
 import hashlib
 import json
 from dataclasses import dataclass, field, replace
@@ -34,7 +35,12 @@ SIGNAL_LIMITS = {
     "current_a": (-60.0, 60.0),
     "hinge_moment_nm": (-5_000.0, 5_000.0),
 }
-IDENTIFIER = r"^[!-~](?:[ -~]{0,198}[!-~])?$"  # printable ASCII, no surrounding blanks: safe in a URL and a CSV
+IDENTIFIER = r"^[!-~](?:[ -~]{0,198}[!-~])?$"
+# Times a trend computes with, bounded where they enter: no airframe flies a million hours, no log predates
+# 2000 or is stamped more than a day ahead of the clock that receives it.
+MAX_FLIGHT_HOURS = 1_000_000.0
+EARLIEST_RECORDED_AT = dt.datetime(2000, 1, 1, tzinfo=dt.UTC)
+CLOCK_SKEW = dt.timedelta(days=1)  # printable ASCII, no surrounding blanks: safe in a URL and a CSV
 
 Number = Annotated[float, Strict(), AllowInfNan(False)]
 Samples = Annotated[list[Number], Field(min_length=MIN_SAMPLES, max_length=MAX_SAMPLES)]
@@ -83,8 +89,14 @@ class WindowDocument(_Contract):
         "bench), where no aircraft model applies and the logged hinge moment is the load",
     )
     signals: SignalsDocument
-    recorded_at: AwareDatetime | None = Field(None, description="when the window began (for trends)")
-    flight_hours: Number | None = Field(None, ge=0, description="the airframe's flight hours then (for trends)")
+    recorded_at: AwareDatetime | None = Field(
+        None,
+        description=f"when the window began (for trends), from {EARLIEST_RECORDED_AT.date()} to a day past the "
+        "receiver's clock",
+    )
+    flight_hours: Number | None = Field(
+        None, ge=0, le=MAX_FLIGHT_HOURS, description="the airframe's flight hours then (for trends)"
+    )
     flight_id: str | None = Field(
         None,
         min_length=1,
@@ -94,6 +106,13 @@ class WindowDocument(_Contract):
         "cannot read its sensors' zero, is read with the zero of one of the same flight that moves both ways",
         examples=["tail-123/2026-11-21T10:00:00Z"],
     )
+
+    @field_validator("recorded_at")
+    @classmethod
+    def _recorded_in_time(cls, value: dt.datetime | None) -> dt.datetime | None:
+        if value is not None and not EARLIEST_RECORDED_AT <= value <= dt.datetime.now(dt.UTC) + CLOCK_SKEW:
+            raise ValueError(f"{value.isoformat()} is before {EARLIEST_RECORDED_AT.date()} or over a day ahead of now")
+        return value
 
     def to_window(self) -> Window:
         """The arrays; signals of unequal lengths are refused naming the first one that differs."""

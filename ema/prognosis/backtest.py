@@ -29,8 +29,10 @@ def backtest(
     values: np.ndarray,
     stds: np.ndarray,
     window_ids: Sequence[str],
+    *,
     threshold: float,
     direction: str,
+    min_span: float = 0.0,
 ) -> list[BacktestPoint]:
     """The prognosis at ``SHARES`` of the history (in time order), each against the windows after it."""
     order = np.argsort(times, kind="stable")
@@ -41,7 +43,16 @@ def backtest(
         k = round(share * len(times))
         if k < MIN_WINDOWS or k >= len(times) or np.ptp(times[:k]) <= 0:
             continue
-        then = outlook(parameter, times[:k], values[:k], stds[:k], ids[:k], threshold, direction)
+        then = outlook(
+            parameter,
+            times[:k],
+            values[:k],
+            stds[:k],
+            ids[:k],
+            threshold=threshold,
+            direction=direction,
+            min_span=min_span,
+        )
         life = then.life
         inside = _inside(then.trend.forecast, times[k:], values[k:], stds[k:])
         points.append(

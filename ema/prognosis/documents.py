@@ -16,6 +16,10 @@ from ema.estimate.documents import Document, Estimate, InertiaReading, Notes
 from ema.model.actuator import Actuator
 
 PARAMETERS = ("FDJ", "eta_O", "eta_A")
+TimeUnit = Literal["flight_hours", "days", "windows"]
+# The least spread a trend needs before it forecasts anything (and a status may say "due"): windows logged
+# within minutes of each other show noise, not wear, however steep their line.
+MIN_SPAN: dict[str, float] = {"flight_hours": 10.0, "days": 2.0, "windows": 5.0}
 
 
 class Stored(Estimate):
@@ -33,6 +37,17 @@ class StoredActuator(Document):
     version: int = Field(ge=1, description="1 for the first document PUT, then one more for each that differs")
     stored_at: str = Field(description="when this version was stored (UTC, ISO 8601)")
     document: Actuator
+
+
+class Withdrawal(Document):
+    """A window taken out of an actuator's history (``DELETE .../estimates/{window_id}``): kept, with why."""
+
+    actuator_id: str
+    window_id: str
+    withdrawn_at: str = Field(description="when it was withdrawn (UTC, ISO 8601)")
+    reason: str = Field(description="what the operator said, or that none was given")
+    stored_at: str = Field(description="when it had been stored")
+    content_sha256: str | None = Field(description="the window's digest as stored (null: stored before digests)")
 
 
 class Point(Document):
@@ -116,7 +131,12 @@ class RemainingLife(Document):
     parameter: str
     threshold: float
     direction: Literal["above", "below"]
-    status: Literal["crossing predicted", "already crossed", "no degradation detected", "too few windows"]
+    status: Literal[
+        "crossing predicted", "already crossed", "no degradation detected", "too few windows", "span too short"
+    ] = Field(
+        description="too few windows: under 3 read the parameter; span too short: they cover less time than a "
+        "trend needs (MIN_SPAN: 10 flight hours, 2 days or 5 windows), so no forecast is made"
+    )
     rul: float | None = Field(description="time from the last window to the crossing, in the time unit")
     rul_low: float | None = Field(description="5 % quantile")
     rul_high: float | None = Field(description="95 % quantile (null: beyond any horizon the data support)")
@@ -148,7 +168,10 @@ class BacktestPoint(Document):
 
 class Prognosis(Document):
     actuator_id: str
-    time_unit: Literal["flight_hours", "days"]
+    time_unit: TimeUnit = Field(
+        description="flight_hours where every window gives them, else days from recorded_at, else windows: "
+        "trended in the order they were stored, a remaining life counted in windows"
+    )
     trends: dict[str, Trend]
     remaining_life: dict[str, RemainingLife]
     sensors: dict[str, Trend] = Field(
@@ -175,3 +198,38 @@ class History(Document):
     legacy: list[dict[str, Any]] = Field(
         default_factory=list, description="results an earlier version stored, in their own format, as stored"
     )
+    withdrawn: list[Withdrawal] = Field(
+        default_factory=list, description="windows taken out of the history, with when and why (oldest first)"
+    )
+
+
+class Threshold(Document):
+    level: float
+    direction: Literal["above", "below"]
+
+
+class ActuatorSummary(Document):
+    """One actuator as the fleet view and ``GET /v1/actuators`` list it: its status, its latest estimate and its
+    most urgent remaining life (``ema.prognosis.status``)."""
+
+    actuator_id: str
+    status: Literal["due", "watch", "healthy", "not enough history", "prognosis failed", "pending"] = Field(
+        description="pending: windows arrived since its prognosis was last computed and it is being brought up to "
+        "date (the figures are those of the line as it was, where there was one)"
+    )
+    reason: str = Field(description="why this status, in words")
+    windows: int = Field(ge=0, description="estimates stored")
+    time_unit: TimeUnit | None = Field(None, description="of soonest and remaining_life (null: no estimates)")
+    soonest: float | None = Field(None, description="the earliest plausible crossing of any parameter, from now")
+    remaining_life: RemainingLife | None = Field(None, description="the most urgent parameter's")
+    latest_window_id: str | None = None
+    latest_when: str | None = Field(None, description="its flight hours or recorded_at as logged (null: neither)")
+    estimates: dict[str, float | None] = Field(
+        default_factory=dict, description="the latest window's FDJ, eta_O and eta_A (null: not read)"
+    )
+    stds: dict[str, float | None] = Field(default_factory=dict)
+    nominal: dict[str, float] = Field(default_factory=dict)
+    thresholds: dict[str, Threshold] = Field(default_factory=dict)
+    reproduced: bool | None = Field(None, description="the model reproduced the latest window")
+    document: str = Field(description="the name of the ema-actuator/1 document it is read with")
+    document_version: int | None = Field(None, description="its stored version (null: the default document)")

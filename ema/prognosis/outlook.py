@@ -96,13 +96,18 @@ def outlook(
     values: np.ndarray,
     stds: np.ndarray,
     window_ids: Sequence[str],
+    *,
     threshold: float,
     direction: str,
+    min_span: float = 0.0,
 ) -> Outlook:
-    """The trend and remaining life of one parameter's history (times in the prognosis's unit)."""
+    """The trend and remaining life of one parameter's history (times in the prognosis's unit); no forecast
+    where fewer than ``MIN_WINDOWS`` windows, or windows spanning less than ``min_span``, read it."""
     trend = fit_trend(parameter, times, values, stds, window_ids)
     if trend.n < MIN_WINDOWS or trend.slope_std is None:
         return Outlook(trend, remaining_life(parameter, None, threshold, direction))
+    if float(np.ptp(times)) < min_span:
+        return Outlook(trend, remaining_life(parameter, None, threshold, direction, span_too_short=True))
     s, weight, t_first, span = law_inputs(times, values, stds)
     weighed = weigh(s, values, weight)
     fc = forecast(weighed, t_first, span)

@@ -12,7 +12,7 @@ from ema.estimate.documents import Note
 from ema.estimate.history import combined_inertia, inertia_change_note
 from ema.model.actuator import Actuator, Airframe
 from ema.prognosis.backtest import backtest
-from ema.prognosis.documents import PARAMETERS, Prognosis, Stored, Trend
+from ema.prognosis.documents import MIN_SPAN, PARAMETERS, Prognosis, Stored, TimeUnit, Trend
 from ema.prognosis.outlook import Outlook, outlook
 from ema.prognosis.trend import fit_trend
 
@@ -20,32 +20,43 @@ AIRFRAME_TOLERANCE = Airframe.model_fields["tolerance"].default
 SENSOR_STDS = 3.0  # stds by which a sensor's level or drift must stand out to be said
 
 
-def _times(stored: Sequence[Stored]) -> tuple[np.ndarray, str, Note | None]:
-    """Flight hours where every window has them, else days from the windows' or the storage's dates."""
+def _times(stored: Sequence[Stored]) -> tuple[np.ndarray, TimeUnit, Note | None]:
+    """Flight hours where every window gives them, else days from their ``recorded_at``, else their order.
+
+    When a window was stored is not when it was logged: a batch posted in a second would read as a collapse.
+    Without a time base the windows are trended in their order, and the remaining life counts windows.
+    """
     if all(s.window.flight_hours is not None for s in stored):
         return np.array([s.window.flight_hours for s in stored], dtype=float), "flight_hours", None
     if all(s.window.recorded_at is not None for s in stored):
-        stamps, note = [s.window.recorded_at for s in stored], None
-    else:
-        text = "windows carry no recorded_at: time is when they were stored"
-        stamps, note = [s.stored_at for s in stored], Note(code="time_from_storage", text=text)
-    seconds = np.array([dt.datetime.fromisoformat(str(t)).timestamp() for t in stamps])
-    return (seconds - seconds.min()) / 86_400.0, "days", note
+        seconds = np.array([dt.datetime.fromisoformat(str(s.window.recorded_at)).timestamp() for s in stored])
+        return (seconds - seconds.min()) / 86_400.0, "days", None
+    timeless = sum(s.window.flight_hours is None and s.window.recorded_at is None for s in stored)
+    text = (
+        f"{timeless} of the {len(stored)} windows give neither flight_hours nor recorded_at (and not all give "
+        "one of them): trended by the order they were stored in, so a remaining life counts windows, not time"
+    )
+    order = np.argsort([s.id for s in stored], kind="stable")
+    return np.argsort(order).astype(float), "windows", Note(code="time_by_window_order", text=text)
 
 
-def prognose(actuator_id: str, stored: Sequence[Stored], actuator: Actuator) -> Prognosis:
+def prognose(actuator_id: str, stored: Sequence[Stored], actuator: Actuator, *, backtested: bool = True) -> Prognosis:
     """Trends and remaining lives of FDJ, η_O and η_A over ``stored`` (any order), to ``actuator``'s
     thresholds; a parameter a window did not read (η_O without a load) is left out of its trend."""
     if not stored:
         return Prognosis(
             actuator_id=actuator_id,
-            time_unit="days",
+            time_unit="windows",
             trends={},
             remaining_life={},
             notes=[Note(code="no_estimates", text="no estimates stored for this actuator")],
         )
     times, unit, note = _times(stored)
-    outlooks = {name: seen for name in PARAMETERS if (seen := _outlook(name, stored, times, actuator)) is not None}
+    outlooks = {
+        name: seen
+        for name in PARAMETERS
+        if (seen := _outlook(name, stored, times, actuator, unit, backtested)) is not None
+    }
     tolerance = actuator.airframe.tolerance if actuator.airframe is not None else AIRFRAME_TOLERANCE
     sensors, said = sensor_trends(stored, times, unit, tolerance)
     inertias = [s.window.inertia_read for s in stored if s.window.inertia_read is not None]
@@ -63,7 +74,9 @@ def prognose(actuator_id: str, stored: Sequence[Stored], actuator: Actuator) -> 
     )
 
 
-def _outlook(name: str, stored: Sequence[Stored], times: np.ndarray, actuator: Actuator) -> Outlook | None:
+def _outlook(
+    name: str, stored: Sequence[Stored], times: np.ndarray, actuator: Actuator, unit: TimeUnit, backtested: bool
+) -> Outlook | None:
     """``name``'s outlook over the windows that read it, or None where none did."""
     read = [(t, e, s.window_id) for t, s in zip(times, stored, strict=True) if (e := getattr(s.estimates, name))]
     if not read:
@@ -71,8 +84,16 @@ def _outlook(name: str, stored: Sequence[Stored], times: np.ndarray, actuator: A
     values = np.array([e.value for _, e, _ in read])
     stds = np.array([np.nan if e.std is None else e.std for _, e, _ in read])
     times_read, ids = np.array([t for t, _, _ in read]), [i for _, _, i in read]
-    seen = outlook(name, times_read, values, stds, ids, *actuator.threshold(name))
-    return replace(seen, backtest=backtest(name, times_read, values, stds, ids, *actuator.threshold(name)))
+    threshold, direction = actuator.threshold(name)
+    seen = outlook(
+        name, times_read, values, stds, ids, threshold=threshold, direction=direction, min_span=MIN_SPAN[unit]
+    )
+    if not backtested:
+        return seen
+    tested = backtest(
+        name, times_read, values, stds, ids, threshold=threshold, direction=direction, min_span=MIN_SPAN[unit]
+    )
+    return replace(seen, backtest=tested)
 
 
 def speeding_note(name: str) -> Note:

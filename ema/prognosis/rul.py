@@ -29,6 +29,8 @@ def remaining_life(
     direction: str,
     speeding_up: bool = False,
     line_probability: float = 1.0,
+    *,
+    span_too_short: bool = False,
 ) -> RemainingLife:
     """RUL of ``parameter`` to ``threshold``, crossed going ``direction`` ("above" or "below"); ``forecast``
     None where the history holds too few windows (or all at one time) to say where it goes;
@@ -39,7 +41,8 @@ def remaining_life(
     common = {"parameter": parameter, "threshold": threshold, "direction": direction, "speeding_up": speeding_up}
     none = {"rul": None, "rul_low": None, "rul_high": None, "rul_earliest": None}
     if forecast is None:
-        return RemainingLife(**common, status="too few windows", **none, probability_degrading=None)
+        status = "span too short" if span_too_short else "too few windows"
+        return RemainingLife(**common, status=status, **none, probability_degrading=None)
     if sign * (float(np.median(forecast.curves[:, 0])) - threshold) >= 0:
         return RemainingLife(
             **common,

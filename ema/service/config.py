@@ -50,7 +50,11 @@ class Settings(BaseSettings):
     api_key: SecretStr | None = Field(None, description="every /v1 request must carry it in X-API-Key")
     api_key_file: Path | None = Field(None, description="a file holding the key (kept out of the environment)")
     api_prefix: str = Field("/v1", pattern=r"^/[a-z0-9]+$")
-    database: Path = Field(default_factory=lambda: default_database(), description="the SQLite history")
+    database: str = Field(
+        default_factory=lambda: str(default_database()),
+        description="the history: an SQLite file's path, or a postgresql://user@host:port/db address",
+    )
+    min_free_bytes: int = Field(50_000_000, ge=0, description="disk room below which new work is refused (SQLite)")
     backend: Literal["local", "ray"] = "local"  # ray: a ground station's service fans out to a cluster
     ray_address: str | None = Field(None, description="'auto' or host:port; none: a local Ray")
     ray_jobs: int = Field(4, ge=1, le=4096, description="with the ray backend: estimates in flight at once")
@@ -75,12 +79,37 @@ class Settings(BaseSettings):
     queue_timeout_s: float = Field(60.0, gt=0)
     max_body_bytes: int = Field(128_000_000, ge=1000)
     body_timeout_s: float = Field(60.0, gt=0, le=3600, description="a request's body must arrive within this")
-    max_uploads: int = Field(8, ge=1, le=1000, description="bodies received at once (beyond: 503)")
+    body_grace_s: float = Field(5.0, gt=0, le=600, description="after this, a body must keep min_body_rate_bps")
+    min_body_rate_bps: float = Field(1000.0, gt=0, description="slowest average pace of a body past its grace (B/s)")
+    max_upload_bytes: int = Field(
+        512_000_000, ge=1000, description="bytes of all bodies being received at once (beyond: 503)"
+    )
+    ui_page_size: int = Field(50, ge=1, le=1000, description="actuators per page of /ui")
+    ui_budget_s: float = Field(
+        3.0, gt=0, le=600, description="seconds one /ui request may spend bringing prognoses up to date"
+    )
     allowed_origins: tuple[str, ...] = Field(
         (), description="origins (scheme://host:port) of web pages allowed to write besides the service's own"
     )
     threads: int | None = Field(None, ge=1, le=256, description="the thread budget; default: the usable cores")
     warm_up: bool = True
+
+    @field_validator("database", mode="before")
+    @classmethod
+    def _database_is_a_path_or_an_address(cls, setting: object) -> str:
+        setting = str(setting) if isinstance(setting, Path) else setting
+        if not isinstance(setting, str):
+            raise ValueError("must be a file path or a postgresql:// address")
+        from ema.history.open import POSTGRES, SCHEME
+
+        scheme = SCHEME.match(setting)
+        if scheme is not None and scheme.group(1).lower() not in POSTGRES:
+            raise ValueError(
+                f"{scheme.group(1)}:// is no database ema opens: give a file path or a postgresql:// address"
+            )
+        if not setting.strip():
+            raise ValueError("is empty: give a file path or a postgresql:// address")
+        return setting
 
     @field_validator("api_key")
     @classmethod

@@ -1,23 +1,31 @@
-"""Shared request dependencies: settings, the store, the job runner, a request's pipeline sizes."""
+"""Shared request dependencies: settings, the history, the job runner, a request's pipeline sizes, the path's
+actuator id, and an actuator's prognosis (one actuator's failure is its own, never the fleet's)."""
 
 from __future__ import annotations
 
+import logging
+import re
 import threading
 from collections import OrderedDict
 from collections.abc import Callable
 from typing import Annotated
 
-from fastapi import Depends, Request
+from fastapi import Depends, Path, Request
 from starlette.concurrency import run_in_threadpool
 
 from ema.estimate.config import PipelineConfig, validated
+from ema.estimate.documents import Note
+from ema.history.open import History
 from ema.model.actuator import THESIS, Actuator
 from ema.model.checks import InputError
-from ema.prognosis.documents import Prognosis
+from ema.model.window import IDENTIFIER
+from ema.prognosis.documents import Prognosis, Stored
 from ema.prognosis.prognose import prognose
 from ema.service.config import Settings
 from ema.service.jobs import CancelledError, JobRunner
-from ema.service.store import EstimateStore
+
+log = logging.getLogger("ema.service")
+IDENTIFIER_RE = re.compile(IDENTIFIER)
 
 
 def get_settings(request: Request) -> Settings:
@@ -25,8 +33,8 @@ def get_settings(request: Request) -> Settings:
     return settings
 
 
-def get_store(request: Request) -> EstimateStore:
-    store: EstimateStore = request.app.state.store
+def get_store(request: Request) -> History:
+    store: History = request.app.state.store
     return store
 
 
@@ -35,9 +43,19 @@ def get_runner(request: Request) -> JobRunner:
     return runner
 
 
+def path_actuator_id(actuator_id: Annotated[str, Path(description="as in the window's actuator_id")]) -> str:
+    """The path's actuator id, under the rule of a window's ``actuator_id`` (printable ASCII, 1–200, no
+    surrounding blanks): a NUL, an RTL override or 10,000 characters are refused, never stored."""
+    if not 1 <= len(actuator_id) <= 200 or not IDENTIFIER_RE.match(actuator_id):
+        shown = actuator_id[:40].encode("unicode_escape").decode()
+        raise InputError("path.actuator_id", f"{shown!r} is not an actuator id (1–200 printable ASCII characters)")
+    return actuator_id
+
+
 SettingsDep = Annotated[Settings, Depends(get_settings)]
-StoreDep = Annotated[EstimateStore, Depends(get_store)]
+StoreDep = Annotated[History, Depends(get_store)]
 RunnerDep = Annotated[JobRunner, Depends(get_runner)]
+ActuatorId = Annotated[str, Depends(path_actuator_id)]
 
 CEILINGS = {"n_simulations": "max_simulations", "n_timesteps": "max_timesteps", "hidden_units": "max_hidden_units"}
 
@@ -52,43 +70,64 @@ def request_config(settings: Settings, **overrides: int | None) -> PipelineConfi
     return validated(PipelineConfig, {**settings.pipeline.model_dump(), **given}, prefix="query.")
 
 
-async def actuator_of(store: EstimateStore, actuator_id: str) -> tuple[Actuator, int | None]:
+def document_of(store: History, actuator_id: str) -> tuple[Actuator, int | None]:
     """The actuator's latest stored document and its version, or the default (``ema.model.actuator.THESIS``, no
     version) where it has none: its windows are then read with the default, and their answers say so."""
-    stored = await run_in_threadpool(store.get_actuator, actuator_id)
+    stored = store.get_actuator(actuator_id)
     return (THESIS, None) if stored is None else (stored.document, stored.version)
 
 
-class Prognoses:
-    """The latest prognoses, each kept until its actuator stores another window or document (a prognosis with its
-    backtest takes seconds; a fleet page asks for every actuator's)."""
+async def actuator_of(store: History, actuator_id: str) -> tuple[Actuator, int | None]:
+    return await run_in_threadpool(document_of, store, actuator_id)
 
-    def __init__(self, size: int = 512) -> None:
+
+def safe_prognosis(
+    actuator_id: str, history: list[Stored], actuator: Actuator, *, backtested: bool = True
+) -> Prognosis:
+    """``prognose``, or a prognosis that says it failed and why: one actuator's numbers never take the view
+    down for the others."""
+    try:
+        return prognose(actuator_id, history, actuator, backtested=backtested)
+    except Exception as exc:  # any failure of the numerics is this actuator's, reported on its own row
+        log.exception("prognosis of %s failed", actuator_id)
+        note = Note(code="prognosis_failed", text=f"the prognosis could not be computed: {type(exc).__name__}: {exc}")
+        return Prognosis(actuator_id=actuator_id, time_unit="windows", trends={}, remaining_life={}, notes=[note])
+
+
+class Prognoses:
+    """The latest prognoses, each kept while its actuator's history and document stand (a prognosis with its
+    backtest takes seconds on a long history)."""
+
+    def __init__(self, size: int = 64) -> None:
         self.size = size
         self._kept: OrderedDict[tuple[str, int, int | None, int | None], Prognosis] = OrderedDict()
+        self._lock = threading.Lock()
 
     def get(self, key: tuple[str, int, int | None, int | None]) -> Prognosis | None:
-        found = self._kept.get(key)
-        if found is not None:
-            self._kept.move_to_end(key)
-        return found
+        with self._lock:
+            found = self._kept.get(key)
+            if found is not None:
+                self._kept.move_to_end(key)
+            return found
 
     def put(self, key: tuple[str, int, int | None, int | None], prognosis: Prognosis) -> None:
-        self._kept[key] = prognosis
-        while len(self._kept) > self.size:
-            self._kept.popitem(last=False)
+        with self._lock:
+            self._kept[key] = prognosis
+            while len(self._kept) > self.size:
+                self._kept.popitem(last=False)
 
 
-async def prognosis_of(prognoses: Prognoses, store: EstimateStore, actuator_id: str) -> Prognosis:
-    """The actuator's prognosis over its stored estimates, to its document's thresholds (kept while they stand)."""
-    current, _ = await run_in_threadpool(store.history, actuator_id)
-    document, version = await actuator_of(store, actuator_id)
+def prognosis_now(prognoses: Prognoses, store: History, actuator_id: str) -> tuple[Prognosis, list[Stored]]:
+    """The actuator's prognosis over its stored estimates to its document's thresholds (kept while they stand),
+    and those estimates; in a worker thread."""
+    current, _ = store.history(actuator_id)
+    document, version = document_of(store, actuator_id)
     key = (actuator_id, len(current), current[-1].id if current else None, version)
     found = prognoses.get(key)
     if found is None:
-        found = await run_in_threadpool(prognose, actuator_id, current, document)
+        found = safe_prognosis(actuator_id, current, document)
         prognoses.put(key, found)
-    return found
+    return found, current
 
 
 def stopper(cancel: threading.Event) -> Callable[[str], None]:

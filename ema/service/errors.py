@@ -1,5 +1,5 @@
-"""Errors as HTTP answers: bad input 422 naming the field, another window under a stored key 409, overload
-503 with Retry-After."""
+"""Errors as HTTP answers: bad input 422 naming the field, another window under a stored key 409, nothing stored
+404, overload 503 with Retry-After, a history that cannot take a write 503 naming why."""
 
 from __future__ import annotations
 
@@ -8,15 +8,15 @@ from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse
 from starlette.requests import ClientDisconnect
 
+from ema.history.errors import ConflictError, StorageError
 from ema.model.checks import InputError
 from ema.service.jobs import CancelledError, OverloadedError
-from ema.service.store import ConflictError
 
 
 def _location(field: str) -> list[str]:
     """``signals.current_a`` -> ["body", "signals", "current_a"]; query parameters keep "query"."""
-    if field.startswith("query."):
-        return ["query", *field.split(".")[1:]]
+    if field.startswith(("query.", "path.")):
+        return field.split(".")
     if field == "body":
         return ["body"]
     return ["body", *field.split(".")]
@@ -29,13 +29,10 @@ async def input_error(request: Request, exc: Exception) -> JSONResponse:
 
 
 class NotStoredError(Exception):
-    """Nothing is stored under the path's actuator_id."""
+    """Nothing is stored under the path's actuator_id (``why`` says what was asked for)."""
 
-    def __init__(self, actuator_id: str) -> None:
-        super().__init__(
-            f"no ema-actuator/1 document is stored for {actuator_id!r}: its windows are read with "
-            "the default actuator (PUT one to this path)"
-        )
+    def __init__(self, actuator_id: str, why: str) -> None:
+        super().__init__(f"actuator {actuator_id!r}: {why}")
 
 
 async def not_stored(request: Request, exc: Exception) -> JSONResponse:
@@ -59,6 +56,15 @@ async def overloaded(request: Request, exc: Exception) -> JSONResponse:
     )
 
 
+async def storage(request: Request, exc: Exception) -> JSONResponse:
+    """The history cannot take a write (deleted, replaced, read-only, a full disk, a database down): no work is
+    started, and nothing is answered 200 that would be lost. No Retry-After: an operator must act."""
+    assert isinstance(exc, StorageError)
+    return JSONResponse(
+        {"detail": f"the history cannot store answers now: {exc}"}, status_code=status.HTTP_503_SERVICE_UNAVAILABLE
+    )
+
+
 async def cancelled(request: Request, exc: Exception) -> JSONResponse:
     """The client is gone; nobody reads this, but the log shows why the request ended."""
     return JSONResponse({"detail": str(exc) or "the client left before its body arrived"}, status_code=499)
@@ -78,5 +84,6 @@ def install(app: FastAPI) -> None:
     app.add_exception_handler(OverloadedError, overloaded)
     app.add_exception_handler(ConflictError, conflict)
     app.add_exception_handler(NotStoredError, not_stored)
+    app.add_exception_handler(StorageError, storage)
     app.add_exception_handler(CancelledError, cancelled)
     app.add_exception_handler(ClientDisconnect, cancelled)  # an abandoned upload: a log line, not a traceback

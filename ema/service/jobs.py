@@ -5,7 +5,7 @@ so running two side by side would only slow both (with the Ray backend, ``slots`
 the cluster). A request is *admitted* once its body is read and parsed: a slow upload holds its
 connection, not a place in the queue. At most ``slots`` + ``max_queue`` hold a place; a request that
 arrives when they are all taken gets 503 at once, before its body is read, with a Retry-After from
-measured job times, and so does one beyond ``max_uploads`` bodies being read. Bodies are parsed one
+measured job times (what bodies in flight may hold is ``service.guard``'s). Bodies are parsed one
 at a time on a thread of their own, so that the event loop (and /healthz) keeps its share of the
 interpreter. A waiting request whose client hangs up leaves the queue;
 a running one is told to stop at its next stage (``Cancelled``), and its slot is freed when its
@@ -19,7 +19,7 @@ import contextlib
 import math
 import threading
 import time
-from collections.abc import Awaitable, Callable, Iterator
+from collections.abc import Awaitable, Callable, Hashable, Iterator
 from concurrent.futures import ThreadPoolExecutor
 from typing import Any, TypeVar
 
@@ -53,20 +53,68 @@ class Ticket:
         self.runner.admitted -= 1
 
 
+class Shared:
+    """One computation that several requests wait for: the first to ask runs it, the others wait for its end
+    (each still holding its place in the queue). It is stopped only once every one of them has left."""
+
+    def __init__(self) -> None:
+        self.done = asyncio.Event()
+        self.waiters = 0
+
+    async def wait(self, gone: Callable[[], Awaitable[bool]]) -> None:
+        """Until the computation ends; CancelledError where this request's client leaves first."""
+        self.waiters += 1
+        try:
+            while not self.done.is_set():
+                with contextlib.suppress(TimeoutError):
+                    await asyncio.wait_for(self.done.wait(), POLL_S)
+                if not self.done.is_set() and await gone():
+                    raise CancelledError("the client left while its window was being estimated for another request")
+        finally:
+            self.waiters -= 1
+
+    def gone(self, leader: Callable[[], Awaitable[bool]]) -> Callable[[], Awaitable[bool]]:
+        """The computation's own ``gone``: its first client has left and nobody waits for it any more."""
+
+        async def everyone() -> bool:
+            return self.waiters == 0 and await leader()
+
+        return everyone
+
+
+class Sharing:
+    """The computations under way, by key (an actuator's window): a second request for one waits for it."""
+
+    def __init__(self) -> None:
+        self._running: dict[Hashable, Shared] = {}
+
+    def running(self, key: Hashable) -> Shared | None:
+        return self._running.get(key)
+
+    @contextlib.contextmanager
+    def lead(self, key: Hashable) -> Iterator[Shared]:
+        """This request computes ``key``; those that ask meanwhile wait for it, and are told when it ends."""
+        shared = self._running[key] = Shared()
+        try:
+            yield shared
+        finally:
+            del self._running[key]
+            shared.done.set()
+
+
 class JobRunner:
     """``slots`` jobs at a time: one on this computer (it uses every core), more when Ray runs them elsewhere."""
 
-    def __init__(self, max_queue: int, queue_timeout_s: float, slots: int = 1, max_uploads: int = 8) -> None:
+    def __init__(self, max_queue: int, queue_timeout_s: float, slots: int = 1) -> None:
         self.max_queue = max_queue
         self.queue_timeout_s = queue_timeout_s
         self.slots = slots
-        self.max_uploads = max_uploads
         self._executor = ThreadPoolExecutor(max_workers=slots, thread_name_prefix="ema-pipeline")
         self.parser = ThreadPoolExecutor(max_workers=1, thread_name_prefix="ema-parse")
         self._slot = asyncio.Semaphore(slots)
         self.admitted = 0  # running + waiting
         self.running = 0
-        self.uploading = 0  # bodies being read or parsed, not yet admitted
+        self.sharing = Sharing()  # on the event loop only
         self._mean_job_s = 1.0  # until measured
 
     @property
@@ -88,20 +136,10 @@ class JobRunner:
         self.admitted += 1
         return Ticket(self)
 
-    @contextlib.contextmanager
-    def receiving(self) -> Iterator[None]:
-        """While a body is read and parsed: OverloadedError at once if the queue is full already (the body
-        would only wait to be refused) or ``max_uploads`` bodies are being read."""
+    def receiving(self) -> None:
+        """Before a body is read: OverloadedError at once if the queue is full already (the body would only wait
+        to be refused)."""
         self._full()
-        if self.uploading >= self.max_uploads:
-            raise OverloadedError(
-                f"{self.uploading} bodies being received (max {self.max_uploads})", self.retry_after_s()
-            )
-        self.uploading += 1
-        try:
-            yield
-        finally:
-            self.uploading -= 1
 
     async def _acquire(self, gone: Callable[[], Awaitable[bool]]) -> None:
         deadline = time.monotonic() + self.queue_timeout_s

@@ -14,29 +14,35 @@ from fastapi import FastAPI
 from fastapi_offline import FastAPIOffline
 
 from ema.estimate import runtime
+from ema.history.open import open_history
 from ema.model import runtime as sim_runtime
 from ema.model.actuator import Actuator
 from ema.model.window import WindowDocument
 from ema.service import errors
 from ema.service.config import Settings
 from ema.service.deps import Prognoses
-from ema.service.guard import Guard
+from ema.service.guard import BodyLimits, Guard
 from ema.service.jobs import JobRunner
 from ema.service.routes import actuators, calibrate, estimate, health, ui
 from ema.service.schemas import CalibrateIn
-from ema.service.store import EstimateStore
 from ema.service.warmup import warm_up
 
 log = logging.getLogger("ema.service")
-DESCRIPTION = """Onboard health monitor for an elevator EMA: one logged window in, FDJ, η_O, η_A out.
 
-Budget per request (defaults; the operator's EMA_* settings may change them): a window of at most
-10 s (EMA_MAX_WINDOW_S), simulations × window seconds at most 1500 (EMA_MAX_SIMULATED_S), a
-calibration of at most 4 s of windows together (EMA_MAX_CALIBRATE_S), a body of at most 128 MB
-(EMA_MAX_BODY_BYTES) that arrives within 60 s (EMA_BODY_TIMEOUT_S). Over it: 422 (413 for the
-body, 408 for a late one) naming the limit. Writes are application/json only (else 415), never
-from a web page of another origin (403). One job runs at a time; at most EMA_MAX_QUEUE wait; the
-rest get 503 with Retry-After. Another body under a stored (actuator_id, window_id): 409."""
+
+def description(settings: Settings) -> str:
+    """The OpenAPI description: this service's own budget, read from its settings (never restated)."""
+    return f"""Onboard health monitor for an electromechanical actuator: one logged window in, FDJ, η_O, η_A out.
+
+Budget per request (EMA_* settings): a window of at most {settings.max_window_s:g} s (EMA_MAX_WINDOW_S),
+simulations × window seconds at most {settings.max_simulated_s:g} (EMA_MAX_SIMULATED_S), a calibration of at
+most {settings.max_calibrate_s:g} s of windows together (EMA_MAX_CALIBRATE_S), a body of at most
+{settings.max_body_bytes} bytes (EMA_MAX_BODY_BYTES) that arrives within {settings.body_timeout_s:g} s
+(EMA_BODY_TIMEOUT_S) and, after {settings.body_grace_s:g} s, at {settings.min_body_rate_bps:g} B/s or more. Over
+it: 422 (413 for the body, 408 for a late or slow one) naming the limit. Writes are uncompressed
+application/json only (else 415), never from a web page of another origin (403). One job runs at a time; at
+most {settings.max_queue} wait (EMA_MAX_QUEUE); the rest get 503 with Retry-After. Another body under a stored
+(actuator_id, window_id): 409. A history that cannot store an answer: 503 naming why, before any work."""
 
 
 def _openapi(app: FastAPI) -> dict[str, Any]:
@@ -58,9 +64,9 @@ def create_app(settings: Settings) -> FastAPI:
     @asynccontextmanager
     async def lifespan(app: FastAPI) -> AsyncIterator[None]:
         threads = runtime.configure(settings.threads)
-        app.state.store = EstimateStore(settings.database)
+        app.state.store = open_history(settings.database, settings.min_free_bytes)
         slots = settings.ray_jobs if settings.backend == "ray" else 1
-        app.state.runner = JobRunner(settings.max_queue, settings.queue_timeout_s, slots, settings.max_uploads)
+        app.state.runner = JobRunner(settings.max_queue, settings.queue_timeout_s, slots)
         if settings.backend == "ray":
             from ema.estimate.remote import connect
 
@@ -74,18 +80,24 @@ def create_app(settings: Settings) -> FastAPI:
         sim_runtime.shutdown()
         app.state.store.close()
 
-    app = FastAPIOffline(title="ema", version=version("ema"), description=DESCRIPTION, lifespan=lifespan)
+    app = FastAPIOffline(title="ema", version=version("ema"), description=description(settings), lifespan=lifespan)
     app.state.settings = settings
     app.state.warm = threading.Event()
     app.state.prognoses = Prognoses()
     app.openapi = lambda: _openapi(app)  # type: ignore[method-assign]
     errors.install(app)
+    limits = BodyLimits(
+        max_body_bytes=settings.max_body_bytes,
+        body_timeout_s=settings.body_timeout_s,
+        body_grace_s=settings.body_grace_s,
+        min_body_rate_bps=settings.min_body_rate_bps,
+        max_upload_bytes=settings.max_upload_bytes,
+    )
     app.add_middleware(
         Guard,
         key=settings.key_bytes(),
         prefix=settings.api_prefix,
-        max_body_bytes=settings.max_body_bytes,
-        body_timeout_s=settings.body_timeout_s,
+        limits=limits,
         allowed_origins=settings.allowed_origins,
     )
     app.include_router(health.router)

@@ -1,34 +1,27 @@
 """The operator's pages, rendered on the server from the documents the API serves (no second model of the data).
 
-``/ui`` lists every actuator, most urgent first: its latest FDJ, η_O and η_A against nominal and thresholds,
-its remaining life, the time of its last window and a status:
-
-- **due**: a threshold is crossed, or the earliest plausible crossing comes within ``DUE_WITHIN`` (time units
-  of its prognosis);
-- **watch**: a crossing is predicted, wear is speeding up, its latest estimate lies outside its healthy range,
-  or the model did not reproduce its latest window;
-- **healthy**: none of these.
-
-``/ui/actuators/{id}`` shows one actuator: a plot per parameter (``ema.service.svg``), the notes of its latest
-windows, the prognosis's notes (sensors, J_M), its backtest, its calibration reports and its document.
-Every page is plain HTML and inline SVG: it works on a network with no other host.
+``/ui`` lists the actuators most urgent first (``ema.prognosis.status``: due, watch, prognosis failed, not
+enough history, healthy), a page at a time, filtered by status or by tail: each with its latest FDJ, η_O
+and η_A against nominal and thresholds, its remaining life and when its last window was logged.
+``/ui/actuators/{id}`` shows one actuator: a plot per parameter (``ema.service.svg``), the notes of its
+latest windows, the prognosis's notes, its backtest, its calibration reports and its document.
+Every page is plain HTML and inline SVG: it works on a network with no other host. Every id in a link
+is URL-encoded, every text HTML-escaped.
 """
 
 from __future__ import annotations
 
 import html
+import urllib.parse
 from collections.abc import Sequence
-from dataclasses import dataclass
-from typing import Literal
 
 from ema.calibration.documents import CalibrationReport
-from ema.model.actuator import Actuator
-from ema.prognosis.documents import PARAMETERS, Prognosis, RemainingLife, Stored, StoredActuator
+from ema.prognosis.documents import ActuatorSummary, Prognosis, RemainingLife, Stored, StoredActuator
+from ema.prognosis.status import URGENCY, status_of
 from ema.service.svg import trend_plot
 
-DUE_WITHIN = 25.0  # flight hours (or days): an earliest plausible crossing this close makes the actuator due
 LATEST_NOTES = 5
-Status = Literal["due", "watch", "healthy"]
+PARAMETER_UNITS = {"FDJ": "FDJ [N·m]", "eta_O": "η_O", "eta_A": "η_A"}
 STYLE = """
 body { font-family: system-ui, sans-serif; margin: 1.5em; color: #202124; }
 table { border-collapse: collapse; } td, th { padding: 4px 10px; border-bottom: 1px solid #ddd; text-align: left; }
@@ -36,45 +29,8 @@ table { border-collapse: collapse; } td, th { padding: 4px 10px; border-bottom: 
 .badge { font-weight: 600; padding: 2px 8px; border-radius: 10px; }
 .due .badge { color: #a50e0e; } .watch .badge { color: #b06000; } .healthy .badge { color: #137333; }
 svg text { font-size: 11px; } svg .title { font-size: 13px; font-weight: 600; }
-code { background: #f1f3f4; padding: 0 3px; }
+code { background: #f1f3f4; padding: 0 3px; } nav a { margin-right: 0.8em; }
 """
-
-
-@dataclass(frozen=True)
-class Row:
-    """One actuator as the fleet page lists it."""
-
-    actuator_id: str
-    latest: Stored | None
-    prognosis: Prognosis
-    actuator: Actuator
-    status: Status
-    soonest: float | None  # the earliest plausible crossing of any parameter (None: none predicted)
-
-
-def status_of(latest: Stored | None, prognosis: Prognosis, actuator: Actuator) -> tuple[Status, float | None]:
-    """The actuator's status (module docstring) and its soonest plausible crossing."""
-    lives = list(prognosis.remaining_life.values())
-    soonest = min((life.rul_earliest for life in lives if life.rul_earliest is not None), default=None)
-    if any(life.status == "already crossed" for life in lives) or (soonest is not None and soonest <= DUE_WITHIN):
-        return "due", soonest
-    predicted = any(life.status == "crossing predicted" or life.speeding_up for life in lives)
-    return ("watch" if predicted or _off_healthy(latest, actuator) else "healthy"), soonest
-
-
-def _off_healthy(latest: Stored | None, actuator: Actuator) -> bool:
-    if latest is None:
-        return False
-    ranges = actuator.ranges
-    fdj, eta_o = latest.estimates.FDJ.value, latest.estimates.eta_O
-    outside = not ranges.fdj_nm[0] <= fdj <= ranges.fdj_nm[1]
-    outside |= eta_o is not None and not ranges.eta_o[0] <= eta_o.value <= ranges.eta_o[1]
-    return outside or not latest.fit_check.reproduced
-
-
-def urgency(row: Row) -> tuple[int, float, str]:
-    soonest = row.soonest if row.soonest is not None else 1e300
-    return {"due": 0, "watch": 1, "healthy": 2}[row.status], soonest, row.actuator_id
 
 
 def _page(title: str, body: str) -> str:
@@ -84,71 +40,106 @@ def _page(title: str, body: str) -> str:
     )
 
 
-def _estimate(stored: Stored | None, name: str, actuator: Actuator) -> str:
-    entry = None if stored is None else getattr(stored.estimates, name)
-    if entry is None:
+def actuator_link(actuator_id: str) -> str:
+    """The link to an actuator's page: its id URL-encoded in the path (a ``?`` or ``#`` stays the id's)."""
+    path = "/ui/actuators/" + urllib.parse.quote(actuator_id, safe="/")
+    return f'<a href="{html.escape(path, quote=True)}">{html.escape(actuator_id)}</a>'
+
+
+def _cell(line: ActuatorSummary, name: str) -> str:
+    value = line.estimates.get(name)
+    if value is None:
         return "—"
-    std = "" if entry.std is None else f" ± {entry.std:.2g}"
-    threshold, direction = actuator.threshold(name)
-    sign = ">" if direction == "above" else "<"
-    return f"{entry.value:.4g}{std} <small>(nominal {entry.nominal:.3g}, fails {sign} {threshold:.3g})</small>"
+    std = line.stds.get(name)
+    shown = f"{value:.4g}" + ("" if std is None else f" ± {std:.2g}")
+    threshold = line.thresholds.get(name)
+    nominal = line.nominal.get(name)
+    limits = [] if nominal is None else [f"nominal {nominal:.3g}"]
+    if threshold is not None:
+        limits.append(f"fails {'>' if threshold.direction == 'above' else '<'} {threshold.level:.3g}")
+    return f"{shown} <small>({html.escape(', '.join(limits))})</small>"
 
 
-def _life(life: RemainingLife | None, unit: str) -> str:
+def life_text(life: RemainingLife | None, unit: str) -> str:
+    """A remaining life in words, with its unit."""
     if life is None:
         return "—"
     if life.status == "already crossed":
         return f"threshold {life.threshold:g} crossed"
     if life.rul is None:
-        return "no degradation detected" if life.status == "no degradation detected" else life.status
+        return life.status
     high = "open" if life.rul_high is None else f"{life.rul_high:.3g}"
-    return f"{life.rul:.3g} {unit} (90 %: {life.rul_low:.3g}–{high}; earliest {life.rul_earliest:.3g})"
+    return f"{life.rul:.3g} {unit} (90 %: {life.rul_low:.3g}–{high} {unit}; earliest {life.rul_earliest:.3g} {unit})"
 
 
-def _most_urgent_life(prognosis: Prognosis) -> RemainingLife | None:
-    lives = [life for life in prognosis.remaining_life.values() if life.rul is not None]
-    if lives:
-        return min(lives, key=lambda life: life.rul_low or 0.0)
-    return next(iter(prognosis.remaining_life.values()), None)
+def _query(**values: str | int | None) -> str:
+    kept = {name: value for name, value in values.items() if value not in (None, "")}
+    return "/ui" + ("?" + urllib.parse.urlencode(kept) if kept else "")
 
 
-def _when(stored: Stored) -> str:
-    """When the window was logged: its flight hours where it gives them, else its date (or when it was stored)."""
-    if stored.window.flight_hours is not None:
-        return f"{stored.window.flight_hours:.4g} flight hours"
-    return html.escape((stored.window.recorded_at or stored.stored_at)[:19].replace("T", " "))
+def _navigation(total: int, page: int, pages: int, status: str | None, tail: str | None) -> str:
+    shown = [f'<a href="{html.escape(_query(tail=tail))}">all</a>']
+    shown += [f'<a href="{html.escape(_query(status=s, tail=tail))}">{s}</a>' for s in URGENCY]
+    steps = []
+    if page > 1:
+        steps.append(f'<a href="{html.escape(_query(status=status, tail=tail, page=page - 1))}">previous</a>')
+    if page < pages:
+        steps.append(f'<a href="{html.escape(_query(status=status, tail=tail, page=page + 1))}">next</a>')
+    form = (
+        '<form method="get" action="/ui" style="display:inline">'
+        f'<input name="tail" placeholder="tail, e.g. tail-123" value="{html.escape(tail or "", quote=True)}">'
+        + (f'<input type="hidden" name="status" value="{html.escape(status, quote=True)}">' if status else "")
+        + "<button>filter</button></form>"
+    )
+    counts = f"{total} actuator(s); page {page} of {pages}."
+    return f"<nav>status: {' '.join(shown)} {form}</nav><p>{counts} {' '.join(steps)}</p>"
 
 
-def fleet_page(rows: Sequence[Row]) -> str:
-    """The fleet: one row per actuator, most urgent first, each linking to its page."""
-    lines = [
-        "<h1>Actuators</h1>",
-        f"<p>{len(rows)} actuator(s); most urgent first.</p>",
-        "<table><tr><th>actuator</th><th>status</th><th>FDJ [N·m]</th><th>η_O</th><th>η_A</th>"
-        "<th>remaining life</th><th>last window</th></tr>",
-    ]
-    for row in sorted(rows, key=urgency):
-        unit = row.prognosis.time_unit.replace("_", " ")
-        last = "—" if row.latest is None else _when(row.latest)
-        link = f'<a href="/ui/actuators/{html.escape(row.actuator_id, quote=True)}">{html.escape(row.actuator_id)}</a>'
+def fleet_page(
+    lines: Sequence[ActuatorSummary],
+    *,
+    page: int,
+    pages: int,
+    total: int,
+    pending: Sequence[str],
+    status: str | None,
+    tail: str | None,
+) -> str:
+    """One page of the fleet, most urgent first, each actuator linking to its page."""
+    parts = ["<h1>Actuators</h1>", _navigation(total, page, pages, status, tail)]
+    if pending:
+        parts.append(
+            f"<p>{len(pending)} actuator(s) stored windows since their line was computed; their prognoses are being "
+            "brought up to date (shown as they were, or pending): reload in a moment.</p>"
+        )
+    head = "".join(f"<th>{html.escape(h)}</th>" for h in ["actuator", "status", *PARAMETER_UNITS.values()])
+    parts.append(f"<table><tr>{head}<th>remaining life</th><th>last window</th></tr>")
+    for line in lines:
+        unit = (line.time_unit or "").replace("_", " ")
+        badge = line.status
         cells = [
-            link,
-            f'<span class="badge">{row.status}</span>',
-            *(_estimate(row.latest, name, row.actuator) for name in PARAMETERS),
-            _life(_most_urgent_life(row.prognosis), unit),
-            last,
+            actuator_link(line.actuator_id),
+            f'<span class="badge" title="{html.escape(line.reason, quote=True)}">{html.escape(badge)}</span>',
+            *(_cell(line, name) for name in PARAMETER_UNITS),
+            html.escape(line.reason) if line.status == "prognosis failed" else life_text(line.remaining_life, unit),
+            html.escape(line.latest_when or line.latest_window_id or "—"),
         ]
-        lines.append(f'<tr class="{row.status}">' + "".join(f"<td>{cell}</td>" for cell in cells) + "</tr>")
-    lines.append("</table>")
-    return _page("ema: actuators", "\n".join(lines))
+        css = line.status.split()[0]
+        parts.append(f'<tr class="{css}">' + "".join(f"<td>{cell}</td>" for cell in cells) + "</tr>")
+    parts.append("</table>")
+    return _page("ema: actuators", "\n".join(parts))
 
 
 def _notes_list(notes: Sequence[tuple[str, str, str]]) -> str:
+    """Notes as a list, each (code, text) once with the windows that carry it."""
     if not notes:
         return "<p>none</p>"
+    grouped: dict[tuple[str, str], list[str]] = {}
+    for source, code, text in notes:
+        grouped.setdefault((code, text), []).append(source)
     items = "".join(
-        f"<li><code>{html.escape(code)}</code> {html.escape(source)}: {html.escape(text)}</li>"
-        for source, code, text in notes
+        f"<li><code>{html.escape(code)}</code> {html.escape(', '.join(sources))}: {html.escape(text)}</li>"
+        for (code, text), sources in grouped.items()
     )
     return f"<ul>{items}</ul>"
 
@@ -162,9 +153,41 @@ def _calibrations(reports: Sequence[tuple[str, CalibrationReport]]) -> str:
         change = ", ".join(
             f"{k} {report.estimates_before[k]:.4g} → {report.estimates_after[k]:.4g}" for k in report.estimates_before
         )
-        rows.append(f"<tr><td>{html.escape(stored_at)}</td><td>{html.escape(effect)}</td><td>{change}</td></tr>")
+        rows.append(
+            f"<tr><td>{html.escape(stored_at)}</td><td>{html.escape(effect)}</td><td>{html.escape(change)}</td></tr>"
+        )
     head = "<table><tr><th>stored</th><th>effect</th><th>estimates before → after</th></tr>"
     return head + "".join(rows) + "</table>"
+
+
+def _read_with(history: Sequence[Stored], document: StoredActuator | None) -> str:
+    """Which document the latest window was read with, and which one is stored now (they may differ)."""
+    stored_now = (
+        "none stored (windows are read with the default)"
+        if document is None
+        else (f"{html.escape(document.document.name)}, version {document.version}")
+    )
+    if not history:
+        return f"document: {stored_now}"
+    read = history[-1].actuator
+    used = "the default" if read.default else f"version {read.version}" if read.version is not None else "given"
+    return f"latest window read with {html.escape(read.name)} ({used}); document stored now: {stored_now}"
+
+
+def _backtest(prognosis: Prognosis, name: str, unit: str) -> str:
+    points = prognosis.backtest.get(name, [])
+    if not points:
+        return ""
+    rows = "".join(
+        f"<tr><td>{p.time:.4g} {unit}</td><td>{p.windows}</td><td>{html.escape(p.status)}</td><td>"
+        f"{'—' if p.crossing is None else f'{p.crossing:.4g} {unit}'}</td><td>"
+        f"{'—' if p.later_inside is None else f'{100 * p.later_inside:.0f} %'}</td></tr>"
+        for p in points
+    )
+    return (
+        "<table><tr><th>backtest at</th><th>windows</th><th>said</th><th>crossing then (from the first window)</th>"
+        f"<th>later windows inside its band</th></tr>{rows}</table>"
+    )
 
 
 def actuator_page(
@@ -172,36 +195,27 @@ def actuator_page(
     history: Sequence[Stored],
     prognosis: Prognosis,
     document: StoredActuator | None,
-    actuator: Actuator,
     reports: Sequence[tuple[str, CalibrationReport]],
 ) -> str:
-    """One actuator: its plots, notes, backtest, calibrations and document."""
+    """One actuator: its status, plots, notes, backtest, calibrations and document."""
+    from ema.model.actuator import THESIS
+
     unit = prognosis.time_unit.replace("_", " ")
-    status, _ = status_of(history[-1] if history else None, prognosis, actuator)
+    actuator = THESIS if document is None else document.document
+    status, _, reason = status_of(history[-1] if history else None, prognosis, actuator, len(history))
     parts = [
         '<p><a href="/ui">all actuators</a></p>',
         f"<h1>{html.escape(actuator_id)}</h1>",
-        f'<p class="{status}"><span class="badge">{status}</span> {len(history)} window(s), time in {unit}; '
-        f"read with {html.escape(actuator.name)}"
-        f"{'' if document is None else f' (version {document.version})'}</p>",
+        f'<p class="{status.split()[0]}"><span class="badge">{status}</span> {html.escape(reason)}; '
+        f"{len(history)} window(s), time in {unit}</p>",
+        f"<p>{_read_with(history, document)}</p>",
     ]
     for name, trend in prognosis.trends.items():
         life = prognosis.remaining_life[name]
-        parts.append(f"<h2>{name}</h2><p>{_life(life, unit)}</p>")
+        parts.append(f"<h2>{PARAMETER_UNITS[name]}</h2><p>{html.escape(life_text(life, unit))}</p>")
         if trend.points:
             parts.append(trend_plot(trend, life, prognosis.time_unit))
-        backtest = prognosis.backtest.get(name, [])
-        if backtest:
-            rows = "".join(
-                f"<tr><td>{p.time:.4g}</td><td>{p.windows}</td><td>{p.status}</td><td>"
-                f"{'—' if p.crossing is None else f'{p.crossing:.4g}'}</td><td>"
-                f"{'—' if p.later_inside is None else f'{100 * p.later_inside:.0f} %'}</td></tr>"
-                for p in backtest
-            )
-            parts.append(
-                "<table><tr><th>backtest at</th><th>windows</th><th>said</th><th>crossing then</th>"
-                f"<th>later windows inside its band</th></tr>{rows}</table>"
-            )
+        parts.append(_backtest(prognosis, name, unit))
     latest = [(s.window_id, n.code, n.text) for s in history[-LATEST_NOTES:] for n in s.notes]
     sensors = [("prognosis", n.code, n.text) for n in prognosis.notes]
     parts += [

@@ -41,11 +41,11 @@ def _parse(model: type[Model], body: bytes) -> Model:
 async def read_body(request: Request, runner: JobRunner, model: type[Model], then: Callable[[Model], T]) -> T:
     """``then`` of the request's body validated as ``model`` (``JobRunner.receiving``: 503 at once when there is
     no room), both on the runner's parsing thread; InputError naming the field otherwise."""
-    with runner.receiving():
-        chunks = [chunk async for chunk in request.stream()]  # joined on the parsing thread, not the event loop
-        return await asyncio.get_running_loop().run_in_executor(
-            runner.parser, lambda: then(_parse(model, b"".join(chunks)))
-        )
+    runner.receiving()
+    chunks = [chunk async for chunk in request.stream()]  # joined on the parsing thread, not the event loop
+    return await asyncio.get_running_loop().run_in_executor(
+        runner.parser, lambda: then(_parse(model, b"".join(chunks)))
+    )
 
 
 def check_budget(window: Window, config: PipelineConfig, settings: Settings, field: str = "signals") -> None:

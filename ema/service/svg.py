@@ -31,8 +31,16 @@ class Axes:
         return HEIGHT - BOTTOM - (y - self.y0) / (self.y1 - self.y0) * (HEIGHT - TOP - BOTTOM)
 
 
-def _ticks(low: float, high: float, count: int = 5) -> np.ndarray:
-    return np.linspace(low, high, count)
+def nice_ticks(low: float, high: float, count: int = 5) -> tuple[np.ndarray, int]:
+    """Round ticks inside [low, high], about ``count`` of them, at 1, 2 or 5 times a power of ten; and the decimals
+    that print them exactly."""
+    raw = (high - low) / max(count - 1, 1)
+    power = 10.0 ** np.floor(np.log10(raw))
+    step = power * min((1.0, 2.0, 5.0, 10.0), key=lambda m: abs(np.log(m * power / raw)))
+    first = np.ceil(low / step - 1e-9) * step
+    ticks = np.arange(first, high + step * 1e-9, step)
+    decimals = max(0, -int(np.floor(np.log10(step) + 1e-9)))
+    return np.round(ticks, decimals + 2) + 0.0, decimals  # + 0.0: no "-0"
 
 
 def _frame(axes: Axes, x_label: str, title: str) -> list[str]:
@@ -42,10 +50,14 @@ def _frame(axes: Axes, x_label: str, title: str) -> list[str]:
         f'<text x="{LEFT}" y="18" class="title">{html.escape(title)}</text>',
         f'<text x="{(LEFT + WIDTH - RIGHT) / 2}" y="{HEIGHT - 6}" text-anchor="middle">{html.escape(x_label)}</text>',
     ]
-    for x in _ticks(axes.x0, axes.x1):
-        parts.append(f'<text x="{axes.px(x):.1f}" y="{HEIGHT - BOTTOM + 15}" text-anchor="middle">{x:.4g}</text>')
-    for y in _ticks(axes.y0, axes.y1):
-        parts.append(f'<text x="{LEFT - 6}" y="{axes.py(y) + 4:.1f}" text-anchor="end">{y:.4g}</text>')
+    xs, x_decimals = nice_ticks(axes.x0, axes.x1)
+    for x in xs:
+        parts.append(
+            f'<text x="{axes.px(x):.1f}" y="{HEIGHT - BOTTOM + 15}" text-anchor="middle">{x:.{x_decimals}f}</text>'
+        )
+    ys, y_decimals = nice_ticks(axes.y0, axes.y1)
+    for y in ys:
+        parts.append(f'<text x="{LEFT - 6}" y="{axes.py(y) + 4:.1f}" text-anchor="end">{y:.{y_decimals}f}</text>')
         parts.append(
             f'<line x1="{LEFT}" x2="{WIDTH - RIGHT}" y1="{axes.py(y):.1f}" y2="{axes.py(y):.1f}" stroke="#eee"/>'
         )

@@ -78,7 +78,7 @@ def test_windows_wanting_what_others_read_are_answered_with_it(tmp_path, capsys,
     that reads the zero less precisely (0.10 A alone), as the service answers it; a doublet that cannot tell
     J_M 1.08x from a weaker motor waits for the thesis window of its actuator."""
     from ema.cli import fleet
-    from ema.service.store import EstimateStore
+    from ema.history.open import open_history
     from tests.foreign.windows import Effects, draw, of_the_same_flight
 
     monkeypatch.setattr(fleet, "ray_installed", lambda: False)
@@ -95,11 +95,11 @@ def test_windows_wanting_what_others_read_are_answered_with_it(tmp_path, capsys,
         (folder / f"{name}.json").write_text(json.dumps({**drawn.document, "actuator_id": "tail-8", "window_id": name}))
     arguments = ["fleet", str(folder), "--out", str(tmp_path / "r.csv"), "--workers", "1", "--database", str(database)]
     assert main([*arguments, *SIZES, "--json"]) == EXIT_OK
-    answers = {s.window_id: s.window for s in EstimateStore(database).history("tail-9")[0]}
+    answers = {s.window_id: s.window for s in open_history(database).history("tail-9")[0]}
     cruise_pieces = {name for name in answers if name.startswith("b#")}  # the archive's windows are cut
     assert answers["a"].sensor_zero_from in cruise_pieces and answers["c"].sensor_zero_from is None
     assert answers["a2"].sensor_zero_from in cruise_pieces and answers["a2"].sensor_zero is None
-    drive = {s.window_id: s.window for s in EstimateStore(database).history("tail-8")[0]}
+    drive = {s.window_id: s.window for s in open_history(database).history("tail-8")[0]}
     assert drive["d"].inertia_from == ["e"] and not drive["d"].inertia_undecided
     count = len(answers) + len(drive)
     assert f"[{count}/{count}]" in capsys.readouterr().err
@@ -111,12 +111,12 @@ def test_history_plots_a_prognosis_whose_interval_holds_the_truth(tmp_path, caps
     from ema.estimate.config import PipelineConfig
     from ema.estimate.documents import parameter
     from ema.estimate.pipeline import estimate_window
-    from ema.service.store import EstimateStore
+    from ema.history.open import open_history
     from tests.servers import free_port, start_server
 
     small = PipelineConfig(n_simulations=16, check_windows=8, n_timesteps=50, hidden_units=8)
     base = estimate_window(synthetic_window(HealthParams.single(), seed=1, duration_s=0.1), small, actuator=THESIS)
-    rng, store = np.random.default_rng(0), EstimateStore(tmp_path / "history.sqlite3")
+    rng, store = np.random.default_rng(0), open_history(tmp_path / "history.sqlite3")
     hours = np.sort(rng.uniform(0, 200, 200))
     for i, h in enumerate(hours):  # FDJ rising 1e-4 N·m per flight hour: crosses 0.075 at 250 h
         fdj = 0.05 + 1e-4 * h + 4e-4 * rng.normal()
@@ -175,7 +175,7 @@ def test_an_archive_carries_its_actuators_documents(tmp_path, capsys, monkeypatc
     """actuators.json maps an actuator to its document: its windows are read with it (and the history stores
     it, versioned); an actuator it does not list is read with the default, and said so."""
     from ema.cli import fleet
-    from ema.service.store import EstimateStore
+    from ema.history.open import open_history
     from tests.foreign.actuators import DRIVES, NOMINAL, document
     from tests.foreign.windows import Ground, draw
 
@@ -190,7 +190,7 @@ def test_an_archive_carries_its_actuators_documents(tmp_path, capsys, monkeypatc
     arguments = ["fleet", str(folder), "--out", str(tmp_path / "r.csv"), "--workers", "1", "--database", str(database)]
     assert main([*arguments, *SIZES, "--json"]) == EXIT_OK
     assert json.loads(capsys.readouterr().out)["answered"] == 2
-    store = EstimateStore(database)
+    store = open_history(database)
     small = store.history("small-1")[0][0]
     assert small.actuator.version == 1 and store.get_actuator("small-1").document.drive.gear_ratio == 800.0
     assert abs(small.estimates.FDJ.value / bench.truth["FDJ"] - 1) < 0.03

@@ -187,3 +187,24 @@ def test_post_waits_out_a_503_and_retries_the_same_window():
     assert answer == {"ok": True}
     assert slept == [2.0]
     assert seen == [window.window_id, window.window_id]
+
+
+def test_a_service_that_dies_mid_request_is_named_as_such(capsys, log_folder):
+    """A server that takes the request and closes the connection: the replay says the service stopped answering,
+    not "internal error"."""
+    import socket
+
+    listener = socket.create_server(("127.0.0.1", 0))
+    port = listener.getsockname()[1]
+
+    def accept_and_drop() -> None:
+        for _ in range(3):
+            connection, _ = listener.accept()
+            connection.recv(65536)
+            connection.close()
+
+    threading.Thread(target=accept_and_drop, daemon=True).start()
+    status = main(["replay", str(log_folder / "b_window.csv"), "--url", f"http://127.0.0.1:{port}"])
+    listener.close()
+    err = capsys.readouterr().err
+    assert status != EXIT_OK and "stopped answering" in err and "internal error" not in err

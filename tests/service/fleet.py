@@ -11,10 +11,10 @@ import numpy as np
 
 from ema.estimate.documents import Estimate, parameter
 from ema.estimate.pipeline import estimate_window
+from ema.history.open import History, open_history
 from ema.model.actuator import THESIS
 from ema.model.params import HealthParams
 from ema.model.synthetic import synthetic_window
-from ema.service.store import EstimateStore
 from tests.servers import free_port, start_server
 from tests.service.conftest import SMALL
 
@@ -27,7 +27,7 @@ FLEET = {
 }
 
 
-def store_fleet(store: EstimateStore, base: Estimate, windows: int = 20, seed: int = 0) -> None:
+def store_fleet(store: History, base: Estimate, windows: int = 20, seed: int = 0) -> None:
     """Every actuator of ``FLEET``, ``windows`` windows over 190 flight hours."""
     rng = np.random.default_rng(seed)
     hours = np.linspace(0.0, 190.0, windows)
@@ -53,7 +53,7 @@ def served_fleet(database: Path) -> Iterator[str]:
     """The URL of a service on a free port whose store (``database``) holds the fleet, copies of one small real
     estimate; the service is stopped on leaving."""
     base = estimate_window(synthetic_window(HealthParams.single(), seed=1, duration_s=0.1), SMALL, actuator=THESIS)
-    store = EstimateStore(database)
+    store = open_history(database)
     store_fleet(store, base)
     store.close()
     port = free_port()

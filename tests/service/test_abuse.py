@@ -34,6 +34,8 @@ def server(tmp_path_factory):
         "EMA_WARM_UP": "false",
         **SMALL_ENV,
         "EMA_BODY_TIMEOUT_S": "4",
+        "EMA_BODY_GRACE_S": "2",
+        "EMA_MAX_BODY_BYTES": "5000000",
     }
     log = (tmp_path_factory.mktemp("log") / "server.log").open("w")
     process = subprocess.Popen([sys.executable, "-c", SERVER.format(port=port)], env=env, stderr=log)
@@ -132,7 +134,7 @@ def _trickle(url: str, stop: threading.Event) -> None:
 
 def test_slow_uploads_hold_their_connections_not_the_queue(live, window_document):
     stop = threading.Event()
-    trickles = [threading.Thread(target=_trickle, args=(live, stop)) for _ in range(5)]
+    trickles = [threading.Thread(target=_trickle, args=(live, stop)) for _ in range(8)]
     for thread in trickles:
         thread.start()
     try:
@@ -162,3 +164,44 @@ def test_a_body_that_does_not_arrive_in_time_is_a_408_and_an_abandoned_one_leave
     time.sleep(1.0)
     with open(log_path) as log:
         assert "Traceback" not in log.read()
+
+
+def test_a_trickle_is_cut_off_once_its_pace_falls_under_the_minimum(live):
+    host, port = live.removeprefix("http://").split(":")
+    head = (
+        f"POST /v1/estimate HTTP/1.1\r\nHost: 127.0.0.1\r\nX-API-Key: {KEY}\r\n"
+        "Content-Type: application/json\r\nContent-Length: 100000\r\n\r\n"
+    )
+    with socket.create_connection((host, int(port)), timeout=30) as connection:
+        connection.sendall(head.encode())
+        started = time.perf_counter()
+        for _ in range(20):  # a byte every 0.1 s: 10 B/s, far under the 1000 B/s kept after the 2 s grace
+            try:
+                connection.sendall(b" ")
+            except OSError:
+                break
+            time.sleep(0.1)
+        status = connection.recv(4096).split(b"\r\n")[0]
+    assert b" 408 " in status + b" " and time.perf_counter() - started < 4.0  # cut at the grace, not the timeout
+
+
+def test_copies_of_one_window_posted_at_once_are_computed_once(live, window_document):
+    window = {**window_document, "window_id": "copies-at-once"}
+    with concurrent.futures.ThreadPoolExecutor(3) as pool:
+        answers = [f.result() for f in [pool.submit(_post, live, window) for _ in range(3)]]
+    assert [a.status_code for a in answers] == [200, 200, 200]
+    assert len({a.json()["id"] for a in answers}) == 1
+    assert sorted(a.json()["replay"] for a in answers) == [False, True, True]  # one run, two answers from it
+
+
+def test_a_refusal_sent_before_the_body_is_read_reaches_a_plain_python_client(live):
+    import urllib.error
+    import urllib.request
+
+    body = b"{" + b" " * 8_000_000 + b"}"  # over this server's 5 MB: refused from its declared length
+    request = urllib.request.Request(
+        f"{live}/v1/estimate", data=body, headers={"content-type": "application/json", "x-api-key": KEY}
+    )
+    with pytest.raises(urllib.error.HTTPError) as refused:
+        urllib.request.urlopen(request, timeout=30)
+    assert refused.value.code == 413

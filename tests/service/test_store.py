@@ -8,10 +8,11 @@ import pytest
 
 from ema.estimate.documents import SensorZero
 from ema.estimate.pipeline import estimate_window
+from ema.history.errors import StorageError
+from ema.history.open import open_history
 from ema.model.actuator import THESIS
 from ema.model.params import HealthParams
 from ema.model.synthetic import synthetic_window
-from ema.service.store import EstimateStore, StorageError
 from tests.service.conftest import SMALL
 
 
@@ -21,7 +22,7 @@ def result():
 
 
 def test_one_row_per_window_and_the_repeat_is_a_replay(tmp_path, result):
-    store = EstimateStore(tmp_path / "h.sqlite3")
+    store = open_history(tmp_path / "h.sqlite3")
     first, again = store.add(result), store.add(result)
     assert not first.replay and again.replay and again.id == first.id
     current, legacy = store.history(result.actuator_id)
@@ -29,23 +30,23 @@ def test_one_row_per_window_and_the_repeat_is_a_replay(tmp_path, result):
 
 
 def test_the_file_is_private(tmp_path, result):
-    EstimateStore(tmp_path / "h.sqlite3").add(result)
+    open_history(tmp_path / "h.sqlite3").add(result)
     assert stat.S_IMODE((tmp_path / "h.sqlite3").stat().st_mode) == 0o600
 
 
 def test_a_file_others_could_read_is_made_private_with_a_warning(tmp_path, result, caplog):
     path = tmp_path / "h.sqlite3"
-    EstimateStore(path).close()
+    open_history(path).close()
     path.chmod(0o644)
-    with caplog.at_level("WARNING", logger="ema.service"):
-        EstimateStore(path).close()
+    with caplog.at_level("WARNING", logger="ema.history"):
+        open_history(path).close()
     assert stat.S_IMODE(path.stat().st_mode) == 0o600 and "made private" in caplog.text
 
 
 def test_another_window_under_a_stored_key_is_a_conflict_and_an_old_row_a_replay(tmp_path, result):
-    from ema.service.store import ConflictError
+    from ema.history.errors import ConflictError
 
-    store = EstimateStore(tmp_path / "h.sqlite3")
+    store = open_history(tmp_path / "h.sqlite3")
     store.add(result)
     other = result.model_copy(update={"window": result.window.model_copy(update={"content_sha256": "f" * 64})})
     with pytest.raises(ConflictError, match=result.window_id):
@@ -53,8 +54,8 @@ def test_another_window_under_a_stored_key_is_a_conflict_and_an_old_row_a_replay
     with pytest.raises(ConflictError):
         store.get(result.actuator_id, result.window_id, "f" * 64)
     assert store.get(result.actuator_id, result.window_id, result.window.content_sha256).replay
-    with store._lock:  # a row stored before digests were kept: its content unknown, taken as the window's
-        store._connection.execute("UPDATE estimates SET content_sha256 = NULL")
+    with sqlite3.connect(tmp_path / "h.sqlite3") as old:  # a row stored before digests: taken as the window's
+        old.execute("UPDATE estimates SET content_sha256 = NULL")
     assert store.get(result.actuator_id, result.window_id, "f" * 64).replay
 
 
@@ -62,7 +63,7 @@ def test_a_file_that_is_not_a_database_is_refused_naming_it(tmp_path):
     broken = tmp_path / "broken.sqlite3"
     broken.write_bytes(b"this is not sqlite" * 100)
     with pytest.raises(StorageError) as error:
-        EstimateStore(broken)
+        open_history(broken)
     assert error.value.path == broken
     assert broken.read_bytes().startswith(b"this is not sqlite")  # refused, never replaced
 
@@ -80,14 +81,14 @@ def test_a_round_one_history_is_migrated_and_nothing_is_lost(tmp_path, result):
     old.executemany("INSERT INTO estimates (actuator_id, window_id, stored_at, result) VALUES (?, ?, ?, ?)", rows)
     old.commit()
     old.close()
-    store = EstimateStore(path)
+    store = open_history(path)
     current, kept = store.history("a")
     assert len(current) == 1 and len(kept) == 1  # one row per window, the old format returned as stored
     assert sqlite3.connect(path).execute("SELECT count(*) FROM estimates_v1").fetchone()[0] == 3
 
 
 def test_the_sensor_zero_is_the_most_precise_of_the_actuators_flight(tmp_path, result):
-    store = EstimateStore(tmp_path / "h.sqlite3")
+    store = open_history(tmp_path / "h.sqlite3")
 
     def stored(actuator_id: str, window_id: str, flight_id: str | None, std: float | None) -> None:
         zero = None if std is None else SensorZero(window_id=window_id, hinge_nm=0.0, current_a=std, torque_std_nm=std)

@@ -6,11 +6,11 @@ import pytest
 from fastapi.testclient import TestClient
 
 from ema.estimate.pipeline import estimate_window
+from ema.history.open import open_history
 from ema.model.actuator import THESIS
 from ema.model.params import HealthParams
 from ema.model.synthetic import synthetic_window
 from ema.service.main import create_app
-from ema.service.store import EstimateStore
 from tests.service.conftest import KEY, LOCAL, SMALL, settings_for
 from tests.service.fleet import FLEET, store_fleet
 
@@ -22,8 +22,8 @@ def base():
 
 @pytest.fixture
 def fleet_settings(tmp_path, base):
-    settings = settings_for(tmp_path)
-    store = EstimateStore(settings.database)
+    settings = settings_for(tmp_path, ui_budget_s=300.0)  # every line computed on the first load
+    store = open_history(settings.database)
     store_fleet(store, base)
     store.close()
     return settings

@@ -1,31 +1,77 @@
-"""An actuator: its ``ema-actuator/1`` document (versioned), its stored estimates, its prognosis."""
+"""The actuators: their lines (status), ``ema-actuator/1`` documents (versioned), stored estimates (withdrawable),
+and prognoses. An actuator with nothing stored is a 404 wherever its history is asked for."""
 
 from __future__ import annotations
 
-from fastapi import APIRouter, Request
+from typing import Annotated
+
+from fastapi import APIRouter, Query, Request
 from starlette.concurrency import run_in_threadpool
 
 from ema.model.actuator import Actuator
-from ema.prognosis.documents import History, Prognosis, StoredActuator
-from ema.service.deps import RunnerDep, StoreDep, prognosis_of
+from ema.prognosis.documents import ActuatorSummary, History, Prognosis, StoredActuator, Withdrawal
+from ema.service.deps import ActuatorId, RunnerDep, SettingsDep, StoreDep, prognosis_now
+from ema.service.errors import NotStoredError
 from ema.service.parsing import read_body
 from ema.service.schemas import json_body, responses
+from ema.service.view import fleet_lines
 
 router = APIRouter(prefix="/actuators", tags=["actuators"])
 
 
-@router.get("/{actuator_id:path}/estimates", response_model=History, responses=responses(401))
-async def history(actuator_id: str, store: StoreDep) -> History:
-    """Every stored estimate of the actuator, oldest first, one per window."""
+@router.get("", response_model=list[ActuatorSummary], responses=responses(401, 503))
+async def actuators(
+    request: Request, settings: SettingsDep, store: StoreDep, runner: RunnerDep
+) -> list[ActuatorSummary]:
+    """Every actuator with a stored window or document, most urgent first, with its latest status (``/ui``'s
+    lines; those not brought up to date within the budget as they were last computed)."""
+    found = await fleet_lines(store, runner, settings.ui_budget_s, request.is_disconnected)
+    return found.lines
+
+
+async def _known(store: StoreDep, actuator_id: str) -> None:
+    if actuator_id not in await run_in_threadpool(store.actuator_ids):
+        raise NotStoredError(actuator_id, "no window or document is stored for it")
+
+
+@router.get("/{actuator_id:path}/estimates", response_model=History, responses=responses(401, 404, 422))
+async def history(actuator_id: ActuatorId, store: StoreDep) -> History:
+    """Every stored estimate of the actuator, oldest first, one per window; withdrawn ones apart."""
+    await _known(store, actuator_id)
     current, legacy = await run_in_threadpool(store.history, actuator_id)
-    return History(actuator_id=actuator_id, estimates=current, legacy=legacy)
+    withdrawn = await run_in_threadpool(store.withdrawals, actuator_id)
+    return History(actuator_id=actuator_id, estimates=current, legacy=legacy, withdrawn=withdrawn)
 
 
-@router.get("/{actuator_id:path}/prognosis", response_model=Prognosis, responses=responses(401))
-async def prognosis(actuator_id: str, request: Request, store: StoreDep) -> Prognosis:
+@router.delete(
+    "/{actuator_id:path}/estimates/{window_id:path}",
+    response_model=Withdrawal,
+    responses=responses(401, 403, 404, 422),
+)
+async def withdraw(
+    actuator_id: ActuatorId,
+    window_id: str,
+    store: StoreDep,
+    reason: Annotated[str, Query(max_length=500, description="why, for the record")] = "none given",
+) -> Withdrawal:
+    """Take a stored window out of the actuator's history (a window that should never have been accepted):
+    its trend and prognosis forget it; the record of it, and of why, stays."""
+    found = await run_in_threadpool(store.withdraw, actuator_id, window_id, reason)
+    if found is None:
+        raise NotStoredError(actuator_id, f"no window {window_id!r} is stored for it")
+    return found
+
+
+@router.get("/{actuator_id:path}/prognosis", response_model=Prognosis, responses=responses(401, 404, 422, 503))
+async def prognosis(actuator_id: ActuatorId, request: Request, store: StoreDep, runner: RunnerDep) -> Prognosis:
     """Trend of FDJ, η_O and η_A and the remaining useful life to the thresholds of the actuator's document
-    (the default actuator's where it has none), with its backtest."""
-    return await prognosis_of(request.app.state.prognoses, store, actuator_id)
+    (the default actuator's where it has none), with its backtest; computed as a job of the queue."""
+    await _known(store, actuator_id)
+    with runner.admit() as ticket:
+        found, _ = await runner.run(
+            ticket, request.is_disconnected, prognosis_now, request.app.state.prognoses, store, actuator_id
+        )
+    return found
 
 
 @router.put(
@@ -35,21 +81,27 @@ async def prognosis(actuator_id: str, request: Request, store: StoreDep) -> Prog
     responses=responses(401, 403, 413, 415, 422, 503),
     openapi_extra=json_body(Actuator, "the actuator's ema-actuator/1 document"),
 )
-async def put_actuator(actuator_id: str, request: Request, store: StoreDep, runner: RunnerDep) -> StoredActuator:
+async def put_actuator(actuator_id: ActuatorId, request: Request, store: StoreDep, runner: RunnerDep) -> StoredActuator:
     """Store the actuator's document as its next version: its windows are read with it from now on (those
     stored keep the version they were read with). The same document again stores nothing new."""
     document = await read_body(request, runner, Actuator, lambda d: d)
+    await run_in_threadpool(store.probe)
     return await run_in_threadpool(store.put_actuator, actuator_id, document)
 
 
 @router.get(
-    "/{actuator_id:path}", response_model=StoredActuator, response_model_by_alias=True, responses=responses(401, 404)
+    "/{actuator_id:path}",
+    response_model=StoredActuator,
+    response_model_by_alias=True,
+    responses=responses(401, 404, 422),
 )
-async def get_actuator(actuator_id: str, store: StoreDep) -> StoredActuator:
+async def get_actuator(actuator_id: ActuatorId, store: StoreDep) -> StoredActuator:
     """The actuator's latest document; 404 where none was stored (its windows are read with the default)."""
-    from ema.service.errors import NotStoredError
-
     stored = await run_in_threadpool(store.get_actuator, actuator_id)
     if stored is None:
-        raise NotStoredError(actuator_id)
+        raise NotStoredError(
+            actuator_id,
+            "no ema-actuator/1 document is stored for it: its windows are read with "
+            "the default actuator (PUT one to this path)",
+        )
     return stored

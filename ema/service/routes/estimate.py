@@ -1,15 +1,20 @@
 from __future__ import annotations
 
+import threading
+from collections.abc import Callable
 from functools import partial
 from typing import Annotated
 
 from fastapi import APIRouter, Query, Request
 from starlette.concurrency import run_in_threadpool
 
-from ema.estimate.config import bounds
+from ema.estimate.config import PipelineConfig, bounds
+from ema.estimate.documents import Estimate
 from ema.estimate.pipeline import estimate_window
+from ema.history.open import History
 from ema.model.window import Window, WindowDocument
 from ema.prognosis.documents import Stored
+from ema.service.config import Settings
 from ema.service.deps import RunnerDep, SettingsDep, StoreDep, actuator_of, request_config, stopper
 from ema.service.parsing import check_budget, read_body
 from ema.service.schemas import json_body, responses
@@ -55,28 +60,39 @@ async def estimate(
     service's settings; over it, 422 naming the limit.
     """
     window, digest = await read_body(request, runner, WindowDocument, _window_and_digest)
+    sizes = {"n_simulations": n_simulations, "n_timesteps": n_timesteps, "hidden_units": hidden_units, "seed": seed}
+    key, found = (
+        (window.actuator_id, window.window_id),
+        partial(store.get, window.actuator_id, window.window_id, digest),
+    )
     with runner.admit() as ticket:
-        stored = await run_in_threadpool(store.get, window.actuator_id, window.window_id, digest)
-        if stored is not None:
+        while (running := runner.sharing.running(key)) is not None:
+            await running.wait(request.is_disconnected)  # the same window posted meanwhile: its answer is ours
+            if (stored := await run_in_threadpool(found)) is not None:
+                return stored
+        with runner.sharing.lead(key) as shared:
+            if (stored := await run_in_threadpool(found)) is not None:
+                return stored
+            config = request_config(settings, **sizes)
+            check_budget(window, config, settings)
+            await run_in_threadpool(store.probe)  # a history that cannot take the answer refuses before any work
+            job = await _job(settings, store, window, config, ticket.cancel)
+            result = await runner.run(ticket, shared.gone(request.is_disconnected), job)
+            stored = await run_in_threadpool(store.add, result)  # committed (fsync) before the answer leaves
+            await run_in_threadpool(store.probe)  # the file it went to is still the history: else no 200
             return stored
-        sizes = {"n_simulations": n_simulations, "n_timesteps": n_timesteps, "hidden_units": hidden_units}
-        config = request_config(settings, **sizes, seed=seed)
-        check_budget(window, config, settings)
-        history = await run_in_threadpool(store.readings, window.actuator_id, window.flight_id)
-        actuator, version = await actuator_of(store, window.actuator_id)
-        if settings.backend == "ray":
-            from ema.estimate.remote import estimate_on_ray
 
-            job = partial(estimate_on_ray, window, config, 1, history, actuator, version)
-        else:
-            job = partial(
-                estimate_window,
-                window,
-                config,
-                actuator=actuator,
-                version=version,
-                on_stage=stopper(ticket.cancel),
-                history=history,
-            )
-        result = await runner.run(ticket, request.is_disconnected, job)
-        return await run_in_threadpool(store.add, result)  # committed (fsync) before the answer leaves
+
+async def _job(
+    settings: Settings, store: History, window: Window, config: PipelineConfig, cancel: threading.Event
+) -> Callable[[], Estimate]:
+    """The pipeline run for ``window``: in this process or on Ray, with what the history lends it."""
+    history = await run_in_threadpool(store.readings, window.actuator_id, window.flight_id)
+    actuator, version = await actuator_of(store, window.actuator_id)
+    if settings.backend == "ray":
+        from ema.estimate.remote import estimate_on_ray
+
+        return partial(estimate_on_ray, window, config, 1, history, actuator, version)
+    return partial(
+        estimate_window, window, config, actuator=actuator, version=version, on_stage=stopper(cancel), history=history
+    )

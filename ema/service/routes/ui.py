@@ -1,37 +1,61 @@
-"""The operator's view: ``/ui`` (the fleet) and ``/ui/actuators/{id}`` (one actuator), HTML from the service."""
+"""The operator's view: ``/ui`` (the fleet, a page at a time) and ``/ui/actuators/{id}`` (one actuator)."""
 
 from __future__ import annotations
 
-from fastapi import APIRouter, Request
-from fastapi.responses import HTMLResponse
+import math
+from typing import Annotated, Literal
+
+from fastapi import APIRouter, Query, Request
+from fastapi.responses import HTMLResponse, RedirectResponse
 from starlette.concurrency import run_in_threadpool
 
-from ema.service.deps import StoreDep, actuator_of, prognosis_of
-from ema.service.pages import Row, actuator_page, fleet_page, status_of
+from ema.service.deps import ActuatorId, RunnerDep, SettingsDep, StoreDep, prognosis_now
+from ema.service.pages import actuator_page, fleet_page
+from ema.service.view import fleet_lines
 
-router = APIRouter(prefix="/ui", tags=["ui"], include_in_schema=False)
-
-
-@router.get("", response_class=HTMLResponse)
-async def fleet(request: Request, store: StoreDep) -> HTMLResponse:
-    """Every actuator, most urgent first."""
-    rows = []
-    for actuator_id in await run_in_threadpool(store.actuator_ids):
-        history, _ = await run_in_threadpool(store.history, actuator_id)
-        prognosis = await prognosis_of(request.app.state.prognoses, store, actuator_id)
-        actuator, _ = await actuator_of(store, actuator_id)
-        latest = history[-1] if history else None
-        status, soonest = status_of(latest, prognosis, actuator)
-        rows.append(Row(actuator_id, latest, prognosis, actuator, status, soonest))
-    return HTMLResponse(fleet_page(rows))
+router = APIRouter(tags=["ui"], include_in_schema=False)
+StatusFilter = Literal["due", "watch", "prognosis failed", "not enough history", "healthy"]
 
 
-@router.get("/actuators/{actuator_id:path}", response_class=HTMLResponse)
-async def actuator(actuator_id: str, request: Request, store: StoreDep) -> HTMLResponse:
-    """One actuator's plots, notes, backtest, calibrations and document."""
-    history, _ = await run_in_threadpool(store.history, actuator_id)
-    prognosis = await prognosis_of(request.app.state.prognoses, store, actuator_id)
+@router.get("/")
+async def root() -> RedirectResponse:
+    """The service's front page is the operator's view."""
+    return RedirectResponse("/ui", status_code=307)
+
+
+@router.get("/ui", response_class=HTMLResponse)
+async def fleet(
+    request: Request,
+    settings: SettingsDep,
+    store: StoreDep,
+    runner: RunnerDep,
+    status: Annotated[StatusFilter | None, Query()] = None,
+    tail: Annotated[str | None, Query(max_length=200, description="actuator ids starting with it")] = None,
+    page: Annotated[int, Query(ge=1, le=1_000_000)] = 1,
+) -> HTMLResponse:
+    """The actuators most urgent first, ``ui_page_size`` a page, filtered by status and by tail."""
+    found = await fleet_lines(store, runner, settings.ui_budget_s, request.is_disconnected)
+    lines = [
+        line
+        for line in found.lines
+        if (status is None or line.status == status) and (not tail or line.actuator_id.startswith(tail))
+    ]
+    size = settings.ui_page_size
+    pages = max(1, math.ceil(len(lines) / size))
+    shown = lines[(min(page, pages) - 1) * size : min(page, pages) * size]
+    body = fleet_page(
+        shown, page=min(page, pages), pages=pages, total=len(lines), pending=found.pending, status=status, tail=tail
+    )
+    return HTMLResponse(body)
+
+
+@router.get("/ui/actuators/{actuator_id:path}", response_class=HTMLResponse)
+async def actuator(actuator_id: ActuatorId, request: Request, store: StoreDep, runner: RunnerDep) -> HTMLResponse:
+    """One actuator's plots, notes, backtest, calibrations and document (its prognosis a job of the queue)."""
+    with runner.admit() as ticket:
+        prognosis, history = await runner.run(
+            ticket, request.is_disconnected, prognosis_now, request.app.state.prognoses, store, actuator_id
+        )
     document = await run_in_threadpool(store.get_actuator, actuator_id)
-    actuator, _ = await actuator_of(store, actuator_id)
     reports = await run_in_threadpool(store.calibrations, actuator_id)
-    return HTMLResponse(actuator_page(actuator_id, history, prognosis, document, actuator, reports))
+    return HTMLResponse(actuator_page(actuator_id, history, prognosis, document, reports))

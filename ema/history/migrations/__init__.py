@@ -1,0 +1,1 @@
+"""Alembic migrations of the history (``ema.history.schema`` runs them)."""

@@ -1,0 +1,339 @@
+"""The history on a SQL database (SQLAlchemy Core): one implementation for SQLite and PostgreSQL.
+
+- One row per (actuator_id, window_id), inserted with "on conflict do nothing": the same window
+  stored twice, by one process or by replicas racing, is one row, and both get that row's answer.
+  Another body under a stored key is a :class:`ConflictError`.
+- Committed before the answer leaves (SQLite: ``synchronous=FULL``; PostgreSQL commits durably).
+- Actuator documents are versioned 1, 2, …; two replicas allocating a version at once collide on
+  the key, and the later one takes the next.
+- A withdrawn window leaves the history but not the database: its row moves to ``withdrawals``.
+- ``probe`` says whether the storage can take a write now (``ema.history.sqlite``,
+  ``ema.history.postgres``); the service asks before any pipeline runs.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+import json
+from collections.abc import Callable, Iterator, Sequence
+from contextlib import contextmanager
+from typing import Any
+
+import sqlalchemy as sa
+from pydantic import ValidationError
+from sqlalchemy.dialects import postgresql, sqlite
+
+from ema.calibration.documents import CalibrationReport
+from ema.estimate.documents import Estimate, HistoryReadings, InertiaReading, SensorZero
+from ema.estimate.history import lent
+from ema.history.errors import ConflictError, StorageError
+from ema.history.tables import actuators, calibrations, estimates, summaries, withdrawals
+from ema.model.actuator import Actuator
+from ema.prognosis.documents import Stored, StoredActuator, Withdrawal
+
+VERSION_ATTEMPTS = 20  # replicas racing for an actuator's next document version
+
+
+def now() -> str:
+    return dt.datetime.now(dt.UTC).isoformat(timespec="milliseconds")
+
+
+class SqlHistory:
+    """An actuator history on ``engine``; ``probe()`` raises StorageError where a write cannot be taken now."""
+
+    def __init__(self, engine: sa.Engine, location: str, probe: Callable[[], None]) -> None:
+        self.engine = engine
+        self.location = location
+        self.probe = probe
+        self._insert = postgresql.insert if engine.dialect.name == "postgresql" else sqlite.insert
+
+    @contextmanager
+    def _writing(self) -> Iterator[sa.Connection]:
+        """A transaction that commits on leaving; a database failure becomes a StorageError naming the history."""
+        try:
+            with self.engine.begin() as connection:
+                yield connection
+        except sa.exc.IntegrityError:
+            raise
+        except sa.exc.SQLAlchemyError as exc:
+            raise StorageError(self.location, f"cannot be written ({_reason(exc)})") from None
+
+    @contextmanager
+    def _reading(self) -> Iterator[sa.Connection]:
+        try:
+            with self.engine.connect() as connection:
+                yield connection
+        except sa.exc.SQLAlchemyError as exc:
+            raise StorageError(self.location, f"cannot be read ({_reason(exc)})") from None
+
+    def close(self) -> None:
+        self.engine.dispose()
+
+    def healthy(self) -> tuple[bool, str]:
+        """(True, "ok"), or (False, what is wrong): the storage can take a write, and answers a read."""
+        try:
+            self.probe()
+            with self._reading() as connection:
+                connection.execute(sa.select(sa.func.count()).select_from(actuators)).scalar_one()
+        except StorageError as exc:
+            return False, str(exc)
+        return True, "ok"
+
+    def add(self, result: Estimate) -> Stored:
+        """Store one result; where its (actuator_id, window_id) is stored already from the same content, that row,
+        marked as a replay (ConflictError where from other content)."""
+        stored_at, document, info = now(), result.model_dump_json(by_alias=True), result.window
+        row = {
+            "actuator_id": result.actuator_id,
+            "window_id": result.window_id,
+            "stored_at": stored_at,
+            "result": document,
+            "content_sha256": info.content_sha256,
+            "flight_id": info.flight_id,
+            "sensor_zero": None if info.sensor_zero is None else info.sensor_zero.model_dump_json(),
+            "inertia_read": None if info.inertia_read is None else info.inertia_read.model_dump_json(),
+        }
+        statement = self._insert(estimates).values(**row).on_conflict_do_nothing().returning(estimates.c.id)
+        with self._writing() as connection:
+            new_id = connection.execute(statement).scalar_one_or_none()
+        if new_id is None:
+            found = self.get(result.actuator_id, result.window_id, info.content_sha256)
+            assert found is not None
+            return found
+        return Stored(**json.loads(document), id=new_id, stored_at=stored_at)
+
+    def get(self, actuator_id: str, window_id: str, digest: str | None = None) -> Stored | None:
+        """The stored answer for this window, marked as a replay, or None; ConflictError where it was stored
+        from content other than ``digest`` (a row stored before digests is taken for the same window)."""
+        query = sa.select(estimates.c.id, estimates.c.stored_at, estimates.c.result, estimates.c.content_sha256)
+        with self._reading() as connection:
+            row = connection.execute(
+                query.where(estimates.c.actuator_id == actuator_id, estimates.c.window_id == window_id)
+            ).first()
+        if row is None:
+            return None
+        stored = Stored(**json.loads(row.result), id=row.id, stored_at=row.stored_at, replay=True)
+        if digest is not None and row.content_sha256 is not None and row.content_sha256 != digest:
+            raise ConflictError(stored, digest)
+        return stored
+
+    def withdraw(self, actuator_id: str, window_id: str, reason: str) -> Withdrawal | None:
+        """Take a stored window out of the history, keeping it and why in ``withdrawals``; None where none is
+        stored under that key."""
+        withdrawn_at = now()
+        with self._writing() as connection:
+            row = connection.execute(
+                sa.delete(estimates)
+                .where(estimates.c.actuator_id == actuator_id, estimates.c.window_id == window_id)
+                .returning(estimates.c.stored_at, estimates.c.content_sha256, estimates.c.result)
+            ).first()
+            if row is None:
+                return None
+            connection.execute(
+                withdrawals.insert().values(
+                    actuator_id=actuator_id,
+                    window_id=window_id,
+                    withdrawn_at=withdrawn_at,
+                    reason=reason,
+                    stored_at=row.stored_at,
+                    content_sha256=row.content_sha256,
+                    result=row.result,
+                )
+            )
+        return Withdrawal(
+            actuator_id=actuator_id,
+            window_id=window_id,
+            withdrawn_at=withdrawn_at,
+            reason=reason,
+            stored_at=row.stored_at,
+            content_sha256=row.content_sha256,
+        )
+
+    def withdrawals(self, actuator_id: str) -> list[Withdrawal]:
+        """The actuator's withdrawn windows, oldest withdrawal first."""
+        columns = [withdrawals.c[name] for name in Withdrawal.model_fields if name != "actuator_id"]
+        with self._reading() as connection:
+            rows = connection.execute(
+                sa.select(*columns).where(withdrawals.c.actuator_id == actuator_id).order_by(withdrawals.c.id)
+            ).all()
+        return [Withdrawal(actuator_id=actuator_id, **row._mapping) for row in rows]
+
+    def put_actuator(self, actuator_id: str, document: Actuator) -> StoredActuator:
+        """Store ``document`` as the actuator's next version (the latest version itself where it is the same
+        document: a PUT repeated stores nothing new). Earlier versions stay, as do the estimates read with them."""
+        text = document.model_dump_json(by_alias=True)
+        for _ in range(VERSION_ATTEMPTS):
+            latest = self._latest_document(actuator_id)
+            if latest is not None and latest.document == text:
+                return StoredActuator(
+                    actuator_id=actuator_id, version=latest.version, stored_at=latest.stored_at, document=document
+                )
+            version, stored_at = 1 if latest is None else latest.version + 1, now()
+            try:
+                with self._writing() as connection:
+                    connection.execute(
+                        actuators.insert().values(
+                            actuator_id=actuator_id, version=version, stored_at=stored_at, document=text
+                        )
+                    )
+            except sa.exc.IntegrityError:
+                continue  # another replica took this version a moment ago: read again
+            return StoredActuator(actuator_id=actuator_id, version=version, stored_at=stored_at, document=document)
+        raise StorageError(self.location, f"no free document version for {actuator_id!r} after {VERSION_ATTEMPTS}")
+
+    def _latest_document(self, actuator_id: str) -> Any:
+        with self._reading() as connection:
+            return connection.execute(
+                sa.select(actuators.c.version, actuators.c.stored_at, actuators.c.document)
+                .where(actuators.c.actuator_id == actuator_id)
+                .order_by(actuators.c.version.desc())
+                .limit(1)
+            ).first()
+
+    def get_actuator(self, actuator_id: str) -> StoredActuator | None:
+        """The actuator's latest stored document, or None where it has none."""
+        row = self._latest_document(actuator_id)
+        if row is None:
+            return None
+        document = Actuator.model_validate_json(row.document)
+        return StoredActuator(actuator_id=actuator_id, version=row.version, stored_at=row.stored_at, document=document)
+
+    def add_calibration(self, actuator_id: str, report: CalibrationReport) -> None:
+        """Keep a calibration report of the actuator's windows (the operator's page lists them)."""
+        report_text = report.model_dump_json(by_alias=True)
+        with self._writing() as connection:
+            connection.execute(
+                calibrations.insert().values(actuator_id=actuator_id, stored_at=now(), report=report_text)
+            )
+
+    def calibrations(self, actuator_id: str) -> list[tuple[str, CalibrationReport]]:
+        """The actuator's calibration reports with when each was stored, latest first."""
+        with self._reading() as connection:
+            rows = connection.execute(
+                sa.select(calibrations.c.stored_at, calibrations.c.report)
+                .where(calibrations.c.actuator_id == actuator_id)
+                .order_by(calibrations.c.id.desc())
+            ).all()
+        return [(row.stored_at, CalibrationReport.model_validate_json(row.report)) for row in rows]
+
+    def actuator_ids(self) -> list[str]:
+        """Every actuator with a stored estimate, document or withdrawn window, in name order."""
+        query = sa.union(
+            sa.select(estimates.c.actuator_id), sa.select(actuators.c.actuator_id), sa.select(withdrawals.c.actuator_id)
+        )
+        with self._reading() as connection:
+            return sorted(row[0] for row in connection.execute(query))
+
+    def versions(self) -> dict[str, tuple[int, int, int]]:
+        """Per actuator: (stored windows, the latest window's row id, its latest document version; 0 for none),
+        which change exactly when its prognosis may."""
+        counted = sa.select(estimates.c.actuator_id, sa.func.count(), sa.func.max(estimates.c.id)).group_by(
+            estimates.c.actuator_id
+        )
+        documents = sa.select(actuators.c.actuator_id, sa.func.max(actuators.c.version)).group_by(
+            actuators.c.actuator_id
+        )
+        with self._reading() as connection:
+            found = {row[0]: (int(row[1]), int(row[2]), 0) for row in connection.execute(counted)}
+            for actuator_id, version in connection.execute(documents):
+                count, last, _ = found.get(actuator_id, (0, 0, 0))
+                found[actuator_id] = (count, last, int(version))
+        return found
+
+    def latest(self, actuator_ids: Sequence[str]) -> dict[str, Stored]:
+        """The latest stored estimate of each of ``actuator_ids`` that has one (one query)."""
+        last = (
+            sa.select(sa.func.max(estimates.c.id))
+            .where(estimates.c.actuator_id.in_(actuator_ids))
+            .group_by(estimates.c.actuator_id)
+        )
+        query = sa.select(estimates.c.id, estimates.c.stored_at, estimates.c.result).where(estimates.c.id.in_(last))
+        with self._reading() as connection:
+            rows = connection.execute(query).all()
+        found = {}
+        for row in rows:
+            try:
+                stored = Stored(**json.loads(row.result), id=row.id, stored_at=row.stored_at)
+            except ValidationError:
+                continue  # an earlier format's row: no line of the view is built from it
+            found[stored.actuator_id] = stored
+        return found
+
+    def latest_documents(self, actuator_ids: Sequence[str]) -> dict[str, StoredActuator]:
+        """The latest document of each of ``actuator_ids`` that has one (one query)."""
+        newest = (
+            sa.select(actuators.c.actuator_id, sa.func.max(actuators.c.version).label("version"))
+            .where(actuators.c.actuator_id.in_(actuator_ids))
+            .group_by(actuators.c.actuator_id)
+            .subquery()
+        )
+        query = sa.select(actuators).join(
+            newest, sa.and_(actuators.c.actuator_id == newest.c.actuator_id, actuators.c.version == newest.c.version)
+        )
+        with self._reading() as connection:
+            rows = connection.execute(query).all()
+        return {
+            row.actuator_id: StoredActuator(
+                actuator_id=row.actuator_id,
+                version=row.version,
+                stored_at=row.stored_at,
+                document=Actuator.model_validate_json(row.document),
+            )
+            for row in rows
+        }
+
+    def readings(self, actuator_id: str, flight_id: str | None) -> HistoryReadings:
+        """What the stored windows of this actuator lend a window of ``flight_id`` (``ema.estimate.history.lent``)."""
+        mine = estimates.c.actuator_id == actuator_id
+        with self._reading() as connection:
+            zeros: list[SensorZero] = []
+            if flight_id is not None:
+                found = connection.execute(
+                    sa.select(estimates.c.sensor_zero)
+                    .where(mine, estimates.c.flight_id == flight_id, estimates.c.sensor_zero.is_not(None))
+                    .order_by(estimates.c.id)
+                ).scalars()
+                zeros = [SensorZero.model_validate_json(zero) for zero in found]
+            inertias = connection.execute(
+                sa.select(estimates.c.inertia_read)
+                .where(mine, estimates.c.inertia_read.is_not(None))
+                .order_by(estimates.c.id)
+            ).scalars()
+            return lent(zeros, [InertiaReading.model_validate_json(reading) for reading in inertias])
+
+    def history(self, actuator_id: str) -> tuple[list[Stored], list[dict[str, Any]]]:
+        """Every stored result of one actuator, oldest first; rows of an earlier format apart, as stored."""
+        with self._reading() as connection:
+            rows = connection.execute(
+                sa.select(estimates.c.id, estimates.c.stored_at, estimates.c.result)
+                .where(estimates.c.actuator_id == actuator_id)
+                .order_by(estimates.c.id)
+            ).all()
+        current, legacy = [], []
+        for row_id, stored_at, result in rows:
+            document = json.loads(result)
+            try:
+                current.append(Stored(**document, id=row_id, stored_at=stored_at))
+            except ValidationError:
+                legacy.append({**document, "id": row_id, "stored_at": stored_at})
+        return current, legacy
+
+    def summaries(self) -> dict[str, tuple[str, str]]:
+        """Every kept fleet-view summary: actuator -> (the state it was computed at, its row as JSON)."""
+        with self._reading() as connection:
+            rows = connection.execute(sa.select(summaries.c.actuator_id, summaries.c.state, summaries.c.row))
+            return {row.actuator_id: (row.state, row.row) for row in rows}
+
+    def put_summary(self, actuator_id: str, state: str, urgency: int, soonest: float | None, row: str) -> None:
+        """Keep the fleet view's summary of an actuator, computed at ``state`` (replacing the one kept)."""
+        values = {"state": state, "urgency": urgency, "soonest": soonest, "row": row}
+        statement = self._insert(summaries).values(actuator_id=actuator_id, **values)
+        statement = statement.on_conflict_do_update(index_elements=[summaries.c.actuator_id], set_=values)
+        with self._writing() as connection:
+            connection.execute(statement)
+
+
+def _reason(exc: sa.exc.SQLAlchemyError) -> str:
+    """The database's own words for a failure, without SQLAlchemy's statement dump."""
+    original = getattr(exc, "orig", None)
+    return str(original if original is not None else exc).splitlines()[0]
