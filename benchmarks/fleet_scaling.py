@@ -53,7 +53,9 @@ def timed(windows: list[Window], workers: int, folder: Path) -> tuple[float, flo
     import ray
 
     started = time.perf_counter()
-    run_fleet(windows, folder / f"results-{workers}.csv", PipelineConfig(), workers, None, threads=1)
+    run_fleet(
+        windows, folder / f"results-{workers}.csv", config=PipelineConfig(), workers=workers, address=None, threads=1
+    )
     rate = len(windows) / (time.perf_counter() - started)
     overhead = task_overhead_s()
     ray.shutdown()

@@ -44,13 +44,13 @@ from ema.estimate.report import healthy_range
 from ema.model import runtime
 from ema.model.actuator import THESIS
 from ema.model.hinge import HINGE_SMOOTHING_S, local_line
-from ema.model.params import ActuatorParams, eta_a_from_eta_o
+from ema.model.params import DriveConstants, eta_a_from_eta_o
 from ema.model.residual import kernel_samples
 from ema.model.window import Window, window_from_dict
 
 GROUPS = ("short window (0.1 s, gust)", "low log rate (1-2 kHz)")  # the groups with errors past 10 % of range
 SENSORS = ("current_a", "motor_speed_radps", "hinge_moment_nm", "position_deg")
-ACTUATOR = ActuatorParams()
+ACTUATOR = DriveConstants()
 
 
 def twins(group: str, i: int) -> tuple[Window, Window, dict[str, float]]:

@@ -22,7 +22,7 @@ from ema.model.aircraft import FlightCondition, load_model
 from ema.model.batch import default_lanes, kernel_constants, simulate_batch
 from ema.model.commands import random_command_knots
 from ema.model.effects import EffectSet
-from ema.model.params import DEFAULT_RANGES, ActuatorParams, HealthParams
+from ema.model.params import DEFAULT_RANGES, DriveConstants, HealthParams
 from ema.model.reference import simulate_numpy
 
 RATE_HZ = 10_000.0
@@ -86,7 +86,7 @@ def main() -> None:
         / short
     )
 
-    c = kernel_constants(ActuatorParams(), EffectSet())
+    c = kernel_constants(DriveConstants(), EffectSet())
     load = load_model(FlightCondition(), STEPS_PER_SAMPLE * 1e-6)
     eta_a = health.eta_a(500.0)
     per_sim = np.stack([health.fdj_nm, health.fsj_nm, 1 - eta_a, 1 / health.eta_o - 1])

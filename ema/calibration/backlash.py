@@ -24,6 +24,10 @@ from ema.calibration.equations import Equations
 from ema.calibration.selection import MIN_Z, Chosen, floor_rms, residual_rms
 
 MIN_ENGAGED = 50  # samples pushing on each face
+# The reading's floor: the dead band read kinematically moves with dynamics the model gets wrong, and the copies
+# share the model's dynamics, so their spread alone understates it (docs/calibration.md): a band is named wider
+# only beyond MIN_Z of this share of its nominal width.
+RESOLUTION = 0.05
 
 
 @dataclass(frozen=True)
@@ -39,7 +43,8 @@ class BacklashReading:
 
     @property
     def z(self) -> float:
-        return self.extra_rad / max(self.null_std_rad * max(self.mismatch, 1.0), 1e-12)
+        spread = max(self.null_std_rad * max(self.mismatch, 1.0), RESOLUTION * abs(self.null_mean_rad), 1e-12)
+        return self.extra_rad / spread
 
     @property
     def significant(self) -> bool:

@@ -4,21 +4,26 @@
 checks them and runs the stages once each, in order, and leaves ``report_`` (the
 ``ema-calibration/1`` document) and the residuals a figure needs:
 
-1. ``ema.estimate.pipeline`` estimates each window with the base model, the document's alone (the answer before;
-   ``ema estimate`` also takes a sensor's offset off and reads the viscous coefficient);
-2. ``ema.calibration.equations`` turns the windows into their equation-error problem;
-3. ``ema.calibration.noise_floor`` builds the same problem on noise-only copies;
-4. ``ema.calibration.families`` and ``ema.calibration.selection`` find what explains held-out samples
-   beyond the floor, name it or describe it (``ema.calibration.twins`` for look-alikes,
-   ``ema.calibration.backlash`` for the dead band);
-5. ``ema.calibration.refit`` re-estimates with the effect in, checks it holds on held-out folds;
-6. ``ema.calibration.report`` assembles the document.
+First ``ema.estimate.pipeline`` estimates each window with the base model, the document's alone (the answer
+before; ``ema estimate`` also takes a sensor's offset off and reads the viscous coefficient). Then the
+stages, numbered as their modules and ``docs/calibration.md`` number them:
+
+1. ``ema.calibration.equations``: the windows' equation-error problem;
+2. ``ema.calibration.noise_floor``: the same problem on noise-only copies;
+3. ``ema.calibration.families``: each effect as a family of columns;
+4. ``ema.calibration.selection``: what explains held-out samples beyond the floor, named or described
+   (``ema.calibration.twins`` for look-alikes, ``ema.calibration.backlash`` for the dead band);
+5. ``ema.calibration.readings``: the effect against its rivals' readings, adopted only where they agree
+   (an ambiguity keeps the base estimates, its stds widened), never where it reads worse;
+6. ``ema.calibration.refit``: the estimates with what is adopted, checked on held-out folds;
+7. ``ema.calibration.report``: the document.
 """
 
 from __future__ import annotations
 
 import time
 from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -28,32 +33,52 @@ from ema.calibration.documents import CalibrationReport, Step
 from ema.calibration.equations import Equations, equations
 from ema.calibration.families import COGGING_ORDERS, Family, generic_families, named_families
 from ema.calibration.noise_floor import COPIES, clean_replicas, noise_copies
+from ema.calibration.readings import AMBIGUOUS_STDS, Contest, combined_stds, reading, settled
 from ema.calibration.refit import MIN_HELD_OUT_GAIN, corrected, fit_with, held_out_rss
-from ema.calibration.selection import MAX_EFFECTS, Chosen, Decision, Evidence, decide, evidence
-from ema.calibration.twins import TWINS, tell_apart
+from ema.calibration.selection import MAX_EFFECTS, MIN_Z, NAME_MARGIN, Chosen, Decision, Evidence, decide, evidence
+from ema.calibration.twins import TWINS, output_error, tell_apart
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import TARGETS, Estimate
+from ema.estimate.physics.scenario import CLEAR_MARGIN
 from ema.estimate.pipeline import estimate_window
 from ema.estimate.prepare.conditioning import prepare
-from ema.model.actuator import Actuator
+from ema.model.actuator import ActuatorDocument
 from ema.model.checks import InputError
 from ema.model.noise import SensorNoise
 from ema.model.window import Window
 
 
-def combined(results: Sequence[Estimate], actuator: Actuator) -> dict[str, float]:
+def combined(results: Sequence[Estimate], actuator: ActuatorDocument) -> dict[str, float]:
     """Inverse-variance mean of FDJ and η_O over windows (one actuator, one health); η_O the nominal where no
     window carries a load to read it by."""
     out = {}
     for name in TARGETS:
         entries = [e for e in (getattr(r.estimates, name) for r in results) if e is not None]
         if not entries:
-            out[name] = actuator.nominal.eta_o
+            out[name] = actuator.health.eta_o
             continue
         values = np.array([e.value for e in entries])
         weights = 1.0 / np.maximum([e.std or 1.0 for e in entries], 1e-12) ** 2
         out[name] = float(values @ weights / weights.sum())
     return out
+
+
+@dataclass(frozen=True)
+class Context:
+    """What every selection step reads: the windows' equations and noise copies, the windows, the base
+    estimates, the sensors' noise and the pipeline's bias."""
+
+    measured: Equations
+    copies: Sequence[Equations]
+    windows: Sequence[Window]
+    before: Mapping[str, float]
+    stds: Mapping[str, float]
+    noise: Sequence[SensorNoise]
+    bias: Mapping[str, float]
+
+    def moves(self, estimates: Mapping[str, float]) -> bool:
+        """``estimates`` lie further from the base ones than ``AMBIGUOUS_STDS`` of their stds."""
+        return any(abs(estimates[t] - self.before[t]) > AMBIGUOUS_STDS * self.stds[t] for t in TARGETS)
 
 
 class Calibrator:
@@ -64,7 +89,7 @@ class Calibrator:
         copies: int = COPIES,
         seed: int = 0,
         *,
-        actuator: Actuator,
+        actuator: ActuatorDocument,
     ) -> None:
         self.actuator = actuator
         self.pipeline = pipeline
@@ -104,8 +129,9 @@ class Calibrator:
             for w in prepared
         ]
         before = combined(base, self.actuator)
+        stds = combined_stds([{n: getattr(getattr(r.estimates, n), "std", None) for n in TARGETS} for r in base])
         bias = {n: float(np.mean([r.methods[n].physics_bias for r in base])) for n in TARGETS}
-        noise = [SensorNoise(**r.dataset.noise_estimated) for r in base]
+        noise = [SensorNoise(**r.dataset.noise_estimated) for r in base if r.dataset is not None]
         rate = prepared[0].sample_rate_hz
         spec = self.actuator.params
         measured = equations([w.signals for w in prepared], rate, COGGING_ORDERS, spec)
@@ -114,7 +140,12 @@ class Calibrator:
         copies = noise_copies(clean, noise, rate, COGGING_ORDERS, self.seed, spec, self.copies, on_copy=check)
         families = named_families(measured, spec) + generic_families(measured)
         stage(f"scoring {len(families)} candidate families against the noise floor")
-        chosen, steps, first_round, unnamed = self._select(measured, copies, families, prepared, before, noise, check)
+        self.contests_: dict[str, Contest] = {}
+        context = Context(measured, copies, prepared, before, stds, noise, bias)
+        chosen, steps, first_round, unnamed = self._select(context, families, check)
+        chosen, ambiguity = settled(measured, chosen, self.contests_, bias, (before, stds))
+        if ambiguity is not None:
+            steps.append(Step(selected=None, reason=ambiguity.reason, indistinguishable_from=ambiguity.effects))
         held, chosen = self._held_out(measured, chosen)
         found = reporting.Found(
             measured, copies, first_round, chosen, steps, unnamed, read_backlash(measured, copies, chosen)
@@ -123,23 +154,19 @@ class Calibrator:
         adopted = found.adopted
         after = corrected(fit_with(measured, adopted).values, bias) if adopted else before
         self.measured_, self.chosen_ = measured, adopted
-        self.report_: CalibrationReport = reporting.assemble(
-            found, before, after, bias, held, truth, time.perf_counter() - started
+        report = reporting.assemble(found, before, after, bias, held, truth, time.perf_counter() - started)
+        stds_after = stds if ambiguity is None else ambiguity.stds_after
+        self.report_: CalibrationReport = report.model_copy(
+            update={"stds_before": stds, "stds_after": stds_after, "ambiguity": ambiguity}
         )
         return self
 
     def _select(
-        self,
-        measured: Equations,
-        copies: Sequence[Equations],
-        families: Sequence[Family],
-        windows: Sequence[Window],
-        before: Mapping[str, float],
-        noise: Sequence[SensorNoise],
-        check: Callable[[], None],
+        self, context: Context, families: Sequence[Family], check: Callable[[], None]
     ) -> tuple[list[Chosen], list[Step], list[Evidence], list[Evidence]]:
         """Forward selection; returns the chosen families, each step, the first round's evidence, and the
         curves that describe what no name fits (``check`` before each family is scored)."""
+        measured, copies = context.measured, context.copies
         chosen: list[Chosen] = []
         steps: list[Step] = []
         first_round: list[Evidence] = []
@@ -154,37 +181,74 @@ class Calibrator:
             if decision.chosen is None:
                 steps.append(Step(selected=None, reason=decision.reason))
                 return chosen, steps, first_round, decision.unnamed
-            pick, step = self._name(decision, found, windows, before, noise)
-            chosen.append(Chosen(pick.family, pick.grid))
+            pick, step, narrow = self._name(decision, found, chosen, context)
             steps.append(step)
+            if pick is None:
+                return chosen, steps, first_round, []
+            chosen.append(Chosen(pick.family, pick.grid))
+            self.contests_[pick.family.name] = Contest(pick, narrow)
         return chosen, steps, first_round, []
 
     def _name(
-        self,
-        decision: Decision,
-        found: Sequence[Evidence],
-        windows: Sequence[Window],
-        before: Mapping[str, float],
-        noise: Sequence[SensorNoise],
-    ) -> tuple[Evidence, Step]:
-        """The decided family, or one of its twins if the simulation says so."""
+        self, decision: Decision, found: Sequence[Evidence], chosen: Sequence[Chosen], context: Context
+    ) -> tuple[Evidence | None, Step, list[Evidence]]:
+        """The decided family, or the rival whose reading's simulation follows the windows clearly better (each
+        simulated at its own re-estimated FDJ and η_O); None where its reading moves the estimates beyond their
+        stds and its simulation follows the windows no better than the model without it (never worse). Also the
+        rivals it could not tell from it clearly."""
         pick = decision.chosen
         assert pick is not None
-        twins = [e for e in found if e.family.name in TWINS.get(pick.family.name, ())]
-        if not twins:
-            return pick, Step(selected=pick.family.name, reason=decision.reason, indistinguishable_from=decision.alike)
-        options = [pick, *twins]
-        simulated, errors, clear = tell_apart(windows, before, options, noise, self.actuator)
-        pick = simulated if clear else pick  # a narrow call is noise: the held-out equations' choice stands
-        others = [o.family.name for o in options if o is not pick]
-        runner = min(others, key=errors.__getitem__)
-        reason = f"{decision.reason}; told from {' and '.join(others)} by the motor speed and current it predicts"
-        return pick, Step(
-            selected=pick.family.name,
-            reason=reason if clear else reason + f" (narrowly from {runner}: the two leave nearly the same trace)",
-            indistinguishable_from=[] if clear else [runner],
-            tie_break_output_error=errors,
+        options = [pick, *self._runners_up(pick, found, decision.alike)]
+        readings = {
+            o.family.name: reading(context.measured, [*chosen, Chosen(o.family, o.grid)], context.bias) for o in options
+        }
+        args = (context.windows, context.noise, self.actuator)
+        simulated, errors, clear = (
+            tell_apart(args[0], readings, options, *args[1:])
+            if len(options) > 1
+            else (pick, {pick.family.name: output_error(args[0], readings[pick.family.name], pick, *args[1:])}, True)
         )
+        pick = simulated if clear else pick  # a narrow call is noise: the held-out equations' choice stands
+        best = errors[pick.family.name]
+        judged = not chosen and context.moves(readings[pick.family.name])
+        base = output_error(args[0], context.before, None, *args[1:]) if judged else float("inf")
+        if best > (1 - CLEAR_MARGIN) * base:
+            reason = (
+                f"{decision.reason}; but simulated with it at its estimates the windows' speed and current are "
+                f"followed no better than without it ({best:.3g} against {base:.3g}): not adopted"
+            )
+            return None, Step(selected=None, reason=reason, tie_break_output_error={**errors, "none": base}), []
+        narrow = [o for o in options if o is not pick and errors[o.family.name] <= (1 + CLEAR_MARGIN) * best]
+        others = [o.family.name for o in options if o is not pick]
+        reason = decision.reason
+        if others:
+            reason += f"; told from {' and '.join(others)} by the motor speed and current each reading predicts"
+        if narrow:
+            reason += f" (narrowly from {', '.join(o.family.name for o in narrow)}: nearly the same trace)"
+        shown = {**errors, **({"none": base} if np.isfinite(base) else {})}
+        step = Step(
+            selected=pick.family.name,
+            reason=reason,
+            indistinguishable_from=[o.family.name for o in narrow] or list(decision.alike),
+            tie_break_output_error=shown,
+        )
+        return pick, step, narrow
+
+    @staticmethod
+    def _runners_up(pick: Evidence, found: Sequence[Evidence], alike: Sequence[str]) -> list[Evidence]:
+        """What the simulation sets against ``pick``: its twins, and the named families that explain held-out
+        samples about as well (within ``NAME_MARGIN``), but for one set aside as the same trace with more shapes
+        (``alike``: the simpler is the reading)."""
+        twins = set(TWINS.get(pick.family.name, ()))
+        return [
+            e
+            for e in found
+            if e.family.named
+            and e.family.name != pick.family.name
+            and e.family.name not in alike
+            and not (e.family.follows == pick.family.follows and len(e.family.grid) > len(pick.family.grid))
+            and (e.family.name in twins or (e.z >= MIN_Z and e.improvement >= (1 - NAME_MARGIN) * pick.improvement))
+        ]
 
     def _held_out(self, measured: Equations, chosen: list[Chosen]) -> tuple[reporting.HeldOutCheck, list[Chosen]]:
         """Keep each effect, in the order chosen, only if re-estimated with it the model predicts

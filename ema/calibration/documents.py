@@ -51,6 +51,46 @@ class Unexplained(Document):
     error_if_added: dict[str, float] | None = None
 
 
+class Ambiguity(Document):
+    """Two or more effects read the windows about as well and move the estimates apart: none is adopted."""
+
+    effects: list[str] = Field(description="the effect selection would have adopted, then its rivals")
+    readings: dict[str, dict[str, float]] = Field(description="FDJ and η_O re-estimated with each")
+    stds_after: dict[str, float] = Field(
+        description="the base estimates' stds, widened until ±2 std holds each reading"
+    )
+    tell_apart: str = Field(description="what data would tell the effects apart")
+    reason: str
+
+
+class DriveLearned(Document):
+    """What healthy runs of a linear actuator taught of its drive (``ema calibrate`` on a document lacking it)."""
+
+    runs: int
+    loads_n: list[float] = Field(description="the load sizes the runs held [N]")
+    current_per_nm_a: float = Field(description="c: drive current per N·m of motor torque along the motion")
+    current_per_nm_std_a: float
+    current_at_zero_torque_a: float = Field(description="I0: the runs' mean current at rest (FDJ's anchor)")
+    current_at_zero_torque_std_a: float = Field(description="its spread over the runs")
+    fdj_nm: float | None = Field(description="the nominal FDJ (null: runs at one load size cannot read it)")
+    fdj_std_nm: float | None
+    eta_o: float | None = Field(description="the nominal η_O (null: runs at one load size cannot read it)")
+    eta_o_std: float | None
+    repeatability_nm: float = Field(description="the run-to-run std of FDJ beyond each run's own noise")
+    not_separable: list[str] = Field(description="constants these runs cannot tell apart, and how they were read")
+
+
+class Change(Document):
+    """A parameter of faulted runs against the calibrated document's nominal."""
+
+    parameter: str
+    nominal: float
+    value: float
+    std: float = Field(description="of the runs' combined value (their repeatability included)")
+    z: float = Field(description="(value − nominal) / std")
+    said: str
+
+
 class NoiseFloor(Document):
     copies: int
     equation_error_ratio: float = Field(description="RMS of the measured Eq. 5.1 residual over the copies' mean")
@@ -83,6 +123,21 @@ class CalibrationReport(Document):
     held_out: HeldOut
     estimates_before: dict[str, float]
     estimates_after: dict[str, float]
+    stds_before: dict[str, float] | None = Field(
+        None, description="of the base estimates, over the windows (inverse-variance)"
+    )
+    stds_after: dict[str, float] | None = Field(
+        None, description="of the estimates after: the base ones, widened where an ambiguity keeps two readings open"
+    )
+    ambiguity: Ambiguity | None = Field(
+        None, description="effects the windows cannot choose between whose estimates differ (null: none)"
+    )
+    drive: DriveLearned | None = Field(
+        None, description="a linear actuator's drive as its healthy runs taught it (null: not a learning run)"
+    )
+    changes: list[Change] = Field(
+        default_factory=list, description="a linear actuator's faulted runs against its calibrated nominal"
+    )
     error_before: dict[str, float] | None = None
     error_after: dict[str, float] | None = None
     error_pct_before: dict[str, float] | None = None

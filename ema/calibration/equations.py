@@ -24,7 +24,7 @@ import numpy as np
 
 from ema.estimate.physics.features import as_read
 from ema.estimate.physics.friction import FitSettings, regressors
-from ema.model.params import ActuatorParams
+from ema.model.params import DriveConstants
 from ema.model.residual import smooth_derivative, smoothed
 
 FOLDS = 5
@@ -78,15 +78,20 @@ def cogging_columns(
     return out
 
 
-def engaged(position_deg: np.ndarray, speed_radps: np.ndarray, rate: float, gear: float) -> np.ndarray:
+STOP_MARGIN_DEG = 1.0  # within this of an end stop the stop, not the dead band, sets where the elevator is
+
+
+def engaged(position_deg: np.ndarray, speed_radps: np.ndarray, rate: float, actuator: DriveConstants) -> np.ndarray:
     """1 where the motor drives the elevator (it moves with the motor, at least half its speed on the
-    motor side), 0 where the motor crosses the dead band after a reversal and the elevator waits."""
-    elevator = gear * smooth_derivative(np.radians(position_deg), rate)
-    return (elevator * np.sign(speed_radps) > 0.5 * np.abs(speed_radps)).astype(float)
+    motor side), 0 where the motor crosses the dead band after a reversal and the elevator waits, and 0 by an
+    end stop, where the stop holds the elevator and the motor's angle says nothing of the band."""
+    elevator = actuator.gear_ratio * smooth_derivative(np.radians(position_deg), rate)
+    free = np.abs(position_deg) < actuator.end_stop_deg - STOP_MARGIN_DEG
+    return ((elevator * np.sign(speed_radps) > 0.5 * np.abs(speed_radps)) & free).astype(float)
 
 
 def _one_window(
-    signals: Mapping[str, np.ndarray], rate: float, actuator: ActuatorParams, orders: Sequence[float], index: int
+    signals: Mapping[str, np.ndarray], rate: float, actuator: DriveConstants, orders: Sequence[float], index: int
 ) -> Equations:
     signals = as_read(signals, rate)  # the hinge moment as the estimators read it
     t, a, o, mask = (x[0] for x in regressors(signals, rate, actuator, FitSettings()))
@@ -104,7 +109,7 @@ def _one_window(
         "acceleration_radps2": sign * smooth_derivative(signals["motor_speed_radps"], rate),  # as T_R reads it
         "direction": sign,
         "motor_angle_rad": angle,
-        "engaged": engaged(signals["position_deg"], speed, rate, actuator.gear_ratio),
+        "engaged": engaged(signals["position_deg"], speed, rate, actuator),
     }
     return Equations(
         y=t[mask],
@@ -122,7 +127,7 @@ def equations(
     windows: Sequence[Mapping[str, np.ndarray]],
     rate: float,
     orders: Sequence[float],
-    actuator: ActuatorParams,
+    actuator: DriveConstants,
 ) -> Equations:
     """The stacked equation-error problem of ``windows`` (each a dict of signals at ``rate``)."""
     parts = [_one_window(signals, rate, actuator, orders, i) for i, signals in enumerate(windows)]

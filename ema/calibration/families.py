@@ -25,7 +25,7 @@ import numpy as np
 from ema.calibration.equations import Equations
 from ema.calibration.fitting import hats, uniform_knots
 from ema.model.effects import EffectSet, FrictionTable
-from ema.model.params import ActuatorParams
+from ema.model.params import DriveConstants
 
 KNOTS = 9  # piecewise-linear curves: 8 segments over the visited range
 # A friction that changes in time (warming, wear-in) does so smoothly over one log: a line with one
@@ -141,7 +141,7 @@ def _gain_term(effect: str, gain: float) -> EffectSet | None:
     return EffectSet({effect: {"gain": gain}}) if 0.7 <= gain <= 1.3 else None
 
 
-def _torque_shift(e: Equations, true_over_logged: np.ndarray, actuator: ActuatorParams) -> np.ndarray:
+def _torque_shift(e: Equations, true_over_logged: np.ndarray, actuator: DriveConstants) -> np.ndarray:
     """(m, G): what T_R takes for friction when the motor's true torque is sat(r·k_T·I) and the model
     assumes sat(k_T·I), for each ratio r of a grid, as t sees it (times sgn ω). Linear in the
     current until the saturation, which a current-sensor gain below 1 reaches (the loop holds the
@@ -161,7 +161,7 @@ def _offset_term(offset_a: float) -> EffectSet | None:
     return EffectSet({"current_sensor_offset": {"offset_a": offset_a}}) if abs(offset_a) <= 5.0 else None
 
 
-def _offset_shift(e: Equations, offsets_a: np.ndarray, actuator: ActuatorParams) -> np.ndarray:
+def _offset_shift(e: Equations, offsets_a: np.ndarray, actuator: DriveConstants) -> np.ndarray:
     """(m, G): what T_R takes for friction when the current sensor reads o too high, for each o of a grid, as t
     sees it (times sgn ω): the true current is the logged one less o, and the motor's torque is cut at its
     peak (the loop holds the *logged* current at I_max)."""
@@ -218,7 +218,7 @@ def _cogging_parameters(b: np.ndarray, order: float) -> dict[str, float]:
     }
 
 
-def named_families(measured: Equations, actuator: ActuatorParams) -> list[Family]:
+def named_families(measured: Equations, actuator: DriveConstants) -> list[Family]:
     """The vocabulary, shaped on the measured window (a bump's centres span what it visited)."""
     n = actuator.gear_ratio
     bumps = bump_grid(measured.variables["position_rad"])

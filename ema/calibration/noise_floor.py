@@ -18,19 +18,19 @@ import numpy as np
 from ema.calibration.equations import Equations, equations
 from ema.estimate.physics.scenario import inside, scenario_from_window
 from ema.model import runtime
-from ema.model.actuator import Actuator
+from ema.model.actuator import ActuatorDocument
 from ema.model.noise import SensorNoise, add_sensor_noise
-from ema.model.params import ActuatorParams
+from ema.model.params import DriveConstants
 from ema.model.window import Window
 
 COPIES = 30
 
 
 def clean_replicas(
-    windows: Sequence[Window], estimates: Mapping[str, float], actuator: Actuator
+    windows: Sequence[Window], estimates: Mapping[str, float], actuator: ActuatorDocument
 ) -> list[dict[str, np.ndarray]]:
     """Each window simulated at ``estimates`` (FSJ at twice FDJ), without noise."""
-    health = inside(estimates["FDJ"], estimates["eta_O"], actuator.nominal.fdj_nm)
+    health = inside(estimates["FDJ"], estimates["eta_O"], actuator.health.fdj_nm)
     return [
         scenario_from_window(w, actuator.params, actuator.hinge).simulate(health, lanes=1).simulation(0)
         for w in windows
@@ -43,7 +43,7 @@ def noise_copies(
     rate: float,
     orders: Sequence[float],
     seed: int,
-    actuator: ActuatorParams,
+    actuator: DriveConstants,
     copies: int = COPIES,
     on_copy: Callable[[], None] | None = None,
 ) -> list[Equations]:

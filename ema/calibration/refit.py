@@ -1,4 +1,4 @@
-"""Stage 5, the estimates once the effect is in: Eq. 5.1 with its columns, η_A tied by Eq. 3.4.
+"""Stage 6, the estimates once the effect is in: Eq. 5.1 with its columns, η_A tied by Eq. 3.4.
 
 The same profile search over η_O as ``ema.estimate.physics.friction``, with FDJ and the effect's
 coefficients solved in closed form at each point. The physics fit's bias on this window's

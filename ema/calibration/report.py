@@ -1,4 +1,4 @@
-"""Stage 6, the report: the ``ema-calibration/1`` document from what the stages found."""
+"""Stage 7, the report: the ``ema-calibration/1`` document from what the stages found."""
 
 from __future__ import annotations
 

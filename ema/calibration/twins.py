@@ -6,8 +6,9 @@ near top speed, hence how the motor speed and current evolve. An inertia off the
 term in dω/dt, which k_T·I mostly is, and moves how fast the speed follows the current. A current
 sensor and a hinge-moment sensor off zero both leave a constant in T_R; only the first is felt by the
 loop, which regulates the logged current. Each twin is added to the simulator in turn, the window
-simulated at the estimates, and the one whose speed and current stay closer to the measured ones (in
-units of their noise) is named; the other is reported as indistinguishable when the difference is small.
+simulated at the estimates re-fitted with it (each reading at its own FDJ and η_O), and the one whose
+speed and current stay closer to the measured ones (in units of their noise) is named; the other is
+reported as indistinguishable when the difference is small.
 """
 
 from __future__ import annotations
@@ -18,7 +19,8 @@ import numpy as np
 
 from ema.calibration.selection import Evidence
 from ema.estimate.physics.scenario import CLEAR_MARGIN, following_error, inside, scenario_from_window
-from ema.model.actuator import Actuator
+from ema.model.actuator import ActuatorDocument
+from ema.model.effects import EffectSet
 from ema.model.noise import SensorNoise
 from ema.model.window import Window
 
@@ -33,15 +35,16 @@ TWINS = {name: tuple(other for other in group if other != name) for group in GRO
 def output_error(
     windows: Sequence[Window],
     estimates: Mapping[str, float],
-    option: Evidence,
+    option: Evidence | None,
     noise: Sequence[SensorNoise],
-    actuator: Actuator,
+    actuator: ActuatorDocument,
 ) -> float:
-    """Mean over windows of RMS(speed)/σ_speed + RMS(current)/σ_current, simulated with ``option`` added."""
-    effects = option.family.term(option.beta, option.grid)
+    """Mean over windows of RMS(speed)/σ_speed + RMS(current)/σ_current, simulated at ``estimates`` with
+    ``option``'s effect added (None: the base model alone)."""
+    effects = EffectSet() if option is None else option.family.term(option.beta, option.grid)
     if effects is None:
-        return float("inf")  # a gain outside what the simulator admits: not this twin
-    health = inside(estimates["FDJ"], estimates["eta_O"], actuator.nominal.fdj_nm)
+        return float("inf")  # a gain outside what the simulator admits: not this reading
+    health = inside(estimates["FDJ"], estimates["eta_O"], actuator.health.fdj_nm)
     errors = [
         following_error(scenario_from_window(w, actuator.params, actuator.hinge, effects), w, health, level)
         for w, level in zip(windows, noise, strict=True)
@@ -51,13 +54,14 @@ def output_error(
 
 def tell_apart(
     windows: Sequence[Window],
-    estimates: Mapping[str, float],
+    readings: Mapping[str, Mapping[str, float]],
     options: Sequence[Evidence],
     noise: Sequence[SensorNoise],
-    actuator: Actuator,
+    actuator: ActuatorDocument,
 ) -> tuple[Evidence, dict[str, float], bool]:
-    """The twin whose simulation follows the windows best, each one's output error, and whether the call is clear."""
-    errors = {o.family.name: output_error(windows, estimates, o, noise, actuator) for o in options}
+    """The reading whose simulation follows the windows best, each simulated at its own estimates
+    (``readings``, by effect name), each one's output error, and whether the call is clear."""
+    errors = {o.family.name: output_error(windows, readings[o.family.name], o, noise, actuator) for o in options}
     ranked = sorted(options, key=lambda o: errors[o.family.name])
     best, runner = errors[ranked[0].family.name], errors[ranked[1].family.name]
     return ranked[0], errors, runner > (1 + CLEAR_MARGIN) * best

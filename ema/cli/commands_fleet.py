@@ -7,7 +7,17 @@ from pathlib import Path
 
 import click
 
-from ema.cli.options import NothingAnsweredError, actuator, as_json, emit, pipeline_config, sizes
+from ema.cli.commands_remote import DEFAULT_WINDOW_S
+from ema.cli.options import (
+    NothingAnsweredError,
+    actuator,
+    as_json,
+    emit,
+    log_map,
+    log_map_document,
+    pipeline_config,
+    sizes,
+)
 
 ARCHIVE = click.Path(exists=True, path_type=Path)
 
@@ -23,25 +33,32 @@ ARCHIVE = click.Path(exists=True, path_type=Path)
 @click.option("--workers", type=click.IntRange(1, 4096), default=2, help="Ray workers (windows at a time)")
 @click.option("--threads", type=click.IntRange(1, 256), default=1, help="threads (CPUs) each worker reserves")
 @click.option("--ray-address", default=None, help="'auto' or HOST:PORT of a cluster [default: a local Ray]")
-@click.option("--window-s", type=click.FloatRange(0.1, 10.0), default=0.5, help="cut recordings into windows [s]")
+@click.option(
+    "--window-s",
+    type=click.FloatRange(0.1, 3600.0),
+    default=None,
+    help="cut recordings into windows of this length [s]  [default: 0.5; with --log-map, a file is one window]",
+)
 @click.option(
     "--database",
-    type=click.Path(dir_okay=False, path_type=Path),
     default=None,
-    help="also store every answer in this SQLite history (the service's)",
+    help="also store every answer in this history: an SQLite file or a postgresql:// address (the service's)",
 )
 @actuator
+@log_map
 @sizes
 @as_json
 def fleet(
     archive: Path,
+    *,
     out: Path,
     workers: int,
     threads: int,
     ray_address: str | None,
-    window_s: float,
-    database: Path | None,
+    window_s: float | None,
+    database: str | None,
     actuator_file: Path | None,
+    log_map_file: Path | None,
     as_json: bool,
     **size_values: int,
 ) -> None:
@@ -59,13 +76,21 @@ def fleet(
     config = pipeline_config(size_values)
     check_engine(workers, ray_address)
     documents = Documents(read_actuators(archive), None if actuator_file is None else read_actuator(actuator_file))
-    read = read_log(archive, window_s)
+    mapping = log_map_document(log_map_file)
+    read = read_log(archive, window_s or (None if mapping else DEFAULT_WINDOW_S), log_map=mapping)
     report_log(read)
     print(f"ema fleet: {len(read.windows)} window(s) from {archive}, {workers} worker(s)", file=sys.stderr)
-    result = {
-        **run_fleet(read.windows, out, config, workers, ray_address, threads, database, documents),
-        "bad_files": read.bad_files,
-    }
+    run = run_fleet(
+        read.windows,
+        out,
+        config=config,
+        workers=workers,
+        address=ray_address,
+        threads=threads,
+        database=database,
+        documents=documents,
+    )
+    result = {**run, "bad_files": read.bad_files}
     emit(result, as_json, _print_fleet)
     if result["answered"] + result["skipped"] == 0 and result["refused"]:
         raise NothingAnsweredError(f"none of the {result['refused']} window(s) was answered (see {out})")

@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import datetime as dt
 import json
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -14,11 +16,14 @@ from ema.cli.options import (
     as_json,
     emit,
     flags_named,
+    log_map,
+    log_map_document,
     pipeline_config,
     progress,
     sizes,
     threads,
 )
+from ema.model.bounds import MAX_FLIGHT_HOURS
 from ema.model.envelope import DEFAULT_AIRSPEED_MPS
 
 FAMILIES = ("thesis", "cruise", "gust", "doublet", "steps")  # ema.model.commands.FAMILIES, without importing numpy here
@@ -73,29 +78,33 @@ def history_of(window: Any, paths: tuple[Path, ...]) -> Any:
     "its sensors' zero where it is of the window's flight_id",
 )
 @actuator
+@log_map
 @sizes
 @threads
 @as_json
 def estimate(
     window: Path,
+    *,
     history: tuple[Path, ...],
     actuator_file: Path | None,
+    log_map_file: Path | None,
     threads: int | None,
     as_json: bool,
     **size_values: int,
 ) -> None:
-    """Estimate FDJ, η_O, η_A (FSJ where it shows) of one ema-window/1 JSON file, in-process."""
+    """Estimate FDJ, η_O, η_A (FSJ where it shows) of one window, in-process: an ema-window/1 JSON file, a CSV or
+    NPZ in ema's columns (docs/model.md), or a rig's own CSV with --log-map."""
+    from ema.cli.logs import read_one
     from ema.cli.printing import print_estimate
     from ema.estimate import runtime
-    from ema.estimate.pipeline import estimate_window
-    from ema.model.window import read_window
+    from ema.estimate.kinds import estimate as estimate_one
 
     config = pipeline_config(size_values)
     document = actuator_document(actuator_file)
-    read = read_window(window)
+    read = read_one(window, log_map_document(log_map_file))
     known = history_of(read, history) if history else None
     runtime.configure(threads)
-    result = estimate_window(read, config, actuator=document, on_stage=progress, history=known)
+    result = estimate_one(read, config, actuator=document, on_stage=progress, history=known)
     emit(result, as_json, print_estimate)
 
 
@@ -123,13 +132,37 @@ def estimate(
 )
 @click.option("--actuator-id", default="synthetic/elevator", help="actuator_id written to the window")
 @click.option("--truth-out", type=click.Path(dir_okay=False, path_type=Path), help="also write the truth as JSON")
+@click.option(
+    "--recorded-at",
+    type=click.DateTime(formats=["%Y-%m-%dT%H:%M:%S%z", "%Y-%m-%dT%H:%M:%S", "%Y-%m-%d"]),
+    default=None,
+    help="when the window began, written as recorded_at (UTC where no offset is given)",
+)
+@click.option(
+    "--flight-hours", type=click.FloatRange(0, MAX_FLIGHT_HOURS), default=None, help="the airframe's hours then"
+)
+@click.option(
+    "--series",
+    type=click.IntRange(1, 10_000),
+    default=1,
+    help="draw this many windows of a degrading actuator into the folder --out (health from --fdj/--eta-o "
+    "to --fdj-end/--eta-o-end, --every hours apart): a history to try the trend on",
+)
+@click.option(
+    "--every", "every_hours", type=click.FloatRange(0.01, 10_000), default=10.0, help="with --series: hours apart"
+)
+@click.option("--fdj-end", type=float, default=None, help="with --series: FDJ of the last window [N·m]")
+@click.option("--eta-o-end", type=float, default=None, help="with --series: η_O of the last window")
 @actuator
 @as_json
 def simulate(as_json: bool, **options: Any) -> None:
-    """Write a synthetic ema-window/1 file from the model (sensor noise unless --clean)."""
+    """Write a synthetic ema-window/1 file from the model (sensor noise unless --clean), or --series of them."""
     from ema.cli.printing import print_simulate
     from ema.cli.synthesis import synthesize
 
+    stamp = options["recorded_at"]
+    if stamp is not None and stamp.tzinfo is None:
+        options["recorded_at"] = stamp.replace(tzinfo=dt.UTC)
     with flags_named(SIMULATE_FLAGS):
         result = synthesize(**options)
     emit(result, as_json, print_simulate)
@@ -145,34 +178,69 @@ def simulate(as_json: bool, **options: Any) -> None:
     help="also write a PNG of the residual before and after",
 )
 @click.option("--copies", type=click.IntRange(8, 500), default=30, help="noise-only copies behind the noise floor")
+@click.option(
+    "--out-actuator",
+    type=click.Path(dir_okay=False, path_type=Path),
+    default=None,
+    metavar="A2.json",
+    help="a linear actuator: write its document completed with what healthy runs taught (c, I0, the nominal)",
+)
 @actuator
+@log_map
 @sizes
 @threads
 @as_json
 def calibrate(
     windows: tuple[Path, ...],
+    *,
     truth: Path | None,
     figure: Path | None,
     copies: int,
+    out_actuator: Path | None,
     actuator_file: Path | None,
+    log_map_file: Path | None,
     threads: int | None,
     as_json: bool,
     **size_values: int,
 ) -> None:
-    """Trace what the model misses in windows of one actuator to an effect, add it, re-estimate."""
+    """Trace what the model misses in windows of one actuator to an effect, add it, re-estimate; for a linear
+    actuator, learn its drive from healthy runs (--out-actuator), or say what faulted runs changed."""
     from ema.calibration.calibrate import Calibrator
     from ema.cli.figures import calibration_figure
+    from ema.cli.logs import read_one
     from ema.cli.printing import print_calibration, read_truth
     from ema.estimate import runtime
-    from ema.model.window import read_window
 
     config = pipeline_config(size_values)
     runtime.configure(threads)
-    loaded = [read_window(path) for path in windows]
-    calibrator = Calibrator(config, copies=copies, seed=config.seed, actuator=actuator_document(actuator_file))
+    document = actuator_document(actuator_file)
+    mapping = log_map_document(log_map_file)
+    loaded = [read_one(path, mapping) for path in windows]
+    if document.kind == "linear":
+        _calibrate_linear(loaded, document, out_actuator, as_json)
+        return
+    calibrator = Calibrator(config, copies=copies, seed=config.seed, actuator=document)
     calibrator.fit(loaded, read_truth(truth), on_stage=progress)
     written = None if figure is None else str(calibration_figure(calibrator, figure))
     emit({**calibrator.report_.model_dump(mode="json", by_alias=True), "figure": written}, as_json, print_calibration)
+
+
+def _calibrate_linear(windows: list[Any], document: Any, out: Path | None, as_json: bool) -> None:
+    """A linear actuator's calibration: the report, and the completed document where ``out`` asks for it."""
+    from ema.calibration.linear_report import calibrate_linear, refuse_mixed
+    from ema.cli.printing import print_calibration
+    from ema.model.checks import InputError
+
+    refuse_mixed(windows, document)
+    report, completed = calibrate_linear(windows, document)
+    written = None
+    if out is not None:
+        if completed is None:
+            raise InputError("--out-actuator", "the document is calibrated already: these runs were compared with it")
+        out.write_text(completed.model_dump_json(by_alias=True, indent=2, exclude_none=True) + "\n")
+        written = str(out)
+        print(f"ema: wrote the completed document to {out}", file=sys.stderr)
+    emit({**report.model_dump(mode="json", by_alias=True), "actuator_written": written}, as_json, print_calibration)
 
 
 @click.command()

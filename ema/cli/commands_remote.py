@@ -10,10 +10,11 @@ from typing import Any
 
 import click
 
-from ema.cli.options import NothingAnsweredError, as_json, emit, flags_named
+from ema.cli.options import NothingAnsweredError, as_json, emit, flags_named, log_map, log_map_document
 from ema.model.envelope import DEFAULT_AIRSPEED_MPS
 
 URL = "http://127.0.0.1:8000"
+DEFAULT_WINDOW_S = 0.5
 LOG = click.Path(exists=True, path_type=Path)
 KEY_FILE = click.Path(exists=True, dir_okay=False, path_type=Path)
 
@@ -34,23 +35,31 @@ def api_key(path: Path | None) -> str | None:
     default=Path("estimates.csv"),
     help="CSV the answers are appended to (a rerun resumes from it)",
 )
-@click.option("--window-s", type=click.FloatRange(0.1, 10.0), default=0.5, help="cut recordings into windows [s]")
+@click.option(
+    "--window-s",
+    type=click.FloatRange(0.1, 3600.0),
+    default=None,
+    help="cut recordings into windows of this length [s]  [default: 0.5; with --log-map, a file is one window]",
+)
 @click.option("--api-key-file", type=KEY_FILE, default=None, help="file holding the API key [default: EMA_API_KEY]")
 @click.option("--actuator-id", default="unknown", help="for CSV/NPZ logs that carry none")
 @click.option("--rate", type=float, default=10_000.0, help="sample rate [Hz] for CSV/NPZ logs that carry none")
 @click.option("--airspeed", type=float, default=DEFAULT_AIRSPEED_MPS, help="[m/s] for CSV/NPZ logs that carry none")
 @click.option("--altitude", type=float, default=0.0, help="[m] for CSV/NPZ logs that carry none")
+@log_map
 @as_json
 def replay(
     log: Path,
+    *,
     url: str,
     out: Path,
-    window_s: float,
+    window_s: float | None,
     api_key_file: Path | None,
     actuator_id: str,
     rate: float,
     airspeed: float,
     altitude: float,
+    log_map_file: Path | None,
     as_json: bool,
 ) -> None:
     """Post a recorded log (JSON window(s), CSV, NPZ or a folder) to the service, window by window.
@@ -61,7 +70,8 @@ def replay(
 
     defaults = Defaults(actuator_id, rate, airspeed, altitude)
     with flags_named({"sample_rate_hz": "--rate", "airspeed_mps": "--airspeed", "altitude_m": "--altitude"}):
-        read = read_log(log, window_s, defaults)
+        mapping = log_map_document(log_map_file)
+        read = read_log(log, window_s or (None if mapping else DEFAULT_WINDOW_S), defaults, mapping)
     report_log(read)
     print(f"replaying {len(read.windows)} window(s) from {log} to {url}", file=sys.stderr)
     rows = post_all(read.windows, url, out, api_key(api_key_file))

@@ -58,7 +58,7 @@ class Documents:
     """The actuators' ema-actuator/1 documents a run reads its windows with (by actuator_id; the rest with
     ``default``, the thesis's where none is given), and the versions a history stored them under."""
 
-    by_actuator: dict[str, Any] = field(default_factory=dict)  # actuator_id -> ema.model.actuator.Actuator
+    by_actuator: dict[str, Any] = field(default_factory=dict)  # actuator_id -> ema.model.actuator.ActuatorDocument
     default: Any = None  # an Actuator, or None: the thesis's (the answer then says so)
     versions: dict[str, int] = field(default_factory=dict)
 
@@ -178,11 +178,12 @@ def _with_history(
 def run_fleet(
     windows: list[Window],
     out: Path,
+    *,
     config: PipelineConfig,
     workers: int,
     address: str | None,
     threads: int = 1,
-    database: Path | None = None,
+    database: str | Path | None = None,
     documents: Documents = Documents(),
 ) -> dict[str, Any]:
     """Every window of ``windows`` not yet in ``out``, on ``workers`` Ray workers of ``threads`` threads each
@@ -264,7 +265,7 @@ def _stored_documents(store: Any, documents: Documents, actuator_ids: set[str]) 
     return replace(documents, versions=versions)
 
 
-def _store(database: Path | None) -> Any:
+def _store(database: str | Path | None) -> Any:
     if database is None:
         return None
     from ema.history.open import open_history

@@ -16,9 +16,10 @@ from typing import Any
 
 import numpy as np
 
-from ema.model.actuator import Actuator, actuator_from_dict
+from ema.model.actuator import ActuatorDocument, actuator_from_dict
 from ema.model.checks import InputError, load_json
 from ema.model.envelope import DEFAULT_AIRSPEED_MPS
+from ema.model.logmap import LogMap, read_mapped
 from ema.model.window import SIGNALS, Window, window_from_dict
 
 SUFFIXES = (".json", ".csv", ".npz")
@@ -114,9 +115,12 @@ def _window(signals: dict[str, np.ndarray], meta: dict[str, Any], defaults: Defa
     return window_from_dict(document)
 
 
-def read_file(path: Path, defaults: Defaults = Defaults()) -> list[Window]:
-    """Every window in one file; errors name the file."""
+def read_file(path: Path, defaults: Defaults = Defaults(), log_map: LogMap | None = None) -> list[Window]:
+    """Every window in one file (a CSV through ``log_map`` where one is given: ``ema.model.logmap``); errors
+    name the file."""
     readers = {".json": lambda: _from_json(path), ".csv": lambda: _from_csv(path, defaults)}
+    if log_map is not None:
+        readers[".csv"] = lambda: [window_from_dict(read_mapped(path, log_map))]
     readers[".npz"] = lambda: _from_npz(path, defaults)
     if path.suffix.lower() not in readers:
         raise InputError(str(path), f"is not a {'/'.join(SUFFIXES)} file")
@@ -140,10 +144,10 @@ class Log:
     bad_files: dict[str, str]  # file -> why it was skipped
 
 
-def read_log(path: Path, window_s: float, defaults: Defaults = Defaults()) -> Log:
+def read_log(path: Path, window_s: float | None, defaults: Defaults = Defaults(), log_map: LogMap | None = None) -> Log:
     """The windows of a file, or of a folder's files in name order, long recordings cut to ``window_s``. A
     bad file given alone is an InputError naming it; in a folder it is skipped and listed, and only a folder
-    with no readable window is an error."""
+    with no readable window is an error. ``window_s`` None: every file's windows as they are."""
     path = Path(path)
     if not path.exists():
         raise InputError(str(path), "does not exist")
@@ -158,14 +162,14 @@ def read_log(path: Path, window_s: float, defaults: Defaults = Defaults()) -> Lo
     bad: dict[str, str] = {}
     for file in files:
         try:
-            recordings = read_file(file, defaults)
+            recordings = read_file(file, defaults, log_map)
         except InputError as exc:
             if not path.is_dir():
                 raise
             bad[str(file)] = exc.message
             continue
         for recording in recordings:
-            pieces, tail = cut(recording, window_s)
+            pieces, tail = cut(recording, window_s) if window_s is not None else ([recording], 0)
             windows.extend(pieces)
             if tail:
                 dropped[pieces[-1].window_id] = tail
@@ -175,7 +179,7 @@ def read_log(path: Path, window_s: float, defaults: Defaults = Defaults()) -> Lo
     return Log(windows, dropped, bad)
 
 
-def read_actuators(folder: Path) -> dict[str, Actuator]:
+def read_actuators(folder: Path) -> dict[str, ActuatorDocument]:
     """The documents of an archive's actuators, from its ``ACTUATORS_FILE`` (none where it has none); a bad
     one is an InputError naming the file and the actuator."""
     path = Path(folder) / ACTUATORS_FILE
@@ -191,3 +195,12 @@ def read_actuators(folder: Path) -> dict[str, Actuator]:
         except InputError as exc:
             raise InputError(f"{path}: {actuator_id}: {exc.field}", exc.message) from None
     return read
+
+
+def read_one(path: Path, log_map: LogMap | None = None) -> Window:
+    """The one window of a file (JSON, CSV or NPZ, a CSV through ``log_map``): what ``ema estimate`` reads; a
+    file of several is refused naming it (``ema replay`` posts each)."""
+    windows = read_file(Path(path), Defaults(), log_map)
+    if len(windows) != 1:
+        raise InputError(str(path), f"holds {len(windows)} windows: ema estimate reads one (ema replay posts each)")
+    return windows[0]

@@ -52,6 +52,24 @@ def actuator_document(path: Path | None) -> Any:
     return THESIS if path is None else read_actuator(path)
 
 
+def log_map(function: F) -> F:
+    return click.option(
+        "--log-map",
+        "log_map_file",
+        type=click.Path(exists=True, dir_okay=False, path_type=Path),
+        default=None,
+        metavar="M.json",
+        help="an ema-logmap/1 document: read CSV logs in the rig's own columns and units",
+    )(function)
+
+
+def log_map_document(path: Path | None) -> Any:
+    """The log map in ``path``, or None."""
+    from ema.model.logmap import read_logmap
+
+    return None if path is None else read_logmap(path)
+
+
 def as_json(function: F) -> F:
     return click.option("--json", "as_json", is_flag=True, help="print one JSON document")(function)
 

@@ -12,14 +12,16 @@ def documents() -> dict[str, type[BaseModel]]:
     """File stem -> the model (imported here: the CLI's help must not pay for them)."""
     from ema.calibration.documents import CalibrationReport
     from ema.estimate.documents import Estimate
-    from ema.model.actuator import Actuator
+    from ema.model.actuator import ActuatorDocument
+    from ema.model.logmap import LogMap
     from ema.model.window import WindowDocument
     from ema.prognosis.documents import ActuatorSummary, History, Prognosis, StoredActuator, Withdrawal
 
     return {
-        "ema-actuator-1": Actuator,
+        "ema-actuator-1": ActuatorDocument,
         "stored-actuator": StoredActuator,
         "ema-window-1": WindowDocument,
+        "ema-logmap-1": LogMap,
         "ema-estimate-1": Estimate,
         "ema-calibration-1": CalibrationReport,
         "history": History,

@@ -2,14 +2,16 @@
 
 from __future__ import annotations
 
+import datetime as dt
 import json
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from ema.cli.options import actuator_document
-from ema.model.actuator import Actuator
+from ema.model.actuator import ActuatorDocument
 from ema.model.aircraft import FlightCondition, GroundLoad
 from ema.model.checks import InputError
 from ema.model.effects import EffectSet
@@ -35,7 +37,7 @@ def parse_effect(text: str) -> tuple[str, dict[str, float]]:
     return name.strip(), parameters
 
 
-def summary(window: Window, actuator: Actuator) -> dict[str, Any]:
+def summary(window: Window, actuator: ActuatorDocument) -> dict[str, Any]:
     """Ranges of the signals and of the reconstructed residual torque, for a human or a script."""
     s = window.signals
     residual = residual_torque_nm(
@@ -56,6 +58,7 @@ def summary(window: Window, actuator: Actuator) -> dict[str, Any]:
 
 
 def synthesize(
+    *,
     out: Path,
     fdj: float | None,
     eta_o: float | None,
@@ -74,9 +77,17 @@ def synthesize(
     actuator_id: str,
     truth_out: Path | None,
     actuator_file: Path | None,
+    recorded_at: dt.datetime | None = None,
+    flight_hours: float | None = None,
+    series: int = 1,
+    every_hours: float = 10.0,
+    fdj_end: float | None = None,
+    eta_o_end: float | None = None,
 ) -> dict[str, Any]:
     """Simulate the actuator of ``actuator_file`` (the thesis's by default) at the given health (its nominal
-    where none is given), write the window (and the truth), return what was written."""
+    where none is given), write the window (and the truth), return what was written. With ``series`` > 1,
+    ``out`` is a folder of that many windows of a degrading actuator, its health moving linearly to
+    ``fdj_end`` and ``eta_o_end``, ``every_hours`` flight hours apart (and as many hours apart in recorded_at)."""
     actuator = actuator_document(actuator_file)
     nominal = actuator.nominal
     health = {
@@ -84,28 +95,47 @@ def synthesize(
         "eta_O": nominal.eta_o if eta_o is None else eta_o,
         "FSJ": nominal.fsj_nm if fsj is None else fsj,
     }
+    end = {
+        "FDJ": health["FDJ"] if fdj_end is None else fdj_end,
+        "eta_O": health["eta_O"] if eta_o_end is None else eta_o_end,
+    }
     effects = EffectSet(dict(parse_effect(text) for text in effect))
     load = GroundLoad(load_nm, load_ramp_nmps) if ground else FlightCondition(airspeed, altitude)
     noise = NO_NOISE if clean else actuator.noise
-    window = synthetic_window(
-        HealthParams.single(fsj_nm=health["FSJ"], fdj_nm=health["FDJ"], eta_o=health["eta_O"]),
-        load,
-        seed=seed,
-        duration_s=duration,
-        sample_rate_hz=rate,
-        noise=noise,
-        effects=effects,
-        actuator_id=actuator_id,
-        command=command,
-        actuator=actuator,
-    )
-    write_window(window, out)
+    if series > 1:
+        out.mkdir(parents=True, exist_ok=True)
+    written, truths = [], []
+    for i in range(series):
+        share = i / max(series - 1, 1)
+        now = {name: health[name] + share * (end[name] - health[name]) for name in end} | {"FSJ": health["FSJ"]}
+        now["FSJ"] = max(now["FSJ"], now["FDJ"])  # static friction never below dynamic
+        window = synthetic_window(
+            HealthParams.single(fsj_nm=now["FSJ"], fdj_nm=now["FDJ"], eta_o=now["eta_O"]),
+            load,
+            seed=seed + i,
+            duration_s=duration,
+            sample_rate_hz=rate,
+            noise=noise,
+            effects=effects,
+            actuator_id=actuator_id,
+            command=command,
+            actuator=actuator,
+        )
+        hours = None if flight_hours is None and series == 1 else (flight_hours or 0.0) + i * every_hours
+        stamp = None if recorded_at is None else (recorded_at + dt.timedelta(hours=i * every_hours)).isoformat()
+        window_id = f"series-{seed}-{i:03d}" if series > 1 else window.window_id
+        window = replace(window, window_id=window_id, flight_hours=hours, recorded_at=stamp)
+        path = out / f"{window.window_id}.json" if series > 1 else out
+        write_window(window, path)
+        written.append(str(path))
+        truths.append({**now, "eta_A": float(actuator.eta_a(now["eta_O"])), "flight_hours": hours})
     if truth_out is not None:
-        truth_out.write_text(json.dumps(health, indent=2))
+        truth_out.write_text(json.dumps(truths[0] if series == 1 else truths, indent=2))
     return {
-        "window": str(out),
+        "window": written[0] if series == 1 else str(out),
+        "windows": written,
         "actuator": actuator.name,
-        "truth": {**health, "eta_A": float(actuator.eta_a(health["eta_O"]))},
+        "truth": truths[0] if series == 1 else truths,
         "command": command,
         "load": "ground" if ground else "flight",
         "effects": effects.as_dict(),

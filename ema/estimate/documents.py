@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from typing import Annotated, Any, Literal
 
-from pydantic import BaseModel, BeforeValidator, ConfigDict, Field
+from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, model_validator
 
 from ema.estimate.config import PipelineConfig
 
@@ -41,6 +41,9 @@ NoteCode = Literal[
     "default_actuator",
     "on_ground",
     "no_load",
+    "low_rate",
+    "current_at_zero_torque",
+    "current_per_nm",
     # how the answer was reached, and how far to trust it
     "network_absent",
     "network_too_few_checks",
@@ -127,16 +130,41 @@ class Estimates(Document):
     FSD: RatioEstimate | None = None
 
 
+STAGES = ("prepare", "physics", "simulate", "learn", "assess", "check", "report")  # the pipeline's, in order
+
+
 class Timings(Document):
-    """Seconds of each stage of ``ema.estimate.pipeline``, in order."""
+    """Seconds of each stage of ``ema.estimate.pipeline``, in order (``STAGES``); a stage that did not run for
+    this window (a low-rate window reads no simulations) is 0, and ``stages`` in the estimate says why."""
 
     prepare: float = Field(0.0, description="the window checked, repaired, aligned, its departures read")
     physics: float = Field(0.0, description="Eq. 5.1 fitted by least squares")
-    simulate: float = Field(description="the window's own dataset simulated")
-    train: float = Field(description="the network trained")
-    predict: float = Field(description="assess: both estimators on held-out simulations, blended")
-    check: float = Field(0.0, description="the window simulated at the answer, and FSJ read")
+    simulate: float = Field(0.0, description="the window's own dataset simulated")
+    learn: float = Field(0.0, description="the network trained")
+    assess: float = Field(0.0, description="both estimators on held-out simulations, weighed and blended")
+    check: float = Field(0.0, description="the window simulated at the answer")
+    report: float = Field(0.0, description="FSJ read at the answer, the notes and the document")
     total: float
+    train: float | None = Field(None, description="deprecated alias of learn (ema-estimate/1 as first published)")
+    predict: float | None = Field(None, description="deprecated alias of assess (ema-estimate/1 as first published)")
+
+    @model_validator(mode="before")
+    @classmethod
+    def _stage_names(cls, values: Any) -> Any:
+        """Stages under their names; a result stored under the first names (train, predict) read as such, and the
+        old names given beside the new ones for one schema version."""
+        if isinstance(values, dict):
+            values = dict(values)
+            for new, old in (("learn", "train"), ("assess", "predict")):
+                if values.get(new) is None and values.get(old) is not None:
+                    values[new] = values[old]
+                if values.get(new) is not None and values.get(old) is None:
+                    values[old] = values[new]
+        return values
+
+    def stages(self) -> dict[str, float]:
+        """Each stage's seconds, in order, under its one name."""
+        return {stage: getattr(self, stage) for stage in STAGES}
 
 
 class MethodReport(Document):
@@ -162,6 +190,11 @@ class FitCheck(Document):
     reproduced: bool = Field(description="the model at these estimates reproduces the window within its noise")
     equation_error_ratio: float = Field(
         description="RMS of the window's Eq. 5.1 residual over what sensor noise alone leaves in simulations (≈ 1)"
+    )
+    equation_error_limit: float | None = Field(
+        None,
+        description="the ratio a window the model explains exceeds 1 % of the time (the held-out simulations' own "
+        "spread): beyond it the note model_misfit says the model lacks something (null: not tested)",
     )
     output_error_ratio: dict[str, float] = Field(
         description="per signal: RMS(measured − simulated at the estimates) over the noise-only floor"
@@ -331,8 +364,13 @@ class Estimate(Document):
     irreversible: bool = Field(description="η_A < 0: the load can never back-drive the transmission (thesis Case 1C)")
     notes: Notes = Field(default_factory=list, description="what a reader of this answer should know")
     timings_s: Timings
-    dataset: DatasetInfo
-    training: TrainingInfo
+    stages: dict[str, str] = Field(
+        default_factory=dict,
+        description="each stage of the pipeline (STAGES): 'run', or 'skipped: ' and why (a window logged under 1 kHz "
+        "is read quasi-statically: no simulation, network or check against a 1 µs simulation)",
+    )
+    dataset: DatasetInfo | None = Field(description="the window's own simulations (null: skipped, see stages)")
+    training: TrainingInfo | None = Field(description="the network's training (null: skipped, see stages)")
     methods: dict[str, MethodReport]
     fit_check: FitCheck
     window: WindowInfo

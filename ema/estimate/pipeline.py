@@ -25,7 +25,7 @@ from dataclasses import replace
 import numpy as np
 
 from ema.estimate.assess.reproduction import output_error_ratios
-from ema.estimate.assess.weighing import Assessed, Candidates, assess
+from ema.estimate.assess.weighing import Assessed, Candidates, assess, misfit_limit
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import ActuatorRead, Estimate, FitCheck, HistoryReadings, Note, Timings
 from ema.estimate.history import known_from
@@ -38,7 +38,7 @@ from ema.estimate.physics.static_friction import read_static_friction
 from ema.estimate.prepare.conditioning import prepare, widened
 from ema.estimate.report import estimate_document
 from ema.estimate.simulate.dataset import Data, simulate_dataset
-from ema.model.actuator import THESIS, Actuator
+from ema.model.actuator import THESIS, ActuatorDocument
 from ema.model.window import Window
 
 # On a few dozen noisy simulations the network stops improving within a few epochs, and the physics fit
@@ -59,7 +59,7 @@ def candidates(
 ) -> tuple[Candidates, FrictionFit]:
     """Physics and network on the window and on the held-out simulations (and the physics fit of those)."""
     held = {name: values[n:] for name, values in data.sims.signals.items()}
-    check_physics = fit_friction(held, window.sample_rate_hz, data.actuator, residual_nm=data.sims.residual_nm[n:])
+    check_physics = fit_friction(held, window.sample_rate_hz, data.drive_as_read, residual_nm=data.sims.residual_nm[n:])
     unit = network.predict_unit(np.vstack([data.inputs[n:], data.window_inputs]))
     fdj, eta_o = data.box.denormalize(unit)
     health = data.sims.health
@@ -88,7 +88,16 @@ def fit_check(
     health = inside(answer.values["FDJ"], answer.values["eta_O"], nominal_fdj_nm)
     floor = float(np.sqrt(np.mean((data.sims.residual_nm[n:] - data.sims.clean_residual_nm)[:, data.sliding] ** 2)))
     known = data.sims.reference_signals if health.identical(data.sims.reference) else None
-    ratios = output_error_ratios(window, data.scenario, health, data.noise, floor, data.sliding, data.actuator, known)
+    ratios = output_error_ratios(
+        window,
+        data.scenario,
+        health,
+        noise=data.noise,
+        residual_floor_nm=floor,
+        sliding=data.sliding,
+        actuator=data.drive_as_read,
+        simulated_at_health=known,
+    )
     reproduced = ratios["residual_torque"] <= MAX_RATIO
     notes = list(answer.notes)
     if not reproduced:
@@ -126,23 +135,14 @@ class Stopwatch:
         self.seconds[name] = time.perf_counter() - started
 
     def timings(self) -> Timings:
-        s = self.seconds
-        return Timings(
-            prepare=s["prepare"],
-            physics=s["physics"],
-            simulate=s["simulate"],
-            train=s["train"],
-            predict=s["assess"],
-            check=s["check"],
-            total=sum(s.values()),
-        )
+        return Timings(**self.seconds, total=sum(self.seconds.values()))
 
 
 def estimate_window(
     window: Window,
     config: PipelineConfig = PipelineConfig(),
     *,
-    actuator: Actuator,
+    actuator: ActuatorDocument,
     version: int | None = None,
     on_stage: Callable[[str], None] | None = None,
     spec_only: bool = False,
@@ -165,23 +165,36 @@ def estimate_window(
         w, n = prepared.window, config.n_simulations
         seen = replace(w, signals=as_read(w.signals, w.sample_rate_hz))
     with watch("physics", "fitting Eq. 5.1"):
-        physics = fit_window(seen.signals, w.sample_rate_hz, prepared.actuator)
+        physics = fit_window(seen.signals, w.sample_rate_hz, prepared.drive_as_read)
     with watch("simulate", f"simulating {config.total_simulations} windows around the physics estimate"):
         effects = prepared.departures.viscosity.effects()
-        data = simulate_dataset(w, seen, physics, config, actuator, prepared.actuator, effects)
-    with watch("train", f"training {config.members} network(s) of {config.hidden_units} neurons"):
+        data = simulate_dataset(w, seen, physics, config, actuator, prepared.drive_as_read, effects)
+    with watch("learn", f"training {config.members} network(s) of {config.hidden_units} neurons"):
         network = train_network(data, config)
     with watch("assess", "weighing the estimators on held-out simulations"):
         found, check_physics = candidates(w, physics, data, network, n)
         floor = np.median(check_physics.residual_rms_nm) if len(check_physics.residual_rms_nm) else np.nan
         equation_ratio = float(physics.residual_rms_nm[0] / floor) if np.isfinite(floor) else 1.0
-        answer = assess(found, equation_ratio)
+        limit = misfit_limit(check_physics.residual_rms_nm)
+        answer = assess(found, equation_ratio, limit)
         answer = replace(answer, stds=widened(answer.stds, prepared))
     with watch("check", "checking the answer against the window"):
-        check = fit_check(seen, data, answer, equation_ratio, n, actuator.nominal.fdj_nm)
+        check = fit_check(seen, data, answer, equation_ratio, n, actuator.health.fdj_nm)
+        check = check.model_copy(update={"equation_error_limit": limit})
+    with watch("report", "reading FSJ at the answer, writing the report"):
         fsj = read_static_friction(
-            seen.signals, w.sample_rate_hz, answer.values["FDJ"], answer.values["eta_O"], data.actuator, data.noise
+            seen.signals, w.sample_rate_hz, answer.values["FDJ"], answer.values["eta_O"], data.drive_as_read, data.noise
         )
-    return estimate_document(
-        prepared, physics, data, network, answer, check, fsj, config, watch.timings(), digest, read_with
-    )
+        document = estimate_document(
+            prepared=prepared,
+            physics=physics,
+            data=data,
+            network=network,
+            answer=answer,
+            check=check,
+            fsj=fsj,
+            config=config,
+            digest=digest,
+            read_with=read_with,
+        )
+    return document.model_copy(update={"timings_s": watch.timings()})

@@ -14,8 +14,8 @@ from typing import Any
 from ema.estimate import runtime
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import Estimate, HistoryReadings
-from ema.estimate.pipeline import estimate_window
-from ema.model.actuator import THESIS, Actuator, actuator_from_dict
+from ema.estimate.kinds import estimate
+from ema.model.actuator import THESIS, ActuatorDocument, actuator_from_dict
 from ema.model.checks import InputError
 from ema.model.window import Window, window_from_dict, window_to_dict
 
@@ -30,12 +30,12 @@ def estimate_document(
 ) -> dict[str, Any]:
     """The estimate of one window as a JSON-able dict, or {"error": {"field", "message"}} for a window refused;
     ``history``: what other windows of the actuator read, ``actuator``: its ema-actuator/1 document and
-    ``version`` (none: the default, ``ema.model.actuator.THESIS``; ``estimate_window``)."""
+    ``version`` (none: the default, ``ema.model.actuator.THESIS``; ``ema.estimate.kinds.estimate``)."""
     runtime.configure(threads)
     known = None if history is None else HistoryReadings.model_validate(history)
     try:
         document = THESIS if actuator is None else actuator_from_dict(actuator)
-        result = estimate_window(
+        result = estimate(
             window_from_dict(window), PipelineConfig(**config), actuator=document, version=version, history=known
         )
     except InputError as exc:
@@ -67,7 +67,7 @@ def estimate_on_ray(
     config: PipelineConfig,
     threads: int,
     history: HistoryReadings | None = None,
-    actuator: Actuator = THESIS,
+    actuator: ActuatorDocument = THESIS,
     version: int | None = None,
 ) -> Estimate:
     """``estimate_window`` run as a Ray task (the service's EMA_BACKEND=ray); blocks this thread until done."""

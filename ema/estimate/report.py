@@ -11,6 +11,7 @@ import numpy as np
 from ema.estimate.assess.weighing import Assessed
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import (
+    STAGES,
     TARGETS,
     ActuatorRead,
     DatasetInfo,
@@ -32,7 +33,7 @@ from ema.estimate.physics.static_friction import StaticFriction
 from ema.estimate.prepare.conditioning import Prepared, conditioning_done, conditioning_notes
 from ema.estimate.prepare.departures.drive_constants import KERNEL_FREE_RATE_HZ
 from ema.estimate.simulate.dataset import Data
-from ema.model.actuator import Actuator
+from ema.model.actuator import ActuatorDocument
 from ema.model.hinge import denoised_hinge_nm
 from ema.model.params import HealthRanges
 
@@ -41,7 +42,7 @@ WEAK_SHARE_OF_RANGE = 0.10
 
 
 def healthy_range(name: str, ranges: HealthRanges) -> tuple[float, float]:
-    """The healthy range of FDJ or eta_O (``ema.model.actuator.Actuator.ranges``)."""
+    """The healthy range of FDJ or eta_O (``ema.model.actuator.ActuatorDocument.ranges``)."""
     return ranges.fdj_nm if name == "FDJ" else ranges.eta_o
 
 
@@ -56,12 +57,14 @@ def weakly_determined(name: str, std: float, ranges: HealthRanges) -> bool:
     return share_of_range(name, 2 * std, ranges) > WEAK_SHARE_OF_RANGE
 
 
-def _estimates(answer: Assessed, fsj: StaticFriction, eta_o_bound: bool, actuator: Actuator, loaded: bool) -> Estimates:
+def _estimates(
+    answer: Assessed, fsj: StaticFriction, eta_o_bound: bool, actuator: ActuatorDocument, loaded: bool
+) -> Estimates:
     """FDJ and η_O as assessed, η_A by Eq. 3.4 with the actuator's gear ratio (its std through the derivative),
     FSJ and FSD if read; each weakly determined where its std says so, and both where Eq. 5.1 put η_O at a
     bound (``eta_o_bound``): FDJ was read with η_O held there. Without a load (``loaded``) η_O and η_A are
     none: no load, no efficiency."""
-    ranges, nominal = actuator.ranges, actuator.nominal
+    ranges, nominal = actuator.ranges, actuator.health
     eta_o, eta_o_std = answer.values["eta_O"], answer.stds["eta_O"]
     slope = float((actuator.eta_a(eta_o + 1e-6) - actuator.eta_a(eta_o - 1e-6)) / 2e-6)
     fdj = answer.values["FDJ"]
@@ -80,7 +83,7 @@ def _estimates(answer: Assessed, fsj: StaticFriction, eta_o_bound: bool, actuato
         FDJ=parameter(fdj, answer.stds["FDJ"], nominal.fdj_nm, weak_fdj),
         eta_O=parameter(eta_o, eta_o_std, nominal.eta_o, weak_eta) if loaded else None,
         eta_A=eta_a if loaded else None,
-        FSJ=None if fsj.value_nm is None else parameter(fsj.value_nm, fsj.std_nm, nominal.fsj_nm),
+        FSJ=None if fsj.value_nm is None else parameter(fsj.value_nm, fsj.std_nm, nominal.fsj_nm or fsj.value_nm),
         FSD=ratio,
     )
 
@@ -153,8 +156,8 @@ def carries_load(prepared: Prepared) -> bool:
     sliding = np.abs(w.signals["motor_speed_radps"]) > FitSettings().sliding_speed_radps(document.params)
     if not np.any(sliding):
         return True  # nothing slides: the physics fit refuses the window, not this rule
-    term = (1.0 / document.nominal.eta_o - 1.0) * np.sqrt(np.mean((load_nm[sliding] / document.gear_ratio) ** 2))
-    return bool(term >= NO_LOAD_SHARE * document.nominal.fdj_nm)
+    term = (1.0 / document.health.eta_o - 1.0) * np.sqrt(np.mean((load_nm[sliding] / document.gear_ratio) ** 2))
+    return bool(term >= NO_LOAD_SHARE * document.health.fdj_nm)
 
 
 def _window_info(prepared: Prepared, data: Data, digest: str) -> WindowInfo:
@@ -189,6 +192,7 @@ def _window_info(prepared: Prepared, data: Data, digest: str) -> WindowInfo:
 
 
 def estimate_document(
+    *,
     prepared: Prepared,
     physics: FrictionFit,
     data: Data,
@@ -197,12 +201,12 @@ def estimate_document(
     check: FitCheck,
     fsj: StaticFriction,
     config: PipelineConfig,
-    timings: Timings,
     digest: str,
     read_with: ActuatorRead,
 ) -> Estimate:
-    """The document of one window's run; ``digest``: the window's content as posted (``Window.content_sha256``),
-    ``read_with``: the actuator's document it was read with."""
+    """The document of one window's run (its timings are the caller's to fill in: the report is a stage too);
+    ``digest``: the window's content as posted (``Window.content_sha256``), ``read_with``: the actuator's document
+    it was read with."""
     w = prepared.window
     loaded = carries_load(prepared)
     estimates = _estimates(answer, fsj, bool(physics.at_search_edge[0]), prepared.document, loaded)
@@ -227,7 +231,8 @@ def estimate_document(
         fsj_note=fsj.reason,
         irreversible=estimates.eta_A is not None and estimates.eta_A.value < 0,
         notes=notes,
-        timings_s=timings,
+        timings_s=Timings(total=0.0),
+        stages=dict.fromkeys(STAGES, "run"),
         dataset=DatasetInfo(
             n_simulations=config.n_simulations,
             n_timesteps=data.inputs.shape[1],

@@ -28,7 +28,7 @@ from ema.estimate.documents import Estimate, HistoryReadings, InertiaReading, Se
 from ema.estimate.history import lent
 from ema.history.errors import ConflictError, StorageError
 from ema.history.tables import actuators, calibrations, estimates, summaries, withdrawals
-from ema.model.actuator import Actuator
+from ema.model.actuator import ActuatorDocument
 from ema.prognosis.documents import Stored, StoredActuator, Withdrawal
 
 VERSION_ATTEMPTS = 20  # replicas racing for an actuator's next document version
@@ -158,7 +158,7 @@ class SqlHistory:
             ).all()
         return [Withdrawal(actuator_id=actuator_id, **row._mapping) for row in rows]
 
-    def put_actuator(self, actuator_id: str, document: Actuator) -> StoredActuator:
+    def put_actuator(self, actuator_id: str, document: ActuatorDocument) -> StoredActuator:
         """Store ``document`` as the actuator's next version (the latest version itself where it is the same
         document: a PUT repeated stores nothing new). Earlier versions stay, as do the estimates read with them."""
         text = document.model_dump_json(by_alias=True)
@@ -195,7 +195,7 @@ class SqlHistory:
         row = self._latest_document(actuator_id)
         if row is None:
             return None
-        document = Actuator.model_validate_json(row.document)
+        document = ActuatorDocument.model_validate_json(row.document)
         return StoredActuator(actuator_id=actuator_id, version=row.version, stored_at=row.stored_at, document=document)
 
     def add_calibration(self, actuator_id: str, report: CalibrationReport) -> None:
@@ -277,7 +277,7 @@ class SqlHistory:
                 actuator_id=row.actuator_id,
                 version=row.version,
                 stored_at=row.stored_at,
-                document=Actuator.model_validate_json(row.document),
+                document=ActuatorDocument.model_validate_json(row.document),
             )
             for row in rows
         }

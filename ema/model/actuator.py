@@ -2,7 +2,7 @@
 friction, backlash, end stops) with its own constants, as its user writes it down.
 
 :class:`Actuator` is the document and what every stage reads its constants from: the drive's constants
-(``params``: the simulator's :class:`~ema.model.params.ActuatorParams`, same field names), the nominal health and
+(``params``: the simulator's :class:`~ema.model.params.DriveConstants`, same field names), the nominal health and
 the healthy range around it (``ranges``), the prognosis's failure levels (``thresholds``), and optionally
 the sensors' noise and the airframe the hinge moment is checked against. ``THESIS`` is the thesis's
 elevator EMA (Table 3.1), the default wherever a user names none; ``examples/actuator.json`` holds it.
@@ -18,15 +18,16 @@ from pydantic import AllowInfNan, BaseModel, ConfigDict, Field, Strict, Validati
 
 from ema.model.aircraft import HingeGeometry
 from ema.model.checks import InputError, from_validation, read_document
-from ema.model.params import MAX_CORRELATION_S, ActuatorParams, HealthRanges, eta_a_from_eta_o
+from ema.model.params import MAX_CORRELATION_S, DriveConstants, HealthRanges, eta_a_from_eta_o
 
 if TYPE_CHECKING:
     from ema.model.noise import SensorNoise
 
 SCHEMA = "ema-actuator/1"
+DEFAULT_ETA_O_BELOW, THESIS_ETA_O = 0.70, 0.85  # the prognosis's default η_O threshold, at the thesis's nominal
 HEALTHY_SPAN = 0.2  # the healthy range: nominal ±20 % (η_O capped below 1), the thesis's §5.4 ranges
 MAX_HEALTHY_ETA_O = 0.98
-STEP_S = ActuatorParams().step_s  # the simulator's 1 µs step: the current loop must be stable at it
+STEP_S = DriveConstants().step_s  # the simulator's 1 µs step: the current loop must be stable at it
 
 Number = Annotated[float, Strict(), AllowInfNan(False)]
 
@@ -62,16 +63,62 @@ class Drive(_Part):
         return self
 
 
+class Screw(_Part):
+    """A linear actuator: a ball screw turned by its motor, and what the drive's logged current says of the motor's
+    torque. A stepper's drive is no current loop ema can simulate: its current per N·m and its current at zero
+    torque are on no data sheet, and ``ema calibrate`` learns them from healthy runs at two loads."""
+
+    lead_mm: Number = Field(gt=0, le=1000, description="the screw's lead: travel per motor revolution [mm]")
+    motor: Literal["stepper"] = Field(
+        "stepper", description="the drive (a stepper: its current is read quasi-statically)"
+    )
+    holding_torque_nm: Number | None = Field(None, gt=0, le=1e4, description="the motor's holding torque (data sheet)")
+    current_per_nm_a: Number | None = Field(
+        None,
+        gt=0,
+        le=1e3,
+        description="c: drive current per N·m of motor torque along the motion (null: not yet learned)",
+    )
+    current_per_nm_std_a: Number | None = Field(None, ge=0, le=1e3, description="its std as learned")
+    current_at_zero_torque_a: Number | None = Field(
+        None,
+        ge=0,
+        le=1e3,
+        description="I0: the current that holds the motor with no torque; a window at rest reads its own",
+    )
+    current_at_zero_torque_std_a: Number | None = Field(
+        None, ge=0, le=1e3, description="I0's spread from one day to the next, for a window that never rests"
+    )
+    eta_o_std: Number | None = Field(None, ge=0, lt=1, description="the std of the nominal η_O as learned")
+    repeatability_nm: Number | None = Field(
+        None, ge=0, le=100, description="the run-to-run std of FDJ beyond each run's own noise, as learned"
+    )
+    stroke_profile_a: list[list[Number]] | None = Field(
+        None, description="the healthy runs' current along each stroke (up, then down; less its mean), binned"
+    )
+
+    @property
+    def gear_ratio(self) -> float:
+        """Motor radians per metre of travel, 2π/lead: the screw's transmission ratio in Eq. 3.4."""
+        return 2.0 * np.pi / (self.lead_mm / 1000.0)
+
+    def load_torque_nm(self, force_n: np.ndarray | float) -> np.ndarray:
+        """The load force as a torque at the motor, F·lead/2π."""
+        return np.asarray(force_n) * (self.lead_mm / 1000.0) / (2.0 * np.pi)
+
+
 class Nominal(_Part):
     """The health of this actuator new."""
 
     fdj_nm: Number = Field(gt=0, le=100, description="FDJ, dynamic friction at the motor shaft")
-    fsj_nm: Number = Field(gt=0, le=100, description="FSJ, static (break-away) friction at the motor shaft")
+    fsj_nm: Number | None = Field(
+        None, gt=0, le=100, description="FSJ, static (break-away) friction at the motor shaft (a rotary actuator's)"
+    )
     eta_o: Number = Field(gt=0, lt=1, description="η_O, efficiency under opposing load")
 
     @model_validator(mode="after")
     def _static_at_least_dynamic(self) -> Nominal:
-        if self.fsj_nm < self.fdj_nm:
+        if self.fsj_nm is not None and self.fsj_nm < self.fdj_nm:
             raise ValueError(
                 f"fsj_nm: {self.fsj_nm:g} is below fdj_nm {self.fdj_nm:g}: static friction is never below dynamic"
             )
@@ -82,7 +129,9 @@ class Thresholds(_Part):
     """Where each parameter ends the actuator's useful life (the prognosis's failure levels)."""
 
     fdj_above_nm: Number | None = Field(None, gt=0, le=100, description="default: 1.5x the nominal FDJ")
-    eta_o_below: Number | None = Field(None, gt=0, lt=1, description="default: 0.70")
+    eta_o_below: Number | None = Field(
+        None, gt=0, lt=1, description="default: 0.70, or 0.70/0.85 of a nominal η_O below 0.85"
+    )
 
 
 class SensorNoiseDocument(_Part):
@@ -118,19 +167,38 @@ class Airframe(_Part):
     )
 
 
-class Actuator(_Part):
+class ActuatorDocument(_Part):
     """``ema-actuator/1``."""
 
     schema_: Literal["ema-actuator/1"] = Field("ema-actuator/1", alias="schema")
     name: str = Field(min_length=1, max_length=200, description="for a person")
-    drive: Drive
-    nominal: Nominal
+    kind: Literal["rotary", "linear"] = Field(
+        "rotary", description="rotary: a gear train to a surface (drive); linear: a ball screw (screw)"
+    )
+    drive: Drive | None = Field(None, description="a rotary actuator's drive and gear train")
+    screw: Screw | None = Field(None, description="a linear actuator's screw and drive")
+    nominal: Nominal | None = Field(
+        None, description="the health new; a linear actuator's is learned by ema calibrate on healthy runs"
+    )
     thresholds: Thresholds = Field(default_factory=Thresholds)
     sensor_noise: SensorNoiseDocument | None = Field(None, description="null: the thesis's levels")
     airframe: Airframe | None = Field(None, description="null: the hinge moment is not checked against an aircraft")
 
     @model_validator(mode="after")
-    def _thresholds_past_nominal(self) -> Actuator:
+    def _one_kind(self) -> ActuatorDocument:
+        needed, other = ("drive", "screw") if self.kind == "rotary" else ("screw", "drive")
+        if getattr(self, needed) is None:
+            raise ValueError(f"{needed}: a {self.kind} actuator's document gives its {needed}")
+        if getattr(self, other) is not None:
+            raise ValueError(f"{other}: a {self.kind} actuator has no {other} (kind: {self.kind})")
+        if self.kind == "rotary" and (self.nominal is None or self.nominal.fsj_nm is None):
+            raise ValueError("nominal.fsj_nm: a rotary actuator's document gives its nominal FDJ, FSJ and η_O")
+        return self
+
+    @model_validator(mode="after")
+    def _thresholds_past_nominal(self) -> ActuatorDocument:
+        if self.nominal is None:
+            return self
         fdj, eta = self.threshold("FDJ")[0], self.threshold("eta_O")[0]
         if fdj <= self.nominal.fdj_nm:
             raise ValueError(f"thresholds.fdj_above_nm: {fdj:g} is not above the nominal FDJ {self.nominal.fdj_nm:g}")
@@ -139,38 +207,57 @@ class Actuator(_Part):
         return self
 
     @property
-    def params(self) -> ActuatorParams:
-        """The drive's constants as the simulator takes them."""
-        return ActuatorParams(**self.drive.model_dump())
+    def params(self) -> DriveConstants:
+        """The drive's constants as the simulator takes them (a rotary actuator's)."""
+        assert self.drive is not None, "a linear actuator has no simulator constants"
+        return DriveConstants(**self.drive.model_dump())
 
     @property
     def gear_ratio(self) -> float:
+        """Motor speed over output speed: a gear train's n, a screw's 2π/lead [rad/m]."""
+        if self.screw is not None:
+            return self.screw.gear_ratio
+        assert self.drive is not None
         return self.drive.gear_ratio
+
+    @property
+    def health(self) -> Nominal:
+        """The nominal health; InputError where a linear actuator's is not learned yet."""
+        if self.nominal is None:
+            raise InputError(
+                "actuator.nominal",
+                "is not known yet: run ema calibrate on healthy runs at two loads "
+                "and read with the document it writes (--out-actuator)",
+            )
+        return self.nominal
 
     @property
     def ranges(self) -> HealthRanges:
         """The healthy range around the nominal health: ``HEALTHY_SPAN`` either way, η_O capped below 1."""
-        n, span = self.nominal, HEALTHY_SPAN
+        n, span = self.health, HEALTHY_SPAN
+        fsj = n.fsj_nm if n.fsj_nm is not None else n.fdj_nm
         eta = (n.eta_o * (1 - span), min(n.eta_o * (1 + span), max(MAX_HEALTHY_ETA_O, n.eta_o)))
         return HealthRanges(
-            fsj_nm=(n.fsj_nm * (1 - span), n.fsj_nm * (1 + span)),
+            fsj_nm=(fsj * (1 - span), fsj * (1 + span)),
             fdj_nm=(n.fdj_nm * (1 - span), n.fdj_nm * (1 + span)),
             eta_o=eta,
-            nominal_fsj_nm=n.fsj_nm,
+            nominal_fsj_nm=fsj,
             nominal_fdj_nm=n.fdj_nm,
             nominal_eta_o=n.eta_o,
         )
 
     def eta_a(self, eta_o: np.ndarray | float) -> np.ndarray:
         """η_A from η_O by Eq. 3.4 with this actuator's gear ratio."""
-        return eta_a_from_eta_o(eta_o, self.drive.gear_ratio)
+        return eta_a_from_eta_o(eta_o, self.gear_ratio)
 
     def threshold(self, parameter: str) -> tuple[float, Literal["above", "below"]]:
         """The failure level of ``parameter`` (FDJ, eta_O or eta_A) and the way it is crossed."""
-        eta_o = self.thresholds.eta_o_below if self.thresholds.eta_o_below is not None else 0.70
+        eta_o = self.thresholds.eta_o_below
+        if eta_o is None:  # the thesis's 0.70, or as far below a lower nominal (0.70 / 0.85 of it)
+            eta_o = min(DEFAULT_ETA_O_BELOW, self.health.eta_o * DEFAULT_ETA_O_BELOW / THESIS_ETA_O)
         if parameter == "FDJ":
             fdj = self.thresholds.fdj_above_nm
-            return (fdj if fdj is not None else 1.5 * self.nominal.fdj_nm), "above"
+            return (fdj if fdj is not None else 1.5 * self.health.fdj_nm), "above"
         if parameter == "eta_O":
             return eta_o, "below"
         return float(self.eta_a(eta_o)), "below"
@@ -190,10 +277,10 @@ class Actuator(_Part):
         return SensorNoise() if self.sensor_noise is None else SensorNoise(**self.sensor_noise.model_dump())
 
 
-def _thesis() -> Actuator:
-    params, hinge = ActuatorParams(), HingeGeometry()
+def _thesis() -> ActuatorDocument:
+    params, hinge = DriveConstants(), HingeGeometry()
     drive = {name: getattr(params, name) for name in Drive.model_fields}
-    return Actuator(
+    return ActuatorDocument(
         name="thesis elevator EMA (Table 3.1)",
         drive=Drive(**drive),
         nominal=Nominal(fdj_nm=0.05, fsj_nm=0.10, eta_o=0.85),
@@ -205,16 +292,16 @@ def _thesis() -> Actuator:
 THESIS = _thesis()
 
 
-def actuator_from_dict(document: Any) -> Actuator:
+def actuator_from_dict(document: Any) -> ActuatorDocument:
     """Parse and validate an ``ema-actuator/1`` document (a dict); errors name the field."""
     if not isinstance(document, dict):
         raise InputError("actuator", f"must be a JSON object, got {type(document).__name__}")
     try:
-        return Actuator.model_validate(document)
+        return ActuatorDocument.model_validate(document)
     except ValidationError as exc:
         raise from_validation(exc) from None
 
 
-def read_actuator(path: str | Path) -> Actuator:
+def read_actuator(path: str | Path) -> ActuatorDocument:
     """Read an ``ema-actuator/1`` JSON file; a bad file raises InputError naming it and the field."""
     return read_document(path, actuator_from_dict)

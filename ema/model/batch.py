@@ -11,7 +11,7 @@ from ema.model import kernels, runtime
 from ema.model.aircraft import FlightCondition, HingeGeometry, Load, load_model
 from ema.model.checks import InputError, finite_array, in_range
 from ema.model.effects import TABLE_VARIABLES, EffectSet
-from ema.model.params import ActuatorParams, HealthParams
+from ema.model.params import DriveConstants, HealthParams
 
 DEFAULT_SAMPLE_RATE_HZ = 10_000.0
 SAMPLE_RATE_RANGE_HZ = (1_000.0, 100_000.0)
@@ -59,7 +59,7 @@ class BatchResult:
         return {name: values[index] for name, values in self.signals.items()}
 
 
-def kernel_constants(actuator: ActuatorParams, effects: EffectSet) -> kernels.KernelConstants:
+def kernel_constants(actuator: DriveConstants, effects: EffectSet) -> kernels.KernelConstants:
     """The step's constants with the effects folded in (derived once per batch)."""
     gain = effects.get("torque_constant", "gain")
     sensor_gain = effects.get("current_sensor_gain", "gain")
@@ -104,7 +104,7 @@ def kernel_constants(actuator: ActuatorParams, effects: EffectSet) -> kernels.Ke
     )
 
 
-def interval_steps(n_samples: int, sample_rate_hz: float, actuator: ActuatorParams) -> np.ndarray:
+def interval_steps(n_samples: int, sample_rate_hz: float, actuator: DriveConstants) -> np.ndarray:
     """(n_samples,) steps of h in each log interval: interval k spans steps round(k/(f·h)) to round((k+1)/(f·h)).
 
     Any rate is exact: at 3 kHz the intervals hold 333 or 334 steps, as a logger's clock would.
@@ -127,7 +127,7 @@ def clipped_knots(command_knots_deg: np.ndarray, n_health: int, end_stop_deg: fl
     return np.clip(knots, -limit, limit)
 
 
-def _checked_initial(initial: InitialState, actuator: ActuatorParams) -> InitialState:
+def _checked_initial(initial: InitialState, actuator: DriveConstants) -> InitialState:
     """``initial``, within the end stops and ``INITIAL_MARGIN`` of the drive's speed and current saturations."""
     stop = actuator.end_stop_deg
     speed, current = (INITIAL_MARGIN * limit for limit in (actuator.max_motor_speed_radps, actuator.max_current_a))
@@ -200,7 +200,7 @@ def simulate_batch(
     sample_rate_hz: float = DEFAULT_SAMPLE_RATE_HZ,
     effects: EffectSet = EffectSet(),
     *,
-    actuator: ActuatorParams,
+    actuator: DriveConstants,
     hinge: HingeGeometry | None = None,
     lanes: int | None = None,
     reuse_output: bool = False,

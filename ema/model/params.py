@@ -12,7 +12,7 @@ MAX_CORRELATION_S = 0.1  # a sensor noise's correlation time: far beyond any fil
 
 
 @dataclass(frozen=True)
-class ActuatorParams:
+class DriveConstants:
     """Constants of the EMA; every value is SI and reduced as the comment says."""
 
     position_gain_per_s: float = 1e5  # G_P [1/s]: user-angle error [rad] -> motor speed reference [rad/s]

@@ -21,7 +21,7 @@ from numba import njit
 
 from ema.model import runtime
 from ema.model.checks import InputError, finite_array, in_range
-from ema.model.params import ActuatorParams
+from ema.model.params import DriveConstants
 
 DEFAULT_DERIVATIVE_WINDOW_S = 2e-3
 # Within this of the end stops the shaft may rest against them: T_R there is not friction.
@@ -179,7 +179,7 @@ def residual_torque_nm(
     motor_speed_radps: np.ndarray,
     hinge_moment_nm: np.ndarray,
     sample_rate_hz: float,
-    actuator: ActuatorParams,
+    actuator: DriveConstants,
     derivative_window_s: float = DEFAULT_DERIVATIVE_WINDOW_S,
 ) -> np.ndarray:
     """T_R [N·m] at the motor shaft, one value per sample; works on one window or a batch (last axis = time)."""

@@ -6,7 +6,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from ema.model.actuator import THESIS, Actuator
+from ema.model.actuator import THESIS, ActuatorDocument
 from ema.model.aircraft import FlightCondition, GroundLoad
 from ema.model.batch import InitialState, simulate_batch
 from ema.model.commands import family_knots
@@ -27,7 +27,7 @@ def synthetic_window(
     actuator_id: str = "synthetic/elevator",
     window_id: str | None = None,
     command: str = "thesis",
-    actuator: Actuator = THESIS,
+    actuator: ActuatorDocument = THESIS,
 ) -> Window:
     """One window logged from the model of ``actuator``: a command of ``command``'s family
     (``ema.model.commands.FAMILIES``), the actuator at rest where the command starts, sensor noise; in flight at
@@ -41,7 +41,7 @@ def synthetic_window(
     rng = np.random.default_rng(seed)
     n_samples = round(duration_s * sample_rate_hz)
     knots = family_knots(command, n_samples, sample_rate_hz, rng)
-    stop = actuator.drive.end_stop_deg - 1.0
+    stop = actuator.params.end_stop_deg - 1.0
     start = InitialState(position_deg=float(np.clip(knots[0], -stop, stop)))
     result = simulate_batch(
         knots, health, condition, start, sample_rate_hz, effects, actuator=actuator.params, hinge=actuator.hinge

@@ -17,16 +17,32 @@ from pathlib import Path
 from typing import Annotated, Any, Literal
 
 import numpy as np
-from pydantic import AllowInfNan, AwareDatetime, BaseModel, ConfigDict, Field, Strict, ValidationError, field_validator
+from pydantic import (
+    AllowInfNan,
+    AwareDatetime,
+    BaseModel,
+    ConfigDict,
+    Field,
+    Strict,
+    ValidationError,
+    field_validator,
+    model_validator,
+)
 
 from ema.model.aircraft import AIRSPEED_RANGE_MPS, ALTITUDE_RANGE_M, FlightCondition
+from ema.model.bounds import CLOCK_SKEW, EARLIEST_RECORDED_AT, IDENTIFIER, MAX_FLIGHT_HOURS
 from ema.model.checks import InputError, from_validation, read_document
 
 SCHEMA = "ema-window/1"
-SIGNALS = ("command_deg", "position_deg", "motor_speed_radps", "current_a", "hinge_moment_nm")
+SIGNALS = ("command_deg", "position_deg", "motor_speed_radps", "current_a", "hinge_moment_nm")  # a rotary window's
+LINEAR_SIGNALS = ("command_mm", "position_mm", "current_a", "load_n")  # a linear actuator's (a ball screw's)
+KIND_SIGNALS = {"rotary": SIGNALS, "linear": LINEAR_SIGNALS}
 MIN_SAMPLES = 100
 MAX_SAMPLES = 1_000_000
-WINDOW_RATE_RANGE_HZ = (1_000.0, 100_000.0)
+# A window may be logged at 10 Hz (a test rig's logger) to 100 kHz; below HIGH_RATE_HZ it is read quasi-statically
+# (``ema.estimate.quasistatic``), at or above it through the whole pipeline.
+WINDOW_RATE_RANGE_HZ = (10.0, 100_000.0)
+HIGH_RATE_HZ = 1_000.0
 # Physical plausibility: beyond these a sample is a sensor fault or a unit error, not a state.
 SIGNAL_LIMITS = {
     "command_deg": (-90.0, 90.0),  # a reference, not a measurement: only a unit error is refused
@@ -34,13 +50,10 @@ SIGNAL_LIMITS = {
     "motor_speed_radps": (-2_000.0, 2_000.0),
     "current_a": (-60.0, 60.0),
     "hinge_moment_nm": (-5_000.0, 5_000.0),
+    "command_mm": (-10_000.0, 10_000.0),
+    "position_mm": (-10_000.0, 10_000.0),
+    "load_n": (-1e6, 1e6),
 }
-IDENTIFIER = r"^[!-~](?:[ -~]{0,198}[!-~])?$"
-# Times a trend computes with, bounded where they enter: no airframe flies a million hours, no log predates
-# 2000 or is stamped more than a day ahead of the clock that receives it.
-MAX_FLIGHT_HOURS = 1_000_000.0
-EARLIEST_RECORDED_AT = dt.datetime(2000, 1, 1, tzinfo=dt.UTC)
-CLOCK_SKEW = dt.timedelta(days=1)  # printable ASCII, no surrounding blanks: safe in a URL and a CSV
 
 Number = Annotated[float, Strict(), AllowInfNan(False)]
 Samples = Annotated[list[Number], Field(min_length=MIN_SAMPLES, max_length=MAX_SAMPLES)]
@@ -56,17 +69,42 @@ class FlightConditionDocument(_Contract):
 
 
 class SignalsDocument(_Contract):
-    """Five signals of one length, uniformly sampled from t = 0, each sample the mean over its interval."""
+    """Signals of one length, uniformly sampled from t = 0, each sample the mean over its interval: a rotary
+    actuator's five (``SIGNALS``), or a linear actuator's four (``LINEAR_SIGNALS``), never a mix."""
 
-    command_deg: Samples = Field(description=f"elevator command; any value within {SIGNAL_LIMITS['command_deg']}")
-    position_deg: Samples = Field(description=f"elevator deflection θ_u, within {SIGNAL_LIMITS['position_deg']}")
-    motor_speed_radps: Samples = Field(description=f"motor speed ω_m, within {SIGNAL_LIMITS['motor_speed_radps']}")
-    current_a: Samples = Field(description=f"phase current I, within {SIGNAL_LIMITS['current_a']}")
-    hinge_moment_nm: Samples = Field(description=f"hinge moment H_e, within {SIGNAL_LIMITS['hinge_moment_nm']}")
+    command_deg: Samples | None = Field(None, description=f"elevator command, within {SIGNAL_LIMITS['command_deg']}")
+    position_deg: Samples | None = Field(None, description=f"deflection θ_u, within {SIGNAL_LIMITS['position_deg']}")
+    motor_speed_radps: Samples | None = Field(
+        None, description=f"motor speed ω_m, within {SIGNAL_LIMITS['motor_speed_radps']}"
+    )
+    current_a: Samples = Field(description=f"the drive's current I, within {SIGNAL_LIMITS['current_a']}")
+    hinge_moment_nm: Samples | None = Field(
+        None, description=f"hinge moment H_e, within {SIGNAL_LIMITS['hinge_moment_nm']}"
+    )
+    command_mm: Samples | None = Field(None, description="a linear actuator's position set point [mm]")
+    position_mm: Samples | None = Field(None, description="a linear actuator's measured position [mm]")
+    load_n: Samples | None = Field(
+        None, description="the force on a linear actuator [N], positive pushing towards increasing position"
+    )
 
-    @field_validator(*SIGNALS)
+    @model_validator(mode="after")
+    def _one_kind(self) -> SignalsDocument:
+        given = {name for name in (*SIGNALS, *LINEAR_SIGNALS) if getattr(self, name) is not None}
+        if any(given == set(names) for names in KIND_SIGNALS.values()):
+            return self
+        rotary, linear = set(SIGNALS) & given - {"current_a"}, set(LINEAR_SIGNALS) & given - {"current_a"}
+        kind = "linear" if len(linear) > len(rotary) else "rotary"
+        missing = [name for name in KIND_SIGNALS[kind] if name not in given]
+        extra = sorted(given - set(KIND_SIGNALS[kind]))
+        field = missing[0] if missing else extra[0]
+        what = f"is missing: a {kind} window carries {', '.join(KIND_SIGNALS[kind])}"
+        raise ValueError(f"{field} {what}" if missing else f"{field} is not a signal of a {kind} window ({what[14:]})")
+
+    @field_validator(*SIGNALS, *LINEAR_SIGNALS[:2], "load_n")
     @classmethod
-    def _plausible(cls, values: list[float], info: Any) -> list[float]:
+    def _plausible(cls, values: list[float] | None, info: Any) -> list[float] | None:
+        if values is None:
+            return None
         low, high = SIGNAL_LIMITS[info.field_name]
         array = np.asarray(values)
         outside = np.flatnonzero((array < low) | (array > high))
@@ -116,11 +154,12 @@ class WindowDocument(_Contract):
 
     def to_window(self) -> Window:
         """The arrays; signals of unequal lengths are refused naming the first one that differs."""
-        arrays = {name: np.asarray(getattr(self.signals, name), dtype=np.float64) for name in SIGNALS}
-        length = len(arrays["command_deg"])
+        names = [name for name in (*SIGNALS, *LINEAR_SIGNALS) if getattr(self.signals, name) is not None]
+        arrays = {name: np.asarray(getattr(self.signals, name), dtype=np.float64) for name in dict.fromkeys(names)}
+        first = next(iter(arrays))
         for name, array in arrays.items():
-            if len(array) != length:
-                raise InputError(f"signals.{name}", f"has {len(array)} samples, command_deg has {length}")
+            if len(array) != len(arrays[first]):
+                raise InputError(f"signals.{name}", f"has {len(array)} samples, {first} has {len(arrays[first])}")
         flight = self.flight_condition
         condition = None if flight is None else FlightCondition(flight.airspeed_mps, flight.altitude_m)
         recorded = None if self.recorded_at is None else self.recorded_at.isoformat()
@@ -151,23 +190,37 @@ class Window:
     flight_id: str | None = None  # one power-on of the drive: its sensors keep one zero
 
     def __post_init__(self) -> None:
-        lengths = {name: len(self.signals[name]) for name in SIGNALS}
+        lengths = {name: len(self.signals[name]) for name in self.signal_names}
         if len(set(lengths.values())) != 1:
             raise InputError("signals", f"signals differ in length: {lengths}")
 
     @property
+    def kind(self) -> str:
+        """ "linear" for a linear actuator's signals (``LINEAR_SIGNALS``), else "rotary"."""
+        return "linear" if "position_mm" in self.signals else "rotary"
+
+    @property
+    def signal_names(self) -> tuple[str, ...]:
+        return KIND_SIGNALS[self.kind]
+
+    @property
+    def high_rate(self) -> bool:
+        """Logged fast enough for the whole pipeline (``HIGH_RATE_HZ``); else read quasi-statically."""
+        return self.sample_rate_hz >= HIGH_RATE_HZ
+
+    @property
     def n_samples(self) -> int:
-        return len(self.signals["command_deg"])
+        return len(self.signals[self.signal_names[0]])
 
     def content_sha256(self) -> str:
         """SHA-256 of everything the window says but its key (actuator_id, window_id): two bodies posted
         under one key are the same window exactly when their digests agree."""
         digest = hashlib.sha256()
-        meta = window_to_dict(replace(self, signals={name: self.signals[name][:0] for name in SIGNALS}))
+        meta = window_to_dict(replace(self, signals={name: self.signals[name][:0] for name in self.signal_names}))
         for key in ("actuator_id", "window_id", "signals"):
             meta.pop(key)
         digest.update(json.dumps(meta, sort_keys=True).encode())
-        for name in SIGNALS:
+        for name in self.signal_names:
             digest.update(np.ascontiguousarray(self.signals[name], dtype="<f8").tobytes())
         return digest.hexdigest()
 
@@ -203,7 +256,7 @@ def window_to_dict(window: Window) -> dict[str, Any]:
             "airspeed_mps": float(window.flight_condition.airspeed_mps),
             "altitude_m": float(window.flight_condition.altitude_m),
         },
-        "signals": {name: window.signals[name].tolist() for name in SIGNALS},
+        "signals": {name: window.signals[name].tolist() for name in window.signal_names},
         **({"recorded_at": window.recorded_at} if window.recorded_at is not None else {}),
         **({"flight_hours": window.flight_hours} if window.flight_hours is not None else {}),
         **({"flight_id": window.flight_id} if window.flight_id is not None else {}),

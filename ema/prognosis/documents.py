@@ -13,7 +13,7 @@ import numpy as np
 from pydantic import Field
 
 from ema.estimate.documents import Document, Estimate, InertiaReading, Notes
-from ema.model.actuator import Actuator
+from ema.model.actuator import ActuatorDocument
 
 PARAMETERS = ("FDJ", "eta_O", "eta_A")
 TimeUnit = Literal["flight_hours", "days", "windows"]
@@ -36,7 +36,7 @@ class StoredActuator(Document):
     actuator_id: str
     version: int = Field(ge=1, description="1 for the first document PUT, then one more for each that differs")
     stored_at: str = Field(description="when this version was stored (UTC, ISO 8601)")
-    document: Actuator
+    document: ActuatorDocument
 
 
 class Withdrawal(Document):

@@ -10,7 +10,7 @@ import numpy as np
 
 from ema.estimate.documents import Note
 from ema.estimate.history import combined_inertia, inertia_change_note
-from ema.model.actuator import Actuator, Airframe
+from ema.model.actuator import ActuatorDocument, Airframe
 from ema.prognosis.backtest import backtest
 from ema.prognosis.documents import MIN_SPAN, PARAMETERS, Prognosis, Stored, TimeUnit, Trend
 from ema.prognosis.outlook import Outlook, outlook
@@ -40,7 +40,9 @@ def _times(stored: Sequence[Stored]) -> tuple[np.ndarray, TimeUnit, Note | None]
     return np.argsort(order).astype(float), "windows", Note(code="time_by_window_order", text=text)
 
 
-def prognose(actuator_id: str, stored: Sequence[Stored], actuator: Actuator, *, backtested: bool = True) -> Prognosis:
+def prognose(
+    actuator_id: str, stored: Sequence[Stored], actuator: ActuatorDocument, *, backtested: bool = True
+) -> Prognosis:
     """Trends and remaining lives of FDJ, η_O and η_A over ``stored`` (any order), to ``actuator``'s
     thresholds; a parameter a window did not read (η_O without a load) is left out of its trend."""
     if not stored:
@@ -75,7 +77,7 @@ def prognose(actuator_id: str, stored: Sequence[Stored], actuator: Actuator, *, 
 
 
 def _outlook(
-    name: str, stored: Sequence[Stored], times: np.ndarray, actuator: Actuator, unit: TimeUnit, backtested: bool
+    name: str, stored: Sequence[Stored], times: np.ndarray, actuator: ActuatorDocument, unit: TimeUnit, backtested: bool
 ) -> Outlook | None:
     """``name``'s outlook over the windows that read it, or None where none did."""
     read = [(t, e, s.window_id) for t, s in zip(times, stored, strict=True) if (e := getattr(s.estimates, name))]

@@ -7,8 +7,9 @@
 - **not enough history**: fewer than ``MIN_WINDOWS`` windows, or windows spread over less than the
   prognosis's ``MIN_SPAN``: no trend can say "due" yet (the latest window alone may still say "watch").
 
-A forecast in window order (windows with no time base) never makes an actuator due: a count of windows
-is not a date. A threshold already crossed does, the level being measured, not forecast.
+Without that evidence the status is never "due", however far the latest window lies past a threshold
+(it is "watch" then). A forecast in window order (windows with no time base) never makes an actuator due
+before its threshold is crossed: a count of windows is not a date.
 """
 
 from __future__ import annotations
@@ -17,7 +18,7 @@ from typing import Literal
 
 import numpy as np
 
-from ema.model.actuator import Actuator
+from ema.model.actuator import ActuatorDocument
 from ema.prognosis.documents import MIN_SPAN, ActuatorSummary, Prognosis, RemainingLife, Stored, Threshold
 
 Status = Literal["due", "watch", "healthy", "not enough history"]
@@ -40,7 +41,7 @@ def lacking_evidence(prognosis: Prognosis, windows: int) -> str | None:
     return None
 
 
-def off_healthy(latest: Stored | None, actuator: Actuator) -> bool:
+def off_healthy(latest: Stored | None, actuator: ActuatorDocument) -> bool:
     """The latest estimate lies outside the healthy range, or the model did not reproduce its window."""
     if latest is None:
         return False
@@ -52,17 +53,17 @@ def off_healthy(latest: Stored | None, actuator: Actuator) -> bool:
 
 
 def status_of(
-    latest: Stored | None, prognosis: Prognosis, actuator: Actuator, windows: int
+    latest: Stored | None, prognosis: Prognosis, actuator: ActuatorDocument, windows: int
 ) -> tuple[Status, float | None, str]:
     """(status, the soonest plausible crossing, why) of an actuator with ``windows`` stored (module docstring)."""
     lives = list(prognosis.remaining_life.values())
-    if any(life.status == "already crossed" for life in lives):
-        return "due", 0.0, "a threshold is crossed"
     lacking = lacking_evidence(prognosis, windows)
     if lacking is not None:
         if off_healthy(latest, actuator):
             return "watch", None, f"the latest window lies outside the healthy range or was not reproduced; {lacking}"
         return "not enough history", None, lacking
+    if any(life.status == "already crossed" for life in lives):
+        return "due", 0.0, "a threshold is crossed"
     soonest = min((life.rul_earliest for life in lives if life.rul_earliest is not None), default=None)
     within = DUE_WITHIN.get(prognosis.time_unit)
     if soonest is not None and within is not None and soonest <= within:
@@ -89,7 +90,7 @@ def when(stored: Stored) -> str | None:
 
 
 def summary(
-    prognosis: Prognosis, latest: Stored | None, windows: int, actuator: Actuator, version: int | None
+    prognosis: Prognosis, latest: Stored | None, windows: int, actuator: ActuatorDocument, version: int | None
 ) -> ActuatorSummary:
     """The actuator's line in the fleet view: ``windows`` stored, ``latest`` the last of them."""
     actuator_id = prognosis.actuator_id
@@ -118,7 +119,9 @@ def summary(
     )
 
 
-def failed(actuator_id: str, windows: int, actuator: Actuator, version: int | None, error: str) -> ActuatorSummary:
+def failed(
+    actuator_id: str, windows: int, actuator: ActuatorDocument, version: int | None, error: str
+) -> ActuatorSummary:
     """The line of an actuator whose prognosis could not be computed: its own error, not the fleet's."""
     return ActuatorSummary(
         actuator_id=actuator_id,

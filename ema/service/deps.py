@@ -16,9 +16,9 @@ from starlette.concurrency import run_in_threadpool
 from ema.estimate.config import PipelineConfig, validated
 from ema.estimate.documents import Note
 from ema.history.open import History
-from ema.model.actuator import THESIS, Actuator
+from ema.model.actuator import THESIS, ActuatorDocument
+from ema.model.bounds import IDENTIFIER
 from ema.model.checks import InputError
-from ema.model.window import IDENTIFIER
 from ema.prognosis.documents import Prognosis, Stored
 from ema.prognosis.prognose import prognose
 from ema.service.config import Settings
@@ -70,19 +70,19 @@ def request_config(settings: Settings, **overrides: int | None) -> PipelineConfi
     return validated(PipelineConfig, {**settings.pipeline.model_dump(), **given}, prefix="query.")
 
 
-def document_of(store: History, actuator_id: str) -> tuple[Actuator, int | None]:
+def document_of(store: History, actuator_id: str) -> tuple[ActuatorDocument, int | None]:
     """The actuator's latest stored document and its version, or the default (``ema.model.actuator.THESIS``, no
     version) where it has none: its windows are then read with the default, and their answers say so."""
     stored = store.get_actuator(actuator_id)
     return (THESIS, None) if stored is None else (stored.document, stored.version)
 
 
-async def actuator_of(store: History, actuator_id: str) -> tuple[Actuator, int | None]:
+async def actuator_of(store: History, actuator_id: str) -> tuple[ActuatorDocument, int | None]:
     return await run_in_threadpool(document_of, store, actuator_id)
 
 
 def safe_prognosis(
-    actuator_id: str, history: list[Stored], actuator: Actuator, *, backtested: bool = True
+    actuator_id: str, history: list[Stored], actuator: ActuatorDocument, *, backtested: bool = True
 ) -> Prognosis:
     """``prognose``, or a prognosis that says it failed and why: one actuator's numbers never take the view
     down for the others."""

@@ -16,7 +16,7 @@ from fastapi_offline import FastAPIOffline
 from ema.estimate import runtime
 from ema.history.open import open_history
 from ema.model import runtime as sim_runtime
-from ema.model.actuator import Actuator
+from ema.model.actuator import ActuatorDocument
 from ema.model.window import WindowDocument
 from ema.service import errors
 from ema.service.config import Settings
@@ -52,7 +52,7 @@ def _openapi(app: FastAPI) -> dict[str, Any]:
 
         schema = get_openapi(title=app.title, version=app.version, description=app.description, routes=app.routes)
         components = schema.setdefault("components", {}).setdefault("schemas", {})
-        for model in (WindowDocument, CalibrateIn, Actuator):
+        for model in (WindowDocument, CalibrateIn, ActuatorDocument):
             document = model.model_json_schema(ref_template="#/components/schemas/{model}", by_alias=True)
             components.update(document.pop("$defs", {}))
             components[model.__name__] = document

@@ -49,7 +49,10 @@ async def read_body(request: Request, runner: JobRunner, model: type[Model], the
 
 
 def check_budget(window: Window, config: PipelineConfig, settings: Settings, field: str = "signals") -> None:
-    """Refuse, naming the field and the limit, a window longer or a request costlier than the settings allow."""
+    """Refuse, naming the field and the limit, a window longer or a request costlier than the settings allow (a
+    window read quasi-statically simulates nothing: its length costs only its samples, which the body limits)."""
+    if window.kind == "linear" or not window.high_rate:
+        return
     if window.duration_s > settings.max_window_s:
         limit = f"{settings.max_window_s:g} s (EMA_MAX_WINDOW_S)"
         raise InputError(field, f"the window lasts {window.duration_s:g} s; this service's limit is {limit}: cut it")

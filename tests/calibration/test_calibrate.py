@@ -243,3 +243,27 @@ def test_a_tanh_stribeck_decay_is_followed_by_an_exponent_between_the_classic_on
     report, _ = calibrate("stribeck", 5901)
     assert report.selected_effect == "stribeck", report.selection_steps[0].reason
     assert combined_error(report, "after") <= max(0.5 * combined_error(report, "before"), 0.01)
+
+
+def _into_the_stops(seed: int, effects: Effects) -> tuple[CalibrationReport, dict]:
+    from tests.foreign.physics import Flight
+
+    drawn = draw(seed, "stops", effects=effects, duration_s=1.5, flight=Flight(airspeed_mps=100.0, altitude_m=5000.0))
+    report = Calibrator(SMALL, copies=16, actuator=THESIS).fit([window_from_dict(drawn.document)], drawn.truth).report_
+    return report, drawn.truth
+
+
+@pytest.mark.parametrize(
+    "effects",
+    [Effects(current_sensor_gain=0.94), pytest.param(Effects(inertia_factor=0.8), marks=pytest.mark.slow)],
+)
+def test_a_window_into_the_stops_is_never_made_worse_nor_a_sensor_fault_made_mechanical(effects):
+    """Into the end stops, a current gain and an inertia leave look-alike traces; whatever the loop names, the
+    estimates after are no worse than before, and a sensor's gain is not named backlash or friction
+    (``benchmarks.calibration_stops`` for the table over seeds)."""
+    report, _ = _into_the_stops(0, effects)
+    assert combined_error(report, "after") <= combined_error(report, "before") + 1e-4
+    assert not set(report.selected_effects) & {"backlash", "position_friction", "stribeck", "viscous", "cogging"}
+    if report.ambiguity is not None:
+        assert report.estimates_after == report.estimates_before
+        assert all(report.stds_after[t] >= report.stds_before[t] for t in ("FDJ", "eta_O"))

@@ -263,3 +263,49 @@ def test_serve_refuses_a_file_that_is_not_a_database(tmp_path, capsys):
     assert main(["serve", "--database", str(broken)]) == EXIT_BAD_INPUT
     assert "broken.sqlite3" in capsys.readouterr().err
     assert broken.read_text().startswith("not a database")
+
+
+def test_simulate_stamps_a_time_and_draws_a_degrading_series(tmp_path, capsys):
+    from ema.model.window import read_window
+
+    one = tmp_path / "one.json"
+    assert (
+        main(
+            [
+                "simulate",
+                "--out",
+                str(one),
+                "--duration",
+                "0.05",
+                "--recorded-at",
+                "2026-11-01T08:00:00",
+                "--flight-hours",
+                "120",
+            ]
+        )
+        == EXIT_OK
+    )
+    window = read_window(one)
+    assert window.recorded_at == "2026-11-01T08:00:00+00:00" and window.flight_hours == 120.0
+    folder = tmp_path / "series"
+    args = [
+        "simulate",
+        "--out",
+        str(folder),
+        "--duration",
+        "0.05",
+        "--series",
+        "4",
+        "--every",
+        "25",
+        "--fdj-end",
+        "0.065",
+        "--json",
+    ]
+    capsys.readouterr()
+    assert main(args) == EXIT_OK
+    result = json.loads(capsys.readouterr().out)
+    windows = [read_window(path) for path in sorted(folder.glob("*.json"))]
+    assert [w.flight_hours for w in windows] == [0.0, 25.0, 50.0, 75.0]
+    assert [t["FDJ"] for t in result["truth"]] == pytest.approx([0.05, 0.055, 0.06, 0.065])
+    assert len({w.window_id for w in windows}) == 4

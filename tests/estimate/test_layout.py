@@ -20,9 +20,12 @@ RANKS = {
     "ema.estimate.learn": 4,
     "ema.estimate.assess": 5,
     "ema.estimate.report": 6,
+    "ema.estimate.quasistatic": 1,
+    "ema.estimate.low_rate": 7,
+    "ema.estimate.kinds": 8,
     "ema.estimate.history": 6,
     "ema.estimate.pipeline": 7,
-    "ema.estimate.remote": 8,
+    "ema.estimate.remote": 9,
 }
 
 

@@ -75,6 +75,17 @@ def hold(rng: np.random.Generator, duration_s: float) -> Command:
     return lambda t: np.full_like(t, level)
 
 
+def stops(rng: np.random.Generator, duration_s: float) -> Command:
+    """Into the end stops and back: a command past ±30° (32–40°), one way then the other, each held a third or more of
+    the window: the surface rests on its stop while the motor pushes (a pilot's full deflection)."""
+    level, sign = rng.uniform(32.0, 40.0), rng.choice([-1.0, 1.0])
+    hold = rng.uniform(0.3, 0.45) * duration_s
+    first = rng.uniform(0.05, 0.15) * duration_s
+    knots_t = [0.0, first, first + hold, first + hold + 0.05 * duration_s, duration_s]
+    knots_v = [0.0, sign * level, sign * level, -sign * level, -sign * level]
+    return lambda t: np.interp(t, knots_t, knots_v)
+
+
 BY_NAME: dict[str, Callable[[np.random.Generator, float], Command]] = {
     "thesis": thesis,
     "cruise": cruise,
@@ -83,4 +94,5 @@ BY_NAME: dict[str, Callable[[np.random.Generator, float], Command]] = {
     "steps": steps,
     "hold": hold,
     "sweep": sweep,
+    "stops": stops,
 }

@@ -7,14 +7,14 @@ import pytest
 
 from ema.model.actuator import THESIS, actuator_from_dict, read_actuator
 from ema.model.checks import InputError
-from ema.model.params import DEFAULT_RANGES, ActuatorParams, eta_a_from_eta_o
+from ema.model.params import DEFAULT_RANGES, DriveConstants, eta_a_from_eta_o
 
 EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "actuator.json"
 
 
 def test_the_thesis_actuator_ships_as_the_example_and_is_table_3_1():
     assert read_actuator(EXAMPLE) == THESIS
-    assert THESIS.params == ActuatorParams()
+    assert THESIS.params == DriveConstants()
     for name in ("fdj_nm", "fsj_nm", "eta_o"):  # the healthy range: Table 3.1's, ±20 % of nominal
         assert getattr(THESIS.ranges, name) == pytest.approx(getattr(DEFAULT_RANGES, name))
     assert THESIS.threshold("FDJ") == (0.075, "above") and THESIS.threshold("eta_O") == (0.70, "below")

@@ -19,7 +19,7 @@ from ema.model.batch import (
 from ema.model.checks import InputError
 from ema.model.commands import random_command_knots
 from ema.model.effects import EffectSet
-from ema.model.params import DEFAULT_RANGES, ActuatorParams, HealthParams, eta_a_from_eta_o
+from ema.model.params import DEFAULT_RANGES, DriveConstants, HealthParams, eta_a_from_eta_o
 from ema.model.reference import simulate_numpy
 from ema.model.residual import residual_torque_nm
 from tests.model.conftest import ramp_knots
@@ -47,7 +47,7 @@ def test_steady_sliding_loss_is_fdj_plus_load_part_plus_viscous(load_nm, kind):
     assert speed.mean() == pytest.approx(np.radians(10.0) * 500, rel=0.01)
     t_ext = abs(load_nm) / 500
     k_load = 1 / 0.8 - 1 if kind == "opposing" else 1 - float(eta_a_from_eta_o(0.8, 500.0))
-    expected = 0.045 + k_load * t_ext + ActuatorParams().viscous_nms * speed
+    expected = 0.045 + k_load * t_ext + DriveConstants().viscous_nms * speed
     np.testing.assert_allclose(result.loss_torque_nm[0, steady], expected, rtol=1e-3)
     # Eq. 5.3 from the recorded signals alone gives the same torque.
     residual = residual_torque_nm(
@@ -123,7 +123,7 @@ def test_kernel_matches_the_plain_numpy_model(effects):
     knots = random_command_knots(30, RATE, rng)[0]
     initial = InitialState(position_deg=0.3, motor_speed_radps=50.0, current_a=2.0)
     fast = simulate_batch(knots, health, initial=initial, effects=effects, actuator=THESIS.params)
-    c = kernel_constants(ActuatorParams(), effects)
+    c = kernel_constants(DriveConstants(), effects)
     eta_a = health.eta_a(500.0)
     per_sim = np.stack([health.fdj_nm, health.fsj_nm, 1 - eta_a, 1 / health.eta_o - 1])
     start = np.repeat(np.array([[np.radians(0.3)], [50.0], [2.0]]), 4, axis=1)
@@ -140,7 +140,7 @@ def test_any_log_rate_is_exact_intervals_of_whole_steps(nominal):
     # A 3 kHz log holds intervals of 333 or 334 steps; each recorded value is the mean of the
     # 1 µs values inside it, so it equals the step-weighted mean of a log taken every step.
     assert list(interval_steps(3, 3_000.0, actuator=THESIS.params)) == [333, 334, 333]
-    c = kernel_constants(ActuatorParams(), EffectSet())
+    c = kernel_constants(DriveConstants(), EffectSet())
     load = load_model(FlightCondition(), 1 / 3_000.0)
     per_sim = np.tile(np.array([[0.05], [0.1], [1 - float(eta_a_from_eta_o(0.85, 500.0))], [1 / 0.85 - 1]]), (1, 8))
     initial = np.zeros((3, 8))

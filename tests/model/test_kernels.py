@@ -6,9 +6,9 @@ import pytest
 from ema.model.batch import kernel_constants
 from ema.model.effects import EffectSet
 from ema.model.kernels import advance
-from ema.model.params import ActuatorParams, eta_a_from_eta_o
+from ema.model.params import DriveConstants, eta_a_from_eta_o
 
-ACTUATOR = ActuatorParams()
+ACTUATOR = DriveConstants()
 FDJ, FSJ, ETA_O = 0.05, 0.10, 0.85
 K_AID = 1.0 - float(eta_a_from_eta_o(ETA_O, 500.0))
 K_OPP = 1.0 / ETA_O - 1.0

@@ -45,7 +45,7 @@ def _broken(document, path, value):
     ("path", "value", "field"),
     [
         (("schema",), "ema-window/2", "schema"),
-        (("sample_rate_hz",), 50.0, "sample_rate_hz"),
+        (("sample_rate_hz",), 5.0, "sample_rate_hz"),
         (("sample_rate_hz",), "fast", "sample_rate_hz"),
         (("flight_condition", "airspeed_mps"), 400.0, "flight_condition.airspeed_mps"),
         (("flight_condition", "altitude_m"), KeyError, "flight_condition.altitude_m"),

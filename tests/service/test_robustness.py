@@ -71,7 +71,7 @@ def no_pipeline(monkeypatch):
     def refused(*_, **__):
         raise AssertionError("the pipeline ran")
 
-    monkeypatch.setattr("ema.service.routes.estimate.estimate_window", refused)
+    monkeypatch.setattr("ema.estimate.kinds.estimate", refused)
 
 
 def test_a_history_deleted_under_the_service_answers_nothing_it_would_lose(tmp_path, document, no_pipeline):

@@ -19,7 +19,7 @@ import numpy as np
 from ema.estimate.physics.features import as_read
 from ema.estimate.physics.scenario import SETTLE_S, Scenario, rms
 from ema.model.noise import SensorNoise
-from ema.model.params import ActuatorParams, HealthParams
+from ema.model.params import DriveConstants, HealthParams
 from ema.model.residual import residual_torque_nm
 from ema.model.window import Window
 
@@ -28,10 +28,11 @@ def output_error_ratios(
     window: Window,
     scenario: Scenario,
     health: HealthParams,
+    *,
     noise: SensorNoise,
     residual_floor_nm: float,
     sliding: np.ndarray,
-    actuator: ActuatorParams,
+    actuator: DriveConstants,
     simulated_at_health: Mapping[str, np.ndarray] | None = None,
 ) -> dict[str, float]:
     """Per signal, RMS(measured − simulated at ``health``) over its noise-only floor; the measured T_R
@@ -56,6 +57,6 @@ def output_error_ratios(
     return ratios
 
 
-def _residual(signals: Mapping[str, np.ndarray], rate: float, actuator: ActuatorParams) -> np.ndarray:
+def _residual(signals: Mapping[str, np.ndarray], rate: float, actuator: DriveConstants) -> np.ndarray:
     current, speed, hinge = signals["current_a"], signals["motor_speed_radps"], signals["hinge_moment_nm"]
     return residual_torque_nm(current, speed, hinge, rate, actuator)

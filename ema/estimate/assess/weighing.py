@@ -18,6 +18,10 @@ see a mismatch between the model and the measured window, so two checks on the w
 - **Equation error.** The window's Eq. 5.1 residual RMS over the simulations' (the same noise,
   no missing physics): ≈ 1 when the model explains the window. Above, the stds are scaled by it
   (the Birge ratio): structure the model lacks widens the uncertainty instead of hiding in it.
+  Whether the model *lacks* something is a test: the simulations' own ratios scatter around 1,
+  log-normally with a spread s read from them, and the window is one more draw under the null. The
+  note ``model_misfit`` is said only beyond exp(t₀.₉₉,ₖ₋₁ · s · √(1 + 1/K)) (``misfit_limit``): a
+  clean window draws it ``MISFIT_FALSE_ALARM`` of the time.
 
 The std is never below the physics fit's block-jackknife std on the window itself.
 """
@@ -36,6 +40,8 @@ MIN_CHECKS = 4  # held-out simulations the scoring needs (those that could not s
 BOX_TOLERANCE = 0.1  # the network may answer this far outside its box (in box units) before it extrapolates
 NETWORK_MARGIN = 0.8  # the network joins only if the blend's RMS error on the checks is below this share of the fit's
 STUDENT_95 = {8: 2.31, 16: 2.12, 32: 2.04}  # t quantiles: a std read from K simulations is itself uncertain
+MISFIT_FALSE_ALARM = 0.01  # the share of clean windows the model_misfit note may be said of
+Z_99 = 2.3263  # the normal's 0.99 quantile, for MISFIT_FALSE_ALARM
 
 
 @dataclass(frozen=True)
@@ -68,6 +74,25 @@ def _t_factor(k: int) -> float:
     """The 95 % Student quantile for K check windows, relative to the normal's 1.96."""
     nearest = min(STUDENT_95, key=lambda n: abs(n - k))
     return max(1.0, STUDENT_95[nearest] / 1.96) if k < 60 else 1.0
+
+
+def student_99(dof: int) -> float:
+    """Student's t 0.99 quantile for ``dof`` degrees of freedom (Cornish–Fisher to 1/dof³: within 1 % from 4)."""
+    z, v = Z_99, max(dof, 1)
+    third = (3 * z**7 + 19 * z**5 + 17 * z**3 - 15 * z) / (384 * v**3)
+    return z + (z**3 + z) / (4 * v) + (5 * z**5 + 16 * z**3 + 3 * z) / (96 * v**2) + third
+
+
+def misfit_limit(check_rms: np.ndarray) -> float:
+    """The equation-error ratio a clean window exceeds ``MISFIT_FALSE_ALARM`` of the time: the held-out simulations'
+    RMS errors, over their median, are log-normal with a spread s; a new draw passes exp(t·s·√(1 + 1/K)) with
+    that probability (inf where too few simulations to read s)."""
+    rms = check_rms[np.isfinite(check_rms) & (check_rms > 0)]
+    k = len(rms)
+    if k < MIN_CHECKS:
+        return float("inf")
+    spread = float(np.std(np.log(rms / np.median(rms)), ddof=1))
+    return float(np.exp(student_99(k - 1) * spread * np.sqrt(1 + 1 / k)))
 
 
 def bias_corrected(physics: np.ndarray, truth: np.ndarray) -> tuple[float, np.ndarray]:
@@ -150,23 +175,24 @@ def _assess_parameter(c: Candidates, name: str, inflation: float) -> tuple[float
     return value, std, report, answer_note
 
 
-def assess(c: Candidates, equation_error_ratio: float) -> Assessed:
+def assess(c: Candidates, equation_error_ratio: float, limit: float) -> Assessed:
     """Per target, the bias-corrected physics fit, blended with the network where it earns it; the stds
-    widened by the equation-error ratio and never below the window's jackknife std."""
+    widened by the equation-error ratio and never below the window's jackknife std; a misfit said only past
+    ``limit`` (``misfit_limit``)."""
     inflation = max(1.0, equation_error_ratio)
     values, stds, methods, notes = {}, {}, {}, list[Note]()
     for name in TARGETS:
         values[name], stds[name], methods[name], note = _assess_parameter(c, name, inflation)
         if note is not None:
             notes.append(note)
-    if inflation > 1.0:
+    if equation_error_ratio > limit:
         notes.append(
             Note(
                 code="model_misfit",
                 text=(
-                    f"the window's Eq. 5.1 residual is {equation_error_ratio:.2f}x what noise alone leaves: "
-                    "the model lacks something this window holds (stds widened by that factor; `ema calibrate` traces "
-                    "it)"
+                    f"the window's Eq. 5.1 residual is {equation_error_ratio:.2f}x what noise alone leaves, beyond the "
+                    f"{limit:.2f}x a window the model explains reaches {100 * MISFIT_FALSE_ALARM:g} % of the time: the "
+                    "model lacks something this window holds (stds widened by that factor; `ema calibrate` traces it)"
                 ),
             )
         )

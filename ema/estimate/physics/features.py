@@ -16,7 +16,7 @@ import numpy as np
 from ema.estimate.physics.friction import FitSettings, FrictionFit, fit_friction
 from ema.model.checks import InputError
 from ema.model.hinge import denoised_hinge_nm
-from ema.model.params import ActuatorParams
+from ema.model.params import DriveConstants
 from ema.model.residual import residual_torque_nm
 
 INPUT_SETS = {
@@ -37,7 +37,7 @@ def as_read(signals: Mapping[str, np.ndarray], sample_rate_hz: float) -> dict[st
 def fit_as_read(
     signals: Mapping[str, np.ndarray],
     sample_rate_hz: float,
-    actuator: ActuatorParams,
+    actuator: DriveConstants,
     settings: FitSettings = FitSettings(),
 ) -> FrictionFit:
     """Eq. 5.1's fit (``ema.estimate.physics.friction``) of a window's signals read as every estimator reads them."""
@@ -92,7 +92,7 @@ def features(
     signals: Mapping[str, np.ndarray],
     sample_rate_hz: float,
     n_timesteps: int,
-    actuator: ActuatorParams,
+    actuator: DriveConstants,
     input_set: str = "residual_torque",
 ) -> np.ndarray:
     """Network inputs from window signals: (n_windows, n_channels · n_timesteps), channels side by side.

@@ -29,7 +29,7 @@ from numba import njit
 from ema.estimate.physics.eta_search import ETA_O_SEARCH, solve
 from ema.estimate.stats import JACKKNIFE_BLOCKS, jackknife_std
 from ema.model.checks import InputError
-from ema.model.params import ActuatorParams
+from ema.model.params import DriveConstants
 from ema.model.residual import (
     DEFAULT_DERIVATIVE_WINDOW_S,
     END_STOP_MARGIN_DEG,
@@ -66,7 +66,7 @@ class FitSettings:
     def nuisances(self) -> tuple[str, ...]:
         return tuple(name for name in NUISANCES if getattr(self, name))
 
-    def sliding_speed_radps(self, actuator: ActuatorParams) -> float:
+    def sliding_speed_radps(self, actuator: DriveConstants) -> float:
         """The |ω| past which the shaft slides, for Eq. 5.1, on ``actuator``."""
         return self.min_speed_share * actuator.max_motor_speed_radps
 
@@ -116,7 +116,7 @@ class FrictionFit:
 def regressors(
     signals: Mapping[str, np.ndarray],
     rate: float,
-    actuator: ActuatorParams,
+    actuator: DriveConstants,
     settings: FitSettings,
     residual_nm: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -143,7 +143,7 @@ def regressors(
 
 
 def nuisance_columns(
-    signals: Mapping[str, np.ndarray], rate: float, actuator: ActuatorParams, settings: FitSettings
+    signals: Mapping[str, np.ndarray], rate: float, actuator: DriveConstants, settings: FitSettings
 ) -> list[np.ndarray]:
     """The columns of ``settings.nuisances``, each (N, n) and, like the target, signed by the direction s:
     s itself (a constant torque), |ω| smoothed (ΔC), −k_T·I smoothed where the motor is not saturated (γ:
@@ -191,7 +191,7 @@ def _block_sums(columns, mask, edges, out):
 def fit_friction(
     signals: Mapping[str, np.ndarray],
     rate: float,
-    actuator: ActuatorParams,
+    actuator: DriveConstants,
     settings: FitSettings = FitSettings(),
     residual_nm: np.ndarray | None = None,
 ) -> FrictionFit:
@@ -227,7 +227,7 @@ def fit_friction(
     )
 
 
-def fit_window(signals: Mapping[str, np.ndarray], rate: float, actuator: ActuatorParams) -> FrictionFit:
+def fit_window(signals: Mapping[str, np.ndarray], rate: float, actuator: DriveConstants) -> FrictionFit:
     """One window's fit; a window that never slides long enough is bad input naming its signals."""
     fitted = fit_friction(signals, rate, actuator)
     if np.isnan(fitted.fdj_nm[0]):

@@ -16,7 +16,7 @@ from ema.model.batch import BatchResult, InitialState, simulate_batch
 from ema.model.commands import knots_from_samples
 from ema.model.effects import EffectSet
 from ema.model.noise import SensorNoise
-from ema.model.params import ActuatorParams, HealthParams
+from ema.model.params import DriveConstants, HealthParams
 from ema.model.residual import smoothed
 from ema.model.window import Window
 
@@ -39,7 +39,7 @@ def physical_fdj_nm(nominal_fdj_nm: float) -> tuple[float, float]:
 class Scenario:
     """What every simulation of a dataset shares: the actuator, the command, the load, the start, the rate."""
 
-    actuator: ActuatorParams  # the drive's constants the simulations run with
+    actuator: DriveConstants  # the drive's constants the simulations run with
     command_knots_deg: np.ndarray  # (n_samples + 1,) one command (Case 1) or (n_sims, n_samples + 1) (Case 2)
     load: Load = field(default_factory=FlightCondition)
     initial: InitialState = field(default_factory=InitialState)
@@ -64,7 +64,7 @@ class Scenario:
         )
 
 
-def initial_state(window: Window, actuator: ActuatorParams) -> InitialState:
+def initial_state(window: Window, actuator: DriveConstants) -> InitialState:
     """The state at t = 0: a parabola through the first samples (at their interval centres), taken at 0.
 
     Not the first sample: the fit averages the sensor noise down, and a parabola follows the motor,
@@ -100,7 +100,7 @@ def logged_load(window: Window, hinge: HingeGeometry | None, sensor_bias_nm: flo
 
 
 def scenario_from_window(
-    window: Window, actuator: ActuatorParams, hinge: HingeGeometry | None, effects: EffectSet = EffectSet()
+    window: Window, actuator: DriveConstants, hinge: HingeGeometry | None, effects: EffectSet = EffectSet()
 ) -> Scenario:
     """Case 1B for a logged window: its actuator, its command, its logged load, its first state."""
     return Scenario(

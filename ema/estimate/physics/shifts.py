@@ -9,7 +9,7 @@ import numpy as np
 
 from ema.estimate.physics.features import as_read
 from ema.estimate.physics.friction import FitSettings, FrictionFit, fit_friction
-from ema.model.params import ActuatorParams
+from ema.model.params import DriveConstants
 
 
 def advanced(values: np.ndarray, samples: float) -> np.ndarray:
@@ -22,7 +22,7 @@ def shifted_fits(
     signals: dict[str, np.ndarray],
     sample_rate_hz: float,
     lags: np.ndarray,
-    actuator: ActuatorParams,
+    actuator: DriveConstants,
     name: str = "current_a",
     settings: FitSettings = FitSettings(),
 ) -> FrictionFit:
@@ -38,7 +38,7 @@ def equation_errors(
     signals: dict[str, np.ndarray],
     sample_rate_hz: float,
     lags: np.ndarray,
-    actuator: ActuatorParams,
+    actuator: DriveConstants,
     name: str = "current_a",
 ) -> np.ndarray:
     """The physics fit's equation error with signal ``name`` read ``lags`` samples later."""

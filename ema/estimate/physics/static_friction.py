@@ -32,7 +32,7 @@ import numpy as np
 from ema.estimate.documents import Note
 from ema.estimate.physics.noise import white_noise_std
 from ema.model.noise import NO_NOISE, SensorNoise, ar1_mean_variance
-from ema.model.params import ActuatorParams, eta_a_from_eta_o
+from ema.model.params import DriveConstants, eta_a_from_eta_o
 from ema.model.residual import END_STOP_MARGIN_DEG, smoothed
 
 REST_SPEED_RADPS = 0.5  # at rest: the smoothed speed below this (the sensor noise alone exceeds a creep of 1 rad/s)
@@ -124,7 +124,7 @@ def _scatter(drive_nm: np.ndarray, begin: int, peak: int) -> float:
     return float(np.sqrt(np.sum(residual**2) / (len(t) - 3)))
 
 
-def _traces(signals: Mapping[str, np.ndarray], rate: float, actuator: ActuatorParams, noise: SensorNoise) -> _Traces:
+def _traces(signals: Mapping[str, np.ndarray], rate: float, actuator: DriveConstants, noise: SensorNoise) -> _Traces:
     """The drive and speed with the per-sample std that *white* noise would need to scatter their means as
     much as this window's does: a sensor filter correlates the noise, and its means scatter more. Read
     white, a filtered drive's noise looks like build-ups, and each reads as a low FSJ."""
@@ -144,7 +144,7 @@ def _traces(signals: Mapping[str, np.ndarray], rate: float, actuator: ActuatorPa
 
 
 def _events(
-    signals: Mapping[str, np.ndarray], rate: float, actuator: ActuatorParams, noise: SensorNoise
+    signals: Mapping[str, np.ndarray], rate: float, actuator: DriveConstants, noise: SensorNoise
 ) -> list[_Event]:
     """Each quasi-static break-away: a rest of ≥ 1 ms, then motion of ≥ 1 ms."""
     run = max(2, round(MIN_RUN_S * rate))
@@ -163,7 +163,7 @@ def read_static_friction(
     rate: float,
     fdj_nm: float,
     eta_o: float,
-    actuator: ActuatorParams,
+    actuator: DriveConstants,
     noise: SensorNoise = NO_NOISE,
 ) -> StaticFriction:
     """FSJ from the quasi-static break-aways of a window, given its dynamic-friction estimates and its

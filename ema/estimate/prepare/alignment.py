@@ -24,7 +24,7 @@ import numpy as np
 
 from ema.estimate.physics.shifts import advanced, equation_errors
 from ema.estimate.prepare.hinge_lag import hinge_lag
-from ema.model.params import ActuatorParams
+from ema.model.params import DriveConstants
 from ema.model.window import Window
 
 MAX_LAG_S = 1e-3
@@ -32,7 +32,7 @@ HALF_STEP = 0.5  # samples: the finest grid searched
 MIN_GAIN = 0.05  # the least relative drop of the equation error a lag must bring
 
 
-def current_lag_samples(signals: dict[str, np.ndarray], sample_rate_hz: float, actuator: ActuatorParams) -> float:
+def current_lag_samples(signals: dict[str, np.ndarray], sample_rate_hz: float, actuator: DriveConstants) -> float:
     """How many samples the logged current trails the logged speed (negative: the speed trails), 0
     unless that lag lowers the window's equation error by ``MIN_GAIN``: whole samples within
     ``MAX_LAG_S`` first, then half a sample either side of the best, then the parabola's vertex."""
@@ -66,7 +66,7 @@ class Lags:
     hinge_weight: float = 0.0  # how likely the moment is late at all (not only its noise filtered)
 
 
-def aligned(window: Window, actuator: ActuatorParams) -> tuple[Window, Lags]:
+def aligned(window: Window, actuator: DriveConstants) -> tuple[Window, Lags]:
     """``window`` with the later of its current and speed advanced onto the other and its hinge moment
     advanced by its lag's posterior mean (``ema.estimate.prepare.hinge_lag``), and those lags."""
     rate, signals = window.sample_rate_hz, dict(window.signals)

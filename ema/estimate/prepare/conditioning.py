@@ -40,17 +40,17 @@ from ema.estimate.physics.noise import white_noise_std
 from ema.estimate.prepare.alignment import Lags, aligned
 from ema.estimate.prepare.consistency import Consistency, check_consistency, kinematics_note
 from ema.estimate.prepare.departures.aircraft_check import TOLERANCE, aircraft_note, check_against_aircraft
-from ema.estimate.prepare.departures.drive_constants import KERNEL_FREE_RATE_HZ, DriveConstants, drive_constants_note
+from ema.estimate.prepare.departures.drive_constants import KERNEL_FREE_RATE_HZ, DriveReading, drive_constants_note
 from ema.estimate.prepare.departures.hinge_gain import hinge_gain_note
 from ema.estimate.prepare.departures.read import Departures, Known, history_note, read_departures
 from ema.estimate.prepare.departures.viscosity import viscosity_note
 from ema.estimate.prepare.departures.zero_offset import offset_note
 from ema.estimate.prepare.stale import Stale, line_between_flanks, stale_note, without_stale
 from ema.estimate.prepare.step_lag import StepLag, step_lag, step_lag_note
-from ema.model.actuator import Actuator
+from ema.model.actuator import ActuatorDocument
 from ema.model.batch import COMMAND_MARGIN_DEG
 from ema.model.noise import NOISY_SIGNALS
-from ema.model.params import ActuatorParams
+from ema.model.params import DriveConstants
 from ema.model.window import Window
 
 MAX_RATE_HZ = 10_000.0
@@ -64,7 +64,7 @@ MAX_GLITCH_S = 3e-4  # ... and so may a shorter one at a low rate: a current pul
 
 @dataclass(frozen=True)
 class Prepared:
-    document: Actuator  # the actuator's document the window is read with
+    document: ActuatorDocument  # the actuator's document the window is read with
     factor: int  # adjacent samples averaged into one
     original_samples: int
     original_rate_hz: float
@@ -82,9 +82,9 @@ class Prepared:
         return self.departures.window
 
     @property
-    def actuator(self) -> ActuatorParams:
+    def drive_as_read(self) -> DriveConstants:
         """What every reconstruction and fit of the window reads it with: the document's, J_M and C as read."""
-        return self.departures.actuator
+        return self.departures.drive_as_read
 
 
 def averaging_factor(n_samples: int, rate_hz: float) -> int:
@@ -140,7 +140,9 @@ def repaired(window: Window) -> tuple[Window, dict[str, int]]:
     return (replace(window, signals=signals) if counts else window), counts
 
 
-def prepare(window: Window, actuator: Actuator, spec_only: bool = False, known: Known | None = None) -> Prepared:
+def prepare(
+    window: Window, actuator: ActuatorDocument, spec_only: bool = False, known: Known | None = None
+) -> Prepared:
     """Cut ``window`` to a stretch its sensors kept updating in (``ema.estimate.prepare.stale``), repair its glitches,
     average it down to the pipeline's sizes, check its signals agree (``ema.estimate.prepare.consistency``: InputError
     naming the field), put its sensors on one clock (``ema.estimate.prepare.alignment``), read what it shows beyond
@@ -163,13 +165,13 @@ def prepare(window: Window, actuator: Actuator, spec_only: bool = False, known: 
     airframe = actuator.airframe
     aircraft = check_against_aircraft(window, actuator.hinge, airframe.tolerance if airframe else TOLERANCE)
     read = (
-        Departures(window, DriveConstants(spec), aircraft=aircraft)
+        Departures(window, DriveReading(spec), aircraft=aircraft)
         if spec_only
         else read_departures(window, actuator, aircraft, known or Known())
     )
     rate = read.window.sample_rate_hz * factor
     # with the departures left in, a lag fits what they leave (an offset above all): the story is no test there
-    step = StepLag() if spec_only else step_lag(read.window, read.actuator)
+    step = StepLag() if spec_only else step_lag(read.window, read.drive_as_read)
     return Prepared(actuator, factor, logged, rate, clipped, glitches, consistent, lags, read, step, stale)
 
 

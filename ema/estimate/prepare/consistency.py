@@ -48,7 +48,7 @@ from ema.estimate.physics.shifts import equation_errors
 from ema.estimate.prepare.departures.zero_offset import OFFSET_FIT
 from ema.model.checks import InputError
 from ema.model.dead_band import dead_band_paths
-from ema.model.params import ActuatorParams
+from ema.model.params import DriveConstants
 from ema.model.window import Window
 
 TRAVEL_GAIN = (0.9, 1.1)  # g accepted
@@ -119,7 +119,7 @@ def _best_band(travel: np.ndarray, y: np.ndarray, halves: np.ndarray) -> tuple[f
     return float(explained[best]), float(slope), best % len(halves)
 
 
-def travel_gain(window: Window, actuator: ActuatorParams) -> float | None:
+def travel_gain(window: Window, actuator: DriveConstants) -> float | None:
     """The drive's kinematic gain g: the least-squares slope (with an intercept) of the position (rad) on
     the speed's integral / n carried through a dead band (``ema.model.dead_band``) whose width (any the travel
     shows: a worn band too; a coarse grid, then a fine one about the best) and start the least squares
@@ -136,14 +136,14 @@ def travel_gain(window: Window, actuator: ActuatorParams) -> float | None:
     return gain if explained >= MIN_EXPLAINED * (y @ y) > 0.0 else None
 
 
-def reaction_s(actuator: ActuatorParams) -> float:
+def reaction_s(actuator: DriveConstants) -> float:
     """How long the drive takes to turn from full speed one way to full speed the other, with a margin (the
     thesis's: 19 ms, taken as 25)."""
     turn = actuator.inertia_kgm2 * 2 * actuator.max_motor_speed_radps / actuator.max_motor_torque_nm
     return REACTION_MARGIN * turn
 
 
-def following(window: Window, actuator: ActuatorParams) -> float | None:
+def following(window: Window, actuator: DriveConstants) -> float | None:
     """The share of ``FOLLOW_STEP_S`` steps, begun over ``FOLLOW_GAP_DEG`` from the command (clipped to the
     end stops) on the side it has stood for the drive's reaction time (``reaction_s``) and moving, that move
     toward it; None where they
@@ -162,7 +162,7 @@ def following(window: Window, actuator: ActuatorParams) -> float | None:
     return float(np.mean(np.sign(step[judged]) == side[judged]))
 
 
-def better_reading(window: Window, actuator: ActuatorParams) -> tuple[str, float] | None:
+def better_reading(window: Window, actuator: DriveConstants) -> tuple[str, float] | None:
     """The reading of ``READINGS`` that fits Eq. 5.1 best, with how many times its equation error is below
     the window's as logged, if by ``MIN_BETTER``; one batched fit of the window and its readings."""
     signals, rate = window.signals, window.sample_rate_hz
@@ -186,7 +186,7 @@ def step_lags(window: Window) -> np.ndarray:
     return lags[np.abs(lags) < window.n_samples / 4]
 
 
-def out_of_step(window: Window, actuator: ActuatorParams) -> tuple[str, float, float] | None:
+def out_of_step(window: Window, actuator: DriveConstants) -> tuple[str, float, float] | None:
     """The channel (current or hinge moment), its lag [s] and how many times better Eq. 5.1 fits with it,
     where a lag of ``STEP_LAGS_S`` fits ``MIN_BETTER`` times better than none; else None."""
     signals, rate, lags = window.signals, window.sample_rate_hz, step_lags(window)
@@ -214,7 +214,7 @@ def check_logged(window: Window) -> None:
             )
 
 
-def consistency(window: Window, actuator: ActuatorParams) -> Consistency:
+def consistency(window: Window, actuator: DriveConstants) -> Consistency:
     """The three relations of the module docstring, read off ``window``."""
     return Consistency(travel_gain(window, actuator), following(window, actuator), better_reading(window, actuator))
 
@@ -233,7 +233,7 @@ def kinematics_note(found: Consistency) -> list[Note]:
 
 
 def _travel_error(
-    gain: float, reading: tuple[str, float] | None, loop: str, window: Window, actuator: ActuatorParams
+    gain: float, reading: tuple[str, float] | None, loop: str, window: Window, actuator: DriveConstants
 ) -> InputError:
     """The error for a travel gain outside ``TRAVEL_GAIN``, naming the field it points to: for a sign, the
     speed where Eq. 5.1 reads the torques against the motion (24–940x better flipped), else the position
@@ -266,7 +266,7 @@ def _travel_error(
     )
 
 
-def check_consistency(window: Window, actuator: ActuatorParams) -> Consistency:
+def check_consistency(window: Window, actuator: DriveConstants) -> Consistency:
     """``window``'s relations, or an InputError naming the field the failing ones point to."""
     check_logged(window)
     found = consistency(window, actuator)

@@ -32,7 +32,7 @@ from ema.estimate.physics.shifts import shifted_fits
 from ema.estimate.prepare.departures.aircraft_band import band_lag_s
 from ema.estimate.stats import JACKKNIFE_BLOCKS, rms_log_likelihood_ratio
 from ema.model.hinge import denoised_hinge_nm
-from ema.model.params import ActuatorParams
+from ema.model.params import DriveConstants
 
 MAX_HINGE_LAG_S = 3e-3
 # How far the filter's delay as read from the noise may be off the true one, in shares of it: one std.
@@ -96,7 +96,7 @@ def band_log_likelihood(
 
 
 def hinge_lag(
-    signals: dict[str, np.ndarray], sample_rate_hz: float, actuator: ActuatorParams, in_flight: bool = True
+    signals: dict[str, np.ndarray], sample_rate_hz: float, actuator: DriveConstants, in_flight: bool = True
 ) -> HingeLag:
     """The hinge moment's lag, where its noise shows a filter: the model average of the module docstring (on
     the ground the moment follows no deflection, and the band reads no lag)."""

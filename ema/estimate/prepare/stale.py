@@ -43,7 +43,7 @@ from ema.estimate.physics.friction import MIN_SLIDING_KERNELS, FitSettings
 from ema.estimate.physics.noise import white_noise_std
 from ema.model.checks import InputError
 from ema.model.noise import NOISY_SIGNALS
-from ema.model.params import ActuatorParams
+from ema.model.params import DriveConstants
 from ema.model.residual import DEFAULT_DERIVATIVE_WINDOW_S, kernel_samples
 from ema.model.window import Window
 
@@ -132,7 +132,7 @@ def stands_off(values: np.ndarray, run: StaleRun, jump: float) -> bool:
     return bool(min(abs(values[run.start - 1] - run.value), abs(values[run.stop] - run.value)) > jump)
 
 
-def slides_during(window: Window, actuator: ActuatorParams, run: StaleRun) -> bool:
+def slides_during(window: Window, actuator: DriveConstants, run: StaleRun) -> bool:
     """Whether the shaft slides during ``run`` of a motion sensor by the other one (module docstring, 3): the
     speed past the sliding speed (``FitSettings.sliding_speed_radps``) for the position; for the speed, its
     frozen value past it, or the position
@@ -154,7 +154,7 @@ def slides_during(window: Window, actuator: ActuatorParams, run: StaleRun) -> bo
     return travel_deg > TRAVEL_STDS * white_noise_std(position) / math.sqrt(width) and mean_speed > sliding_radps
 
 
-def stale_runs(window: Window, actuator: ActuatorParams) -> tuple[StaleRun, ...]:
+def stale_runs(window: Window, actuator: DriveConstants) -> tuple[StaleRun, ...]:
     """Every sensor's stale runs (module docstring), in the order of the samples."""
     n, found = window.n_samples, []
     for name in NOISY_SIGNALS:
@@ -173,7 +173,7 @@ def stale_runs(window: Window, actuator: ActuatorParams) -> tuple[StaleRun, ...]
     return tuple(sorted(found, key=lambda r: r.start))
 
 
-def best_stretch(window: Window, runs: tuple[StaleRun, ...], actuator: ActuatorParams) -> tuple[int, int, int]:
+def best_stretch(window: Window, runs: tuple[StaleRun, ...], actuator: DriveConstants) -> tuple[int, int, int]:
     """(start, stop, sliding samples) of the stretch free of ``runs`` with the most sliding samples by the
     speed (the longest of equals)."""
     free = np.ones(window.n_samples, dtype=bool)
@@ -188,7 +188,7 @@ def best_stretch(window: Window, runs: tuple[StaleRun, ...], actuator: ActuatorP
     return int(starts[best]), int(stops[best]), int(sliding[stops[best]] - sliding[starts[best]])
 
 
-def without_stale(window: Window, actuator: ActuatorParams) -> tuple[Window, Stale]:
+def without_stale(window: Window, actuator: DriveConstants) -> tuple[Window, Stale]:
     """``window`` with its short stale runs bridged and cut to its best stretch free of the long ones, and
     what was found; InputError naming the sensor where too little sliding motion is left (module docstring)."""
     rate, n = window.sample_rate_hz, window.n_samples

@@ -36,7 +36,7 @@ from ema.estimate.physics.shifts import shifted_fits
 from ema.estimate.prepare.consistency import step_lags
 from ema.estimate.prepare.hinge_lag import band_log_likelihood
 from ema.estimate.stats import UNDECIDED_NOTE_WEIGHT, UNDECIDED_PRIOR_LOG_ODDS, odds_weight, rms_log_likelihood_ratio
-from ema.model.params import ActuatorParams
+from ema.model.params import DriveConstants
 from ema.model.window import Window
 
 # the prior odds of "out of step" against "in step", and the weight from which a note says so
@@ -53,7 +53,7 @@ class StepLag:
     spread: dict[str, float] = field(default_factory=dict)  # per target, the std the story adds
 
 
-def step_lag(window: Window, actuator: ActuatorParams) -> StepLag:
+def step_lag(window: Window, actuator: DriveConstants) -> StepLag:
     """The hinge moment's out-of-step story on ``window`` (its departures taken off, ``actuator`` as read)."""
     rate, lags = window.sample_rate_hz, np.concatenate([[0.0], step_lags(window)])
     if len(lags) == 1:

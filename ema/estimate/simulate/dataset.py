@@ -13,10 +13,10 @@ from ema.estimate.physics.friction import FitSettings, FrictionFit, regressors
 from ema.estimate.physics.noise import excess_noise
 from ema.estimate.physics.scenario import Scenario, scenario_from_window
 from ema.estimate.simulate import design
-from ema.model.actuator import Actuator
+from ema.model.actuator import ActuatorDocument
 from ema.model.effects import EffectSet
 from ema.model.noise import SensorNoise, add_seeded_noise
-from ema.model.params import ActuatorParams, HealthParams
+from ema.model.params import DriveConstants, HealthParams
 from ema.model.residual import residual_torque_nm
 from ema.model.window import Window
 
@@ -77,7 +77,7 @@ class Data:
     sliding: np.ndarray  # (n_samples,) the window's Eq. 5.1 samples
     inputs: np.ndarray  # (n_total, n_timesteps) network inputs of every simulation
     window_inputs: np.ndarray  # (1, n_timesteps)
-    actuator: ActuatorParams  # as the window is read (``Prepared.actuator``: J_M and C as it shows them)
+    drive_as_read: DriveConstants  # as the window is read (``Prepared.drive_as_read``: J_M and C as it shows them)
 
 
 def simulate_dataset(
@@ -85,8 +85,8 @@ def simulate_dataset(
     seen: Window,
     physics: FrictionFit,
     config: PipelineConfig,
-    document: Actuator,
-    actuator: ActuatorParams,
+    document: ActuatorDocument,
+    actuator: DriveConstants,
     effects: EffectSet,
 ) -> Data:
     """The box around the physics estimate, the window's sensor noise (measured on ``window`` as logged),
@@ -94,7 +94,7 @@ def simulate_dataset(
     features of both (the window read as ``seen``: through ``as_read``, its T_R with ``actuator``, the
     document's drive with J_M and C as the window shows them)."""
     fdj, eta_o = physics.fdj_nm[0], physics.eta_o[0]
-    box = design.box_around(fdj, physics.fdj_std_nm[0], eta_o, physics.eta_o_std[0], document.nominal.fdj_nm)
+    box = design.box_around(fdj, physics.fdj_std_nm[0], eta_o, physics.eta_o_std[0], document.health.fdj_nm)
     scenario = scenario_from_window(seen, document.params, document.hinge, effects)
     health = design.draw(box, config.total_simulations, config.seed)
     sims = simulate_noisy(scenario, health, window, design.centre(box), config.seed + 1, config.check_windows)

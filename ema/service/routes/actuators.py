@@ -8,7 +8,7 @@ from typing import Annotated
 from fastapi import APIRouter, Query, Request
 from starlette.concurrency import run_in_threadpool
 
-from ema.model.actuator import Actuator
+from ema.model.actuator import ActuatorDocument
 from ema.prognosis.documents import ActuatorSummary, History, Prognosis, StoredActuator, Withdrawal
 from ema.service.deps import ActuatorId, RunnerDep, SettingsDep, StoreDep, prognosis_now
 from ema.service.errors import NotStoredError
@@ -79,12 +79,12 @@ async def prognosis(actuator_id: ActuatorId, request: Request, store: StoreDep, 
     response_model=StoredActuator,
     response_model_by_alias=True,
     responses=responses(401, 403, 413, 415, 422, 503),
-    openapi_extra=json_body(Actuator, "the actuator's ema-actuator/1 document"),
+    openapi_extra=json_body(ActuatorDocument, "the actuator's ema-actuator/1 document"),
 )
 async def put_actuator(actuator_id: ActuatorId, request: Request, store: StoreDep, runner: RunnerDep) -> StoredActuator:
     """Store the actuator's document as its next version: its windows are read with it from now on (those
     stored keep the version they were read with). The same document again stores nothing new."""
-    document = await read_body(request, runner, Actuator, lambda d: d)
+    document = await read_body(request, runner, ActuatorDocument, lambda d: d)
     await run_in_threadpool(store.probe)
     return await run_in_threadpool(store.put_actuator, actuator_id, document)
 

@@ -8,9 +8,9 @@ from typing import Annotated
 from fastapi import APIRouter, Query, Request
 from starlette.concurrency import run_in_threadpool
 
+from ema.estimate import kinds
 from ema.estimate.config import PipelineConfig, bounds
 from ema.estimate.documents import Estimate
-from ema.estimate.pipeline import estimate_window
 from ema.history.open import History
 from ema.model.window import Window, WindowDocument
 from ema.prognosis.documents import Stored
@@ -94,5 +94,5 @@ async def _job(
 
         return partial(estimate_on_ray, window, config, 1, history, actuator, version)
     return partial(
-        estimate_window, window, config, actuator=actuator, version=version, on_stage=stopper(cancel), history=history
+        kinds.estimate, window, config, actuator=actuator, version=version, on_stage=stopper(cancel), history=history
     )

@@ -56,7 +56,7 @@ def test_the_shrinkage_is_positive_part_james_stein():
 
 @pytest.mark.parametrize("seed", range(5))
 def test_a_network_that_barely_helps_on_the_simulations_stays_out(seed):
-    result = assess(candidates(np.random.default_rng(seed), physics_error=0.01, network_error=0.011), 1.0)
+    result = assess(candidates(np.random.default_rng(seed), physics_error=0.01, network_error=0.011), 1.0, 1.1)
     for name in ("FDJ", "eta_O"):
         assert result.methods[name].weight_network == 0.0
         assert result.values[name] == pytest.approx(0.5 - result.methods[name].physics_bias)
@@ -66,7 +66,7 @@ def test_a_network_that_barely_helps_on_the_simulations_stays_out(seed):
 
 @pytest.mark.parametrize("seed", range(5))
 def test_a_network_much_better_on_the_simulations_joins_the_answer(seed):
-    result = assess(candidates(np.random.default_rng(seed), physics_error=0.01, network_error=0.003), 1.0)
+    result = assess(candidates(np.random.default_rng(seed), physics_error=0.01, network_error=0.003), 1.0, 1.1)
     for name in ("FDJ", "eta_O"):
         assert result.methods[name].weight_network > 0.5
         assert result.methods[name].rms_error_blend < NETWORK_MARGIN * result.methods[name].rms_error_physics
@@ -75,5 +75,35 @@ def test_a_network_much_better_on_the_simulations_joins_the_answer(seed):
 def test_the_std_is_never_below_the_windows_jackknife_and_widens_with_the_equation_error():
     c = candidates(np.random.default_rng(1), physics_error=1e-4, network_error=1e-4)
     c = Candidates(**{**c.__dict__, "physics_std": {"FDJ": 0.02, "eta_O": 0.03}})
-    assert assess(c, 1.0).stds == pytest.approx({"FDJ": 0.02, "eta_O": 0.03})
-    assert assess(c, 2.5).stds == pytest.approx({"FDJ": 0.05, "eta_O": 0.075})
+    assert assess(c, 1.0, 1.1).stds == pytest.approx({"FDJ": 0.02, "eta_O": 0.03})
+    assert assess(c, 2.5, 1.1).stds == pytest.approx({"FDJ": 0.05, "eta_O": 0.075})
+
+
+def test_the_student_quantile_is_scipys_within_one_percent():
+    from scipy import stats
+
+    from ema.estimate.assess.weighing import student_99
+
+    for dof in (4, 7, 15, 23, 60, 200):
+        assert student_99(dof) == pytest.approx(stats.t.ppf(0.99, dof), rel=1e-2)
+
+
+def test_a_clean_window_passes_the_misfit_limit_at_the_stated_rate():
+    """K simulations' RMS errors and the window's, all one log-normal null (spreads as the pipeline sees them,
+    0.03-0.05): the window passes ``misfit_limit`` 1 % of the time."""
+    from ema.estimate.assess.weighing import MISFIT_FALSE_ALARM, misfit_limit
+
+    rng = np.random.default_rng(7)
+    trials, passed = 20_000, 0
+    for _ in range(trials):
+        spread, k = rng.uniform(0.03, 0.05), int(rng.integers(16, 25))
+        draws = np.exp(spread * rng.standard_normal(k + 1))
+        passed += draws[-1] / np.median(draws[:-1]) > misfit_limit(draws[:-1])
+    rate = passed / trials
+    assert abs(rate - MISFIT_FALSE_ALARM) < 3 * np.sqrt(MISFIT_FALSE_ALARM / trials) + 0.002, rate
+
+
+def test_the_misfit_note_is_said_past_the_limit_only():
+    c = candidates(np.random.default_rng(2), physics_error=1e-3, network_error=1e-3)
+    assert "model_misfit" not in [n.code for n in assess(c, 1.08, 1.1).notes]
+    assert "model_misfit" in [n.code for n in assess(c, 1.12, 1.1).notes]

@@ -9,7 +9,7 @@ from ema.model.aircraft import GroundLoad
 from ema.model.batch import simulate_batch
 from ema.model.checks import InputError
 from ema.model.noise import NO_NOISE, SensorNoise, add_sensor_noise
-from ema.model.params import ActuatorParams, HealthParams
+from ema.model.params import DriveConstants, HealthParams
 from ema.model.synthetic import synthetic_window
 from ema.model.window import window_from_dict
 from tests.foreign.windows import draw
@@ -88,7 +88,7 @@ def test_an_offset_is_not_fitted_where_the_motion_goes_one_way():
 def test_a_viscous_coefficient_beyond_the_actuators_is_read_exactly_and_moves_nothing_else():
     """Motor torque ΔC·ω more (the current k_T⁻¹·ΔC·ω more): the viscous fit reads ΔC, FDJ and η_O stay put."""
     window = synthetic_window(HealthParams.single(0.1, 0.052, 0.8), seed=5, noise=SensorNoise())
-    unclipped = ActuatorParams(max_motor_torque_nm=100.0)  # the extra torque is not lost where the motor saturates
+    unclipped = DriveConstants(max_motor_torque_nm=100.0)  # the extra torque is not lost where the motor saturates
     settings = FitSettings(offset=True, viscous=True)
     plain = fit_friction(window.signals, 10_000.0, unclipped, settings)
     extra = 3e-5 * window.signals["motor_speed_radps"] / 0.0752
@@ -105,7 +105,7 @@ def test_a_scaled_motor_torque_is_read_exactly_and_moves_nothing_else():
     """A current logged 3 % low (or k_T 3 % above the spec's): the scale fit reads γ = 1/0.97 − 1, FDJ and η_O
     stay put; without it, FDJ moves by several % of its range."""
     window = synthetic_window(HealthParams.single(0.1, 0.052, 0.8), seed=5, noise=SensorNoise())
-    unclipped = ActuatorParams(max_motor_torque_nm=100.0)  # no sample saturated: the scale holds everywhere
+    unclipped = DriveConstants(max_motor_torque_nm=100.0)  # no sample saturated: the scale holds everywhere
     settings = FitSettings(offset=True, torque_scale=True)
     plain = fit_friction(window.signals, 10_000.0, unclipped, settings)
     low = dict(window.signals, current_a=0.97 * window.signals["current_a"])

@@ -10,12 +10,12 @@ from ema.model.actuator import THESIS
 from ema.model.aircraft import GroundLoad
 from ema.model.batch import simulate_batch
 from ema.model.noise import SensorNoise, add_sensor_noise
-from ema.model.params import ActuatorParams, HealthParams
+from ema.model.params import DriveConstants, HealthParams
 from ema.model.window import window_from_dict
 from tests.foreign.windows import Effects, draw
 
 RATE = 10_000.0
-KT = ActuatorParams().torque_constant_nm_per_a
+KT = DriveConstants().torque_constant_nm_per_a
 
 
 def trace(rest_speed_radps: float, rest_current_a: np.ndarray, after_current_a: float, seed: int) -> dict:

@@ -25,7 +25,7 @@ def _physics(document: dict) -> tuple[dict[str, float], dict[str, float], Prepar
     """Eq. 5.1's answer to the window as prepared, its stds widened by what conditioning left open."""
     prepared = prepare(window_from_dict(document), actuator=THESIS)
     w = prepared.window
-    fitted = fit_window(as_read(w.signals, w.sample_rate_hz), w.sample_rate_hz, prepared.actuator)
+    fitted = fit_window(as_read(w.signals, w.sample_rate_hz), w.sample_rate_hz, prepared.drive_as_read)
     stds = widened({"FDJ": float(fitted.fdj_std_nm[0]), "eta_O": float(fitted.eta_o_std[0])}, prepared)
     return {"FDJ": float(fitted.fdj_nm[0]), "eta_O": float(fitted.eta_o[0])}, stds, prepared
 

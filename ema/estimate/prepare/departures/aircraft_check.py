@@ -49,7 +49,7 @@ from ema.estimate.stats import JACKKNIFE_BLOCKS, jackknife_std
 from ema.model.actuator import Airframe
 from ema.model.aircraft import HingeGeometry
 from ema.model.checks import InputError
-from ema.model.params import ActuatorParams
+from ema.model.params import DriveConstants
 from ema.model.residual import kernel_samples
 from ema.model.window import Window
 
@@ -202,7 +202,7 @@ def divided_out(read: AircraftCheck) -> AircraftCheck:
     return replace(read, factor=read.ratio) if read.decisive and read.beyond(DEPART_STDS) else read
 
 
-def banded(read: AircraftCheck, window: Window, gain: float, actuator: ActuatorParams) -> AircraftCheck:
+def banded(read: AircraftCheck, window: Window, gain: float, actuator: DriveConstants) -> AircraftCheck:
     """``read`` with the stds it adds to FDJ and η_O of ``window`` (its ratio divided out already, where
     it departs) where the window's own loads read no ``gain`` (``ema.estimate.prepare.departures.hinge_gain``); as it is
     otherwise. Divided out: half of what the ends of the ratio's band move them (the tolerance and the
@@ -219,7 +219,7 @@ def banded(read: AircraftCheck, window: Window, gain: float, actuator: ActuatorP
     return replace(read, spread=_moved(window, actuator, 1.0 - band, 1.0 + band, 0.5))
 
 
-def _moved(window: Window, actuator: ActuatorParams, first: float, second: float, share: float) -> dict[str, float]:
+def _moved(window: Window, actuator: DriveConstants, first: float, second: float, share: float) -> dict[str, float]:
     """``share`` of how far FDJ and η_O of Eq. 5.1's fit move between the hinge moment divided by
     ``first`` and by ``second``."""
     ends = [fit_as_read(divided_hinge(window, g).signals, window.sample_rate_hz, actuator) for g in (first, second)]

@@ -37,7 +37,7 @@ from ema.estimate.physics.friction import FitSettings, FrictionFit
 from ema.estimate.prepare.departures.zero_offset import equation_z, log_likelihood_ratio
 from ema.estimate.stats import DECISIVE_Z
 from ema.model.checks import InputError
-from ema.model.params import ActuatorParams
+from ema.model.params import DriveConstants
 from ema.model.window import Window
 
 ITERATIONS = 3  # refits of the corrected window at most: each settles what the peak torque's cut left
@@ -66,15 +66,15 @@ KERNEL_FREE_RATE_HZ = 5_000.0
 
 
 @dataclass(frozen=True)
-class DriveConstants:
+class DriveReading:
     """γ and ΔJ read on a window (0: the document's), and what their stds add to FDJ's and η_O's."""
 
-    spec: ActuatorParams  # the drive's constants the departures are read against
+    spec: DriveConstants  # the drive's constants the departures are read against
     torque_scale: float = 0.0  # γ: the motor's torque is (1 + γ)·k_T·I
     inertia_kgm2: float = 0.0  # ΔJ beyond the document's J_M
     stds: dict[str, float] = field(default_factory=dict)  # per field read, its std
     spread: dict[str, float] = field(default_factory=dict)  # per target, the std the constants' uncertainty adds
-    alternative: DriveConstants | None = None  # where the window did not tell ΔJ from this γ: the ΔJ reading
+    alternative: DriveReading | None = None  # where the window did not tell ΔJ from this γ: the ΔJ reading
     unit_scale: float = 0.0  # γ fitted alone beyond any motor, its answer's gap in ``spread`` (``unit_story``)
 
     @property
@@ -88,11 +88,11 @@ class DriveConstants:
         return 1.0 + self.inertia_kgm2 / self.spec.inertia_kgm2
 
     @property
-    def actuator(self) -> ActuatorParams:
+    def drive_as_read(self) -> DriveConstants:
         """The actuator the window's T_R is reconstructed with: the document's, its J_M as read."""
         return replace(self.spec, inertia_kgm2=self.spec.inertia_kgm2 + self.inertia_kgm2)
 
-    def added(self, left: FrictionFit) -> DriveConstants:
+    def added(self, left: FrictionFit) -> DriveReading:
         """These constants with what a fit of the corrected window left of them."""
         scale = self.torque_factor * (1.0 + float(left.term("torque_scale")[0])) - 1.0
         return replace(self, torque_scale=scale, inertia_kgm2=self.inertia_kgm2 + float(left.term("inertia")[0]))
@@ -104,11 +104,11 @@ class DriveConstants:
         return replace(window, signals=dict(window.signals, current_a=self.torque_factor * window.signals["current_a"]))
 
 
-def _fit(window: Window, actuator: ActuatorParams, settings: FitSettings) -> FrictionFit:
+def _fit(window: Window, actuator: DriveConstants, settings: FitSettings) -> FrictionFit:
     return fit_as_read(window.signals, window.sample_rate_hz, actuator, settings)
 
 
-def read_drive_constants(window: Window, actuator: ActuatorParams) -> DriveConstants:
+def read_drive_constants(window: Window, actuator: DriveConstants) -> DriveReading:
     """γ or ΔJ where it stands out (module docstring), with FDJ's and η_O's change across it ± its std. Where
     both do, the likelier if the window decides (``DECISIVE``); else γ, with ΔJ beside it as the
     ``alternative`` (``ema.estimate.prepare.departures.read`` replays both, or widens the stds by their gap)."""
@@ -126,13 +126,13 @@ def read_drive_constants(window: Window, actuator: ActuatorParams) -> DriveConst
 
 
 def _read_constants(
-    window: Window, actuator: ActuatorParams, plain: FrictionFit, alone: dict[str, FrictionFit]
-) -> DriveConstants:
+    window: Window, actuator: DriveConstants, plain: FrictionFit, alone: dict[str, FrictionFit]
+) -> DriveReading:
     rate = window.sample_rate_hz
     found = [name for name in FIELDS if _stands_out(plain, alone[name], name, rate, actuator)]
     readings = {name: _reading(window, actuator, name, alone[name]) for name in found}
     if not readings:
-        return DriveConstants(spec=actuator)
+        return DriveReading(spec=actuator)
     if len(readings) == 1:
         return _with_spread(window, next(iter(readings.values()))[0])
     (scale, scale_fit), (inertia, inertia_fit) = readings["torque_scale"], readings["inertia"]
@@ -150,7 +150,7 @@ def beyond_any_motor(plain: FrictionFit, scale: FrictionFit, rate: float) -> flo
     return gamma if beyond else 0.0
 
 
-def no_drive_error(gamma: float, inertia_alone: FrictionFit, spec: ActuatorParams) -> InputError | None:
+def no_drive_error(gamma: float, inertia_alone: FrictionFit, spec: DriveConstants) -> InputError | None:
     """The error naming the current where Eq. 5.1 balances the window only with a motor torque per k_T·I
     and an inertia no drive has, each fitted alone (``gamma`` from ``beyond_any_motor``; ΔJ, its rival
     where the motor saturates, beyond ``PLAUSIBLE`` too): a current in other units (a tenth: γ = 9). None
@@ -168,7 +168,7 @@ def no_drive_error(gamma: float, inertia_alone: FrictionFit, spec: ActuatorParam
     )
 
 
-def unit_story(read: DriveConstants, gamma: float, plain: FrictionFit, alone: dict[str, FrictionFit]) -> DriveConstants:
+def unit_story(read: DriveReading, gamma: float, plain: FrictionFit, alone: dict[str, FrictionFit]) -> DriveReading:
     """``read`` with the story of a current in other units weighed in, where γ fitted alone lies beyond any
     motor (``gamma`` from ``beyond_any_motor``) and yet ΔJ reads a drive: a current logged 0.71x (RMS for
     amplitude) reads as a rotor ~0.7x as heavy with other friction, and a rotor 1.3–1.45x as heavy as a
@@ -182,7 +182,7 @@ def unit_story(read: DriveConstants, gamma: float, plain: FrictionFit, alone: di
     return replace(read, unit_scale=gamma, spread=spread)
 
 
-def _stands_out(plain: FrictionFit, alone: FrictionFit, name: str, rate: float, spec: ActuatorParams) -> bool:
+def _stands_out(plain: FrictionFit, alone: FrictionFit, name: str, rate: float, spec: DriveConstants) -> bool:
     """The fit with constant ``name`` explains the window ``DECISIVE_Z`` stds better, read within ``PLAUSIBLE``."""
     relative = float(alone.term(name)[0]) / (spec.inertia_kgm2 if name == "inertia" else 1.0)
     return bool(
@@ -194,32 +194,32 @@ def _stands_out(plain: FrictionFit, alone: FrictionFit, name: str, rate: float, 
 
 
 def _reading(
-    window: Window, actuator: ActuatorParams, name: str, first: FrictionFit
-) -> tuple[DriveConstants, FrictionFit]:
+    window: Window, actuator: DriveConstants, name: str, first: FrictionFit
+) -> tuple[DriveReading, FrictionFit]:
     """Constant ``name``, refitted on the corrected window until nothing is left, its std ΔJ's with the
     kernel's (``kernel_inertia_std``); and the last fit (its likelihood)."""
     settings, std = replace(BESIDE, **{name: True}), float(first.term_std(name)[0])
     kernel = kernel_inertia_std(window.sample_rate_hz, actuator) if name == "inertia" else 0.0
-    read, left = DriveConstants(spec=actuator, stds={FIELDS[name]: float(np.hypot(std, kernel))}), first
+    read, left = DriveReading(spec=actuator, stds={FIELDS[name]: float(np.hypot(std, kernel))}), first
     for _ in range(ITERATIONS + 1):
         read = read.added(left)
-        left = _fit(read.corrected(window), read.actuator, settings)
+        left = _fit(read.corrected(window), read.drive_as_read, settings)
         if abs(float(left.term(name)[0])) < SETTLED * std:  # ΔJ is linear: settled at once; γ within a few
             break
     return read, left
 
 
-def kernel_inertia_std(rate_hz: float, spec: ActuatorParams) -> float:
+def kernel_inertia_std(rate_hz: float, spec: DriveConstants) -> float:
     """The std [kg·m²] the reconstruction's kernel at ``rate_hz`` adds to ΔJ (``KERNEL_INERTIA_SHARE``)."""
     return KERNEL_INERTIA_SHARE * (1_000.0 / rate_hz) ** 2 * spec.inertia_kgm2
 
 
-def _plain(window: Window, read: DriveConstants) -> dict[str, float]:
-    fitted = _fit(read.corrected(window), read.actuator, FitSettings())
+def _plain(window: Window, read: DriveReading) -> dict[str, float]:
+    fitted = _fit(read.corrected(window), read.drive_as_read, FitSettings())
     return {name: float(value) for name, value in fitted.values().items()}
 
 
-def _with_spread(window: Window, read: DriveConstants) -> DriveConstants:
+def _with_spread(window: Window, read: DriveReading) -> DriveReading:
     """``read`` with, per target, half the change of the plain fit across each read constant ± its std, in
     quadrature."""
     spread = {"FDJ": 0.0, "eta_O": 0.0}
@@ -229,7 +229,7 @@ def _with_spread(window: Window, read: DriveConstants) -> DriveConstants:
     return replace(read, spread=spread)
 
 
-def drive_constants_note(read: DriveConstants) -> list[Note]:
+def drive_constants_note(read: DriveReading) -> list[Note]:
     """The constants, and the story of a current in other units, for the result's notes."""
     notes = []
     constants = _constants_note(read)
@@ -255,7 +255,7 @@ def drive_constants_note(read: DriveConstants) -> list[Note]:
     return notes
 
 
-def _constants_note(read: DriveConstants) -> str | None:
+def _constants_note(read: DriveReading) -> str | None:
     found = []
     if read.torque_scale:
         found.append(

@@ -32,7 +32,7 @@ from ema.estimate.physics.features import as_read, fit_as_read
 from ema.estimate.physics.friction import MIN_SLIDING_KERNELS, FitSettings, nuisance_columns, regressors
 from ema.estimate.prepare.departures.drive_constants import BESIDE, FIELDS
 from ema.estimate.stats import DECISIVE_Z, JACKKNIFE_BLOCKS, jackknife_std, rms_log_likelihood_ratio
-from ema.model.params import ActuatorParams
+from ema.model.params import DriveConstants
 from ema.model.residual import DEFAULT_DERIVATIVE_WINDOW_S, kernel_samples
 from ema.model.window import Window
 
@@ -72,7 +72,7 @@ def eta_o_from_product(product: np.ndarray, gear: float) -> np.ndarray:
 
 
 def free_load_fit(
-    window: Window, actuator: ActuatorParams, beside: FitSettings = FitSettings()
+    window: Window, actuator: DriveConstants, beside: FitSettings = FitSettings()
 ) -> tuple[np.ndarray, float, int] | None:
     """The least squares of t on (1, a, o) and ``beside``'s nuisance columns over the sliding samples: g
     from the whole window and from each jackknife block left out ((B + 1,), the whole first), the RMS
@@ -94,7 +94,7 @@ def free_load_fit(
     return 1.0 / ((1 + betas[:, 2]) * eta_o), rms, used
 
 
-def _margin(window: Window, actuator: ActuatorParams, free_rms: float, used: int, rivals: list[FitSettings]) -> float:
+def _margin(window: Window, actuator: DriveConstants, free_rms: float, used: int, rivals: list[FitSettings]) -> float:
     """ln LR by which the free load fit explains ``window`` better than the best of Eq. 5.1's fits with
     g = 1 and ``rivals``' terms (−inf where one cannot be compared)."""
     rate = window.sample_rate_hz
@@ -104,7 +104,7 @@ def _margin(window: Window, actuator: ActuatorParams, free_rms: float, used: int
     return rms_log_likelihood_ratio(best, free_rms, used, rate)
 
 
-def read_hinge_gain(window: Window, actuator: ActuatorParams, leading: bool = False) -> HingeGain:
+def read_hinge_gain(window: Window, actuator: DriveConstants, leading: bool = False) -> HingeGain:
     """g where it stands out and is plausible (module docstring), with FDJ's and η_O's change across g ± its
     std; ``leading``: only where it also explains the window ``DECISIVE`` (ln LR) better than γ or ΔJ alone,
     each beside an offset and ΔC, to be read before them (which would each take a part of it)."""

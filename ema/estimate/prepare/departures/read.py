@@ -28,14 +28,14 @@ from ema.estimate.physics.features import fit_as_read
 from ema.estimate.physics.noise import white_noise_std
 from ema.estimate.physics.scenario import CLEAR_MARGIN, MAX_RATIO, following_error, inside, scenario_from_window
 from ema.estimate.prepare.departures.aircraft_check import AircraftCheck, banded, divided_out
-from ema.estimate.prepare.departures.drive_constants import UNDECIDED_SHARE, DriveConstants, read_drive_constants
+from ema.estimate.prepare.departures.drive_constants import UNDECIDED_SHARE, DriveReading, read_drive_constants
 from ema.estimate.prepare.departures.hinge_gain import HingeGain, read_hinge_gain
 from ema.estimate.prepare.departures.viscosity import Viscosity, read_viscosity
 from ema.estimate.prepare.departures.zero_offset import ZeroOffset, read_zero_offset, zeroed
-from ema.model.actuator import Actuator
+from ema.model.actuator import ActuatorDocument
 from ema.model.checks import InputError
 from ema.model.noise import SensorNoise
-from ema.model.params import ActuatorParams
+from ema.model.params import DriveConstants
 from ema.model.window import Window
 
 # A reading agrees with the J_M an actuator's history holds where it lies within this many stds of it.
@@ -55,7 +55,7 @@ class Known:
 @dataclass(frozen=True)
 class Departures:
     window: Window  # zeroed, its current on the document's k_T
-    drive: DriveConstants  # γ and ΔJ, and the drive's constants they were read against
+    drive: DriveReading  # γ and ΔJ, and the drive's constants they were read against
     offset: ZeroOffset = field(default_factory=ZeroOffset)
     viscosity: Viscosity = field(default_factory=Viscosity)
     hinge: HingeGain = field(default_factory=HingeGain)
@@ -63,20 +63,20 @@ class Departures:
     inertia_from: tuple[str, ...] = ()  # γ or ΔJ undecided by the window: the windows whose J_M decided
 
     @property
-    def actuator(self) -> ActuatorParams:
+    def drive_as_read(self) -> DriveConstants:
         """What every reconstruction and fit of the window reads it with: the document's, J_M and C as read."""
-        return self.viscosity.actuator(self.drive.actuator)
+        return self.viscosity.drive_as_read(self.drive.drive_as_read)
 
     @cached_property
     def answer(self) -> dict[str, float]:
         """FDJ and η_O of Eq. 5.1's fit of the window as read (fitted once: the tie-break and the stds ask)."""
-        fitted = fit_as_read(self.window.signals, self.window.sample_rate_hz, self.actuator)
+        fitted = fit_as_read(self.window.signals, self.window.sample_rate_hz, self.drive_as_read)
         return {name: float(value) for name, value in fitted.values().items()}
 
 
 def read_departures(
     window: Window,
-    actuator: Actuator,
+    actuator: ActuatorDocument,
     aircraft: AircraftCheck = AircraftCheck(),
     known: Known = Known(),
 ) -> Departures:
@@ -109,7 +109,7 @@ def _doubted(read: Departures, divided: Departures) -> Departures:
     return replace(read, aircraft=replace(read.aircraft, spread=spread))
 
 
-def _read(window: Window, actuator: Actuator, aircraft: AircraftCheck, known: Known) -> Departures:
+def _read(window: Window, actuator: ActuatorDocument, aircraft: AircraftCheck, known: Known) -> Departures:
     """``read_departures`` with ``aircraft``'s factor as decided."""
     zero, spec = known.zero, actuator.params
     window = aircraft.corrected(window)
@@ -131,7 +131,9 @@ def _read(window: Window, actuator: Actuator, aircraft: AircraftCheck, known: Kn
     return replace(read, drive=replace(drive, spread=spread))
 
 
-def _told_apart(window: Window, scale: Departures, inertia: Departures, actuator: Actuator) -> Departures | None:
+def _told_apart(
+    window: Window, scale: Departures, inertia: Departures, actuator: ActuatorDocument
+) -> Departures | None:
     """The reading whose simulation follows the window's motor speed and current clearly better
     (``CLEAR_MARGIN``), or None: γ as a torque constant or as a current sensor's gain, whichever
     follows better, against ΔJ; each at its own answer, with the viscous coefficient it read. Only
@@ -146,7 +148,7 @@ def _told_apart(window: Window, scale: Departures, inertia: Departures, actuator
     def error(read: Departures, effect: str, **parameters: float) -> float:
         effects = read.viscosity.effects().with_effect(effect, **parameters)
         scenario = scenario_from_window(window, actuator.params, actuator.hinge, effects)
-        health = inside(read.answer["FDJ"], read.answer["eta_O"], actuator.nominal.fdj_nm)
+        health = inside(read.answer["FDJ"], read.answer["eta_O"], actuator.health.fdj_nm)
         return following_error(scenario, window, health, noise)
 
     factor = scale.drive.torque_factor
@@ -181,7 +183,7 @@ def _by_history(scale: Departures, inertia: Departures, known: Known) -> Departu
 def _along(
     window: Window,
     offset: ZeroOffset,
-    drive: DriveConstants,
+    drive: DriveReading,
     hinge: HingeGain,
     aircraft: AircraftCheck,
     zero: ZeroOffset | None,
@@ -191,13 +193,13 @@ def _along(
     aircraft's where that was divided out and the window reads none, then C."""
     if drive.stds:
         window = drive.corrected(window)
-        offset = read_zero_offset(window, drive.actuator, zero)
+        offset = read_zero_offset(window, drive.drive_as_read, zero)
     window = zeroed(window, offset)
     if hinge.gain == 1.0:
-        hinge = read_hinge_gain(window, drive.actuator)
+        hinge = read_hinge_gain(window, drive.drive_as_read)
         window = hinge.corrected(window)
-    aircraft = banded(aircraft, window, hinge.gain, drive.actuator)
-    return Departures(window, drive, offset, read_viscosity(window, drive.actuator), hinge, aircraft)
+    aircraft = banded(aircraft, window, hinge.gain, drive.drive_as_read)
+    return Departures(window, drive, offset, read_viscosity(window, drive.drive_as_read), hinge, aircraft)
 
 
 def history_note(read: Departures) -> list[Note]:

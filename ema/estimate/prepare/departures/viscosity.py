@@ -32,7 +32,7 @@ from ema.estimate.physics.features import as_read
 from ema.estimate.physics.friction import FitSettings, fit_friction
 from ema.estimate.stats import DECISIVE_Z, UNDECIDED_NOTE_WEIGHT, UNDECIDED_PRIOR_LOG_ODDS, odds_weight
 from ema.model.effects import EffectSet
-from ema.model.params import ActuatorParams
+from ema.model.params import DriveConstants
 from ema.model.window import Window
 
 MIN_CHANGE = 0.1  # of the document's C
@@ -65,7 +65,7 @@ class Viscosity:
         """The coefficient read over the document's (1 where none was read, or the document's is 0)."""
         return 1.0 + self.change_nms / self.spec_nms if self.change_nms and self.spec_nms > 0 else 1.0
 
-    def actuator(self, spec: ActuatorParams) -> ActuatorParams:
+    def drive_as_read(self, spec: DriveConstants) -> DriveConstants:
         """The actuator every fit of the window reads it with."""
         return replace(spec, viscous_nms=spec.viscous_nms + self.change_nms) if self.change_nms else spec
 
@@ -74,7 +74,7 @@ class Viscosity:
         return EffectSet({"viscous": {"coefficient_nms": self.change_nms}}) if self.change_nms else EffectSet()
 
 
-def read_viscosity(window: Window, spec: ActuatorParams) -> Viscosity:
+def read_viscosity(window: Window, spec: DriveConstants) -> Viscosity:
     """ΔC where it stands out, with FDJ's and η_O's change across C ± its std; elsewhere the document's C,
     with what the change the window leans to would move them, by its weight (module docstring)."""
     rate = window.sample_rate_hz
@@ -92,7 +92,7 @@ def read_viscosity(window: Window, spec: ActuatorParams) -> Viscosity:
 
 
 def _targets_at(
-    seen: dict[str, np.ndarray], rate: float, spec: ActuatorParams, changes: tuple[float, ...]
+    seen: dict[str, np.ndarray], rate: float, spec: DriveConstants, changes: tuple[float, ...]
 ) -> list[dict[str, float]]:
     """FDJ and η_O read with the document's C plus each change."""
     fits = (fit_friction(seen, rate, replace(spec, viscous_nms=spec.viscous_nms + d)) for d in changes)
@@ -100,14 +100,14 @@ def _targets_at(
 
 
 def _half_change(
-    seen: dict[str, np.ndarray], rate: float, spec: ActuatorParams, change: float, std: float
+    seen: dict[str, np.ndarray], rate: float, spec: DriveConstants, change: float, std: float
 ) -> dict[str, float]:
     """Per target, half its change across the document's C plus ``change`` ± ``std``: the std that uncertainty adds."""
     low, high = _targets_at(seen, rate, spec, (change - std, change + std))
     return {name: abs(high[name] - low[name]) / 2 for name in low}
 
 
-def _unseen(seen: dict[str, np.ndarray], rate: float, spec: ActuatorParams) -> Viscosity:
+def _unseen(seen: dict[str, np.ndarray], rate: float, spec: DriveConstants) -> Viscosity:
     """The document's C where the window cannot tell C·|ω| from FDJ, with the stds carrying a change of
     ``UNSEEN_SHARE`` of it either way (module docstring)."""
     spread = _half_change(seen, rate, spec, 0.0, UNSEEN_SHARE * spec.viscous_nms)
@@ -116,7 +116,7 @@ def _unseen(seen: dict[str, np.ndarray], rate: float, spec: ActuatorParams) -> V
     return Viscosity(spread=spread, spec_nms=spec.viscous_nms, unseen=True)
 
 
-def _leaning(seen: dict[str, np.ndarray], rate: float, spec: ActuatorParams, change: float, std: float) -> Viscosity:
+def _leaning(seen: dict[str, np.ndarray], rate: float, spec: DriveConstants, change: float, std: float) -> Viscosity:
     """The document's C, with the story "off by ``change``" weighed into the stds (module docstring)."""
     weight = odds_weight((change / std) ** 2 / 2 + PRIOR_LOG_ODDS)
     change = float(np.clip(change, *CHANGE_BOUNDS_NMS))

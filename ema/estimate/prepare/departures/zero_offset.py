@@ -36,7 +36,7 @@ from ema.estimate.documents import Note
 from ema.estimate.physics.features import fit_as_read
 from ema.estimate.physics.friction import FitSettings, FrictionFit
 from ema.estimate.stats import DECISIVE_Z, odds_weight, rms_log_likelihood_ratio
-from ema.model.params import ActuatorParams
+from ema.model.params import DriveConstants
 from ema.model.window import Window
 
 # A flight's zero holds on a window where, taken off it, the constant left lies within this many stds of none: a
@@ -82,7 +82,7 @@ def _shifted(signals: dict[str, np.ndarray], hinge_nm: float = 0.0, current_a: f
 
 
 def sensor_offset(
-    signals: dict[str, np.ndarray], rate: float, torque_nm: float, sensor: str, actuator: ActuatorParams
+    signals: dict[str, np.ndarray], rate: float, torque_nm: float, sensor: str, actuator: DriveConstants
 ) -> float:
     """The offset of ``sensor`` (``hinge_nm`` or ``current_a``) that leaves no constant in T_R: from the
     shaft's c in the sensor's unit, refitted as the reading moves (``ITERATIONS``)."""
@@ -114,7 +114,7 @@ def second_weight(first: FrictionFit, second: FrictionFit, rate: float) -> float
     return odds_weight(log_likelihood_ratio(first, second, rate))
 
 
-def read_zero_offset(window: Window, actuator: ActuatorParams, carried: ZeroOffset | None = None) -> ZeroOffset:
+def read_zero_offset(window: Window, actuator: DriveConstants, carried: ZeroOffset | None = None) -> ZeroOffset:
     """The window's constant torque beyond friction, where the fit with it explains the window ``DECISIVE_Z``
     stds better, and the two readings of it (module docstring) weighed; the zero ``carried`` from a window
     of the same flight where it is the more precise and holds here (``flight_zero``); where the motion goes
@@ -132,7 +132,7 @@ def read_zero_offset(window: Window, actuator: ActuatorParams, carried: ZeroOffs
 
 
 def own_reading(
-    signals: dict[str, np.ndarray], rate: float, actuator: ActuatorParams, found: FrictionFit
+    signals: dict[str, np.ndarray], rate: float, actuator: DriveConstants, found: FrictionFit
 ) -> ZeroOffset:
     """The offset the window reads itself from ``found``, Eq. 5.1's fit with one (module docstring)."""
     torque, std = float(found.term("offset")[0]), float(found.term_std("offset")[0])
@@ -160,7 +160,7 @@ def own_reading(
 
 
 def flight_zero(
-    signals: dict[str, np.ndarray], rate: float, actuator: ActuatorParams, carried: ZeroOffset, own: ZeroOffset
+    signals: dict[str, np.ndarray], rate: float, actuator: DriveConstants, carried: ZeroOffset, own: ZeroOffset
 ) -> ZeroOffset:
     """The flight's zero ``carried``, where it holds on this window (taken off, the constant left lies within
     ``HOLDS_Z`` stds of none); else the window's ``own`` reading, with how far the flight's is off."""

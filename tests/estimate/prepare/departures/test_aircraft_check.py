@@ -159,7 +159,8 @@ def test_where_a_short_window_puts_the_gauge_in_doubt_the_stds_reach_the_moment_
         if not read.in_doubt:
             continue
         prepared = prepare(slipped, actuator=THESIS)
-        fitted = fit_as_read(prepared.departures.window.signals, slipped.sample_rate_hz, prepared.departures.actuator)
+        departures = prepared.departures
+        fitted = fit_as_read(departures.window.signals, slipped.sample_rate_hz, departures.drive_as_read)
         stds = widened({"FDJ": float(fitted.fdj_std_nm[0]), "eta_O": float(fitted.eta_o_std[0])}, prepared)
         answer = prepared.departures.answer
         doubted += 1

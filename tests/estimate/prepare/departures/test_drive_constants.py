@@ -5,7 +5,7 @@ import pytest
 
 from ema.estimate.pipeline import estimate_window
 from ema.estimate.prepare.conditioning import prepare
-from ema.estimate.prepare.departures.drive_constants import DriveConstants
+from ema.estimate.prepare.departures.drive_constants import DriveReading
 from ema.model.actuator import THESIS
 from ema.model.checks import InputError
 from ema.model.window import window_from_dict
@@ -14,7 +14,7 @@ from tests.foreign.windows import Effects, draw
 FAMILIES = ("thesis", "cruise", "gust", "doublet", "steps")
 
 
-def _read(seed: int, effects: Effects) -> DriveConstants:
+def _read(seed: int, effects: Effects) -> DriveReading:
     drawn = draw(seed, FAMILIES[seed % 5], effects=effects)
     return prepare(window_from_dict(drawn.document), actuator=THESIS).departures.drive
 
@@ -57,10 +57,10 @@ def test_a_heavier_inertia_the_window_cannot_tell_from_a_weaker_motor_widens_the
 def test_the_specs_constants_are_left_alone():
     """On 420 clean foreign windows of every benchmark group no constant stood MIN_Z stds out; nor do a sensor
     off zero or a viscous coefficient 1.2–2x the spec's pass for one."""
-    assert all(_read(seed, Effects()) == DriveConstants(THESIS.params) for seed in range(70, 80))
-    assert _read(80, Effects(hinge_bias_nm=8.0)) == DriveConstants(THESIS.params)
-    assert _read(81, Effects(current_bias_a=-0.2)) == DriveConstants(THESIS.params)
-    assert _read(82, Effects(viscous_factor=1.8)) == DriveConstants(THESIS.params)
+    assert all(_read(seed, Effects()) == DriveReading(THESIS.params) for seed in range(70, 80))
+    assert _read(80, Effects(hinge_bias_nm=8.0)) == DriveReading(THESIS.params)
+    assert _read(81, Effects(current_bias_a=-0.2)) == DriveReading(THESIS.params)
+    assert _read(82, Effects(viscous_factor=1.8)) == DriveReading(THESIS.params)
 
 
 def _logged_scaled(seed: int, factor: float) -> dict:

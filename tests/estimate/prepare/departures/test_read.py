@@ -19,7 +19,7 @@ def test_where_a_scale_and_an_inertia_cannot_be_told_apart_the_stds_reach_both_e
     prepared = prepare(window_from_dict(drawn.document), actuator=THESIS)
     assert prepared.departures.drive.alternative is not None
     w = prepared.window
-    fitted = fit_window(as_read(w.signals, w.sample_rate_hz), w.sample_rate_hz, prepared.actuator)
+    fitted = fit_window(as_read(w.signals, w.sample_rate_hz), w.sample_rate_hz, prepared.drive_as_read)
     std = widened({"FDJ": float(fitted.fdj_std_nm[0])}, prepared)["FDJ"]
     error = abs(float(fitted.fdj_nm[0]) - drawn.truth["FDJ"])
     assert error > 0.3 * 0.02  # the γ end is far off ...
@@ -87,6 +87,6 @@ def test_a_gauge_gain_in_doubt_that_only_a_drive_no_one_has_explains_does_not_re
     aircraft = prepared.departures.aircraft
     assert aircraft.in_doubt and aircraft.spread == {}
     w = prepared.window
-    fitted = fit_window(as_read(w.signals, w.sample_rate_hz), w.sample_rate_hz, prepared.actuator)
+    fitted = fit_window(as_read(w.signals, w.sample_rate_hz), w.sample_rate_hz, prepared.drive_as_read)
     std = widened({"FDJ": float(fitted.fdj_std_nm[0])}, prepared)["FDJ"]
     assert abs(float(fitted.fdj_nm[0]) - drawn.truth["FDJ"]) < 2 * std

@@ -9,12 +9,12 @@ from ema.estimate.physics.friction import fit_friction
 from ema.estimate.prepare.conditioning import prepare
 from ema.estimate.prepare.departures.viscosity import NOTE_WEIGHT, Viscosity, viscosity_note
 from ema.model.actuator import THESIS
-from ema.model.params import ActuatorParams
+from ema.model.params import DriveConstants
 from ema.model.window import window_from_dict
 from tests.foreign.windows import Effects, draw, of_the_same_flight
 
 FAMILIES = ("thesis", "cruise", "gust", "doublet", "steps")
-SPEC_C = ActuatorParams().viscous_nms
+SPEC_C = DriveConstants().viscous_nms
 
 
 def _read(seed: int, factor: float) -> Viscosity:
@@ -53,7 +53,7 @@ def test_a_change_too_unclear_to_read_is_weighed_into_fdjs_std():
             continue
         unread += 1
         fit = fit_friction(
-            as_read(window.signals, window.sample_rate_hz), window.sample_rate_hz, prepared.departures.actuator
+            as_read(window.signals, window.sample_rate_hz), window.sample_rate_hz, prepared.departures.drive_as_read
         )
         error = abs(float(fit.fdj_nm[0]) - drawn.truth["FDJ"])
         assert read.leaning_nms > 0.1 * SPEC_C, seed  # it leans the true way
@@ -84,7 +84,7 @@ def test_where_the_speed_hardly_varies_an_unseen_coefficient_is_in_the_stds(fact
     assert prepared.departures.viscosity.unseen and prepared.departures.offset.carried_from == "c"
     assert viscosity_note(prepared.departures.viscosity)[0].code == "viscosity_unseen"
     w = prepared.window
-    fitted = fit_window(as_read(w.signals, w.sample_rate_hz), w.sample_rate_hz, prepared.actuator)
+    fitted = fit_window(as_read(w.signals, w.sample_rate_hz), w.sample_rate_hz, prepared.drive_as_read)
     std = widened({"FDJ": float(fitted.fdj_std_nm[0])}, prepared)["FDJ"]
     assert abs(float(fitted.fdj_nm[0]) - gust.truth["FDJ"]) < 2 * std and weakly_determined(
         "FDJ", std, ranges=THESIS.ranges

@@ -1,0 +1,199 @@
+"""Calibration of a linear actuator's drive on its own runs: what the document lacks, learned; what changed, said.
+
+A stepper's drive has no data-sheet current per N·m. At constant speed its current is I = I0 + c·τ, τ the
+motor's torque along the motion (``ema.estimate.quasistatic``), I0 the current at zero torque, which the
+drive also draws to hold the motor at rest. At constant speed I0 and c·FDJ are one number: no run tells
+them apart, and the runs' mean current at rest anchors I0 (FDJ is read against it; the report says so).
+Over runs at two loads or more:
+
+    I − I0 = c·FDJ + c·(k·|T_L| − s·T_L),   k = 1/η_O − 1 opposing, 1 − η_A aiding,
+
+is linear in c and c·FDJ at each η_O, so a profile over η_O fits all three. Opposing against aiding
+stretches give c whatever FDJ; the loads' sizes separate FDJ from η_O; one load size leaves them one
+number (FDJ + k·|T_L|), said so, and no nominal is written. Each run's FDJ scatters about the nominal
+by more than its own noise: that excess is the runs' repeatability, written into the document and into
+every later estimate's std.
+
+**Learn** (the document lacks c or a nominal health): ``fit_drive`` writes the completed document.
+**Compare** (a calibrated document): the runs are read with it, their FDJ (and η_O where their loads
+differ) set against the nominal, and the current along the stroke against the healthy runs' own
+profile (``screw.stroke_profile_a``): a friction that changes along the stroke (a local defect) is named
+only where it stands ``MIN_Z`` of its run-to-run noise above that profile; where nothing does, the
+report says what 25 Hz cannot show.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ema.estimate.quasistatic import ETA_GRID, Stretch, speed_and_load, stretches
+from ema.model.actuator import ActuatorDocument
+from ema.model.checks import InputError
+from ema.model.window import Window
+
+MIN_Z = 6.0
+PROFILE_BINS = 8  # the current along each stroke, in this many bins, against the healthy runs'
+
+
+@dataclass(frozen=True)
+class Run:
+    """One run as its stretches show it: each stretch's current over the run's own current at rest."""
+
+    window_id: str
+    stretches: list[Stretch]
+    rest_a: float
+    rest_std_a: float
+    profile: np.ndarray  # (2, PROFILE_BINS): current along each direction's stroke, less its stroke's mean
+
+
+def read_run(window: Window, actuator: ActuatorDocument) -> Run:
+    """A run's stretches and rest; InputError naming the window where it has no stretch or never rests."""
+    speed, load = speed_and_load(window, actuator.gear_ratio)
+    found, rest = stretches(speed, window.signals["current_a"], load, window.sample_rate_hz)
+    if not found or rest is None:
+        why = "no stretch at constant speed" if not found else "no rest (the current at zero torque is read there)"
+        raise InputError(f"window {window.window_id}", f"{why}: a calibration run moves at constant speed and rests")
+    return Run(window.window_id, found, rest.current_a, rest.current_std_a, stroke_profile(window, found))
+
+
+def stroke_profile(window: Window, found: list[Stretch]) -> np.ndarray:
+    """(2, PROFILE_BINS): the current along each direction's first stretch (0: positive, 1: negative), binned by
+    position and less that stretch's mean; NaN where a direction has none."""
+    current, out = window.signals["current_a"], np.full((2, PROFILE_BINS), np.nan)
+    for row, direction in enumerate((1, -1)):
+        stretch = next((s for s in found if s.direction == direction), None)
+        if stretch is None:
+            continue
+        values = current[stretch.first : stretch.first + stretch.samples]
+        bins = np.array_split(values, PROFILE_BINS)
+        out[row] = [b.mean() - values.mean() for b in bins]
+    return out
+
+
+@dataclass(frozen=True)
+class DriveFit:
+    """What healthy runs say of the drive and of the actuator new."""
+
+    current_per_nm_a: float
+    current_per_nm_std_a: float
+    current_at_zero_torque_a: float
+    current_at_zero_torque_std_a: float
+    fdj_nm: float | None  # None: the runs' loads keep one size, FDJ and η_O are one number
+    fdj_std_nm: float | None
+    eta_o: float | None
+    eta_o_std: float | None
+    repeatability_nm: float
+    residual_before_a: float  # RMS of the stretches' current about the document's model (I0 alone where it has none)
+    residual_after_a: float
+    loads_n: list[float]
+    profile: np.ndarray
+
+
+def _design(runs: list[Run], eta: float, actuator: ActuatorDocument) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(X, y, w): y = I − I0 per stretch (I0 the runs' mean current at rest: the anchor of FDJ), X = [g, 1] with
+    g = k·|T_L| − s·T_L at ``eta``, weights 1/σ²."""
+    rest = float(np.mean([run.rest_a for run in runs]))
+    k_opp, k_aid = 1.0 / eta - 1.0, 1.0 - float(actuator.eta_a(eta))
+    rows, y, w = [], [], []
+    for run in runs:
+        for s in run.stretches:
+            opposing = s.direction * s.load_nm < 0
+            rows.append([(k_opp if opposing else k_aid) * abs(s.load_nm) - s.direction * s.load_nm, 1.0])
+            y.append(s.current_a - rest)
+            w.append(1.0 / max(s.current_std_a**2, 1e-12))
+    return np.array(rows), np.array(y), np.array(w)
+
+
+def _solve(x: np.ndarray, y: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
+    gram = x.T @ (w[:, None] * x)
+    covariance = np.linalg.pinv(gram)
+    beta = covariance @ x.T @ (w * y)
+    return beta, covariance, float(np.sum(w * (y - x @ beta) ** 2))
+
+
+def fit_drive(runs: list[Run], actuator: ActuatorDocument) -> DriveFit:
+    """c, I0, and (at two load sizes or more) the nominal FDJ and η_O, from healthy ``runs`` (module docstring)."""
+    profiles = [_solve(*_design(runs, float(eta), actuator)) for eta in ETA_GRID]
+    chi2 = np.array([p[2] for p in profiles])
+    best = int(np.argmin(chi2))
+    (c, c_fdj), covariance, chi2_min = profiles[best]
+    x, y, _ = _design(runs, float(ETA_GRID[best]), actuator)
+    dof = max(len(y) - 3, 1)
+    birge = max(1.0, float(np.sqrt(chi2_min / dof)))
+    sizes = sorted({round(abs(s.load_nm), 6) for run in runs for s in run.stretches})
+    separable = len(sizes) > 1 and float(np.ptp(sizes)) > 0.2 * float(np.mean(sizes))
+    rests = np.array([run.rest_a for run in runs])
+    c_std = float(np.sqrt(covariance[0, 0])) * birge
+    fdj = c_fdj / c
+    eta_std = float(np.ptp(ETA_GRID[chi2 <= chi2_min + birge**2]) / 2) or float(ETA_GRID[1] - ETA_GRID[0])
+    per_run = [_run_fdj(run, c, float(ETA_GRID[best]), actuator) for run in runs]
+    repeat = _excess_std(np.array([f for f, _ in per_run]), np.array([s for _, s in per_run]))
+    return DriveFit(
+        current_per_nm_a=float(c),
+        current_per_nm_std_a=c_std,
+        current_at_zero_torque_a=float(rests.mean()),
+        current_at_zero_torque_std_a=float(rests.std(ddof=1)) if len(rests) > 1 else float(runs[0].rest_std_a),
+        fdj_nm=float(fdj) if separable else None,
+        fdj_std_nm=float(np.sqrt(covariance[1, 1]) * birge / c) if separable else None,
+        eta_o=float(ETA_GRID[best]) if separable else None,
+        eta_o_std=eta_std if separable else None,
+        repeatability_nm=repeat,
+        residual_before_a=_rms(y - _predicted_before(runs, actuator)),
+        residual_after_a=_rms(y - x @ np.array([c, c_fdj])),
+        loads_n=[round(size * actuator.gear_ratio, 3) for size in sizes],
+        profile=np.nanmean([run.profile for run in runs], axis=0),
+    )
+
+
+def _run_fdj(run: Run, c: float, eta: float, actuator: ActuatorDocument) -> tuple[float, float]:
+    """One run's FDJ (and its std) at ``c`` and ``eta``: the stretches' mean of (I − I0)/c − g."""
+    x, y, w = _design([run], eta, actuator)
+    values = y / c - x[:, 0]
+    weights = w * c**2
+    return float(np.sum(weights * values) / np.sum(weights)), float(1.0 / np.sqrt(np.sum(weights)))
+
+
+def _excess_std(values: np.ndarray, stds: np.ndarray) -> float:
+    """τ ≥ 0 with Σ (v − m)²/(σ² + τ²) = n − 1: the scatter beyond the stated stds (0 where they explain it)."""
+    if len(values) < 3:
+        return 0.0
+
+    def excess(tau2: float) -> float:
+        weights = 1.0 / (stds**2 + tau2)
+        mean = np.sum(weights * values) / np.sum(weights)
+        return float(np.sum(weights * (values - mean) ** 2) - (len(values) - 1))
+
+    if excess(0.0) <= 0:
+        return 0.0
+    low, high = 0.0, float(np.var(values)) * 10 + 1e-18
+    for _ in range(60):
+        mid = 0.5 * (low + high)
+        low, high = (mid, high) if excess(mid) > 0 else (low, mid)
+    return float(np.sqrt(0.5 * (low + high)))
+
+
+def _predicted_before(runs: list[Run], actuator: ActuatorDocument) -> np.ndarray:
+    """What the document as given predicts of I − I0: its own c and nominal where it has them, else nothing."""
+    screw, nominal = actuator.screw, actuator.nominal
+    if screw is None or screw.current_per_nm_a is None or nominal is None:
+        return np.zeros(sum(len(run.stretches) for run in runs))
+    x, _, _ = _design(runs, nominal.eta_o, actuator)
+    return screw.current_per_nm_a * (x[:, 0] + nominal.fdj_nm)
+
+
+def _rms(values: np.ndarray) -> float:
+    return float(np.sqrt(np.mean(values**2))) if len(values) else 0.0
+
+
+def profile_change(runs: list[Run], baseline: np.ndarray) -> tuple[float, np.ndarray]:
+    """z of the runs' current along the stroke against the healthy ``baseline`` profile (the largest bin's
+    departure over its run-to-run std of the mean), and that departure per bin."""
+    stack = np.array([run.profile for run in runs])
+    if len(runs) < 2 or baseline is None or not np.isfinite(baseline).any():
+        return 0.0, np.zeros_like(stack[0])
+    departure = np.nanmean(stack, axis=0) - baseline
+    spread = np.nanstd(stack, axis=0, ddof=1) / np.sqrt(len(runs))
+    z = np.abs(departure) / np.maximum(spread, 1e-6)
+    return float(np.nanmax(z)), departure

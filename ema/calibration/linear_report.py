@@ -1,0 +1,243 @@
+"""``ema calibrate`` for a linear actuator: learn its drive from healthy runs, or say what faulted runs changed.
+
+Learning (the document lacks c or a nominal health; ``ema.calibration.linear.fit_drive``): the report's
+``drive`` holds what was learned, the residual of the runs' current before (the document's model) and
+after, and a leave-one-run-out check; ``completed`` is the document with it. Comparing (a calibrated
+document): each run read with it (``ema.estimate.low_rate``), FDJ (and η_O where the runs' loads
+differ) set against the nominal in ``changes``, and the current along the stroke against the healthy
+profile, named ``position_friction`` only beyond ``MIN_Z``.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+
+from ema.calibration.documents import (
+    CalibrationReport,
+    Candidate,
+    Change,
+    DriveLearned,
+    HeldOut,
+    NoiseFloor,
+    Step,
+)
+from ema.calibration.linear import MIN_Z, DriveFit, Run, fit_drive, profile_change, read_run
+from ema.estimate.config import PipelineConfig
+from ema.estimate.documents import ActuatorRead
+from ema.estimate.low_rate import estimate_low_rate
+from ema.model.actuator import ActuatorDocument, Nominal
+from ema.model.checks import InputError
+from ema.model.window import Window
+
+ANCHOR = (
+    "the current at zero torque and FDJ: at constant speed one number (I0 + c·FDJ); read against the runs' "
+    "mean current at rest, I0"
+)
+
+
+def calibrate_linear(
+    windows: Sequence[Window], actuator: ActuatorDocument, truth: Mapping[str, float] | None = None
+) -> tuple[CalibrationReport, ActuatorDocument | None]:
+    """The report, and the completed document where the runs taught the drive (None when comparing)."""
+    started = time.perf_counter()
+    runs = [read_run(w, actuator) for w in windows]
+    screw = actuator.screw
+    assert screw is not None
+    if screw.current_per_nm_a is None or actuator.nominal is None:
+        return _learned(runs, actuator, started)
+    return _compared(windows, runs, actuator, started), None
+
+
+def _learned(runs: list[Run], actuator: ActuatorDocument, started: float) -> tuple[CalibrationReport, ActuatorDocument]:
+    fit = fit_drive(runs, actuator)
+    unread = [ANCHOR] + (
+        []
+        if fit.fdj_nm is not None
+        else [
+            "FDJ and η_O: the runs hold one load size, so only FDJ + (1/η_O − 1)·|T_L| shows; give runs at a "
+            "second load"
+        ]
+    )
+    drive = DriveLearned(
+        runs=len(runs),
+        loads_n=fit.loads_n,
+        current_per_nm_a=fit.current_per_nm_a,
+        current_per_nm_std_a=fit.current_per_nm_std_a,
+        current_at_zero_torque_a=fit.current_at_zero_torque_a,
+        current_at_zero_torque_std_a=fit.current_at_zero_torque_std_a,
+        fdj_nm=fit.fdj_nm,
+        fdj_std_nm=fit.fdj_std_nm,
+        eta_o=fit.eta_o,
+        eta_o_std=fit.eta_o_std,
+        repeatability_nm=fit.repeatability_nm,
+        not_separable=unread,
+    )
+    before = {} if actuator.nominal is None else {"FDJ": actuator.nominal.fdj_nm, "eta_O": actuator.nominal.eta_o}
+    after = {} if fit.fdj_nm is None or fit.eta_o is None else {"FDJ": fit.fdj_nm, "eta_O": fit.eta_o}
+    reason = (
+        f"learned from {len(runs)} healthy run(s) at {', '.join(f'{n:.0f} N' for n in fit.loads_n)}: c "
+        f"{fit.current_per_nm_a:.4f} ± {fit.current_per_nm_std_a:.4f} A/N·m, I0 {fit.current_at_zero_torque_a:.3f} A"
+    )
+    report = _report(
+        len(runs),
+        fit.residual_before_a,
+        fit.residual_after_a,
+        before,
+        after,
+        steps=[Step(selected=None, reason=reason)],
+        held=_leave_one_out(runs, actuator),
+        started=started,
+    )
+    return report.model_copy(update={"drive": drive}), completed(actuator, fit)
+
+
+def completed(actuator: ActuatorDocument, fit: DriveFit) -> ActuatorDocument:
+    """``actuator`` with what the runs taught (the nominal only where two load sizes read it)."""
+    assert actuator.screw is not None
+    screw = actuator.screw.model_copy(
+        update={
+            "current_per_nm_a": fit.current_per_nm_a,
+            "current_per_nm_std_a": fit.current_per_nm_std_a,
+            "current_at_zero_torque_a": fit.current_at_zero_torque_a,
+            "current_at_zero_torque_std_a": fit.current_at_zero_torque_std_a,
+            "eta_o_std": fit.eta_o_std,
+            "repeatability_nm": fit.repeatability_nm,
+            "stroke_profile_a": np.nan_to_num(fit.profile).round(5).tolist(),
+        }
+    )
+    nominal = actuator.nominal
+    if fit.fdj_nm is not None and fit.eta_o is not None:
+        nominal = Nominal(fdj_nm=round(fit.fdj_nm, 5), eta_o=round(fit.eta_o, 4))
+    document = actuator.model_dump(by_alias=True) | {
+        "screw": screw.model_dump(),
+        "nominal": nominal and nominal.model_dump(),
+    }
+    return ActuatorDocument.model_validate(document)
+
+
+def _leave_one_out(runs: list[Run], actuator: ActuatorDocument) -> HeldOut:
+    """Each run's stretches predicted by the drive learned on the others (at two runs or more)."""
+    if len(runs) < 3:
+        return HeldOut(rss_before=0.0, rss_after=0.0, adopted=True, note="too few runs to hold one out")
+    before, after = 0.0, 0.0
+    for i, run in enumerate(runs):
+        others = fit_drive([r for j, r in enumerate(runs) if j != i], actuator)
+        if others.fdj_nm is None or others.eta_o is None:
+            return HeldOut(rss_before=0.0, rss_after=0.0, adopted=True, note="one load size: no run is predicted")
+        rest, eta = others.current_at_zero_torque_a, others.eta_o
+        for s in run.stretches:
+            opposing = s.direction * s.load_nm < 0
+            k = 1.0 / eta - 1.0 if opposing else 1.0 - float(actuator.eta_a(eta))
+            torque = others.fdj_nm + k * abs(s.load_nm) - s.direction * s.load_nm
+            predicted = rest + others.current_per_nm_a * torque
+            before += (s.current_a - rest) ** 2
+            after += (s.current_a - predicted) ** 2
+    return HeldOut(
+        rss_before=before,
+        rss_after=after,
+        adopted=after < before,
+        note=f"each run predicted by the drive learned on the other {len(runs) - 1}: the residual of its "
+        f"stretches' current {np.sqrt(before / max(len(runs), 1)):.3f} → {np.sqrt(after / len(runs)):.3f} A",
+    )
+
+
+def _compared(
+    windows: Sequence[Window], runs: list[Run], actuator: ActuatorDocument, started: float
+) -> CalibrationReport:
+    read_with = ActuatorRead(name=actuator.name)
+    results = [estimate_low_rate(w, PipelineConfig(), actuator=actuator, read_with=read_with) for w in windows]
+    values = np.array([r.estimates.FDJ.value for r in results])
+    stds = np.array([r.estimates.FDJ.std or np.inf for r in results])
+    weights = 1.0 / stds**2
+    fdj, fdj_std = float(np.sum(weights * values) / np.sum(weights)), float(np.median(stds))
+    nominal = actuator.health
+    z = (fdj - nominal.fdj_nm) / fdj_std
+    said = (
+        f"FDJ rose by {fdj - nominal.fdj_nm:+.3f} N·m ({z:+.1f} stds of one run): a friction rise"
+        if z > 2
+        else f"FDJ moved {fdj - nominal.fdj_nm:+.3f} N·m, {z:+.1f} stds of one run: within what runs of one state show"
+    )
+    changes = [Change(parameter="FDJ", nominal=nominal.fdj_nm, value=fdj, std=fdj_std, z=z, said=said)]
+    profile_z, departure = profile_change(runs, _baseline(actuator))
+    named = profile_z >= MIN_Z
+    candidate = Candidate(
+        effect="position_friction",
+        follows="position_mm",
+        named=True,
+        parameters={f"bin_{i}": float(v) for i, v in enumerate(np.nan_to_num(departure).ravel())},
+        rms_reduction=0.0,
+        held_out_drop=0.0,
+        score=profile_z,
+        plausible=True,
+    )
+    reason = (
+        f"the current along the stroke departs from the healthy runs' by {profile_z:.1f} run-to-run stds: a "
+        "friction that changes along the stroke (a local defect)"
+        if named
+        else f"nothing beyond FDJ stands above the runs' noise along the stroke (z = {profile_z:.1f} < {MIN_Z:g}): a "
+        "local defect such as a spall may well be invisible in a current logged at 25 Hz"
+    )
+    report = _report(
+        len(runs),
+        0.0,
+        0.0,
+        {"FDJ": nominal.fdj_nm},
+        {"FDJ": fdj},
+        steps=[Step(selected="position_friction" if named else None, reason=reason)],
+        held=HeldOut(rss_before=0.0, rss_after=0.0, adopted=False, note="runs read with the document"),
+        started=started,
+        candidates=[candidate],
+    )
+    return report.model_copy(
+        update={
+            "changes": changes,
+            "selected_effect": "position_friction" if named else None,
+            "selected_effects": ["position_friction"] if named else [],
+        }
+    )
+
+
+def _baseline(actuator: ActuatorDocument) -> np.ndarray:
+    profile = None if actuator.screw is None else actuator.screw.stroke_profile_a
+    return np.array(profile, dtype=float) if profile else np.full((2, 1), np.nan)
+
+
+def _report(
+    n: int,
+    before_a: float,
+    after_a: float,
+    before: dict,
+    after: dict,
+    *,
+    steps: list[Step],
+    held: HeldOut,
+    started: float,
+    candidates: list[Candidate] | None = None,
+) -> CalibrationReport:
+    return CalibrationReport(
+        n_windows=n,
+        noise_floor=NoiseFloor(copies=0, equation_error_ratio=1.0),
+        residual_rms_before={"current_a": before_a},
+        residual_rms_after={"current_a": after_a},
+        candidates=candidates or [],
+        selected_effect=None,
+        selected_effects=[],
+        selected_parameters=None,
+        effects={},
+        selection_steps=steps,
+        unexplained=None,
+        held_out=held,
+        estimates_before=before,
+        estimates_after=after,
+        timings_s={"total": time.perf_counter() - started},
+    )
+
+
+def refuse_mixed(windows: Sequence[Window], actuator: ActuatorDocument) -> None:
+    """InputError naming the first window that is not the linear actuator's."""
+    for w in windows:
+        if w.kind != "linear":
+            raise InputError(f"window {w.window_id}", f"is a {w.kind} actuator's, the document a linear one's")

@@ -1,0 +1,217 @@
+"""A window logged under 1 kHz, read with what its rate allows: Eq. 5.1 at constant speed.
+
+At constant speed the inertia takes nothing (J·dω/dt = 0), and the motor's torque along the motion is
+
+    τ = FDJ + k·|T_L| − s·T_L,   k = 1/η_O − 1 (opposing: s·T_L < 0) or 1 − η_A (aiding),
+
+with s = sgn(ω) and T_L the load torque at the motor in the positive direction (a hinge moment over the
+gear ratio, a screw's force times lead/2π). Each stretch at constant speed gives one mean τ and one
+|T_L|. Where the stretches hold loads of several sizes the profile over η_O (η_A tied by Eq. 3.4) reads
+FDJ and η_O together; at one load only FDJ + k·|T_L| is in the window, η_O is not read (``eta_O`` null,
+note ``eta_o_unread``), and FDJ is read with the document's η_O, its std carrying that η_O's.
+
+What the current says of τ is the kind's (``TorqueReading``): a current-piloted motor's k_T·I, or a
+stepper drive's (I − I0)/c, its current at zero torque I0 read at rest in this window (it drifts from
+one day to the next; a window that never rests takes the document's, with its day-to-day spread).
+
+The std is honest about repeatability: each stretch's mean carries its noise (a block estimate: the
+current is correlated over samples), and the document's run-to-run spread (``screw.repeatability_nm``,
+learned by ``ema calibrate``) is added, so the same state logged again lands within ±2 std. The stages that
+need a high rate (the window's own simulations, the network, the check against a 1 µs simulation) are
+skipped, and the estimate says so (``stages``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from ema.model.window import Window
+
+BLOCKS = 5  # a stretch's mean and its std from this many blocks (the current is correlated over samples)
+SETTLE_S = 0.4  # after a change of speed, the drive settles this long before a stretch is read
+REST_SETTLE_S = 1.5  # after the motion stops, the drive's current settles this long before it reads I0
+MIN_STRETCH_S = 1.0  # a stretch at constant speed, or at rest, this long at least (after settling)
+SPEED_TOLERANCE = 0.02  # constant speed: within this share of the stretch's own speed
+ETA_GRID = np.linspace(0.30, 0.99, 139)
+MIN_LOAD_SPREAD = 0.2  # |T_L| must vary by this share of its mean for a window to read η_O beside FDJ
+
+
+@dataclass(frozen=True)
+class Stretch:
+    """A stretch at constant speed: its motion's sign, its mean current and load torque, with stds."""
+
+    direction: int  # sgn(ω)
+    current_a: float
+    current_std_a: float
+    load_nm: float  # T_L at the motor, positive direction
+    samples: int
+    first: int  # its first sample (for the report)
+
+
+@dataclass(frozen=True)
+class Rest:
+    current_a: float
+    current_std_a: float
+    samples: int
+
+
+def block_mean(values: np.ndarray) -> tuple[float, float]:
+    """The mean and its std from ``BLOCKS`` block means (honest where samples are correlated)."""
+    blocks = np.array_split(values, min(BLOCKS, len(values)))
+    means = np.array([b.mean() for b in blocks])
+    return float(values.mean()), float(means.std(ddof=1) / np.sqrt(len(means))) if len(means) > 1 else float("inf")
+
+
+def runs(mask: np.ndarray) -> list[tuple[int, int]]:
+    """[start, stop) of each run of True in ``mask``."""
+    edges = np.flatnonzero(np.diff(np.concatenate([[0], mask.astype(int), [0]])))
+    return list(zip(edges[::2].tolist(), edges[1::2].tolist(), strict=True))
+
+
+def stretches(
+    speed: np.ndarray, current: np.ndarray, load_nm: np.ndarray, rate: float
+) -> tuple[list[Stretch], Rest | None]:
+    """The stretches at constant speed (by the commanded or logged ``speed``) and at rest, each after its
+    settling (``SETTLE_S``; at rest ``REST_SETTLE_S``: a stepper's current decays for a second after it stops),
+    at least ``MIN_STRETCH_S`` long."""
+    settle, least = round(SETTLE_S * rate), max(round(MIN_STRETCH_S * rate), BLOCKS)
+    rest_settle = round(REST_SETTLE_S * rate)
+    top = float(np.max(np.abs(speed))) if len(speed) else 0.0
+    moving = np.abs(speed) > 0.05 * top
+    change = np.abs(np.diff(speed, prepend=speed[0])) > SPEED_TOLERANCE * max(top, 1e-12)
+    found, rest = [], []
+    for start, stop in runs(moving & ~change):
+        start += settle
+        if stop - start >= least:
+            mean, std = block_mean(current[start:stop])
+            found.append(Stretch(int(np.sign(speed[start])), mean, std, float(load_nm[start:stop].mean()),
+                                 stop - start, start))  # fmt: skip
+    for start, stop in runs(~moving):
+        if stop - (start + rest_settle) >= least:
+            rest.append(current[start + rest_settle : stop])
+    if not rest:
+        return found, None
+    held = np.concatenate(rest)
+    mean, std = block_mean(held)
+    return found, Rest(mean, std, len(held))
+
+
+@dataclass(frozen=True)
+class TorqueReading:
+    """What the drive's current says of the motor's torque along the motion: τ = (I·s − offset) / per_nm."""
+
+    per_nm_a: float  # current per N·m (1/k_T for a current-piloted motor, c for a stepper)
+    per_nm_std_a: float
+    offset_a: float  # current at zero torque (0 for a current-piloted motor)
+    offset_std_a: float
+    signed: bool  # the current's sign follows the torque's (a phase current), else a magnitude along the motion
+
+    def torque(self, stretch: Stretch) -> tuple[float, float]:
+        """τ along the motion and its std from the stretch's own noise (I0's and c's, common to every stretch,
+        enter FDJ's std in the fit)."""
+        along = stretch.current_a * stretch.direction if self.signed else stretch.current_a
+        return (along - self.offset_a) / self.per_nm_a, stretch.current_std_a / self.per_nm_a
+
+
+@dataclass(frozen=True)
+class QuasiStaticFit:
+    fdj_nm: float
+    fdj_std_nm: float
+    eta_o: float
+    eta_o_std: float
+    eta_o_read: bool  # False: held at the document's (one load)
+    chi2_per_dof: float  # of the stretches about the model, with their stds (≈ 1 where it explains them)
+    per_nm_read_a: float | None  # c (or 1/k_T) as the window reads it from opposing against aiding stretches
+    per_nm_read_std_a: float | None
+
+
+def load_factors(eta_o: np.ndarray | float, eta_a: Callable[[np.ndarray], np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """(k_opp, k_aid) of Eq. 5.1 at ``eta_o``."""
+    eta = np.asarray(eta_o, dtype=float)
+    return 1.0 / eta - 1.0, 1.0 - eta_a(eta)
+
+
+def fit_stretches(
+    found: list[Stretch],
+    reading: TorqueReading,
+    eta_a: Callable[[np.ndarray], np.ndarray],
+    *,
+    eta_o_document: tuple[float, float],
+    repeatability_nm: float = 0.0,
+) -> QuasiStaticFit:
+    """FDJ (and η_O where the loads differ enough) from ``found`` stretches: y = τ + s·T_L = FDJ + k·|T_L|."""
+    torques = np.array([reading.torque(s) for s in found])
+    tau, tau_std = torques[:, 0], torques[:, 1]
+    load = np.array([s.load_nm for s in found])
+    direction = np.array([s.direction for s in found])
+    y, size, opposing = tau + direction * load, np.abs(load), direction * load < 0
+    weight = 1.0 / np.maximum(tau_std, 1e-12) ** 2
+    spread = float(np.ptp(size)) / max(float(np.mean(size)), 1e-12) if len(size) else 0.0
+
+    def fdj_at(eta: float) -> tuple[float, float]:
+        k_opp, k_aid = load_factors(eta, eta_a)
+        rest = y - np.where(opposing, k_opp, k_aid) * size
+        fdj = float(np.sum(weight * rest) / np.sum(weight))
+        return fdj, float(np.sum(weight * (rest - fdj) ** 2))
+
+    read = spread >= MIN_LOAD_SPREAD and len(found) >= 3
+    if read:
+        chi2 = np.array([fdj_at(eta)[1] for eta in ETA_GRID])
+        best = int(np.argmin(chi2))
+        eta, eta_std = float(ETA_GRID[best]), _profile_std(ETA_GRID, chi2, best)
+    else:
+        eta, eta_std = eta_o_document
+    fdj, chi2_min = fdj_at(eta)
+    dof = max(len(found) - 1 - int(read), 1)
+    slope = float(np.mean(np.where(opposing, 1.0 / eta**2, -_eta_a_slope(eta, eta_a)) * size))  # ∂FDJ/∂η_O
+    within = float(1.0 / np.sqrt(np.sum(weight)))
+    scale = float(np.mean(np.abs(tau))) * _rel(reading)  # every torque scales with c: FDJ's share of it
+    offset = reading.offset_std_a / reading.per_nm_a  # I0's spread moves every torque, so FDJ, alike
+    fdj_std = float(np.sqrt(within**2 + (slope * eta_std) ** 2 + repeatability_nm**2 + scale**2 + offset**2))
+    return QuasiStaticFit(fdj, fdj_std, eta, eta_std, read, chi2_min / dof, *_per_nm_read(found, reading, eta, eta_a))
+
+
+def _rel(reading: TorqueReading) -> float:
+    """c's relative std: every torque, and so FDJ, scales with it."""
+    return reading.per_nm_std_a / reading.per_nm_a
+
+
+def _eta_a_slope(eta: float, eta_a: Callable[[np.ndarray], np.ndarray]) -> float:
+    h = 1e-5
+    return float((eta_a(np.array(eta + h)) - eta_a(np.array(eta - h))) / (2 * h))
+
+
+def _profile_std(grid: np.ndarray, chi2: np.ndarray, best: int) -> float:
+    """η_O's std from where χ² rises by 1 about its minimum (the grid step at least)."""
+    inside = grid[chi2 <= chi2[best] + 1.0]
+    return float(max((inside.max() - inside.min()) / 2.0, grid[1] - grid[0]))
+
+
+def _per_nm_read(
+    found: list[Stretch], reading: TorqueReading, eta: float, eta_a: Callable[[np.ndarray], np.ndarray]
+) -> tuple[float | None, float | None]:
+    """The current per N·m the window shows: opposing and aiding stretches at one load differ by
+    (1/η_O + η_A)·|T_L| of torque, whatever FDJ; None where it holds not both."""
+    load = np.array([s.load_nm for s in found])
+    along = np.array([s.current_a * (s.direction if reading.signed else 1) for s in found])
+    stds = np.array([s.current_std_a for s in found])
+    opposing = np.array([s.direction for s in found]) * load < 0
+    if opposing.all() or not opposing.any():
+        return None, None
+    gap = float(np.mean(along[opposing]) - np.mean(along[~opposing]))
+    torque_gap = float(np.mean(np.abs(load)) * (1.0 / eta + eta_a(np.array(eta))))
+    gap_std = float(np.hypot(np.sqrt(np.mean(stds[opposing] ** 2)), np.sqrt(np.mean(stds[~opposing] ** 2))))
+    return gap / torque_gap, gap_std / torque_gap
+
+
+def speed_and_load(window: Window, gear_ratio: float) -> tuple[np.ndarray, np.ndarray]:
+    """The motion a window's stretches are found by (a linear window's set point speed, a rotary window's logged
+    motor speed) and its load torque at the motor in the positive direction."""
+    rate = window.sample_rate_hz
+    s = window.signals
+    if window.kind == "linear":  # the set point's speed: exact where a potentiometer's is noise; F·lead/2π = F/n
+        return np.gradient(s["command_mm"]) * rate, s["load_n"] / gear_ratio
+    return s["motor_speed_radps"], s["hinge_moment_nm"] / gear_ratio

@@ -1,0 +1,100 @@
+"""The real rig (Ruiz-Carcel and Starr 2018; Cranfield CORD 5097649): its logs read as recorded, its drive
+learned from healthy runs at two loads, and its states told apart, on runs the calibration did not see."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from ema.calibration.linear import read_run
+from ema.calibration.linear_report import calibrate_linear
+from ema.estimate.kinds import estimate
+from ema.model.actuator import read_actuator
+from ema.model.checks import InputError
+from ema.model.logmap import read_logmap, read_mapped
+from ema.model.window import window_from_dict
+
+RIG = Path(__file__).resolve().parents[2] / "examples" / "ballscrew-rig"
+MAP = read_logmap(RIG / "log-map.json")
+DOCUMENT = read_actuator(RIG / "actuator.json")
+
+
+def runs(state: str, load: int, numbers: range) -> list:
+    first = 51 if load == 40 else 1
+    paths = [RIG / "runs" / f"{state}_load{load}_run{first + n:03d}.csv" for n in numbers]
+    return [window_from_dict(read_mapped(path, MAP)) for path in paths]
+
+
+@pytest.fixture(scope="module")
+def learned():
+    """The drive learned on half the healthy runs at each load; the other half is for the tests."""
+    report, completed = calibrate_linear(runs("normal", 20, range(5)) + runs("normal", 40, range(5)), DOCUMENT)
+    return report, completed
+
+
+def test_the_rigs_columns_become_a_linear_window():
+    window = runs("normal", 20, range(1))[0]
+    assert window.kind == "linear" and window.sample_rate_hz == pytest.approx(25.0)
+    raw = np.genfromtxt(RIG / "runs" / "normal_load20_run001.csv", delimiter=",", names=True, dtype=None, encoding=None)
+    assert np.allclose(window.signals["position_mm"], raw["set_point"] - raw["position_error"])
+    assert window.signals["load_n"][0] == pytest.approx(20 * 9.80665)
+
+
+def test_a_file_that_does_not_match_the_map_is_refused_naming_the_column(tmp_path):
+    text = (RIG / "runs" / "normal_load20_run001.csv").read_text().replace("position_error", "err")
+    (tmp_path / "run.csv").write_text(text)
+    with pytest.raises(InputError, match=r"'position_error'.*error\.column"):
+        read_mapped(tmp_path / "run.csv", MAP)
+
+
+def test_healthy_runs_at_two_loads_teach_the_drive(learned):
+    report, completed = learned
+    drive = report.drive
+    assert drive is not None and drive.fdj_nm is not None and drive.eta_o is not None
+    assert 0.5 < drive.current_per_nm_a < 1.0 and 0.25 < drive.current_at_zero_torque_a < 0.45
+    assert report.residual_rms_after["current_a"] < 0.1 * report.residual_rms_before["current_a"]
+    assert any("one number" in line for line in drive.not_separable)  # I0 and c·FDJ: said, not guessed
+    assert completed is not None and completed.nominal is not None and completed.screw.current_per_nm_a is not None
+
+
+def test_runs_at_one_load_leave_fdj_and_eta_o_one_number():
+    report, completed = calibrate_linear(runs("normal", 20, range(5)), DOCUMENT)
+    assert report.drive is not None and report.drive.fdj_nm is None and report.drive.eta_o is None
+    assert completed is not None and completed.nominal is None
+    assert any("one load size" in line for line in report.drive.not_separable)
+
+
+def _fdj(windows, document) -> np.ndarray:
+    results = [estimate(w, actuator=document) for w in windows]
+    assert all(r.estimates.eta_O is None and r.stages["simulate"].startswith("skipped") for r in results)
+    return np.array([(r.estimates.FDJ.value, r.estimates.FDJ.std) for r in results])
+
+
+def test_states_are_told_apart_on_runs_the_calibration_did_not_see(learned):
+    _, document = learned
+    held_out = range(5, 10)
+    normal20, normal40 = _fdj(runs("normal", 20, held_out), document), _fdj(runs("normal", 40, held_out), document)
+    dry20 = _fdj(runs("lackLubrication1", 20, range(10)), document)
+    med = {name: float(np.median(v[:, 0])) for name, v in [("n20", normal20), ("n40", normal40), ("dry", dry20)]}
+    std = float(np.median(np.concatenate([normal20[:, 1], normal40[:, 1], dry20[:, 1]])))
+    assert abs(med["n20"] - med["n40"]) < 2 * std  # the healthy state's FDJ whatever the load
+    assert med["dry"] - med["n20"] > 2 * std  # a lack of lubrication is a friction rise, beyond 2 std
+    for values in (normal20, normal40, dry20):  # each run's ±2 std holds its set's median
+        assert np.mean(np.abs(values[:, 0] - np.median(values[:, 0])) <= 2 * values[:, 1]) >= 0.9
+
+
+def test_faulted_runs_against_the_baseline_say_what_changed(learned):
+    _, document = learned
+    report, completed = calibrate_linear(runs("lackLubrication1", 20, range(10)), document)
+    assert completed is None and report.changes[0].parameter == "FDJ" and report.changes[0].z > 2
+    assert "friction rise" in report.changes[0].said
+
+
+def test_a_run_that_never_rests_is_refused_for_learning_naming_it():
+    window = runs("normal", 20, range(1))[0]
+    moving = slice(0, 120)  # the first stroke only
+    cut = window.__class__(
+        {k: v[moving] for k, v in window.signals.items()}, window.sample_rate_hz, None, window.actuator_id, "cut"
+    )
+    with pytest.raises(InputError, match="window cut"):
+        read_run(cut, DOCUMENT)

@@ -1,0 +1,66 @@
+"""A status is earned: no "due" without a time base and a spread of windows (and never a life in a unit the
+windows do not have)."""
+
+import datetime as dt
+
+import pytest
+
+from ema.estimate.documents import parameter
+from ema.estimate.pipeline import estimate_window
+from ema.model.actuator import THESIS
+from ema.model.params import HealthParams
+from ema.model.synthetic import synthetic_window
+from ema.prognosis.documents import Stored
+from ema.prognosis.prognose import prognose
+from ema.prognosis.status import status_of
+from tests.service.conftest import SMALL
+
+
+@pytest.fixture(scope="module")
+def base():
+    return estimate_window(synthetic_window(HealthParams.single(), seed=1, duration_s=0.1), SMALL, actuator=THESIS)
+
+
+def _history(base, fdjs, **times):
+    """Stored windows of FDJ ``fdjs``, each with the time fields given as lists (absent: none)."""
+    stored = []
+    for i, fdj in enumerate(fdjs):
+        window = base.window.model_copy(update={name: values[i] for name, values in times.items()})
+        estimates = base.estimates.model_copy(update={"FDJ": parameter(fdj, 2e-4, 0.05)})
+        document = base.model_copy(update={"window_id": f"w{i}", "window": window, "estimates": estimates})
+        stored.append(Stored(**document.model_dump(by_alias=True), id=i + 1, stored_at=f"2026-11-26T10:00:0{i}+00:00"))
+    return stored
+
+
+def test_windows_without_a_time_base_trend_in_windows_and_are_never_due(base):
+    stored = _history(base, [0.050, 0.055, 0.060, 0.065, 0.070])  # a collapse, if storage time were time
+    prognosis = prognose("a", stored, THESIS)
+    assert prognosis.time_unit == "windows" and prognosis.notes[0].code == "time_by_window_order"
+    status, _, _ = status_of(stored[-1], prognosis, THESIS, len(stored))
+    assert status != "due"
+    life = prognosis.remaining_life["FDJ"]
+    assert life.rul is None or life.status == "crossing predicted"  # counted in windows, the unit it has
+
+
+def test_windows_logged_within_a_second_are_not_enough_history(base):
+    start = dt.datetime(2026, 11, 26, 10, tzinfo=dt.UTC)
+    stamps = [(start + dt.timedelta(seconds=0.2 * i)).isoformat() for i in range(5)]
+    stored = _history(base, [0.050, 0.055, 0.060, 0.065, 0.070], recorded_at=stamps)
+    prognosis = prognose("a", stored, THESIS)
+    assert prognosis.time_unit == "days" and prognosis.remaining_life["FDJ"].status == "span too short"
+    status, soonest, reason = status_of(stored[-1], prognosis, THESIS, len(stored))
+    assert status in ("not enough history", "watch") and soonest is None and "days" in reason
+
+
+def test_a_crossed_threshold_is_due_once_the_windows_are_evidence(base):
+    few = _history(base, [0.080, 0.081, 0.080, 0.082, 0.081])  # five windows in order: a span of four
+    assert status_of(few[-1], prognose("a", few, THESIS), THESIS, len(few))[0] == "watch"
+    enough = _history(base, [0.080, 0.081, 0.080, 0.082, 0.081], flight_hours=[0, 5, 10, 15, 20])
+    assert status_of(enough[-1], prognose("a", enough, THESIS), THESIS, len(enough))[0] == "due"
+
+
+def test_a_spread_of_flight_hours_earns_a_forecast(base):
+    stored = _history(base, [0.050, 0.053, 0.056, 0.059, 0.062, 0.065], flight_hours=[0, 20, 40, 60, 80, 100])
+    prognosis = prognose("a", stored, THESIS)
+    assert prognosis.remaining_life["FDJ"].status == "crossing predicted"
+    assert status_of(stored[-1], prognosis, THESIS, len(stored))[0] in ("watch", "due")
