@@ -18,13 +18,14 @@ RUN useradd --create-home --uid 10001 ema && mkdir -p /data /opt/ema/numba-cache
 # The CPU wheel of torch: the default index would pull a multi-GB CUDA build.
 COPY pyproject.toml /tmp/ema/
 RUN pip install --index-url https://download.pytorch.org/whl/cpu "torch==2.13.0" \
-    && python -c "import tomllib; d = tomllib.load(open('/tmp/ema/pyproject.toml', 'rb'))['project']['dependencies']; \
-print('\n'.join(x for x in d if not x.startswith('torch')))" > /tmp/requirements.txt \
+    && python -c "import tomllib; p = tomllib.load(open('/tmp/ema/pyproject.toml', 'rb'))['project']; \
+x = p['optional-dependencies']; d = p['dependencies'] + x['history'] + x['service'][1:] + x['postgres'][1:]; \
+print('\n'.join(r for r in d if not r.startswith('torch')))" > /tmp/requirements.txt \
     && pip install -r /tmp/requirements.txt
 
 # The code, installed into site-packages; the sources are not kept beside it.
 COPY ema /tmp/ema/ema
-RUN pip install --no-deps /tmp/ema && rm -rf /tmp/ema
+RUN pip install --no-deps /tmp/ema && rm -rf /tmp/ema  # the service's extras came with the requirements above
 
 USER ema
 WORKDIR /data

@@ -31,9 +31,8 @@ from ema.model.actuator import THESIS
 from ema.model.window import WindowDocument
 
 SECTION = "A warm request, step by step"
-STAGES = ("prepare", "physics", "simulate", "train", "assess", "check")  # in the order the pipeline runs them
+STAGES = ("prepare", "physics", "simulate", "learn", "assess", "check", "report")  # the pipeline's, in order
 SIMULATIONS = PipelineConfig().total_simulations
-TIMING_FIELDS = {"assess": "predict"}  # the stage's field in ``timings_s`` where it is named otherwise
 PARTS = (  # (stage, "module:function" as the stage calls it, what the step does)
     ("prepare", "ema.estimate.prepare.conditioning:without_stale", "cut to the stretch the sensors kept updating"),
     ("prepare", "ema.estimate.prepare.conditioning:repaired", "glitches repaired"),
@@ -49,14 +48,14 @@ PARTS = (  # (stage, "module:function" as the stage calls it, what the step does
     ("simulate", "ema.estimate.simulate.dataset:as_read", "the simulations read as the window is"),
     ("simulate", "ema.estimate.simulate.dataset:residual_torque_nm", "T_R of the simulations and the window"),
     ("simulate", "ema.estimate.simulate.dataset:sliding_features", "the network's inputs"),
-    ("train", "ema.estimate.pipeline:train_network", "the network trained"),
+    ("learn", "ema.estimate.pipeline:train_network", "the network trained"),
     ("assess", "ema.estimate.pipeline:fit_friction", "Eq. 5.1 on the held-out simulations"),
     ("assess", "ema.estimate.learn.estimator:NetworkEstimator.predict_unit", "the network on them and the window"),
     ("assess", "ema.estimate.pipeline:assess", "the estimators weighed and blended"),
     ("check", "ema.model.batch:run_groups", "the window simulated at the answer (where not reused)"),
     ("check", "ema.estimate.assess.reproduction:as_read", "that simulation read as the window is"),
     ("check", "ema.estimate.assess.reproduction:residual_torque_nm", "T_R of both"),
-    ("check", "ema.estimate.pipeline:read_static_friction", "FSJ read where the window shows one"),
+    ("report", "ema.estimate.pipeline:read_static_friction", "FSJ read where the window shows one"),
 )
 
 
@@ -128,7 +127,7 @@ def measure(count: int, seed: int) -> tuple[dict[tuple[str, str], float], dict[s
             clock.index = -1
             timings = estimate_window(window, actuator=THESIS, on_stage=clock.next_stage).timings_s
             for stage in STAGES:
-                stages[stage] += getattr(timings, TIMING_FIELDS.get(stage, stage)) / count
+                stages[stage] += getattr(timings, stage) / count
     return {k: v / count for k, v in clock.seconds.items()}, dict(stages)
 
 

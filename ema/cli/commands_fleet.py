@@ -109,8 +109,8 @@ def _print_fleet(result: dict) -> None:
 @click.option(
     "--out",
     type=click.Path(file_okay=False, path_type=Path),
-    default=Path("bench-out"),
-    help="folder for bench.json and bench.png",
+    default=None,
+    help="also write the figures as bench.json in this folder  [default: print them, write nothing]",
 )
 @click.option("--repeats", type=click.IntRange(1, 1000), default=10, help="windows per duration")
 @click.option("--durations", default="0.5,2", help="window durations [s], comma-separated")
@@ -124,7 +124,7 @@ def _print_fleet(result: dict) -> None:
 @sizes
 @as_json
 def bench(
-    out: Path, repeats: int, durations: str, under_load: int, docs: bool, as_json: bool, **size_values: int
+    *, out: Path | None, repeats: int, durations: str, under_load: int, docs: bool, as_json: bool, **size_values: int
 ) -> None:
     """Latency of one window -> estimates: p50/p95 per stage, real-time factor, accuracy (idle, and under load)."""
     from ema.cli.bench import run_bench
@@ -134,7 +134,9 @@ def bench(
         seconds = [float(d) for d in durations.split(",")]
     except ValueError:
         raise InputError("--durations", f"must be numbers separated by commas, got {durations!r}") from None
-    result = run_bench(pipeline_config(size_values), seconds, repeats, under_load, out, docs)
+    result = run_bench(
+        pipeline_config(size_values), seconds, repeats=repeats, under_load=under_load, out=out, docs=docs
+    )
     emit(result, as_json, lambda r: click.echo(r["table"]))
 
 

@@ -11,6 +11,7 @@ from typing import Any
 import click
 
 from ema.cli.options import (
+    about_file,
     actuator,
     actuator_document,
     as_json,
@@ -104,7 +105,8 @@ def estimate(
     read = read_one(window, log_map_document(log_map_file))
     known = history_of(read, history) if history else None
     runtime.configure(threads)
-    result = estimate_one(read, config, actuator=document, on_stage=progress, history=known)
+    with about_file(window):
+        result = estimate_one(read, config, actuator=document, on_stage=progress, history=known)
     emit(result, as_json, print_estimate)
 
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import os
 import sys
+import urllib.error
 import urllib.parse
 from pathlib import Path
 from typing import Any
@@ -32,8 +33,9 @@ def api_key(path: Path | None) -> str | None:
 @click.option(
     "--out",
     type=click.Path(dir_okay=False, path_type=Path),
-    default=Path("estimates.csv"),
-    help="CSV the answers are appended to (a rerun resumes from it)",
+    default=None,
+    help="CSV the answers are appended to (a rerun resumes from it)  [default: one per log and service in "
+    "$XDG_STATE_HOME/ema/replay, said where]",
 )
 @click.option(
     "--window-s",
@@ -52,7 +54,7 @@ def replay(
     log: Path,
     *,
     url: str,
-    out: Path,
+    out: Path | None,
     window_s: float | None,
     api_key_file: Path | None,
     actuator_id: str,
@@ -73,8 +75,11 @@ def replay(
         mapping = log_map_document(log_map_file)
         read = read_log(log, window_s or (None if mapping else DEFAULT_WINDOW_S), defaults, mapping)
     report_log(read)
-    print(f"replaying {len(read.windows)} window(s) from {log} to {url}", file=sys.stderr)
-    rows = post_all(read.windows, url, out, api_key(api_key_file))
+    key = api_key(api_key_file)
+    check_service(url, key)  # a service that is not there: said now, and no file written
+    out = out or default_results(log, url)
+    print(f"replaying {len(read.windows)} window(s) from {log} to {url}; answers in {out}", file=sys.stderr)
+    rows = post_all(read.windows, url, out, key)
     refused = [row for row in rows if row.get("error")]
     result = {
         "csv": str(out),
@@ -87,6 +92,23 @@ def replay(
     emit(result, as_json, _print_replay)
     if rows and not result["answered"]:
         raise NothingAnsweredError(f"none of the {len(rows)} window(s) posted was answered (see {out})")
+
+
+def default_results(log: Path, url: str) -> Path:
+    """Where a replay's answers go when --out names no file: the user's state folder, one file per log and
+    service (so a rerun resumes it), never the working directory."""
+    import hashlib
+
+    home = os.environ.get("XDG_STATE_HOME") or str(Path.home() / ".local" / "state")
+    key = hashlib.sha256(f"{log.resolve()}|{url.rstrip('/')}".encode()).hexdigest()[:12]
+    return Path(home) / "ema" / "replay" / f"{log.stem}-{key}.csv"
+
+
+def check_service(url: str, key: str | None) -> None:
+    """ServiceError where nothing answers at ``url`` (before any file is written)."""
+    from ema.cli.replay import request
+
+    request(f"{url.rstrip('/')}/healthz", key, timeout=10)
 
 
 def report_log(read: Any) -> None:
@@ -126,12 +148,20 @@ def history(
     """An actuator's stored estimates, their trend and its remaining useful life."""
     from ema.cli.figures import prognosis_figure
     from ema.cli.printing import print_prognosis
-    from ema.cli.replay import request
+    from ema.cli.replay import ServiceError, refusal_text, request
+    from ema.model.checks import InputError
     from ema.prognosis.documents import History, Prognosis
 
     key = api_key(api_key_file)
     base = f"{url.rstrip('/')}/v1/actuators/{urllib.parse.quote(actuator_id, safe='/')}"
-    stored = History.model_validate(request(f"{base}/estimates", key, timeout=60))
+    try:
+        stored = History.model_validate(request(f"{base}/estimates", key, timeout=60))
+    except urllib.error.HTTPError as error:
+        if error.code in (404, 422):
+            raise InputError(
+                "ACTUATOR_ID", f"{actuator_id!r}: {refusal_text(error.code, error.read().decode())}"
+            ) from None
+        raise ServiceError(f"HTTP {error.code} from {url}") from None
     prognosis = Prognosis.model_validate(request(f"{base}/prognosis", key, timeout=60))
     if plot is not None and parameter in prognosis.trends:
         prognosis_figure(prognosis, parameter, plot)

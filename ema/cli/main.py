@@ -30,8 +30,24 @@ for module in (commands_local, commands_remote, commands_fleet):
         ema.add_command(command)
 
 
+EXTRAS = {  # a module an optional extra brings -> the extra
+    "fastapi": "service",
+    "uvicorn": "service",
+    "pydantic_settings": "service",
+    "fastapi_offline": "service",
+    "sqlalchemy": "history",
+    "alembic": "history",
+    "matplotlib": "plots",
+    "ray": "fleet",
+    "psycopg": "postgres",
+}
+
+
 def _bad_input(exc: BaseException) -> str | None:
     """The message for an error that is the user's input (named field, flag or file), else None."""
+    if isinstance(exc, ModuleNotFoundError) and (exc.name or "").split(".")[0] in EXTRAS:
+        extra = EXTRAS[(exc.name or "").split(".")[0]]
+        return f"this needs the optional extra '{extra}': pip install 'ema[{extra}]'"
     from ema.history.errors import StorageError
     from ema.model.checks import InputError
 

@@ -102,6 +102,19 @@ def flags_named(flags: Mapping[str, str]) -> Iterator[None]:
         raise InputError(flag, exc.message) from None
 
 
+@contextlib.contextmanager
+def about_file(path: Path) -> Iterator[None]:
+    """Re-raise an InputError about a window's field as one about that field of the file the user gave."""
+    from ema.model.checks import InputError
+
+    try:
+        yield
+    except InputError as exc:
+        if exc.field.startswith(str(path)):
+            raise
+        raise InputError(f"{path}: {exc.field}", exc.message) from None
+
+
 def progress(text: str) -> None:
     print(f"ema: {text}…", file=sys.stderr, flush=True)
 

@@ -54,7 +54,9 @@ def print_estimate(result: Any) -> None:
 def check_line(check: Any) -> str:
     """The answer against the window in one line: the simulation at the estimates, and the equation-error test;
     never the one saying "reproduced" where the other says the model lacks something."""
-    signal, output = next(iter(check.output_error_ratio.items()))
+    ratios = check.output_error_ratio
+    signal = "residual_torque" if "residual_torque" in ratios else next(iter(ratios))
+    output = ratios[signal]
     what = "residual torque" if signal == "residual_torque" else "the stretches' current"
     limit = check.equation_error_limit
     misfit = limit is not None and check.equation_error_ratio > limit
@@ -149,42 +151,53 @@ def _print_drive(drive: dict[str, Any]) -> None:
         click.echo(f"  not separable: {unread}")
 
 
-def _slope(trend: Any) -> str:
+UNITS = {"FDJ": " N·m", "eta_O": "", "eta_A": "", "hinge_aircraft_ratio": ""}
+TIME_UNITS = {
+    "flight_hours": ("flight hour", "flight hours"),
+    "days": ("day", "days"),
+    "windows": ("window", "windows"),
+}
+
+
+def _slope(trend: Any, unit: str) -> str:
+    """The trend's slope with its unit: the parameter's per the prognosis's time unit."""
     if trend.slope_std is None:
         return "no slope yet"
-    return f"slope {trend.slope_per_unit:+.3g} ± {trend.slope_std:.2g} per unit"
+    return f"slope {trend.slope_per_unit:+.3g} ± {trend.slope_std:.2g}{UNITS.get(trend.parameter, '')} per {unit}"
 
 
-def _life(life: Any) -> str:
+def _life(life: Any, unit: str) -> str:
+    """A remaining life, counted from the last window, in the prognosis's time unit."""
     if life.rul is None:
         return life.status
     high = "open" if life.rul_high is None else f"{life.rul_high:.3g}"
     faster = "; speeding up" if life.speeding_up else ""
     return (
-        f"{life.threshold:g} crossed in {life.rul:.3g} (90 %: {life.rul_low:.3g} to {high}; earliest plausible "
-        f"{life.rul_earliest:.3g}){faster}"
+        f"{life.threshold:g} crossed in {life.rul:.3g} {unit} from the last window (90 %: {life.rul_low:.3g} to "
+        f"{high}; earliest plausible {life.rul_earliest:.3g}){faster}"
     )
 
 
 def print_prognosis(stored: Any, prognosis: Any, plot: Path | None) -> None:
     """An actuator's outlook per parameter, the laws it weighs, its backtest, its sensors' trends and notes."""
-    click.echo(f"{prognosis.actuator_id}: {len(stored.estimates)} window(s), time in {prognosis.time_unit}")
+    one, many = TIME_UNITS[prognosis.time_unit]
+    click.echo(f"{prognosis.actuator_id}: {len(stored.estimates)} window(s), time in {many}")
     for name, trend in prognosis.trends.items():
         level, level_std = trend.now()
         laws = ", ".join(f"{law} {w:.2f}" for law, w in sorted(trend.laws.items(), key=lambda x: -x[1]) if w >= 0.05)
-        life = _life(prognosis.remaining_life[name])
-        click.echo(f"{name:<6} now {level:.5g} ± {level_std:.2g}, {_slope(trend)}; {life}")
+        life = _life(prognosis.remaining_life[name], many)
+        click.echo(f"{name:<6} now {level:.5g} ± {level_std:.2g}{UNITS[name]}, {_slope(trend, one)}; {life}")
         if laws:
             click.echo(f"       laws weighed by how they predicted later windows: {laws}")
         for point in prognosis.backtest.get(name, []):
             inside = "—" if point.later_inside is None else f"{100 * point.later_inside:.0f} %"
-            said = "no crossing" if point.crossing is None else f"crossing at {point.crossing:.4g}"
+            said = "no crossing" if point.crossing is None else f"crossing at {point.crossing:.4g} {many}"
             click.echo(
-                f"       backtest at {point.time:.4g} ({point.windows} windows): {said}; of the "
-                f"{point.later_windows} later windows {inside} inside its 90 % band"
+                f"       backtest at {point.time:.4g} {many} ({point.windows} windows; times from the first window): "
+                f"{said}; of the {point.later_windows} later windows {inside} inside its 90 % band"
             )
     for name, trend in prognosis.sensors.items():
-        click.echo(f"{name} now {trend.level:.4g} ± {trend.level_std:.2g}, {_slope(trend)} ({trend.n} windows)")
+        click.echo(f"{name} now {trend.level:.4g} ± {trend.level_std:.2g}, {_slope(trend, one)} ({trend.n} windows)")
     if prognosis.inertia is not None:
         inertia = prognosis.inertia
         click.echo(

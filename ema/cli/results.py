@@ -28,8 +28,8 @@ COLUMNS = (
     "reproduced",
     "replay",
     "simulate_s",
-    "train_s",
-    "predict_s",
+    "learn_s",
+    "assess_s",
     "total_s",
     "error",
 )
@@ -45,7 +45,13 @@ def row_of(actuator_id: str, window_id: str, answer: dict[str, Any]) -> dict[str
         entry = answer["estimates"][name]
         row[name], row[f"{name}_std"] = (None, None) if entry is None else (entry["value"], entry["std"])
     timings = answer["timings_s"]
-    row.update({f"{stage}_s": timings[stage] for stage in ("simulate", "train", "predict", "total")})
+    aliases = {"learn": "train", "assess": "predict"}  # an answer of a service of the first stage names
+    row.update(
+        {
+            f"{stage}_s": timings.get(stage, timings.get(aliases.get(stage, "")))
+            for stage in ("simulate", "learn", "assess", "total")
+        }
+    )
     row["reproduced"] = answer["fit_check"]["reproduced"]
     row["replay"] = answer.get("replay", False)
     return row
@@ -62,22 +68,37 @@ def done_windows(path: Path, answered_only: bool = False) -> set[tuple[str, str]
 
 
 class ResultsWriter:
-    """Appends rows to the CSV, each flushed to disk before the next window starts."""
+    """Appends rows to the CSV, each flushed to disk before the next window starts; the file is created at the
+    first row (a run that answers nothing writes nothing), and an existing file keeps its own columns."""
 
     def __init__(self, path: Path) -> None:
-        new = not path.exists() or path.stat().st_size == 0
-        self._handle = path.open("a", newline="")
-        self._writer = csv.DictWriter(self._handle, fieldnames=COLUMNS)
+        self.path = path
+        self._handle: Any = None
+        self._writer: csv.DictWriter | None = None
+
+    def _open(self) -> csv.DictWriter:
+        new = not self.path.exists() or self.path.stat().st_size == 0
+        columns = list(COLUMNS)
+        if not new:
+            with self.path.open(newline="") as handle:
+                columns = next(csv.reader(handle), columns)
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        self._handle = self.path.open("a", newline="")
+        writer = csv.DictWriter(self._handle, fieldnames=columns, extrasaction="ignore", restval="")
         if new:
-            self._writer.writeheader()
+            writer.writeheader()
+        return writer
 
     def write(self, row: dict[str, Any]) -> None:
+        if self._writer is None:
+            self._writer = self._open()
         self._writer.writerow(row)
         self._handle.flush()
         os.fsync(self._handle.fileno())
 
     def close(self) -> None:
-        self._handle.close()
+        if self._handle is not None:
+            self._handle.close()
 
     def __enter__(self) -> ResultsWriter:
         return self

@@ -115,8 +115,7 @@ def _notes(prepared: Prepared, physics: FrictionFit, estimates: Estimates, check
                 text=(
                     "the window carries no load (its hinge moment at the motor moves the friction by under "
                     f"{100 * NO_LOAD_SHARE:g} % of the nominal FDJ at any efficiency): η_O and η_A cannot show, and "
-                    f"are "
-                    "not read; FDJ is"
+                    "are not read; FDJ is read alone"
                 ),
             )
         )

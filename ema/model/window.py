@@ -110,7 +110,10 @@ class SignalsDocument(_Contract):
         outside = np.flatnonzero((array < low) | (array > high))
         if len(outside):
             index = int(outside[0])
-            raise ValueError(f"sample {index} = {array[index]:g} is outside [{low:g}, {high:g}]")
+            hint = ""
+            if info.field_name == "motor_speed_radps" and np.all(np.abs(array) * np.pi / 30.0 <= high):
+                hint = ": in rpm? (rad/s = rpm × π/30)"
+            raise ValueError(f"sample {index} = {array[index]:g} is outside [{low:g}, {high:g}]{hint}")
         return values
 
 

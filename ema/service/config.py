@@ -133,8 +133,8 @@ class Settings(BaseSettings):
             object.__setattr__(self, "api_key", SecretStr(_read_key(self.api_key_file)))
         if self.api_key is None and not is_loopback(self.host):
             raise ValueError(
-                f"host {self.host} is reachable beyond this machine: set EMA_API_KEY or EMA_API_KEY_FILE "
-                "(or bind 127.0.0.1)"
+                f"host {self.host} is reachable beyond this machine: give a key (--api-key-file, or EMA_API_KEY or "
+                "EMA_API_KEY_FILE), or bind 127.0.0.1"
             )
         return self
 

@@ -128,6 +128,11 @@ def test_a_replay_whose_every_window_is_refused_exits_2_and_says_why_in_full(tmp
     detail = json.dumps({"detail": [{"loc": ["body", "signals", "motor_speed_radps"], "msg": message}]}).encode()
 
     class Handler(BaseHTTPRequestHandler):
+        def do_GET(self):  # /healthz: the replay asks first
+            self.send_response(200)
+            self.end_headers()
+            self.wfile.write(b'{"status": "ok"}')
+
         def do_POST(self):
             self.rfile.read(int(self.headers["content-length"]))
             self.send_response(422)
@@ -187,6 +192,17 @@ def test_post_waits_out_a_503_and_retries_the_same_window():
     assert answer == {"ok": True}
     assert slept == [2.0]
     assert seen == [window.window_id, window.window_id]
+
+
+def test_a_replay_writes_nothing_in_the_working_folder(tmp_path, capsys, monkeypatch, log_folder):
+    """To a service that is not there: said at once, no file anywhere; the answers' CSV goes to the user's state
+    folder unless --out names one, and the replay says where."""
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("XDG_STATE_HOME", str(tmp_path / "state"))
+    assert main(["replay", str(log_folder / "b_window.csv"), "--url", "http://127.0.0.1:9"]) != EXIT_OK
+    assert "cannot reach the service" in capsys.readouterr().err
+    assert sorted(p.name for p in tmp_path.iterdir()) == [] or not (tmp_path / "state").exists()
+    assert not list(tmp_path.glob("*.csv"))
 
 
 def test_a_service_that_dies_mid_request_is_named_as_such(capsys, log_folder):

@@ -179,8 +179,8 @@ def read_static_friction(
                 parameter="FSJ",
                 text=(
                     "no quasi-static break-away in the window: the shaft never rests for 1 ms and then creeps "
-                    "free (in flight the position loop keeps it hunting in the backlash; after a step the drive "
-                    "jumps past the static level within one log interval)"
+                    "free (where the position loop holds the surface it hunts in the backlash; after a step the "
+                    "drive jumps past the static level within one log interval)"
                 ),
             ),
         )

@@ -247,21 +247,30 @@ def _travel_error(
         return InputError("signals.motor_speed_radps", f"runs against position_deg and the torques: {travel}: a sign?")
     if gain < 0:
         return InputError("signals.position_deg", f"runs against motor_speed_radps: {travel}: a sign?")
-    for factor, field, slip in UNIT_SLIPS:
-        if abs(gain / factor - 1.0) < UNIT_SLIP_TOLERANCE:
-            return InputError(field, f"{slip} {travel}")
+    unit = next(
+        ((field, slip) for factor, field, slip in UNIT_SLIPS if abs(gain / factor - 1.0) < UNIT_SLIP_TOLERANCE), None
+    )
     rate = window.sample_rate_hz
-    if any(abs(gain / factor - 1.0) < RATE_SLIP_TOLERANCE for factor in RATE_SLIPS):
+    rate_slip = any(abs(gain / factor - 1.0) < RATE_SLIP_TOLERANCE for factor in RATE_SLIPS)
+    if unit is not None and rate_slip:  # a logger's rate setting fits more closely than a unit (2 % against 10 %)
         return InputError(
             "sample_rate_hz",
-            f"{travel}: at {rate * gain:.6g} Hz instead of {rate:.6g} it would be 1 (a rate stated "
-            f"{1 / gain:.3g}x the log's?); or is motor_speed_radps in other units, or the document's gear ratio off?",
+            f"is {rate:.6g} Hz, but {travel}: at {rate / gain:.6g} Hz it would be 1 "
+            f"(a rate stated {gain:.3g}x the log's?); or {unit[0].split('.')[-1]} {unit[1]}",
+        )
+    if unit is not None:
+        return InputError(unit[0], f"{unit[1]} {travel}")
+    if rate_slip:
+        return InputError(
+            "sample_rate_hz",
+            f"{travel}: at {rate / gain:.6g} Hz instead of {rate:.6g} it would be 1 (a rate stated "
+            f"{gain:.3g}x the log's?); or is motor_speed_radps in other units, or the document's gear ratio off?",
         )
     return InputError(
         "actuator.drive.gear_ratio",
         f"{travel}: the drive that logged this window turns as a gear ratio of {actuator.gear_ratio / gain:.4g} "
         f"would; is the actuator's document the right one (its gear ratio, k_T, end stops)? Else the sample rate "
-        f"is off (at {rate * gain:.6g} Hz instead of {rate:.6g} it would be 1) or motor_speed_radps is in other "
+        f"is off (at {rate / gain:.6g} Hz instead of {rate:.6g} it would be 1) or motor_speed_radps is in other "
         "units",
     )
 

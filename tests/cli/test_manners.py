@@ -1,0 +1,96 @@
+"""The first hour of a new user: what each command reads, writes and says (the manners probe, in tests)."""
+
+import json
+
+import numpy as np
+from fastapi.testclient import TestClient
+
+from ema.cli.main import EXIT_BAD_INPUT, EXIT_OK, main
+from ema.model.params import HealthParams
+from ema.model.synthetic import synthetic_window
+from ema.model.window import SIGNALS, window_to_dict
+from ema.service.main import create_app
+from tests.service.conftest import LOCAL, SMALL, settings_for
+
+SIZES = [
+    "--sims",
+    str(SMALL.n_simulations),
+    "--checks",
+    str(SMALL.check_windows),
+    "--timesteps",
+    str(SMALL.n_timesteps),
+    "--hidden",
+    str(SMALL.hidden_units),
+]
+
+
+def test_estimate_reads_a_csv_window_as_replay_does(tmp_path, capsys):
+    window = synthetic_window(HealthParams.single(), seed=4, duration_s=0.1, actuator_id="csv/1")
+    rows = np.stack([window.signals[name] for name in SIGNALS], axis=1)
+    text = "# window_id: csv-window\n# sample_rate_hz: 10000\n" + ",".join(SIGNALS) + "\n"
+    (tmp_path / "w.csv").write_text(text + "\n".join(",".join(f"{v:.9g}" for v in row) for row in rows))
+    assert main(["estimate", str(tmp_path / "w.csv"), "--json", *SIZES]) == EXIT_OK
+    result = json.loads(capsys.readouterr().out)
+    assert result["window_id"] == "csv-window" and result["estimates"]["FDJ"]["value"] > 0
+
+
+def test_a_unit_slip_names_the_file_and_the_field(tmp_path, capsys):
+    document = window_to_dict(synthetic_window(HealthParams.single(), seed=3, duration_s=0.3))
+    document["sample_rate_hz"] = 1000.0  # logged at 10 kHz
+    (tmp_path / "w.json").write_text(json.dumps(document))
+    assert main(["estimate", str(tmp_path / "w.json"), *SIZES]) == EXIT_BAD_INPUT
+    err = capsys.readouterr().err
+    assert f"{tmp_path / 'w.json'}: sample_rate_hz" in err and "at 9999" in err and "rate stated 0.1x" in err
+
+
+def test_bench_writes_nothing_unless_asked(tmp_path, monkeypatch):
+    import ema.cli.bench as bench
+
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(bench, "time_windows", lambda *a, **k: {"p50_s": {}, "p95_s": {}})
+    monkeypatch.setattr(bench, "references", lambda: {})
+    monkeypatch.setattr(bench, "markdown", lambda *a, **k: "table")
+    monkeypatch.setattr(bench, "estimate_window", lambda *a, **k: None)
+    result = bench.run_bench(SMALL, [0.5], repeats=1, under_load=0, out=None, docs=False)
+    assert result["json"] is None and list(tmp_path.iterdir()) == []
+
+
+def test_the_front_page_leads_to_the_view_and_the_actuators_are_listed(tmp_path):
+    document = window_to_dict(synthetic_window(HealthParams.single(), seed=3, duration_s=0.1, actuator_id="m/1"))
+    with TestClient(create_app(settings_for(tmp_path)), base_url=LOCAL) as client:
+        front = client.get("/", follow_redirects=False)
+        assert front.status_code in (302, 307) and front.headers["location"] == "/ui"
+        assert client.post("/v1/estimate", json=document).status_code == 200
+        listed = client.get("/v1/actuators").json()
+        assert [line["actuator_id"] for line in listed] == ["m/1"] and listed[0]["windows"] == 1
+        assert client.get("/v1/actuators/nope/estimates").status_code == 404
+        assert client.get("/v1/actuators/nope/prognosis").status_code == 404
+
+
+def test_an_unknown_actuator_exits_2(capsys):
+    from http.server import BaseHTTPRequestHandler, HTTPServer
+    from threading import Thread
+
+    class Handler(BaseHTTPRequestHandler):
+        def do_GET(self):
+            body = json.dumps({"detail": [{"loc": ["path", "actuator_id"], "msg": "nothing stored"}]}).encode()
+            self.send_response(404)
+            self.end_headers()
+            self.wfile.write(body)
+
+        def log_message(self, *args):
+            pass
+
+    server = HTTPServer(("127.0.0.1", 0), Handler)
+    Thread(target=server.serve_forever, daemon=True).start()
+    try:
+        assert main(["history", "nope", "--url", f"http://127.0.0.1:{server.server_port}"]) == EXIT_BAD_INPUT
+    finally:
+        server.shutdown()
+    assert "nothing stored" in capsys.readouterr().err
+
+
+def test_serve_beyond_loopback_without_a_key_names_the_flag(tmp_path, capsys, monkeypatch):
+    monkeypatch.delenv("EMA_API_KEY", raising=False)
+    assert main(["serve", "--host", "0.0.0.0", "--database", str(tmp_path / "h.sqlite3")]) == EXIT_BAD_INPUT
+    assert "--api-key-file" in capsys.readouterr().err

@@ -1,0 +1,97 @@
+"""One contract for every history: SQLite and PostgreSQL pass the same tests (``setting`` runs each on both)."""
+
+import concurrent.futures
+
+import pytest
+
+from ema.estimate.documents import SensorZero
+from ema.history.errors import ConflictError, StorageError
+from ema.history.open import open_history
+from ema.model.actuator import THESIS
+
+
+def _as(result, actuator_id: str, window_id: str, **window):
+    info = result.window.model_copy(update={"content_sha256": f"{actuator_id}#{window_id}", **window})
+    return result.model_copy(update={"actuator_id": actuator_id, "window_id": window_id, "window": info})
+
+
+def test_one_row_per_window_and_the_repeat_is_a_replay(history, result):
+    first, again = history.add(result), history.add(result)
+    assert not first.replay and again.replay and again.id == first.id
+    current, legacy = history.history(result.actuator_id)
+    assert [s.id for s in current] == [first.id] and legacy == []
+
+
+def test_another_window_under_a_stored_key_is_a_conflict(history, result):
+    history.add(result)
+    other = result.model_copy(update={"window": result.window.model_copy(update={"content_sha256": "f" * 64})})
+    with pytest.raises(ConflictError, match=result.window_id):
+        history.add(other)
+    with pytest.raises(ConflictError):
+        history.get(result.actuator_id, result.window_id, "f" * 64)
+    assert history.get(result.actuator_id, result.window_id, result.window.content_sha256).replay
+
+
+def test_the_same_window_stored_at_once_from_many_threads_is_one_row(history, result):
+    with concurrent.futures.ThreadPoolExecutor(8) as pool:
+        stored = list(pool.map(lambda _: history.add(result), range(8)))
+    assert len({s.id for s in stored}) == 1 and sum(not s.replay for s in stored) == 1
+    assert len(history.history(result.actuator_id)[0]) == 1
+
+
+def test_document_versions_never_collide(history):
+    documents = [THESIS.model_copy(update={"name": f"variant {i}"}) for i in range(6)]
+    with concurrent.futures.ThreadPoolExecutor(6) as pool:
+        versions = [s.version for s in pool.map(lambda d: history.put_actuator("a/1", d), documents)]
+    assert sorted(versions) == [1, 2, 3, 4, 5, 6]
+    assert history.put_actuator("a/1", history.get_actuator("a/1").document).version == 6  # the same: no new one
+
+
+def test_a_withdrawn_window_leaves_the_history_and_its_record_stays(history, result):
+    history.add(result)
+    gone = history.withdraw(result.actuator_id, result.window_id, "wrong actuator")
+    assert gone is not None and gone.reason == "wrong actuator"
+    assert history.history(result.actuator_id)[0] == [] and history.withdraw(result.actuator_id, "x", "") is None
+    assert [w.window_id for w in history.withdrawals(result.actuator_id)] == [result.window_id]
+    assert result.actuator_id in history.actuator_ids()
+
+
+def test_the_sensor_zero_lent_is_the_most_precise_of_the_actuators_flight(history, result):
+    for actuator_id, window_id, flight_id, std in [
+        ("a", "w1", "f", 3e-4),
+        ("a", "w2", "f", 1e-4),
+        ("a", "w3", "f", None),
+        ("a", "w4", "g", 1e-5),
+        ("b", "w5", "f", 1e-6),
+        ("a", "w6", None, 1e-6),
+    ]:
+        zero = None if std is None else SensorZero(window_id=window_id, hinge_nm=0.0, current_a=std, torque_std_nm=std)
+        history.add(_as(result, actuator_id, window_id, flight_id=flight_id, sensor_zero=zero))
+    assert history.readings("a", "f").sensor_zero.window_id == "w2"
+    assert history.readings("a", "g").sensor_zero.window_id == "w4"
+    assert history.readings("a", "h").sensor_zero is None and history.readings("c", "f").sensor_zero is None
+
+
+def test_the_views_lookups_answer_every_actuator_at_once(history, result):
+    for actuator_id in ("a", "b"):
+        for i in range(3):
+            history.add(_as(result, actuator_id, f"w{i}"))
+    history.put_actuator("b", THESIS)
+    versions = history.versions()
+    assert versions["a"][0] == 3 and versions["b"][0] == 3 and versions["b"][2] == 1 and versions["a"][2] == 0
+    latest = history.latest(["a", "b", "c"])
+    assert sorted(latest) == ["a", "b"] and latest["a"].window_id == "w2"
+    assert list(history.latest_documents(["a", "b"])) == ["b"]
+    history.put_summary("a", "3:3:0", 4, None, "{}")
+    history.put_summary("a", "3:4:0", 3, 1.5, "{}")
+    assert history.summaries() == {"a": ("3:4:0", "{}")}
+
+
+def test_a_setting_that_is_neither_path_nor_address_is_refused_naming_it(tmp_path):
+    with pytest.raises(StorageError, match="mysql:// is no database"):
+        open_history("mysql://ema@localhost/ema")
+    assert not (tmp_path / "mysql:").exists()
+
+
+def test_a_history_is_healthy_until_its_storage_goes(history):
+    assert history.healthy() == (True, "ok")
