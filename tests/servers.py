@@ -27,9 +27,10 @@ def free_port() -> int:
         return probe.getsockname()[1]
 
 
-def start_server(port: int, database: Path) -> subprocess.Popen:
-    """``ema serve`` on ``port`` with ``database`` and ``SMALL_ENV``, returned once /healthz says warm."""
-    env = {**os.environ, **SMALL_ENV}
+def start_server(port: int, database: Path | str, **env_extra: str) -> subprocess.Popen:
+    """``ema serve`` on ``port`` with ``database`` (a file or a postgresql:// address) and ``SMALL_ENV``, returned
+    once /healthz says warm."""
+    env = {**os.environ, **SMALL_ENV, **env_extra}
     command = [sys.executable, "-m", "ema.cli.main", "serve", "--port", str(port), "--database", str(database)]
     server = subprocess.Popen(command, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     deadline = time.monotonic() + 180

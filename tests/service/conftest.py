@@ -39,3 +39,6 @@ def settings(tmp_path) -> Settings:
 def client(settings):
     with TestClient(create_app(settings), base_url=LOCAL) as test_client:
         yield test_client
+
+
+from tests.history.conftest import postgres  # noqa: E402,F401  (the replicas' server, started once a session)
