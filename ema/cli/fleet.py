@@ -28,6 +28,7 @@ from ema.estimate.config import PipelineConfig
 from ema.model.window import Window, window_to_dict
 
 IN_FLIGHT_PER_WORKER = 2  # tasks queued per worker: enough to keep it busy, few enough to stop quickly
+NODE_LOSSES = 3  # a window whose task died with its node this often (past Ray's retries) fails the run
 
 
 @dataclass
@@ -85,23 +86,36 @@ def _in_process(jobs: list[Job], config: PipelineConfig, threads: int, documents
 def _on_ray(
     jobs: list[Job], config: PipelineConfig, workers: int, threads: int, address: str | None, documents: Documents
 ) -> Iterator[Answer]:
+    """Each job's answer as Ray returns it. A task lost with its node (past Ray's own retries) is submitted
+    again, up to ``NODE_LOSSES`` times: a node that dies mid-run loses no window, and each is answered once."""
     import ray
 
     from ema.estimate.remote import connect, ray_task
 
     connect(address, workers * threads)
     task = ray_task(threads)
-    pending: dict[Any, Window] = {}
+    pending: dict[Any, Job] = {}
+    losses: dict[str, int] = {}
     queue = list(reversed(jobs))
     while queue or pending:
         while queue and len(pending) < IN_FLIGHT_PER_WORKER * workers:
-            window, history = queue.pop()
+            window, history = job = queue.pop()
             actuator, version = documents.task_arguments(window)
             reference = task.remote(window_to_dict(window), config.model_dump(), threads, history, actuator, version)
-            pending[reference] = window
+            pending[reference] = job
         ready, _ = ray.wait(list(pending), num_returns=1)
         for reference in ready:
-            yield pending.pop(reference), ray.get(reference)
+            job = pending.pop(reference)
+            try:
+                answer = ray.get(reference)
+            except (ray.exceptions.WorkerCrashedError, ray.exceptions.NodeDiedError, ray.exceptions.ObjectLostError):
+                key = job[0].window_id
+                losses[key] = losses.get(key, 0) + 1
+                if losses[key] > NODE_LOSSES:
+                    raise
+                queue.append(job)
+                continue
+            yield job[0], answer
 
 
 @dataclass

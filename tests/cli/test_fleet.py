@@ -195,3 +195,49 @@ def test_an_archive_carries_its_actuators_documents(tmp_path, capsys, monkeypatc
     assert small.actuator.version == 1 and store.get_actuator("small-1").document.drive.gear_ratio == 800.0
     assert abs(small.estimates.FDJ.value / bench.truth["FDJ"] - 1) < 0.03
     assert store.history("thesis-1")[0][0].actuator.default and store.get_actuator("thesis-1") is None
+
+
+@pytest.mark.slow
+def test_a_node_that_dies_mid_run_loses_no_window_and_duplicates_none(tmp_path):
+    """A Ray cluster of two nodes on this machine; the worker node is removed once two windows are answered."""
+    import threading
+    import time
+
+    import ray
+    from ray.cluster_utils import Cluster
+
+    from ema.cli.fleet import run_fleet
+    from ema.estimate.config import PipelineConfig
+    from ema.history.open import open_history
+
+    windows = [
+        synthetic_window(HealthParams.single(), seed=i, duration_s=0.1, actuator_id=f"tail-{i % 2}", window_id=f"w{i}")
+        for i in range(12)
+    ]
+    cluster = Cluster(initialize_head=True, head_node_args={"num_cpus": 1})
+    worker = cluster.add_node(num_cpus=1)
+    out, database = tmp_path / "results.csv", tmp_path / "history.sqlite3"
+
+    killed_at: list[int] = []
+
+    def kill_when_two_answered() -> None:
+        while not out.exists() or len(_rows(out)) < 2:
+            time.sleep(0.05)
+        killed_at.append(len(_rows(out)))
+        cluster.remove_node(worker, allow_graceful=False)
+
+    killer = threading.Thread(target=kill_when_two_answered, daemon=True)
+    killer.start()
+    try:
+        small = PipelineConfig(n_simulations=16, check_windows=8, n_timesteps=50, hidden_units=8)
+        run_fleet(windows, out, config=small, workers=2, address=cluster.address, database=database)
+    finally:
+        ray.shutdown()
+        cluster.shutdown()
+    killer.join(timeout=5)
+    assert killed_at and killed_at[0] < len(windows)  # the node died with windows still to answer
+    rows = _rows(out)
+    assert sorted(r["window_id"] for r in rows) == sorted(w.window_id for w in windows)  # each once
+    store = open_history(database)
+    stored = [s.window_id for a in ("tail-0", "tail-1") for s in store.history(a)[0]]
+    assert sorted(stored) == sorted(w.window_id for w in windows)
