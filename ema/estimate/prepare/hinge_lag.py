@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ema.estimate.physics.friction import FitSettings
-from ema.estimate.physics.noise import MAX_LAG, noise_of
+from ema.estimate.physics.noise import MAX_LAG, noise_of, white_noise_std
 from ema.estimate.physics.shifts import shifted_fits
 from ema.estimate.prepare.departures.aircraft_band import band_lag_s
 from ema.estimate.stats import JACKKNIFE_BLOCKS, rms_log_likelihood_ratio
@@ -55,6 +55,11 @@ class HingeLag:
     late: float = 0.0  # the posterior's weight of "late at all" (1 − that of on time)
     advance: float = 0.0  # the posterior mean lag: the moment is advanced by this
     spread: dict[str, float] = field(default_factory=dict)  # per target, the posterior std over the lags
+
+
+# A sensor whose white-noise std is under this share of its range logged no noise (a simulator's clean trace): the
+# noise a real strain gauge leaves is orders of magnitude above it, even behind its amplifier's filter.
+NOISELESS = 1e-4
 
 
 def filter_delay_samples(noise: np.ndarray, sample_rate_hz: float, max_lag: int, rising_is_noise: bool) -> float:
@@ -101,6 +106,8 @@ def hinge_lag(
     """The hinge moment's lag, where its noise shows a filter: the model average of the module docstring (on
     the ground the moment follows no deflection, and the band reads no lag)."""
     hinge = signals["hinge_moment_nm"]
+    if white_noise_std(hinge) < NOISELESS * float(np.max(np.abs(hinge)) or 1.0):
+        return HingeLag()  # a moment logged without noise shows no filter (what is left is the denoiser's own)
     noise = hinge - denoised_hinge_nm(hinge, signals["position_deg"], sample_rate_hz)
     delay = min(
         filter_delay_samples(noise, sample_rate_hz, MAX_LAG["hinge_moment_nm"], True), MAX_HINGE_LAG_S * sample_rate_hz

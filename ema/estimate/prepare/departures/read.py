@@ -131,6 +131,9 @@ def _read(window: Window, actuator: ActuatorDocument, aircraft: AircraftCheck, k
     return replace(read, drive=replace(drive, spread=spread))
 
 
+NOISELESS_SPEED = 1e-6  # a speed's white-noise std under this share of its range: logged without noise
+
+
 def _told_apart(
     window: Window, scale: Departures, inertia: Departures, actuator: ActuatorDocument
 ) -> Departures | None:
@@ -144,6 +147,8 @@ def _told_apart(
     noise = SensorNoise(
         motor_speed_radps=white_noise_std(signals["motor_speed_radps"]), current_a=white_noise_std(signals["current_a"])
     )
+    if noise.motor_speed_radps < NOISELESS_SPEED * float(np.max(np.abs(signals["motor_speed_radps"])) or 1.0):
+        return None  # a speed logged without noise: no replay follows it "within twice the noise" (saves three)
 
     def error(read: Departures, effect: str, **parameters: float) -> float:
         effects = read.viscosity.effects().with_effect(effect, **parameters)
