@@ -121,14 +121,24 @@ def test_sensors_behind_filters_give_no_static_friction_from_their_noise(seed, f
     assert result.dataset.noise_estimated["hinge_moment_nm_corr_s"] > 5e-4  # read as correlated
 
 
-@pytest.mark.slow
-def test_coverage_of_two_stds_over_mixed_windows_is_at_least_90_percent():
+def _coverage(windows: int) -> float:
+    """The share of FDJ and η_O answers whose ±2 std holds the truth, over mixed foreign windows (half worn)."""
     families = ("thesis", "cruise", "gust", "doublet", "steps")
     z = []
-    for seed in range(40):
+    for seed in range(windows):
         drawn = worn(200 + seed, family=families[seed % 5]) if seed % 2 else draw(200 + seed, families[seed % 5])
         z += [zz for _, zz in _errors(_estimate(drawn, PipelineConfig()), drawn.truth).values()]
-    assert np.mean(np.array(z) <= 2.0) >= 0.9
+    return float(np.mean(np.array(z) <= 2.0))
+
+
+def test_two_stds_hold_the_truth_on_most_of_a_dozen_foreign_windows():
+    """The promise of every std, in the default run: ±2 std holds the truth for 90 % of the answers."""
+    assert _coverage(12) >= 0.9
+
+
+@pytest.mark.slow
+def test_coverage_of_two_stds_over_mixed_windows_is_at_least_90_percent():
+    assert _coverage(40) >= 0.9
 
 
 def test_a_window_that_holds_little_of_eta_o_says_so_and_one_that_holds_it_does_not():
