@@ -137,7 +137,7 @@ class Calibrator:
         measured = equations([w.signals for w in prepared], rate, COGGING_ORDERS, spec)
         stage(f"simulating {self.copies} noise-only copies")
         clean = clean_replicas(prepared, before, self.actuator)
-        copies = noise_copies(clean, noise, rate, COGGING_ORDERS, self.seed, spec, self.copies, on_copy=check)
+        copies = noise_copies(clean, noise, rate, COGGING_ORDERS, self.seed, spec, copies=self.copies, on_copy=check)
         families = named_families(measured, spec) + generic_families(measured)
         stage(f"scoring {len(families)} candidate families against the noise floor")
         self.contests_: dict[str, Contest] = {}
@@ -154,7 +154,9 @@ class Calibrator:
         adopted = found.adopted
         after = corrected(fit_with(measured, adopted).values, bias) if adopted else before
         self.measured_, self.chosen_ = measured, adopted
-        report = reporting.assemble(found, before, after, bias, held, truth, time.perf_counter() - started)
+        report = reporting.assemble(
+            found, before, after, bias, held, truth=truth, seconds=time.perf_counter() - started
+        )
         stds_after = stds if ambiguity is None else ambiguity.stds_after
         self.report_: CalibrationReport = report.model_copy(
             update={"stds_before": stds, "stds_after": stds_after, "ambiguity": ambiguity}

@@ -29,8 +29,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from ema.estimate.quasistatic import ETA_GRID, Stretch, speed_and_load, stretches
+from ema.estimate.stats import rms
 from ema.model.actuator import ActuatorDocument
 from ema.model.checks import InputError
+from ema.model.params import load_factors
 from ema.model.window import Window
 
 MIN_Z = 6.0
@@ -95,7 +97,7 @@ def _design(runs: list[Run], eta: float, actuator: ActuatorDocument) -> tuple[np
     """(X, y, w): y = I − I0 per stretch (I0 the runs' mean current at rest: the anchor of FDJ), X = [g, 1] with
     g = k·|T_L| − s·T_L at ``eta``, weights 1/σ²."""
     rest = float(np.mean([run.rest_a for run in runs]))
-    k_opp, k_aid = 1.0 / eta - 1.0, 1.0 - float(actuator.eta_a(eta))
+    k_aid, k_opp = load_factors(eta, actuator.gear_ratio)
     rows, y, w = [], [], []
     for run in runs:
         for s in run.stretches:
@@ -140,8 +142,8 @@ def fit_drive(runs: list[Run], actuator: ActuatorDocument) -> DriveFit:
         eta_o=float(ETA_GRID[best]) if separable else None,
         eta_o_std=eta_std if separable else None,
         repeatability_nm=repeat,
-        residual_before_a=_rms(y - _predicted_before(runs, actuator)),
-        residual_after_a=_rms(y - x @ np.array([c, c_fdj])),
+        residual_before_a=rms(y - _predicted_before(runs, actuator)),
+        residual_after_a=rms(y - x @ np.array([c, c_fdj])),
         loads_n=[round(size * actuator.gear_ratio, 3) for size in sizes],
         profile=np.nanmean([run.profile for run in runs], axis=0),
     )
@@ -181,10 +183,6 @@ def _predicted_before(runs: list[Run], actuator: ActuatorDocument) -> np.ndarray
         return np.zeros(sum(len(run.stretches) for run in runs))
     x, _, _ = _design(runs, nominal.eta_o, actuator)
     return screw.current_per_nm_a * (x[:, 0] + nominal.fdj_nm)
-
-
-def _rms(values: np.ndarray) -> float:
-    return float(np.sqrt(np.mean(values**2))) if len(values) else 0.0
 
 
 def profile_change(runs: list[Run], baseline: np.ndarray) -> tuple[float, np.ndarray]:

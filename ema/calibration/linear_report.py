@@ -30,6 +30,7 @@ from ema.estimate.documents import ActuatorRead
 from ema.estimate.low_rate import estimate_low_rate
 from ema.model.actuator import ActuatorDocument, Nominal
 from ema.model.checks import InputError
+from ema.model.params import load_factors
 from ema.model.window import Window
 
 ANCHOR = (
@@ -130,7 +131,7 @@ def _leave_one_out(runs: list[Run], actuator: ActuatorDocument) -> HeldOut:
         rest, eta = others.current_at_zero_torque_a, others.eta_o
         for s in run.stretches:
             opposing = s.direction * s.load_nm < 0
-            k = 1.0 / eta - 1.0 if opposing else 1.0 - float(actuator.eta_a(eta))
+            k = load_factors(eta, actuator.gear_ratio)[1 if opposing else 0]
             torque = others.fdj_nm + k * abs(s.load_nm) - s.direction * s.load_nm
             predicted = rest + others.current_per_nm_a * torque
             before += (s.current_a - rest) ** 2

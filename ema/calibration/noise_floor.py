@@ -44,6 +44,7 @@ def noise_copies(
     orders: Sequence[float],
     seed: int,
     actuator: DriveConstants,
+    *,
     copies: int = COPIES,
     on_copy: Callable[[], None] | None = None,
 ) -> list[Equations]:

@@ -18,7 +18,7 @@ import numpy as np
 from ema.calibration.equations import FOLDS, Equations
 from ema.calibration.selection import Chosen
 from ema.estimate.physics.eta_search import ETA_O_SEARCH, GRID_POINTS, REFINEMENTS
-from ema.model.params import eta_a_from_eta_o
+from ema.model.params import load_factors
 
 MIN_HELD_OUT_GAIN = 0.01  # a model with an effect must cut the held-out residual by at least 1 % to be adopted
 
@@ -57,14 +57,9 @@ def _loads(e: Equations, chosen: Sequence[Chosen]) -> np.ndarray:
     return loads
 
 
-def _load_factors(eta_o: np.ndarray | float, gear_ratio: float) -> tuple[np.ndarray, np.ndarray]:
-    """(k_aid, k_opp) at η_O (η_A by Eq. 3.4): the load-dependent friction's share of a and o."""
-    return 1.0 - eta_a_from_eta_o(eta_o, gear_ratio), 1.0 / np.asarray(eta_o, dtype=np.float64) - 1.0
-
-
 def _target(y: np.ndarray, eta_o: float, loads: np.ndarray, gear_ratio: float) -> np.ndarray:
     """t minus the load-dependent friction at η_O: what FDJ and the effect must explain."""
-    k_aid, k_opp = _load_factors(eta_o, gear_ratio)
+    k_aid, k_opp = load_factors(np.asarray(eta_o, dtype=np.float64), gear_ratio)
     return y - k_aid * loads[:, 0] - k_opp * loads[:, 1]
 
 
@@ -83,7 +78,7 @@ def fit_with(e: Equations, chosen: Sequence[Chosen], rows: np.ndarray | None = N
     low, high = ETA_O_SEARCH
     for _ in range(REFINEMENTS):
         grid = np.linspace(low, high, GRID_POINTS)
-        mixes = np.vstack([np.ones(GRID_POINTS), *(-k for k in _load_factors(grid, e.gear_ratio))])  # (3, G)
+        mixes = np.vstack([np.ones(GRID_POINTS), *(-k for k in load_factors(grid, e.gear_ratio))])  # (3, G)
         best = int(np.argmin(np.sum((residuals @ mixes) ** 2, axis=0)))
         step = grid[1] - grid[0]
         low, high = max(grid[best] - step, ETA_O_SEARCH[0]), min(grid[best] + step, ETA_O_SEARCH[1])

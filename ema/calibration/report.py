@@ -184,6 +184,7 @@ def assemble(
     after: Mapping[str, float],
     bias: Mapping[str, float],
     held: HeldOutCheck,
+    *,
     truth: Mapping[str, float] | None,
     seconds: float,
 ) -> CalibrationReport:

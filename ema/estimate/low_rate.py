@@ -125,7 +125,7 @@ def estimate_low_rate(
     eta_std = (screw.eta_o_std if screw is not None else None) or 0.0
     repeat = (screw.repeatability_nm if screw is not None else None) or 0.0
     fit = fit_stretches(
-        found, reading, actuator.eta_a, eta_o_document=(nominal.eta_o, eta_std), repeatability_nm=repeat
+        found, reading, actuator.gear_ratio, eta_o_document=(nominal.eta_o, eta_std), repeatability_nm=repeat
     )
     seconds["physics"] = time.perf_counter() - started - seconds["prepare"]
     announce("writing the report")

@@ -168,7 +168,9 @@ def estimate_window(
         physics = fit_window(seen.signals, w.sample_rate_hz, prepared.drive_as_read)
     with watch("simulate", f"simulating {config.total_simulations} windows around the physics estimate"):
         effects = prepared.departures.viscosity.effects()
-        data = simulate_dataset(w, seen, physics, config, actuator, prepared.drive_as_read, effects)
+        data = simulate_dataset(
+            w, seen, physics, config, document=actuator, actuator=prepared.drive_as_read, effects=effects
+        )
     with watch("learn", f"training {config.members} network(s) of {config.hidden_units} neurons"):
         network = train_network(data, config)
     with watch("assess", "weighing the estimators on held-out simulations"):

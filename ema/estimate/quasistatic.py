@@ -23,11 +23,11 @@ skipped, and the estimate says so (``stages``).
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 
+from ema.model.params import eta_a_of, load_factors
 from ema.model.window import Window
 
 BLOCKS = 5  # a stretch's mean and its std from this many blocks (the current is correlated over samples)
@@ -128,16 +128,10 @@ class QuasiStaticFit:
     per_nm_read_std_a: float | None
 
 
-def load_factors(eta_o: np.ndarray | float, eta_a: Callable[[np.ndarray], np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
-    """(k_opp, k_aid) of Eq. 5.1 at ``eta_o``."""
-    eta = np.asarray(eta_o, dtype=float)
-    return 1.0 / eta - 1.0, 1.0 - eta_a(eta)
-
-
 def fit_stretches(
     found: list[Stretch],
     reading: TorqueReading,
-    eta_a: Callable[[np.ndarray], np.ndarray],
+    gear_ratio: float,
     *,
     eta_o_document: tuple[float, float],
     repeatability_nm: float = 0.0,
@@ -152,7 +146,7 @@ def fit_stretches(
     spread = float(np.ptp(size)) / max(float(np.mean(size)), 1e-12) if len(size) else 0.0
 
     def fdj_at(eta: float) -> tuple[float, float]:
-        k_opp, k_aid = load_factors(eta, eta_a)
+        k_aid, k_opp = load_factors(eta, gear_ratio)
         rest = y - np.where(opposing, k_opp, k_aid) * size
         fdj = float(np.sum(weight * rest) / np.sum(weight))
         return fdj, float(np.sum(weight * (rest - fdj) ** 2))
@@ -166,12 +160,13 @@ def fit_stretches(
         eta, eta_std = eta_o_document
     fdj, chi2_min = fdj_at(eta)
     dof = max(len(found) - 1 - int(read), 1)
-    slope = float(np.mean(np.where(opposing, 1.0 / eta**2, -_eta_a_slope(eta, eta_a)) * size))  # ∂FDJ/∂η_O
+    slope = float(np.mean(np.where(opposing, 1.0 / eta**2, -_eta_a_slope(eta, gear_ratio)) * size))  # ∂FDJ/∂η_O
     within = float(1.0 / np.sqrt(np.sum(weight)))
     scale = float(np.mean(np.abs(tau))) * _rel(reading)  # every torque scales with c: FDJ's share of it
     offset = reading.offset_std_a / reading.per_nm_a  # I0's spread moves every torque, so FDJ, alike
     fdj_std = float(np.sqrt(within**2 + (slope * eta_std) ** 2 + repeatability_nm**2 + scale**2 + offset**2))
-    return QuasiStaticFit(fdj, fdj_std, eta, eta_std, read, chi2_min / dof, *_per_nm_read(found, reading, eta, eta_a))
+    per_nm = _per_nm_read(found, reading, eta, gear_ratio)
+    return QuasiStaticFit(fdj, fdj_std, eta, eta_std, read, chi2_min / dof, *per_nm)
 
 
 def _rel(reading: TorqueReading) -> float:
@@ -179,9 +174,9 @@ def _rel(reading: TorqueReading) -> float:
     return reading.per_nm_std_a / reading.per_nm_a
 
 
-def _eta_a_slope(eta: float, eta_a: Callable[[np.ndarray], np.ndarray]) -> float:
+def _eta_a_slope(eta: float, gear_ratio: float) -> float:
     h = 1e-5
-    return float((eta_a(np.array(eta + h)) - eta_a(np.array(eta - h))) / (2 * h))
+    return float((eta_a_of(eta + h, gear_ratio) - eta_a_of(eta - h, gear_ratio)) / (2 * h))
 
 
 def _profile_std(grid: np.ndarray, chi2: np.ndarray, best: int) -> float:
@@ -191,7 +186,7 @@ def _profile_std(grid: np.ndarray, chi2: np.ndarray, best: int) -> float:
 
 
 def _per_nm_read(
-    found: list[Stretch], reading: TorqueReading, eta: float, eta_a: Callable[[np.ndarray], np.ndarray]
+    found: list[Stretch], reading: TorqueReading, eta: float, gear_ratio: float
 ) -> tuple[float | None, float | None]:
     """The current per N·m the window shows: opposing and aiding stretches at one load differ by
     (1/η_O + η_A)·|T_L| of torque, whatever FDJ; None where it holds not both."""
@@ -202,7 +197,7 @@ def _per_nm_read(
     if opposing.all() or not opposing.any():
         return None, None
     gap = float(np.mean(along[opposing]) - np.mean(along[~opposing]))
-    torque_gap = float(np.mean(np.abs(load)) * (1.0 / eta + eta_a(np.array(eta))))
+    torque_gap = float(np.mean(np.abs(load)) * (1.0 / eta + eta_a_of(eta, gear_ratio)))
     gap_std = float(np.hypot(np.sqrt(np.mean(stds[opposing] ** 2)), np.sqrt(np.mean(stds[~opposing] ** 2))))
     return gap / torque_gap, gap_std / torque_gap
 

@@ -30,6 +30,11 @@ def odds_weight(log_odds: float) -> float:
     return float(1.0 / (1.0 + np.exp(-np.clip(log_odds, -50.0, 50.0))))
 
 
+def rms(values: np.ndarray) -> float:
+    """The root mean square of ``values`` (0 for none)."""
+    return float(np.sqrt(np.mean(values**2))) if len(values) else 0.0
+
+
 def rms_log_likelihood_ratio(worse_rms: float, better_rms: float, n_sliding: float, rate: float) -> float:
     """ln of the likelihood ratio of two fits of one window's ``n_sliding`` samples by their RMS equation
     errors, with one independent value per reconstruction kernel (the kernel smooths both sides of Eq. 5.1)."""

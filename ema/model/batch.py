@@ -11,7 +11,7 @@ from ema.model import kernels, runtime
 from ema.model.aircraft import FlightCondition, HingeGeometry, Load, load_model
 from ema.model.checks import InputError, finite_array, in_range
 from ema.model.effects import TABLE_VARIABLES, EffectSet
-from ema.model.params import DriveConstants, HealthParams
+from ema.model.params import DriveConstants, HealthParams, load_factors
 
 DEFAULT_SAMPLE_RATE_HZ = 10_000.0
 SAMPLE_RATE_RANGE_HZ = (1_000.0, 100_000.0)
@@ -232,8 +232,8 @@ def simulate_batch(
     if len(loads.slow_table_nm) not in (0, n_samples):
         raise InputError("load", f"a logged load needs {n_samples} values, got {len(loads.slow_table_nm)}")
 
-    eta_a = health.eta_a(actuator.gear_ratio)
-    per_sim = _padded(np.stack([health.fdj_nm, health.fsj_nm, 1.0 - eta_a, 1.0 / health.eta_o - 1.0]), lanes)
+    k_aid, k_opp = load_factors(health.eta_o, actuator.gear_ratio)
+    per_sim = _padded(np.stack([health.fdj_nm, health.fsj_nm, k_aid, k_opp]), lanes)
     start = [np.radians(initial.position_deg), initial.motor_speed_radps, initial.current_a]
     initial_rows = np.repeat(np.array(start)[:, None], per_sim.shape[1], axis=1)
     out = _recording((kernels.N_RECORDED, per_sim.shape[1], n_samples), reuse_output)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, fields
+from typing import Any
 
 import numpy as np
 
@@ -38,9 +39,20 @@ class DriveConstants:
 
 def eta_a_from_eta_o(eta_o: np.ndarray | float, gear_ratio: float) -> np.ndarray:
     """Aiding efficiency from opposing efficiency, thesis Eq. 3.4 with τ = n."""
-    n = gear_ratio
-    eta_o = np.asarray(eta_o, dtype=np.float64)
-    return (2 * n**2 * eta_o - n**2 + n) / (n**2 * eta_o + n - eta_o + 1)
+    return eta_a_of(np.asarray(eta_o, dtype=np.float64), gear_ratio)
+
+
+def eta_a_of(eta_o: Any, n: float) -> Any:
+    """Eq. 3.4 itself, η_A = (2n²η_O − n² + n) / (n²η_O + n − η_O + 1), on scalars or arrays (and compiled in
+    ``ema.estimate.physics.eta_search``)."""
+    return (2 * n * n * eta_o - n * n + n) / (n * n * eta_o + n - eta_o + 1)
+
+
+def load_factors(eta_o: Any, gear_ratio: float) -> tuple[Any, Any]:
+    """(k_aid, k_opp) of Eq. 5.1 at η_O: what a load adds to the friction per N·m, aiding (1 − η_A, Eq. 3.4) and
+    opposing (1/η_O − 1); on scalars or arrays, and the one definition the simulator, the fits and the calibration
+    use."""
+    return 1.0 - eta_a_of(eta_o, gear_ratio), 1.0 / eta_o - 1.0
 
 
 @dataclass(frozen=True)

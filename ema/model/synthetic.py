@@ -19,6 +19,7 @@ from ema.model.window import Window
 def synthetic_window(
     health: HealthParams,
     condition: FlightCondition | GroundLoad = FlightCondition(),
+    *,
     seed: int = 0,
     duration_s: float = 0.5,
     sample_rate_hz: float = 10_000.0,

@@ -14,6 +14,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ema.estimate.stats import rms
+
 
 @dataclass(frozen=True)
 class Blend:
@@ -33,8 +35,5 @@ def fit_blend(truth: np.ndarray, network: np.ndarray, baseline: np.ndarray) -> B
     denominator = float(difference @ difference)
     weight = 0.5 if denominator == 0.0 else float(np.clip(-(e_base @ difference) / denominator, 0.0, 1.0))
     blended = weight * e_net + (1.0 - weight) * e_base
-
-    def rms(errors: np.ndarray) -> float:
-        return float(np.sqrt(np.mean(errors**2)))
 
     return Blend(weight, rms(blended), rms(e_net), rms(e_base))

@@ -17,7 +17,8 @@ from collections.abc import Mapping
 import numpy as np
 
 from ema.estimate.physics.features import as_read
-from ema.estimate.physics.scenario import SETTLE_S, Scenario, rms
+from ema.estimate.physics.scenario import SETTLE_S, Scenario
+from ema.estimate.stats import rms
 from ema.model.noise import SensorNoise
 from ema.model.params import DriveConstants, HealthParams
 from ema.model.residual import residual_torque_nm

@@ -34,6 +34,7 @@ import numpy as np
 
 from ema.estimate.assess.blend import fit_blend
 from ema.estimate.documents import TARGETS, MethodReport, Note
+from ema.estimate.stats import rms
 
 MAX_DISAGREEMENT_Z = 3.0
 MIN_CHECKS = 4  # held-out simulations the scoring needs (those that could not slide are left out)
@@ -66,10 +67,6 @@ class Assessed:
     notes: list[Note]
 
 
-def _rms(errors: np.ndarray) -> float:
-    return float(np.sqrt(np.mean(errors**2))) if len(errors) else 0.0
-
-
 def _t_factor(k: int) -> float:
     """The 95 % Student quantile for K check windows, relative to the normal's 1.96."""
     nearest = min(STUDENT_95, key=lambda n: abs(n - k))
@@ -87,11 +84,11 @@ def misfit_limit(check_rms: np.ndarray) -> float:
     """The equation-error ratio a clean window exceeds ``MISFIT_FALSE_ALARM`` of the time: the held-out simulations'
     RMS errors, over their median, are log-normal with a spread s; a new draw passes exp(t·s·√(1 + 1/K)) with
     that probability (inf where too few simulations to read s)."""
-    rms = check_rms[np.isfinite(check_rms) & (check_rms > 0)]
-    k = len(rms)
+    finite = check_rms[np.isfinite(check_rms) & (check_rms > 0)]
+    k = len(finite)
     if k < MIN_CHECKS:
         return float("inf")
-    spread = float(np.std(np.log(rms / np.median(rms)), ddof=1))
+    spread = float(np.std(np.log(finite / np.median(finite)), ddof=1))
     return float(np.exp(student_99(k - 1) * spread * np.sqrt(1 + 1 / k)))
 
 
@@ -139,17 +136,17 @@ def _assess_parameter(c: Candidates, name: str, inflation: float) -> tuple[float
     """(value, std, report, note for the answer) of one parameter."""
     truth = c.check_truth[name]
     bias, phys = bias_corrected(c.check_physics[name], truth)
-    physics, rms_physics = c.physics[name] - bias, _rms(phys - truth)
+    physics, rms_physics = c.physics[name] - bias, rms(phys - truth)
     note = network_note(c, name)
     answer_note = None
     if note is not None and c.network is not None:
         answer_note = Note(code="physics_only", parameter=name, text=f"{name}: physics fit only; {note.text}")
-    weight, rms, rms_net, value = 0.0, rms_physics, None, physics
+    weight, rms_used, rms_net, value = 0.0, rms_physics, None, physics
     if note is None and c.network is not None and c.check_network is not None:
         blend = fit_blend(truth, c.check_network[name], phys)
         rms_net = blend.rms_error_network
         if blend.rms_error <= NETWORK_MARGIN * rms_physics:
-            weight, rms, value = blend.weight_network, blend.rms_error, blend.apply(c.network[name], physics)
+            weight, rms_used, value = blend.weight_network, blend.rms_error, blend.apply(c.network[name], physics)
         else:  # routine, so the method report says it and the answer does not
             note = Note(
                 code="network_not_better",
@@ -160,7 +157,7 @@ def _assess_parameter(c: Candidates, name: str, inflation: float) -> tuple[float
                     f"{100 * (1 - NETWORK_MARGIN):.0f} % it must"
                 ),
             )
-    std = inflation * max(_t_factor(len(truth)) * rms, c.physics_std[name])
+    std = inflation * max(_t_factor(len(truth)) * rms_used, c.physics_std[name])
     report = MethodReport(
         physics=c.physics[name],
         physics_bias=bias,
@@ -169,7 +166,7 @@ def _assess_parameter(c: Candidates, name: str, inflation: float) -> tuple[float
         weight_network=weight,
         rms_error_physics=rms_physics,
         rms_error_network=rms_net,
-        rms_error_blend=rms,
+        rms_error_blend=rms_used,
         network_note=note,
     )
     return value, std, report, answer_note

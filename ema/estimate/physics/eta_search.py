@@ -12,6 +12,9 @@ from __future__ import annotations
 
 import numpy as np
 from numba import njit
+from numba.extending import register_jitable
+
+from ema.model.params import eta_a_of, load_factors
 
 ETA_O_SEARCH = (0.20, 0.999)  # η_O searched over; Case 1C reaches 0.44
 GRID_POINTS = 41
@@ -53,6 +56,12 @@ def solve(stats: np.ndarray, gear: float, nuisances: tuple[str, ...] = ()) -> tu
     return beta, eta_o, sse
 
 
+# Eq. 3.4 and the load factors are plain Python in ema.model (the documents import them without Numba); registered
+# here, the kernel compiles the one definition.
+register_jitable(eta_a_of)
+register_jitable(load_factors)
+
+
 @njit(cache=True, nogil=True, error_model="numpy")
 def _search(stats, free, used, gear, unit_grid, low_bound, high_bound, refinements, beta, eta_o, sse):
     """Fill beta (R, F), eta_o (R,), sse (R,) for stats (R, P, P), ``free`` (F,) the columns regressed on
@@ -63,7 +72,7 @@ def _search(stats, free, used, gear, unit_grid, low_bound, high_bound, refinemen
 
     at each η of ``refinements`` grids, each spanning ± one step around the last one's best point.
     """
-    n_free, n2 = free.shape[0], gear * gear
+    n_free = free.shape[0]
     gram, rhs, work, b = np.empty((n_free, n_free)), np.empty(n_free), np.empty(n_free), np.empty(n_free)
     for r in range(stats.shape[0]):
         s = stats[r]
@@ -73,8 +82,7 @@ def _search(stats, free, used, gear, unit_grid, low_bound, high_bound, refinemen
             best, best_eta, best_sse = -1, 0.0, np.inf
             for g in range(unit_grid.shape[0]):
                 eta = low + (high - low) * unit_grid[g]
-                k_opp = 1.0 / eta - 1.0
-                k_aid = 1.0 - (2 * n2 * eta - n2 + gear) / (n2 * eta + gear - eta + 1)
+                k_aid, k_opp = load_factors(eta, gear)
                 uu = (
                     s[0, 0]
                     + k_aid**2 * s[1, 1]

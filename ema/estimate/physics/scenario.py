@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ema.estimate.stats import rms
 from ema.model.aircraft import FlightCondition, HingeGeometry, Load, LoggedLoad
 from ema.model.batch import BatchResult, InitialState, simulate_batch
 from ema.model.commands import knots_from_samples
@@ -129,7 +130,3 @@ def following_error(scenario: Scenario, window: Window, health: HealthParams, no
         rms(window.signals[name][keep] - simulated[name][keep]) / max(sigma, 1e-9)
         for name, sigma in (("motor_speed_radps", noise.motor_speed_radps), ("current_a", noise.current_a))
     )
-
-
-def rms(values: np.ndarray) -> float:
-    return float(np.sqrt(np.mean(values**2))) if len(values) else 0.0

@@ -32,7 +32,7 @@ import numpy as np
 from ema.estimate.documents import Note
 from ema.estimate.physics.noise import white_noise_std
 from ema.model.noise import NO_NOISE, SensorNoise, ar1_mean_variance
-from ema.model.params import DriveConstants, eta_a_from_eta_o
+from ema.model.params import DriveConstants, load_factors
 from ema.model.residual import END_STOP_MARGIN_DEG, smoothed
 
 REST_SPEED_RADPS = 0.5  # at rest: the smoothed speed below this (the sensor noise alone exceeds a creep of 1 rad/s)
@@ -186,7 +186,7 @@ def read_static_friction(
         )
     load = smoothed(signals["hinge_moment_nm"] / actuator.gear_ratio, rate)
     direction = np.sign(smoothed(signals["motor_speed_radps"], rate))
-    k_aid, k_opp = 1.0 - float(eta_a_from_eta_o(eta_o, actuator.gear_ratio)), 1.0 / eta_o - 1.0
+    k_aid, k_opp = (float(k) for k in load_factors(float(eta_o), actuator.gear_ratio))
     levels = []
     for event in events:
         moving = direction[min(event.index + round(MIN_RUN_S * rate), len(direction) - 1)]

@@ -85,6 +85,7 @@ def simulate_dataset(
     seen: Window,
     physics: FrictionFit,
     config: PipelineConfig,
+    *,
     document: ActuatorDocument,
     actuator: DriveConstants,
     effects: EffectSet,

@@ -41,6 +41,7 @@ def _window_and_digest(document: WindowDocument) -> tuple[Window, str]:
 )
 async def estimate(
     request: Request,
+    *,
     settings: SettingsDep,
     store: StoreDep,
     runner: RunnerDep,

@@ -26,6 +26,7 @@ async def root() -> RedirectResponse:
 @router.get("/ui", response_class=HTMLResponse)
 async def fleet(
     request: Request,
+    *,
     settings: SettingsDep,
     store: StoreDep,
     runner: RunnerDep,
