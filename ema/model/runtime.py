@@ -20,8 +20,10 @@
   same arithmetic, docs/benchmarks.md). Groups are then whole multiples of ``INTERLEAVE`` vectors
   (``ema.model.batch.LANE_MULTIPLE``), or their remainder runs scalar. The option is LLVM's, for every
   loop compiled afterwards (interleaving never changes a loop's result, and a loop of fewer
-  iterations keeps its scalar path); numba's cache does not key on it, so a kernel compiled before
-  :func:`configure` keeps its single vector until its source changes.
+  iterations keeps its scalar path). Numba's cache does not key on it: a kernel compiled without it
+  (by a test, a notebook) would be the cache's, ~1.3x slower, for every later process until its source
+  changed. So the dispatchers (``run_rows``, ``map_on_pool``) set it, and the vector width, before any
+  kernel they run, whoever calls them (``compiler_options``).
 """
 
 from __future__ import annotations
@@ -55,6 +57,7 @@ class _Budget:
         self.pool: ThreadPoolExecutor | None = None
         self.blas_limited = False  # the limit lasts for the process: set once (a fleet worker configures per window)
         self.interleaved = False  # LLVM's option, likewise
+        self.compiler_set = False  # compiler_options has run
 
 
 _BUDGET = _Budget()
@@ -118,6 +121,7 @@ def run_rows(work: Callable[[int, int], None], n_rows: int) -> None:
     of the budget (none below ``MIN_ROWS_PER_THREAD`` rows), on the pool, inline when one part: for
     compiled loops over independent rows that release the GIL. Waits for every part (``wait_all``); inline
     in a pool thread."""
+    compiler_options()
     parts = max(1, min(threads(), n_rows // MIN_ROWS_PER_THREAD))
     if parts == 1 or _inline():
         work(0, n_rows)
@@ -129,6 +133,7 @@ def run_rows(work: Callable[[int, int], None], n_rows: int) -> None:
 def map_on_pool(work: Callable[[T], R], items: Sequence[T]) -> list[R]:
     """``work`` of each item, in order, the items spread over the pool (inline with one thread or one item):
     for independent pieces of work whose compiled loops release the GIL; inline in a pool thread."""
+    compiler_options()
     if _inline() or len(items) <= 1:
         return [work(item) for item in items]
     futures = [pool().submit(work, item) for item in items]
@@ -148,6 +153,16 @@ def wait_all(futures: Sequence[Future]) -> None:
         raise
 
 
+def compiler_options() -> None:
+    """The vector width and the interleaving every kernel is compiled (or loaded from the cache) under, set once
+    per process before the first kernel runs (see the module docstring)."""
+    if _BUDGET.compiler_set:
+        return
+    prefer_wide_vectors()
+    interleave_vector_loops()
+    _BUDGET.compiler_set = True
+
+
 def prefer_wide_vectors() -> None:
     """Let LLVM use 512-bit vectors where the CPU has them (see the module docstring)."""
     if "NUMBA_CPU_FEATURES" in os.environ:
@@ -163,8 +178,7 @@ def prefer_wide_vectors() -> None:
 def configure(threads: int | None = None) -> int:
     """The entry points' one call: vector width and interleaving, BLAS on one thread, then the thread budget
     (default: the usable cores)."""
-    prefer_wide_vectors()
-    interleave_vector_loops()
+    compiler_options()
     single_threaded_blas()
     set_threads(threads or available_cores())
     return _BUDGET.threads

@@ -1,5 +1,6 @@
 """The process's one thread budget: the simulator's pool, and NumPy's BLAS on one thread."""
 
+import os
 import subprocess
 import sys
 import tempfile
@@ -18,6 +19,17 @@ def test_configure_puts_every_blas_numpy_loaded_on_one_thread():
     )
     found = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, check=True).stdout.split()
     assert int(found[0]) >= 1 and found[1:] == ["1", "2"]  # a BLAS found, on one thread; the pool on two
+
+
+def test_a_kernel_run_without_configure_is_compiled_interleaved():
+    """Whoever runs a kernel first compiles it into the shared cache: the dispatchers set the compiler's options
+    before any kernel they run, configured or not (``runtime.compiler_options``)."""
+    script = (
+        "import numpy as np; from ema.model import runtime; "
+        "runtime.run_rows(lambda a, b: None, 1); print(runtime._BUDGET.interleaved)"
+    )
+    found = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, check=True).stdout
+    assert found.strip() == "True"
 
 
 def test_map_on_pool_keeps_the_items_order_and_raises_a_pieces_error():
@@ -68,12 +80,13 @@ def test_work_the_pool_runs_may_use_the_pool_again_without_waiting_for_ever():
 @pytest.mark.slow
 def test_the_interleaved_lane_loop_computes_what_the_plain_one_does():
     """``configure`` has LLVM interleave three vectors of lanes an iteration: the same arithmetic per lane, so
-    48 lanes record what one lane at a time records, and what a process that never configured records."""
+    48 lanes record what one lane at a time records, and what a kernel compiled without the option records
+    (each process compiles afresh in a cache of its own: the plain kernel never reaches the shared cache)."""
     script = (
         "import sys, numpy as np; from ema.model import runtime; from ema.model.actuator import THESIS; "
         "from ema.model.batch import simulate_batch; from ema.model.commands import random_command_knots; "
         "from ema.model.params import DEFAULT_RANGES, HealthParams; "
-        "runtime.configure(1) if sys.argv[1] == 'configured' else None; "
+        "runtime.configure(1) if sys.argv[1] == 'configured' else setattr(runtime._BUDGET, 'compiler_set', True); "
         "rng = np.random.default_rng(5); health = HealthParams.uniform(48, DEFAULT_RANGES, rng); "
         "knots = random_command_knots(300, 10_000.0, rng)[0]; "
         "runs = [simulate_batch(knots, health, lanes=k, actuator=THESIS.params) for k in (48, 1)]; "
@@ -84,7 +97,8 @@ def test_the_interleaved_lane_loop_computes_what_the_plain_one_does():
     recorded = {}
     for mode in ("configured", "plain"):
         path = f"{tempfile.mkdtemp()}/{mode}.npy"
-        subprocess.run([sys.executable, "-c", script, mode, path], check=True)
+        cache = {"NUMBA_CACHE_DIR": tempfile.mkdtemp()}
+        subprocess.run([sys.executable, "-c", script, mode, path], check=True, env={**os.environ, **cache})
         recorded[mode] = np.load(path)
     assert np.array_equal(recorded["configured"][0], recorded["configured"][1])  # 48 lanes == 1 lane at a time
     assert np.array_equal(recorded["configured"], recorded["plain"])
