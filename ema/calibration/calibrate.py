@@ -10,7 +10,7 @@ stages, numbered as their modules and ``docs/calibration.md`` number them:
 
 1. ``ema.calibration.equations``: the windows' equation-error problem;
 2. ``ema.calibration.noise_floor``: the same problem on noise-only copies;
-3. ``ema.calibration.families``: each effect as a family of columns;
+3. ``ema.calibration.families``, ``vocabulary``: each effect as a family of columns;
 4. ``ema.calibration.selection``: what explains held-out samples beyond the floor, named or described
    (``ema.calibration.twins`` for look-alikes, ``ema.calibration.backlash`` for the dead band);
 5. ``ema.calibration.readings``: the effect against its rivals' readings, adopted only where they agree
@@ -31,12 +31,13 @@ from ema.calibration import report as reporting
 from ema.calibration.backlash import read_backlash
 from ema.calibration.documents import CalibrationReport, Step
 from ema.calibration.equations import Equations, equations
-from ema.calibration.families import COGGING_ORDERS, Family, generic_families, named_families
+from ema.calibration.families import Family, generic_families
 from ema.calibration.noise_floor import COPIES, clean_replicas, noise_copies
 from ema.calibration.readings import AMBIGUOUS_STDS, Contest, combined_stds, reading, settled
 from ema.calibration.refit import MIN_HELD_OUT_GAIN, corrected, fit_with, held_out_rss
 from ema.calibration.selection import MAX_EFFECTS, MIN_Z, NAME_MARGIN, Chosen, Decision, Evidence, decide, evidence
 from ema.calibration.twins import TWINS, output_error, tell_apart
+from ema.calibration.vocabulary import COGGING_ORDERS, named_families
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import TARGETS, Estimate
 from ema.estimate.physics.scenario import CLEAR_MARGIN

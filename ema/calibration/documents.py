@@ -10,7 +10,7 @@ from typing import Literal
 
 from pydantic import Field
 
-from ema.estimate.documents import Document
+from ema.model.document import Document
 
 
 class Candidate(Document):

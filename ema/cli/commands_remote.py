@@ -11,13 +11,12 @@ from typing import Any
 
 import click
 
-from ema.cli.options import NothingAnsweredError, as_json, emit, flags_named, log_map, log_map_document
+from ema.cli.options import EXISTING, NothingAnsweredError, as_json, emit, flags_named, log_map, log_map_document
 from ema.model.envelope import DEFAULT_AIRSPEED_MPS
 
 URL = "http://127.0.0.1:8000"
 DEFAULT_WINDOW_S = 0.5
 LOG = click.Path(exists=True, path_type=Path)
-KEY_FILE = click.Path(exists=True, dir_okay=False, path_type=Path)
 
 
 def api_key(path: Path | None) -> str | None:
@@ -43,7 +42,7 @@ def api_key(path: Path | None) -> str | None:
     default=None,
     help="cut recordings into windows of this length [s]  [default: 0.5; with --log-map, a file is one window]",
 )
-@click.option("--api-key-file", type=KEY_FILE, default=None, help="file holding the API key [default: EMA_API_KEY]")
+@click.option("--api-key-file", type=EXISTING, default=None, help="file holding the API key [default: EMA_API_KEY]")
 @click.option("--actuator-id", default="unknown", help="for CSV/NPZ logs that carry none")
 @click.option("--rate", type=float, default=10_000.0, help="sample rate [Hz] for CSV/NPZ logs that carry none")
 @click.option("--airspeed", type=float, default=DEFAULT_AIRSPEED_MPS, help="[m/s] for CSV/NPZ logs that carry none")
@@ -138,7 +137,7 @@ def _print_replay(result: dict[str, Any]) -> None:
 @click.command()
 @click.argument("actuator_id")
 @click.option("--url", default=URL, help="the service")
-@click.option("--api-key-file", type=KEY_FILE, default=None, help="file holding the API key [default: EMA_API_KEY]")
+@click.option("--api-key-file", type=EXISTING, default=None, help="file holding the API key [default: EMA_API_KEY]")
 @click.option("--plot", type=click.Path(dir_okay=False, path_type=Path), default=None, help="PNG of the prognosis")
 @click.option("--parameter", type=click.Choice(["FDJ", "eta_O", "eta_A"]), default="FDJ", help="what --plot draws")
 @as_json

@@ -13,7 +13,7 @@ from collections.abc import Sequence
 
 import click
 
-from ema.cli import commands_fleet, commands_local, commands_remote
+from ema.cli import commands_fleet, commands_local, commands_remote, commands_serve
 from ema.cli.options import NothingAnsweredError, PipeClosedError
 
 EXIT_OK, EXIT_INTERNAL, EXIT_BAD_INPUT, EXIT_INTERRUPTED = 0, 1, 2, 130
@@ -25,7 +25,7 @@ def ema() -> None:
     """Onboard health monitor for an elevator electromechanical actuator (EMA)."""
 
 
-for module in (commands_local, commands_remote, commands_fleet):
+for module in (commands_local, commands_serve, commands_remote, commands_fleet):
     for command in module.COMMANDS:
         ema.add_command(command)
 

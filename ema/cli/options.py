@@ -14,6 +14,7 @@ import click
 from ema.estimate.sizes import SIZES as PIPELINE_SIZES
 
 F = TypeVar("F", bound=Callable[..., Any])
+EXISTING = click.Path(exists=True, dir_okay=False, path_type=Path)  # a file that must be there
 SIZES = {  # flag -> PipelineConfig field
     "--sims": "n_simulations",
     "--checks": "check_windows",
@@ -38,7 +39,7 @@ def actuator(function: F) -> F:
     return click.option(
         "--actuator",
         "actuator_file",
-        type=click.Path(exists=True, dir_okay=False, path_type=Path),
+        type=EXISTING,
         default=None,
         metavar="A.json",
         help="the actuator's ema-actuator/1 document [default: the thesis's, examples/actuator.json]",
@@ -56,7 +57,7 @@ def log_map(function: F) -> F:
     return click.option(
         "--log-map",
         "log_map_file",
-        type=click.Path(exists=True, dir_okay=False, path_type=Path),
+        type=EXISTING,
         default=None,
         metavar="M.json",
         help="an ema-logmap/1 document: read CSV logs in the rig's own columns and units",

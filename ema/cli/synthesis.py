@@ -57,6 +57,32 @@ def summary(window: Window, actuator: ActuatorDocument) -> dict[str, Any]:
     }
 
 
+def _healths(
+    actuator: ActuatorDocument,
+    *,
+    start: tuple[float | None, float | None, float | None],
+    end: tuple[float | None, float | None],
+    series: int,
+) -> list[dict[str, float]]:
+    """Each window's FDJ, η_O and FSJ: ``start`` (FDJ, η_O, FSJ; the nominal where None) moving linearly to
+    ``end`` (FDJ, η_O; no change where None) over ``series`` windows, FSJ never below FDJ (static friction
+    never below dynamic)."""
+    if actuator.kind != "rotary" or actuator.nominal is None or actuator.nominal.fsj_nm is None:
+        raise InputError("--actuator", f"a {actuator.kind} actuator's drive is not simulated: give a rotary one")
+    nominal = (actuator.nominal.fdj_nm, actuator.nominal.eta_o, actuator.nominal.fsj_nm)
+    first = {
+        name: default if given is None else given
+        for name, given, default in zip(("FDJ", "eta_O", "FSJ"), start, nominal, strict=True)
+    }
+    last = {name: first[name] if given is None else given for name, given in zip(("FDJ", "eta_O"), end, strict=True)}
+    healths: list[dict[str, float]] = []
+    for i in range(series):
+        share = i / max(series - 1, 1)
+        now = {name: first[name] + share * (last[name] - first[name]) for name in last}
+        healths.append(now | {"FSJ": max(first["FSJ"], now["FDJ"])})
+    return healths
+
+
 def synthesize(
     *,
     out: Path,
@@ -89,26 +115,14 @@ def synthesize(
     ``out`` is a folder of that many windows of a degrading actuator, its health moving linearly to
     ``fdj_end`` and ``eta_o_end``, ``every_hours`` flight hours apart (and as many hours apart in recorded_at)."""
     actuator = actuator_document(actuator_file)
-    nominal = actuator.nominal
-    health = {
-        "FDJ": nominal.fdj_nm if fdj is None else fdj,
-        "eta_O": nominal.eta_o if eta_o is None else eta_o,
-        "FSJ": nominal.fsj_nm if fsj is None else fsj,
-    }
-    end = {
-        "FDJ": health["FDJ"] if fdj_end is None else fdj_end,
-        "eta_O": health["eta_O"] if eta_o_end is None else eta_o_end,
-    }
+    healths = _healths(actuator, start=(fdj, eta_o, fsj), end=(fdj_end, eta_o_end), series=series)
     effects = EffectSet(dict(parse_effect(text) for text in effect))
     load = GroundLoad(load_nm, load_ramp_nmps) if ground else FlightCondition(airspeed, altitude)
     noise = NO_NOISE if clean else actuator.noise
     if series > 1:
         out.mkdir(parents=True, exist_ok=True)
     written, truths = [], []
-    for i in range(series):
-        share = i / max(series - 1, 1)
-        now = {name: health[name] + share * (end[name] - health[name]) for name in end} | {"FSJ": health["FSJ"]}
-        now["FSJ"] = max(now["FSJ"], now["FDJ"])  # static friction never below dynamic
+    for i, now in enumerate(healths):
         window = synthetic_window(
             HealthParams.single(fsj_nm=now["FSJ"], fdj_nm=now["FDJ"], eta_o=now["eta_O"]),
             load,

@@ -9,9 +9,11 @@ from __future__ import annotations
 
 from typing import Annotated, Any, Literal
 
-from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, model_validator
+from pydantic import BeforeValidator, Field, model_validator
 
 from ema.estimate.config import PipelineConfig
+from ema.estimate.window_info import WindowInfo
+from ema.model.document import Document
 
 TARGETS = ("FDJ", "eta_O")  # what the estimators fit; η_A follows by Eq. 3.4, FSD from FSJ
 
@@ -74,12 +76,6 @@ NoteCode = Literal[
     # a note stored by an earlier version, as a sentence only
     "unspecified",
 ]
-
-
-class Document(BaseModel):
-    """A public document: immutable, strict about unknown fields."""
-
-    model_config = ConfigDict(frozen=True, extra="forbid", populate_by_name=True)
 
 
 class Note(Document):
@@ -201,126 +197,6 @@ class FitCheck(Document):
     )
     uncertainty_inflation: float = Field(description="factor applied to the stds for what the model did not reproduce")
     notes: Notes = Field(default_factory=list)
-
-
-class SensorZero(Document):
-    """The sensors' zero as a window moving both ways read it (``ema.estimate.prepare.departures.zero_offset``):
-    what a window of
-    the same flight that moves one way, and so cannot read it, is read with."""
-
-    window_id: str = Field(description="the window that read it")
-    hinge_nm: float = Field(description="taken off the logged hinge moment")
-    current_a: float = Field(description="taken off the logged current")
-    torque_std_nm: float = Field(ge=0, description="its std, as a constant torque at the motor shaft")
-
-
-class InertiaReading(Document):
-    """J_M as windows of an actuator read it where each told a heavier rotor from a weaker motor itself
-    (``ema.estimate.prepare.departures.drive_constants``): a window that cannot is read with it (J_M stays with
-    the build)."""
-
-    factor: float = Field(description="the inertia at the motor shaft over the document's J_M")
-    std: float = Field(ge=0, description="its std")
-    window_ids: list[str] = Field(description="the windows that read it")
-
-
-class HistoryReadings(Document):
-    """What other windows of an actuator read that one window may not: the sensor zero of its flight
-    (``flight_id``) and the actuator's J_M. The service takes them from its history."""
-
-    sensor_zero: SensorZero | None = None
-    inertia: InertiaReading | None = None
-
-
-class WindowInfo(Document):
-    content_sha256: str | None = Field(
-        default=None,
-        description="SHA-256 of the window as posted, but its actuator_id and window_id (ema.model.window): another "
-        "body under the same key is another window",
-    )
-    n_samples: int
-    duration_s: float
-    sample_rate_hz: float
-    processed_rate_hz: float = Field(description="after averaging adjacent samples (exact for interval means)")
-    command_clipped_fraction: float = Field(description="share of command samples past the end stops, saturating")
-    glitches_repaired: dict[str, int] = Field(
-        default_factory=dict,
-        description="per sensor, samples of glitches (short runs far off both flanks, which agree), "
-        "replaced by the line between the flanks",
-    )
-    stale_samples: dict[str, int] = Field(
-        default_factory=dict,
-        description="per sensor, samples of runs that repeated one value exactly where a working sensor shows its "
-        "noise (it stopped updating, or a logging gap was filled in): a run up to the 2 ms reconstruction kernel "
-        "bridged by the line between its flanks, a longer one cut out with the window read from read_span",
-    )
-    read_span: list[int] | None = Field(
-        default=None,
-        description="[first, one past the last] logged sample read, where stale runs cut the window (null: all)",
-    )
-    current_lag_s: float = Field(
-        default=0.0, description="how late the current is logged behind the speed (negative: the speed), undone"
-    )
-    hinge_lag_s: float = Field(default=0.0, description="how late the hinge moment is logged (its filter), undone")
-    hinge_offset_nm: float = Field(default=0.0, description="taken off the logged hinge moment (a sensor off zero)")
-    current_offset_a: float = Field(default=0.0, description="taken off the logged current (a sensor off zero)")
-    torque_scale: float = Field(
-        default=1.0,
-        description="the motor's torque per spec k_T·I as read (k_T warm or cold, a current sensor's gain); "
-        "the current was multiplied by it before every estimator",
-    )
-    inertia_factor: float = Field(
-        default=1.0,
-        description="the inertia at the motor shaft over the document's J_M as read; "
-        "the current carries the difference",
-    )
-    viscous_factor: float = Field(
-        default=1.0,
-        description="the viscous coefficient every estimator used over the document's C_M (read where it departs)",
-    )
-    hinge_gain: float = Field(
-        default=1.0,
-        description="the logged hinge moment over the load it shows (a strain gauge calibrated off, other units); "
-        "the moment was divided by it before every estimator",
-    )
-    hinge_aircraft_ratio: float | None = Field(
-        default=None,
-        description="the logged hinge moment's part that follows the deflection over the aircraft model's "
-        "q̄·S_e·c_e·C_hδ at the flight condition (1 where gauge and model agree; null: too little fast motion)",
-    )
-    hinge_aircraft_ratio_std: float | None = Field(default=None, description="the std of hinge_aircraft_ratio")
-    kinematic_gain: float | None = Field(
-        default=None,
-        description="the position's travel over the speed's integral / gear ratio through the dead band (1 in a "
-        "consistent log; 0.9-1.1 accepted; null: too little motion to tell)",
-    )
-    sliding_fraction: float = Field(description="share of samples the friction fit could use")
-    recorded_at: str | None = None
-    flight_hours: float | None = None
-    flight_id: str | None = None
-    sensor_zero: SensorZero | None = Field(
-        default=None,
-        description="the sensors' zero as this window read it, for the windows of its flight that move one way "
-        "(null: it moves one way itself, took its flight's instead (sensor_zero_from), or was read with the document's "
-        "model alone)",
-    )
-    sensor_zero_from: str | None = Field(
-        default=None, description="the window of its flight whose sensor_zero it was read with (null: its own)"
-    )
-    inertia_read: InertiaReading | None = Field(
-        default=None,
-        description="J_M as this window read it, where it told a heavier rotor from a weaker motor itself (null: "
-        "it read none, or could not tell)",
-    )
-    inertia_undecided: bool = Field(
-        default=False,
-        description="it could not tell a heavier rotor from a weaker motor, nor did a J_M read by other windows of "
-        "the actuator decide: its stds carry both readings",
-    )
-    inertia_from: list[str] | None = Field(
-        default=None,
-        description="it could not tell a heavier rotor from a weaker motor: the windows whose J_M (history) decided",
-    )
 
 
 class DatasetInfo(Document):

@@ -27,7 +27,7 @@ import numpy as np
 from ema.estimate.assess.reproduction import output_error_ratios
 from ema.estimate.assess.weighing import Assessed, Candidates, assess, misfit_limit
 from ema.estimate.config import PipelineConfig
-from ema.estimate.documents import ActuatorRead, Estimate, FitCheck, HistoryReadings, Note, Timings
+from ema.estimate.documents import ActuatorRead, Estimate, FitCheck, Note, Timings
 from ema.estimate.history import known_from
 from ema.estimate.learn.estimator import NetworkEstimator
 from ema.estimate.learn.network import TrainConfig
@@ -35,9 +35,10 @@ from ema.estimate.physics.features import as_read
 from ema.estimate.physics.friction import FIT_ARRAYS, FrictionFit, fit_friction, fit_window
 from ema.estimate.physics.scenario import MAX_RATIO, inside
 from ema.estimate.physics.static_friction import read_static_friction
-from ema.estimate.prepare.conditioning import prepare, widened
+from ema.estimate.prepare.conditioning import Prepared, prepare, widened
 from ema.estimate.report import estimate_document
 from ema.estimate.simulate.dataset import Data, simulate_dataset
+from ema.estimate.window_info import HistoryReadings
 from ema.model.actuator import THESIS, ActuatorDocument
 from ema.model.window import Window
 
@@ -138,6 +139,19 @@ class Stopwatch:
         return Timings(**self.seconds, total=sum(self.seconds.values()))
 
 
+def weighed(
+    window: Window, physics: FrictionFit, data: Data, network: NetworkEstimator, *, prepared: Prepared, n: int
+) -> tuple[Assessed, float, float]:
+    """The assessed answer (its stds widened by what prepare left undecided), the window's equation error over
+    its held-out simulations' median, and the misfit limit that ratio is held to."""
+    found, check_physics = candidates(window, physics, data, network, n)
+    floor = np.median(check_physics.residual_rms_nm) if len(check_physics.residual_rms_nm) else np.nan
+    equation_ratio = float(physics.residual_rms_nm[0] / floor) if np.isfinite(floor) else 1.0
+    limit = misfit_limit(check_physics.residual_rms_nm)
+    answer = assess(found, equation_ratio, limit)
+    return replace(answer, stds=widened(answer.stds, prepared)), equation_ratio, limit
+
+
 def estimate_window(
     window: Window,
     config: PipelineConfig = PipelineConfig(),
@@ -174,12 +188,7 @@ def estimate_window(
     with watch("learn", f"training {config.members} network(s) of {config.hidden_units} neurons"):
         network = train_network(data, config)
     with watch("assess", "weighing the estimators on held-out simulations"):
-        found, check_physics = candidates(w, physics, data, network, n)
-        floor = np.median(check_physics.residual_rms_nm) if len(check_physics.residual_rms_nm) else np.nan
-        equation_ratio = float(physics.residual_rms_nm[0] / floor) if np.isfinite(floor) else 1.0
-        limit = misfit_limit(check_physics.residual_rms_nm)
-        answer = assess(found, equation_ratio, limit)
-        answer = replace(answer, stds=widened(answer.stds, prepared))
+        answer, equation_ratio, limit = weighed(w, physics, data, network, prepared=prepared, n=n)
     with watch("check", "checking the answer against the window"):
         check = fit_check(seen, data, answer, equation_ratio, n, actuator.health.fdj_nm)
         check = check.model_copy(update={"equation_error_limit": limit})

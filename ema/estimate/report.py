@@ -18,13 +18,10 @@ from ema.estimate.documents import (
     Estimate,
     Estimates,
     FitCheck,
-    InertiaReading,
     Note,
     RatioEstimate,
-    SensorZero,
     Timings,
     TrainingInfo,
-    WindowInfo,
     parameter,
 )
 from ema.estimate.learn.estimator import NetworkEstimator
@@ -33,6 +30,7 @@ from ema.estimate.physics.static_friction import StaticFriction
 from ema.estimate.prepare.conditioning import Prepared, conditioning_done, conditioning_notes
 from ema.estimate.prepare.departures.drive_constants import KERNEL_FREE_RATE_HZ
 from ema.estimate.simulate.dataset import Data
+from ema.estimate.window_info import InertiaReading, SensorZero, WindowInfo
 from ema.model.actuator import ActuatorDocument
 from ema.model.hinge import denoised_hinge_nm
 from ema.model.params import HealthRanges
@@ -212,16 +210,8 @@ def estimate_document(
     first = network.fits_[0]
     notes = _notes(prepared, physics, estimates, check)
     if read_with.default:
-        notes.insert(
-            0,
-            Note(
-                code="default_actuator",
-                text=(
-                    f"read with the default actuator ({read_with.name}): no ema-actuator/1 document was given for "
-                    f"{w.actuator_id}"
-                ),
-            ),
-        )
+        text = f"read with the default actuator ({read_with.name}): no ema-actuator/1 document was given for "
+        notes.insert(0, Note(code="default_actuator", text=text + w.actuator_id))
     return Estimate(
         actuator_id=w.actuator_id,
         window_id=w.window_id,

@@ -12,8 +12,10 @@ from typing import Any, Literal
 import numpy as np
 from pydantic import Field
 
-from ema.estimate.documents import Document, Estimate, InertiaReading, Notes
+from ema.estimate.documents import Estimate, Notes
+from ema.estimate.window_info import InertiaReading
 from ema.model.actuator import ActuatorDocument
+from ema.model.document import Document
 
 PARAMETERS = ("FDJ", "eta_O", "eta_A")
 TimeUnit = Literal["flight_hours", "days", "windows"]

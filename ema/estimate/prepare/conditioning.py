@@ -215,9 +215,29 @@ def conditioning_done(prepared: Prepared) -> dict[str, Any]:
     }
 
 
+def _lag_notes(lags: Lags) -> list[Note]:
+    """The sensors found logged late, and what was done about it."""
+    notes = []
+    if lags.current_s:
+        late, by = ("current", lags.current_s) if lags.current_s > 0 else ("speed", -lags.current_s)
+        text = (
+            f"the {late} is logged {1e6 * by:.0f} µs late (a sensor filter): advanced onto the other before Eq. 5.1, "
+            "which it otherwise breaks at every acceleration"
+        )
+        notes.append(Note(code="current_lag", text=text))
+    if lags.hinge_filter_s:
+        text = (
+            f"the hinge moment's noise is correlated as behind a filter delaying {1e6 * lags.hinge_filter_s:.0f} µs; "
+            f"the deflection and Eq. 5.1 put weight {lags.hinge_weight:.2f} on the moment being late too: advanced "
+            f"by {1e6 * lags.hinge_s:.0f} µs (the weighted lag) before Eq. 5.1, the stds include the lags' spread"
+        )
+        notes.append(Note(code="hinge_lag", parameter="hinge_moment_nm", text=text))
+    return notes
+
+
 def conditioning_notes(prepared: Prepared) -> list[Note]:
     """What conditioning did to the window and found in it, for the result's notes."""
-    notes, lags = [], prepared.lags
+    notes = []
     if prepared.command_clipped_fraction > 0:
         notes.append(
             Note(
@@ -229,33 +249,7 @@ def conditioning_notes(prepared: Prepared) -> list[Note]:
                 ),
             )
         )
-    if lags.current_s:
-        late, by = ("current", lags.current_s) if lags.current_s > 0 else ("speed", -lags.current_s)
-        notes.append(
-            Note(
-                code="current_lag",
-                text=(
-                    f"the {late} is logged {1e6 * by:.0f} µs late (a sensor filter): advanced onto the other before "
-                    f"Eq. 5.1, "
-                    "which it otherwise breaks at every acceleration"
-                ),
-            )
-        )
-    if lags.hinge_filter_s:
-        notes.append(
-            Note(
-                code="hinge_lag",
-                parameter="hinge_moment_nm",
-                text=(
-                    "the hinge moment's noise is correlated as behind a filter delaying "
-                    f"{1e6 * lags.hinge_filter_s:.0f} µs; "
-                    f"the deflection and Eq. 5.1 put weight {lags.hinge_weight:.2f} on the moment being late too: "
-                    f"advanced "
-                    f"by {1e6 * lags.hinge_s:.0f} µs (the weighted lag) before Eq. 5.1, the stds include the lags' "
-                    f"spread"
-                ),
-            )
-        )
+    notes.extend(_lag_notes(prepared.lags))
     found = (
         stale_note(prepared.stale),
         kinematics_note(prepared.consistency),
