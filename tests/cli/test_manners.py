@@ -1,6 +1,7 @@
 """The first hour of a new user: what each command reads, writes and says (the manners probe, in tests)."""
 
 import json
+from pathlib import Path
 
 import numpy as np
 from fastapi.testclient import TestClient
@@ -94,3 +95,9 @@ def test_serve_beyond_loopback_without_a_key_names_the_flag(tmp_path, capsys, mo
     monkeypatch.delenv("EMA_API_KEY", raising=False)
     assert main(["serve", "--host", "0.0.0.0", "--database", str(tmp_path / "h.sqlite3")]) == EXIT_BAD_INPUT
     assert "--api-key-file" in capsys.readouterr().err
+
+
+def test_simulate_refuses_a_linear_actuator_naming_the_flag(tmp_path, capsys):
+    rig = Path(__file__).parents[2] / "examples" / "ballscrew-rig" / "actuator.json"
+    assert main(["simulate", "--out", str(tmp_path / "w.json"), "--actuator", str(rig)]) == EXIT_BAD_INPUT
+    assert "--actuator" in capsys.readouterr().err and not (tmp_path / "w.json").exists()
