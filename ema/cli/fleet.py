@@ -127,7 +127,7 @@ class _Readings:
     inertias: dict[str, list[Any]] = field(default_factory=dict)
 
     def add(self, window: Window, answer: dict[str, Any]) -> None:
-        from ema.estimate.window_info import WindowInfo
+        from ema.estimate.documents.window import WindowInfo
 
         info = WindowInfo.model_validate(answer["window"])
         if info.sensor_zero is not None and window.flight_id is not None:
@@ -138,8 +138,8 @@ class _Readings:
     def lacked(self, window: Window, answer: dict[str, Any]) -> dict[str, Any] | None:
         """What the run's other windows lend this one that it lacks (``ema.estimate.history.wanted``), as JSON; or
         None."""
+        from ema.estimate.documents.window import WindowInfo
         from ema.estimate.history import lent, wanted
-        from ema.estimate.window_info import WindowInfo
 
         flight = self.zeros.get((window.actuator_id, window.flight_id), [])
         others = lent((z for z in flight if z.window_id != window.window_id), self.inertias.get(window.actuator_id, []))

@@ -15,9 +15,9 @@ from collections.abc import Iterable, Sequence
 import numpy as np
 
 from ema.estimate.documents import Note
+from ema.estimate.documents.window import HistoryReadings, InertiaReading, SensorZero, WindowInfo
 from ema.estimate.prepare.departures.read import Known
 from ema.estimate.prepare.departures.zero_offset import ZeroOffset
-from ema.estimate.window_info import HistoryReadings, InertiaReading, SensorZero, WindowInfo
 
 NAMED_WINDOWS = 10  # the latest windows an actuator's J_M names as read by (all weigh in)
 SCATTER_NOTED = 3.0  # stds (a reading's from the others', or the Birge ratio) from which J_M readings disagree

@@ -19,9 +19,9 @@ from typing import Protocol
 
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import STAGES, ActuatorRead, Estimate
+from ema.estimate.documents.window import HistoryReadings
 from ema.estimate.low_rate import SKIPPED, estimate_low_rate
 from ema.estimate.pipeline import estimate_window
-from ema.estimate.window_info import HistoryReadings
 from ema.model.actuator import THESIS, ActuatorDocument
 from ema.model.checks import InputError
 from ema.model.window import KIND_SIGNALS, Window

@@ -16,6 +16,7 @@ import numpy as np
 
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import STAGES, ActuatorRead, Estimate, Estimates, FitCheck, Note, Timings, parameter
+from ema.estimate.documents.window import WindowInfo
 from ema.estimate.quasistatic import (
     MIN_STRETCH_S,
     QuasiStaticFit,
@@ -27,7 +28,6 @@ from ema.estimate.quasistatic import (
     stretches,
 )
 from ema.estimate.report import weakly_determined
-from ema.estimate.window_info import WindowInfo
 from ema.model.actuator import ActuatorDocument
 from ema.model.checks import InputError
 from ema.model.window import HIGH_RATE_HZ, Window

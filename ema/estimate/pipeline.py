@@ -28,6 +28,7 @@ from ema.estimate.assess.reproduction import output_error_ratios
 from ema.estimate.assess.weighing import Assessed, Candidates, assess, misfit_limit
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import ActuatorRead, Estimate, FitCheck, Note, Timings
+from ema.estimate.documents.window import HistoryReadings
 from ema.estimate.history import known_from
 from ema.estimate.learn.estimator import NetworkEstimator
 from ema.estimate.learn.network import TrainConfig
@@ -38,7 +39,6 @@ from ema.estimate.physics.static_friction import read_static_friction
 from ema.estimate.prepare.conditioning import Prepared, prepare, widened
 from ema.estimate.report import estimate_document
 from ema.estimate.simulate.dataset import Data, simulate_dataset
-from ema.estimate.window_info import HistoryReadings
 from ema.model.actuator import THESIS, ActuatorDocument
 from ema.model.window import Window
 

@@ -14,8 +14,8 @@ from typing import Any
 from ema.estimate import runtime
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import Estimate
+from ema.estimate.documents.window import HistoryReadings
 from ema.estimate.kinds import estimate
-from ema.estimate.window_info import HistoryReadings
 from ema.model.actuator import THESIS, ActuatorDocument, actuator_from_dict
 from ema.model.checks import InputError
 from ema.model.window import Window, window_from_dict, window_to_dict

@@ -24,13 +24,13 @@ from ema.estimate.documents import (
     TrainingInfo,
     parameter,
 )
+from ema.estimate.documents.window import InertiaReading, SensorZero, WindowInfo
 from ema.estimate.learn.estimator import NetworkEstimator
 from ema.estimate.physics.friction import FitSettings, FrictionFit
 from ema.estimate.physics.static_friction import StaticFriction
 from ema.estimate.prepare.conditioning import Prepared, conditioning_done, conditioning_notes
 from ema.estimate.prepare.departures.drive_constants import KERNEL_FREE_RATE_HZ
 from ema.estimate.simulate.dataset import Data
-from ema.estimate.window_info import InertiaReading, SensorZero, WindowInfo
 from ema.model.actuator import ActuatorDocument
 from ema.model.hinge import denoised_hinge_nm
 from ema.model.params import HealthRanges

@@ -14,7 +14,7 @@ from typing import Protocol
 
 from ema.calibration.documents import CalibrationReport
 from ema.estimate.documents import Estimate
-from ema.estimate.window_info import HistoryReadings
+from ema.estimate.documents.window import HistoryReadings
 from ema.history.errors import StorageError
 from ema.model.actuator import ActuatorDocument
 from ema.prognosis.documents import Stored, StoredActuator, Withdrawal

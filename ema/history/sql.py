@@ -25,8 +25,8 @@ from sqlalchemy.dialects import postgresql, sqlite
 
 from ema.calibration.documents import CalibrationReport
 from ema.estimate.documents import Estimate
+from ema.estimate.documents.window import HistoryReadings, InertiaReading, SensorZero
 from ema.estimate.history import lent
-from ema.estimate.window_info import HistoryReadings, InertiaReading, SensorZero
 from ema.history.errors import ConflictError, StorageError
 from ema.history.tables import actuators, calibrations, estimates, summaries, withdrawals
 from ema.model.actuator import ActuatorDocument

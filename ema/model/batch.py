@@ -158,7 +158,7 @@ def default_lanes(n_sims: int) -> int:
 def run_groups(inputs: tuple, out: np.ndarray, lanes: int) -> None:
     """``kernels.run_group`` for every group of ``lanes`` simulations, on the simulator's thread pool
     (``runtime.map_on_pool``: inline with one thread or one group). ``inputs`` are the kernel's arguments
-    before ``first``."""
+    before ``first``: its constants and its inputs."""
 
     def run(first: int) -> None:
         kernels.run_group(*inputs, first, lanes, out)  # type: ignore[call-arg]  # numba's Dispatcher
@@ -240,7 +240,7 @@ def simulate_batch(
     constants = kernel_constants(actuator, effects)
     knots_rad = np.ascontiguousarray(np.radians(knots))
     table_nm = np.zeros(2) if effects.table is None else np.array(effects.table.values_nm)
-    run_groups((constants, table_nm, loads, per_sim, knots_rad, steps, initial_rows), out, lanes)
+    run_groups((constants, (table_nm, loads, per_sim, knots_rad, steps, initial_rows)), out, lanes)
     out = out[:, :n_sims]
     signals = {
         "position_deg": np.degrees(out[kernels.POSITION]),

@@ -75,31 +75,21 @@ class KernelConstants(NamedTuple):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def advance(
-    c,
-    load_delta,
-    command_rad,
-    load_slow,
-    cogging,
-    dry_dynamic,
-    dry_static,
-    k_aid,
-    k_opp,
-    current,
-    speed,
-    angle,
-    position,
-):
+def advance(c, load_delta, command_rad, lane, state):
     """One step h of controller, RL phase, shaft with Borello friction, end stops and backlash.
 
-    ``angle`` is θ_m / n (the motor angle seen on the elevator side), ``position`` the elevator
-    deflection θ_u after the backlash. The load torque at the motor shaft is
-    ``load_slow + load_delta·position``; ``dry_dynamic`` / ``dry_static`` are the load-independent
-    friction levels (FDJ / FSJ plus any friction effect) and ``cogging`` the cogging torque (0 when off).
-    Returns the new (current, speed, angle, position) and the step's transmission loss torque
-    [N·m] (dry + viscous + cogging). Written branch-free (selects, min/max) so that a loop over
-    simulations vectorizes; constants are pre-folded in ``KernelConstants`` to save operations.
+    ``lane`` = (load_slow, cogging, dry_dynamic, dry_static, k_aid, k_opp): the load torque at the motor shaft
+    is ``load_slow + load_delta·position``; ``dry_dynamic`` / ``dry_static`` are the load-independent
+    friction levels (FDJ / FSJ plus any friction effect), ``cogging`` the cogging torque (0 when off).
+    ``state`` = (current, speed, angle, position): ``angle`` is θ_m / n (the motor angle seen on the
+    elevator side), ``position`` the elevator deflection θ_u after the backlash. Returns the new
+    (current, speed, angle, position) and the step's transmission loss torque [N·m] (dry + viscous +
+    cogging). Written branch-free (selects, min/max) so that a loop over simulations vectorizes;
+    constants are pre-folded in ``KernelConstants`` to save operations (the tuples are unpacked where
+    the step is inlined: they cost nothing).
     """
+    load_slow, cogging, dry_dynamic, dry_static, k_aid, k_opp = lane
+    current, speed, angle, position = state
     # Controller: P position loop -> speed reference, P speed loop -> current reference.
     speed_ref = min(max(c.position_gain * (command_rad - position), -c.max_speed_ref), c.max_speed_ref)
     current_ref = min(max(c.speed_gain_over_kt * (speed_ref - speed), -c.max_current), c.max_current)
@@ -193,21 +183,16 @@ def _advance_lanes(c, load_delta, j, lane):
             lane[COGGING, s] = c.cogging_amplitude * np.sin(c.cogging_wavenumber * lane[ANGLE_NOW, s] + c.cogging_phase)
     for s in range(n_lanes):
         command = lane[COMMAND0, s] + lane[COMMAND_STEP, s] * j
-        current, speed, angle, position, loss = advance(
-            c,
-            load_delta,
-            command,
+        levels = (
             lane[LOAD_SLOW, s],
             lane[COGGING, s],
             lane[DRY_DYNAMIC, s],
             lane[DRY_STATIC, s],
             lane[LANE_K_AID, s],
             lane[LANE_K_OPP, s],
-            lane[CURRENT_NOW, s],
-            lane[SPEED_NOW, s],
-            lane[ANGLE_NOW, s],
-            lane[POSITION_NOW, s],
         )
+        state = (lane[CURRENT_NOW, s], lane[SPEED_NOW, s], lane[ANGLE_NOW, s], lane[POSITION_NOW, s])
+        current, speed, angle, position, loss = advance(c, load_delta, command, levels, state)
         lane[CURRENT_NOW, s] = current
         lane[SPEED_NOW, s] = speed
         lane[ANGLE_NOW, s] = angle
@@ -219,7 +204,7 @@ def _advance_lanes(c, load_delta, j, lane):
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
-def run_group(c, table_nm, load, per_sim, knots_rad, interval_steps, initial, first, lanes, out):
+def run_group(c, inputs, first, lanes, out):
     """Simulate sims [first, first + lanes) in lock-step and write their interval means into ``out``.
 
     Over log interval k (``interval_steps[k]`` steps of h, so logs of any rate are exact), each
@@ -234,6 +219,7 @@ def run_group(c, table_nm, load, per_sim, knots_rad, interval_steps, initial, fi
 
     Parameters
     ----------
+    inputs : (table_nm, load, per_sim, knots_rad, interval_steps, initial), as below
     table_nm : (K,) the friction table's values (``c.table_variable`` says against what; 0: unused)
     per_sim : (4, N) FDJ, FSJ, 1 − η_A, 1/η_O − 1, N a multiple of ``lanes``
     knots_rad : (1, K + 1) one command for the batch, or (N, K + 1) one per simulation
@@ -241,6 +227,7 @@ def run_group(c, table_nm, load, per_sim, knots_rad, interval_steps, initial, fi
     initial : (3, N) position [rad], motor speed [rad/s], current [A] at t = 0
     out : (6, N, K) written for columns [first, first + lanes)
     """
+    table_nm, load, per_sim, knots_rad, interval_steps, initial = inputs
     n_samples = out.shape[2]
     per_sim_command = knots_rad.shape[0] > 1
     use_table = load.slow_table_nm.shape[0] > 0
@@ -263,7 +250,7 @@ def run_group(c, table_nm, load, per_sim, knots_rad, interval_steps, initial, fi
             for j in range(steps):
                 _advance_lanes(c, load_delta, j, lane)
         elapsed_steps += steps
-        _record(c, load, lane, first, k, steps, out)
+        _record(c, load, lane, (first, k), steps, out)
         for s in range(lanes):
             if use_table:
                 lane[LOAD_SLOW, s] = load.slow_table_nm[min(k + 1, n_samples - 1)] * c.inverse_gear
@@ -295,8 +282,9 @@ def _start_lanes(c, load, per_sim, initial, first, lanes):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _record(c, load, lane, first, k, steps, out):
-    """Interval means of lane sums into column k of ``out``."""
+def _record(c, load, lane, at, steps, out):
+    """Interval means of lane sums into ``out`` at ``at`` = (the group's first simulation, the interval k)."""
+    first, k = at
     for s in range(lane.shape[1]):
         mean_position = lane[SUM_POSITION, s] / steps
         out[POSITION, first + s, k] = mean_position

@@ -110,11 +110,14 @@ def _correlate_rows(rows, weights, odd_extension, out):
 
 
 @njit(cache=True, nogil=True)
-def _residual_rows(current, speed, hinge, smoothing, derivative, constants, out):
+def _residual_rows(signals, weights, constants, out):
     """out[r] = smoothing ⋆ (clip(k_T·I, ±T_M,max) + H_e / n) − J_M · (derivative ⋆ ω), rows (R, n), ⋆ the
-    padded correlation of ``_correlate_rows`` (even for the torques, odd for the speed); ``constants``
-    = (k_T, T_M,max, n, J_M). The same operations in the same order as the separate steps, in one pass
-    per row and without the batch-sized temporaries."""
+    padded correlation of ``_correlate_rows`` (even for the torques, odd for the speed); ``signals`` =
+    (I, ω, H_e), each (R, n), ``weights`` = (smoothing, derivative), ``constants`` = (k_T, T_M,max, n, J_M).
+    The same operations in the same order as the separate steps, in one pass per row and without the
+    batch-sized temporaries."""
+    current, speed, hinge = signals
+    smoothing, derivative = weights
     torque_constant, max_torque, gear, inertia = constants
     n, half = current.shape[1], smoothing.shape[0] // 2
     driving, padded = np.empty(n), np.empty(n + 2 * half)
@@ -200,6 +203,6 @@ def residual_torque_nm(
     smoothing, derivative = smoothing_weights(half), derivative_weights(half, rate)
     out = np.empty(i.shape)
     runtime.run_rows(
-        lambda r, s: _residual_rows(i[r:s], w[r:s], h[r:s], smoothing, derivative, constants, out[r:s]), len(out)
+        lambda r, s: _residual_rows((i[r:s], w[r:s], h[r:s]), (smoothing, derivative), constants, out[r:s]), len(out)
     )
     return out.reshape(shape)

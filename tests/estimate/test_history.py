@@ -3,9 +3,9 @@
 import numpy as np
 import pytest
 
+from ema.estimate.documents.window import HistoryReadings, InertiaReading, SensorZero
 from ema.estimate.history import NAMED_WINDOWS, best_zero, combined_inertia, known_from, readings_of, since_change
 from ema.estimate.pipeline import estimate_window
-from ema.estimate.window_info import HistoryReadings, InertiaReading, SensorZero
 from ema.model.actuator import THESIS
 from ema.model.params import HealthParams
 from ema.model.synthetic import synthetic_window

@@ -5,9 +5,9 @@ import pytest
 
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import Estimate
+from ema.estimate.documents.window import HistoryReadings
 from ema.estimate.pipeline import estimate_window
 from ema.estimate.report import share_of_range
-from ema.estimate.window_info import HistoryReadings
 from ema.model.actuator import THESIS
 from ema.model.checks import InputError
 from ema.model.params import HealthParams

@@ -4,7 +4,7 @@ import concurrent.futures
 
 import pytest
 
-from ema.estimate.window_info import SensorZero
+from ema.estimate.documents.window import SensorZero
 from ema.history.errors import ConflictError, StorageError
 from ema.history.open import open_history
 from ema.model.actuator import THESIS

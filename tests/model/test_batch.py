@@ -147,21 +147,11 @@ def test_any_log_rate_is_exact_intervals_of_whole_steps(nominal):
     every_step = np.empty((6, 8, 1000))
     knots = np.radians(np.linspace(0.0, 3.0, 1001))[None]
     frozen = load._replace(ad=np.eye(4), bd=np.zeros(4))  # the aircraft held still: only the logging differs
-    kernels.run_group(c, np.zeros(2), frozen, per_sim, knots, np.ones(1000, np.int64), initial, 0, 8, every_step)
+    kernels.run_group(c, (np.zeros(2), frozen, per_sim, knots, np.ones(1000, np.int64), initial), 0, 8, every_step)
     logged = np.empty((6, 8, 3))
     three = knots[:, [0, 333, 667, 1000]]
-    kernels.run_group(
-        c,
-        np.zeros(2),
-        frozen,
-        per_sim,
-        three,
-        interval_steps(3, 3_000.0, actuator=THESIS.params),
-        initial,
-        0,
-        8,
-        logged,
-    )
+    steps = interval_steps(3, 3_000.0, actuator=THESIS.params)
+    kernels.run_group(c, (np.zeros(2), frozen, per_sim, three, steps, initial), 0, 8, logged)
     for k, (lo, hi) in enumerate([(0, 333), (333, 667), (667, 1000)]):
         for row in (kernels.SPEED, kernels.CURRENT):
             np.testing.assert_allclose(logged[row, 0, k], every_step[row, 0, lo:hi].mean(), rtol=1e-9)

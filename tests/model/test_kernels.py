@@ -22,7 +22,8 @@ def step(speed: float, load_nm: float) -> tuple[float, float, float]:
     the step produced, exactly as the friction model saw it.
     """
     c = kernel_constants(ACTUATOR, EffectSet())._replace(position_gain=0.0, speed_gain_over_kt=0.0)
-    current, new_speed, _, _, loss = advance(c, 0.0, 0.0, load_nm, 0.0, FDJ, FSJ, K_AID, K_OPP, 0.0, speed, 0.0, 0.0)
+    levels = (load_nm, 0.0, FDJ, FSJ, K_AID, K_OPP)
+    current, new_speed, _, _, loss = advance(c, 0.0, 0.0, levels, (0.0, speed, 0.0, 0.0))
     drive = ACTUATOR.torque_constant_nm_per_a * current + load_nm - ACTUATOR.viscous_nms * speed
     return new_speed, loss, drive
 
@@ -78,16 +79,15 @@ def test_irreversible_transmission_never_back_drives():
     assert k_aid > 1.0
     c = kernel_constants(ACTUATOR, EffectSet())._replace(position_gain=0.0, speed_gain_over_kt=0.0)
     for load in (0.1, 0.5, 1.0):
-        _, new_speed, *_ = advance(c, 0.0, 0.0, load, 0.0, FDJ, FSJ, k_aid, 1 / eta_o - 1, 0.0, 0.0, 0.0, 0.0)
+        _, new_speed, *_ = advance(c, 0.0, 0.0, (load, 0.0, FDJ, FSJ, k_aid, 1 / eta_o - 1), (0.0, 0.0, 0.0, 0.0))
         assert new_speed == 0.0
 
 
 def test_end_stop_clamps_angle_and_stops_the_shaft():
     c = kernel_constants(ACTUATOR, EffectSet())
     stop = np.radians(30.0)
-    _, speed, angle, position, _ = advance(
-        c, 0.0, stop + 0.1, 0.0, 0.0, FDJ, FSJ, K_AID, K_OPP, 20.0, 600.0, stop, stop
-    )
+    levels = (0.0, 0.0, FDJ, FSJ, K_AID, K_OPP)
+    _, speed, angle, position, _ = advance(c, 0.0, stop + 0.1, levels, (20.0, 600.0, stop, stop))
     assert angle == stop
     assert speed == 0.0
     assert position <= stop

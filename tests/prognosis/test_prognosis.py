@@ -141,7 +141,7 @@ def test_a_strain_gauge_drifting_against_the_aircraft_is_trended_and_said(one_es
 
 
 def test_the_actuators_j_m_is_its_windows_readings_and_a_replaced_part_is_said(one_estimate):
-    from ema.estimate.window_info import InertiaReading
+    from ema.estimate.documents.window import InertiaReading
     from ema.prognosis.prognose import prognose
 
     def with_reads(factors):

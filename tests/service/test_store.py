@@ -6,8 +6,8 @@ import stat
 
 import pytest
 
+from ema.estimate.documents.window import SensorZero
 from ema.estimate.pipeline import estimate_window
-from ema.estimate.window_info import SensorZero
 from ema.history.errors import StorageError
 from ema.history.open import open_history
 from ema.model.actuator import THESIS

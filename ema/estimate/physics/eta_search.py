@@ -52,7 +52,7 @@ def solve(stats: np.ndarray, gear: float, nuisances: tuple[str, ...] = ()) -> tu
     unit_grid = np.linspace(0.0, 1.0, GRID_POINTS)
     beta = np.zeros((len(stats), len(free)))
     eta_o, sse = np.empty(len(stats)), np.empty(len(stats))
-    _search(stats, free, used, float(gear), unit_grid, ETA_O_SEARCH[0], ETA_O_SEARCH[1], REFINEMENTS, beta, eta_o, sse)
+    _search((stats, free, used, float(gear)), (unit_grid, *ETA_O_SEARCH, REFINEMENTS), (beta, eta_o, sse))
     return beta, eta_o, sse
 
 
@@ -63,17 +63,22 @@ register_jitable(load_factors)
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
-def _search(stats, free, used, gear, unit_grid, low_bound, high_bound, refinements, beta, eta_o, sse):
-    """Fill beta (R, F), eta_o (R,), sse (R,) for stats (R, P, P), ``free`` (F,) the columns regressed on
-    (the constant first), ``used`` (R, F), ``unit_grid`` (G,) = linspace(0, 1, G):
+def _search(problem, grid, out):
+    """Fill ``out`` = (beta (R, F), eta_o (R,), sse (R,)) for ``problem`` = (stats (R, P, P), ``free`` (F,) the
+    columns regressed on (the constant first), ``used`` (R, F), the gear ratio) on ``grid`` = (``unit_grid``
+    (G,) = linspace(0, 1, G), the lowest and highest η, the refinements):
 
         k_opp = 1/η − 1,  k_aid = 1 − η_A(η),  u = t − k_aid·a − k_opp·o,
         β = (Zᵀ Z)⁻¹ Zᵀ u over the used terms,  SSE = uᵀu − βᵀ Zᵀu,
 
     at each η of ``refinements`` grids, each spanning ± one step around the last one's best point.
     """
+    stats, free, used, gear = problem
+    unit_grid, low_bound, high_bound, refinements = grid
+    beta, eta_o, sse = out
     n_free = free.shape[0]
-    gram, rhs, work, b = np.empty((n_free, n_free)), np.empty(n_free), np.empty(n_free), np.empty(n_free)
+    scratch = (np.empty((n_free, n_free)), np.empty(n_free))  # the Gram matrix and its right side, as solved
+    rhs, b = np.empty(n_free), np.empty(n_free)
     for r in range(stats.shape[0]):
         s = stats[r]
         low, high = low_bound, high_bound
@@ -97,7 +102,7 @@ def _search(stats, free, used, gear, unit_grid, low_bound, high_bound, refinemen
                 if n_free == 1:  # FDJ alone: u's mean over the sliding samples, no solve
                     b[0] = rhs[0] / max(s[-1, -1], 1.0)
                 else:
-                    _regression(s, free, used[r], rhs, gram, work, b)
+                    _regression(s, free, used[r], rhs, scratch, b)
                 value = uu
                 for f in range(n_free):
                     value -= b[f] * rhs[f]
@@ -109,8 +114,10 @@ def _search(stats, free, used, gear, unit_grid, low_bound, high_bound, refinemen
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _regression(s, free, used, rhs, gram, work, b):
-    """b = (Zᵀ Z)⁻¹ Zᵀ u over the ``used`` terms, a term not used getting an identity row (so 0)."""
+def _regression(s, free, used, rhs, scratch, b):
+    """b = (Zᵀ Z)⁻¹ Zᵀ u over the ``used`` terms, a term not used getting an identity row (so 0); ``scratch``
+    = (gram (F, F), work (F,)), overwritten."""
+    gram, work = scratch
     n_free = free.shape[0]
     for f in range(n_free):
         work[f] = rhs[f]

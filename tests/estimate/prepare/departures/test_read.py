@@ -2,11 +2,11 @@
 
 import pytest
 
+from ema.estimate.documents.window import HistoryReadings, InertiaReading
 from ema.estimate.history import known_from
 from ema.estimate.physics.features import as_read
 from ema.estimate.physics.friction import fit_window
 from ema.estimate.prepare.conditioning import prepare, widened
-from ema.estimate.window_info import HistoryReadings, InertiaReading
 from ema.model.actuator import THESIS
 from ema.model.window import window_from_dict
 from tests.foreign.windows import Effects, draw, of_the_same_flight, worn

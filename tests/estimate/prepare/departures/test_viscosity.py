@@ -3,11 +3,11 @@
 import numpy as np
 import pytest
 
+from ema.estimate.documents.window import SensorZero
 from ema.estimate.physics.features import as_read
 from ema.estimate.physics.friction import fit_friction
 from ema.estimate.prepare.conditioning import prepare
 from ema.estimate.prepare.departures.viscosity import NOTE_WEIGHT, Viscosity, viscosity_note
-from ema.estimate.window_info import SensorZero
 from ema.model.actuator import THESIS
 from ema.model.params import DriveConstants
 from ema.model.window import window_from_dict
@@ -68,11 +68,11 @@ def test_where_the_speed_hardly_varies_an_unseen_coefficient_is_in_the_stds(fact
     """A 0.1 s gust moving one way near slew, its current 0.2 A off and that zero known from a cruise window of
     its flight: C·|ω| is FDJ's twin. Read with the spec's C and a std without it, C 1.24x put FDJ 40 % of
     range high at 10 std (foreign history, actuator 407)."""
+    from ema.estimate.documents.window import HistoryReadings
     from ema.estimate.history import known_from
     from ema.estimate.physics.friction import fit_window
     from ema.estimate.prepare.conditioning import widened
     from ema.estimate.report import weakly_determined
-    from ema.estimate.window_info import HistoryReadings
 
     effects = Effects(viscous_factor=factor, current_bias_a=0.2)
     gust = draw(318, "gust", duration_s=0.1, effects=effects)

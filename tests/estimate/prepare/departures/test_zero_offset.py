@@ -6,10 +6,10 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+from ema.estimate.documents.window import HistoryReadings, SensorZero
 from ema.estimate.history import known_from
 from ema.estimate.prepare.conditioning import prepare
 from ema.estimate.prepare.departures.zero_offset import ZeroOffset
-from ema.estimate.window_info import HistoryReadings, SensorZero
 from ema.model.actuator import THESIS
 from ema.model.window import window_from_dict
 from tests.foreign.windows import Draw, Effects, draw, of_the_same_flight

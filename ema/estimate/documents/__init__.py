@@ -12,7 +12,7 @@ from typing import Annotated, Any, Literal
 from pydantic import BeforeValidator, Field, model_validator
 
 from ema.estimate.config import PipelineConfig
-from ema.estimate.window_info import WindowInfo
+from ema.estimate.documents.window import WindowInfo
 from ema.model.document import Document
 
 TARGETS = ("FDJ", "eta_O")  # what the estimators fit; η_A follows by Eq. 3.4, FSD from FSJ
