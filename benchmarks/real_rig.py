@@ -4,7 +4,8 @@ C. Ruiz-Carcel and A. Starr, "Data-based detection and diagnosis of faults in li
 Instrumentation and Measurement, 2018; data: Cranfield University, CORD, article 5097649. The runs are
 ``examples/ballscrew-rig/runs`` (``../shared/data/ballscrew-rig`` beside a checkout, or ``--runs``).
 
-The drive is learned (``ema calibrate``'s linear path) on the first half of the healthy runs at each load;
+Every (state, load) in the folder is read (file names as the data set's: ``<state>_load<kgf>_run<n>.csv``).
+The drive is learned (``ema calibrate``'s linear path) on the first five healthy runs at each positive load;
 every other run is then read with the completed document, as ``ema estimate --log-map`` reads it: per
 state and load, the median FDJ, the runs' own stds, their scatter, how many runs' ±2 std hold their
 set's median, and the steps between states in stds. A figure shows every run's FDJ ± 2 std.
@@ -15,6 +16,7 @@ set's median, and the steps between states in stds. A figure shows every run's F
 from __future__ import annotations
 
 import argparse
+import re
 from pathlib import Path
 
 import numpy as np
@@ -28,12 +30,20 @@ from ema.model.window import window_from_dict
 
 ROOT = Path(__file__).resolve().parent.parent
 RIG = ROOT / "examples" / "ballscrew-rig"
-SETS = [("normal", 20), ("normal", 40), ("lackLubrication1", 20)]
+RUN = re.compile(r"^(?P<state>[A-Za-z0-9]+)_load(?P<load>-?[0-9]+)_run[0-9]+\.csv$")  # the data set's file names
+HEALTHY = "normal"
+LEARN_RUNS = 5  # the first runs of each healthy load teach the drive; the rest are held out
+
+
+def sets(folder: Path) -> list[tuple[str, int]]:
+    """Every (state, load) the folder holds runs of, healthy first, then by load and name."""
+    found = {(m["state"], int(m["load"])) for p in folder.glob("*.csv") if (m := RUN.match(p.name))}
+    return sorted(found, key=lambda s: (s[0] != HEALTHY, s[1], s[0]))
 
 
 def windows(folder: Path, state: str, load: int, which: slice) -> list:
     mapping = read_logmap(RIG / "log-map.json")
-    paths = sorted(folder.glob(f"{state}_load{load}_run*.csv"))[which]
+    paths = sorted(p for p in folder.glob(f"{state}_load{load}_run*.csv") if RUN.match(p.name))[which]
     return [window_from_dict(read_mapped(path, mapping)) for path in paths]
 
 
@@ -65,14 +75,16 @@ def main() -> None:
     parser.add_argument("--docs", action="store_true", help="rewrite its section of docs/results.md and its figure")
     args = parser.parse_args()
     document = read_actuator(RIG / "actuator.json")
-    first = slice(0, 5)
-    report, learned = calibrate_linear(
-        windows(args.runs, "normal", 20, first) + windows(args.runs, "normal", 40, first), document
-    )
+    found = sets(args.runs)
+    first = slice(0, LEARN_RUNS)
+    teach = [
+        w for state, load in found if state == HEALTHY and load > 0 for w in windows(args.runs, state, load, first)
+    ]
+    report, learned = calibrate_linear(teach, document)
     assert learned is not None and report.drive is not None
     rows: dict[str, np.ndarray] = {}
-    for state, load in SETS:
-        held = slice(5, None) if state == "normal" else slice(None)
+    for state, load in found:
+        held = slice(LEARN_RUNS, None) if state == HEALTHY and load > 0 else slice(None)
         results = [estimate(w, actuator=learned) for w in windows(args.runs, state, load, held)]
         rows[f"{state} {load} kgf"] = np.array([(r.estimates.FDJ.value, r.estimates.FDJ.std) for r in results])
     body = _body(report.drive, rows)
@@ -101,21 +113,24 @@ def _body(drive, rows: dict[str, np.ndarray]) -> str:
         )
     medians = {name: float(np.median(v[:, 0])) for name, v in rows.items()}
     std = float(np.median(np.concatenate([v[:, 1] for v in rows.values()])))
-    names = list(rows)
-    steps = (
-        f"Between the loads, the healthy medians differ by {abs(medians[names[0]] - medians[names[1]]):.3f} "
-        f"N·m ({abs(medians[names[0]] - medians[names[1]]) / std:.1f} stds); lack of lubrication (stage 1) "
-        f"raises FDJ by {medians[names[2]] - medians[names[0]]:+.3f} N·m at 20 kgf "
-        f"({(medians[names[2]] - medians[names[0]]) / std:.1f} stds of one run)."
-    )
+    steps = []
+    for name, median in medians.items():
+        state, load = name.split()[0], name.split()[1]
+        base = f"{HEALTHY} {load} kgf"
+        if state != HEALTHY and base in medians:
+            change = median - medians[base]
+            steps.append(f"{state} at {load} kgf: FDJ {change:+.3f} N·m ({change / std:+.1f} stds of one run).")
+    healthy = [medians[n] for n in medians if n.startswith(HEALTHY + " ")]
+    spread = max(healthy) - min(healthy)
+    steps.insert(0, f"Healthy, across its loads: the medians span {spread:.3f} N·m ({spread / std:.1f} stds).")
     learned = (
-        f"Learned on 10 healthy runs (5 at 20 kgf, 5 at 40 kgf): current per N·m c = "
+        f"Learned on the first {LEARN_RUNS} healthy runs at each positive load: current per N·m c = "
         f"{drive.current_per_nm_a:.3f} ± {drive.current_per_nm_std_a:.3f} A/(N·m), current at zero torque "
         f"{drive.current_at_zero_torque_a:.3f} ± {drive.current_at_zero_torque_std_a:.3f} A, nominal FDJ "
         f"{drive.fdj_nm:.3f} ± {drive.fdj_std_nm:.3f} N·m, η_O {drive.eta_o:.2f} ± {drive.eta_o_std:.2f}, "
         f"repeatability {drive.repeatability_nm:.3f} N·m. Not separable: {'; '.join(drive.not_separable)}."
     )
-    return "\n".join([learned, "", *table, "", steps, "", "![every run's FDJ ± 2 std](figures/rig_fdj.png)"])
+    return "\n".join([learned, "", *table, "", *steps, "", "![every run's FDJ ± 2 std](figures/rig_fdj.png)"])
 
 
 if __name__ == "__main__":

@@ -105,7 +105,7 @@ def report(passes: dict[str, list[Pass]], yardsticks: dict[str, float], count: i
         f"{count} hidden 0.5 s windows at 10 kHz (`tests.foreign`: {', '.join(FAMILIES)} commands in turn),",
         "posted one after another to a warm `ema serve` on loopback, each under a new `window_id`, idle and",
         "loaded passes alternating in blocks; the figure is the client's wall time of `POST /v1/estimate`.",
-        f"Same run: the yardstick (`clients/yardstick.py`, 500 x 0.5 s on a 16-lane kernel) takes "
+        f"Same run: the yardstick (`ema/cli/yardstick.py`, 500 x 0.5 s on a 16-lane kernel) takes "
         f"{yardsticks['one thread']:.3f} s on one thread and {yardsticks['every thread']:.3f} s on every thread;",
         f"beside the same busy processes {yardsticks['every thread, loaded']:.3f} s on every thread, "
         f"{yardsticks['every thread, loaded'] / yardsticks['every thread']:.2f}x: what a program that keeps "

@@ -108,7 +108,7 @@ def reference_lines(rows: list[dict[str, Any]], refs: dict[str, float]) -> list[
         f"Same run: our kernel simulates {SIMS} x {DURATION_S:g} s in {refs['kernel_s']:.3f} s "
         f"({refs['kernel_ns_per_step']:.2f} ns per simulation-step, {default_lanes(SIMS)} lanes a group, every thread "
         "of the budget); "
-        f"the yardstick (`clients/yardstick.py`, an independent 16-lane kernel) in {refs['yardstick_s']:.3f} s on one "
+        f"the yardstick (`ema/cli/yardstick.py`, an independent 16-lane kernel) in {refs['yardstick_s']:.3f} s on one "
         f"thread, {refs['yardstick_every_thread_s']:.3f} s on every thread.",
         "",
         "| load | window | total p50 / yardstick | total p95 / yardstick | p95 / yardstick on every thread "

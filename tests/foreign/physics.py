@@ -265,8 +265,11 @@ def _current(p, command, theta_u, speed, current, decay):
 
 
 @njit(cache=True)
-def _new_speed(p, t, h, theta_u, theta_m, speed, current, load):
-    """Motor speed after one explicit Euler step, with stick-slip."""
+def _new_speed(p, t, h, angles, motion, load):
+    """Motor speed after one explicit Euler step, with stick-slip; ``angles`` = (θ_u, θ_m), ``motion`` =
+    (speed, current)."""
+    theta_u, theta_m = angles
+    speed, current = motion
     torque = max(-p[P_TMAX], min(p[P_TMAX], p[P_KT] * current))
     bump = p[P_BUMP_A] * np.exp(-0.5 * ((theta_u - p[P_BUMP_C]) / p[P_BUMP_W]) ** 2)
     dynamic = p[P_FDJ] * (1.0 + p[P_DRIFT] * max(t, 0.0)) + bump
@@ -296,10 +299,14 @@ def _rk4(a, b, x, u, dt):
 
 
 @njit(cache=True)
-def _run(p, a, b, command_rad, logged_rad, loop_noise_radps, first_step, n_steps, rate_hz, theta0, out):
-    """Integrate from step ``first_step`` (negative: a pre-roll before the log starts) to ``n_steps``; the
-    loop follows ``command_rad`` and reads the speed with ``loop_noise_radps`` (one value per block of
-    LOOP_SAMPLE_STEPS) added, the log records ``logged_rad`` (both 100 kHz tables) and the true states."""
+def _run(p, aircraft, tables, clock, theta0, out):
+    """Integrate from step ``first_step`` (negative: a pre-roll before the log starts) to ``n_steps``, logging
+    at ``rate_hz`` (``clock``); the loop follows ``command_rad`` and reads the speed with ``loop_noise_radps``
+    (one value per block of LOOP_SAMPLE_STEPS) added, the log records ``logged_rad`` (both 100 kHz tables:
+    ``tables``) and the true states; ``aircraft`` = (A, B)."""
+    a, b = aircraft
+    command_rad, logged_rad, loop_noise_radps = tables
+    first_step, n_steps, rate_hz = clock
     h = 1e-6
     gear = p[P_GEAR]
     current, speed = 0.0, 0.0
@@ -317,7 +324,7 @@ def _run(p, a, b, command_rad, logged_rad, loop_noise_radps, first_step, n_steps
         logged = logged_rad[j] + (pos - j) * (logged_rad[j + 1] - logged_rad[j])
         block = (i - first_step) // LOOP_SAMPLE_STEPS
         current = _current(p, command, theta_u, speed + loop_noise_radps[block], current, decay)
-        new_speed = _new_speed(p, i * h, h, theta_u, theta_m, speed, current, _hinge(p, x, theta_u, i * h) / gear)
+        new_speed = _new_speed(p, i * h, h, (theta_u, theta_m), (speed, current), _hinge(p, x, theta_u, i * h) / gear)
         theta_m += 0.5 * h * (speed + new_speed)
         speed = new_speed
         limit = p[P_STOP] * gear
@@ -370,19 +377,8 @@ def simulate(setup: Setup, command_deg, duration_s: float, preroll_s: float = 0.
     first, last = -round(preroll_s / STEP_S), round(duration_s / STEP_S) + 10
     stop = np.radians(setup.drive.end_stop_deg)
     start = float(np.clip(command_rad[0], -stop, stop))
-    _run(
-        parameters(setup),
-        a,
-        b,
-        command_rad,
-        logged_rad,
-        _loop_noise(setup.effects, last - first),
-        first,
-        last,
-        rate,
-        start,
-        out,
-    )
+    tables = (command_rad, logged_rad, _loop_noise(setup.effects, last - first))
+    _run(parameters(setup), (a, b), tables, (first, last, rate), start, out)
     names = ("position_deg", "motor_speed_radps", "current_a", "hinge_moment_nm", "command_deg")
     signals = dict(zip(names, out, strict=True))
     signals["position_deg"] = np.degrees(signals["position_deg"])

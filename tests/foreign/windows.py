@@ -120,6 +120,7 @@ def noisy(
 def draw(
     seed: int,
     family: str = "thesis",
+    *,
     health: Health | None = None,
     effects: Effects = Effects(),
     flight: Flight | Ground | None = None,
@@ -179,7 +180,14 @@ def of_the_same_flight(drawn: Draw, seed: int, family: str = "cruise", duration_
     flight condition and logger, a command of ``family``."""
     setup = drawn.setup
     other = draw(
-        seed, family, setup.health, setup.effects, setup.flight, duration_s, setup.sample_rate_hz, drive=setup.drive
+        seed,
+        family,
+        health=setup.health,
+        effects=setup.effects,
+        flight=setup.flight,
+        duration_s=duration_s,
+        sample_rate_hz=setup.sample_rate_hz,
+        drive=setup.drive,
     )
     other.document["actuator_id"] = drawn.document["actuator_id"]
     return other
