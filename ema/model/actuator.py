@@ -11,14 +11,16 @@ elevator EMA (Table 3.1), the default wherever a user names none; ``examples/act
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated, Any, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
-from pydantic import AllowInfNan, BaseModel, ConfigDict, Field, Strict, ValidationError, model_validator
+from pydantic import Field, ValidationError, model_validator
 
 from ema.model.aircraft import HingeGeometry
 from ema.model.checks import InputError, from_validation, read_document
+from ema.model.document import Document, Number
 from ema.model.params import MAX_CORRELATION_S, DriveConstants, HealthRanges, eta_a_from_eta_o
+from ema.model.screw import Screw
 
 if TYPE_CHECKING:
     from ema.model.noise import SensorNoise
@@ -29,14 +31,8 @@ HEALTHY_SPAN = 0.2  # the healthy range: nominal ±20 % (η_O capped below 1), t
 MAX_HEALTHY_ETA_O = 0.98
 STEP_S = DriveConstants().step_s  # the simulator's 1 µs step: the current loop must be stable at it
 
-Number = Annotated[float, Strict(), AllowInfNan(False)]
 
-
-class _Part(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True, populate_by_name=True)
-
-
-class Drive(_Part):
+class Drive(Document):
     """The drive's constants, under the simulator's names (units in the names)."""
 
     position_gain_per_s: Number = Field(gt=0, le=1e7, description="G_P: elevator angle error [rad] -> speed ref")
@@ -63,51 +59,7 @@ class Drive(_Part):
         return self
 
 
-class Screw(_Part):
-    """A linear actuator: a ball screw turned by its motor, and what the drive's logged current says of the motor's
-    torque. A stepper's drive is no current loop ema can simulate: its current per N·m and its current at zero
-    torque are on no data sheet, and ``ema calibrate`` learns them from healthy runs at two loads."""
-
-    lead_mm: Number = Field(gt=0, le=1000, description="the screw's lead: travel per motor revolution [mm]")
-    motor: Literal["stepper"] = Field(
-        "stepper", description="the drive (a stepper: its current is read quasi-statically)"
-    )
-    holding_torque_nm: Number | None = Field(None, gt=0, le=1e4, description="the motor's holding torque (data sheet)")
-    current_per_nm_a: Number | None = Field(
-        None,
-        gt=0,
-        le=1e3,
-        description="c: drive current per N·m of motor torque along the motion (null: not yet learned)",
-    )
-    current_per_nm_std_a: Number | None = Field(None, ge=0, le=1e3, description="its std as learned")
-    current_at_zero_torque_a: Number | None = Field(
-        None,
-        ge=0,
-        le=1e3,
-        description="I0: the current that holds the motor with no torque; a window at rest reads its own",
-    )
-    current_at_zero_torque_std_a: Number | None = Field(
-        None, ge=0, le=1e3, description="I0's spread from one day to the next, for a window that never rests"
-    )
-    eta_o_std: Number | None = Field(None, ge=0, lt=1, description="the std of the nominal η_O as learned")
-    repeatability_nm: Number | None = Field(
-        None, ge=0, le=100, description="the run-to-run std of FDJ beyond each run's own noise, as learned"
-    )
-    stroke_profile_a: list[list[Number]] | None = Field(
-        None, description="the healthy runs' current along each stroke (up, then down; less its mean), binned"
-    )
-
-    @property
-    def gear_ratio(self) -> float:
-        """Motor radians per metre of travel, 2π/lead: the screw's transmission ratio in Eq. 3.4."""
-        return 2.0 * np.pi / (self.lead_mm / 1000.0)
-
-    def load_torque_nm(self, force_n: np.ndarray | float) -> np.ndarray:
-        """The load force as a torque at the motor, F·lead/2π."""
-        return np.asarray(force_n) * (self.lead_mm / 1000.0) / (2.0 * np.pi)
-
-
-class Nominal(_Part):
+class Nominal(Document):
     """The health of this actuator new."""
 
     fdj_nm: Number = Field(gt=0, le=100, description="FDJ, dynamic friction at the motor shaft")
@@ -125,7 +77,7 @@ class Nominal(_Part):
         return self
 
 
-class Thresholds(_Part):
+class Thresholds(Document):
     """Where each parameter ends the actuator's useful life (the prognosis's failure levels)."""
 
     fdj_above_nm: Number | None = Field(None, gt=0, le=100, description="default: 1.5x the nominal FDJ")
@@ -134,7 +86,7 @@ class Thresholds(_Part):
     )
 
 
-class SensorNoiseDocument(_Part):
+class SensorNoiseDocument(Document):
     """Each sensor's noise std per sample, and its correlation time (0: white); what ``ema simulate`` draws."""
 
     position_deg: Number = Field(ge=0, le=1e3)
@@ -147,7 +99,7 @@ class SensorNoiseDocument(_Part):
     hinge_moment_nm_corr_s: Number = Field(0.0, ge=0, le=MAX_CORRELATION_S)
 
 
-class Airframe(_Part):
+class Airframe(Document):
     """The control surface's hinge-moment model, what the logged moment is checked against in flight."""
 
     area_m2: Number = Field(gt=0, le=100, description="S_e, the surface's area")
@@ -167,7 +119,7 @@ class Airframe(_Part):
     )
 
 
-class ActuatorDocument(_Part):
+class ActuatorDocument(Document):
     """``ema-actuator/1``."""
 
     schema_: Literal["ema-actuator/1"] = Field("ema-actuator/1", alias="schema")

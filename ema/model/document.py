@@ -2,7 +2,11 @@
 
 from __future__ import annotations
 
-from pydantic import BaseModel, ConfigDict
+from typing import Annotated
+
+from pydantic import AllowInfNan, BaseModel, ConfigDict, Strict
+
+Number = Annotated[float, Strict(), AllowInfNan(False)]  # a finite float, never a string or a bool read as one
 
 
 class Document(BaseModel):

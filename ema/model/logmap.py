@@ -10,15 +10,15 @@ from __future__ import annotations
 
 import csv
 from pathlib import Path
-from typing import Annotated, Any, Literal
+from typing import Any, Literal
 
 import numpy as np
-from pydantic import AllowInfNan, BaseModel, ConfigDict, Field, Strict, ValidationError, model_validator
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
 from ema.model.checks import InputError, from_validation, read_document
+from ema.model.document import Number
 
 SCHEMA = "ema-logmap/1"
-Number = Annotated[float, Strict(), AllowInfNan(False)]
 LENGTH_MM = {"mm": 1.0, "m": 1000.0, "in": 25.4}
 ANGLE_DEG = {"deg": 1.0, "rad": 180.0 / np.pi}
 CURRENT_A = {"A": 1.0, "mA": 1e-3}

@@ -18,12 +18,10 @@ from typing import Annotated, Any, Literal
 
 import numpy as np
 from pydantic import (
-    AllowInfNan,
     AwareDatetime,
     BaseModel,
     ConfigDict,
     Field,
-    Strict,
     ValidationError,
     field_validator,
     model_validator,
@@ -32,6 +30,7 @@ from pydantic import (
 from ema.model.aircraft import AIRSPEED_RANGE_MPS, ALTITUDE_RANGE_M, FlightCondition
 from ema.model.bounds import CLOCK_SKEW, EARLIEST_RECORDED_AT, IDENTIFIER, MAX_FLIGHT_HOURS
 from ema.model.checks import InputError, from_validation, read_document
+from ema.model.document import Number
 
 SCHEMA = "ema-window/1"
 SIGNALS = ("command_deg", "position_deg", "motor_speed_radps", "current_a", "hinge_moment_nm")  # a rotary window's
@@ -55,7 +54,6 @@ SIGNAL_LIMITS = {
     "load_n": (-1e6, 1e6),
 }
 
-Number = Annotated[float, Strict(), AllowInfNan(False)]
 Samples = Annotated[list[Number], Field(min_length=MIN_SAMPLES, max_length=MAX_SAMPLES)]
 
 

@@ -4,7 +4,7 @@ With η_A tied to η_O by Eq. 3.4, the model t = FDJ + k_aid·a + k_opp·o (+ nu
 everything but η_O. At each η_O of a grid, u = t − k_aid·a − k_opp·o is regressed on (1, nuisances…)
 in closed form from the sums alone, and the grid is refined around its best point (the SSE is smooth
 and unimodal in η_O). A fit and its block jackknife solve thousands of such rows per window, so the
-search runs in one compiled pass (``_search``); ``tests/training/physics`` holds the plain vectorized
+search runs in one compiled pass (``_search``); ``tests/estimate/physics`` holds the plain vectorized
 form it must equal.
 """
 

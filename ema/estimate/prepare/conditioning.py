@@ -38,7 +38,7 @@ import numpy as np
 from ema.estimate.documents import Note
 from ema.estimate.physics.noise import white_noise_std
 from ema.estimate.prepare.alignment import Lags, aligned
-from ema.estimate.prepare.consistency import Consistency, check_consistency, kinematics_note
+from ema.estimate.prepare.consistency import Consistency
 from ema.estimate.prepare.departures.aircraft_check import TOLERANCE, aircraft_note, check_against_aircraft
 from ema.estimate.prepare.departures.drive_constants import KERNEL_FREE_RATE_HZ, DriveReading, drive_constants_note
 from ema.estimate.prepare.departures.hinge_gain import hinge_gain_note
@@ -47,6 +47,7 @@ from ema.estimate.prepare.departures.viscosity import viscosity_note
 from ema.estimate.prepare.departures.zero_offset import offset_note
 from ema.estimate.prepare.stale import Stale, line_between_flanks, stale_note, without_stale
 from ema.estimate.prepare.step_lag import StepLag, step_lag, step_lag_note
+from ema.estimate.prepare.verdict import check_consistency, kinematics_note
 from ema.model.actuator import ActuatorDocument
 from ema.model.batch import COMMAND_MARGIN_DEG
 from ema.model.noise import NOISY_SIGNALS

@@ -28,7 +28,7 @@ between such runs with the most sliding samples (``window.read_span``); both are
 (``window.stale_samples``) and said in a note. Where that stretch holds fewer than
 ``ema.estimate.physics.friction.MIN_SLIDING_KERNELS`` kernel widths of sliding samples, the window is refused naming the
 sensor and its run. A sensor that repeats one value over the whole window is left to
-``consistency.check_logged``, which names it as not logged.
+``verdict.check_logged``, which names it as not logged.
 """
 
 from __future__ import annotations

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from ema.estimate.prepare.conditioning import conditioning_notes, prepare
-from ema.estimate.prepare.consistency import check_consistency
+from ema.estimate.prepare.verdict import check_consistency
 from ema.model.actuator import THESIS
 from ema.model.checks import InputError
 from ema.model.window import window_from_dict
