@@ -63,7 +63,7 @@ def report(counts: dict[str, Counter], per_slip: int, seconds: float) -> str:
         f"{per_slip} windows of `tests/foreign`, one of each group of the accuracy table in turn (0.1–2 s,",
         "1–100 kHz, worn, filtered, off zero, drives unlike the document's), each exported once more with one",
         "slip (`tests/foreign/careless.py`) and sent as it is. *Refused, naming it*: the error names the",
-        "field the slip is in (`training/consistency.py`); *answered*: the estimate, scored against the",
+        "field the slip is in (`ema/estimate/prepare/verdict.py`); *answered*: the estimate, scored against the",
         f"truth: within the bound if no parameter is past {100 * BOUND:.0f} % of range, or said weak if each",
         "past it says so; *confidently wrong* if one past it does not. A hinge moment in lbf·ft (0.74x) is",
         "much what η_O 0.74x as high would read in Eq. 5.1; the part of it that follows the deflection is",

@@ -18,8 +18,10 @@ every later estimate's std.
 **Compare** (a calibrated document): the runs are read with it, their FDJ (and η_O where their loads
 differ) set against the nominal, and the current along the stroke against the healthy runs' own
 profile (``screw.stroke_profile_a``): a friction that changes along the stroke (a local defect) is named
-only where it stands ``MIN_Z`` of its run-to-run noise above that profile; where nothing does, the
-report says what 25 Hz cannot show.
+only where the runs' mean stands ``MIN_Z`` of one run's scatter (the larger of theirs and the healthy
+runs', ``screw.stroke_profile_std_a``) above that profile; where nothing does, the report says what 25 Hz
+cannot show. One run's scatter, not the standard error of the runs' mean: runs of one set share their
+day and their load, and healthy sets logged apart differ by several standard errors of their means.
 """
 
 from __future__ import annotations
@@ -90,7 +92,8 @@ class DriveFit:
     residual_before_a: float  # RMS of the stretches' current about the document's model (I0 alone where it has none)
     residual_after_a: float
     loads_n: list[float]
-    profile: np.ndarray
+    profile: np.ndarray  # (2, PROFILE_BINS): the runs' mean current along each stroke (``Run.profile``)
+    profile_std: np.ndarray  # its run-to-run std per bin
 
 
 def _design(runs: list[Run], eta: float, actuator: ActuatorDocument) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -146,6 +149,9 @@ def fit_drive(runs: list[Run], actuator: ActuatorDocument) -> DriveFit:
         residual_after_a=rms(y - x @ np.array([c, c_fdj])),
         loads_n=[round(size * actuator.gear_ratio, 3) for size in sizes],
         profile=np.nanmean([run.profile for run in runs], axis=0),
+        profile_std=np.nanstd([run.profile for run in runs], axis=0, ddof=1)
+        if len(runs) > 1
+        else np.full((2, PROFILE_BINS), np.nan),
     )
 
 
@@ -185,13 +191,14 @@ def _predicted_before(runs: list[Run], actuator: ActuatorDocument) -> np.ndarray
     return screw.current_per_nm_a * (x[:, 0] + nominal.fdj_nm)
 
 
-def profile_change(runs: list[Run], baseline: np.ndarray) -> tuple[float, np.ndarray]:
-    """z of the runs' current along the stroke against the healthy ``baseline`` profile (the largest bin's
-    departure over its run-to-run std of the mean), and that departure per bin."""
+def profile_change(runs: list[Run], baseline: np.ndarray, baseline_std: np.ndarray) -> tuple[float, np.ndarray]:
+    """z of the runs' current along the stroke against the healthy ``baseline`` profile: the largest bin's
+    departure of the runs' mean over one run's scatter there (the larger of the runs' std and the healthy
+    runs' ``baseline_std``; module docstring), and that departure per bin."""
     stack = np.array([run.profile for run in runs])
-    if len(runs) < 2 or baseline is None or not np.isfinite(baseline).any():
+    if len(runs) < 2 or not np.isfinite(baseline).any():
         return 0.0, np.zeros_like(stack[0])
     departure = np.nanmean(stack, axis=0) - baseline
-    spread = np.nanstd(stack, axis=0, ddof=1) / np.sqrt(len(runs))
+    spread = np.fmax(np.nanstd(stack, axis=0, ddof=1), baseline_std)
     z = np.abs(departure) / np.maximum(spread, 1e-6)
     return float(np.nanmax(z)), departure

@@ -107,6 +107,7 @@ def completed(actuator: ActuatorDocument, fit: DriveFit) -> ActuatorDocument:
             "eta_o_std": fit.eta_o_std,
             "repeatability_nm": fit.repeatability_nm,
             "stroke_profile_a": np.nan_to_num(fit.profile).round(5).tolist(),
+            "stroke_profile_std_a": np.nan_to_num(fit.profile_std).round(5).tolist(),
         }
     )
     nominal = actuator.nominal
@@ -162,7 +163,7 @@ def _compared(
         else f"FDJ moved {fdj - nominal.fdj_nm:+.3f} N·m, {z:+.1f} stds of one run: within what runs of one state show"
     )
     changes = [Change(parameter="FDJ", nominal=nominal.fdj_nm, value=fdj, std=fdj_std, z=z, said=said)]
-    profile_z, departure = profile_change(runs, _baseline(actuator))
+    profile_z, departure = profile_change(runs, *_baseline(actuator))
     named = profile_z >= MIN_Z
     candidate = Candidate(
         effect="position_friction",
@@ -201,9 +202,14 @@ def _compared(
     )
 
 
-def _baseline(actuator: ActuatorDocument) -> np.ndarray:
-    profile = None if actuator.screw is None else actuator.screw.stroke_profile_a
-    return np.array(profile, dtype=float) if profile else np.full((2, 1), np.nan)
+def _baseline(actuator: ActuatorDocument) -> tuple[np.ndarray, np.ndarray]:
+    """The healthy runs' profile along the stroke and its run-to-run std (NaN where the document has none)."""
+    screw = actuator.screw
+    profile = None if screw is None else screw.stroke_profile_a
+    if not profile:
+        return np.full((2, 1), np.nan), np.full((2, 1), np.nan)
+    std = None if screw is None else screw.stroke_profile_std_a
+    return np.array(profile, dtype=float), np.array(std, dtype=float) if std else np.zeros_like(np.array(profile))
 
 
 def _report(

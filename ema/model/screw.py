@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import Annotated, Literal
 
 import numpy as np
 from pydantic import Field
@@ -42,6 +42,9 @@ class Screw(Document):
     )
     stroke_profile_a: list[list[Number]] | None = Field(
         None, description="the healthy runs' current along each stroke (up, then down; less its mean), binned"
+    )
+    stroke_profile_std_a: list[list[Annotated[Number, Field(ge=0)]]] | None = Field(
+        None, description="the healthy runs' run-to-run std of that current, per bin (null: not learned)"
     )
 
     @property

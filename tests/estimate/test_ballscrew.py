@@ -1,12 +1,13 @@
 """The real rig (Ruiz-Carcel and Starr 2018; Cranfield CORD 5097649): its logs read as recorded, its drive
 learned from healthy runs at two loads, and its states told apart, on runs the calibration did not see."""
 
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from ema.calibration.linear import read_run
+from ema.calibration.linear import MIN_Z, read_run
 from ema.calibration.linear_report import calibrate_linear
 from ema.estimate.kinds import estimate
 from ema.model.actuator import read_actuator
@@ -88,6 +89,29 @@ def test_faulted_runs_against_the_baseline_say_what_changed(learned):
     report, completed = calibrate_linear(runs("lackLubrication1", 20, range(10)), document)
     assert completed is None and report.changes[0].parameter == "FDJ" and report.changes[0].z > 2
     assert "friction rise" in report.changes[0].said
+
+
+def test_healthy_runs_logged_apart_name_nothing_along_the_stroke(learned):
+    """Healthy runs the calibration did not see, at either load: their FDJ within one run's scatter, and no
+    local defect (their mean current along the stroke stays within one run's noise of the healthy profile)."""
+    _, document = learned
+    for load in (20, 40):
+        report, _ = calibrate_linear(runs("normal", load, range(5, 10)), document)
+        assert report.selected_effects == [] and report.candidates[0].score < MIN_Z
+        assert abs(report.changes[0].z) < 2
+
+
+def test_a_local_rise_of_the_current_along_the_stroke_is_named(learned):
+    """A spall's form, added to held-out healthy runs: 0.3 A more current wherever the nut passes 60-75 mm."""
+    _, document = learned
+    spalled = []
+    for window in runs("normal", 20, range(5, 10)):
+        signals = dict(window.signals)
+        over = (signals["position_mm"] > 60.0) & (signals["position_mm"] < 75.0)
+        signals["current_a"] = signals["current_a"] + 0.3 * over * (np.abs(np.gradient(signals["position_mm"])) > 0.5)
+        spalled.append(replace(window, signals=signals))
+    report, _ = calibrate_linear(spalled, document)
+    assert report.selected_effects == ["position_friction"] and report.candidates[0].score >= MIN_Z
 
 
 def test_a_run_that_never_rests_is_refused_for_learning_naming_it():
