@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import tempfile
 import time
 from pathlib import Path
@@ -114,7 +115,7 @@ def main() -> None:
             "",
             f"Projection: a fleet-day of {FLEET_DAY:,} windows (100 aircraft x 2 EMAs x a window every 20 s over 10 "
             f"flight hours) needs {FLEET_DAY / 86_400:.1f} windows/s: at {best:.2f} windows per core-second, "
-            f"**{FLEET_DAY / 86_400 / best:.0f} cores** working around the clock.",
+            f"**{math.ceil(FLEET_DAY / 86_400 / best)} cores** working around the clock.",
         ]
     )
     print(body)

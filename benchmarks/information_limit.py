@@ -178,8 +178,8 @@ def report(rows: dict[str, list[dict[str, np.ndarray]]], draws: int) -> str:
         [
             "The limit the sensor noise sets on windows of `benchmarks.foreign_accuracy`'s seeds (module",
             "docstring: GLS on Eq. 5.1's raw samples, each sensor's realized noise, linearized at the true",
-            f"health). Mean error in % of the range; *ours*: `training/baseline.py` over {draws} fresh noise",
-            "draws on each clean twin.",
+            "health). Mean error in % of the range; *ours*: `ema/estimate/physics/friction.py` over "
+            f"{draws} fresh noise draws on each clean twin.",
             "",
             table(rows),
             "",

@@ -185,7 +185,7 @@ def write_results(results: list[dict], comparison: list[str], command: str) -> N
         "MSE on normalized targets; *reserved* = 100 simulations never used in training (thesis §6).",
         "*Err.* is the thesis's measure: mean relative error of the normalized FDJ / η_O (it inflates",
         "near 0, as the thesis's footnote warns). Our networks use the 16-component input projection",
-        "unless the row says *raw inputs* (see `training/network.py`).",
+        "unless the row says *raw inputs* (see `ema/estimate/learn/network.py`).",
         "",
         "| case | timesteps | sims | neurons | inputs | sim [s] | train [s] | epochs | stop | train MSE | test MSE"
         " | reserved MSE | Err. FDJ / η_O | thesis |",
@@ -217,14 +217,15 @@ def write_results(results: list[dict], comparison: list[str], command: str) -> N
         "- **Case 2** fails for us as for the thesis: with a new command per simulation, the residual",
         "  torque trace is dominated by the command, not by FDJ or η_O; no shallow network on 1 000",
         "  simulations can invert that. Retraining per window (Case 1B on the logged command,",
-        "  `training/pipeline.py`) is the answer the thesis proposed in §6.3, and what the product does.",
+        "  `ema/estimate/pipeline.py`) is the answer the thesis proposed in §6.3, and what the product does.",
         "",
         "### Network or physics? Both, on the same noisy windows",
         "",
         "Mean absolute relative error (physical units) over synthetic 0.5 s in-flight windows with",
         "realistic sensor noise: the window's network, the least-squares baseline of Eq. 5.1",
-        "(`training/baseline.py`, no simulation), and the answer the product reports (the baseline,",
-        "less its bias on held-out simulations, blended with the network where it earns it: `training/assess.py`).",
+        "(`ema/estimate/physics/friction.py`, no simulation), and the answer the product reports (the baseline,",
+        "less its bias on held-out simulations, blended with the network where it earns it: "
+        "`ema/estimate/assess/weighing.py`).",
         "",
         "| estimator | FDJ | η_O |",
         "|---|---:|---:|",
@@ -232,10 +233,10 @@ def write_results(results: list[dict], comparison: list[str], command: str) -> N
         "",
         "FSJ: in flight the position loop keeps the shaft hunting in the backlash and it rarely rests;",
         "after a pilot's step the drive jumps past the static level within one log interval. FSJ is",
-        "read only at quasi-static break-aways (`training/static_friction.py`); otherwise the product",
+        "read only at quasi-static break-aways (`ema/estimate/physics/static_friction.py`); otherwise the product",
         "reports `FSJ: null` with the reason. On the ground with a slowly rising load the shaft rests",
         "and breaks away: FSJ is read within 2 % there, within its ±2 std under sensor noise; a shaft held",
-        "and then stepped away shows only a lower bound, not read (tests/training/test_static_friction.py).",
+        "and then stepped away shows only a lower bound, not read (tests/estimate/physics/test_static_friction.py).",
     ]
     write_section("Thesis chapter 6, reproduced", command, "\n".join(lines), DOCS / "results.md")
 

@@ -59,14 +59,20 @@ def serve(database: Path, port: int) -> subprocess.Popen[bytes]:
         stdout=subprocess.DEVNULL,
         stderr=subprocess.DEVNULL,
     )
+    last = "no answer"
     for _ in range(600):
         try:
-            if httpx.get(f"http://127.0.0.1:{port}/healthz", timeout=1.0).status_code == 200:
+            answer = httpx.get(f"http://127.0.0.1:{port}/healthz", timeout=1.0)
+            if answer.status_code == 200:
                 return process
-        except httpx.HTTPError:
-            time.sleep(0.2)
+            last = f"/healthz {answer.status_code}: {answer.text[:300]}"
+        except httpx.HTTPError as error:
+            last = repr(error)
+        if process.poll() is not None:
+            break
+        time.sleep(0.2)
     process.kill()
-    raise RuntimeError("the service did not start")
+    raise RuntimeError(f"the service did not start (exit code {process.poll()}; last: {last})")
 
 
 def quiet_collector() -> None:
