@@ -14,10 +14,10 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
-from pydantic import Field, ValidationError, model_validator
+from pydantic import Field, model_validator
 
 from ema.model.aircraft import HingeGeometry
-from ema.model.checks import InputError, from_validation, read_document
+from ema.model.checks import InputError, read_document, validated
 from ema.model.document import Document, Number
 from ema.model.params import MAX_CORRELATION_S, DriveConstants, HealthRanges, eta_a_from_eta_o
 from ema.model.screw import Screw
@@ -246,12 +246,7 @@ THESIS = _thesis()
 
 def actuator_from_dict(document: Any) -> ActuatorDocument:
     """Parse and validate an ``ema-actuator/1`` document (a dict); errors name the field."""
-    if not isinstance(document, dict):
-        raise InputError("actuator", f"must be a JSON object, got {type(document).__name__}")
-    try:
-        return ActuatorDocument.model_validate(document)
-    except ValidationError as exc:
-        raise from_validation(exc) from None
+    return validated(ActuatorDocument, document, "actuator")
 
 
 def read_actuator(path: str | Path) -> ActuatorDocument:

@@ -9,6 +9,7 @@ from pathlib import Path
 from typing import Any, TypeVar
 
 import numpy as np
+from pydantic import BaseModel, ValidationError
 
 
 class InputError(ValueError):
@@ -21,6 +22,7 @@ class InputError(ValueError):
 
 
 Parsed = TypeVar("Parsed")
+Model = TypeVar("Model", bound=BaseModel)
 
 
 def load_json(path: str | Path) -> Any:
@@ -38,6 +40,17 @@ def read_document(path: str | Path, parse: Callable[[Any], Parsed]) -> Parsed:
         return parse(document)
     except InputError as exc:
         raise InputError(f"{path}: {exc.field}", exc.message) from None
+
+
+def validated(model: type[Model], document: Any, what: str) -> Model:
+    """``document`` (a dict) validated as ``model``; anything else, or a field it refuses, is an InputError naming
+    it (``what``: the document's name where the whole is wrong)."""
+    if not isinstance(document, dict):
+        raise InputError(what, f"must be a JSON object, got {type(document).__name__}")
+    try:
+        return model.model_validate(document)
+    except ValidationError as exc:
+        raise from_validation(exc) from None
 
 
 def finite_array(field: str, values: object, ndim: int | None = None) -> np.ndarray:

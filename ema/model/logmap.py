@@ -13,9 +13,9 @@ from pathlib import Path
 from typing import Any, Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+from pydantic import BaseModel, ConfigDict, Field, model_validator
 
-from ema.model.checks import InputError, from_validation, read_document
+from ema.model.checks import InputError, read_document, validated
 from ema.model.document import Number
 
 SCHEMA = "ema-logmap/1"
@@ -89,12 +89,7 @@ class LogMap(_Part):
 
 
 def logmap_from_dict(document: Any) -> LogMap:
-    if not isinstance(document, dict):
-        raise InputError("log map", f"must be a JSON object, got {type(document).__name__}")
-    try:
-        return LogMap.model_validate(document)
-    except ValidationError as exc:
-        raise from_validation(exc) from None
+    return validated(LogMap, document, "log map")
 
 
 def read_logmap(path: str | Path) -> LogMap:

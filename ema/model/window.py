@@ -22,14 +22,13 @@ from pydantic import (
     BaseModel,
     ConfigDict,
     Field,
-    ValidationError,
     field_validator,
     model_validator,
 )
 
 from ema.model.aircraft import AIRSPEED_RANGE_MPS, ALTITUDE_RANGE_M, FlightCondition
 from ema.model.bounds import CLOCK_SKEW, EARLIEST_RECORDED_AT, IDENTIFIER, MAX_FLIGHT_HOURS
-from ema.model.checks import InputError, from_validation, read_document
+from ema.model.checks import InputError, read_document, validated
 from ema.model.document import Number
 
 SCHEMA = "ema-window/1"
@@ -236,12 +235,7 @@ class Window:
 
 def window_from_dict(document: Any) -> Window:
     """Parse and validate an ``ema-window/1`` document (a dict); errors name the field."""
-    if not isinstance(document, dict):
-        raise InputError("window", f"must be a JSON object, got {type(document).__name__}")
-    try:
-        return WindowDocument.model_validate(document).to_window()
-    except ValidationError as exc:
-        raise from_validation(exc) from None
+    return validated(WindowDocument, document, "window").to_window()
 
 
 def window_to_dict(window: Window) -> dict[str, Any]:
