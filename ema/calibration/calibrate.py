@@ -35,8 +35,8 @@ from ema.calibration.families import Family, generic_families
 from ema.calibration.noise_floor import COPIES, clean_replicas, noise_copies
 from ema.calibration.readings import AMBIGUOUS_STDS, Contest, combined_stds, reading, settled
 from ema.calibration.refit import MIN_HELD_OUT_GAIN, corrected, fit_with, held_out_rss
-from ema.calibration.selection import MAX_EFFECTS, MIN_Z, NAME_MARGIN, Chosen, Decision, Evidence, decide, evidence
-from ema.calibration.twins import TWINS, output_error, tell_apart
+from ema.calibration.selection import MAX_EFFECTS, Chosen, Decision, Evidence, decide, evidence
+from ema.calibration.twins import TWINS, output_error, runners_up, tell_apart
 from ema.calibration.vocabulary import COGGING_ORDERS, named_families
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import TARGETS, Estimate
@@ -47,6 +47,8 @@ from ema.model.actuator import ActuatorDocument
 from ema.model.checks import InputError
 from ema.model.noise import SensorNoise
 from ema.model.window import Window
+
+SEPARATION = 0.5  # a rival's excess output error, as a share of the pick's gain over no effect, that tells them apart
 
 
 def combined(results: Sequence[Estimate], actuator: ActuatorDocument) -> dict[str, float]:
@@ -77,9 +79,10 @@ class Context:
     noise: Sequence[SensorNoise]
     bias: Mapping[str, float]
 
-    def moves(self, estimates: Mapping[str, float]) -> bool:
-        """``estimates`` lie further from the base ones than ``AMBIGUOUS_STDS`` of their stds."""
-        return any(abs(estimates[t] - self.before[t]) > AMBIGUOUS_STDS * self.stds[t] for t in TARGETS)
+    def moves(self, estimates: Mapping[str, float], reference: Mapping[str, float] | None = None) -> bool:
+        """``estimates`` lie further from ``reference`` (the base ones) than ``AMBIGUOUS_STDS`` of their stds."""
+        reference = self.before if reference is None else reference
+        return any(abs(estimates[t] - reference[t]) > AMBIGUOUS_STDS * self.stds[t] for t in TARGETS)
 
 
 class Calibrator:
@@ -196,32 +199,47 @@ class Calibrator:
         self, decision: Decision, found: Sequence[Evidence], chosen: Sequence[Chosen], context: Context
     ) -> tuple[Evidence | None, Step, list[Evidence]]:
         """The decided family, or the rival whose reading's simulation follows the windows clearly better (each
-        simulated at its own re-estimated FDJ and η_O); None where its reading moves the estimates beyond their
-        stds and its simulation follows the windows no better than the model without it (never worse). Also the
-        rivals it could not tell from it clearly."""
+        simulated at its own re-estimated FDJ and η_O, beside the effects already chosen); None where its reading
+        moves the estimates beyond their stds from the reading without it and its simulation follows the windows
+        no better than the model without it (never worse, at every step). Also the rivals it could not tell from
+        it clearly."""
         pick = decision.chosen
         assert pick is not None
-        options = [pick, *self._runners_up(pick, found, decision.alike)]
-        readings = {
-            o.family.name: reading(context.measured, [*chosen, Chosen(o.family, o.grid)], context.bias) for o in options
-        }
+        prior = reading(context.measured, chosen, context.bias) if chosen else context.before  # without it
+
+        def read(o: Evidence) -> dict[str, float]:
+            return reading(context.measured, [*chosen, Chosen(o.family, o.grid)], context.bias)
+
+        readings = {pick.family.name: read(pick)}
+        moved = context.moves(readings[pick.family.name], prior)
+        options = [pick, *runners_up(pick, found, decision.alike, wide=moved)]
+        readings |= {o.family.name: read(o) for o in options[1:]}
         args = (context.windows, context.noise, self.actuator)
+        beside = [self.contests_[c.family.name].pick for c in chosen]  # simulated with every reading
         simulated, errors, clear = (
-            tell_apart(args[0], readings, options, *args[1:])
+            tell_apart(args[0], readings, options, *args[1:], beside)
             if len(options) > 1
-            else (pick, {pick.family.name: output_error(args[0], readings[pick.family.name], pick, *args[1:])}, True)
+            else (
+                pick,
+                {pick.family.name: output_error(args[0], readings[pick.family.name], pick, *args[1:], beside)},
+                True,
+            )
         )
         pick = simulated if clear else pick  # a narrow call is noise: the held-out equations' choice stands
         best = errors[pick.family.name]
-        judged = not chosen and context.moves(readings[pick.family.name])
-        base = output_error(args[0], context.before, None, *args[1:]) if judged else float("inf")
+        judged = context.moves(readings[pick.family.name], prior)
+        base = output_error(args[0], prior, None, *args[1:], beside) if judged else float("inf")
         if best > (1 - CLEAR_MARGIN) * base:
             reason = (
                 f"{decision.reason}; but simulated with it at its estimates the windows' speed and current are "
                 f"followed no better than without it ({best:.3g} against {base:.3g}): not adopted"
             )
             return None, Step(selected=None, reason=reason, tie_break_output_error={**errors, "none": base}), []
-        narrow = [o for o in options if o is not pick and errors[o.family.name] <= (1 + CLEAR_MARGIN) * best]
+        # where its reading moves the estimates, a rival is told apart only by a margin of at least SEPARATION of
+        # the pick's own margin over the model without it: the simulation must tell them apart about as clearly
+        # as it tells the effect from none, or the windows hold two readings (``readings.settled``)
+        margin = max(CLEAR_MARGIN * best, SEPARATION * (base - best) if np.isfinite(base) else 0.0)
+        narrow = [o for o in options if o is not pick and errors[o.family.name] <= best + margin]
         others = [o.family.name for o in options if o is not pick]
         reason = decision.reason
         if others:
@@ -232,26 +250,11 @@ class Calibrator:
         step = Step(
             selected=pick.family.name,
             reason=reason,
-            indistinguishable_from=[o.family.name for o in narrow] or list(decision.alike),
+            indistinguishable_from=[o.family.name for o in narrow]
+            or [a for a in decision.alike if a != pick.family.name],
             tie_break_output_error=shown,
         )
         return pick, step, narrow
-
-    @staticmethod
-    def _runners_up(pick: Evidence, found: Sequence[Evidence], alike: Sequence[str]) -> list[Evidence]:
-        """What the simulation sets against ``pick``: its twins, and the named families that explain held-out
-        samples about as well (within ``NAME_MARGIN``), but for one set aside as the same trace with more shapes
-        (``alike``: the simpler is the reading)."""
-        twins = set(TWINS.get(pick.family.name, ()))
-        return [
-            e
-            for e in found
-            if e.family.named
-            and e.family.name != pick.family.name
-            and e.family.name not in alike
-            and not (e.family.follows == pick.family.follows and len(e.family.grid) > len(pick.family.grid))
-            and (e.family.name in twins or (e.z >= MIN_Z and e.improvement >= (1 - NAME_MARGIN) * pick.improvement))
-        ]
 
     def _held_out(self, measured: Equations, chosen: list[Chosen]) -> tuple[reporting.HeldOutCheck, list[Chosen]]:
         """Keep each effect, in the order chosen, only if re-estimated with it the model predicts

@@ -3,7 +3,8 @@ moves the estimates elsewhere.
 
 Each effect selection would adopt is set against its **rivals**: its twins where the simulation could
 not tell them apart clearly (``ema.calibration.twins``), and the other named families that explain
-about as much of the held-out residual (within ``NAME_MARGIN``). The windows are re-estimated with each
+about as much of the held-out residual (within ``NAME_MARGIN``; where the effect's reading moves the
+estimates, of the measured residual too). The windows are re-estimated with each
 in its place (``ema.calibration.refit``). Where a rival's estimates differ from the effect's by more
 than ``AMBIGUOUS_STDS`` of the base estimates' stds, the windows hold two readings and the evidence does
 not choose: neither is adopted, the base estimates are kept, their stds are widened until ±2 std holds

@@ -8,7 +8,8 @@ sensor and a hinge-moment sensor off zero both leave a constant in T_R; only the
 loop, which regulates the logged current. Each twin is added to the simulator in turn, the window
 simulated at the estimates re-fitted with it (each reading at its own FDJ and η_O), and the one whose
 speed and current stay closer to the measured ones (in units of their noise) is named; the other is
-reported as indistinguishable when the difference is small.
+reported as indistinguishable when the difference is small. ``runners_up`` is what the simulation sets
+against an effect: its twins, always, and the named families that read the windows about as well.
 """
 
 from __future__ import annotations
@@ -17,7 +18,7 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
-from ema.calibration.selection import Evidence
+from ema.calibration.selection import MIN_Z, NAME_MARGIN, Evidence
 from ema.estimate.physics.scenario import CLEAR_MARGIN, following_error, inside, scenario_from_window
 from ema.model.actuator import ActuatorDocument
 from ema.model.effects import EffectSet
@@ -38,10 +39,11 @@ def output_error(
     option: Evidence | None,
     noise: Sequence[SensorNoise],
     actuator: ActuatorDocument,
+    beside: Sequence[Evidence] = (),
 ) -> float:
     """Mean over windows of RMS(speed)/σ_speed + RMS(current)/σ_current, simulated at ``estimates`` with
-    ``option``'s effect added (None: the base model alone)."""
-    effects = EffectSet() if option is None else option.family.term(option.beta, option.grid)
+    ``option``'s effect added (None: no more than ``beside``, the effects already chosen)."""
+    effects = simulated_effects([*beside, *([option] if option is not None else [])])
     if effects is None:
         return float("inf")  # a gain outside what the simulator admits: not this reading
     health = inside(estimates["FDJ"], estimates["eta_O"], actuator.health.fdj_nm)
@@ -52,16 +54,56 @@ def output_error(
     return float(np.mean(errors))
 
 
+def simulated_effects(options: Sequence[Evidence]) -> EffectSet | None:
+    """The simulator's terms for ``options`` together (one friction table: the first); None where one of them is
+    outside what the simulator admits."""
+    values: dict[str, dict[str, float]] = {}
+    table = None
+    for option in options:
+        term = option.family.term(option.beta, option.grid)
+        if term is None:
+            return None
+        values.update({name: dict(parameters) for name, parameters in term.values.items()})
+        table = table or term.table
+    return EffectSet(values, table)
+
+
 def tell_apart(
     windows: Sequence[Window],
     readings: Mapping[str, Mapping[str, float]],
     options: Sequence[Evidence],
     noise: Sequence[SensorNoise],
     actuator: ActuatorDocument,
+    beside: Sequence[Evidence] = (),
 ) -> tuple[Evidence, dict[str, float], bool]:
     """The reading whose simulation follows the windows best, each simulated at its own estimates
-    (``readings``, by effect name), each one's output error, and whether the call is clear."""
-    errors = {o.family.name: output_error(windows, readings[o.family.name], o, noise, actuator) for o in options}
+    (``readings``, by effect name) beside the effects already chosen, each one's output error, and whether the
+    call is clear."""
+    errors = {
+        o.family.name: output_error(windows, readings[o.family.name], o, noise, actuator, beside) for o in options
+    }
     ranked = sorted(options, key=lambda o: errors[o.family.name])
     best, runner = errors[ranked[0].family.name], errors[ranked[1].family.name]
     return ranked[0], errors, runner > (1 + CLEAR_MARGIN) * best
+
+
+def runners_up(pick: Evidence, found: Sequence[Evidence], alike: Sequence[str], *, wide: bool) -> list[Evidence]:
+    """What the simulation sets against ``pick``: its twins, and the named families that explain held-out
+    samples about as well (within ``NAME_MARGIN``), but for one set aside as the same trace with more shapes
+    (``alike``: the simpler is the reading). ``wide`` (``pick``'s reading moves the estimates beyond their
+    stds): also those that explain the measured samples about as well, though held-out folds cannot tell (an
+    inertia lives in the few samples that accelerate, and a fold without them cannot read it)."""
+    twins = set(TWINS.get(pick.family.name, ()))
+
+    def rival(e: Evidence) -> bool:
+        if e.family.name in twins:
+            return True  # the same trace in the equations by construction: only the simulation tells them apart
+        if e.family.name in alike or (
+            e.family.follows == pick.family.follows and len(e.family.grid) > len(pick.family.grid)
+        ):
+            return False
+        held_out = e.z >= MIN_Z and e.improvement >= (1 - NAME_MARGIN) * pick.improvement
+        in_sample = wide and e.rms_reduction >= (1 - NAME_MARGIN) * pick.rms_reduction
+        return held_out or in_sample
+
+    return [e for e in found if e.family.named and e.family.name != pick.family.name and rival(e)]

@@ -10,9 +10,11 @@ from ema.model.actuator import THESIS
 from ema.model.checks import InputError
 from ema.model.window import window_from_dict
 from tests.foreign.effects import CASES
+from tests.foreign.physics import Flight
 from tests.foreign.windows import Effects, draw, filter_widths
 
 SMALL = PipelineConfig(n_simulations=32, check_windows=16, n_timesteps=100, hidden_units=20)
+STOPS_FLIGHT = Flight(airspeed_mps=100.0, altitude_m=5000.0)  # a low q̄: the motor holds the stop against it
 
 
 def calibrate(case: str, seed: int, scale: float = 1.0) -> tuple[CalibrationReport, dict]:
@@ -246,11 +248,24 @@ def test_a_tanh_stribeck_decay_is_followed_by_an_exponent_between_the_classic_on
 
 
 def _into_the_stops(seed: int, effects: Effects) -> tuple[CalibrationReport, dict]:
-    from tests.foreign.physics import Flight
-
-    drawn = draw(seed, "stops", effects=effects, duration_s=1.5, flight=Flight(airspeed_mps=100.0, altitude_m=5000.0))
+    drawn = draw(seed, "stops", effects=effects, duration_s=1.5, flight=STOPS_FLIGHT)
     report = Calibrator(SMALL, copies=16, actuator=THESIS).fit([window_from_dict(drawn.document)], drawn.truth).report_
     return report, drawn.truth
+
+
+@pytest.mark.slow
+def test_a_light_rotor_into_the_stops_is_not_read_as_a_stribeck_decay():
+    """Seed 3 of ``benchmarks.calibration_stops``: a Stribeck decay explains held-out samples best and its simulation
+    beats the base model's, but puts FDJ 2.2x the truth; an inertia (which held-out folds cannot read) follows the
+    window nearly as well at the true FDJ. Two readings: neither is adopted (it was adopted, 0.069 -> 1.15)."""
+    drawn = draw(3, "stops", effects=Effects(inertia_factor=0.8), duration_s=1.5, flight=STOPS_FLIGHT)
+    report = Calibrator(seed=3, actuator=THESIS).fit([window_from_dict(drawn.document)], drawn.truth).report_
+    assert combined_error(report, "after") <= combined_error(report, "before") + 1e-4
+    assert report.ambiguity is not None and "inertia" in report.ambiguity.effects
+    assert abs(report.ambiguity.readings["inertia"]["FDJ"] - drawn.truth["FDJ"]) < 0.1 * drawn.truth["FDJ"]
+
+
+MECHANICAL = {"backlash", "position_friction", "stribeck", "viscous", "cogging"}
 
 
 @pytest.mark.parametrize(
@@ -263,7 +278,19 @@ def test_a_window_into_the_stops_is_never_made_worse_nor_a_sensor_fault_made_mec
     (``benchmarks.calibration_stops`` for the table over seeds)."""
     report, _ = _into_the_stops(0, effects)
     assert combined_error(report, "after") <= combined_error(report, "before") + 1e-4
-    assert not set(report.selected_effects) & {"backlash", "position_friction", "stribeck", "viscous", "cogging"}
+    if effects.current_sensor_gain != 1.0:
+        assert not set(report.selected_effects) & MECHANICAL
     if report.ambiguity is not None:
         assert report.estimates_after == report.estimates_before
         assert all(report.stds_after[t] >= report.stds_before[t] for t in ("FDJ", "eta_O"))
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(
+    strict=True,
+    reason="open: a light rotor's dynamics move the kinematic dead-band reading past its floor, and a wider band "
+    "is named (the estimates are kept)",
+)
+def test_a_light_rotor_into_the_stops_is_not_named_a_mechanical_effect():
+    report, _ = _into_the_stops(0, Effects(inertia_factor=0.8))
+    assert not set(report.selected_effects) & MECHANICAL
