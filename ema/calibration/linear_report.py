@@ -163,7 +163,8 @@ def _compared(
         else f"FDJ moved {fdj - nominal.fdj_nm:+.3f} N·m, {z:+.1f} stds of one run: within what runs of one state show"
     )
     changes = [Change(parameter="FDJ", nominal=nominal.fdj_nm, value=fdj, std=fdj_std, z=z, said=said)]
-    profile_z, departure = profile_change(runs, *_baseline(actuator))
+    baseline = _baseline(actuator)
+    profile_z, departure = profile_change(runs, *baseline)
     named = profile_z >= MIN_Z
     candidate = Candidate(
         effect="position_friction",
@@ -181,6 +182,9 @@ def _compared(
         if named
         else f"nothing beyond FDJ stands above the runs' noise along the stroke (z = {profile_z:.1f} < {MIN_Z:g}): a "
         "local defect such as a spall may well be invisible in a current logged at 25 Hz"
+        if np.isfinite(baseline[1]).any()
+        else "the stroke is not compared: the document holds no healthy profile along it with its run-to-run spread "
+        "(learn the drive again with ema calibrate on healthy runs)"
     )
     report = _report(
         len(runs),
@@ -203,13 +207,12 @@ def _compared(
 
 
 def _baseline(actuator: ActuatorDocument) -> tuple[np.ndarray, np.ndarray]:
-    """The healthy runs' profile along the stroke and its run-to-run std (NaN where the document has none)."""
+    """The healthy runs' profile along the stroke and its run-to-run std; NaN where the document lacks either (one
+    learned before the std was kept: the runs' own scatter alone would take a load's profile for a defect)."""
     screw = actuator.screw
-    profile = None if screw is None else screw.stroke_profile_a
-    if not profile:
+    if screw is None or not screw.stroke_profile_a or not screw.stroke_profile_std_a:
         return np.full((2, 1), np.nan), np.full((2, 1), np.nan)
-    std = None if screw is None else screw.stroke_profile_std_a
-    return np.array(profile, dtype=float), np.array(std, dtype=float) if std else np.zeros_like(np.array(profile))
+    return np.array(screw.stroke_profile_a, dtype=float), np.array(screw.stroke_profile_std_a, dtype=float)
 
 
 def _report(

@@ -101,6 +101,15 @@ def test_healthy_runs_logged_apart_name_nothing_along_the_stroke(learned):
         assert abs(report.changes[0].z) < 2
 
 
+def test_a_document_without_the_healthy_spread_does_not_compare_the_stroke(learned):
+    """A document learned before the spread was kept: the runs' own scatter alone would take the profile of
+    another load for a defect, so the stroke is not compared, and the report says why."""
+    _, document = learned
+    older = document.model_copy(update={"screw": document.screw.model_copy(update={"stroke_profile_std_a": None})})
+    report, _ = calibrate_linear(runs("normal", 40, range(5, 10)), older)
+    assert report.selected_effects == [] and "not compared" in report.selection_steps[0].reason
+
+
 def test_a_local_rise_of_the_current_along_the_stroke_is_named(learned):
     """A spall's form, added to held-out healthy runs: 0.3 A more current wherever the nut passes 60-75 mm."""
     _, document = learned
