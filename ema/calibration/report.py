@@ -74,22 +74,15 @@ def _backlash_candidate(reading: BacklashReading) -> Candidate:
 
 def adopted_effects(found: Found) -> EffectSet:
     """The simulator's terms for everything adopted (one friction table at most: the first)."""
-    values: dict[str, dict[str, float]] = {}
-    table = None
     evidence = {e.family.name: e for e in found.evidence}
-    for c in found.chosen:
-        e = evidence[c.family.name]
-        term = c.family.term(e.beta, c.grid)
-        if term is not None:
-            values.update({name: dict(p) for name, p in term.values.items()})
-            table = table or term.table
+    terms = [c.family.term(evidence[c.family.name].beta, c.grid) for c in found.chosen]
     if found.described is not None:
         lead = found.unnamed[0]
-        term = lead.family.term(lead.beta, lead.grid)
-        table = table or (term.table if term is not None else None)
+        terms.append(lead.family.term(lead.beta, lead.grid))  # a friction table: no parameters of its own
+    effects = EffectSet.combined(term for term in terms if term is not None)
     if found.backlash.significant:
-        values["backlash"] = {"extra_rad": float(np.clip(found.backlash.extra_rad, -5e-3, 0.1))}
-    return EffectSet(values, table)
+        effects = effects.with_effect("backlash", extra_rad=float(np.clip(found.backlash.extra_rad, -5e-3, 0.1)))
+    return effects
 
 
 def _errors(values: Mapping[str, float], truth: Mapping[str, float] | None) -> tuple[dict, dict] | tuple[None, None]:

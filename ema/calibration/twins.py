@@ -57,15 +57,8 @@ def output_error(
 def simulated_effects(options: Sequence[Evidence]) -> EffectSet | None:
     """The simulator's terms for ``options`` together (one friction table: the first); None where one of them is
     outside what the simulator admits."""
-    values: dict[str, dict[str, float]] = {}
-    table = None
-    for option in options:
-        term = option.family.term(option.beta, option.grid)
-        if term is None:
-            return None
-        values.update({name: dict(parameters) for name, parameters in term.values.items()})
-        table = table or term.table
-    return EffectSet(values, table)
+    terms = [option.family.term(option.beta, option.grid) for option in options]
+    return None if any(term is None for term in terms) else EffectSet.combined(t for t in terms if t is not None)
 
 
 def tell_apart(

@@ -9,7 +9,7 @@ time: the data-driven term the calibration loop offers when no named effect fits
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from types import MappingProxyType
 
@@ -135,6 +135,17 @@ class EffectSet:
     def with_effect(self, effect: str, **parameters: float) -> EffectSet:
         """A copy with ``effect`` switched on (or replaced)."""
         return EffectSet({**self.values, effect: parameters}, self.table)
+
+    @classmethod
+    def combined(cls, sets: Iterable[EffectSet]) -> EffectSet:
+        """Every effect of ``sets`` together (a later set's parameters win for an effect in two), and one friction
+        table: the first (the simulator adds one)."""
+        values: dict[str, dict[str, float]] = {}
+        table = None
+        for effects in sets:
+            values.update(effects.as_dict())
+            table = table or effects.table
+        return cls(values, table)
 
     def with_table(self, table: FrictionTable | None) -> EffectSet:
         return EffectSet(self.values, table)
