@@ -7,26 +7,22 @@
 - Actuator documents are versioned 1, 2, …; two replicas allocating a version at once collide on
   the key, and the later one takes the next.
 - A withdrawn window leaves the history but not the database: its row moves to ``withdrawals``.
-- ``probe`` says whether the storage can take a write now (``ema.history.sqlite``,
-  ``ema.history.postgres``); the service asks before any pipeline runs.
 """
 
 from __future__ import annotations
 
-import datetime as dt
 import json
-from collections.abc import Callable, Iterator, Sequence
-from contextlib import contextmanager
+from collections.abc import Sequence
 from typing import Any
 
 import sqlalchemy as sa
 from pydantic import ValidationError
-from sqlalchemy.dialects import postgresql, sqlite
 
 from ema.calibration.documents import CalibrationReport
 from ema.estimate.documents import Estimate
 from ema.estimate.documents.window import HistoryReadings, InertiaReading, SensorZero
 from ema.estimate.history import lent
+from ema.history.connection import SqlStore, now
 from ema.history.errors import ConflictError, StorageError
 from ema.history.tables import actuators, calibrations, estimates, summaries, withdrawals
 from ema.model.actuator import ActuatorDocument
@@ -35,50 +31,8 @@ from ema.prognosis.documents import Stored, StoredActuator, Withdrawal
 VERSION_ATTEMPTS = 20  # replicas racing for an actuator's next document version
 
 
-def now() -> str:
-    return dt.datetime.now(dt.UTC).isoformat(timespec="milliseconds")
-
-
-class SqlHistory:
+class SqlHistory(SqlStore):
     """An actuator history on ``engine``; ``probe()`` raises StorageError where a write cannot be taken now."""
-
-    def __init__(self, engine: sa.Engine, location: str, probe: Callable[[], None]) -> None:
-        self.engine = engine
-        self.location = location
-        self.probe = probe
-        self._insert = postgresql.insert if engine.dialect.name == "postgresql" else sqlite.insert
-
-    @contextmanager
-    def _writing(self) -> Iterator[sa.Connection]:
-        """A transaction that commits on leaving; a database failure becomes a StorageError naming the history."""
-        try:
-            with self.engine.begin() as connection:
-                yield connection
-        except sa.exc.IntegrityError:
-            raise
-        except sa.exc.SQLAlchemyError as exc:
-            raise StorageError(self.location, f"cannot be written ({_reason(exc)})") from None
-
-    @contextmanager
-    def _reading(self) -> Iterator[sa.Connection]:
-        try:
-            with self.engine.connect() as connection:
-                yield connection
-        except sa.exc.SQLAlchemyError as exc:
-            raise StorageError(self.location, f"cannot be read ({_reason(exc)})") from None
-
-    def close(self) -> None:
-        self.engine.dispose()
-
-    def healthy(self) -> tuple[bool, str]:
-        """(True, "ok"), or (False, what is wrong): the storage can take a write, and answers a read."""
-        try:
-            self.probe()
-            with self._reading() as connection:
-                connection.execute(sa.select(sa.func.count()).select_from(actuators)).scalar_one()
-        except StorageError as exc:
-            return False, str(exc)
-        return True, "ok"
 
     def add(self, result: Estimate) -> Stored:
         """Store one result; where its (actuator_id, window_id) is stored already from the same content, that row,
@@ -332,9 +286,3 @@ class SqlHistory:
         statement = statement.on_conflict_do_update(index_elements=[summaries.c.actuator_id], set_=values)
         with self._writing() as connection:
             connection.execute(statement)
-
-
-def _reason(exc: sa.exc.SQLAlchemyError) -> str:
-    """The database's own words for a failure, without SQLAlchemy's statement dump."""
-    original = getattr(exc, "orig", None)
-    return str(original if original is not None else exc).splitlines()[0]
