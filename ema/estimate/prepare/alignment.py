@@ -22,7 +22,8 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ema.estimate.physics.shifts import advanced, equation_errors
+from ema.estimate.physics.friction import FitSettings
+from ema.estimate.physics.shifts import advanced, shifted_fits
 from ema.estimate.prepare.hinge_lag import hinge_lag
 from ema.model.params import DriveConstants
 from ema.model.window import Window
@@ -30,24 +31,34 @@ from ema.model.window import Window
 MAX_LAG_S = 1e-3
 HALF_STEP = 0.5  # samples: the finest grid searched
 MIN_GAIN = 0.05  # the least relative drop of the equation error a lag must bring
+# Each shift is fitted with a free scale of the motor torque and a free inertia: a current read a few per cent
+# high (or a k_T off the document's) leaves γ·k_T·I, an inertia off the document's ΔJ·dω/dt, both largest where
+# the shaft accelerates, and with the current decaying after a step a shifted current took either (a 6 % gain
+# read as 0.5 ms, a rotor 20 % light as 0.9 ms). A lag leaves k_T·τ·dI/dt, which neither matches.
+LAG_FIT = FitSettings(torque_scale=True, inertia=True)
+
+
+def _errors(signals: dict[str, np.ndarray], rate: float, lags: np.ndarray, actuator: DriveConstants) -> np.ndarray:
+    return shifted_fits(signals, rate, lags, actuator, settings=LAG_FIT).residual_rms_nm
 
 
 def current_lag_samples(signals: dict[str, np.ndarray], sample_rate_hz: float, actuator: DriveConstants) -> float:
     """How many samples the logged current trails the logged speed (negative: the speed trails), 0
-    unless that lag lowers the window's equation error by ``MIN_GAIN``: whole samples within
-    ``MAX_LAG_S`` first, then half a sample either side of the best, then the parabola's vertex."""
+    unless that lag lowers the window's equation error by ``MIN_GAIN`` inside ``MAX_LAG_S``: whole samples
+    first, then half a sample either side of the best, then the parabola's vertex. A best shift at the end
+    of the search is no minimum: the shift trades with the free drive constants there, and none is made."""
     reach = max(1.0, np.floor(MAX_LAG_S * sample_rate_hz))
     grid = np.arange(-reach, reach + 0.5)
-    coarse = equation_errors(signals, sample_rate_hz, grid, actuator)
+    coarse = _errors(signals, sample_rate_hz, grid, actuator)
     if not np.all(np.isfinite(coarse)):
         return 0.0  # too little sliding motion: the physics fit says so next
     near = grid[int(np.argmin(coarse))] + np.array([-HALF_STEP, HALF_STEP])
     errors = dict(zip(grid, coarse, strict=True)) | dict(
-        zip(near, equation_errors(signals, sample_rate_hz, near, actuator), strict=True)
+        zip(near, _errors(signals, sample_rate_hz, near, actuator), strict=True)
     )
     best = min(errors, key=errors.__getitem__)
-    if errors[best] >= (1.0 - MIN_GAIN) * errors[0.0]:
-        return 0.0
+    if errors[best] >= (1.0 - MIN_GAIN) * errors[0.0] or abs(best) >= reach:
+        return 0.0  # no drop worth a shift, or a minimum at the end of the search: none there, only a trade
     if best - HALF_STEP in errors and best + HALF_STEP in errors:  # a filter's delay falls between: the vertex
         below, at, above = (errors[best + d] ** 2 for d in (-HALF_STEP, 0.0, HALF_STEP))
         return float(best + 0.5 * HALF_STEP * (below - above) / (below - 2 * at + above))

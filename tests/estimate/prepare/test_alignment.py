@@ -7,6 +7,7 @@ import pytest
 from ema.estimate.prepare.alignment import Lags, aligned
 from ema.model.actuator import THESIS
 from ema.model.window import window_from_dict
+from tests.foreign.physics import Effects, Flight
 from tests.foreign.windows import draw, noisy
 
 FAMILIES = ("thesis", "cruise", "gust", "doublet", "steps")
@@ -93,3 +94,21 @@ def test_the_hinge_lags_read_uncertainty_is_carried_as_a_spread_only_where_one_i
     _, lags = aligned(_window(3, {"hinge_moment_nm": lambda x: moving_average(x, 30)}), actuator=THESIS.params)
     assert lags.hinge_s > 0 and 0.0 < lags.spread["FDJ"] < 2e-3 and lags.spread["eta_O"] >= 0.0
     assert aligned(_window(3, {}), actuator=THESIS.params)[1] == Lags()
+
+
+@pytest.mark.parametrize(
+    ("seed", "effects"),
+    [
+        (0, Effects(current_sensor_gain=1.06)),
+        (1, Effects(current_sensor_gain=0.94)),
+        (2, Effects(current_sensor_gain=1.10)),
+        (0, Effects(inertia_factor=0.8)),
+        (1, Effects(inertia_factor=1.2)),
+    ],
+)
+def test_a_drive_constant_off_the_documents_is_not_read_as_a_lag(seed, effects):
+    """After a step the current decays while the shaft accelerates: a gain's trace γ·k_T·I and an inertia's
+    ΔJ·dω/dt then look like a shifted current (a 6 % gain was read 5 samples late, a rotor 20 % light 9 samples
+    early); each shift is fitted with both free, and no lag is left."""
+    drawn = draw(seed, "stops", effects=effects, duration_s=1.5, flight=Flight(airspeed_mps=100.0, altitude_m=5000.0))
+    assert aligned(window_from_dict(drawn.document), actuator=THESIS.params)[1].current_s == 0.0
