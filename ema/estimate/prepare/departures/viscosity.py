@@ -30,6 +30,7 @@ import numpy as np
 from ema.estimate.documents import Note
 from ema.estimate.physics.features import as_read
 from ema.estimate.physics.friction import FitSettings, fit_friction
+from ema.estimate.prepare.departures.drive_constants import UNDECIDED_SHARE
 from ema.estimate.stats import DECISIVE_Z, UNDECIDED_NOTE_WEIGHT, UNDECIDED_PRIOR_LOG_ODDS, odds_weight
 from ema.model.effects import EffectSet
 from ema.model.params import DriveConstants
@@ -44,6 +45,12 @@ READ_ERROR_OF_C = 0.025
 UNSEEN_SHARE = 0.3
 CHANGE_BOUNDS_NMS = (-5e-5, 5e-3)  # what the simulator's viscous effect accepts (``ema.model.effects``)
 VISCOUS_FIT = FitSettings(offset=True, viscous=True)
+# A change that stands out is fitted again beside a scale of the motor torque: at the drive's top speed the
+# speed falls as the load grows, so C·|ω| follows the load, and a current read a few per cent high (which scales
+# the aiding and the opposing load's share alike, against Eq. 3.4) reads as a viscous change. Where it no longer
+# stands out there, the window cannot tell the two: C stays the document's, and the stds carry
+# ``UNDECIDED_SHARE`` of what reading the change would move.
+BESIDE_A_GAIN = FitSettings(offset=True, viscous=True, torque_scale=True)
 # the prior odds of "C is off" where the change does not stand out, and the note's weight (as step_lag's)
 PRIOR_LOG_ODDS, NOTE_WEIGHT = UNDECIDED_PRIOR_LOG_ODDS, UNDECIDED_NOTE_WEIGHT
 
@@ -59,11 +66,19 @@ class Viscosity:
     leaning_nms: float = 0.0  # where no change was read: the ΔC the window leans to, weighed into ``spread``
     leaning_weight: float = 0.0  # the posterior weight of "C is off by ``leaning_nms``"
     unseen: bool = False  # the window cannot tell C·|ω| from FDJ: ``spread`` carries a C ``UNSEEN_SHARE`` off
+    gain_alike: bool = (
+        False  # a change stood out that a gain of the current's reading explains as well (``leaning_nms``)
+    )
 
     @property
     def factor(self) -> float:
         """The coefficient read over the document's (1 where none was read, or the document's is 0)."""
         return 1.0 + self.change_nms / self.spec_nms if self.change_nms and self.spec_nms > 0 else 1.0
+
+    @property
+    def leaning_factor(self) -> float:
+        """The coefficient the window leans to, over the document's."""
+        return 1.0 + self.leaning_nms / self.spec_nms if self.spec_nms > 0 else 1.0
 
     def drive_as_read(self, spec: DriveConstants) -> DriveConstants:
         """The actuator every fit of the window reads it with."""
@@ -88,7 +103,18 @@ def read_viscosity(window: Window, spec: DriveConstants) -> Viscosity:
     if not stands_out:
         return _leaning(seen, rate, spec, change, std)
     change = float(np.clip(change, *CHANGE_BOUNDS_NMS))
+    beside = fit_friction(seen, rate, spec, BESIDE_A_GAIN)
+    if not abs(float(beside.term("viscous")[0])) > DECISIVE_Z * float(beside.term_std("viscous")[0]):
+        return _gain_alike(seen, rate, spec, change)
     return Viscosity(change, std, _half_change(seen, rate, spec, change, std), spec.viscous_nms)
+
+
+def _gain_alike(seen: dict[str, np.ndarray], rate: float, spec: DriveConstants, change: float) -> Viscosity:
+    """The document's C where ``change`` stands out alone but not beside a gain of the motor torque (``BESIDE_A_GAIN``),
+    with ``UNDECIDED_SHARE`` of what reading it would move each target in the stds."""
+    spec_read, off_read = _targets_at(seen, rate, spec, (0.0, change))
+    spread = {name: float(UNDECIDED_SHARE * abs(off_read[name] - spec_read[name])) for name in spec_read}
+    return Viscosity(spread=spread, spec_nms=spec.viscous_nms, leaning_nms=change, gain_alike=True)
 
 
 def _targets_at(
@@ -139,6 +165,16 @@ def viscosity_note(viscosity: Viscosity) -> list[Note]:
                 f"way)",
             )
         ]
+    if viscosity.gain_alike:
+        return [
+            Note(
+                code="viscosity_leaning",
+                text=f"friction follows the speed as a viscous coefficient {viscosity.leaning_factor:.2f} times the "
+                "document's would, and as a current read a few per cent off would (at top speed the speed falls as "
+                "the load grows): the window cannot tell them apart; read with the document's coefficient, the stds "
+                "include what the other reading would change",
+            )
+        ]
     if not viscosity.change_nms:
         return _leaning_note(viscosity)
     return [
@@ -159,7 +195,7 @@ def _leaning_note(viscosity: Viscosity) -> list[Note]:
     return [
         Note(
             code="viscosity_leaning",
-            text=f"the viscous coefficient leans to {1 + viscosity.leaning_nms / viscosity.spec_nms:.2f} times the "
+            text=f"the viscous coefficient leans to {viscosity.leaning_factor:.2f} times the "
             f"document's, "
             f"too unclear to read (weight {viscosity.leaning_weight:.2f}); read with the document's, the stds include "
             "what that "
