@@ -7,10 +7,11 @@ samples where the elevator moves with the motor (after a reversal the motor firs
 band, d between the faces, and a wide band read over those samples comes out narrow). The noise
 copies, simulated with the nominal band, give the reading's own spread and bias: a band of any
 size is named when it stands ``MIN_Z`` of those stds from them, and its extra width is the
-difference. The copies are replicas of the model as estimated; where it does not reproduce the
-window (an equation error R times the copies', with what was adopted), they understate every
-spread about R-fold, and the spread is widened by R: a torque constant at half its value moves the
-motor differently enough to shift the reading, and is not a worn dead band.
+difference. The copies are replicas of the base model as estimated, without what the torque channel
+adopts; where it does not reproduce the window (an equation error R times the copies'), they
+understate every spread about R-fold, and the spread is widened by R: a torque constant at half its
+value, or a hinge-moment bias of 500 N·m, moves the motor differently enough to shift the reading,
+and is not a worn dead band, even once the torque channel has named it.
 """
 
 from __future__ import annotations
@@ -21,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ema.calibration.equations import Equations
-from ema.calibration.selection import MIN_Z, Chosen, floor_rms, residual_rms
+from ema.calibration.selection import MIN_Z, floor_rms, residual_rms
 
 MIN_ENGAGED = 50  # samples pushing on each face
 # The reading's floor: the dead band read kinematically moves with dynamics the model gets wrong, and the copies
@@ -65,8 +66,8 @@ def width_rad(e: Equations) -> float:
     return float(np.linalg.lstsq(design, e.kinematic[rows], rcond=None)[0][-1])
 
 
-def read_backlash(measured: Equations, copies: Sequence[Equations], chosen: Sequence[Chosen]) -> BacklashReading:
-    """The dead band against the copies', given the effects adopted in the torque channel."""
+def read_backlash(measured: Equations, copies: Sequence[Equations]) -> BacklashReading:
+    """The dead band against the copies', their spread widened by how far their model is from the window."""
     null = [width_rad(c) for c in copies]
-    mismatch = residual_rms(measured, chosen) / max(floor_rms(copies), 1e-300)
+    mismatch = residual_rms(measured, []) / max(floor_rms(copies), 1e-300)
     return BacklashReading(width_rad(measured), float(np.mean(null)), float(np.std(null, ddof=1)), mismatch)

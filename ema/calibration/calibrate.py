@@ -151,9 +151,7 @@ class Calibrator:
         if ambiguity is not None:
             steps.append(Step(selected=None, reason=ambiguity.reason, indistinguishable_from=ambiguity.effects))
         held, chosen = self._held_out(measured, chosen)
-        found = reporting.Found(
-            measured, copies, first_round, chosen, steps, unnamed, read_backlash(measured, copies, chosen)
-        )
+        found = reporting.Found(measured, copies, first_round, chosen, steps, unnamed, read_backlash(measured, copies))
         found, held = reporting.adopt_described(found, held)
         adopted = found.adopted
         after = corrected(fit_with(measured, adopted).values, bias) if adopted else before

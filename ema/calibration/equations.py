@@ -8,23 +8,25 @@ states, sample by sample, over the sliding samples:
     t = sgn(ω)·(T_R − C_M·ω) = FDJ + k_aid·a + k_opp·o + Σ effect columns + noise,
 
 with a and o the smoothed aiding and opposing |T_ext|, the hinge moment read as the estimators
-read it (``ema.estimate.physics.features.as_read``). A second channel carries the backlash:
-the motor angle (integrated measured speed) minus the elevator angle, d = θ_m/n − θ_u, sits at
-c ± BLK/2 depending on which side of the dead band the motor pushes. Simulated windows go
-through this very function, so the noise floor (``ema.calibration.noise_floor``) sees what the
-measured window sees.
+read it (``ema.estimate.physics.features.as_read``), k_aid and k_opp tied by Eq. 3.4
+(``Equations.tied``). A second channel carries the backlash: the motor angle (integrated measured
+speed) minus the elevator angle, d = θ_m/n − θ_u, sits at c ± BLK/2 depending on which side of the
+dead band the motor pushes. Simulated windows go through this very function, so the noise floor
+(``ema.calibration.noise_floor``) sees what the measured window sees.
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
+from ema.estimate.physics.eta_search import ETA_O_SEARCH
 from ema.estimate.physics.features import as_read
 from ema.estimate.physics.friction import FitSettings, regressors
-from ema.model.params import DriveConstants
+from ema.model.params import DriveConstants, load_factors
 from ema.model.residual import smooth_derivative, smoothed
 
 FOLDS = 5
@@ -50,6 +52,25 @@ class Equations:
     @property
     def m(self) -> int:
         return len(self.y)
+
+    @cached_property
+    def tied(self) -> tuple[np.ndarray, np.ndarray]:
+        """(design (m, 2), fixed (m,)): the base with η_A tied to η_O by Eq. 3.4, as the estimators tie it:
+        t ≈ FDJ + k_opp·(o + r·a) + q·a, the aiding factor k_aid = q + r·k_opp linearized where this window's
+        free fit sits (over η_O 0.5–0.95 and n ≥ 150, r stays within 2 % of 1). The tie is what a gain of the
+        current's reading breaks: it scales the aiding and the opposing load's share alike, where Eq. 3.4 makes
+        them differ by the transmission's loss; free columns a and o would absorb it into FDJ and η_O."""
+        free = np.linalg.lstsq(self.base, self.y, rcond=None)[0]
+        eta_o = float(np.clip(1.0 / (1.0 + max(0.5 * (free[1] + free[2]), 0.0)), *ETA_O_SEARCH))
+        step = 1e-4
+        (aid_low, opp_low), (aid_high, opp_high) = (
+            load_factors(x, self.gear_ratio) for x in (eta_o - step, eta_o + step)
+        )
+        slope = (aid_high - aid_low) / (opp_high - opp_low)
+        k_aid, k_opp = load_factors(eta_o, self.gear_ratio)
+        aiding, opposing = self.base[:, 1], self.base[:, 2]
+        design = np.column_stack([self.base[:, 0], opposing + slope * aiding])
+        return design, (k_aid - slope * k_opp) * aiding
 
 
 def motor_angle_rad(speed_radps: np.ndarray, position_deg: np.ndarray, rate_hz: float, gear: float) -> np.ndarray:

@@ -52,6 +52,9 @@ class Family:
     # The physics fixes the size (a gain's trace, given the gain): its one column enters with
     # coefficient 1, subtracted from t, and only the grid value is fitted.
     offset: bool = False
+    # Its grid is the effect's size (a gain, an offset, a bias): a best value at either end is a bound, not a
+    # reading, and the effect is larger than any the loop names.
+    sized: bool = False
 
     def grid_columns(self, e: Equations) -> np.ndarray:
         """(m, G, c) columns for every grid value."""

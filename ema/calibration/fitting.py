@@ -1,6 +1,7 @@
 """Least squares on the equation error, scored on held-out folds from per-fold sums.
 
-Every candidate is a few columns added to the base design (1, a, o and what is already chosen).
+Every candidate is a few columns added to the base design (FDJ's and the tied load's, ``Equations.tied``,
+and what is already chosen).
 Its score is the held-out residual: fit on four folds, predict the fifth, in turn. The Gram
 matrices of each fold are summed once, so a fit without fold f is (G − G_f)⁻¹(b − b_f) and its
 held-out error y_fᵀy_f − 2βᵀb_f + βᵀG_fβ: a candidate costs one pass over the samples, and a

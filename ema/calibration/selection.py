@@ -52,6 +52,7 @@ class Evidence:
     null_std: float
     rms_reduction: float  # 1 − √(in-sample RSS with it / without)
     beta: np.ndarray  # its coefficients on the measured windows
+    at_bound: bool = False  # a sized family's best value at an end of its grid (``Family.sized``)
 
     @property
     def z(self) -> float:
@@ -59,11 +60,13 @@ class Evidence:
 
 
 def problem(e: Equations, chosen: Sequence[Chosen]) -> tuple[np.ndarray, np.ndarray]:
-    """(design, target): the base columns (1, a, o) and the chosen families' columns at their grid
-    values; t less the chosen families whose size the physics fixes."""
+    """(design, target): the base columns with η_A tied to η_O (``Equations.tied``) and the chosen families'
+    columns at their grid values; t less the tie's fixed part and the chosen families whose size the physics
+    fixes."""
+    base, fixed = e.tied
     columns = [c.family.columns(e, c.grid) for c in chosen if not c.family.offset]
     offsets = [c.family.columns(e, c.grid)[:, 0] for c in chosen if c.family.offset]
-    return np.concatenate([e.base, *columns], axis=1), e.y - sum(offsets, np.zeros(e.m))
+    return np.concatenate([base, *columns], axis=1), e.y - fixed - sum(offsets, np.zeros(e.m))
 
 
 def residual_rms(e: Equations, chosen: Sequence[Chosen]) -> float:
@@ -104,6 +107,7 @@ def evidence(measured: Equations, copies: Sequence[Equations], chosen: Sequence[
         null_std=float(np.std(null, ddof=1)),
         rms_reduction=1.0 - float(np.sqrt(rss[best] / max(base.rss, 1e-300))),
         beta=beta[best],
+        at_bound=family.sized and best in (0, len(family.grid) - 1),
     )
 
 
@@ -162,8 +166,11 @@ def decide(
     found: Sequence[Evidence], measured: Equations, copies: Sequence[Equations], chosen: Sequence[Chosen]
 ) -> Decision:
     """One forward step: adopt the best significant family if a name is earned; else describe."""
-    significant = sorted((e for e in found if e.z >= MIN_Z), key=lambda e: -e.improvement)
+    significant = sorted((e for e in found if e.z >= MIN_Z and not e.at_bound), key=lambda e: -e.improvement)
     if not significant:
+        bounded = [e.family.name for e in found if e.z >= MIN_Z and e.at_bound]
+        if bounded:
+            return Decision(None, [], f"{', '.join(bounded)} reads at the end of its search: larger than any it names")
         return Decision(None, [], f"no candidate lowers the held-out residual beyond {MIN_Z:g} noise-floor stds")
     best = significant[0]
     close = [e for e in significant[1:] if e.improvement >= (1 - NAME_MARGIN) * best.improvement]

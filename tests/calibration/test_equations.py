@@ -35,3 +35,25 @@ def test_the_dead_band_width_is_read_from_the_windows_own_angles():
     # BLK of Table 3.1, within the few % that smoothing over the reversals takes (the noise floor's
     # copies carry the same, so ema.calibration.backlash reads extra width against them, not against BLK)
     assert width_rad(problem) == pytest.approx(5e-3, rel=0.1)
+
+
+@pytest.mark.parametrize("gear_ratio", [20.0, 500.0])
+@pytest.mark.parametrize("eta_o", [0.6, 0.85])
+def test_the_tied_base_holds_eq_3_4_near_the_windows_efficiency(gear_ratio, eta_o):
+    """t = FDJ + k_aid(η_O)·a + k_opp(η_O)·o exactly (Eq. 3.4): the tied design, linearized where the free fit
+    sits, reproduces it with k_opp as its load coefficient."""
+    from dataclasses import replace
+
+    from ema.calibration.fitting import score
+    from ema.model.params import load_factors
+
+    rng = np.random.default_rng(7)
+    e = equations([synthetic_window(HealthParams.single(), seed=1).signals], 10_000.0, [], actuator=THESIS.params)
+    a, o = rng.uniform(0, 0.1, e.m) * (rng.random(e.m) < 0.5), rng.uniform(0, 0.1, e.m)
+    k_aid, k_opp = load_factors(eta_o, gear_ratio)
+    base = np.column_stack([np.ones(e.m), a, o])
+    tied = replace(e, y=0.05 + k_aid * a + k_opp * o, base=base, gear_ratio=gear_ratio)
+    design, fixed = tied.tied
+    fit = score(design, tied.y - fixed, e.folds)
+    assert np.sqrt(fit.rss / e.m) < 1e-4 * 0.05
+    assert fit.beta[1] == pytest.approx(k_opp, rel=1e-3)
