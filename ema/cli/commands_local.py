@@ -160,13 +160,13 @@ def estimate(
 def simulate(as_json: bool, **options: Any) -> None:
     """Write a synthetic ema-window/1 file from the model (sensor noise unless --clean), or --series of them."""
     from ema.cli.printing import print_simulate
-    from ema.cli.synthesis import synthesize
+    from ema.cli.synthesis import Draw, synthesize
 
     stamp = options["recorded_at"]
     if stamp is not None and stamp.tzinfo is None:
         options["recorded_at"] = stamp.replace(tzinfo=dt.UTC)
     with flags_named(SIMULATE_FLAGS):
-        result = synthesize(**options)
+        result = synthesize(Draw(**options))
     emit(result, as_json, print_simulate)
 
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import datetime as dt
 import json
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -15,7 +15,7 @@ from ema.model.actuator import ActuatorDocument
 from ema.model.aircraft import FlightCondition, GroundLoad
 from ema.model.checks import InputError
 from ema.model.effects import EffectSet
-from ema.model.noise import NO_NOISE
+from ema.model.noise import NO_NOISE, SensorNoise
 from ema.model.params import HealthParams
 from ema.model.residual import residual_torque_nm
 from ema.model.synthetic import synthetic_window
@@ -83,76 +83,95 @@ def _healths(
     return healths
 
 
-def synthesize(
+@dataclass(frozen=True)
+class Draw:
+    """What ``ema simulate`` was asked for, one field per flag (``--fdj`` is ``fdj``, and so on)."""
+
+    out: Path
+    fdj: float | None
+    eta_o: float | None
+    fsj: float | None
+    airspeed: float
+    altitude: float
+    ground: bool
+    load_nm: float
+    load_ramp_nmps: float
+    command: str
+    seed: int
+    duration: float
+    rate: float
+    clean: bool
+    effect: tuple[str, ...]
+    actuator_id: str
+    truth_out: Path | None
+    actuator_file: Path | None
+    recorded_at: dt.datetime | None = None
+    flight_hours: float | None = None
+    series: int = 1
+    every_hours: float = 10.0
+    fdj_end: float | None = None
+    eta_o_end: float | None = None
+
+
+def _window(
+    draw: Draw,
+    actuator: ActuatorDocument,
+    health: dict[str, float],
+    index: int,
     *,
-    out: Path,
-    fdj: float | None,
-    eta_o: float | None,
-    fsj: float | None,
-    airspeed: float,
-    altitude: float,
-    ground: bool,
-    load_nm: float,
-    load_ramp_nmps: float,
-    command: str,
-    seed: int,
-    duration: float,
-    rate: float,
-    clean: bool,
-    effect: tuple[str, ...],
-    actuator_id: str,
-    truth_out: Path | None,
-    actuator_file: Path | None,
-    recorded_at: dt.datetime | None = None,
-    flight_hours: float | None = None,
-    series: int = 1,
-    every_hours: float = 10.0,
-    fdj_end: float | None = None,
-    eta_o_end: float | None = None,
-) -> dict[str, Any]:
+    noise: SensorNoise,
+    effects: EffectSet,
+) -> Window:
+    """The ``index``-th window of ``draw`` at ``health`` (FDJ, η_O, FSJ), stamped ``index`` steps of
+    ``every_hours`` on from ``flight_hours`` and ``recorded_at`` where a series or a time was asked for."""
+    window = synthetic_window(
+        HealthParams.single(fsj_nm=health["FSJ"], fdj_nm=health["FDJ"], eta_o=health["eta_O"]),
+        GroundLoad(draw.load_nm, draw.load_ramp_nmps) if draw.ground else FlightCondition(draw.airspeed, draw.altitude),
+        seed=draw.seed + index,
+        duration_s=draw.duration,
+        sample_rate_hz=draw.rate,
+        noise=noise,
+        effects=effects,
+        actuator_id=draw.actuator_id,
+        command=draw.command,
+        actuator=actuator,
+    )
+    offset = index * draw.every_hours
+    hours = None if draw.flight_hours is None and draw.series == 1 else (draw.flight_hours or 0.0) + offset
+    stamp = None if draw.recorded_at is None else (draw.recorded_at + dt.timedelta(hours=offset)).isoformat()
+    window_id = f"series-{draw.seed}-{index:03d}" if draw.series > 1 else window.window_id
+    return replace(window, window_id=window_id, flight_hours=hours, recorded_at=stamp)
+
+
+def synthesize(draw: Draw) -> dict[str, Any]:
     """Simulate the actuator of ``actuator_file`` (the thesis's by default) at the given health (its nominal
     where none is given), write the window (and the truth), return what was written. With ``series`` > 1,
     ``out`` is a folder of that many windows of a degrading actuator, its health moving linearly to
     ``fdj_end`` and ``eta_o_end``, ``every_hours`` flight hours apart (and as many hours apart in recorded_at)."""
-    actuator = actuator_document(actuator_file)
-    healths = _healths(actuator, start=(fdj, eta_o, fsj), end=(fdj_end, eta_o_end), series=series)
-    effects = EffectSet(dict(parse_effect(text) for text in effect))
-    load = GroundLoad(load_nm, load_ramp_nmps) if ground else FlightCondition(airspeed, altitude)
-    noise = NO_NOISE if clean else actuator.noise
-    if series > 1:
-        out.mkdir(parents=True, exist_ok=True)
+    actuator = actuator_document(draw.actuator_file)
+    noise = NO_NOISE if draw.clean else actuator.noise
+    effects = EffectSet(dict(parse_effect(text) for text in draw.effect))  # a malformed flag named before any write
+    start, end = (draw.fdj, draw.eta_o, draw.fsj), (draw.fdj_end, draw.eta_o_end)
+    healths = _healths(actuator, start=start, end=end, series=draw.series)
+    if draw.series > 1:
+        draw.out.mkdir(parents=True, exist_ok=True)
     written, truths = [], []
-    for i, now in enumerate(healths):
-        window = synthetic_window(
-            HealthParams.single(fsj_nm=now["FSJ"], fdj_nm=now["FDJ"], eta_o=now["eta_O"]),
-            load,
-            seed=seed + i,
-            duration_s=duration,
-            sample_rate_hz=rate,
-            noise=noise,
-            effects=effects,
-            actuator_id=actuator_id,
-            command=command,
-            actuator=actuator,
-        )
-        hours = None if flight_hours is None and series == 1 else (flight_hours or 0.0) + i * every_hours
-        stamp = None if recorded_at is None else (recorded_at + dt.timedelta(hours=i * every_hours)).isoformat()
-        window_id = f"series-{seed}-{i:03d}" if series > 1 else window.window_id
-        window = replace(window, window_id=window_id, flight_hours=hours, recorded_at=stamp)
-        path = out / f"{window.window_id}.json" if series > 1 else out
+    for i, health in enumerate(healths):
+        window = _window(draw, actuator, health, i, noise=noise, effects=effects)
+        path = draw.out / f"{window.window_id}.json" if draw.series > 1 else draw.out
         write_window(window, path)
         written.append(str(path))
-        truths.append({**now, "eta_A": float(actuator.eta_a(now["eta_O"])), "flight_hours": hours})
-    if truth_out is not None:
-        truth_out.write_text(json.dumps(truths[0] if series == 1 else truths, indent=2))
+        truths.append({**health, "eta_A": float(actuator.eta_a(health["eta_O"])), "flight_hours": window.flight_hours})
+    if draw.truth_out is not None:
+        draw.truth_out.write_text(json.dumps(truths[0] if draw.series == 1 else truths, indent=2))
     return {
-        "window": written[0] if series == 1 else str(out),
+        "window": written[0] if draw.series == 1 else str(draw.out),
         "windows": written,
         "actuator": actuator.name,
-        "truth": truths[0] if series == 1 else truths,
-        "command": command,
-        "load": "ground" if ground else "flight",
+        "truth": truths[0] if draw.series == 1 else truths,
+        "command": draw.command,
+        "load": "ground" if draw.ground else "flight",
         "effects": effects.as_dict(),
-        "noise": "none" if clean else noise.as_dict(),
+        "noise": "none" if draw.clean else noise.as_dict(),
         "summary": summary(window, actuator),
     }
