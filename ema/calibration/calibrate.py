@@ -43,11 +43,16 @@ from ema.estimate.documents import TARGETS, Estimate
 from ema.estimate.physics.scenario import CLEAR_MARGIN
 from ema.estimate.pipeline import estimate_window
 from ema.estimate.prepare.conditioning import prepare
+from ema.estimate.report import healthy_range
 from ema.model.actuator import ActuatorDocument
 from ema.model.checks import InputError
 from ema.model.noise import SensorNoise
+from ema.model.params import HealthRanges
 from ema.model.window import Window
 
+# A std past this share of the healthy range does not place the actuator in it: a reading's move is judged on
+# no wider a std (a base model a sensor fault defeats carried 3 N·m on FDJ, and then nothing counted as a move).
+MOVE_SHARE_OF_RANGE = 0.5
 SEPARATION = 0.5  # a rival's excess output error, as a share of the pick's gain over no effect, that tells them apart
 
 
@@ -78,11 +83,17 @@ class Context:
     stds: Mapping[str, float]
     noise: Sequence[SensorNoise]
     bias: Mapping[str, float]
+    ranges: HealthRanges
 
     def moves(self, estimates: Mapping[str, float], reference: Mapping[str, float] | None = None) -> bool:
-        """``estimates`` lie further from ``reference`` (the base ones) than ``AMBIGUOUS_STDS`` of their stds."""
+        """``estimates`` lie further from ``reference`` (the base ones) than ``AMBIGUOUS_STDS`` of their stds, each
+        std at most ``MOVE_SHARE_OF_RANGE`` of the healthy range."""
         reference = self.before if reference is None else reference
-        return any(abs(estimates[t] - reference[t]) > AMBIGUOUS_STDS * self.stds[t] for t in TARGETS)
+        return any(abs(estimates[t] - reference[t]) > AMBIGUOUS_STDS * self._scale(t) for t in TARGETS)
+
+    def _scale(self, target: str) -> float:
+        low, high = healthy_range(target, self.ranges)
+        return min(self.stds[target], MOVE_SHARE_OF_RANGE * (high - low))
 
 
 class Calibrator:
@@ -145,7 +156,7 @@ class Calibrator:
         families = named_families(measured, spec) + generic_families(measured)
         stage(f"scoring {len(families)} candidate families against the noise floor")
         self.contests_: dict[str, Contest] = {}
-        context = Context(measured, copies, prepared, before, stds, noise, bias)
+        context = Context(measured, copies, prepared, before, stds, noise, bias, self.actuator.ranges)
         chosen, steps, first_round, unnamed = self._select(context, families, check)
         chosen, ambiguity = settled(measured, chosen, self.contests_, bias, (before, stds))
         if ambiguity is not None:
@@ -240,6 +251,8 @@ class Calibrator:
         narrow = [o for o in options if o is not pick and errors[o.family.name] <= best + margin]
         others = [o.family.name for o in options if o is not pick]
         reason = decision.reason
+        if pick is not decision.chosen:
+            reason += f"; simulated, {pick.family.name} follows the windows best"
         if others:
             reason += f"; told from {' and '.join(others)} by the motor speed and current each reading predicts"
         if narrow:

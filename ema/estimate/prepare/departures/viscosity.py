@@ -66,9 +66,7 @@ class Viscosity:
     leaning_nms: float = 0.0  # where no change was read: the ΔC the window leans to, weighed into ``spread``
     leaning_weight: float = 0.0  # the posterior weight of "C is off by ``leaning_nms``"
     unseen: bool = False  # the window cannot tell C·|ω| from FDJ: ``spread`` carries a C ``UNSEEN_SHARE`` off
-    gain_alike: bool = (
-        False  # a change stood out that a gain of the current's reading explains as well (``leaning_nms``)
-    )
+    gain_alike: bool = False  # a change (``leaning_nms``) stood out that a current gain explains as well
 
     @property
     def factor(self) -> float:
