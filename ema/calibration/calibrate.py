@@ -96,6 +96,19 @@ class Context:
         return min(self.stds[target], MOVE_SHARE_OF_RANGE * (high - low))
 
 
+def _told_apart(decision: Decision, pick: Evidence, options: Sequence[Evidence], narrow: Sequence[Evidence]) -> str:
+    """A step's reason: why the family was decided, which one the simulation named, what it was told from."""
+    others = [o.family.name for o in options if o is not pick]
+    reason = decision.reason
+    if pick is not decision.chosen:
+        reason += f"; simulated, {pick.family.name} follows the windows best"
+    if others:
+        reason += f"; told from {' and '.join(others)} by the motor speed and current each reading predicts"
+    if narrow:
+        reason += f" (narrowly from {', '.join(o.family.name for o in narrow)}: nearly the same trace)"
+    return reason
+
+
 class Calibrator:
     def __init__(
         self,
@@ -249,14 +262,7 @@ class Calibrator:
         # as it tells the effect from none, or the windows hold two readings (``readings.settled``)
         margin = max(CLEAR_MARGIN * best, SEPARATION * (base - best) if np.isfinite(base) else 0.0)
         narrow = [o for o in options if o is not pick and errors[o.family.name] <= best + margin]
-        others = [o.family.name for o in options if o is not pick]
-        reason = decision.reason
-        if pick is not decision.chosen:
-            reason += f"; simulated, {pick.family.name} follows the windows best"
-        if others:
-            reason += f"; told from {' and '.join(others)} by the motor speed and current each reading predicts"
-        if narrow:
-            reason += f" (narrowly from {', '.join(o.family.name for o in narrow)}: nearly the same trace)"
+        reason = _told_apart(decision, pick, options, narrow)
         shown = {**errors, **({"none": base} if np.isfinite(base) else {})}
         step = Step(
             selected=pick.family.name,
