@@ -23,11 +23,12 @@ from typing import Any
 import numpy as np
 
 from ema.calibration.calibrate import Calibrator, combined
-from ema.cli.figures import calibration_figure
+from ema.cli.figures import residual_figure
 from ema.cli.report import write_section
 from ema.estimate import runtime
 from ema.estimate.config import PipelineConfig
 from ema.estimate.pipeline import estimate_window
+from ema.kinds.rotary import residual_plot
 from ema.model.actuator import THESIS
 from ema.model.checks import InputError
 from ema.model.window import window_from_dict
@@ -62,7 +63,7 @@ def one(case: str, scale: float, seed: int, figure: Path | None) -> dict[str, An
     seconds = time.perf_counter() - started
     report = calibrator.report_
     if figure is not None:
-        calibration_figure(calibrator, figure)
+        residual_figure(residual_plot(calibrator), figure)
 
     def error(when: str) -> float:
         errors = getattr(report, f"error_pct_{when}")

@@ -23,7 +23,7 @@ import numpy as np
 
 from ema.calibration.linear_report import calibrate_linear
 from ema.cli.report import write_section
-from ema.estimate.kinds import estimate
+from ema.kinds import estimate
 from ema.model.actuator import read_actuator
 from ema.model.logmap import read_logmap, read_mapped
 from ema.model.window import window_from_dict
@@ -95,7 +95,7 @@ def main() -> None:
     teach = [
         w for state, load in found if state == HEALTHY and load > 0 for w in windows(args.runs, state, load, first)
     ]
-    report, learned = calibrate_linear(teach, document)
+    report, learned, _ = calibrate_linear(teach, document)
     assert learned is not None and report.drive is not None
     rows: dict[str, np.ndarray] = {}
     said: dict[str, str] = {}
@@ -121,7 +121,7 @@ def _compared(runs: list, learned) -> str:
     """What ``ema calibrate`` says of ``runs`` against the learned healthy baseline: FDJ's change, then the stroke."""
     if len(runs) < 2:
         return "too few runs to compare"
-    report, _ = calibrate_linear(runs, learned)
+    report, _, _ = calibrate_linear(runs, learned)
     return f"{report.changes[0].said}; {report.selection_steps[0].reason}"
 
 

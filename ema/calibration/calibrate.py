@@ -63,7 +63,7 @@ def combined(results: Sequence[Estimate], actuator: ActuatorDocument) -> dict[st
     for name in TARGETS:
         entries = [e for e in (getattr(r.estimates, name) for r in results) if e is not None]
         if not entries:
-            out[name] = actuator.health.eta_o
+            out[name] = actuator.health.efficiency
             continue
         values = np.array([e.value for e in entries])
         weights = 1.0 / np.maximum([e.std or 1.0 for e in entries], 1e-12) ** 2

@@ -10,6 +10,7 @@ from typing import Literal
 
 from pydantic import Field
 
+from ema.model.actuator import ActuatorDocument
 from ema.model.document import Document
 
 
@@ -80,6 +81,16 @@ class DriveLearned(Document):
     not_separable: list[str] = Field(description="constants these runs cannot tell apart, and how they were read")
 
 
+class Learned(Document):
+    """A constant the windows taught, in the actuator document's words: one consistent model. A constant that
+    differs with the direction of motion is named twice, ``_up`` (towards increasing position) and ``_down``."""
+
+    name: str = Field(description="FDJ, mass, viscous, offset, current_per_nm, …; with _up and _down where it differs")
+    value: float
+    std: float = Field(description="one standard deviation, in its unit")
+    unit: str
+
+
 class Change(Document):
     """A parameter of faulted runs against the calibrated document's nominal."""
 
@@ -88,6 +99,12 @@ class Change(Document):
     value: float
     std: float = Field(description="of the runs' combined value (their repeatability included)")
     z: float = Field(description="(value − nominal) / std")
+    departed: bool = Field(
+        False,
+        description="the change, either way, lies beyond what runs of one state show (a fall of friction as well as "
+        "a rise)",
+    )
+    unit: str | None = None
     said: str
 
 
@@ -138,8 +155,29 @@ class CalibrationReport(Document):
     changes: list[Change] = Field(
         default_factory=list, description="a linear actuator's faulted runs against its calibrated nominal"
     )
+    learned: list[Learned] = Field(
+        default_factory=list,
+        description="what the windows taught that the document lacks, each with its std and unit (a servo's mass, "
+        "viscous friction, FDJ and offset, an adopted effect's constants; a stepper's drive)",
+    )
+    model_error_pct_before: dict[str, float] | None = Field(
+        None,
+        description="per signal: 100·‖y − ŷ‖/‖y‖, the model's reconstruction of the log (the identification "
+        "benchmarks' error) with the base model",
+    )
+    model_error_pct_after: dict[str, float] | None = Field(None, description="the same with the effects in")
+    model_error_pct_document: dict[str, float] | None = Field(
+        None,
+        description="the same for the document's model as it stands, its constants fixed (null where it holds none): "
+        "how well what was learned before reads these windows",
+    )
     error_before: dict[str, float] | None = None
     error_after: dict[str, float] | None = None
     error_pct_before: dict[str, float] | None = None
     error_pct_after: dict[str, float] | None = None
+    completed_actuator: ActuatorDocument | None = Field(
+        None,
+        description="the actuator's ema-actuator/1 document completed with what the windows taught (a linear "
+        "actuator's drive, a servo's load): store it with PUT /v1/actuators/{id} (null: nothing to complete)",
+    )
     timings_s: dict[str, float]

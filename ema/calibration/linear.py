@@ -94,6 +94,9 @@ class DriveFit:
     loads_n: list[float]
     profile: np.ndarray  # (2, PROFILE_BINS): the runs' mean current along each stroke (``Run.profile``)
     profile_std: np.ndarray  # its run-to-run std per bin
+    stretch_load_nm: np.ndarray  # (S,) each stretch's load torque at the motor, + pushing towards increasing position
+    stretch_residual_before_a: np.ndarray  # (S,) its current about the document's model
+    stretch_residual_after_a: np.ndarray  # (S,) about the drive learned
 
 
 def _design(runs: list[Run], eta: float, actuator: ActuatorDocument) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -147,6 +150,9 @@ def fit_drive(runs: list[Run], actuator: ActuatorDocument) -> DriveFit:
         repeatability_nm=repeat,
         residual_before_a=rms(y - _predicted_before(runs, actuator)),
         residual_after_a=rms(y - x @ np.array([c, c_fdj])),
+        stretch_load_nm=np.array([s.load_nm for run in runs for s in run.stretches]),
+        stretch_residual_before_a=y - _predicted_before(runs, actuator),
+        stretch_residual_after_a=y - x @ np.array([c, c_fdj]),
         loads_n=[round(size * actuator.gear_ratio, 3) for size in sizes],
         profile=np.nanmean([run.profile for run in runs], axis=0),
         profile_std=np.nanstd([run.profile for run in runs], axis=0, ddof=1)
@@ -187,7 +193,7 @@ def _predicted_before(runs: list[Run], actuator: ActuatorDocument) -> np.ndarray
     screw, nominal = actuator.screw, actuator.nominal
     if screw is None or screw.current_per_nm_a is None or nominal is None:
         return np.zeros(sum(len(run.stretches) for run in runs))
-    x, _, _ = _design(runs, nominal.eta_o, actuator)
+    x, _, _ = _design(runs, nominal.efficiency, actuator)
     return screw.current_per_nm_a * (x[:, 0] + nominal.fdj_nm)
 
 

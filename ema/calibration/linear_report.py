@@ -21,15 +21,16 @@ from ema.calibration.documents import (
     Change,
     DriveLearned,
     HeldOut,
+    Learned,
     NoiseFloor,
     Step,
 )
 from ema.calibration.linear import MIN_Z, DriveFit, Run, fit_drive, profile_change, read_run
+from ema.calibration.plot import ResidualPlot, Series
 from ema.estimate.config import PipelineConfig
-from ema.estimate.documents import ActuatorRead
+from ema.estimate.documents import DIMENSIONLESS, ActuatorRead
 from ema.estimate.low_rate import estimate_low_rate
 from ema.model.actuator import ActuatorDocument, Nominal
-from ema.model.checks import InputError
 from ema.model.params import load_factors
 from ema.model.window import Window
 
@@ -41,19 +42,49 @@ ANCHOR = (
 
 def calibrate_linear(
     windows: Sequence[Window], actuator: ActuatorDocument, truth: Mapping[str, float] | None = None
-) -> tuple[CalibrationReport, ActuatorDocument | None]:
-    """The report, and the completed document where the runs taught the drive (None when comparing)."""
+) -> tuple[CalibrationReport, ActuatorDocument | None, ResidualPlot]:
+    """The report, the completed document where the runs taught the drive (None when comparing), and its figure."""
     started = time.perf_counter()
     runs = [read_run(w, actuator) for w in windows]
     screw = actuator.screw
     assert screw is not None
     if screw.current_per_nm_a is None or actuator.nominal is None:
-        return _learned(runs, actuator, started)
-    return _compared(windows, runs, actuator, started), None
+        fit = fit_drive(runs, actuator)
+        return _learned(runs, fit, actuator, started), completed(actuator, fit), _drive_plot(fit)
+    return _compared(windows, runs, actuator, started), None, _stroke_plot(runs, actuator)
 
 
-def _learned(runs: list[Run], actuator: ActuatorDocument, started: float) -> tuple[CalibrationReport, ActuatorDocument]:
-    fit = fit_drive(runs, actuator)
+def _drive_plot(fit: DriveFit) -> ResidualPlot:
+    """Each stretch's current about the document's model and about the drive learned, against its load."""
+    return ResidualPlot(
+        title="calibration: the drive learned",
+        x_label="load torque at the motor, + towards increasing position [N·m]",
+        y_label="current about the model [A]",
+        series=[
+            Series("before", fit.stretch_load_nm.tolist(), fit.stretch_residual_before_a.tolist()),
+            Series("after", fit.stretch_load_nm.tolist(), fit.stretch_residual_after_a.tolist()),
+        ],
+    )
+
+
+def _stroke_plot(runs: list[Run], actuator: ActuatorDocument) -> ResidualPlot:
+    """The current along each stroke, less its mean: the healthy runs' (the document's) and these runs'."""
+    baseline, _ = _baseline(actuator)
+    mean = np.nanmean([run.profile for run in runs], axis=0)
+    bins = mean.shape[1]
+    along = ((np.arange(bins) + 0.5) / bins).tolist()
+    series = [Series(f"these runs, {way}", along, mean[row].tolist()) for row, way in enumerate(("up", "down"))]
+    if np.isfinite(baseline).all() and baseline.shape == mean.shape:
+        series += [Series(f"healthy, {way}", along, baseline[row].tolist()) for row, way in enumerate(("up", "down"))]
+    return ResidualPlot(
+        title="calibration: the current along the stroke",
+        x_label="share of the stroke",
+        y_label="current less its stroke's mean [A]",
+        series=series,
+    )
+
+
+def _learned(runs: list[Run], fit: DriveFit, actuator: ActuatorDocument, started: float) -> CalibrationReport:
     unread = [ANCHOR] + (
         []
         if fit.fdj_nm is not None
@@ -76,7 +107,7 @@ def _learned(runs: list[Run], actuator: ActuatorDocument, started: float) -> tup
         repeatability_nm=fit.repeatability_nm,
         not_separable=unread,
     )
-    before = {} if actuator.nominal is None else {"FDJ": actuator.nominal.fdj_nm, "eta_O": actuator.nominal.eta_o}
+    before = {} if actuator.nominal is None else {"FDJ": actuator.nominal.fdj, "eta_O": actuator.nominal.eta_o}
     after = {} if fit.fdj_nm is None or fit.eta_o is None else {"FDJ": fit.fdj_nm, "eta_O": fit.eta_o}
     reason = (
         f"learned from {len(runs)} healthy run(s) at {', '.join(f'{n:.0f} N' for n in fit.loads_n)}: c "
@@ -92,7 +123,22 @@ def _learned(runs: list[Run], actuator: ActuatorDocument, started: float) -> tup
         held=_leave_one_out(runs, actuator),
         started=started,
     )
-    return report.model_copy(update={"drive": drive}), completed(actuator, fit)
+    learned = [
+        Learned(name="current_per_nm", value=fit.current_per_nm_a, std=fit.current_per_nm_std_a, unit="A/(N·m)"),
+        Learned(
+            name="current_at_zero_torque",
+            value=fit.current_at_zero_torque_a,
+            std=fit.current_at_zero_torque_std_a,
+            unit="A",
+        ),
+    ]
+    if fit.fdj_nm is not None and fit.fdj_std_nm is not None and fit.eta_o is not None and fit.eta_o_std is not None:
+        learned += [
+            Learned(name="FDJ", value=fit.fdj_nm, std=fit.fdj_std_nm, unit="N·m"),
+            Learned(name="eta_O", value=fit.eta_o, std=fit.eta_o_std, unit=DIMENSIONLESS),
+        ]
+    learned.append(Learned(name="repeatability", value=fit.repeatability_nm, std=0.0, unit="N·m"))
+    return report.model_copy(update={"drive": drive, "learned": learned})
 
 
 def completed(actuator: ActuatorDocument, fit: DriveFit) -> ActuatorDocument:
@@ -156,13 +202,13 @@ def _compared(
     weights = 1.0 / stds**2
     fdj, fdj_std = float(np.sum(weights * values) / np.sum(weights)), float(np.median(stds))
     nominal = actuator.health
-    z = (fdj - nominal.fdj_nm) / fdj_std
+    z = (fdj - nominal.fdj) / fdj_std
     said = (
-        f"FDJ rose by {fdj - nominal.fdj_nm:+.3f} N·m ({z:+.1f} stds of one run): a friction rise"
+        f"FDJ rose by {fdj - nominal.fdj:+.3f} N·m ({z:+.1f} stds of one run): a friction rise"
         if z > 2
-        else f"FDJ moved {fdj - nominal.fdj_nm:+.3f} N·m, {z:+.1f} stds of one run: within what runs of one state show"
+        else f"FDJ moved {fdj - nominal.fdj:+.3f} N·m, {z:+.1f} stds of one run: within what runs of one state show"
     )
-    changes = [Change(parameter="FDJ", nominal=nominal.fdj_nm, value=fdj, std=fdj_std, z=z, said=said)]
+    changes = [Change(parameter="FDJ", nominal=nominal.fdj, value=fdj, std=fdj_std, z=z, said=said)]
     baseline = _baseline(actuator)
     profile_z, departure = profile_change(runs, *baseline)
     named = profile_z >= MIN_Z
@@ -190,7 +236,7 @@ def _compared(
         len(runs),
         0.0,
         0.0,
-        {"FDJ": nominal.fdj_nm},
+        {"FDJ": nominal.fdj},
         {"FDJ": fdj},
         steps=[Step(selected="position_friction" if named else None, reason=reason)],
         held=HeldOut(rss_before=0.0, rss_after=0.0, adopted=False, note="runs read with the document"),
@@ -244,10 +290,3 @@ def _report(
         estimates_after=after,
         timings_s={"total": time.perf_counter() - started},
     )
-
-
-def refuse_mixed(windows: Sequence[Window], actuator: ActuatorDocument) -> None:
-    """InputError naming the first window that is not the linear actuator's."""
-    for w in windows:
-        if w.kind != "linear":
-            raise InputError(f"window {w.window_id}", f"is a {w.kind} actuator's, the document a linear one's")

@@ -30,7 +30,7 @@ def clean_replicas(
     windows: Sequence[Window], estimates: Mapping[str, float], actuator: ActuatorDocument
 ) -> list[dict[str, np.ndarray]]:
     """Each window simulated at ``estimates`` (FSJ at twice FDJ), without noise."""
-    health = inside(estimates["FDJ"], estimates["eta_O"], actuator.health.fdj_nm)
+    health = inside(estimates["FDJ"], estimates["eta_O"], actuator.health.fdj)
     return [
         scenario_from_window(w, actuator.params, actuator.hinge).simulate(health, lanes=1).simulation(0)
         for w in windows

@@ -46,7 +46,7 @@ def output_error(
     effects = simulated_effects([*beside, *([option] if option is not None else [])])
     if effects is None:
         return float("inf")  # a gain outside what the simulator admits: not this reading
-    health = inside(estimates["FDJ"], estimates["eta_O"], actuator.health.fdj_nm)
+    health = inside(estimates["FDJ"], estimates["eta_O"], actuator.health.fdj)
     errors = [
         following_error(scenario_from_window(w, actuator.params, actuator.hinge, effects), w, health, level)
         for w, level in zip(windows, noise, strict=True)

@@ -98,7 +98,7 @@ def estimate(
     from ema.cli.logs import read_one
     from ema.cli.printing import print_estimate
     from ema.estimate import runtime
-    from ema.estimate.kinds import estimate as estimate_one
+    from ema.kinds import estimate as estimate_one
 
     config = pipeline_config(size_values)
     document = actuator_document(actuator_file)
@@ -205,44 +205,36 @@ def calibrate(
     as_json: bool,
     **size_values: int,
 ) -> None:
-    """Trace what the model misses in windows of one actuator to an effect, add it, re-estimate; for a linear
-    actuator, learn its drive from healthy runs (--out-actuator), or say what faulted runs changed."""
-    from ema.calibration.calibrate import Calibrator
-    from ema.cli.figures import calibration_figure
+    """Trace what the model misses in windows of one actuator to an effect, add it, re-estimate; learn what the
+    document lacks (a linear actuator's drive, a servo's load: --out-actuator), or say what faulted runs changed."""
+    from ema import kinds
+    from ema.cli.figures import residual_figure
     from ema.cli.logs import read_one
     from ema.cli.printing import print_calibration, read_truth
     from ema.estimate import runtime
+    from ema.model.checks import InputError
 
     config = pipeline_config(size_values)
     runtime.configure(threads)
     document = actuator_document(actuator_file)
     mapping = log_map_document(log_map_file)
     loaded = [read_one(path, mapping) for path in windows]
-    if document.kind == "linear":
-        _calibrate_linear(loaded, document, out_actuator, as_json)
-        return
-    calibrator = Calibrator(config, copies=copies, seed=config.seed, actuator=document)
-    calibrator.fit(loaded, read_truth(truth), on_stage=progress)
-    written = None if figure is None else str(calibration_figure(calibrator, figure))
-    emit({**calibrator.report_.model_dump(mode="json", by_alias=True), "figure": written}, as_json, print_calibration)
-
-
-def _calibrate_linear(windows: list[Any], document: Any, out: Path | None, as_json: bool) -> None:
-    """A linear actuator's calibration: the report, and the completed document where ``out`` asks for it."""
-    from ema.calibration.linear_report import calibrate_linear, refuse_mixed
-    from ema.cli.printing import print_calibration
-    from ema.model.checks import InputError
-
-    refuse_mixed(windows, document)
-    report, completed = calibrate_linear(windows, document)
-    written = None
-    if out is not None:
-        if completed is None:
-            raise InputError("--out-actuator", "the document is calibrated already: these runs were compared with it")
-        out.write_text(completed.model_dump_json(by_alias=True, indent=2, exclude_none=True) + "\n")
-        written = str(out)
-        print(f"ema: wrote the completed document to {out}", file=sys.stderr)
-    emit({**report.model_dump(mode="json", by_alias=True), "actuator_written": written}, as_json, print_calibration)
+    request = kinds.CalibrationRequest(config, document, read_truth(truth), copies=copies, on_stage=progress)
+    calibrated = kinds.calibrate(loaded, request)
+    written: dict[str, str | None] = {"figure": None, "actuator_written": None}
+    if out_actuator is not None:
+        if calibrated.completed is None:
+            raise InputError(
+                "--out-actuator", "these windows taught the document nothing to complete: they were read with it"
+            )
+        out_actuator.write_text(calibrated.completed.model_dump_json(by_alias=True, indent=2, exclude_none=True) + "\n")
+        written["actuator_written"] = str(out_actuator)
+        print(f"ema: wrote the completed document to {out_actuator}", file=sys.stderr)
+    if figure is not None:
+        if calibrated.plot is None:
+            raise InputError("--figure", f"a {document.kind} actuator's calibration has no figure")
+        written["figure"] = str(residual_figure(calibrated.plot, figure))
+    emit({**calibrated.report.model_dump(mode="json", by_alias=True), **written}, as_json, print_calibration)
 
 
 @click.command()

@@ -7,16 +7,6 @@ from typing import Any
 
 import numpy as np
 
-LABELS = {
-    "speed_radps": "motor speed |ω| [rad/s]",
-    "current_a": "current · sgn(ω) [A]",
-    "time_s": "time in the window [s]",
-    "position_rad": "elevator position [rad]",
-    "motor_angle_rad": "motor angle mod 2π [rad]",
-    "direction": "direction of motion",
-    "load_nm": "load at the shaft, + aiding [N·m]",
-}
-
 
 def _pyplot() -> Any:
     import matplotlib
@@ -27,29 +17,14 @@ def _pyplot() -> Any:
     return plt
 
 
-def calibration_figure(calibrator: Any, path: Path) -> Path:
-    """The equation-error residual before and after, against the variable that explains it."""
-    from ema.calibration.fitting import score
-    from ema.calibration.selection import problem
-
+def residual_figure(plot: Any, path: Path) -> Path:
+    """A calibration's ``ResidualPlot``: each series against the variable that explains it."""
     plt = _pyplot()
-    e, report = calibrator.measured_, calibrator.report_
-    chosen = calibrator.chosen_
-    variable = "time_s"
-    if chosen:
-        variable = chosen[0].family.follows
-    elif report.unexplained is not None:
-        variable = report.unexplained.variables[0]
-    x = e.variables[variable]
-    if variable == "motor_angle_rad":
-        x = np.mod(x, 2 * np.pi)
     figure, axis = plt.subplots(figsize=(7, 4))
-    for label, model, colour in (("before", [], "tab:red"), ("after", chosen, "tab:blue")):
-        design, target = problem(e, model)
-        residual = target - design @ score(design, target, e.folds).beta
-        axis.scatter(x[::4], residual[::4], s=3, alpha=0.4, color=colour, label=label)
-    axis.set(xlabel=LABELS.get(variable, variable), ylabel="equation error of Eq. 5.1 [N·m]")
-    axis.set_title(f"calibration: {report.selected_effect or 'no effect named'}")
+    for series, colour in zip(plot.series, ("tab:red", "tab:blue", "tab:orange", "tab:green"), strict=False):
+        axis.scatter(series.x, series.y, s=3, alpha=0.4, color=colour, label=series.label)
+    axis.set(xlabel=plot.x_label, ylabel=plot.y_label)
+    axis.set_title(plot.title)
     axis.legend(markerscale=4)
     figure.tight_layout()
     figure.savefig(path, dpi=90)

@@ -73,7 +73,7 @@ class Documents:
 
 
 def _in_process(jobs: list[Job], config: PipelineConfig, threads: int, documents: Documents) -> Iterator[Answer]:
-    from ema.estimate.remote import estimate_document
+    from ema.kinds.remote import estimate_document
 
     for window, history in jobs:
         actuator, version = documents.task_arguments(window)
@@ -90,7 +90,7 @@ def _on_ray(
     again, up to ``NODE_LOSSES`` times: a node that dies mid-run loses no window, and each is answered once."""
     import ray
 
-    from ema.estimate.remote import connect, ray_task
+    from ema.kinds.remote import connect, ray_task
 
     connect(address, workers * threads)
     task = ray_task(threads)

@@ -8,7 +8,6 @@ names none), so a piece moving one way is read with the sensors' zero another pi
 
 from __future__ import annotations
 
-import csv
 import json
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -20,9 +19,10 @@ from ema.model.actuator import ActuatorDocument, actuator_from_dict
 from ema.model.checks import InputError, load_json
 from ema.model.envelope import DEFAULT_AIRSPEED_MPS
 from ema.model.logmap import LogMap, read_mapped
+from ema.model.tables import TABLE_SUFFIXES, read_table
 from ema.model.window import SIGNALS, Window, window_from_dict
 
-SUFFIXES = (".json", ".csv", ".npz")
+SUFFIXES = (".json", *TABLE_SUFFIXES)
 ACTUATORS_FILE = "actuators.json"  # in an archive's folder: {actuator_id: its ema-actuator/1 document}
 
 
@@ -60,38 +60,16 @@ def _from_json(path: Path) -> list[Window]:
     return [window_from_dict(d) for d in documents]
 
 
-def _from_csv(path: Path, defaults: Defaults) -> list[Window]:
-    """Columns named as the window's signals (others ignored); ``# key: value`` lines on top give metadata
-    (``actuator_id``, ``window_id``, ``sample_rate_hz``, ``airspeed_mps``, ``altitude_m``, ``recorded_at``,
-    ``flight_hours``, ``flight_id``)."""
-    meta: dict[str, str] = {}
-    lines = path.read_text().splitlines()
-    body = [line for line in lines if not line.startswith("#")]
-    for line in lines:
-        if line.startswith("#") and ":" in line:
-            key, value = line[1:].split(":", 1)
-            meta[key.strip()] = value.strip()
-    rows = list(csv.DictReader(body))
-    if not rows:
-        raise InputError(str(path), "has no data rows")
-    missing = [name for name in SIGNALS if name not in rows[0]]
+def _from_table(path: Path, defaults: Defaults) -> list[Window]:
+    """A CSV or NPZ in ema's own columns, named as a rotary window's signals (others ignored); a CSV's
+    ``# key: value`` lines on top, an NPZ's text arrays, give metadata (``actuator_id``, ``window_id``,
+    ``sample_rate_hz``, ``airspeed_mps``, ``altitude_m``, ``recorded_at``, ``flight_hours``, ``flight_id``)."""
+    table = read_table(path)
+    missing = [name for name in SIGNALS if name not in table.columns]
     if missing:
-        raise InputError(str(path), f"lacks the column(s) {', '.join(missing)}")
-    try:
-        signals = {name: np.array([float(row[name]) for row in rows]) for name in SIGNALS}
-    except (TypeError, ValueError) as exc:
-        raise InputError(str(path), f"has a non-numeric value ({exc})") from None
-    return [_window(signals, meta, defaults, path)]
-
-
-def _from_npz(path: Path, defaults: Defaults) -> list[Window]:
-    with np.load(path, allow_pickle=False) as archive:
-        missing = [name for name in SIGNALS if name not in archive]
-        if missing:
-            raise InputError(str(path), f"lacks the array(s) {', '.join(missing)}")
-        signals = {name: np.asarray(archive[name], dtype=np.float64) for name in SIGNALS}
-        meta = {key: str(archive[key]) for key in archive.files if key not in SIGNALS}
-    return [_window(signals, meta, defaults, path)]
+        raise InputError(str(path), f"lacks the numeric column(s) {', '.join(missing)}")
+    meta = {**{k: str(v) for k, v in table.scalars.items()}, **table.meta}
+    return [_window({name: table.columns[name] for name in SIGNALS}, meta, defaults, path)]
 
 
 def _window(signals: dict[str, np.ndarray], meta: dict[str, Any], defaults: Defaults, path: Path) -> Window:
@@ -116,18 +94,21 @@ def _window(signals: dict[str, np.ndarray], meta: dict[str, Any], defaults: Defa
 
 
 def read_file(path: Path, defaults: Defaults = Defaults(), log_map: LogMap | None = None) -> list[Window]:
-    """Every window in one file (a CSV through ``log_map`` where one is given: ``ema.model.logmap``); errors
-    name the file."""
-    readers = {".json": lambda: _from_json(path), ".csv": lambda: _from_csv(path, defaults)}
-    if log_map is not None:
-        readers[".csv"] = lambda: [window_from_dict(read_mapped(path, log_map))]
-    readers[".npz"] = lambda: _from_npz(path, defaults)
-    if path.suffix.lower() not in readers:
+    """Every window in one file: a JSON window, a CSV or NPZ in ema's columns, or any logged file (CSV, MATLAB,
+    NPZ) through ``log_map`` (``ema.model.logmap``); errors name the file."""
+    suffix = path.suffix.lower()
+    if suffix not in SUFFIXES:
         raise InputError(str(path), f"is not a {'/'.join(SUFFIXES)} file")
+    if suffix == ".mat" and log_map is None:
+        raise InputError(str(path), "is a MATLAB file: its variables become a window's signals through --log-map")
     try:
-        return readers[path.suffix.lower()]()
+        if suffix == ".json":
+            return _from_json(path)
+        if log_map is not None:
+            return [window_from_dict(read_mapped(path, log_map))]
+        return _from_table(path, defaults)
     except InputError as exc:
-        if exc.field == str(path):
+        if exc.field.startswith(str(path)):
             raise
         raise InputError(str(path), f"{exc.field}: {exc.message}") from None
     except (OSError, UnicodeDecodeError, json.JSONDecodeError, ValueError) as exc:
@@ -198,7 +179,7 @@ def read_actuators(folder: Path) -> dict[str, ActuatorDocument]:
 
 
 def read_one(path: Path, log_map: LogMap | None = None) -> Window:
-    """The one window of a file (JSON, CSV or NPZ, a CSV through ``log_map``): what ``ema estimate`` reads; a
+    """The one window of a file (JSON, CSV or NPZ, any logged file through ``log_map``): what ``ema estimate`` reads; a
     file of several is refused naming it (``ema replay`` posts each)."""
     windows = read_file(Path(path), Defaults(), log_map)
     if len(windows) != 1:

@@ -26,17 +26,22 @@ def _std(std: float | None) -> str:
     return "—" if std is None else f"{std:.2g}"
 
 
+def _row(name: str, entry: Any) -> str:
+    nominal = "—" if entry.nominal is None else f"{entry.nominal:.4g}"
+    drift = "—" if entry.drift_pct is None else f"{entry.drift_pct:.2f}%"
+    weak = "  weakly determined" if entry.weakly_determined else ""
+    return f"{name:<22}{entry.value:>12.5g}{_std(entry.std):>10}{nominal:>11}{drift:>10}  {entry.unit or ''}{weak}"
+
+
 def print_estimate(result: Any) -> None:
     click.echo(f"{result.actuator_id}  window {result.window_id}")
-    click.echo(f"{'parameter':<10}{'value':>12}{'± std':>12}{'nominal':>12}{'drift':>10}")
+    click.echo(f"{'parameter':<22}{'value':>12}{'± std':>10}{'nominal':>11}{'drift':>10}  unit")
     for name in ("FDJ", "eta_O", "eta_A", "FSJ"):
         entry = getattr(result.estimates, name)
-        if entry is None:
-            continue
-        weak = "  weakly determined" if entry.weakly_determined else ""
-        click.echo(
-            f"{name:<10}{entry.value:>12.5g}{_std(entry.std):>12}{entry.nominal:>12.4g}{entry.drift_pct:>9.2f}%{weak}"
-        )
+        if entry is not None:
+            click.echo(_row(name, entry))
+    for name, entry in result.estimates.constants.items():
+        click.echo(_row(name, entry))
     if result.estimates.FSJ is None:
         click.echo(f"FSJ: not estimated: {result.fsj_note.text}")
     click.echo(check_line(result.fit_check))
@@ -51,13 +56,21 @@ def print_estimate(result: Any) -> None:
     click.echo(f"time: {times}  total {result.timings_s.total:.2f} s")
 
 
+SIGNAL_WORDS = {"residual_torque": "residual torque", "current_a": "stretches' current",
+                "drive_force_n": "drive force"}  # fmt: skip
+
+
 def check_line(check: Any) -> str:
     """The answer against the window in one line: the simulation at the estimates, and the equation-error test;
     never the one saying "reproduced" where the other says the model lacks something."""
     ratios = check.output_error_ratio
     signal = "residual_torque" if "residual_torque" in ratios else next(iter(ratios))
     output = ratios[signal]
-    what = "residual torque" if signal == "residual_torque" else "the stretches' current"
+    what = SIGNAL_WORDS.get(signal, signal)
+    if check.output_error_pct:
+        what += (
+            " (" + ", ".join(f"{name} {pct:.3g} %" for name, pct in check.output_error_pct.items()) + " from the log)"
+        )
     limit = check.equation_error_limit
     misfit = limit is not None and check.equation_error_ratio > limit
     if not check.reproduced:
@@ -119,7 +132,8 @@ def print_calibration(report: dict[str, Any]) -> None:
             f"nominal {change['nominal']:.4g})"
         )
     click.echo(f"held out: {report['held_out']['note']}")
-    units = {"FDJ": " N·m", "eta_O": ""}
+    learned = {entry["name"]: entry for entry in report.get("learned", [])}
+    units = {"FDJ": " " + learned["FDJ"]["unit"] if "FDJ" in learned else " N·m", "eta_O": ""}
     for name in ("FDJ", "eta_O"):
         if name not in report["estimates_after"]:
             continue
@@ -129,6 +143,15 @@ def print_calibration(report: dict[str, Any]) -> None:
         if report.get("error_pct_before"):
             line += f"   error {report['error_pct_before'][name]:.2f} % -> {report['error_pct_after'][name]:.2f} %"
         click.echo(line)
+    if learned and not report.get("drive"):
+        click.echo("learned (one model):")
+        for entry in learned.values():
+            click.echo(f"  {entry['name']:<24}{entry['value']:>12.5g} ± {entry['std']:<10.2g}{entry['unit']}")
+    for when in ("before", "after", "document"):
+        errors = report.get(f"model_error_pct_{when}")
+        if errors:
+            said = ", ".join(f"{name.replace('_', ' ')} {pct:.2f} %" for name, pct in errors.items())
+            click.echo(f"model error {when}: {said}  (100·‖y − ŷ‖/‖y‖)")
     if report.get("figure"):
         click.echo(f"figure: {report['figure']}")
 

@@ -67,9 +67,10 @@ def _healths(
     """Each window's FDJ, η_O and FSJ: ``start`` (FDJ, η_O, FSJ; the nominal where None) moving linearly to
     ``end`` (FDJ, η_O; no change where None) over ``series`` windows, FSJ never below FDJ (static friction
     never below dynamic)."""
-    if actuator.kind != "rotary" or actuator.nominal is None or actuator.nominal.fsj_nm is None:
+    nominal_health = actuator.nominal
+    if actuator.drive is None or nominal_health is None or nominal_health.fsj_nm is None:
         raise InputError("--actuator", f"a {actuator.kind} actuator's drive is not simulated: give a rotary one")
-    nominal = (actuator.nominal.fdj_nm, actuator.nominal.eta_o, actuator.nominal.fsj_nm)
+    nominal = (nominal_health.fdj, nominal_health.efficiency, nominal_health.fsj_nm)
     first = {
         name: default if given is None else given
         for name, given, default in zip(("FDJ", "eta_O", "FSJ"), start, nominal, strict=True)

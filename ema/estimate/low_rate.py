@@ -15,7 +15,17 @@ from collections.abc import Callable
 import numpy as np
 
 from ema.estimate.config import PipelineConfig
-from ema.estimate.documents import STAGES, ActuatorRead, Estimate, Estimates, FitCheck, Note, Timings, parameter
+from ema.estimate.documents import (
+    DIMENSIONLESS,
+    STAGES,
+    ActuatorRead,
+    Estimate,
+    Estimates,
+    FitCheck,
+    Note,
+    Timings,
+    parameter,
+)
 from ema.estimate.documents.window import WindowInfo
 from ema.estimate.quasistatic import (
     MIN_STRETCH_S,
@@ -40,6 +50,7 @@ SKIPPED = {
     "assess": "no held-out simulations: the std is the stretches' own noise and the document's repeatability",
     "check": "no simulation of the window at the answer: the stretches' fit to Eq. 5.1 is the check",
 }
+QUASI_STATIC = tuple(stage for stage in STAGES if stage not in SKIPPED)  # the stages a low-rate window runs
 
 
 REST_DEPARTURE = 4.0  # a window's current at rest this many day-to-day spreads off the document's: said
@@ -116,7 +127,7 @@ def estimate_low_rate(
     eta_std = (screw.eta_o_std if screw is not None else None) or 0.0
     repeat = (screw.repeatability_nm if screw is not None else None) or 0.0
     fit = fit_stretches(
-        found, reading, actuator.gear_ratio, eta_o_document=(nominal.eta_o, eta_std), repeatability_nm=repeat
+        found, reading, actuator.gear_ratio, eta_o_document=(nominal.efficiency, eta_std), repeatability_nm=repeat
     )
     seconds["physics"] = time.perf_counter() - started - seconds["prepare"]
     announce("writing the report")
@@ -129,15 +140,16 @@ def estimate_low_rate(
 
 
 def _estimates(actuator: ActuatorDocument, fit: QuasiStaticFit) -> Estimates:
-    nominal, ranges = actuator.health, actuator.ranges
+    nominal, ranges, friction = actuator.health, actuator.ranges, actuator.facts.friction_unit
     eta_a = float(actuator.eta_a(fit.eta_o))
     slope = float((actuator.eta_a(fit.eta_o + 1e-5) - actuator.eta_a(fit.eta_o - 1e-5)) / 2e-5)
-    eta_o = parameter(fit.eta_o, fit.eta_o_std, nominal.eta_o, weakly_determined("eta_O", fit.eta_o_std, ranges))
-    eta_a_entry = parameter(
-        eta_a, abs(slope) * fit.eta_o_std, float(actuator.eta_a(nominal.eta_o)), eta_o.weakly_determined
-    )
+    weak_eta = weakly_determined("eta_O", fit.eta_o_std, ranges)
+    eta_o = parameter(fit.eta_o, fit.eta_o_std, nominal.eta_o, weak_eta, unit=DIMENSIONLESS)
+    nominal_eta_a = None if nominal.eta_o is None else float(actuator.eta_a(nominal.eta_o))
+    eta_a_entry = parameter(eta_a, abs(slope) * fit.eta_o_std, nominal_eta_a, weak_eta, unit=DIMENSIONLESS)
+    weak_fdj = weakly_determined("FDJ", fit.fdj_std_nm, ranges)
     return Estimates(
-        FDJ=parameter(fit.fdj_nm, fit.fdj_std_nm, nominal.fdj_nm, weakly_determined("FDJ", fit.fdj_std_nm, ranges)),
+        FDJ=parameter(fit.fdj_nm, fit.fdj_std_nm, nominal.fdj, weak_fdj, unit=friction),
         eta_O=eta_o if fit.eta_o_read else None,
         eta_A=eta_a_entry if fit.eta_o_read else None,
         FSJ=None,

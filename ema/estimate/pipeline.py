@@ -17,9 +17,7 @@ The thesis's §6.3 proposal, made to hold on data our simulator did not draw:
 
 from __future__ import annotations
 
-import contextlib
-import time
-from collections.abc import Callable, Iterator
+from collections.abc import Callable
 from dataclasses import replace
 
 import numpy as np
@@ -27,7 +25,7 @@ import numpy as np
 from ema.estimate.assess.reproduction import output_error_ratios
 from ema.estimate.assess.weighing import Assessed, Candidates, assess, misfit_limit
 from ema.estimate.config import PipelineConfig
-from ema.estimate.documents import ActuatorRead, Estimate, FitCheck, Note, Timings
+from ema.estimate.documents import ActuatorRead, Estimate, FitCheck, Note
 from ema.estimate.documents.window import HistoryReadings
 from ema.estimate.history import known_from
 from ema.estimate.learn.estimator import NetworkEstimator
@@ -39,6 +37,7 @@ from ema.estimate.physics.static_friction import read_static_friction
 from ema.estimate.prepare.conditioning import Prepared, prepare, widened
 from ema.estimate.report import estimate_document
 from ema.estimate.simulate.dataset import Data, simulate_dataset
+from ema.estimate.stopwatch import Stopwatch
 from ema.model.actuator import THESIS, ActuatorDocument
 from ema.model.window import Window
 
@@ -121,24 +120,6 @@ def fit_check(
     )
 
 
-class Stopwatch:
-    """Each stage's seconds, announced to ``on_stage`` as it starts (which may raise to stop the job there)."""
-
-    def __init__(self, on_stage: Callable[[str], None] | None) -> None:
-        self.on_stage = on_stage or (lambda _: None)
-        self.seconds: dict[str, float] = {}
-
-    @contextlib.contextmanager
-    def __call__(self, name: str, announcement: str) -> Iterator[None]:
-        self.on_stage(announcement)
-        started = time.perf_counter()
-        yield
-        self.seconds[name] = time.perf_counter() - started
-
-    def timings(self) -> Timings:
-        return Timings(**self.seconds, total=sum(self.seconds.values()))
-
-
 def weighed(
     window: Window, physics: FrictionFit, data: Data, network: NetworkEstimator, *, prepared: Prepared, n: int
 ) -> tuple[Assessed, float, float]:
@@ -190,7 +171,7 @@ def estimate_window(
     with watch("assess", "weighing the estimators on held-out simulations"):
         answer, equation_ratio, limit = weighed(w, physics, data, network, prepared=prepared, n=n)
     with watch("check", "checking the answer against the window"):
-        check = fit_check(seen, data, answer, equation_ratio, n, actuator.health.fdj_nm)
+        check = fit_check(seen, data, answer, equation_ratio, n, actuator.health.fdj)
         check = check.model_copy(update={"equation_error_limit": limit})
     with watch("report", "reading FSJ at the answer, writing the report"):
         fsj = read_static_friction(

@@ -11,6 +11,7 @@ import numpy as np
 from ema.estimate.assess.weighing import Assessed
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import (
+    DIMENSIONLESS,
     STAGES,
     TARGETS,
     ActuatorRead,
@@ -74,14 +75,21 @@ def _estimates(
     # stops there for a reason it does not know (a unit, a departure), and FDJ with it where the window is loaded
     weak_eta = weakly_determined("eta_O", eta_o_std, ranges) or eta_o_bound
     weak_fdj = weakly_determined("FDJ", answer.stds["FDJ"], ranges) or (eta_o_bound and loaded)
+    friction = actuator.facts.friction_unit
     eta_a = parameter(
-        float(actuator.eta_a(eta_o)), abs(slope) * eta_o_std, float(actuator.eta_a(nominal.eta_o)), weak_eta
+        float(actuator.eta_a(eta_o)),
+        abs(slope) * eta_o_std,
+        float(actuator.eta_a(nominal.efficiency)),
+        weak_eta,
+        unit=DIMENSIONLESS,
     )
     return Estimates(
-        FDJ=parameter(fdj, answer.stds["FDJ"], nominal.fdj_nm, weak_fdj),
-        eta_O=parameter(eta_o, eta_o_std, nominal.eta_o, weak_eta) if loaded else None,
+        FDJ=parameter(fdj, answer.stds["FDJ"], nominal.fdj, weak_fdj, unit=friction),
+        eta_O=parameter(eta_o, eta_o_std, nominal.eta_o, weak_eta, unit=DIMENSIONLESS) if loaded else None,
         eta_A=eta_a if loaded else None,
-        FSJ=None if fsj.value_nm is None else parameter(fsj.value_nm, fsj.std_nm, nominal.fsj_nm or fsj.value_nm),
+        FSJ=None
+        if fsj.value_nm is None
+        else parameter(fsj.value_nm, fsj.std_nm, nominal.fsj_nm or fsj.value_nm, unit=friction),
         FSD=ratio,
     )
 
@@ -153,8 +161,8 @@ def carries_load(prepared: Prepared) -> bool:
     sliding = np.abs(w.signals["motor_speed_radps"]) > FitSettings().sliding_speed_radps(document.params)
     if not np.any(sliding):
         return True  # nothing slides: the physics fit refuses the window, not this rule
-    term = (1.0 / document.health.eta_o - 1.0) * np.sqrt(np.mean((load_nm[sliding] / document.gear_ratio) ** 2))
-    return bool(term >= NO_LOAD_SHARE * document.health.fdj_nm)
+    term = (1.0 / document.health.efficiency - 1.0) * np.sqrt(np.mean((load_nm[sliding] / document.gear_ratio) ** 2))
+    return bool(term >= NO_LOAD_SHARE * document.health.fdj)
 
 
 def _window_info(prepared: Prepared, data: Data, digest: str) -> WindowInfo:

@@ -19,8 +19,10 @@ from pydantic import Field, model_validator
 from ema.model.aircraft import HingeGeometry
 from ema.model.checks import InputError, read_document, validated
 from ema.model.document import Document, Number
+from ema.model.kinds import KINDS, KindFacts
 from ema.model.params import MAX_CORRELATION_S, DriveConstants, HealthRanges, eta_a_from_eta_o
 from ema.model.screw import Screw
+from ema.model.servo import Servo
 
 if TYPE_CHECKING:
     from ema.model.noise import SensorNoise
@@ -60,27 +62,53 @@ class Drive(Document):
 
 
 class Nominal(Document):
-    """The health of this actuator new."""
+    """The health of this actuator new, FDJ in its kind's unit (``ema.model.kinds``: at the motor shaft, or on the
+    load for a kind logged on the load side)."""
 
-    fdj_nm: Number = Field(gt=0, le=100, description="FDJ, dynamic friction at the motor shaft")
+    fdj_nm: Number | None = Field(None, gt=0, le=100, description="FDJ, dynamic friction at the motor shaft [N·m]")
+    fdj_n: Number | None = Field(
+        None, gt=0, le=1e6, description="FDJ, dynamic friction on the load [N] (a kind logged on the load side)"
+    )
     fsj_nm: Number | None = Field(
         None, gt=0, le=100, description="FSJ, static (break-away) friction at the motor shaft (a rotary actuator's)"
     )
-    eta_o: Number = Field(gt=0, lt=1, description="η_O, efficiency under opposing load")
+    eta_o: Number | None = Field(
+        None, gt=0, lt=1, description="η_O, efficiency under opposing load (null: never shown, as without a load)"
+    )
 
     @model_validator(mode="after")
-    def _static_at_least_dynamic(self) -> Nominal:
-        if self.fsj_nm is not None and self.fsj_nm < self.fdj_nm:
+    def _one_friction(self) -> Nominal:
+        if (self.fdj_nm is None) == (self.fdj_n is None):
+            raise ValueError("fdj_nm: give the nominal FDJ once, at the motor shaft (fdj_nm) or on the load (fdj_n)")
+        if self.fsj_nm is not None and self.fdj_nm is not None and self.fsj_nm < self.fdj_nm:
             raise ValueError(
                 f"fsj_nm: {self.fsj_nm:g} is below fdj_nm {self.fdj_nm:g}: static friction is never below dynamic"
             )
         return self
 
+    @property
+    def fdj(self) -> float:
+        """The nominal FDJ in the kind's unit."""
+        value = self.fdj_nm if self.fdj_nm is not None else self.fdj_n
+        assert value is not None  # _one_friction
+        return value
+
+    @property
+    def efficiency(self) -> float:
+        """The nominal η_O; InputError where the document has none (a servo run without a load)."""
+        if self.eta_o is None:
+            raise InputError("actuator.nominal.eta_o", "is not known: no run with a load has shown it")
+        return self.eta_o
+
 
 class Thresholds(Document):
-    """Where each parameter ends the actuator's useful life (the prognosis's failure levels)."""
+    """Where each parameter ends the actuator's useful life (the prognosis's failure levels): FDJ above its upper
+    level, or below its lower one (a screw that loses its preload loses friction), η_O below its level."""
 
     fdj_above_nm: Number | None = Field(None, gt=0, le=100, description="default: 1.5x the nominal FDJ")
+    fdj_below_nm: Number | None = Field(None, gt=0, le=100, description="default: none (no lower level)")
+    fdj_above_n: Number | None = Field(None, gt=0, le=1e6, description="a load-side kind's, in N: default 1.5x")
+    fdj_below_n: Number | None = Field(None, gt=0, le=1e6, description="a load-side kind's, in N: default none")
     eta_o_below: Number | None = Field(
         None, gt=0, lt=1, description="default: 0.70, or 0.70/0.85 of a nominal η_O below 0.85"
     )
@@ -124,13 +152,16 @@ class ActuatorDocument(Document):
 
     schema_: Literal["ema-actuator/1"] = Field("ema-actuator/1", alias="schema")
     name: str = Field(min_length=1, max_length=200, description="for a person")
-    kind: Literal["rotary", "linear"] = Field(
-        "rotary", description="rotary: a gear train to a surface (drive); linear: a ball screw (screw)"
+    kind: Literal["rotary", "linear", "servo"] = Field(
+        "rotary",
+        description="rotary: a gear train to a surface (drive); linear: a ball screw turned by a stepper (screw); "
+        "servo: a linear axis under a known position controller, logged on the load side (servo)",
     )
     drive: Drive | None = Field(None, description="a rotary actuator's drive and gear train")
     screw: Screw | None = Field(None, description="a linear actuator's screw and drive")
+    servo: Servo | None = Field(None, description="a servo's drive, controller and load")
     nominal: Nominal | None = Field(
-        None, description="the health new; a linear actuator's is learned by ema calibrate on healthy runs"
+        None, description="the health new; a linear actuator's or a servo's is learned by ema calibrate"
     )
     thresholds: Thresholds = Field(default_factory=Thresholds)
     sensor_noise: SensorNoiseDocument | None = Field(None, description="null: the thesis's levels")
@@ -138,81 +169,114 @@ class ActuatorDocument(Document):
 
     @model_validator(mode="after")
     def _one_kind(self) -> ActuatorDocument:
-        needed, other = ("drive", "screw") if self.kind == "rotary" else ("screw", "drive")
-        if getattr(self, needed) is None:
-            raise ValueError(f"{needed}: a {self.kind} actuator's document gives its {needed}")
-        if getattr(self, other) is not None:
-            raise ValueError(f"{other}: a {self.kind} actuator has no {other} (kind: {self.kind})")
-        if self.kind == "rotary" and (self.nominal is None or self.nominal.fsj_nm is None):
-            raise ValueError("nominal.fsj_nm: a rotary actuator's document gives its nominal FDJ, FSJ and η_O")
+        own = self.facts.section
+        if getattr(self, own) is None:
+            raise ValueError(f"{own}: a {self.kind} actuator's document gives its {own}")
+        for other in (k.section for k in KINDS.values() if k.section != own):
+            if getattr(self, other) is not None:
+                raise ValueError(f"{other}: a {self.kind} actuator has no {other} (kind: {self.kind})")
+        if self.facts.nominal_given and (
+            self.nominal is None or self.nominal.fsj_nm is None or self.nominal.eta_o is None
+        ):
+            raise ValueError(f"nominal.fsj_nm: a {self.kind} actuator's document gives its nominal FDJ, FSJ and η_O")
+        unit_field = self.facts.friction_field("fdj")
+        if self.nominal is not None and getattr(self.nominal, unit_field) is None:
+            raise ValueError(f"nominal.{unit_field}: a {self.kind} actuator's FDJ is in {self.facts.friction_unit}")
         return self
 
     @model_validator(mode="after")
     def _thresholds_past_nominal(self) -> ActuatorDocument:
         if self.nominal is None:
             return self
-        fdj, eta = self.threshold("FDJ")[0], self.threshold("eta_O")[0]
-        if fdj <= self.nominal.fdj_nm:
-            raise ValueError(f"thresholds.fdj_above_nm: {fdj:g} is not above the nominal FDJ {self.nominal.fdj_nm:g}")
-        if eta >= self.nominal.eta_o:
-            raise ValueError(f"thresholds.eta_o_below: {eta:g} is not below the nominal η_O {self.nominal.eta_o:g}")
+        for name, nominal in (("FDJ", self.nominal.fdj), ("eta_O", self.nominal.eta_o)):
+            for level, way in self.limits(name) if nominal is not None else []:
+                assert nominal is not None
+                if level <= nominal if way == "above" else level >= nominal:
+                    field = self.facts.friction_field(f"fdj_{way}") if name == "FDJ" else "eta_o_below"
+                    raise ValueError(f"thresholds.{field}: {level:g} is not {way} the nominal {name} {nominal:g}")
         return self
+
+    @property
+    def facts(self) -> KindFacts:
+        """What this document's kind is (``ema.model.kinds``)."""
+        return KINDS[self.kind]
+
+    @property
+    def section(self) -> Drive | Screw | Servo:
+        """The kind's own section of the document (its drive, its screw, its servo)."""
+        section = getattr(self, self.facts.section)
+        assert section is not None  # _one_kind
+        return section
 
     @property
     def params(self) -> DriveConstants:
         """The drive's constants as the simulator takes them (a rotary actuator's)."""
-        assert self.drive is not None, "a linear actuator has no simulator constants"
+        if self.drive is None:
+            raise InputError("actuator.kind", f"a {self.kind} actuator has no rotary drive to simulate")
         return DriveConstants(**self.drive.model_dump())
 
     @property
     def gear_ratio(self) -> float:
-        """Motor speed over output speed: a gear train's n, a screw's 2π/lead [rad/m]."""
-        if self.screw is not None:
-            return self.screw.gear_ratio
-        assert self.drive is not None
-        return self.drive.gear_ratio
+        """Motor speed over output speed: a gear train's n, a screw's 2π/lead [rad/m], a servo's 1 (its log is on
+        the load)."""
+        return self.section.gear_ratio
 
     @property
     def health(self) -> Nominal:
-        """The nominal health; InputError where a linear actuator's is not learned yet."""
+        """The nominal health; InputError where it is not learned yet."""
         if self.nominal is None:
             raise InputError(
                 "actuator.nominal",
-                "is not known yet: run ema calibrate on healthy runs at two loads "
+                "is not known yet: run ema calibrate on healthy runs (a stepper's at two loads) "
                 "and read with the document it writes (--out-actuator)",
             )
         return self.nominal
 
     @property
     def ranges(self) -> HealthRanges:
-        """The healthy range around the nominal health: ``HEALTHY_SPAN`` either way, η_O capped below 1."""
+        """The healthy range around the nominal health: ``HEALTHY_SPAN`` either way, η_O capped below 1 (the thesis's
+        nominal where the document has none)."""
         n, span = self.health, HEALTHY_SPAN
-        fsj = n.fsj_nm if n.fsj_nm is not None else n.fdj_nm
-        eta = (n.eta_o * (1 - span), min(n.eta_o * (1 + span), max(MAX_HEALTHY_ETA_O, n.eta_o)))
+        fsj = n.fsj_nm if n.fsj_nm is not None else n.fdj
+        eta_o = n.eta_o if n.eta_o is not None else THESIS_ETA_O
+        eta = (eta_o * (1 - span), min(eta_o * (1 + span), max(MAX_HEALTHY_ETA_O, eta_o)))
         return HealthRanges(
             fsj_nm=(fsj * (1 - span), fsj * (1 + span)),
-            fdj_nm=(n.fdj_nm * (1 - span), n.fdj_nm * (1 + span)),
+            fdj_nm=(n.fdj * (1 - span), n.fdj * (1 + span)),
             eta_o=eta,
             nominal_fsj_nm=fsj,
-            nominal_fdj_nm=n.fdj_nm,
-            nominal_eta_o=n.eta_o,
+            nominal_fdj_nm=n.fdj,
+            nominal_eta_o=eta_o,
         )
 
     def eta_a(self, eta_o: np.ndarray | float) -> np.ndarray:
         """η_A from η_O by Eq. 3.4 with this actuator's gear ratio."""
         return eta_a_from_eta_o(eta_o, self.gear_ratio)
 
-    def threshold(self, parameter: str) -> tuple[float, Literal["above", "below"]]:
-        """The failure level of ``parameter`` (FDJ, eta_O or eta_A) and the way it is crossed."""
+    def limits(self, parameter: str) -> list[tuple[float, Literal["above", "below"]]]:
+        """The failure levels of ``parameter`` (FDJ, eta_O or eta_A), each with the way it is crossed: FDJ's upper
+        one (default 1.5x nominal) and its lower one where the document gives it; η's lower one (none where the
+        nominal η_O is unknown)."""
+        if parameter == "FDJ":
+            above = getattr(self.thresholds, self.facts.friction_field("fdj_above"))
+            below = getattr(self.thresholds, self.facts.friction_field("fdj_below"))
+            levels: list[tuple[float, Literal["above", "below"]]] = [
+                (above if above is not None else 1.5 * self.health.fdj, "above")
+            ]
+            return levels + ([(below, "below")] if below is not None else [])
         eta_o = self.thresholds.eta_o_below
         if eta_o is None:  # the thesis's 0.70, or as far below a lower nominal (0.70 / 0.85 of it)
+            if self.health.eta_o is None:
+                return []
             eta_o = min(DEFAULT_ETA_O_BELOW, self.health.eta_o * DEFAULT_ETA_O_BELOW / THESIS_ETA_O)
-        if parameter == "FDJ":
-            fdj = self.thresholds.fdj_above_nm
-            return (fdj if fdj is not None else 1.5 * self.health.fdj_nm), "above"
-        if parameter == "eta_O":
-            return eta_o, "below"
-        return float(self.eta_a(eta_o)), "below"
+        return [(eta_o if parameter == "eta_O" else float(self.eta_a(eta_o)), "below")]
+
+    def threshold(self, parameter: str) -> tuple[float, Literal["above", "below"]]:
+        """The first failure level of ``parameter`` (``limits``): FDJ's upper one, η's lower one."""
+        found = self.limits(parameter)
+        if not found:
+            raise InputError(f"thresholds.{parameter}", "has no level: the nominal η_O is not known")
+        return found[0]
 
     @property
     def hinge(self) -> HingeGeometry | None:

@@ -30,11 +30,10 @@ from ema.model.aircraft import AIRSPEED_RANGE_MPS, ALTITUDE_RANGE_M, FlightCondi
 from ema.model.bounds import CLOCK_SKEW, EARLIEST_RECORDED_AT, IDENTIFIER, MAX_FLIGHT_HOURS
 from ema.model.checks import InputError, read_document, validated
 from ema.model.document import Number
+from ema.model.kinds import ALL_SIGNALS, DEFAULT_KIND, KINDS, kind_of_signals, nearest_kind
 
 SCHEMA = "ema-window/1"
-SIGNALS = ("command_deg", "position_deg", "motor_speed_radps", "current_a", "hinge_moment_nm")  # a rotary window's
-LINEAR_SIGNALS = ("command_mm", "position_mm", "current_a", "load_n")  # a linear actuator's (a ball screw's)
-KIND_SIGNALS = {"rotary": SIGNALS, "linear": LINEAR_SIGNALS}
+SIGNALS = KINDS[DEFAULT_KIND].signals  # a rotary window's, the layout a CSV or NPZ log without a map is read in
 MIN_SAMPLES = 100
 MAX_SAMPLES = 1_000_000
 # A window may be logged at 10 Hz (a test rig's logger) to 100 kHz; below HIGH_RATE_HZ it is read quasi-statically
@@ -51,7 +50,11 @@ SIGNAL_LIMITS = {
     "command_mm": (-10_000.0, 10_000.0),
     "position_mm": (-10_000.0, 10_000.0),
     "load_n": (-1e6, 1e6),
+    "set_point_m": (-100.0, 100.0),
+    "position_m": (-100.0, 100.0),
+    "drive_force_n": (-1e6, 1e6),
 }
+CONSTANT_NAME = r"^[a-z][a-z0-9_]{0,63}$"
 
 Samples = Annotated[list[Number], Field(min_length=MIN_SAMPLES, max_length=MAX_SAMPLES)]
 
@@ -66,38 +69,45 @@ class FlightConditionDocument(_Contract):
 
 
 class SignalsDocument(_Contract):
-    """Signals of one length, uniformly sampled from t = 0, each sample the mean over its interval: a rotary
-    actuator's five (``SIGNALS``), or a linear actuator's four (``LINEAR_SIGNALS``), never a mix."""
+    """Signals of one length, uniformly sampled from t = 0, each sample the mean over its interval: one kind's
+    (``ema.model.kinds``: a rotary actuator's five, a linear one's four, a servo's three and its load where it
+    has one), never a mix."""
 
     command_deg: Samples | None = Field(None, description=f"elevator command, within {SIGNAL_LIMITS['command_deg']}")
     position_deg: Samples | None = Field(None, description=f"deflection θ_u, within {SIGNAL_LIMITS['position_deg']}")
     motor_speed_radps: Samples | None = Field(
         None, description=f"motor speed ω_m, within {SIGNAL_LIMITS['motor_speed_radps']}"
     )
-    current_a: Samples = Field(description=f"the drive's current I, within {SIGNAL_LIMITS['current_a']}")
+    current_a: Samples | None = Field(None, description=f"the drive's current I, within {SIGNAL_LIMITS['current_a']}")
     hinge_moment_nm: Samples | None = Field(
         None, description=f"hinge moment H_e, within {SIGNAL_LIMITS['hinge_moment_nm']}"
     )
     command_mm: Samples | None = Field(None, description="a linear actuator's position set point [mm]")
     position_mm: Samples | None = Field(None, description="a linear actuator's measured position [mm]")
     load_n: Samples | None = Field(
-        None, description="the force on a linear actuator [N], positive pushing towards increasing position"
+        None,
+        description="the external force on a linear actuator or a servo [N], positive pushing towards increasing "
+        "position (a servo logged without one carries no load)",
+    )
+    set_point_m: Samples | None = Field(None, description="a servo's position set point, on the load side [m]")
+    position_m: Samples | None = Field(None, description="a servo's measured position, on the load side [m]")
+    drive_force_n: Samples | None = Field(
+        None, description="the force a servo's drive applies to the load [N]: its command times the drive's gain"
     )
 
     @model_validator(mode="after")
     def _one_kind(self) -> SignalsDocument:
-        given = {name for name in (*SIGNALS, *LINEAR_SIGNALS) if getattr(self, name) is not None}
-        if any(given == set(names) for names in KIND_SIGNALS.values()):
+        given = [name for name in ALL_SIGNALS if getattr(self, name) is not None]
+        if kind_of_signals(given) is not None:
             return self
-        rotary, linear = set(SIGNALS) & given - {"current_a"}, set(LINEAR_SIGNALS) & given - {"current_a"}
-        kind = "linear" if len(linear) > len(rotary) else "rotary"
-        missing = [name for name in KIND_SIGNALS[kind] if name not in given]
-        extra = sorted(given - set(KIND_SIGNALS[kind]))
+        kind = nearest_kind(given)
+        missing = [name for name in kind.signals if name not in given]
+        extra = [name for name in given if name not in kind.all_signals]
         field = missing[0] if missing else extra[0]
-        what = f"is missing: a {kind} window carries {', '.join(KIND_SIGNALS[kind])}"
-        raise ValueError(f"{field} {what}" if missing else f"{field} is not a signal of a {kind} window ({what[14:]})")
+        carries = f"a {kind.name} window carries {', '.join(kind.signals)}"
+        raise ValueError(f"{field}: is missing ({carries})" if missing else f"{field}: is no signal of it ({carries})")
 
-    @field_validator(*SIGNALS, *LINEAR_SIGNALS[:2], "load_n")
+    @field_validator(*ALL_SIGNALS)
     @classmethod
     def _plausible(cls, values: list[float] | None, info: Any) -> list[float] | None:
         if values is None:
@@ -145,6 +155,13 @@ class WindowDocument(_Contract):
         examples=["tail-123/2026-11-21T10:00:00Z"],
     )
 
+    constants: dict[Annotated[str, Field(pattern=CONSTANT_NAME)], Number] | None = Field(
+        None,
+        max_length=64,
+        description="constants the log recorded beside its signals, under the names of the actuator document's "
+        "section (a servo's controller gains): read with the document, which must agree where it gives them too",
+    )
+
     @field_validator("recorded_at")
     @classmethod
     def _recorded_in_time(cls, value: dt.datetime | None) -> dt.datetime | None:
@@ -154,8 +171,8 @@ class WindowDocument(_Contract):
 
     def to_window(self) -> Window:
         """The arrays; signals of unequal lengths are refused naming the first one that differs."""
-        names = [name for name in (*SIGNALS, *LINEAR_SIGNALS) if getattr(self.signals, name) is not None]
-        arrays = {name: np.asarray(getattr(self.signals, name), dtype=np.float64) for name in dict.fromkeys(names)}
+        names = [name for name in ALL_SIGNALS if getattr(self.signals, name) is not None]
+        arrays = {name: np.asarray(getattr(self.signals, name), dtype=np.float64) for name in names}
         first = next(iter(arrays))
         for name, array in arrays.items():
             if len(array) != len(arrays[first]):
@@ -172,6 +189,7 @@ class WindowDocument(_Contract):
             recorded_at=recorded,
             flight_hours=self.flight_hours,
             flight_id=self.flight_id,
+            constants=dict(self.constants or {}),
         )
 
 
@@ -188,6 +206,7 @@ class Window:
     recorded_at: str | None = None  # ISO 8601 with a time zone
     flight_hours: float | None = None
     flight_id: str | None = None  # one power-on of the drive: its sensors keep one zero
+    constants: dict[str, float] = field(default_factory=dict)  # what the log recorded beside its signals
 
     def __post_init__(self) -> None:
         lengths = {name: len(self.signals[name]) for name in self.signal_names}
@@ -196,12 +215,16 @@ class Window:
 
     @property
     def kind(self) -> str:
-        """ "linear" for a linear actuator's signals (``LINEAR_SIGNALS``), else "rotary"."""
-        return "linear" if "position_mm" in self.signals else "rotary"
+        """The kind whose signals these are (``ema.model.kinds``)."""
+        found = kind_of_signals(self.signals)
+        if found is None:
+            raise InputError("signals", f"{', '.join(self.signals)} are no one kind's signals")
+        return found.name
 
     @property
     def signal_names(self) -> tuple[str, ...]:
-        return KIND_SIGNALS[self.kind]
+        """The signals the window carries, in its kind's order."""
+        return tuple(name for name in KINDS[self.kind].all_signals if name in self.signals)
 
     @property
     def high_rate(self) -> bool:
@@ -255,6 +278,7 @@ def window_to_dict(window: Window) -> dict[str, Any]:
         **({"recorded_at": window.recorded_at} if window.recorded_at is not None else {}),
         **({"flight_hours": window.flight_hours} if window.flight_hours is not None else {}),
         **({"flight_id": window.flight_id} if window.flight_id is not None else {}),
+        **({"constants": dict(window.constants)} if window.constants else {}),
     }
 
 

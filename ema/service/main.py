@@ -68,7 +68,7 @@ def create_app(settings: Settings) -> FastAPI:
         slots = settings.ray_jobs if settings.backend == "ray" else 1
         app.state.runner = JobRunner(settings.max_queue, settings.queue_timeout_s, slots)
         if settings.backend == "ray":
-            from ema.estimate.remote import connect
+            from ema.kinds.remote import connect
 
             connect(settings.ray_address, threads)
         if settings.warm_up:

@@ -16,6 +16,7 @@ from typing import TypeVar
 from fastapi import Request
 from pydantic import BaseModel, ValidationError
 
+from ema import kinds
 from ema.estimate.config import PipelineConfig
 from ema.model.checks import InputError, from_validation
 from ema.model.window import Window
@@ -49,26 +50,25 @@ async def read_body(request: Request, runner: JobRunner, model: type[Model], the
 
 
 def check_budget(window: Window, config: PipelineConfig, settings: Settings, field: str = "signals") -> None:
-    """Refuse, naming the field and the limit, a window longer or a request costlier than the settings allow (a
-    window read quasi-statically simulates nothing: its length costs only its samples, which the body limits)."""
-    if window.kind == "linear" or not window.high_rate:
-        return
-    if window.duration_s > settings.max_window_s:
+    """Refuse, naming the field and the limit, a window longer or a request costlier than the settings allow, by
+    what its kind really does (``ema.kinds.cost``: a window read quasi-statically simulates nothing, a servo's
+    simulations step at its controller's rate)."""
+    cost = kinds.cost(window, config)
+    if cost.window_s > settings.max_window_s:
         limit = f"{settings.max_window_s:g} s (EMA_MAX_WINDOW_S)"
         raise InputError(field, f"the window lasts {window.duration_s:g} s; this service's limit is {limit}: cut it")
-    work = config.total_simulations * window.duration_s
-    if work > settings.max_simulated_s:
+    if cost.simulated_s > settings.max_simulated_s:
         raise InputError(
             "query.n_simulations",
-            f"{config.total_simulations} simulations of a {window.duration_s:g} s "
-            f"window are {work:g} simulated seconds; this service's limit is {settings.max_simulated_s:g} "
-            "(EMA_MAX_SIMULATED_S)",
+            f"{config.total_simulations} simulations of this {window.duration_s:g} s window are "
+            f"{cost.simulated_s:g} s of 1 µs simulation steps; this service's limit is "
+            f"{settings.max_simulated_s:g} (EMA_MAX_SIMULATED_S)",
         )
 
 
 def check_calibration_budget(windows: Sequence[Window], config: PipelineConfig, settings: Settings) -> None:
-    """One budget for a whole calibration: its windows' count, their seconds together, and the simulation work
-    of estimating them all; over any, InputError naming the field and the limit."""
+    """One budget for a whole calibration: its windows' count, the seconds of them its kind's loop grows with,
+    and the simulation work of reading them all; over any, InputError naming the field and the limit."""
     if len(windows) > settings.max_calibrate_windows:
         raise InputError(
             "windows",
@@ -77,18 +77,17 @@ def check_calibration_budget(windows: Sequence[Window], config: PipelineConfig, 
         )
     for i, window in enumerate(windows):
         check_budget(window, config, settings, field=f"windows.{i}.signals")
-    seconds = sum(window.duration_s for window in windows)
-    if seconds > settings.max_calibrate_s:
+    cost = kinds.calibration_cost(windows, config)
+    if cost.window_s > settings.max_calibrate_s:
         raise InputError(
             "windows",
-            f"the windows last {seconds:g} s together; this service's limit for one "
+            f"the windows last {cost.window_s:g} s together; this service's limit for one "
             f"calibration is {settings.max_calibrate_s:g} s (EMA_MAX_CALIBRATE_S)",
         )
-    work = config.total_simulations * seconds
+    work = cost.simulated_s + sum(kinds.cost(window, config).simulated_s for window in windows)
     if work > settings.max_simulated_s:
         raise InputError(
             "windows",
-            f"{config.total_simulations} simulations of {seconds:g} s of windows are "
-            f"{work:g} simulated seconds; this service's limit is {settings.max_simulated_s:g} "
-            "(EMA_MAX_SIMULATED_S)",
+            f"reading and calibrating these windows is {work:g} s of 1 µs simulation steps; this service's limit "
+            f"is {settings.max_simulated_s:g} (EMA_MAX_SIMULATED_S)",
         )

@@ -120,7 +120,7 @@ def test_history_plots_a_prognosis_whose_interval_holds_the_truth(tmp_path, caps
     hours = np.sort(rng.uniform(0, 200, 200))
     for i, h in enumerate(hours):  # FDJ rising 1e-4 N·m per flight hour: crosses 0.075 at 250 h
         fdj = 0.05 + 1e-4 * h + 4e-4 * rng.normal()
-        estimates = base.estimates.model_copy(update={"FDJ": parameter(fdj, 4e-4, 0.05)})
+        estimates = base.estimates.model_copy(update={"FDJ": parameter(fdj, 4e-4, 0.05, unit="N·m")})
         window = base.window.model_copy(update={"flight_hours": float(h)})
         store.add(
             base.model_copy(

@@ -9,7 +9,7 @@ import pytest
 
 from ema.calibration.linear import MIN_Z, read_run
 from ema.calibration.linear_report import calibrate_linear
-from ema.estimate.kinds import estimate
+from ema.kinds import estimate
 from ema.model.actuator import read_actuator
 from ema.model.checks import InputError
 from ema.model.logmap import read_logmap, read_mapped
@@ -29,7 +29,7 @@ def runs(state: str, load: int, numbers: range) -> list:
 @pytest.fixture(scope="module")
 def learned():
     """The drive learned on half the healthy runs at each load; the other half is for the tests."""
-    report, completed = calibrate_linear(runs("normal", 20, range(5)) + runs("normal", 40, range(5)), DOCUMENT)
+    report, completed, _ = calibrate_linear(runs("normal", 20, range(5)) + runs("normal", 40, range(5)), DOCUMENT)
     return report, completed
 
 
@@ -59,7 +59,7 @@ def test_healthy_runs_at_two_loads_teach_the_drive(learned):
 
 
 def test_runs_at_one_load_leave_fdj_and_eta_o_one_number():
-    report, completed = calibrate_linear(runs("normal", 20, range(5)), DOCUMENT)
+    report, completed, _ = calibrate_linear(runs("normal", 20, range(5)), DOCUMENT)
     assert report.drive is not None and report.drive.fdj_nm is None and report.drive.eta_o is None
     assert completed is not None and completed.nominal is None
     assert any("one load size" in line for line in report.drive.not_separable)
@@ -86,7 +86,7 @@ def test_states_are_told_apart_on_runs_the_calibration_did_not_see(learned):
 
 def test_faulted_runs_against_the_baseline_say_what_changed(learned):
     _, document = learned
-    report, completed = calibrate_linear(runs("lackLubrication1", 20, range(10)), document)
+    report, completed, _ = calibrate_linear(runs("lackLubrication1", 20, range(10)), document)
     assert completed is None and report.changes[0].parameter == "FDJ" and report.changes[0].z > 2
     assert "friction rise" in report.changes[0].said
 
@@ -96,7 +96,7 @@ def test_healthy_runs_logged_apart_name_nothing_along_the_stroke(learned):
     local defect (their mean current along the stroke stays within one run's noise of the healthy profile)."""
     _, document = learned
     for load in (20, 40):
-        report, _ = calibrate_linear(runs("normal", load, range(5, 10)), document)
+        report, _, _ = calibrate_linear(runs("normal", load, range(5, 10)), document)
         assert report.selected_effects == [] and report.candidates[0].score < MIN_Z
         assert abs(report.changes[0].z) < 2
 
@@ -106,7 +106,7 @@ def test_a_document_without_the_healthy_spread_does_not_compare_the_stroke(learn
     another load for a defect, so the stroke is not compared, and the report says why."""
     _, document = learned
     older = document.model_copy(update={"screw": document.screw.model_copy(update={"stroke_profile_std_a": None})})
-    report, _ = calibrate_linear(runs("normal", 40, range(5, 10)), older)
+    report, _, _ = calibrate_linear(runs("normal", 40, range(5, 10)), older)
     assert report.selected_effects == [] and "not compared" in report.selection_steps[0].reason
 
 
@@ -119,7 +119,7 @@ def test_a_local_rise_of_the_current_along_the_stroke_is_named(learned):
         over = (signals["position_mm"] > 60.0) & (signals["position_mm"] < 75.0)
         signals["current_a"] = signals["current_a"] + 0.3 * over * (np.abs(np.gradient(signals["position_mm"])) > 0.5)
         spalled.append(replace(window, signals=signals))
-    report, _ = calibrate_linear(spalled, document)
+    report, _, _ = calibrate_linear(spalled, document)
     assert report.selected_effects == ["position_friction"] and report.candidates[0].score >= MIN_Z
 
 

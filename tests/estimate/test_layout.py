@@ -14,6 +14,7 @@ RANKS = {
     "ema.estimate.documents": 0,
     "ema.estimate.runtime": 0,
     "ema.estimate.stats": 0,
+    "ema.estimate.stopwatch": 0,
     "ema.estimate.physics": 1,
     "ema.estimate.prepare": 2,
     "ema.estimate.simulate": 3,
@@ -22,10 +23,9 @@ RANKS = {
     "ema.estimate.report": 6,
     "ema.estimate.quasistatic": 1,
     "ema.estimate.low_rate": 7,
-    "ema.estimate.kinds": 8,
     "ema.estimate.history": 6,
     "ema.estimate.pipeline": 7,
-    "ema.estimate.remote": 9,
+    "ema.estimate.servo": 7,
 }
 
 

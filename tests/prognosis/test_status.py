@@ -26,7 +26,7 @@ def _history(base, fdjs, **times):
     stored = []
     for i, fdj in enumerate(fdjs):
         window = base.window.model_copy(update={name: values[i] for name, values in times.items()})
-        estimates = base.estimates.model_copy(update={"FDJ": parameter(fdj, 2e-4, 0.05)})
+        estimates = base.estimates.model_copy(update={"FDJ": parameter(fdj, 2e-4, 0.05, unit="N·m")})
         document = base.model_copy(update={"window_id": f"w{i}", "window": window, "estimates": estimates})
         stored.append(Stored(**document.model_dump(by_alias=True), id=i + 1, stored_at=f"2026-11-26T10:00:0{i}+00:00"))
     return stored

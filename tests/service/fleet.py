@@ -34,7 +34,7 @@ def store_fleet(store: History, base: Estimate, windows: int = 20, seed: int = 0
     for actuator_id, (start, slope, curvature, _) in FLEET.items():
         for i, h in enumerate(hours):
             fdj = start + slope * h + curvature * h**2 + 3e-4 * rng.normal()
-            estimates = base.estimates.model_copy(update={"FDJ": parameter(fdj, 3e-4, 0.05)})
+            estimates = base.estimates.model_copy(update={"FDJ": parameter(fdj, 3e-4, 0.05, unit="N·m")})
             window = base.window.model_copy(update={"flight_hours": float(h), "content_sha256": f"{actuator_id}-{i}"})
             store.add(
                 base.model_copy(

@@ -24,7 +24,7 @@ def base():
 
 
 def _copy(base, actuator_id: str, window_id: str, hours: float, fdj: float = 0.05):
-    estimates = base.estimates.model_copy(update={"FDJ": parameter(fdj, 3e-4, 0.05)})
+    estimates = base.estimates.model_copy(update={"FDJ": parameter(fdj, 3e-4, 0.05, unit="N·m")})
     window = base.window.model_copy(update={"flight_hours": hours, "content_sha256": f"{actuator_id}#{window_id}"})
     return base.model_copy(
         update={"actuator_id": actuator_id, "window_id": window_id, "estimates": estimates, "window": window}
@@ -71,7 +71,7 @@ def no_pipeline(monkeypatch):
     def refused(*_, **__):
         raise AssertionError("the pipeline ran")
 
-    monkeypatch.setattr("ema.estimate.kinds.estimate", refused)
+    monkeypatch.setattr("ema.kinds.estimate", refused)
 
 
 def test_a_history_deleted_under_the_service_answers_nothing_it_would_lose(tmp_path, document, no_pipeline):

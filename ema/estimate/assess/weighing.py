@@ -23,7 +23,8 @@ see a mismatch between the model and the measured window, so two checks on the w
   note ``model_misfit`` is said only beyond exp(t₀.₉₉,ₖ₋₁ · s · √(1 + 1/K)) (``misfit_limit``): a
   clean window draws it ``MISFIT_FALSE_ALARM`` of the time.
 
-The std is never below the physics fit's block-jackknife std on the window itself.
+The std is never below the physics fit's block-jackknife std on the window itself (or, where that std was read
+from the window's own residual, as a servo's Newey–West std is, never below it unscaled).
 """
 
 from __future__ import annotations
@@ -56,6 +57,10 @@ class Candidates:
     check_truth: dict[str, np.ndarray]
     check_physics: dict[str, np.ndarray]
     check_network: dict[str, np.ndarray] | None
+    targets: tuple[str, ...] = TARGETS  # what both estimate, in the network's output order
+    # True where the physics std was read from the window's own residual (its size and its correlation): then the
+    # misfit has widened it already, and only the held-out errors are scaled by the equation-error ratio
+    physics_std_observed: bool = False
 
 
 @dataclass(frozen=True)
@@ -116,7 +121,7 @@ def network_note(c: Candidates, name: str) -> Note | None:
     if len(c.check_truth[name]) < MIN_CHECKS:
         text = "too few held-out simulations could be scored to trust the network with"
         return Note(code="network_too_few_checks", parameter=name, text=text)
-    index = TARGETS.index(name)
+    index = c.targets.index(name)
     if not -BOX_TOLERANCE <= c.network_unit[index] <= 1 + BOX_TOLERANCE:
         text = f"the network answered {c.network_unit[index]:.2f} box units: outside the box it was trained in"
         return Note(code="network_out_of_box", parameter=name, text=text)
@@ -126,7 +131,7 @@ def network_note(c: Candidates, name: str) -> Note | None:
     if abs(z) > MAX_DISAGREEMENT_Z:
         text = (
             f"network and physics disagree by {z:.1f} times their spread on simulations: the network reads "
-            "a residual-torque trace the simulator does not produce"
+            "a trace the simulator does not produce"
         )
         return Note(code="network_disagrees", parameter=name, text=text)
     return None
@@ -157,7 +162,11 @@ def _assess_parameter(c: Candidates, name: str, inflation: float) -> tuple[float
                     f"{100 * (1 - NETWORK_MARGIN):.0f} % it must"
                 ),
             )
-    std = inflation * max(_t_factor(len(truth)) * rms_used, c.physics_std[name])
+    held_out = _t_factor(len(truth)) * rms_used
+    if c.physics_std_observed:
+        std = max(inflation * held_out, c.physics_std[name])
+    else:
+        std = inflation * max(held_out, c.physics_std[name])
     report = MethodReport(
         physics=c.physics[name],
         physics_bias=bias,
@@ -178,7 +187,7 @@ def assess(c: Candidates, equation_error_ratio: float, limit: float) -> Assessed
     ``limit`` (``misfit_limit``)."""
     inflation = max(1.0, equation_error_ratio)
     values, stds, methods, notes = {}, {}, {}, list[Note]()
-    for name in TARGETS:
+    for name in c.targets:
         values[name], stds[name], methods[name], note = _assess_parameter(c, name, inflation)
         if note is not None:
             notes.append(note)

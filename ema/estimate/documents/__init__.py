@@ -46,6 +46,8 @@ NoteCode = Literal[
     "low_rate",
     "current_at_zero_torque",
     "current_per_nm",
+    "controller_mismatch",
+    "command_saturated",
     # how the answer was reached, and how far to trust it
     "network_absent",
     "network_too_few_checks",
@@ -100,11 +102,19 @@ Notes = Annotated[list[Note], BeforeValidator(_sentences_as_notes)]
 OptionalNote = Annotated[Note | None, BeforeValidator(_sentences_as_notes)]
 
 
+DIMENSIONLESS = "1"  # η's unit
+
+
 class ParameterEstimate(Document):
     value: float
     std: float | None = Field(description="one standard deviation, in the parameter's unit; null: not assessed")
-    nominal: float
-    drift_pct: float = Field(description="100 · (value − nominal) / nominal")
+    nominal: float | None = Field(description="the actuator's value new (null: its document has none yet)")
+    drift_pct: float | None = Field(description="100 · (value − nominal) / nominal (null without a nominal)")
+    unit: str | None = Field(
+        None,
+        description="the value's unit: N·m for a friction at the motor shaft, N for one on the load (a servo), 1 for "
+        "an efficiency (null: stored before units were given)",
+    )
     weakly_determined: bool = Field(
         default=False,
         description="the window holds little of this parameter: its ±2 std spans more than 10 % of the healthy "
@@ -124,6 +134,11 @@ class Estimates(Document):
     eta_A: ParameterEstimate | None = Field(description="null with eta_O")
     FSJ: ParameterEstimate | None
     FSD: RatioEstimate | None = None
+    constants: dict[str, ParameterEstimate] = Field(
+        default_factory=dict,
+        description="the other constants the window read beside its health, in the names of the actuator's document "
+        "(a servo's mass_kg, viscous_ns_per_m, offset_n), each with its unit",
+    )
 
 
 STAGES = ("prepare", "physics", "simulate", "learn", "assess", "check", "report")  # the pipeline's, in order
@@ -195,6 +210,11 @@ class FitCheck(Document):
     output_error_ratio: dict[str, float] = Field(
         description="per signal: RMS(measured − simulated at the estimates) over the noise-only floor"
     )
+    output_error_pct: dict[str, float] = Field(
+        default_factory=dict,
+        description="per signal: 100·‖measured − simulated‖/‖measured‖, the identification benchmarks' error "
+        "(a servo's; empty where not computed)",
+    )
     uncertainty_inflation: float = Field(description="factor applied to the stds for what the model did not reproduce")
     notes: Notes = Field(default_factory=list)
 
@@ -253,7 +273,8 @@ class Estimate(Document):
     config: PipelineConfig
 
 
-def parameter(value: float, std: float | None, nominal: float, weak: bool = False) -> ParameterEstimate:
-    return ParameterEstimate(
-        value=value, std=std, nominal=nominal, drift_pct=100.0 * (value - nominal) / nominal, weakly_determined=weak
-    )
+def parameter(
+    value: float, std: float | None, nominal: float | None, weak: bool = False, *, unit: str | None
+) -> ParameterEstimate:
+    drift = None if nominal is None or nominal == 0 else 100.0 * (value - nominal) / nominal
+    return ParameterEstimate(value=value, std=std, nominal=nominal, drift_pct=drift, weakly_determined=weak, unit=unit)

@@ -18,28 +18,46 @@ from ema.estimate.simulate.design import Box
 from ema.model.checks import InputError
 
 
+class NetworkRegressor:
+    """Networks from inputs to targets already in box units (0 and 1 at the box's edges): the members' mean,
+    unclipped. scikit-learn shape: settings in ``__init__``, ``fit`` returns self, learned values end in ``_``."""
+
+    def __init__(self, train: TrainConfig = TrainConfig(), members: int = 1) -> None:
+        self.train = train
+        self.members = members
+
+    def fit(self, inputs: np.ndarray, unit_targets: np.ndarray) -> NetworkRegressor:
+        if not 1 <= self.members <= 20:
+            raise InputError("members", f"must be in [1, 20], got {self.members}")
+        self.fits_: list[FitResult] = [
+            fit(inputs, unit_targets, replace(self.train, seed=self.train.seed + member))
+            for member in range(self.members)
+        ]
+        return self
+
+    def predict_unit(self, inputs: np.ndarray) -> np.ndarray:
+        """(N, T) the targets in box units, the members' mean, unclipped."""
+        x = torch.as_tensor(np.atleast_2d(inputs), dtype=torch.float64)
+        with torch.no_grad():
+            return np.mean([f.model.eval()(x).numpy() for f in self.fits_], axis=0)
+
+
 class NetworkEstimator:
-    """scikit-learn shape: settings in ``__init__``, ``fit`` returns self, learned values end in ``_``."""
+    """FDJ and η_O through a ``Box`` (the rotary pipeline's targets), by a ``NetworkRegressor``."""
 
     def __init__(self, train: TrainConfig = TrainConfig(), members: int = 1) -> None:
         self.train = train
         self.members = members
 
     def fit(self, inputs: np.ndarray, fdj_nm: np.ndarray, eta_o: np.ndarray, box: Box) -> NetworkEstimator:
-        if not 1 <= self.members <= 20:
-            raise InputError("members", f"must be in [1, 20], got {self.members}")
-        targets = box.normalize(fdj_nm, eta_o)
-        self.fits_: list[FitResult] = [
-            fit(inputs, targets, replace(self.train, seed=self.train.seed + member)) for member in range(self.members)
-        ]
+        self.regressor_ = NetworkRegressor(self.train, self.members).fit(inputs, box.normalize(fdj_nm, eta_o))
+        self.fits_ = self.regressor_.fits_
         self.box_ = box
         return self
 
     def predict_unit(self, inputs: np.ndarray) -> np.ndarray:
         """(N, 2) FDJ, η_O in box units, the members' mean, unclipped."""
-        x = torch.as_tensor(np.atleast_2d(inputs), dtype=torch.float64)
-        with torch.no_grad():
-            return np.mean([f.model.eval()(x).numpy() for f in self.fits_], axis=0)
+        return self.regressor_.predict_unit(inputs)
 
     def predict(self, inputs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """FDJ [N·m] and η_O for each row of ``inputs`` (N, F)."""

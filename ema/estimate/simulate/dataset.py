@@ -95,7 +95,7 @@ def simulate_dataset(
     features of both (the window read as ``seen``: through ``as_read``, its T_R with ``actuator``, the
     document's drive with J_M and C as the window shows them)."""
     fdj, eta_o = physics.fdj_nm[0], physics.eta_o[0]
-    box = design.box_around(fdj, physics.fdj_std_nm[0], eta_o, physics.eta_o_std[0], document.health.fdj_nm)
+    box = design.box_around(fdj, physics.fdj_std_nm[0], eta_o, physics.eta_o_std[0], document.health.fdj)
     scenario = scenario_from_window(seen, document.params, document.hinge, effects)
     health = design.draw(box, config.total_simulations, config.seed)
     sims = simulate_noisy(scenario, health, window, design.centre(box), config.seed + 1, config.check_windows)

@@ -22,7 +22,7 @@ from ema.model.params import HealthParams
 
 SPAN_SIGMAS = 6.0  # the box's half-width in jackknife standard deviations of the centre
 MIN_HALF_SPAN = {"fdj_nm": 0.05, "eta_o": 0.025}  # FDJ relative to the centre, η_O absolute
-HALTON_PRIMES = (2, 3, 5)
+HALTON_PRIMES = (2, 3, 5, 7, 11, 13, 17, 19)
 
 
 @dataclass(frozen=True)
@@ -94,18 +94,21 @@ def centre(box: Box) -> HealthParams:
     return HealthParams.single(2.0 * fdj, fdj, float(np.mean(box.eta_o)))
 
 
-def halton(n: int, seed: int) -> np.ndarray:
-    """(n, 3) points of a Halton sequence in bases 2, 3, 5, randomly shifted modulo 1 (Cranley–Patterson)."""
+def halton(n: int, seed: int, dims: int = 3) -> np.ndarray:
+    """(n, dims) points of a Halton sequence in the first ``dims`` prime bases, randomly shifted modulo 1
+    (Cranley–Patterson)."""
+    if not 1 <= dims <= len(HALTON_PRIMES):
+        raise InputError("dims", f"a Halton sequence here has 1 to {len(HALTON_PRIMES)} dimensions, got {dims}")
     index = np.arange(1, n + 1)
     columns = []
-    for base in HALTON_PRIMES:
+    for base in HALTON_PRIMES[:dims]:
         value, fraction, i = np.zeros(n), 1.0 / base, index.copy()
         while np.any(i > 0):
             value += fraction * (i % base)
             i //= base
             fraction /= base
         columns.append(value)
-    shift = np.random.default_rng(seed).uniform(size=len(HALTON_PRIMES))
+    shift = np.random.default_rng(seed).uniform(size=dims)
     return np.mod(np.stack(columns, axis=1) + shift, 1.0)
 
 

@@ -8,7 +8,7 @@ from typing import Annotated
 from fastapi import APIRouter, Query, Request
 from starlette.concurrency import run_in_threadpool
 
-from ema.estimate import kinds
+from ema import kinds
 from ema.estimate.config import PipelineConfig, bounds
 from ema.estimate.documents import Estimate
 from ema.history.open import History
@@ -91,7 +91,7 @@ async def _job(
     history = await run_in_threadpool(store.readings, window.actuator_id, window.flight_id)
     actuator, version = await actuator_of(store, window.actuator_id)
     if settings.backend == "ray":
-        from ema.estimate.remote import estimate_on_ray
+        from ema.kinds.remote import estimate_on_ray
 
         return partial(estimate_on_ray, window, config, 1, history, actuator, version)
     return partial(

@@ -153,7 +153,7 @@ def _told_apart(
     def error(read: Departures, effect: str, **parameters: float) -> float:
         effects = read.viscosity.effects().with_effect(effect, **parameters)
         scenario = scenario_from_window(window, actuator.params, actuator.hinge, effects)
-        health = inside(read.answer["FDJ"], read.answer["eta_O"], actuator.health.fdj_nm)
+        health = inside(read.answer["FDJ"], read.answer["eta_O"], actuator.health.fdj)
         return following_error(scenario, window, health, noise)
 
     factor = scale.drive.torque_factor

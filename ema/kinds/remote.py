@@ -15,7 +15,7 @@ from ema.estimate import runtime
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import Estimate
 from ema.estimate.documents.window import HistoryReadings
-from ema.estimate.kinds import estimate
+from ema.kinds import estimate
 from ema.model.actuator import THESIS, ActuatorDocument, actuator_from_dict
 from ema.model.checks import InputError
 from ema.model.window import Window, window_from_dict, window_to_dict
@@ -31,7 +31,7 @@ def estimate_document(
 ) -> dict[str, Any]:
     """The estimate of one window as a JSON-able dict, or {"error": {"field", "message"}} for a window refused;
     ``history``: what other windows of the actuator read, ``actuator``: its ema-actuator/1 document and
-    ``version`` (none: the default, ``ema.model.actuator.THESIS``; ``ema.estimate.kinds.estimate``)."""
+    ``version`` (none: the default, ``ema.model.actuator.THESIS``; ``ema.kinds.estimate``)."""
     runtime.configure(threads)
     known = None if history is None else HistoryReadings.model_validate(history)
     try:

@@ -1,0 +1,316 @@
+"""``ema calibrate`` for a servo: learn what the document lacks, then find what the model still misses, name it,
+add it, and report the error before and after.
+
+1. **Learn.** Eq. 5.1 in the load frame (``ema.estimate.physics.inverse``) over every window at once: M, C,
+   FDJ and the offset, each with its Newey–West std and unit (``learned``); the model's error is the
+   identification benchmarks' own, 100·‖y − ŷ‖/‖y‖ on the decimated force.
+2. **Find.** Each effect of ``ema.calibration.servo_effects`` is fitted on four fifths of every window and
+   predicts the fifth left out, in turn (its nonlinear constant chosen the same way). An effect is taken only
+   where it is physical (its constants' signs), predicts every fold better (a real effect shows in each part
+   of a log, noise does not), and cuts the held-out residual by ``MIN_HELD_OUT_DROP`` at least; then the next,
+   on top of it, up to ``MAX_EFFECTS``.
+3. **Add and report.** The learned list is one consistent model: the adopted effects' constants join it, a
+   constant that differs with the direction of motion named ``_up`` and ``_down``. The error before and after
+   is the inverse model's, and the closed loop's: each window simulated at the constants, its force against
+   the log's.
+
+Where the document already holds the load's constants (a completed document read on a new run), the report
+also gives the error of the document's model as it stands, in the inverse and in the closed loop.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from ema.calibration.documents import (
+    CalibrationReport,
+    Candidate,
+    HeldOut,
+    Learned,
+    NoiseFloor,
+    Step,
+)
+from ema.calibration.plot import ResidualPlot, Series
+from ema.calibration.servo_effects import EFFECTS, ServoEffect
+from ema.estimate.physics.inverse import UNITS, decimated, inverse_columns, newey_west_lags, newey_west_std
+from ema.estimate.prepare.servo import ServoPrepared, document_effects, prepare_servo
+from ema.estimate.simulate.servo import lane_parameters
+from ema.model.actuator import ActuatorDocument, Nominal
+from ema.model.servo_sim import simulate_servo
+from ema.model.window import Window
+
+FOLDS = 5
+MIN_HELD_OUT_DROP = 0.05  # of the held-out residual sum of squares
+MAX_EFFECTS = 2
+LEARNED_NAMES = {
+    "fdj_n": "FDJ",
+    "mass_kg": "mass",
+    "viscous_ns_per_m": "viscous",
+    "viscous_up_ns_per_m": "viscous_up",
+    "viscous_down_ns_per_m": "viscous_down",
+    "offset_n": "offset",
+}
+
+
+@dataclass(frozen=True)
+class Problem:
+    """Every window's decimated force and columns, stacked, and each row's fold."""
+
+    y: np.ndarray
+    x: dict[str, np.ndarray]
+    fold: np.ndarray
+    window: np.ndarray  # each row's window
+
+    def design(self, names: Sequence[str]) -> np.ndarray:
+        return np.column_stack([self.x[name] for name in names])
+
+
+def problem(prepared: Sequence[ServoPrepared], model: dict[str, float]) -> Problem:
+    """The stacked problem of ``model`` (effect name -> its nonlinear constant) over the windows."""
+    ys, xs, folds, windows = [], [], [], []
+    for i, p in enumerate(prepared):
+        columns = inverse_columns(p.motion, model)
+        y = decimated(p.force_n, p.motion.decimation)
+        xs.append({name: decimated(column, p.motion.decimation) for name, column in columns.items()})
+        ys.append(y)
+        folds.append(np.minimum(np.arange(len(y)) * FOLDS // len(y), FOLDS - 1))
+        windows.append(np.full(len(y), i))
+    names = list(xs[0])
+    return Problem(
+        np.concatenate(ys),
+        {name: np.concatenate([x[name] for x in xs]) for name in names},
+        np.concatenate(folds),
+        np.concatenate(windows),
+    )
+
+
+@dataclass(frozen=True)
+class Fitted:
+    values: dict[str, float]
+    stds: dict[str, float]
+    error_pct: float
+    held_out_rss: np.ndarray  # (FOLDS,) each fold's residual sum of squares, predicted by the other folds
+    residual: np.ndarray
+
+
+def fitted(p: Problem) -> Fitted:
+    names = list(p.x)
+    x = p.design(names)
+    beta, *_ = np.linalg.lstsq(x, p.y, rcond=None)
+    residual = p.y - x @ beta
+    stds = newey_west_std(x, residual, newey_west_lags(len(p.y)))
+    held = np.zeros(FOLDS)
+    for k in range(FOLDS):
+        out = p.fold == k
+        b, *_ = np.linalg.lstsq(x[~out], p.y[~out], rcond=None)
+        held[k] = float(np.sum((p.y[out] - x[out] @ b) ** 2))
+    return Fitted(
+        dict(zip(names, beta.tolist(), strict=True)),
+        dict(zip(names, stds.tolist(), strict=True)),
+        float(100.0 * np.linalg.norm(residual) / np.linalg.norm(p.y)),
+        held,
+        residual,
+    )
+
+
+def _best_of(effect: ServoEffect, prepared: Sequence[ServoPrepared], model: dict[str, float]) -> tuple[float, Fitted]:
+    """The effect at the grid value that predicts the held-out folds best."""
+    trials = [(value, fitted(problem(prepared, {**model, effect.name: value}))) for value in effect.grid]
+    return min(trials, key=lambda trial: float(trial[1].held_out_rss.sum()))
+
+
+def _candidate(effect: ServoEffect, value: float, fit: Fitted, base: Fitted) -> tuple[Candidate, bool]:
+    drop = 1.0 - fit.held_out_rss.sum() / base.held_out_rss.sum()
+    every_fold = bool(np.all(fit.held_out_rss < base.held_out_rss))
+    plausible = effect.plausible(fit.values)
+    parameters = {name: fit.values[name] for name in fit.values if name not in base.values}
+    if effect.constant is not None:
+        parameters[effect.constant[0]] = value
+    candidate = Candidate(
+        effect=effect.name,
+        follows="speed_mps" if effect.name != "position_force" else "position_m",
+        named=True,
+        parameters=parameters,
+        rms_reduction=float(1.0 - fit.error_pct / base.error_pct),
+        held_out_drop=float(drop),
+        score=float(np.min(1.0 - fit.held_out_rss / base.held_out_rss)),
+        plausible=plausible,
+    )
+    return candidate, plausible and every_fold and drop >= MIN_HELD_OUT_DROP
+
+
+def select(prepared: Sequence[ServoPrepared], base_model: dict[str, float]) -> tuple[dict[str, float], list, list]:
+    """The effects adopted on top of ``base_model``, every candidate considered, and the steps' reasons."""
+    model, candidates, steps = dict(base_model), [], []
+    current = fitted(problem(prepared, model))
+    for _ in range(MAX_EFFECTS):
+        trials = []
+        for effect in (e for e in EFFECTS if e.name not in model):
+            value, fit = _best_of(effect, prepared, model)
+            candidate, earned = _candidate(effect, value, fit, current)
+            candidates.append(candidate)
+            trials.append((candidate.held_out_drop, earned, effect, value, fit))
+        earned_trials = [t for t in trials if t[1]]
+        if not earned_trials:
+            steps.append(Step(selected=None, reason=_nothing_earned(trials)))
+            break
+        drop, _, effect, value, fit = max(earned_trials, key=lambda t: t[0])
+        model[effect.name], current = value, fit
+        steps.append(
+            Step(
+                selected=effect.name,
+                reason=f"{effect.description}: predicts every fifth of the log(s) left out better, "
+                f"{100 * drop:.0f} % less held-out residual; its constants are physical",
+            )
+        )
+    return model, candidates, steps
+
+
+def _nothing_earned(trials: list) -> str:
+    if not trials:
+        return "every effect is in the model"
+    best = max(trials, key=lambda t: t[0])
+    return (
+        f"no further effect earns its place: the best, {best[2].name}, cuts the held-out residual by "
+        f"{100 * best[0]:.1f} % (at least {100 * MIN_HELD_OUT_DROP:.0f} % in every fold, with physical constants, "
+        "is asked)"
+    )
+
+
+def learned(fit: Fitted, model: dict[str, float]) -> list[Learned]:
+    """The model's constants, each with its std and unit, in the document's words (``_up``/``_down`` by
+    direction), the adopted effects' nonlinear constants beside them."""
+    out = [
+        Learned(name=LEARNED_NAMES.get(name, name), value=value, std=fit.stds[name], unit=UNITS[name])
+        for name, value in fit.values.items()
+    ]
+    for effect in EFFECTS:
+        if effect.name in model and effect.constant is not None:
+            out.append(Learned(name=effect.constant[0], value=model[effect.name], std=0.0, unit=effect.constant[1]))
+    return out
+
+
+def closed_loop_error_pct(
+    prepared: Sequence[ServoPrepared], values: dict[str, float], effects: dict[str, float] | None = None
+) -> float:
+    """100·‖F − F̂‖/‖F‖ over every window, each simulated in closed loop at ``values`` with ``effects`` (those the
+    simulator has; the others left out)."""
+    errors, norms = 0.0, 0.0
+    for p in prepared:
+        s, first = p.window.signals, p.motion.first
+        start = (float(s["position_m"][0]), float((s["position_m"][1] - s["position_m"][0]) * p.window.sample_rate_hz))
+        lane = lane_parameters(values, effects)[None, :]
+        run = simulate_servo(s["set_point_m"], lane, p.loop, load_n=s.get("load_n"), start=start)
+        errors += float(np.sum((s["drive_force_n"][first:] - run.drive_force_n[0, first:]) ** 2))
+        norms += float(np.sum(s["drive_force_n"][first:] ** 2))
+    return float(100.0 * np.sqrt(errors / norms))
+
+
+def _document_check(prepared: Sequence[ServoPrepared], actuator: ActuatorDocument) -> dict[str, float] | None:
+    """The error of the document's own model as it stands (its load's constants fixed), inverse and closed loop;
+    None where the document does not hold them."""
+    servo, nominal = prepared[0].servo, actuator.nominal
+    if servo.mass_kg is None or servo.viscous_ns_per_m is None or nominal is None or nominal.fdj_n is None:
+        return None
+    values = {"mass_kg": servo.mass_kg, "fdj_n": nominal.fdj_n, "offset_n": servo.force_offset_n or 0.0}
+    if servo.viscous_down_ns_per_m is None:
+        values["viscous_ns_per_m"] = servo.viscous_ns_per_m
+    else:
+        values |= {"viscous_up_ns_per_m": servo.viscous_ns_per_m, "viscous_down_ns_per_m": servo.viscous_down_ns_per_m}
+    p = problem(prepared, {"viscous_down": 1.0} if servo.viscous_down_ns_per_m is not None else {})
+    residual = p.y - p.design(list(values)) @ np.array(list(values.values()))
+    return {
+        "drive_force_n": float(100.0 * np.linalg.norm(residual) / np.linalg.norm(p.y)),
+        "drive_force_n_closed_loop": closed_loop_error_pct(prepared, values, document_effects(servo)),
+    }
+
+
+def completed(
+    actuator: ActuatorDocument, prepared: ServoPrepared, fit: Fitted, model: dict[str, float]
+) -> ActuatorDocument:
+    """The document with what the runs taught: the log's controller constants, the load's, the adopted effects,
+    the nominal FDJ."""
+    v, sd = fit.values, fit.stds
+    split = "viscous_down_ns_per_m" in v
+    up = "viscous_up_ns_per_m" if split else "viscous_ns_per_m"
+    servo = prepared.servo.model_copy(
+        update={
+            "mass_kg": v["mass_kg"],
+            "mass_std_kg": sd["mass_kg"],
+            "viscous_ns_per_m": v[up],
+            "viscous_std_ns_per_m": sd[up],
+            "viscous_down_ns_per_m": v.get("viscous_down_ns_per_m"),
+            "viscous_down_std_ns_per_m": sd.get("viscous_down_ns_per_m"),
+            "force_offset_n": v["offset_n"],
+            "force_offset_std_n": sd["offset_n"],
+            "bandwidth_hz": prepared.bandwidth_hz,
+            "effects": {name: value for name, value in model.items() if name != "viscous_down"},
+        }
+    )
+    nominal = Nominal(fdj_n=round(v["fdj_n"], 6), eta_o=actuator.nominal.eta_o if actuator.nominal else None)
+    document = actuator.model_dump(by_alias=True) | {"servo": servo.model_dump(), "nominal": nominal.model_dump()}
+    return ActuatorDocument.model_validate(document)
+
+
+def _plot(prepared: Sequence[ServoPrepared], base: Fitted, after: Fitted, model: dict[str, float]) -> ResidualPlot:
+    """The decimated force's residual before and after, against the speed (what the effects follow)."""
+    speed = np.concatenate([decimated(p.motion.speed_mps, p.motion.decimation) for p in prepared])
+    return ResidualPlot(
+        title=f"calibration: {', '.join(model) or 'no effect named'}",
+        x_label="speed of the load [m/s]",
+        y_label="force the model leaves [N]",
+        series=[
+            Series("before", speed.tolist(), base.residual.tolist()),
+            Series("after", speed.tolist(), after.residual.tolist()),
+        ],
+    )
+
+
+def calibrate_servo(
+    windows: Sequence[Window], actuator: ActuatorDocument
+) -> tuple[CalibrationReport, ActuatorDocument, ResidualPlot]:
+    """The report (module docstring), the document completed with what the windows taught, and the figure."""
+    started = time.perf_counter()
+    prepared = [prepare_servo(w, actuator) for w in windows]
+    base_model = document_effects(prepared[0].servo)
+    base = fitted(problem(prepared, base_model))
+    model, candidates, steps = select(prepared, base_model)
+    after = fitted(problem(prepared, model))
+    adopted = [name for name in model if name not in base_model]
+    closed = {
+        "before": closed_loop_error_pct(prepared, base.values, base_model),
+        "after": closed_loop_error_pct(prepared, after.values, model),
+    }
+    report = CalibrationReport(
+        n_windows=len(windows),
+        noise_floor=NoiseFloor(copies=0, equation_error_ratio=1.0),
+        residual_rms_before={"drive_force_n": float(np.sqrt(np.mean(base.residual**2)))},
+        residual_rms_after={"drive_force_n": float(np.sqrt(np.mean(after.residual**2)))},
+        candidates=candidates,
+        selected_effect=adopted[0] if adopted else None,
+        selected_effects=adopted,
+        selected_parameters={k: v for k, v in after.values.items() if k not in base.values} or None,
+        effects={name: model[name] for name in adopted},
+        selection_steps=steps,
+        unexplained=None,
+        held_out=HeldOut(
+            rss_before=float(base.held_out_rss.sum()),
+            rss_after=float(after.held_out_rss.sum()),
+            adopted=bool(adopted),
+            note=f"each fifth of every window predicted from the other four: {FOLDS} folds",
+        ),
+        estimates_before={"FDJ": base.values["fdj_n"]},
+        estimates_after={"FDJ": after.values["fdj_n"]},
+        stds_before={"FDJ": base.stds["fdj_n"]},
+        stds_after={"FDJ": after.stds["fdj_n"]},
+        learned=learned(after, model),
+        model_error_pct_before={"drive_force_n": base.error_pct, "drive_force_n_closed_loop": closed["before"]},
+        model_error_pct_after={"drive_force_n": after.error_pct, "drive_force_n_closed_loop": closed["after"]},
+        model_error_pct_document=_document_check(prepared, actuator),
+        timings_s={"total": time.perf_counter() - started},
+    )
+    return report, completed(actuator, prepared[0], after, model), _plot(prepared, base, after, model)

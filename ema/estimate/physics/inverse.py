@@ -1,0 +1,208 @@
+"""Eq. 5.1 on the load side: a servo's inverse dynamic model, fitted by least squares (IDIM-LS).
+
+A servo's log holds the force its drive applied and the motion it caused, both on the load. The force is
+what moved the load:
+
+    F = M·q̈ + FDJ·sgn(q̇) + C·q̇ + F_offset + F_load                              (Eq. 5.1, load frame)
+
+linear in the constants once q̇ and q̈ are known. They come from the measured position: a zero-phase
+4th-order Butterworth low-pass at ``CUTOFF_BANDWIDTHS`` times the closed loop's bandwidth, then central
+differences. The equation holds at every sample, but its noise (the controller's answer to the position's
+quantization, the drive's ripple) lives far above the motion: every column and the force are decimated
+alike (an 8th-order Chebyshev low-pass at 0.8 of the new Nyquist rate, zero phase, then every r-th sample)
+down to ``DECIMATED_BANDWIDTHS`` times the bandwidth. This is Gautier's IDIM-LS practice, and what the EMPS
+benchmark's own identification does, so its error 100·‖y − ŷ‖/‖y‖ is comparable with the published one.
+
+The residual is not white (a misfit at each reversal spans many decimated samples), so the least-squares
+std would claim several times what a second run of the same machine can confirm; the std here is
+Newey–West's, which weighs the residual's own correlation (``NEWEY_WEST_LAGS``).
+
+Columns beyond the four (a viscous coefficient per direction, a Stribeck term) are the model's effects
+(``inverse_columns``), named as the calibration names them.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+import numpy as np
+
+from ema.model.checks import InputError
+
+FILTER_ORDER = 4  # the position's Butterworth low-pass
+CUTOFF_BANDWIDTHS = 5.0  # its cutoff, in loop bandwidths
+DECIMATED_BANDWIDTHS = 2.0  # the decimation's anti-alias edge, in loop bandwidths
+DECIMATION_RIPPLE_DB = 0.05  # the Chebyshev's pass-band ripple (MATLAB's decimate)
+DECIMATION_ORDER = 8
+EDGE_CUTOFF_PERIODS = 5.0  # the filters' start-up, left out of the fit
+POLYNOMIAL_ORDER = 3  # an effect along the stroke: Legendre polynomials up to this order
+BASE = ("mass_kg", "viscous_ns_per_m", "fdj_n", "offset_n")
+UNITS = {
+    "mass_kg": "kg",
+    "viscous_ns_per_m": "N·s/m",
+    "viscous_up_ns_per_m": "N·s/m",
+    "viscous_down_ns_per_m": "N·s/m",
+    "fdj_n": "N",
+    "offset_n": "N",
+    "stribeck_n": "N",
+    "stribeck_speed_mps": "m/s",
+    "presliding_n": "N",
+    "presliding_travel_m": "m",
+    **{f"position_{kind}_p{k}_n": "N" for kind in ("force", "friction") for k in range(1, POLYNOMIAL_ORDER + 1)},
+}
+
+
+@dataclass(frozen=True)
+class Motion:
+    """The load's motion as the fit reads it, full rate, its start-up left out (from ``first``)."""
+
+    position_m: np.ndarray
+    speed_mps: np.ndarray
+    acceleration_mps2: np.ndarray
+    first: int  # the first sample of the window these arrays start at
+    decimation: int  # r: every r-th sample of the decimated columns
+
+
+def _butter_lowpass(rate_hz: float, cutoff_hz: float) -> tuple[np.ndarray, np.ndarray]:
+    from scipy.signal import butter
+
+    return butter(FILTER_ORDER, min(cutoff_hz / (rate_hz / 2.0), 0.99))
+
+
+def _filtfilt(b: np.ndarray, a: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """Zero-phase filtering, its start-up padded as MATLAB's filtfilt pads (3·(order) samples, odd reflection)."""
+    from scipy.signal import filtfilt
+
+    return filtfilt(b, a, x, padlen=3 * (max(len(a), len(b)) - 1))
+
+
+def central_difference(values: np.ndarray, rate_hz: float) -> np.ndarray:
+    """dv/dt by central differences, one-sided at the two ends."""
+    out = np.empty_like(values)
+    out[1:-1] = (values[2:] - values[:-2]) / 2.0
+    out[0], out[-1] = values[1] - values[0], values[-1] - values[-2]
+    return out * rate_hz
+
+
+def load_motion(position_m: np.ndarray, rate_hz: float, bandwidth_hz: float) -> Motion:
+    """The filtered position, its speed and acceleration (module docstring), past the filters' start-up."""
+    cutoff = CUTOFF_BANDWIDTHS * bandwidth_hz
+    decimation = max(1, round(0.8 * (rate_hz / 2.0) / (DECIMATED_BANDWIDTHS * bandwidth_hz)))
+    first = max(round(EDGE_CUTOFF_PERIODS * rate_hz / cutoff) - 1, 1)
+    if len(position_m) - first < 20 * decimation:
+        raise InputError("signals.position_m", f"{len(position_m)} samples are too few to read its motion from")
+    filtered = _filtfilt(*_butter_lowpass(rate_hz, cutoff), position_m)
+    speed = central_difference(filtered, rate_hz)
+    acceleration = central_difference(speed, rate_hz)
+    return Motion(filtered[first:], speed[first:], acceleration[first:], first, decimation)
+
+
+def decimated(values: np.ndarray, factor: int) -> np.ndarray:
+    """Every ``factor``-th sample after a zero-phase anti-alias low-pass, aligned on the last sample (as MATLAB's
+    ``decimate``): what every column and the force go through alike."""
+    if factor == 1:
+        return values
+    from scipy.signal import cheby1
+
+    b, a = cheby1(DECIMATION_ORDER, DECIMATION_RIPPLE_DB, 0.8 / factor)
+    smooth = _filtfilt(b, a, values)
+    n = len(values)
+    begin = factor - (factor * -(-n // factor) - n)
+    return smooth[begin - 1 :: factor]
+
+
+def travel_since_reversal(speed: np.ndarray, position: np.ndarray) -> np.ndarray:
+    """|q − q at the last change of the motion's sign| at each sample (from the first sample before any)."""
+    sign = np.sign(speed)
+    held = np.maximum.accumulate(np.where(sign != 0, np.arange(len(sign)), 0))
+    direction = sign[held]
+    starts = np.zeros(len(sign), dtype=int)
+    change = np.flatnonzero(np.diff(direction) != 0) + 1
+    starts[change] = change
+    return np.abs(position - position[np.maximum.accumulate(starts)])
+
+
+def _legendre(position: np.ndarray) -> list[np.ndarray]:
+    """P1..P``POLYNOMIAL_ORDER`` of the position over the stroke the window covers."""
+    x = 2.0 * (position - position.min()) / max(float(np.ptp(position)), 1e-12) - 1.0
+    return [np.polynomial.legendre.Legendre.basis(k)(x) for k in range(1, POLYNOMIAL_ORDER + 1)]
+
+
+def inverse_columns(motion: Motion, effects: Mapping[str, float] | None = None) -> dict[str, np.ndarray]:
+    """The model's columns at full rate: M, C, FDJ, the offset, and each effect in ``effects`` (name -> its
+    nonlinear constant, ``ema.calibration.servo_effects`` says what each is): ``viscous_down`` splits C by
+    direction; ``stribeck`` (v_S) adds sgn(q̇)·exp(−(q̇/v_S)²); ``presliding`` (σ) adds −sgn(q̇)·exp(−s/σ), s the
+    travel since the last reversal; ``position_force`` adds P1..P3 of the position, ``position_friction``
+    sgn(q̇)·P1..P3."""
+    v, q = motion.speed_mps, motion.position_m
+    sign = np.sign(v)
+    columns = {"mass_kg": motion.acceleration_mps2, "viscous_ns_per_m": v, "fdj_n": sign, "offset_n": np.ones_like(v)}
+    effects = effects or {}
+    if "viscous_down" in effects:
+        del columns["viscous_ns_per_m"]
+        columns = {"viscous_up_ns_per_m": v * (v > 0), "viscous_down_ns_per_m": v * (v < 0), **columns}
+    if "stribeck" in effects:
+        columns["stribeck_n"] = sign * np.exp(-((v / effects["stribeck"]) ** 2))
+    if "presliding" in effects:
+        columns["presliding_n"] = -sign * np.exp(-travel_since_reversal(v, q) / effects["presliding"])
+    if "position_force" in effects:
+        columns |= {f"position_force_p{k}_n": p for k, p in enumerate(_legendre(q), start=1)}
+    if "position_friction" in effects:
+        columns |= {f"position_friction_p{k}_n": sign * p for k, p in enumerate(_legendre(q), start=1)}
+    return columns
+
+
+@dataclass(frozen=True)
+class InverseFit:
+    """Eq. 5.1 fitted: each constant with its Newey–West std, the error as the benchmark states it."""
+
+    values: dict[str, float]
+    stds: dict[str, float]
+    error_pct: float  # 100·‖y − ŷ‖/‖y‖ on the decimated force
+    residual_rms_n: float  # RMS of that residual
+    samples: int  # decimated samples fitted
+
+    def predicted(self, columns: Mapping[str, np.ndarray]) -> np.ndarray:
+        return sum((self.values[name] * column for name, column in columns.items()), np.zeros(1))
+
+
+def newey_west_lags(n: int) -> int:
+    """The residual's correlation lags the std weighs: Newey and West's (1994) plug-in, 4·(n/100)^(2/9)."""
+    return int(4.0 * (n / 100.0) ** (2.0 / 9.0))
+
+
+def newey_west_std(x: np.ndarray, residual: np.ndarray, lags: int) -> np.ndarray:
+    """Each coefficient's std from the sandwich (XᵀX)⁻¹·S·(XᵀX)⁻¹, S the residual's long-run covariance with
+    Bartlett weights 1 − k/(lags + 1)."""
+    inverse = np.linalg.pinv(x.T @ x)
+    scores = x * residual[:, None]
+    s = scores.T @ scores
+    for k in range(1, lags + 1):
+        shifted = scores[k:].T @ scores[:-k]
+        s += (1.0 - k / (lags + 1.0)) * (shifted + shifted.T)
+    return np.sqrt(np.clip(np.diag(inverse @ s @ inverse), 0.0, None))
+
+
+def fit_inverse(
+    force_n: np.ndarray, columns: Mapping[str, np.ndarray], decimation: int, fixed: Mapping[str, float] | None = None
+) -> InverseFit:
+    """Least squares of the force on ``columns`` (full rate, one length), both decimated by ``decimation``;
+    ``fixed`` constants (name -> value) are moved to the force's side and reported with std 0."""
+    fixed = dict(fixed or {})
+    y = decimated(force_n, decimation)
+    for name, value in fixed.items():
+        y = y - value * decimated(columns[name], decimation)
+    free = [name for name in columns if name not in fixed]
+    x = np.column_stack([decimated(columns[name], decimation) for name in free])
+    beta, *_ = np.linalg.lstsq(x, y, rcond=None)
+    residual = y - x @ beta
+    stds = newey_west_std(x, residual, newey_west_lags(len(y)))
+    total = y + sum((value * decimated(columns[name], decimation) for name, value in fixed.items()), np.zeros(1))
+    return InverseFit(
+        values={**dict(zip(free, beta.tolist(), strict=True)), **fixed},
+        stds={**dict(zip(free, stds.tolist(), strict=True)), **dict.fromkeys(fixed, 0.0)},
+        error_pct=float(100.0 * np.linalg.norm(residual) / max(float(np.linalg.norm(total)), 1e-300)),
+        residual_rms_n=float(np.sqrt(np.mean(residual**2))),
+        samples=len(y),
+    )

@@ -1,0 +1,151 @@
+"""A servo's window made ready: its document completed by the log, its controller checked, its motion read.
+
+- The controller's constants the document leaves out are the log's (``ema-window/1`` ``constants``); one both
+  give differently is refused naming it, and one neither gives is refused naming the document's field.
+- The log is the controller's own: its rate must be the controller's (within ``RATE_TOLERANCE``).
+- The position sensor's step is the document's, else the smallest step the log's position takes (0: a sensor
+  without one, where fewer than ``MIN_QUANTIZED`` of the steps are whole multiples of it).
+- The command is recomputed from the set point and the position with the document's controller: a log whose
+  command does not follow it (RMS beyond ``CONTROLLER_TOLERANCE`` of the command's) was run under another
+  controller, and the window's own simulations would not be its (note ``controller_mismatch``).
+- The loop's bandwidth (the document's, else the natural frequency √(kp·kv·g/M) of the position loop, M from a
+  first fit) sets the inverse model's filters (``ema.estimate.physics.inverse``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ema.estimate.documents import Note
+from ema.estimate.physics.inverse import Motion, fit_inverse, inverse_columns, load_motion
+from ema.model.actuator import ActuatorDocument
+from ema.model.checks import InputError
+from ema.model.servo import Servo
+from ema.model.servo_sim import ServoLoop
+from ema.model.window import Window
+
+RATE_TOLERANCE = 0.01
+CONTROLLER_TOLERANCE = 0.05
+MIN_QUANTIZED = 0.9
+PROVISIONAL_BANDWIDTH_SHARE = 0.02  # a first fit's loop bandwidth, as a share of the rate (20 Hz at 1 kHz)
+
+
+@dataclass(frozen=True)
+class ServoPrepared:
+    window: Window
+    servo: Servo  # the document's section completed by the log
+    loop: ServoLoop
+    motion: Motion
+    force_n: np.ndarray  # the drive's force less the external load, over the motion's samples
+    loaded: bool  # the window carries an external load
+    bandwidth_hz: float
+    effects: dict[str, float]  # the document's adopted effects (name -> its nonlinear constant)
+    notes: list[Note]
+
+
+def completed(actuator: ActuatorDocument, window: Window) -> Servo:
+    """The document's servo section with the log's constants; InputError naming what neither gives."""
+    assert actuator.servo is not None  # the kind's own section (ema.kinds)
+    servo = actuator.servo.with_constants(window.constants, "window.constants")
+    missing = servo.missing()
+    if missing:
+        raise InputError(f"actuator.servo.{missing[0]}", "neither the document nor the log gives it")
+    return servo
+
+
+def resolution(position_m: np.ndarray) -> float:
+    """The position sensor's step: the smallest step the log takes, where the steps are its whole multiples."""
+    steps = np.abs(np.diff(position_m))
+    moving = steps[steps > 1e-12]
+    if len(moving) < 10:
+        return 0.0
+    step = float(np.min(moving))
+    multiples = moving / step
+    whole = np.abs(multiples - np.round(multiples)) < 0.02
+    return step if np.mean(whole) >= MIN_QUANTIZED else 0.0
+
+
+def commanded(servo: Servo, set_point_m: np.ndarray, position_m: np.ndarray, rate_hz: float) -> np.ndarray:
+    """The command [its unit] the document's controller gives at each sample of the log."""
+    taps = np.asarray(servo.speed_filter)
+    padded = np.concatenate([np.full(len(taps) - 1, position_m[0]), position_m])
+    filtered = np.convolve(padded, taps, mode="valid")
+    speed = np.diff(filtered, prepend=filtered[0]) * rate_hz
+    assert servo.position_gain_per_s is not None and servo.speed_gain_per_mps is not None  # completed
+    command = servo.speed_gain_per_mps * (servo.position_gain_per_s * (set_point_m - position_m) - speed)
+    limit = servo.command_limit if servo.command_limit is not None else np.inf
+    return np.clip(command, -limit, limit)
+
+
+def _controller_note(servo: Servo, window: Window) -> Note | None:
+    s, gain = window.signals, servo.drive_gain_n_per_unit
+    assert gain is not None  # completed
+    logged = s["drive_force_n"] / gain
+    rate = window.sample_rate_hz
+    off = np.sqrt(np.mean((logged[1:] - commanded(servo, s["set_point_m"], s["position_m"], rate)[1:]) ** 2))
+    share = float(off / max(np.sqrt(np.mean(logged**2)), 1e-300))
+    if share <= CONTROLLER_TOLERANCE:
+        return None
+    return Note(
+        code="controller_mismatch",
+        parameter="drive_force_n",
+        text=f"the logged command differs from what the document's controller gives by {100 * share:.1f} % RMS "
+        "(its gains, filter or drive gain are not the log's): the window's own simulations are not its",
+    )
+
+
+def bandwidth(servo: Servo, mass_kg: float) -> float:
+    """The position loop's bandwidth [Hz]: the document's, else its natural frequency √(kp·kv·g/M)/2π."""
+    if servo.bandwidth_hz is not None:
+        return servo.bandwidth_hz
+    assert servo.position_gain_per_s and servo.speed_gain_per_mps and servo.drive_gain_n_per_unit  # completed
+    stiffness = servo.position_gain_per_s * servo.speed_gain_per_mps * servo.drive_gain_n_per_unit
+    return float(np.sqrt(stiffness / mass_kg) / (2 * np.pi))
+
+
+def document_effects(servo: Servo) -> dict[str, float]:
+    """The effects the document adopted (``ema calibrate``), as the inverse model's columns name them."""
+    return {**servo.effects, **({"viscous_down": 1.0} if servo.viscous_down_ns_per_m is not None else {})}
+
+
+def prepare_servo(window: Window, actuator: ActuatorDocument) -> ServoPrepared:
+    """The window ready for its physics (module docstring); InputError naming what cannot be read."""
+    servo = completed(actuator, window)
+    rate = servo.controller_rate_hz or window.sample_rate_hz
+    if abs(window.sample_rate_hz / rate - 1.0) > RATE_TOLERANCE:
+        raise InputError(
+            "sample_rate_hz",
+            f"{window.sample_rate_hz:g} Hz, but the controller runs at {rate:g} Hz: a servo's log is its controller's",
+        )
+    s = window.signals
+    load = s.get("load_n", np.zeros(window.n_samples))
+    mass = servo.mass_kg
+    if mass is None and servo.bandwidth_hz is None:  # a first fit, for the loop's natural frequency
+        first = load_motion(s["position_m"], rate, PROVISIONAL_BANDWIDTH_SHARE * rate)
+        columns = inverse_columns(first)
+        mass = fit_inverse((s["drive_force_n"] - load)[first.first :], columns, first.decimation).values["mass_kg"]
+    loop_hz = bandwidth(servo, max(float(mass or 1.0), 1e-6))
+    motion = load_motion(s["position_m"], rate, loop_hz)
+    step = servo.position_resolution_m if servo.position_resolution_m is not None else resolution(s["position_m"])
+    assert servo.position_gain_per_s and servo.speed_gain_per_mps and servo.drive_gain_n_per_unit  # completed
+    loop = ServoLoop(
+        position_gain_per_s=servo.position_gain_per_s,
+        speed_gain_per_mps=servo.speed_gain_per_mps,
+        drive_gain_n_per_unit=servo.drive_gain_n_per_unit,
+        command_limit=servo.command_limit if servo.command_limit is not None else np.inf,
+        period_s=1.0 / rate,
+        resolution_m=step,
+        taps=tuple(servo.speed_filter),
+    )
+    notes = [n for n in (_controller_note(servo, window),) if n is not None]
+    loaded = bool(np.any(load != 0.0))
+    if not loaded:
+        notes.append(
+            Note(code="no_load", parameter="eta_O", text="the window carries no external load: η_O is not shown")
+        )
+    return ServoPrepared(
+        window, servo, loop, motion, (s["drive_force_n"] - load)[motion.first :], loaded, loop_hz,
+        document_effects(servo), notes,
+    )  # fmt: skip

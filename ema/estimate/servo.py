@@ -1,0 +1,264 @@
+"""A servo's window -> ``ema-estimate/1``, every stage of the method on a log taken on the load side.
+
+1. **prepare** (``ema.estimate.prepare.servo``): the document completed by the log's constants, the controller
+   checked against the logged command, the motion read;
+2. **physics** (``ema.estimate.physics.inverse``): Eq. 5.1 in the load frame, F = M·q̈ + FDJ·sgn(q̇) + C·q̇ +
+   F_offset, by least squares, Newey–West stds;
+3. **simulate** (``ema.estimate.simulate.servo``): the window's own set point run in closed loop, its controller
+   at its rate, at constants drawn around the physics estimate;
+4. **learn**: the shallow network from the simulated force to the constants;
+5. **assess** (``ema.estimate.assess.weighing``): both estimators on held-out simulations, blended per
+   constant, the window's equation error against the simulations';
+6. **check**: the window simulated in closed loop at the answer, its force and position against the log's;
+7. **report**: the document, FDJ in N (the load's friction), the other constants beside it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import replace
+
+import numpy as np
+
+from ema.estimate.assess.weighing import Assessed, Candidates, assess, misfit_limit
+from ema.estimate.config import PipelineConfig
+from ema.estimate.documents import (
+    STAGES,
+    ActuatorRead,
+    DatasetInfo,
+    Estimate,
+    Estimates,
+    FitCheck,
+    Note,
+    Timings,
+    TrainingInfo,
+    parameter,
+)
+from ema.estimate.documents.window import WindowInfo
+from ema.estimate.learn.estimator import NetworkRegressor
+from ema.estimate.learn.network import TrainConfig
+from ema.estimate.physics.inverse import UNITS, InverseFit, decimated, fit_inverse, inverse_columns, load_motion
+from ema.estimate.physics.scenario import MAX_RATIO
+from ema.estimate.prepare.servo import ServoPrepared, prepare_servo
+from ema.estimate.simulate.servo import ServoData, lane_parameters, simulate_servo_dataset
+from ema.estimate.stopwatch import Stopwatch
+from ema.model.actuator import ActuatorDocument
+from ema.model.servo_sim import simulate_servo
+from ema.model.window import Window
+
+SERVO_TRAINING = TrainConfig(max_epochs=60, max_validation_failures=6)  # as the rotary pipeline's (a few dozen runs)
+FDJ = "fdj_n"
+NOMINAL_FIELDS = {  # a constant of the inverse model -> the servo section's field of its nominal value
+    "mass_kg": "mass_kg",
+    "viscous_ns_per_m": "viscous_ns_per_m",
+    "viscous_up_ns_per_m": "viscous_ns_per_m",
+    "viscous_down_ns_per_m": "viscous_down_ns_per_m",
+    "offset_n": "force_offset_n",
+}
+
+
+def physics_of(prepared: ServoPrepared) -> InverseFit:
+    """Eq. 5.1 fitted to the window with the document's effects."""
+    columns = inverse_columns(prepared.motion, prepared.effects)
+    return fit_inverse(prepared.force_n, columns, prepared.motion.decimation)
+
+
+def held_out_physics(prepared: ServoPrepared, data: ServoData, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """(K, T) the physics fit of each held-out simulation, and (K,) its residual RMS."""
+    rate, values, residuals = prepared.window.sample_rate_hz, [], []
+    for position, force in zip(data.runs.position_m[n:], data.runs.drive_force_n[n:], strict=True):
+        motion = load_motion(position, rate, prepared.bandwidth_hz)
+        load = prepared.window.signals.get("load_n", np.zeros(len(position)))
+        fit = fit_inverse((force - load)[motion.first :], inverse_columns(motion, prepared.effects), motion.decimation)
+        values.append([fit.values[name] for name in data.targets])
+        residuals.append(fit.residual_rms_n)
+    return np.array(values), np.array(residuals)
+
+
+def learned(data: ServoData, config: PipelineConfig) -> NetworkRegressor:
+    train = replace(SERVO_TRAINING, hidden=config.hidden_units, seed=config.seed)
+    n = config.n_simulations
+    return NetworkRegressor(train, config.members).fit(data.inputs[:n], data.normalize(data.truth[:n]))
+
+
+def weighed(
+    prepared: ServoPrepared, physics: InverseFit, data: ServoData, network: NetworkRegressor, n: int
+) -> tuple[Assessed, float, float]:
+    """The assessed answer, the window's equation error over the held-out simulations' median, and its limit."""
+    check_physics, check_rms = held_out_physics(prepared, data, n)
+    unit = network.predict_unit(np.vstack([data.inputs[n:], data.window_inputs]))
+    values = data.denormalize(unit)
+    names = data.targets
+    candidates = Candidates(
+        physics={name: physics.values[name] for name in names},
+        physics_std={name: physics.stds[name] for name in names},
+        network={name: float(values[-1, i]) for i, name in enumerate(names)},
+        network_unit=unit[-1],
+        check_truth={name: data.truth[n:, i] for i, name in enumerate(names)},
+        check_physics={name: check_physics[:, i] for i, name in enumerate(names)},
+        check_network={name: values[:-1, i] for i, name in enumerate(names)},
+        targets=names,
+        physics_std_observed=True,
+    )
+    ratio = physics.residual_rms_n / float(np.median(check_rms))
+    limit = misfit_limit(check_rms)
+    return assess(candidates, ratio, limit), ratio, limit
+
+
+def _relative_error_pct(measured: np.ndarray, simulated: np.ndarray) -> float:
+    return float(100.0 * np.linalg.norm(measured - simulated) / max(float(np.linalg.norm(measured)), 1e-300))
+
+
+def closed_loop_check(prepared: ServoPrepared, answer: Assessed, ratio: float, limit: float) -> FitCheck:
+    """The window simulated in closed loop at the answer: its force and position against the log's, in %, and the
+    force's misfit over its noise floor (the part of both forces above the inverse model's band, which no model
+    of the motion follows)."""
+    window, first = prepared.window, prepared.motion.first
+    s = window.signals
+    start = (float(s["position_m"][0]), float((s["position_m"][1] - s["position_m"][0]) * window.sample_rate_hz))
+    lane = lane_parameters(answer.values, prepared.effects)[None, :]
+    run = simulate_servo(s["set_point_m"], lane, prepared.loop, load_n=s.get("load_n"), start=start)
+    measured, simulated = s["drive_force_n"][first:], run.drive_force_n[0, first:]
+    factor = prepared.motion.decimation
+    noise = np.hypot(_above_band(measured, factor), _above_band(simulated, factor))
+    force_ratio = float(np.sqrt(np.mean((measured - simulated) ** 2)) / max(noise, 1e-300))
+    reproduced = force_ratio <= MAX_RATIO
+    notes = list(answer.notes)
+    if not reproduced:
+        notes.append(
+            Note(
+                code="not_reproduced",
+                text=f"simulated in closed loop at these estimates, the drive's force differs from the log's by "
+                f"{force_ratio:.1f}x its noise floor: the model lacks something this window holds (ema calibrate "
+                "traces it)",
+            )
+        )
+    return FitCheck(
+        reproduced=reproduced,
+        equation_error_ratio=ratio,
+        equation_error_limit=limit,
+        output_error_ratio={"drive_force_n": force_ratio},
+        output_error_pct={
+            "drive_force_n": _relative_error_pct(measured, simulated),
+            "position_m": _relative_error_pct(s["position_m"][first:], run.position_m[0, first:]),
+        },
+        uncertainty_inflation=answer.inflation,
+        notes=notes,
+    )
+
+
+def _above_band(force: np.ndarray, factor: int) -> float:
+    """RMS of the force above the inverse model's band: itself less its decimation low-pass, interpolated back."""
+    slow = decimated(force, factor)
+    grid = np.arange(len(force))
+    kept = grid[len(force) - 1 - (len(slow) - 1) * factor :: factor] if factor > 1 else grid
+    return float(np.sqrt(np.mean((force - np.interp(grid, kept, slow)) ** 2)))
+
+
+def _estimates(actuator: ActuatorDocument, prepared: ServoPrepared, physics: InverseFit, answer: Assessed) -> Estimates:
+    """FDJ in N against the document's nominal (none before ema calibrate), the other constants beside it (an
+    effect's that the simulator lacks as the physics fit read it)."""
+    nominal = None if actuator.nominal is None else actuator.nominal.fdj
+    values, stds = {**physics.values, **answer.values}, {**physics.stds, **answer.stds}
+    constants = {}
+    for name in values:
+        if name == FDJ:
+            continue
+        document = getattr(prepared.servo, NOMINAL_FIELDS.get(name, ""), None)
+        constants[name] = parameter(values[name], stds[name], document, unit=UNITS[name])
+    return Estimates(
+        FDJ=parameter(answer.values[FDJ], answer.stds[FDJ], nominal, unit=UNITS[FDJ]),
+        eta_O=None,
+        eta_A=None,
+        FSJ=None,
+        constants=constants,
+    )
+
+
+def _report(
+    prepared: ServoPrepared,
+    physics: InverseFit,
+    data: ServoData,
+    network: NetworkRegressor,
+    answer: Assessed,
+    check: FitCheck,
+    *,
+    actuator: ActuatorDocument,
+    read_with: ActuatorRead,
+    config: PipelineConfig,
+) -> Estimate:
+    window, fit = prepared.window, network.fits_[0]
+    return Estimate(
+        actuator_id=window.actuator_id,
+        window_id=window.window_id,
+        actuator=read_with,
+        estimates=_estimates(actuator, prepared, physics, answer),
+        fsj_note=Note(
+            code="fsj_no_break_away",
+            text="a servo's static friction is not read: its drive never lets the load rest under a rising force",
+        ),
+        irreversible=False,
+        notes=[*prepared.notes, *check.notes],
+        timings_s=Timings(total=0.0),  # the caller's stopwatch sets them
+        stages=dict.fromkeys(STAGES, "run"),
+        dataset=DatasetInfo(
+            n_simulations=config.n_simulations,
+            n_timesteps=data.inputs.shape[1],
+            inputs=["drive_force_n"],
+            check_windows=config.check_windows,
+            noise_estimated={"position_resolution_m": prepared.loop.resolution_m},
+            box={name: (float(lo), float(hi)) for name, lo, hi in zip(data.targets, data.low, data.high, strict=True)},
+        ),
+        training=TrainingInfo(
+            epochs=fit.epochs,
+            stop_reason=fit.stop_reason,
+            val_mse=fit.val_mse,
+            test_mse=fit.test_mse,
+            members=config.members,
+            hidden_units=config.hidden_units,
+        ),
+        methods={"FDJ" if name == FDJ else name: report for name, report in answer.methods.items()},
+        fit_check=check,
+        window=WindowInfo(
+            content_sha256=window.content_sha256(),
+            n_samples=window.n_samples,
+            duration_s=window.duration_s,
+            sample_rate_hz=window.sample_rate_hz,
+            processed_rate_hz=window.sample_rate_hz / prepared.motion.decimation,
+            command_clipped_fraction=0.0,
+            sliding_fraction=float(np.mean(prepared.motion.speed_mps != 0.0)),
+            recorded_at=window.recorded_at,
+            flight_hours=window.flight_hours,
+            flight_id=window.flight_id,
+        ),
+        config=config,
+    )
+
+
+def estimate_servo(
+    window: Window,
+    config: PipelineConfig,
+    *,
+    actuator: ActuatorDocument,
+    read_with: ActuatorRead,
+    on_stage: Callable[[str], None] | None = None,
+) -> Estimate:
+    """The ``ema-estimate/1`` result of a servo's window, every stage run and timed (module docstring)."""
+    watch, n = Stopwatch(on_stage), config.n_simulations
+    with watch("prepare", "completing the document from the log, checking its controller"):
+        prepared = prepare_servo(window, actuator)
+    with watch("physics", "fitting Eq. 5.1 on the load side"):
+        physics = physics_of(prepared)
+    with watch("simulate", f"simulating {config.total_simulations} runs of the window's set point in closed loop"):
+        data = simulate_servo_dataset(prepared, physics, config)
+    with watch("learn", f"training {config.members} network(s) of {config.hidden_units} neurons"):
+        network = learned(data, config)
+    with watch("assess", "weighing the estimators on held-out simulations"):
+        answer, ratio, limit = weighed(prepared, physics, data, network, n)
+    with watch("check", "simulating the window at the answer"):
+        check = closed_loop_check(prepared, answer, ratio, limit)
+    with watch("report", "writing the report"):
+        document = _report(
+            prepared, physics, data, network, answer, check, actuator=actuator, read_with=read_with, config=config
+        )
+    return document.model_copy(update={"timings_s": watch.timings()})

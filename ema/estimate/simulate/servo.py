@@ -1,0 +1,109 @@
+"""A servo window's own dataset: its set point run in closed loop (``ema.model.servo_sim``) at constants drawn
+around the physics estimate.
+
+Every constant the inverse model read that the simulator has (M, C or C per direction, FDJ, the offset, a
+Stribeck term) is drawn in a box centred on
+its estimate, ±``SPAN_SIGMAS`` of its std wide but never narrower than ``MIN_HALF_SHARE`` of FDJ (the offset
+may be near 0) or of itself, filled by a scrambled Halton sequence. Each simulation reads its position sensor
+at its own phase of the sensor's step (the quantization a real log carries, drawn anew). The network's inputs
+are the drive's force, averaged into ``n_timesteps`` bins: what a window of this command shows of its
+constants.
+"""
+
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass
+
+import numpy as np
+
+from ema.estimate.config import PipelineConfig
+from ema.estimate.physics.inverse import InverseFit
+from ema.estimate.prepare.servo import ServoPrepared
+from ema.estimate.simulate.design import halton
+from ema.model.servo_sim import LANE_PARAMETERS, ServoRuns, simulate_servo
+
+SPAN_SIGMAS = 6.0
+MIN_HALF_SHARE = 0.05
+LANE_COLUMNS = {
+    "mass_kg": (0,),
+    "fdj_n": (1,),
+    "viscous_ns_per_m": (2, 3),
+    "viscous_up_ns_per_m": (2,),
+    "viscous_down_ns_per_m": (3,),
+    "offset_n": (4,),
+    "stribeck_n": (5,),
+    "presliding_n": (7,),
+}  # a constant of the inverse model the simulator has -> the lane parameters it sets (``LANE_PARAMETERS``)
+NONLINEAR_COLUMNS = {"stribeck": LANE_PARAMETERS.index("stribeck_speed_mps"),
+                     "presliding": LANE_PARAMETERS.index("presliding_travel_m")}  # fmt: skip
+
+
+@dataclass(frozen=True)
+class ServoData:
+    targets: tuple[str, ...]  # the constants drawn, in the inverse model's names
+    low: np.ndarray  # (T,) the box
+    high: np.ndarray  # (T,)
+    truth: np.ndarray  # (S, T) each simulation's constants
+    runs: ServoRuns  # (S, N) position and force as the controller logged them
+    inputs: np.ndarray  # (S, F) the network's inputs
+    window_inputs: np.ndarray  # (F,) the window's
+
+    def normalize(self, values: np.ndarray) -> np.ndarray:
+        return (values - self.low) / (self.high - self.low)
+
+    def denormalize(self, unit: np.ndarray) -> np.ndarray:
+        return self.low + unit * (self.high - self.low)
+
+
+def lane_parameters(values: dict[str, float], effects: dict[str, float] | None = None) -> np.ndarray:
+    """(7,) a lane's parameters (``LANE_PARAMETERS``) from the inverse model's named constants and its effects'
+    nonlinear constants; the simulator leaves out what it has no parameter for."""
+    lane = np.zeros(len(LANE_PARAMETERS))
+    for name, value in values.items():
+        for column in LANE_COLUMNS.get(name, ()):
+            lane[column] = value
+    for effect, column in NONLINEAR_COLUMNS.items():
+        lane[column] = (effects or {}).get(effect, 0.0)
+    return lane
+
+
+def box(physics: InverseFit, targets: tuple[str, ...]) -> tuple[np.ndarray, np.ndarray]:
+    """(low, high) of each target: its estimate ±max(``SPAN_SIGMAS`` stds, ``MIN_HALF_SHARE`` of its scale)."""
+    scale = {name: abs(physics.values[name]) for name in targets}
+    scale["offset_n"] = abs(physics.values["fdj_n"])  # an offset near 0 is drawn on FDJ's scale
+    centre = np.array([physics.values[name] for name in targets])
+    half = np.array([max(SPAN_SIGMAS * physics.stds[n], MIN_HALF_SHARE * scale[n], 1e-9) for n in targets])
+    low = centre - half
+    floor = np.array(
+        [-np.inf if name == "offset_n" else 1e-3 * abs(c) for name, c in zip(targets, centre, strict=True)]
+    )
+    shift = np.maximum(floor - low, 0.0)  # a box that would reach a negative mass or friction moves up, not shrinks
+    return low + shift, centre + half + shift
+
+
+def binned(force: np.ndarray, bins: int) -> np.ndarray:
+    """(…, bins) means of the force over ``bins`` equal parts of the window."""
+    edges = np.linspace(0, force.shape[-1], bins + 1).astype(int)
+    return np.stack([force[..., a:b].mean(axis=-1) for a, b in itertools.pairwise(edges)], axis=-1)
+
+
+def simulate_servo_dataset(prepared: ServoPrepared, physics: InverseFit, config: PipelineConfig) -> ServoData:
+    """The window's ``config.total_simulations`` closed-loop runs, their constants and the network's inputs."""
+    targets = tuple(name for name in physics.values if name in LANE_COLUMNS)
+    low, high = box(physics, targets)
+    count = config.total_simulations
+    unit = halton(count, config.seed, len(targets))
+    truth = low + unit * (high - low)
+    effects = prepared.effects
+    lanes = np.stack([lane_parameters(dict(zip(targets, row, strict=True)), effects) for row in truth])
+    window = prepared.window
+    s = window.signals
+    start = (float(s["position_m"][0]), float((s["position_m"][1] - s["position_m"][0]) * window.sample_rate_hz))
+    phases = np.random.default_rng(config.seed).uniform(size=count)
+    runs = simulate_servo(s["set_point_m"], lanes, prepared.loop, load_n=s.get("load_n"), start=start, phase=phases)
+    first = prepared.motion.first
+    bins = min(config.n_timesteps, (window.n_samples - first) // 2)
+    inputs = binned(runs.drive_force_n[:, first:], bins)
+    window_inputs = binned(s["drive_force_n"][first:], bins)
+    return ServoData(targets, low, high, truth, runs, inputs, window_inputs)

@@ -1,0 +1,104 @@
+"""Each kind of actuator whole, in one module: how its windows are read, what a request costs, how its runs are
+calibrated (after NASA progpy's ``PrognosticsModel``: a model declares what it has, a predictor calls it).
+
+A kind's documents (its window's signals, its actuator document's section, what its log map may name) are its
+``ema.model.kinds.KindFacts``; its module here adds the method:
+
+- ``ema.kinds.rotary``: the thesis's elevator EMA, the whole pipeline at 1 kHz or more, quasi-static below;
+- ``ema.kinds.linear``: a ball screw turned by a stepper, read quasi-statically at any rate;
+- ``ema.kinds.servo``: a linear axis under a known position controller, logged on the load side, the whole
+  method in the load frame.
+
+``estimate``, ``calibrate`` and ``cost`` are the entries the command line, the service and the fleet call; a
+fourth kind is a module here and a row of ``ema.model.kinds``, not branches in the stages.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+
+from ema.estimate.config import PipelineConfig
+from ema.estimate.documents import Estimate
+from ema.estimate.documents.window import HistoryReadings
+from ema.kinds.base import ActuatorKind, Calibrated, CalibrationRequest, Cost, Request
+from ema.kinds.linear import LINEAR
+from ema.kinds.rotary import ROTARY
+from ema.kinds.servo import SERVO
+from ema.model.actuator import ActuatorDocument
+from ema.model.checks import InputError
+from ema.model.window import Window
+
+__all__ = [
+    "KINDS",
+    "Calibrated",
+    "CalibrationRequest",
+    "Cost",
+    "Request",
+    "calibrate",
+    "calibration_cost",
+    "cost",
+    "estimate",
+    "kind_of",
+]
+
+
+KINDS: dict[str, ActuatorKind] = {kind.facts.name: kind for kind in (ROTARY, LINEAR, SERVO)}
+
+
+def kind_of(actuator: ActuatorDocument) -> ActuatorKind:
+    """The method of ``actuator``'s kind."""
+    return KINDS[actuator.kind]
+
+
+def same_kind(windows: Sequence[Window], actuator: ActuatorDocument) -> None:
+    """InputError naming the first window whose signals are another kind's than the document's."""
+    for i, window in enumerate(windows):
+        if window.kind != actuator.kind:
+            where = "signals" if len(windows) == 1 else f"windows.{i}.signals"
+            raise InputError(
+                where,
+                f"are a {window.kind} actuator's ({', '.join(window.signal_names)}), but the document "
+                f"{actuator.name!r} is of a {actuator.kind} one (its kind): window {window.window_id}",
+            )
+
+
+def estimate(
+    window: Window,
+    config: PipelineConfig = PipelineConfig(),
+    *,
+    actuator: ActuatorDocument,
+    version: int | None = None,
+    on_stage: Callable[[str], None] | None = None,
+    history: HistoryReadings | None = None,
+    spec_only: bool = False,
+) -> Estimate:
+    """The ``ema-estimate/1`` result for ``window``, read by its actuator's kind; InputError where the window's
+    signals are another kind's than its document's."""
+    same_kind([window], actuator)
+    return kind_of(actuator).estimate(window, Request(config, actuator, version, on_stage, history, spec_only))
+
+
+def calibrate(windows: Sequence[Window], request: CalibrationRequest) -> Calibrated:
+    """``ema-calibration/1`` for windows of one actuator, by its kind; InputError naming a window of another
+    kind or of another actuator."""
+    if not windows:
+        raise InputError("windows", "a calibration needs one window at least")
+    same_kind(windows, request.actuator)
+    for i, window in enumerate(windows):
+        if window.actuator_id != windows[0].actuator_id:
+            raise InputError(
+                f"windows.{i}.actuator_id",
+                f"is {window.actuator_id!r}; a calibration reads the windows of one actuator "
+                f"({windows[0].actuator_id!r})",
+            )
+    return kind_of(request.actuator).calibrate(windows, request)
+
+
+def cost(window: Window, config: PipelineConfig) -> Cost:
+    """What reading ``window`` asks of a service (``Cost``), by its signals' kind."""
+    return KINDS[window.kind].cost(window, config)
+
+
+def calibration_cost(windows: Sequence[Window], config: PipelineConfig) -> Cost:
+    """What calibrating ``windows`` asks of a service beside reading each (``Cost``), by their kind."""
+    return KINDS[windows[0].kind].calibration_cost(windows, config) if windows else Cost(0.0, 0.0)

@@ -1,0 +1,73 @@
+"""What every kind of actuator declares (``ActuatorKind``) and the requests and answers its methods share."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+from typing import Protocol
+
+from ema.calibration.documents import CalibrationReport
+from ema.calibration.noise_floor import COPIES
+from ema.calibration.plot import ResidualPlot
+from ema.estimate.config import PipelineConfig
+from ema.estimate.documents import ActuatorRead, Estimate
+from ema.estimate.documents.window import HistoryReadings
+from ema.model.actuator import THESIS, ActuatorDocument
+from ema.model.kinds import KindFacts
+from ema.model.window import Window
+
+
+@dataclass(frozen=True)
+class Request:
+    """What a window is read with besides itself."""
+
+    config: PipelineConfig
+    actuator: ActuatorDocument
+    version: int | None = None
+    on_stage: Callable[[str], None] | None = None
+    history: HistoryReadings | None = None
+    spec_only: bool = False
+
+    @property
+    def read_with(self) -> ActuatorRead:
+        return ActuatorRead(name=self.actuator.name, version=self.version, default=self.actuator is THESIS)
+
+
+@dataclass(frozen=True)
+class CalibrationRequest:
+    """What a calibration is run with besides its windows."""
+
+    config: PipelineConfig
+    actuator: ActuatorDocument
+    truth: Mapping[str, float] | None = None
+    copies: int = COPIES
+    on_stage: Callable[[str], None] | None = None
+    checkpoint: Callable[[], None] | None = None
+
+
+@dataclass(frozen=True)
+class Calibrated:
+    report: CalibrationReport
+    completed: ActuatorDocument | None = None  # the document with what the runs taught (None: nothing to write)
+    plot: ResidualPlot | None = None
+
+
+@dataclass(frozen=True)
+class Cost:
+    """What a request asks of a service, in the units of its limits: the work of its simulations as seconds of
+    the rotary simulator's 1 µs steps (a kind that simulates nothing: 0; a servo's steps at its controller's rate
+    count as many 1 µs steps), and the window seconds its limit on a window's length (or a calibration's) holds
+    (0: the kind's work does not grow with them beyond what its samples and its simulations say)."""
+
+    simulated_s: float
+    window_s: float
+
+
+class ActuatorKind(Protocol):
+    @property
+    def facts(self) -> KindFacts: ...
+    def stages(self, window: Window) -> tuple[str, ...]: ...
+    def estimate(self, window: Window, request: Request) -> Estimate: ...
+    def calibrate(self, windows: Sequence[Window], request: CalibrationRequest) -> Calibrated: ...
+    def cost(self, window: Window, config: PipelineConfig) -> Cost: ...
+    def calibration_cost(self, windows: Sequence[Window], config: PipelineConfig) -> Cost: ...

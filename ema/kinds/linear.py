@@ -1,0 +1,45 @@
+"""The linear kind: a ball screw turned by a stepper, logged by a rig at its own rate.
+
+Its windows are read quasi-statically at any rate (``ema.estimate.low_rate``: the stepper's drive is no
+current loop ema can simulate), its torque from the drive's current as ``ema calibrate`` learned it
+(``ema.calibration.linear``): healthy runs teach the drive, faulted runs are compared with it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+from ema.calibration.linear_report import calibrate_linear
+from ema.estimate.config import PipelineConfig
+from ema.estimate.documents import Estimate
+from ema.estimate.low_rate import QUASI_STATIC, estimate_low_rate
+from ema.kinds.base import Calibrated, CalibrationRequest, Cost, Request
+from ema.model.kinds import KINDS, KindFacts
+from ema.model.window import Window
+
+
+@dataclass(frozen=True)
+class Linear:
+    facts: KindFacts = KINDS["linear"]
+
+    def stages(self, window: Window) -> tuple[str, ...]:
+        return QUASI_STATIC
+
+    def estimate(self, window: Window, request: Request) -> Estimate:
+        return estimate_low_rate(
+            window, request.config, actuator=request.actuator, read_with=request.read_with, on_stage=request.on_stage
+        )
+
+    def calibrate(self, windows: Sequence[Window], request: CalibrationRequest) -> Calibrated:
+        report, completed, plot = calibrate_linear(windows, request.actuator, request.truth)
+        return Calibrated(report.model_copy(update={"completed_actuator": completed}), completed, plot)
+
+    def cost(self, window: Window, config: PipelineConfig) -> Cost:
+        return Cost(simulated_s=0.0, window_s=0.0)  # no simulation: its samples alone bound the work
+
+    def calibration_cost(self, windows: Sequence[Window], config: PipelineConfig) -> Cost:
+        return Cost(simulated_s=0.0, window_s=0.0)
+
+
+LINEAR = Linear()

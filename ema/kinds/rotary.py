@@ -1,0 +1,113 @@
+"""The rotary kind: the thesis's elevator EMA, a current-piloted motor and a gear train to a surface.
+
+A window at 1 kHz or more goes through the whole pipeline (``ema.estimate.pipeline``), one logged slower is
+read quasi-statically (``ema.estimate.low_rate``); its calibration is the loop of ``ema.calibration.calibrate``,
+which reads windows at 1 kHz or more.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from ema.calibration.calibrate import Calibrator
+from ema.calibration.plot import ResidualPlot, Series
+from ema.estimate.config import PipelineConfig
+from ema.estimate.documents import STAGES, Estimate
+from ema.estimate.low_rate import QUASI_STATIC, estimate_low_rate
+from ema.estimate.pipeline import estimate_window
+from ema.kinds.base import Calibrated, CalibrationRequest, Cost, Request
+from ema.model.checks import InputError
+from ema.model.kinds import KINDS, KindFacts
+from ema.model.window import HIGH_RATE_HZ, Window
+
+VARIABLES = {
+    "speed_radps": "motor speed |ω| [rad/s]",
+    "current_a": "current · sgn(ω) [A]",
+    "time_s": "time in the window [s]",
+    "position_rad": "elevator position [rad]",
+    "motor_angle_rad": "motor angle mod 2π [rad]",
+    "direction": "direction of motion",
+    "load_nm": "load at the shaft, + aiding [N·m]",
+}
+
+
+@dataclass(frozen=True)
+class Rotary:
+    facts: KindFacts = KINDS["rotary"]
+
+    def stages(self, window: Window) -> tuple[str, ...]:
+        return STAGES if window.high_rate else QUASI_STATIC
+
+    def estimate(self, window: Window, request: Request) -> Estimate:
+        if not window.high_rate:
+            return estimate_low_rate(
+                window,
+                request.config,
+                actuator=request.actuator,
+                read_with=request.read_with,
+                on_stage=request.on_stage,
+            )
+        return estimate_window(
+            window,
+            request.config,
+            actuator=request.actuator,
+            version=request.version,
+            on_stage=request.on_stage,
+            spec_only=request.spec_only,
+            history=request.history,
+        )
+
+    def calibrate(self, windows: Sequence[Window], request: CalibrationRequest) -> Calibrated:
+        for i, window in enumerate(windows):
+            if not window.high_rate:
+                raise InputError(
+                    f"windows.{i}.sample_rate_hz",
+                    f"{window.sample_rate_hz:g} Hz: a rotary actuator's calibration simulates its windows and reads "
+                    f"them at {HIGH_RATE_HZ:g} Hz or more",
+                )
+        config = request.config
+        calibrator = Calibrator(config, copies=request.copies, seed=config.seed, actuator=request.actuator)
+        calibrator.fit(windows, request.truth, on_stage=request.on_stage, checkpoint=request.checkpoint)
+        return Calibrated(calibrator.report_, None, residual_plot(calibrator))
+
+    def cost(self, window: Window, config: PipelineConfig) -> Cost:
+        if not window.high_rate:
+            return Cost(simulated_s=0.0, window_s=0.0)
+        return Cost(simulated_s=config.total_simulations * window.duration_s, window_s=window.duration_s)
+
+    def calibration_cost(self, windows: Sequence[Window], config: PipelineConfig) -> Cost:
+        seconds = sum(w.duration_s for w in windows)
+        return Cost(simulated_s=config.total_simulations * seconds, window_s=seconds)
+
+
+def residual_plot(calibrator: Calibrator) -> ResidualPlot:
+    """The equation-error residual before and after, against the variable that explains it."""
+    from ema.calibration.fitting import score
+    from ema.calibration.selection import problem
+
+    e, report, chosen = calibrator.measured_, calibrator.report_, calibrator.chosen_
+    variable = "time_s"
+    if chosen:
+        variable = chosen[0].family.follows
+    elif report.unexplained is not None:
+        variable = report.unexplained.variables[0]
+    x = e.variables[variable]
+    if variable == "motor_angle_rad":
+        x = np.mod(x, 2 * np.pi)
+    series = []
+    for label, model in (("before", []), ("after", chosen)):
+        design, target = problem(e, model)
+        residual = target - design @ score(design, target, e.folds).beta
+        series.append(Series(label, x[::4].tolist(), residual[::4].tolist()))
+    return ResidualPlot(
+        title=f"calibration: {report.selected_effect or 'no effect named'}",
+        x_label=VARIABLES.get(variable, variable),
+        y_label="equation error of Eq. 5.1 [N·m]",
+        series=series,
+    )
+
+
+ROTARY = Rotary()

@@ -1,0 +1,55 @@
+"""The servo kind: a linear axis driven by a force command from a known position controller, logged on the load
+side (the EMPS benchmark's machine is one).
+
+Its windows go through every stage of the method in the load frame (``ema.estimate.servo``): its own set point
+simulated in closed loop by ``ema.model.servo_sim``, a network learned from those runs, both estimators
+assessed, the window simulated at the answer. Its calibration (``ema.calibration.servo``) learns the load's
+constants and traces what the model still misses to a named effect.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+from ema.calibration.servo import calibrate_servo
+from ema.estimate.config import PipelineConfig
+from ema.estimate.documents import STAGES, Estimate
+from ema.estimate.servo import estimate_servo
+from ema.kinds.base import Calibrated, CalibrationRequest, Cost, Request
+from ema.model.kinds import KINDS, KindFacts
+from ema.model.params import DriveConstants
+from ema.model.servo_sim import SUBSTEPS
+from ema.model.window import Window
+
+ROTARY_STEP_S = DriveConstants().step_s  # what a service's simulation limit counts in
+
+
+@dataclass(frozen=True)
+class Servo:
+    facts: KindFacts = KINDS["servo"]
+
+    def stages(self, window: Window) -> tuple[str, ...]:
+        return STAGES
+
+    def estimate(self, window: Window, request: Request) -> Estimate:
+        return estimate_servo(
+            window, request.config, actuator=request.actuator, read_with=request.read_with, on_stage=request.on_stage
+        )
+
+    def calibrate(self, windows: Sequence[Window], request: CalibrationRequest) -> Calibrated:
+        report, completed, plot = calibrate_servo(windows, request.actuator)
+        return Calibrated(report.model_copy(update={"completed_actuator": completed}), completed, plot)
+
+    def cost(self, window: Window, config: PipelineConfig) -> Cost:
+        """Its simulations' load steps, counted as as many of the rotary simulator's 1 µs steps (a lane-step of
+        either costs a few ns)."""
+        steps = (config.total_simulations + 1) * window.n_samples * SUBSTEPS
+        return Cost(simulated_s=steps * ROTARY_STEP_S, window_s=0.0)
+
+    def calibration_cost(self, windows: Sequence[Window], config: PipelineConfig) -> Cost:
+        steps = sum(window.n_samples * SUBSTEPS * 2 for window in windows)  # the closed loop before and after
+        return Cost(simulated_s=steps * ROTARY_STEP_S, window_s=0.0)
+
+
+SERVO = Servo()

@@ -1,0 +1,133 @@
+"""Each kind of actuator as its documents see it: the signals of its windows, the section of its actuator
+document, what its log map may name and in which units, and the unit its friction is read in.
+
+One table (``KINDS``): the window, the actuator document and the log map ask it, and nothing compares a kind
+with a literal. How each kind is read, simulated and calibrated is declared beside it in ``ema.kinds``.
+
+- **rotary**: the thesis's elevator EMA, a current-piloted motor and a gear train; friction at the motor
+  shaft (N·m).
+- **linear**: a ball screw turned by a stepper, logged by a rig at its own rate; friction at the motor
+  shaft (N·m), the drive's current read through what ``ema calibrate`` learned.
+- **servo**: a linear axis whose drive takes a force command from a known position controller, everything
+  logged on the load side (positions in m, forces in N): friction on the load (N).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass
+from types import MappingProxyType
+
+from ema.model.units import ANGLE_DEG, CURRENT_A, FORCE_N, LENGTH_M, LENGTH_MM, SPEED_RADPS, TORQUE_NM
+
+
+@dataclass(frozen=True)
+class Role:
+    """A quantity a log map may name: the window signal it becomes and the units it may be written in."""
+
+    signal: str
+    units: Mapping[str, float]  # unit -> factor to the signal's own unit
+    required: bool = True
+
+
+@dataclass(frozen=True)
+class KindFacts:
+    name: str
+    summary: str
+    signals: tuple[str, ...]  # a window's signals, in order
+    section: str  # the actuator document's field that holds this kind's constants
+    friction_unit: str  # the unit FDJ is read in: "N·m" at the motor shaft, "N" on the load
+    roles: Mapping[str, Role]  # log-map role -> signal; "position" may be given as "error" (set point less it)
+    optional_signals: tuple[str, ...] = ()
+    nominal_given: bool = False  # the document's author gives the nominal health (else ema calibrate learns it)
+    static_friction: bool = False  # a window can show a break-away (FSJ)
+    load_side: bool = False  # the log is on the load side: FDJ is the load's friction force
+
+    @property
+    def all_signals(self) -> tuple[str, ...]:
+        return self.signals + self.optional_signals
+
+    def friction_field(self, prefix: str) -> str:
+        """The document's field of a friction value in this kind's unit (``fdj`` -> ``fdj_nm`` or ``fdj_n``)."""
+        return f"{prefix}_{FRICTION_SUFFIX[self.friction_unit]}"
+
+
+FRICTION_SUFFIX = MappingProxyType({"N·m": "nm", "N": "n"})
+
+_ROTARY = KindFacts(
+    name="rotary",
+    summary="a current-piloted motor and a gear train to a surface",
+    signals=("command_deg", "position_deg", "motor_speed_radps", "current_a", "hinge_moment_nm"),
+    section="drive",
+    friction_unit="N·m",
+    roles=MappingProxyType(
+        {
+            "set_point": Role("command_deg", ANGLE_DEG),
+            "position": Role("position_deg", ANGLE_DEG),
+            "motor_speed": Role("motor_speed_radps", SPEED_RADPS),
+            "current": Role("current_a", CURRENT_A),
+            "load": Role("hinge_moment_nm", TORQUE_NM),
+        }
+    ),
+    nominal_given=True,
+    static_friction=True,
+)
+_LINEAR = KindFacts(
+    name="linear",
+    summary="a ball screw turned by a stepper, its current read through what ema calibrate learned",
+    signals=("command_mm", "position_mm", "current_a", "load_n"),
+    section="screw",
+    friction_unit="N·m",
+    roles=MappingProxyType(
+        {
+            "set_point": Role("command_mm", LENGTH_MM),
+            "position": Role("position_mm", LENGTH_MM),
+            "current": Role("current_a", CURRENT_A),
+            "load": Role("load_n", FORCE_N),
+        }
+    ),
+)
+_SERVO = KindFacts(
+    name="servo",
+    summary="a linear axis driven by a force command from a known position controller, logged on the load side",
+    signals=("set_point_m", "position_m", "drive_force_n"),
+    optional_signals=("load_n",),
+    section="servo",
+    friction_unit="N",
+    roles=MappingProxyType(
+        {
+            "set_point": Role("set_point_m", LENGTH_M),
+            "position": Role("position_m", LENGTH_M),
+            "force": Role("drive_force_n", FORCE_N),
+            "load": Role("load_n", FORCE_N, required=False),
+        }
+    ),
+    load_side=True,
+)
+KINDS: Mapping[str, KindFacts] = MappingProxyType({k.name: k for k in (_ROTARY, _LINEAR, _SERVO)})
+DEFAULT_KIND = _ROTARY.name
+KIND_NAMES = tuple(KINDS)
+ALL_SIGNALS = tuple(dict.fromkeys(name for k in KINDS.values() for name in k.all_signals))
+
+
+def facts(kind: str) -> KindFacts:
+    return KINDS[kind]
+
+
+def kind_of_signals(names: Iterable[str]) -> KindFacts | None:
+    """The kind whose window carries exactly these signals (its own, and any of its optional ones), or None."""
+    given = set(names)
+    for kind in KINDS.values():
+        if set(kind.signals) <= given <= set(kind.all_signals):
+            return kind
+    return None
+
+
+def nearest_kind(names: Iterable[str]) -> KindFacts:
+    """The kind these signals come closest to (most of its own signals among them): what a refusal names."""
+    given = set(names)
+
+    def closeness(kind: KindFacts) -> tuple[int, int]:
+        return len(given & set(kind.signals)) - len(given - set(kind.all_signals)), -len(kind.signals)
+
+    return max(KINDS.values(), key=closeness)

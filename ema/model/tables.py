@@ -1,0 +1,134 @@
+"""A logged file as named columns and constants: CSV (read as a stream), MATLAB (``.mat``) or NumPy (``.npz``).
+
+Limits are checked before the work: a file over ``MAX_LOG_BYTES`` is refused from its size, and a CSV is
+read row by row and refused at its ``MAX_ROWS + 1``-th row (a window holds at most ``MAX_SAMPLES``), so a
+huge file costs neither minutes nor gigabytes. Errors name the file, and the variable where one is at fault.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ema.model.checks import InputError
+
+MAX_LOG_BYTES = 256 * 2**20  # a logged file's size limit: ~4x the largest window's CSV
+MAX_ROWS = 1_000_000  # a window's samples at most (ema.model.window.MAX_SAMPLES)
+TABLE_SUFFIXES = (".csv", ".mat", ".npz")
+
+
+@dataclass(frozen=True)
+class Table:
+    """A file's numeric columns (1-D, one length each), its scalar constants and its ``# key: value`` lines."""
+
+    columns: dict[str, np.ndarray]
+    scalars: dict[str, float] = field(default_factory=dict)
+    meta: dict[str, str] = field(default_factory=dict)
+
+
+def read_table(path: str | Path) -> Table:
+    """The table in ``path`` by its suffix; InputError naming the file where it cannot be read or is too large."""
+    path = Path(path)
+    readers = {".csv": _csv, ".mat": _mat, ".npz": _npz}
+    suffix = path.suffix.lower()
+    if suffix not in readers:
+        raise InputError(str(path), f"is not a {'/'.join(TABLE_SUFFIXES)} file")
+    try:
+        size = path.stat().st_size
+    except OSError as exc:
+        raise InputError(str(path), f"cannot be read ({exc.strerror})") from None
+    if size > MAX_LOG_BYTES:
+        raise InputError(
+            str(path), f"is {size / 2**20:.0f} MiB, over the {MAX_LOG_BYTES // 2**20} MiB a logged file may be: cut it"
+        )
+    return readers[suffix](path)
+
+
+def _rows(handle: io.TextIOBase, meta: dict[str, str]) -> Iterator[str]:
+    """The data lines of a CSV, its ``# key: value`` lines kept in ``meta``."""
+    for line in handle:
+        if line.startswith("#"):
+            key, colon, value = line[1:].partition(":")
+            if colon:
+                meta[key.strip()] = value.strip()
+            continue
+        yield line
+
+
+def _csv(path: Path) -> Table:
+    """A CSV's numeric columns (a column with any non-number is text: left out), read row by row."""
+    meta: dict[str, str] = {}
+    try:
+        with path.open(newline="", encoding="utf-8") as handle:
+            reader = csv.reader(_rows(handle, meta))
+            header = next(reader, None)
+            if header is None:
+                raise InputError(str(path), "has no header row")
+            values: list[list[float | None]] = [[] for _ in header]
+            count = 0
+            for count, row in enumerate(reader, start=1):  # count: the rows read
+                if count > MAX_ROWS:
+                    raise InputError(str(path), f"has over {MAX_ROWS:,} rows, more than a window may hold: cut it")
+                for column, text in zip(values, row, strict=False):
+                    column.append(_number(text))
+    except UnicodeDecodeError:
+        raise InputError(str(path), "is not text (a CSV is UTF-8)") from None
+    except csv.Error as exc:
+        raise InputError(str(path), f"is not a CSV ({exc})") from None
+    if count == 0:
+        raise InputError(str(path), "has no data rows")
+    columns = {}
+    for name, column in zip(header, values, strict=True):
+        if len(column) == count and all(v is not None for v in column):
+            columns[name.strip()] = np.array(column, dtype=np.float64)
+    return Table(columns, meta=meta)
+
+
+def _number(text: str) -> float | None:
+    try:
+        return float(text)
+    except ValueError:
+        return None
+
+
+def _mat(path: Path) -> Table:
+    """A MATLAB file's vectors (any n×1 or 1×n) as columns, its 1×1 values as constants."""
+    from scipy.io import loadmat  # the reader of MATLAB's files; imported only for one
+
+    try:
+        variables = loadmat(path, squeeze_me=False)
+    except NotImplementedError:
+        raise InputError(str(path), "is a MATLAB 7.3 (HDF5) file: save it with -v7 (scipy reads up to 7.2)") from None
+    except (ValueError, TypeError, OSError) as exc:
+        raise InputError(str(path), f"is not a MATLAB file ({exc})") from None
+    return _arrays(path, {k: v for k, v in variables.items() if not k.startswith("__")})
+
+
+def _npz(path: Path) -> Table:
+    try:
+        with np.load(path, allow_pickle=False) as archive:
+            return _arrays(path, {name: archive[name] for name in archive.files})
+    except (ValueError, OSError) as exc:
+        raise InputError(str(path), f"is not a NumPy .npz archive ({exc})") from None
+
+
+def _arrays(path: Path, variables: dict[str, np.ndarray]) -> Table:
+    columns, scalars, meta = {}, {}, {}
+    for name, value in variables.items():
+        array = np.asarray(value)
+        if array.dtype.kind in "US":
+            meta[name] = str(array.ravel()[0]) if array.size else ""
+        elif array.dtype.kind not in "biuf":
+            continue  # a struct or a cell: not a signal
+        elif array.size == 1:
+            scalars[name] = float(array.ravel()[0])
+        elif sum(d > 1 for d in array.shape) == 1:
+            if array.size > MAX_ROWS:
+                raise InputError(f"{path}: {name}", f"has {array.size:,} samples, more than a window may hold")
+            columns[name] = array.ravel().astype(np.float64)
+    return Table(columns, scalars, meta)

@@ -1,0 +1,19 @@
+"""The units a log may be written in, each as the factor to ema's own unit of its quantity.
+
+ema computes with the unit in each name (``position_mm``, ``load_n``): a log map names its columns' units,
+each role of a kind (``ema.model.kinds``) reads them from its quantity's table, and the reader multiplies by the
+factor.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+LENGTH_MM = {"mm": 1.0, "m": 1000.0, "in": 25.4, "um": 1e-3}  # to mm
+LENGTH_M = {name: factor / 1000.0 for name, factor in LENGTH_MM.items()}  # to m
+ANGLE_DEG = {"deg": 1.0, "rad": 180.0 / np.pi}
+CURRENT_A = {"A": 1.0, "mA": 1e-3}
+FORCE_N = {"N": 1.0, "kN": 1e3, "kgf": 9.80665, "lbf": 4.4482216152605}
+TORQUE_NM = {"N·m": 1.0, "Nm": 1.0}
+SPEED_RADPS = {"rad/s": 1.0, "rpm": 2.0 * np.pi / 60.0}
+TIME_S = {"s": 1.0, "ms": 1e-3}
