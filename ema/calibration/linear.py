@@ -30,7 +30,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ema.estimate.quasistatic import ETA_GRID, Stretch, speed_and_load, stretches
+from ema.estimate.quasistatic import ETA_GRID, Stretch, set_point_motion, stretches
 from ema.estimate.stats import rms
 from ema.model.actuator import ActuatorDocument
 from ema.model.checks import InputError
@@ -54,7 +54,7 @@ class Run:
 
 def read_run(window: Window, actuator: ActuatorDocument) -> Run:
     """A run's stretches and rest; InputError naming the window where it has no stretch or never rests."""
-    speed, load = speed_and_load(window, actuator.gear_ratio)
+    speed, load = set_point_motion(window, actuator.gear_ratio)
     found, rest = stretches(speed, window.signals["current_a"], load, window.sample_rate_hz)
     if not found or rest is None:
         why = "no stretch at constant speed" if not found else "no rest (the current at zero torque is read there)"

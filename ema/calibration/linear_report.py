@@ -29,7 +29,7 @@ from ema.calibration.linear import MIN_Z, DriveFit, Run, fit_drive, profile_chan
 from ema.calibration.plot import ResidualPlot, Series
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import DIMENSIONLESS, ActuatorRead
-from ema.estimate.low_rate import estimate_low_rate
+from ema.estimate.low_rate import STEPPER_READING, estimate_low_rate
 from ema.model.actuator import ActuatorDocument, Nominal
 from ema.model.params import load_factors
 from ema.model.window import Window
@@ -196,7 +196,10 @@ def _compared(
     windows: Sequence[Window], runs: list[Run], actuator: ActuatorDocument, started: float
 ) -> CalibrationReport:
     read_with = ActuatorRead(name=actuator.name)
-    results = [estimate_low_rate(w, PipelineConfig(), actuator=actuator, read_with=read_with) for w in windows]
+    results = [
+        estimate_low_rate(w, PipelineConfig(), reading=STEPPER_READING, actuator=actuator, read_with=read_with)
+        for w in windows
+    ]
     values = np.array([r.estimates.FDJ.value for r in results])
     stds = np.array([r.estimates.FDJ.std or np.inf for r in results])
     weights = 1.0 / stds**2

@@ -4,7 +4,10 @@ add it, and report the error before and after.
 1. **Learn.** Eq. 5.1 in the load frame (``ema.estimate.physics.inverse``) over every window at once: M, C,
    FDJ and the offset, each with its Newey–West std and unit (``learned``); the model's error is the
    identification benchmarks' own, 100·‖y − ŷ‖/‖y‖ on the decimated force.
-2. **Find.** Each effect of ``ema.calibration.servo_effects`` is fitted on four fifths of every window and
+2. **Find**, where there is something to find: the windows' residual must stand beyond what noise alone leaves,
+   the same fit on ``COPIES`` noise-only copies (each window simulated in closed loop at the learned constants,
+   its sensor read at another phase of its step), at a 1 % false alarm (``misfit_limit``). Then each effect of
+   ``ema.calibration.servo_effects`` is fitted on four fifths of every window and
    predicts the fifth left out, in turn (its nonlinear constant chosen the same way). An effect is taken only
    where it is physical (its constants' signs), predicts every fold better (a real effect shows in each part
    of a log, noise does not), and cuts the held-out residual by ``MIN_HELD_OUT_DROP`` at least; then the next,
@@ -22,7 +25,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -36,7 +39,16 @@ from ema.calibration.documents import (
 )
 from ema.calibration.plot import ResidualPlot, Series
 from ema.calibration.servo_effects import EFFECTS, ServoEffect
-from ema.estimate.physics.inverse import UNITS, decimated, inverse_columns, newey_west_lags, newey_west_std
+from ema.estimate.assess.weighing import misfit_limit
+from ema.estimate.physics.inverse import (
+    UNITS,
+    decimated,
+    decimated_problem,
+    inverse_columns,
+    load_motion,
+    newey_west_lags,
+    newey_west_std,
+)
 from ema.estimate.prepare.servo import ServoPrepared, document_effects, prepare_servo
 from ema.estimate.simulate.servo import lane_parameters
 from ema.model.actuator import ActuatorDocument, Nominal
@@ -44,6 +56,7 @@ from ema.model.servo_sim import simulate_servo
 from ema.model.window import Window
 
 FOLDS = 5
+COPIES = 8
 MIN_HELD_OUT_DROP = 0.05  # of the held-out residual sum of squares
 MAX_EFFECTS = 2
 LEARNED_NAMES = {
@@ -73,9 +86,8 @@ def problem(prepared: Sequence[ServoPrepared], model: dict[str, float]) -> Probl
     """The stacked problem of ``model`` (effect name -> its nonlinear constant) over the windows."""
     ys, xs, folds, windows = [], [], [], []
     for i, p in enumerate(prepared):
-        columns = inverse_columns(p.motion, model)
-        y = decimated(p.force_n, p.motion.decimation)
-        xs.append({name: decimated(column, p.motion.decimation) for name, column in columns.items()})
+        y, x = decimated_problem(p.force_n, inverse_columns(p.motion, model), p.motion)
+        xs.append(x)
         ys.append(y)
         folds.append(np.minimum(np.arange(len(y)) * FOLDS // len(y), FOLDS - 1))
         windows.append(np.full(len(y), i))
@@ -143,6 +155,29 @@ def _candidate(effect: ServoEffect, value: float, fit: Fitted, base: Fitted) -> 
     return candidate, plausible and every_fold and drop >= MIN_HELD_OUT_DROP
 
 
+def noise_floor(prepared: Sequence[ServoPrepared], base: Fitted, model: dict[str, float]) -> tuple[float, float]:
+    """(the windows' residual RMS over the noise-only copies' median, the ratio a clean log exceeds 1 % of the
+    time): the copies are the windows simulated at the ``base`` constants, their sensor read at other phases."""
+    copies = []
+    for phase in np.linspace(0.0, 1.0, COPIES, endpoint=False):
+        twins = [_simulated(p, base.values, model, phase) for p in prepared]
+        copies.append(float(np.sqrt(np.mean(fitted(problem(twins, model)).residual ** 2))))
+    rms = float(np.sqrt(np.mean(base.residual**2)))
+    return rms / float(np.median(copies)), misfit_limit(np.array(copies))
+
+
+def _simulated(p: ServoPrepared, values: dict[str, float], model: dict[str, float], phase: float) -> ServoPrepared:
+    """``p`` with its window's position and force as the closed loop at ``values`` logs them."""
+    s = p.window.signals
+    start = (float(s["position_m"][0]), float((s["position_m"][1] - s["position_m"][0]) * p.window.sample_rate_hz))
+    lane = lane_parameters(values, model)[None, :]
+    run = simulate_servo(s["set_point_m"], lane, p.loop, load_n=s.get("load_n"), start=start, phase=np.array([phase]))
+    rate = p.window.sample_rate_hz
+    motion = load_motion(run.position_m[0], rate, p.bandwidth_hz, p.loop.resolution_m)
+    force = (run.drive_force_n[0] - s.get("load_n", 0.0))[motion.samples]
+    return replace(p, motion=motion, force_n=force)
+
+
 def select(prepared: Sequence[ServoPrepared], base_model: dict[str, float]) -> tuple[dict[str, float], list, list]:
     """The effects adopted on top of ``base_model``, every candidate considered, and the steps' reasons."""
     model, candidates, steps = dict(base_model), [], []
@@ -201,12 +236,12 @@ def closed_loop_error_pct(
     simulator has; the others left out)."""
     errors, norms = 0.0, 0.0
     for p in prepared:
-        s, first = p.window.signals, p.motion.first
+        s, kept = p.window.signals, p.motion.samples
         start = (float(s["position_m"][0]), float((s["position_m"][1] - s["position_m"][0]) * p.window.sample_rate_hz))
         lane = lane_parameters(values, effects)[None, :]
         run = simulate_servo(s["set_point_m"], lane, p.loop, load_n=s.get("load_n"), start=start)
-        errors += float(np.sum((s["drive_force_n"][first:] - run.drive_force_n[0, first:]) ** 2))
-        norms += float(np.sum(s["drive_force_n"][first:] ** 2))
+        errors += float(np.sum((s["drive_force_n"][kept] - run.drive_force_n[0, kept]) ** 2))
+        norms += float(np.sum(s["drive_force_n"][kept] ** 2))
     return float(100.0 * np.sqrt(errors / norms))
 
 
@@ -258,7 +293,7 @@ def completed(
 
 def _plot(prepared: Sequence[ServoPrepared], base: Fitted, after: Fitted, model: dict[str, float]) -> ResidualPlot:
     """The decimated force's residual before and after, against the speed (what the effects follow)."""
-    speed = np.concatenate([decimated(p.motion.speed_mps, p.motion.decimation) for p in prepared])
+    speed = np.concatenate([decimated(p.motion.speed_mps, p.motion.decimation)[p.motion.sliding] for p in prepared])
     return ResidualPlot(
         title=f"calibration: {', '.join(model) or 'no effect named'}",
         x_label="speed of the load [m/s]",
@@ -278,7 +313,18 @@ def calibrate_servo(
     prepared = [prepare_servo(w, actuator) for w in windows]
     base_model = document_effects(prepared[0].servo)
     base = fitted(problem(prepared, base_model))
-    model, candidates, steps = select(prepared, base_model)
+    ratio, limit = noise_floor(prepared, base, base_model)
+    if ratio > limit:
+        model, candidates, steps = select(prepared, base_model)
+    else:
+        model, candidates = dict(base_model), []
+        steps = [
+            Step(
+                selected=None,
+                reason=f"the residual is {ratio:.2f}x what noise alone leaves, within the "
+                f"{limit:.2f}x a log the model explains reaches: nothing to trace",
+            )
+        ]
     after = fitted(problem(prepared, model))
     adopted = [name for name in model if name not in base_model]
     closed = {
@@ -287,7 +333,7 @@ def calibrate_servo(
     }
     report = CalibrationReport(
         n_windows=len(windows),
-        noise_floor=NoiseFloor(copies=0, equation_error_ratio=1.0),
+        noise_floor=NoiseFloor(copies=COPIES, equation_error_ratio=ratio),
         residual_rms_before={"drive_force_n": float(np.sqrt(np.mean(base.residual**2)))},
         residual_rms_after={"drive_force_n": float(np.sqrt(np.mean(after.residual**2)))},
         candidates=candidates,

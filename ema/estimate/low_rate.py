@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -34,7 +35,8 @@ from ema.estimate.quasistatic import (
     Stretch,
     TorqueReading,
     fit_stretches,
-    speed_and_load,
+    logged_motion,
+    set_point_motion,
     stretches,
 )
 from ema.estimate.report import weakly_determined
@@ -56,20 +58,21 @@ QUASI_STATIC = tuple(stage for stage in STAGES if stage not in SKIPPED)  # the s
 REST_DEPARTURE = 4.0  # a window's current at rest this many day-to-day spreads off the document's: said
 
 
-def torque_reading(actuator: ActuatorDocument, rest: Rest | None) -> tuple[TorqueReading, Note | None]:
-    """What the kind's drive current says of the torque along the motion, and a note where the window's current
-    at rest departs from the document's current at zero torque.
+def motor_torque(actuator: ActuatorDocument, rest: Rest | None) -> tuple[TorqueReading, Note | None]:
+    """A current-piloted motor's torque: k_T·I, signed."""
+    return TorqueReading(1.0 / actuator.params.torque_constant_nm_per_a, 0.0, 0.0, 0.0, signed=True), None
 
-    A stepper's current at zero torque is the document's, learned over healthy runs, its std their spread: a
-    window's own reading at rest scatters by more than its noise from one stop to the next (where the motor
-    comes to rest within a step) and tells nothing of its current while it moves, so it only checks the
-    document (a drive whose zero-torque current moved: recalibrate)."""
-    if actuator.kind == "rotary":
-        k_t = actuator.params.torque_constant_nm_per_a
-        return TorqueReading(1.0 / k_t, 0.0, 0.0, 0.0, signed=True), None
+
+def stepper_torque(actuator: ActuatorDocument, rest: Rest | None) -> tuple[TorqueReading, Note | None]:
+    """A stepper drive's torque along the motion, (I − I0)/c, and a note where the window's current at rest
+    departs from the document's current at zero torque.
+
+    Its current at zero torque is the document's, learned over healthy runs, its std their spread: a window's own
+    reading at rest scatters by more than its noise from one stop to the next (where the motor comes to rest
+    within a step) and tells nothing of its current while it moves, so it only checks the document (a drive
+    whose zero-torque current moved: recalibrate)."""
     screw = actuator.screw
-    assert screw is not None
-    if screw.current_per_nm_a is None or screw.current_at_zero_torque_a is None:
+    if screw is None or screw.current_per_nm_a is None or screw.current_at_zero_torque_a is None:
         raise InputError(
             "actuator.screw.current_per_nm_a",
             "is not known yet: a stepper's current per N·m and its "
@@ -87,21 +90,32 @@ def torque_reading(actuator: ActuatorDocument, rest: Rest | None) -> tuple[Torqu
         parameter="current_a",
         text=(
             f"at rest the drive draws {rest.current_a:.3f} A, {REST_DEPARTURE:g} or more of its day-to-day spreads "
-            f"from "
-            f"the {screw.current_at_zero_torque_a:.3f} ± {spread:.3f} A the document learned: its zero-torque current "
-            f"may "
-            "have moved (another day, another drive setting); FDJ counts it as friction until ema calibrate is rerun "
-            "on "
-            "healthy runs"
+            f"from the {screw.current_at_zero_torque_a:.3f} ± {spread:.3f} A the document learned: its zero-torque "
+            "current may have moved (another day, another drive setting); FDJ counts it as friction until ema "
+            "calibrate is rerun on healthy runs"
         ),
     )
     return reading, note
+
+
+@dataclass(frozen=True)
+class QuasiStaticReading:
+    """What a kind reads a slow window by: its motion and load (``ema.estimate.quasistatic``), and what its
+    drive's current says of the torque."""
+
+    motion: Callable[[Window, float], tuple[np.ndarray, np.ndarray]]
+    torque: Callable[[ActuatorDocument, Rest | None], tuple[TorqueReading, Note | None]]
+
+
+MOTOR_READING = QuasiStaticReading(motion=logged_motion, torque=motor_torque)  # the logged speed, k_T·I
+STEPPER_READING = QuasiStaticReading(motion=set_point_motion, torque=stepper_torque)  # the set point, (I − I0)/c
 
 
 def estimate_low_rate(
     window: Window,
     config: PipelineConfig,
     *,
+    reading: QuasiStaticReading,
     actuator: ActuatorDocument,
     read_with: ActuatorRead,
     on_stage: Callable[[str], None] | None = None,
@@ -111,7 +125,7 @@ def estimate_low_rate(
     started = time.perf_counter()
     announce("finding the stretches at constant speed and at rest")
     digest = window.content_sha256()
-    speed, load = speed_and_load(window, actuator.gear_ratio)
+    speed, load = reading.motion(window, actuator.gear_ratio)
     found, rest = stretches(speed, window.signals["current_a"], load, window.sample_rate_hz)
     if not found:
         raise InputError(
@@ -119,7 +133,7 @@ def estimate_low_rate(
             f"no stretch at constant speed lasts {MIN_STRETCH_S:g} s: at "
             f"{window.sample_rate_hz:g} Hz a window shows friction only at constant speed",
         )
-    reading, rest_note = torque_reading(actuator, rest)
+    torque, rest_note = reading.torque(actuator, rest)
     seconds["prepare"] = time.perf_counter() - started
     announce("fitting Eq. 5.1 to the stretches")
     nominal = actuator.health
@@ -127,12 +141,12 @@ def estimate_low_rate(
     eta_std = (screw.eta_o_std if screw is not None else None) or 0.0
     repeat = (screw.repeatability_nm if screw is not None else None) or 0.0
     fit = fit_stretches(
-        found, reading, actuator.gear_ratio, eta_o_document=(nominal.efficiency, eta_std), repeatability_nm=repeat
+        found, torque, actuator.gear_ratio, eta_o_document=(nominal.efficiency, eta_std), repeatability_nm=repeat
     )
     seconds["physics"] = time.perf_counter() - started - seconds["prepare"]
     announce("writing the report")
-    document = _document(window, actuator, fit, found, reading, digest=digest, read_with=read_with, config=config)
-    notes = [n for n in (rest_note, *_notes(window, actuator, fit, reading)) if n is not None]
+    document = _document(window, actuator, fit, found, torque, digest=digest, read_with=read_with, config=config)
+    notes = [n for n in (rest_note, *_notes(window, actuator, fit, torque)) if n is not None]
     seconds["report"] = time.perf_counter() - started - seconds["prepare"] - seconds["physics"]
     return document.model_copy(
         update={"notes": [*document.notes, *notes], "timings_s": Timings(**seconds, total=sum(seconds.values()))}

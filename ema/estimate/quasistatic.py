@@ -202,11 +202,14 @@ def _per_nm_read(
     return gap / torque_gap, gap_std / torque_gap
 
 
-def speed_and_load(window: Window, gear_ratio: float) -> tuple[np.ndarray, np.ndarray]:
-    """The motion a window's stretches are found by (a linear window's set point speed, a rotary window's logged
-    motor speed) and its load torque at the motor in the positive direction."""
-    rate = window.sample_rate_hz
+def set_point_motion(window: Window, gear_ratio: float) -> tuple[np.ndarray, np.ndarray]:
+    """A linear window's motion by its set point's speed (exact where a potentiometer's is noise) and its load
+    torque at the motor in the positive direction (F·lead/2π = F/n)."""
     s = window.signals
-    if window.kind == "linear":  # the set point's speed: exact where a potentiometer's is noise; F·lead/2π = F/n
-        return np.gradient(s["command_mm"]) * rate, s["load_n"] / gear_ratio
+    return np.gradient(s["command_mm"]) * window.sample_rate_hz, s["load_n"] / gear_ratio
+
+
+def logged_motion(window: Window, gear_ratio: float) -> tuple[np.ndarray, np.ndarray]:
+    """A rotary window's motion by its logged motor speed, and its hinge moment at the motor (H/n)."""
+    s = window.signals
     return s["motor_speed_radps"], s["hinge_moment_nm"] / gear_ratio

@@ -60,16 +60,16 @@ NOMINAL_FIELDS = {  # a constant of the inverse model -> the servo section's fie
 def physics_of(prepared: ServoPrepared) -> InverseFit:
     """Eq. 5.1 fitted to the window with the document's effects."""
     columns = inverse_columns(prepared.motion, prepared.effects)
-    return fit_inverse(prepared.force_n, columns, prepared.motion.decimation)
+    return fit_inverse(prepared.force_n, columns, prepared.motion)
 
 
 def held_out_physics(prepared: ServoPrepared, data: ServoData, n: int) -> tuple[np.ndarray, np.ndarray]:
     """(K, T) the physics fit of each held-out simulation, and (K,) its residual RMS."""
     rate, values, residuals = prepared.window.sample_rate_hz, [], []
     for position, force in zip(data.runs.position_m[n:], data.runs.drive_force_n[n:], strict=True):
-        motion = load_motion(position, rate, prepared.bandwidth_hz)
+        motion = load_motion(position, rate, prepared.bandwidth_hz, prepared.loop.resolution_m)
         load = prepared.window.signals.get("load_n", np.zeros(len(position)))
-        fit = fit_inverse((force - load)[motion.first :], inverse_columns(motion, prepared.effects), motion.decimation)
+        fit = fit_inverse((force - load)[motion.samples], inverse_columns(motion, prepared.effects), motion)
         values.append([fit.values[name] for name in data.targets])
         residuals.append(fit.residual_rms_n)
     return np.array(values), np.array(residuals)
@@ -113,12 +113,12 @@ def closed_loop_check(prepared: ServoPrepared, answer: Assessed, ratio: float, l
     """The window simulated in closed loop at the answer: its force and position against the log's, in %, and the
     force's misfit over its noise floor (the part of both forces above the inverse model's band, which no model
     of the motion follows)."""
-    window, first = prepared.window, prepared.motion.first
+    window, kept = prepared.window, prepared.motion.samples
     s = window.signals
     start = (float(s["position_m"][0]), float((s["position_m"][1] - s["position_m"][0]) * window.sample_rate_hz))
     lane = lane_parameters(answer.values, prepared.effects)[None, :]
     run = simulate_servo(s["set_point_m"], lane, prepared.loop, load_n=s.get("load_n"), start=start)
-    measured, simulated = s["drive_force_n"][first:], run.drive_force_n[0, first:]
+    measured, simulated = s["drive_force_n"][kept], run.drive_force_n[0, kept]
     factor = prepared.motion.decimation
     noise = np.hypot(_above_band(measured, factor), _above_band(simulated, factor))
     force_ratio = float(np.sqrt(np.mean((measured - simulated) ** 2)) / max(noise, 1e-300))
@@ -140,7 +140,7 @@ def closed_loop_check(prepared: ServoPrepared, answer: Assessed, ratio: float, l
         output_error_ratio={"drive_force_n": force_ratio},
         output_error_pct={
             "drive_force_n": _relative_error_pct(measured, simulated),
-            "position_m": _relative_error_pct(s["position_m"][first:], run.position_m[0, first:]),
+            "position_m": _relative_error_pct(s["position_m"][kept], run.position_m[0, kept]),
         },
         uncertainty_inflation=answer.inflation,
         notes=notes,
@@ -226,7 +226,7 @@ def _report(
             sample_rate_hz=window.sample_rate_hz,
             processed_rate_hz=window.sample_rate_hz / prepared.motion.decimation,
             command_clipped_fraction=0.0,
-            sliding_fraction=float(np.mean(prepared.motion.speed_mps != 0.0)),
+            sliding_fraction=float(np.mean(prepared.motion.sliding)),
             recorded_at=window.recorded_at,
             flight_hours=window.flight_hours,
             flight_id=window.flight_id,

@@ -50,13 +50,13 @@ def kind_of(actuator: ActuatorDocument) -> ActuatorKind:
     return KINDS[actuator.kind]
 
 
-def same_kind(windows: Sequence[Window], actuator: ActuatorDocument) -> None:
-    """InputError naming the first window whose signals are another kind's than the document's."""
+def same_kind(windows: Sequence[Window], actuator: ActuatorDocument, *, listed: bool = True) -> None:
+    """InputError naming the first window whose signals are another kind's than the document's (``windows.i.signals``,
+    or ``signals`` for a window posted alone: ``listed`` False)."""
     for i, window in enumerate(windows):
         if window.kind != actuator.kind:
-            where = "signals" if len(windows) == 1 else f"windows.{i}.signals"
             raise InputError(
-                where,
+                f"windows.{i}.signals" if listed else "signals",
                 f"are a {window.kind} actuator's ({', '.join(window.signal_names)}), but the document "
                 f"{actuator.name!r} is of a {actuator.kind} one (its kind): window {window.window_id}",
             )
@@ -74,7 +74,7 @@ def estimate(
 ) -> Estimate:
     """The ``ema-estimate/1`` result for ``window``, read by its actuator's kind; InputError where the window's
     signals are another kind's than its document's."""
-    same_kind([window], actuator)
+    same_kind([window], actuator, listed=False)
     return kind_of(actuator).estimate(window, Request(config, actuator, version, on_stage, history, spec_only))
 
 

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 from ema.calibration.linear_report import calibrate_linear
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import Estimate
-from ema.estimate.low_rate import QUASI_STATIC, estimate_low_rate
+from ema.estimate.low_rate import QUASI_STATIC, STEPPER_READING, estimate_low_rate
 from ema.kinds.base import Calibrated, CalibrationRequest, Cost, Request
 from ema.model.kinds import KINDS, KindFacts
 from ema.model.window import Window
@@ -28,7 +28,12 @@ class Linear:
 
     def estimate(self, window: Window, request: Request) -> Estimate:
         return estimate_low_rate(
-            window, request.config, actuator=request.actuator, read_with=request.read_with, on_stage=request.on_stage
+            window,
+            request.config,
+            reading=STEPPER_READING,
+            actuator=request.actuator,
+            read_with=request.read_with,
+            on_stage=request.on_stage,
         )
 
     def calibrate(self, windows: Sequence[Window], request: CalibrationRequest) -> Calibrated:

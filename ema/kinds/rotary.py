@@ -16,7 +16,7 @@ from ema.calibration.calibrate import Calibrator
 from ema.calibration.plot import ResidualPlot, Series
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import STAGES, Estimate
-from ema.estimate.low_rate import QUASI_STATIC, estimate_low_rate
+from ema.estimate.low_rate import MOTOR_READING, QUASI_STATIC, estimate_low_rate
 from ema.estimate.pipeline import estimate_window
 from ema.kinds.base import Calibrated, CalibrationRequest, Cost, Request
 from ema.model.checks import InputError
@@ -46,6 +46,7 @@ class Rotary:
             return estimate_low_rate(
                 window,
                 request.config,
+                reading=MOTOR_READING,
                 actuator=request.actuator,
                 read_with=request.read_with,
                 on_stage=request.on_stage,

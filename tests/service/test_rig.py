@@ -4,6 +4,8 @@ and the friction rising in its prognosis and on the operator's page."""
 from fastapi.testclient import TestClient
 
 from ema.calibration.linear_report import calibrate_linear
+from ema.model.params import HealthParams
+from ema.model.synthetic import synthetic_window
 from ema.model.window import window_to_dict
 from ema.service.main import create_app
 from tests.estimate.test_ballscrew import DOCUMENT, runs
@@ -27,3 +29,34 @@ def test_runs_posted_in_order_show_the_friction_rising(tmp_path):
         assert prognosis["time_unit"] == "windows" and trend["slope_per_unit"] > 2 * trend["slope_std"]
         page = client.get(f"/ui/actuators/{actuator_id}")
         assert page.status_code == 200 and page.text.count("<svg") == 1  # FDJ alone: η_O is not read at one load
+
+
+def test_a_linear_actuator_is_calibrated_through_the_service_as_through_the_cli(tmp_path):
+    """Healthy runs teach the stored document's drive; the answer carries the completed document; two 13 s runs
+    at 25 Hz simulate nothing, so neither the window limit nor the simulation budget refuses them."""
+    healthy = runs("normal", 20, range(3)) + runs("normal", 40, range(1))
+    body = {"windows": [window_to_dict(w) for w in healthy]}
+    with TestClient(create_app(settings_for(tmp_path, max_window_s=4.0)), base_url=LOCAL) as client:
+        actuator_id = healthy[0].actuator_id
+        assert client.put(
+            f"/v1/actuators/{actuator_id}", json=DOCUMENT.model_dump(mode="json", by_alias=True)
+        ).is_success
+        answer = client.post("/v1/calibrate", json=body)
+        assert answer.status_code == 200, answer.text
+        report = answer.json()
+        assert report["completed_actuator"]["screw"]["current_per_nm_a"] > 0
+        assert {entry["name"] for entry in report["learned"]} >= {"current_per_nm", "FDJ", "eta_O"}
+
+
+def test_windows_of_another_kind_than_the_document_are_a_422_naming_the_signals(tmp_path):
+    linear = {"windows": [window_to_dict(w) for w in runs("normal", 20, range(2))]}
+    with TestClient(create_app(settings_for(tmp_path)), base_url=LOCAL) as client:
+        unstored = client.post("/v1/calibrate", json=linear)  # no document stored: the default is a rotary one
+        assert unstored.status_code == 422, unstored.text
+        assert unstored.json()["detail"][0]["loc"] == ["body", "windows", "0", "signals"]
+        actuator_id = runs("normal", 20, range(1))[0].actuator_id
+        client.put(f"/v1/actuators/{actuator_id}", json=DOCUMENT.model_dump(mode="json", by_alias=True))
+        rotary = synthetic_window(HealthParams.single(), seed=2, duration_s=0.1, actuator_id=actuator_id)
+        answer = client.post("/v1/calibrate", json={"windows": [window_to_dict(rotary)]})
+        assert answer.status_code == 422, answer.text
+        assert answer.json()["detail"][0]["loc"] == ["body", "windows", "0", "signals"]

@@ -35,7 +35,10 @@ CUTOFF_BANDWIDTHS = 5.0  # its cutoff, in loop bandwidths
 DECIMATED_BANDWIDTHS = 2.0  # the decimation's anti-alias edge, in loop bandwidths
 DECIMATION_RIPPLE_DB = 0.05  # the Chebyshev's pass-band ripple (MATLAB's decimate)
 DECIMATION_ORDER = 8
-EDGE_CUTOFF_PERIODS = 5.0  # the filters' start-up, left out of the fit
+EDGE_CUTOFF_PERIODS = 5.0  # the filters' transients at either end, left out of the fit
+REST_STEPS_PER_SAMPLE = 2.0  # a filtered speed under this many sensor steps a sample: the load rests (dithers)
+REST_SHARE_OF_TOP = 0.002  # the same, for a sensor without a step: this share of the top speed
+REST_MARGIN_DECIMATIONS = 2  # a decimated row this near a rest (in decimation factors) is left out too
 POLYNOMIAL_ORDER = 3  # an effect along the stroke: Legendre polynomials up to this order
 BASE = ("mass_kg", "viscous_ns_per_m", "fdj_n", "offset_n")
 UNITS = {
@@ -55,13 +58,20 @@ UNITS = {
 
 @dataclass(frozen=True)
 class Motion:
-    """The load's motion as the fit reads it, full rate, its start-up left out (from ``first``)."""
+    """The load's motion as the fit reads it, full rate, the filters' transients at both ends left out (samples
+    ``first`` to ``first + len``)."""
 
     position_m: np.ndarray
     speed_mps: np.ndarray
     acceleration_mps2: np.ndarray
     first: int  # the first sample of the window these arrays start at
     decimation: int  # r: every r-th sample of the decimated columns
+    sliding: np.ndarray  # (rows,) bool: the decimated rows where the load slides (at rest, static friction holds it)
+
+    @property
+    def samples(self) -> slice:
+        """The window's samples these arrays cover."""
+        return slice(self.first, self.first + len(self.speed_mps))
 
 
 def _butter_lowpass(rate_hz: float, cutoff_hz: float) -> tuple[np.ndarray, np.ndarray]:
@@ -85,17 +95,33 @@ def central_difference(values: np.ndarray, rate_hz: float) -> np.ndarray:
     return out * rate_hz
 
 
-def load_motion(position_m: np.ndarray, rate_hz: float, bandwidth_hz: float) -> Motion:
-    """The filtered position, its speed and acceleration (module docstring), past the filters' start-up."""
+def load_motion(position_m: np.ndarray, rate_hz: float, bandwidth_hz: float, resolution_m: float = 0.0) -> Motion:
+    """The filtered position, its speed and acceleration (module docstring), past the filters' start-up, and the
+    decimated rows where the load slides: Eq. 5.1's sgn(q̇)·FDJ holds only there (a load at rest is held by
+    whatever static friction balances the force, and its filtered speed is the sensor's dither), so a row within
+    ``REST_MARGIN_DECIMATIONS`` of a rest is left out."""
     cutoff = CUTOFF_BANDWIDTHS * bandwidth_hz
     decimation = max(1, round(0.8 * (rate_hz / 2.0) / (DECIMATED_BANDWIDTHS * bandwidth_hz)))
-    first = max(round(EDGE_CUTOFF_PERIODS * rate_hz / cutoff) - 1, 1)
-    if len(position_m) - first < 20 * decimation:
+    edge = max(round(EDGE_CUTOFF_PERIODS * rate_hz / cutoff) - 1, 1)
+    if len(position_m) - 2 * edge < 20 * decimation:
         raise InputError("signals.position_m", f"{len(position_m)} samples are too few to read its motion from")
+    kept = slice(edge, len(position_m) - edge)
     filtered = _filtfilt(*_butter_lowpass(rate_hz, cutoff), position_m)
-    speed = central_difference(filtered, rate_hz)
-    acceleration = central_difference(speed, rate_hz)
-    return Motion(filtered[first:], speed[first:], acceleration[first:], first, decimation)
+    speed = central_difference(filtered, rate_hz)[kept]
+    acceleration = central_difference(central_difference(filtered, rate_hz), rate_hz)[kept]
+    top = float(np.max(np.abs(speed)))
+    rest = REST_STEPS_PER_SAMPLE * resolution_m * rate_hz if resolution_m > 0 else REST_SHARE_OF_TOP * top
+    resting = np.abs(speed) < rest
+    margin = REST_MARGIN_DECIMATIONS * decimation
+    near_rest = np.convolve(resting, np.ones(2 * margin + 1), mode="same") > 0
+    rows = decimated_indices(len(speed), decimation)
+    return Motion(filtered[kept], speed, acceleration, edge, decimation, ~near_rest[rows])
+
+
+def decimated_indices(n: int, factor: int) -> np.ndarray:
+    """The samples ``decimated`` keeps of ``n``: every ``factor``-th, aligned on the last."""
+    begin = factor - (factor * -(-n // factor) - n)
+    return np.arange(begin - 1, n, factor) if factor > 1 else np.arange(n)
 
 
 def decimated(values: np.ndarray, factor: int) -> np.ndarray:
@@ -106,10 +132,7 @@ def decimated(values: np.ndarray, factor: int) -> np.ndarray:
     from scipy.signal import cheby1
 
     b, a = cheby1(DECIMATION_ORDER, DECIMATION_RIPPLE_DB, 0.8 / factor)
-    smooth = _filtfilt(b, a, values)
-    n = len(values)
-    begin = factor - (factor * -(-n // factor) - n)
-    return smooth[begin - 1 :: factor]
+    return _filtfilt(b, a, values)[decimated_indices(len(values), factor)]
 
 
 def travel_since_reversal(speed: np.ndarray, position: np.ndarray) -> np.ndarray:
@@ -163,9 +186,6 @@ class InverseFit:
     residual_rms_n: float  # RMS of that residual
     samples: int  # decimated samples fitted
 
-    def predicted(self, columns: Mapping[str, np.ndarray]) -> np.ndarray:
-        return sum((self.values[name] * column for name, column in columns.items()), np.zeros(1))
-
 
 def newey_west_lags(n: int) -> int:
     """The residual's correlation lags the std weighs: Newey and West's (1994) plug-in, 4·(n/100)^(2/9)."""
@@ -184,25 +204,29 @@ def newey_west_std(x: np.ndarray, residual: np.ndarray, lags: int) -> np.ndarray
     return np.sqrt(np.clip(np.diag(inverse @ s @ inverse), 0.0, None))
 
 
-def fit_inverse(
-    force_n: np.ndarray, columns: Mapping[str, np.ndarray], decimation: int, fixed: Mapping[str, float] | None = None
-) -> InverseFit:
-    """Least squares of the force on ``columns`` (full rate, one length), both decimated by ``decimation``;
-    ``fixed`` constants (name -> value) are moved to the force's side and reported with std 0."""
-    fixed = dict(fixed or {})
-    y = decimated(force_n, decimation)
-    for name, value in fixed.items():
-        y = y - value * decimated(columns[name], decimation)
-    free = [name for name in columns if name not in fixed]
-    x = np.column_stack([decimated(columns[name], decimation) for name in free])
+def decimated_problem(
+    force_n: np.ndarray, columns: Mapping[str, np.ndarray], motion: Motion
+) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+    """The force and every column decimated alike, on the rows where the load slides."""
+    rows = motion.sliding
+    y = decimated(force_n, motion.decimation)[rows]
+    return y, {name: decimated(column, motion.decimation)[rows] for name, column in columns.items()}
+
+
+def fit_inverse(force_n: np.ndarray, columns: Mapping[str, np.ndarray], motion: Motion) -> InverseFit:
+    """Least squares of the force on ``columns`` (full rate, one length), both decimated, on the sliding rows."""
+    y, decimated_columns = decimated_problem(force_n, columns, motion)
+    names = list(decimated_columns)
+    x = np.column_stack([decimated_columns[name] for name in names])
+    if len(y) < 4 * len(names):
+        raise InputError("signals.position_m", f"the load slides in {len(y)} of the decimated samples: too few to read")
     beta, *_ = np.linalg.lstsq(x, y, rcond=None)
     residual = y - x @ beta
     stds = newey_west_std(x, residual, newey_west_lags(len(y)))
-    total = y + sum((value * decimated(columns[name], decimation) for name, value in fixed.items()), np.zeros(1))
     return InverseFit(
-        values={**dict(zip(free, beta.tolist(), strict=True)), **fixed},
-        stds={**dict(zip(free, stds.tolist(), strict=True)), **dict.fromkeys(fixed, 0.0)},
-        error_pct=float(100.0 * np.linalg.norm(residual) / max(float(np.linalg.norm(total)), 1e-300)),
+        values=dict(zip(names, beta.tolist(), strict=True)),
+        stds=dict(zip(names, stds.tolist(), strict=True)),
+        error_pct=float(100.0 * np.linalg.norm(residual) / max(float(np.linalg.norm(y)), 1e-300)),
         residual_rms_n=float(np.sqrt(np.mean(residual**2))),
         samples=len(y),
     )

@@ -27,7 +27,7 @@ from ema.model.servo_sim import ServoLoop
 from ema.model.window import Window
 
 RATE_TOLERANCE = 0.01
-CONTROLLER_TOLERANCE = 0.05
+CONTROLLER_TOLERANCE = 0.02
 MIN_QUANTIZED = 0.9
 PROVISIONAL_BANDWIDTH_SHARE = 0.02  # a first fit's loop bandwidth, as a share of the rate (20 Hz at 1 kHz)
 
@@ -121,14 +121,14 @@ def prepare_servo(window: Window, actuator: ActuatorDocument) -> ServoPrepared:
         )
     s = window.signals
     load = s.get("load_n", np.zeros(window.n_samples))
+    step = servo.position_resolution_m if servo.position_resolution_m is not None else resolution(s["position_m"])
     mass = servo.mass_kg
     if mass is None and servo.bandwidth_hz is None:  # a first fit, for the loop's natural frequency
-        first = load_motion(s["position_m"], rate, PROVISIONAL_BANDWIDTH_SHARE * rate)
-        columns = inverse_columns(first)
-        mass = fit_inverse((s["drive_force_n"] - load)[first.first :], columns, first.decimation).values["mass_kg"]
+        first = load_motion(s["position_m"], rate, PROVISIONAL_BANDWIDTH_SHARE * rate, step)
+        forces = (s["drive_force_n"] - load)[first.samples]
+        mass = fit_inverse(forces, inverse_columns(first), first).values["mass_kg"]
     loop_hz = bandwidth(servo, max(float(mass or 1.0), 1e-6))
-    motion = load_motion(s["position_m"], rate, loop_hz)
-    step = servo.position_resolution_m if servo.position_resolution_m is not None else resolution(s["position_m"])
+    motion = load_motion(s["position_m"], rate, loop_hz, step)
     assert servo.position_gain_per_s and servo.speed_gain_per_mps and servo.drive_gain_n_per_unit  # completed
     loop = ServoLoop(
         position_gain_per_s=servo.position_gain_per_s,
@@ -146,6 +146,6 @@ def prepare_servo(window: Window, actuator: ActuatorDocument) -> ServoPrepared:
             Note(code="no_load", parameter="eta_O", text="the window carries no external load: η_O is not shown")
         )
     return ServoPrepared(
-        window, servo, loop, motion, (s["drive_force_n"] - load)[motion.first :], loaded, loop_hz,
+        window, servo, loop, motion, (s["drive_force_n"] - load)[motion.samples], loaded, loop_hz,
         document_effects(servo), notes,
     )  # fmt: skip

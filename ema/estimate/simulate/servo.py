@@ -102,8 +102,8 @@ def simulate_servo_dataset(prepared: ServoPrepared, physics: InverseFit, config:
     start = (float(s["position_m"][0]), float((s["position_m"][1] - s["position_m"][0]) * window.sample_rate_hz))
     phases = np.random.default_rng(config.seed).uniform(size=count)
     runs = simulate_servo(s["set_point_m"], lanes, prepared.loop, load_n=s.get("load_n"), start=start, phase=phases)
-    first = prepared.motion.first
-    bins = min(config.n_timesteps, (window.n_samples - first) // 2)
-    inputs = binned(runs.drive_force_n[:, first:], bins)
-    window_inputs = binned(s["drive_force_n"][first:], bins)
+    kept = prepared.motion.samples
+    bins = min(config.n_timesteps, (kept.stop - kept.start) // 2)
+    inputs = binned(runs.drive_force_n[:, kept], bins)
+    window_inputs = binned(s["drive_force_n"][kept], bins)
     return ServoData(targets, low, high, truth, runs, inputs, window_inputs)

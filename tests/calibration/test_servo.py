@@ -1,0 +1,73 @@
+"""A servo's calibration: what the document lacks learned with stds and units, an effect named only where the
+windows hold one (the closed-form foreign servo, several seeds), and the EMPS log's own misfit traced."""
+
+from pathlib import Path
+
+import pytest
+
+from ema.estimate.config import PipelineConfig
+from ema.kinds import CalibrationRequest, calibrate, estimate
+from ema.model.actuator import actuator_from_dict, read_actuator
+from ema.model.logmap import read_logmap, read_mapped
+from ema.model.window import window_from_dict
+from tests.foreign import servo as foreign
+
+EMPS = Path(__file__).resolve().parents[2] / "examples" / "emps"
+FOREIGN = actuator_from_dict(foreign.DOCUMENT)
+
+
+def _calibrated(windows, document):
+    return calibrate(windows, CalibrationRequest(PipelineConfig(), document))
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_a_clean_servo_names_nothing(seed):
+    report = _calibrated([window_from_dict(foreign.draw(seed))], FOREIGN).report
+    assert report.selected_effects == []
+    assert report.model_error_pct_after == report.model_error_pct_before
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_a_viscous_friction_that_differs_with_direction_is_named_and_learned(seed):
+    load = foreign.Load(viscous_up_ns_per_m=160.0, viscous_down_ns_per_m=240.0)
+    calibrated = _calibrated([window_from_dict(foreign.draw(seed, load))], FOREIGN)
+    report = calibrated.report
+    assert report.selected_effects[:1] == ["viscous_down"]
+    learned = {entry.name: entry for entry in report.learned}
+    for name, truth in (("viscous_up", 160.0), ("viscous_down", 240.0), ("mass", 90.0), ("FDJ", 20.0)):
+        assert abs(learned[name].value - truth) <= max(3 * learned[name].std, 0.01 * truth), name
+    assert learned["FDJ"].unit == "N" and learned["viscous_down"].unit == "N·s/m" and "viscous" not in learned
+    assert report.model_error_pct_after["drive_force_n"] < 0.2 * report.model_error_pct_before["drive_force_n"]
+    servo = calibrated.completed.servo
+    assert servo.viscous_down_ns_per_m == pytest.approx(learned["viscous_down"].value)
+
+
+@pytest.fixture(scope="module")
+def emps():
+    window = window_from_dict(read_mapped(EMPS / "DATA_EMPS.mat", read_logmap(EMPS / "log-map.json")))
+    return window, _calibrated([window], read_actuator(EMPS / "actuator.json"))
+
+
+def test_the_emps_logs_misfit_is_traced_to_a_direction_dependent_viscous_friction(emps):
+    _, calibrated = emps
+    report = calibrated.report
+    assert report.selected_effects[0] == "viscous_down"
+    before, after = report.model_error_pct_before, report.model_error_pct_after
+    assert after["drive_force_n"] <= 3.2 < before["drive_force_n"]  # the benchmark's symmetric model: 4.08 %
+    assert after["drive_force_n_closed_loop"] < before["drive_force_n_closed_loop"]
+    learned = {entry.name: entry for entry in report.learned}
+    assert learned["mass"].value == pytest.approx(95.1089, rel=0.02) and learned["mass"].unit == "kg"
+    assert learned["FDJ"].value == pytest.approx(20.3935, rel=0.03)
+    assert learned["viscous_up"].value < learned["viscous_down"].value
+    assert not [c for c in report.candidates if c.effect == "stribeck" and c.plausible]  # a negative excess
+
+
+def test_the_completed_document_reads_the_log_closer(emps):
+    window, calibrated = emps
+    before = estimate(window, actuator=read_actuator(EMPS / "actuator.json"))
+    after = estimate(window, actuator=calibrated.completed)
+    assert after.fit_check.equation_error_ratio < before.fit_check.equation_error_ratio
+    assert after.fit_check.output_error_pct["drive_force_n"] < before.fit_check.output_error_pct["drive_force_n"]
+    assert after.estimates.FDJ.nominal == pytest.approx(calibrated.completed.nominal.fdj_n)
+    again = _calibrated([window], calibrated.completed).report
+    assert again.model_error_pct_document["drive_force_n"] <= before.fit_check.output_error_pct["drive_force_n"]

@@ -1,0 +1,100 @@
+"""A servo read through every stage: on windows of the independent closed-form servo (tests/foreign/servo.py), and
+on the EMPS benchmark's real log (Janot, Gautier and Brunot 2019), bundled in examples/emps."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from ema.estimate.documents import STAGES
+from ema.estimate.physics.inverse import fit_inverse, inverse_columns
+from ema.estimate.prepare.servo import prepare_servo
+from ema.kinds import estimate
+from ema.model.actuator import actuator_from_dict, read_actuator
+from ema.model.checks import InputError
+from ema.model.logmap import read_logmap, read_mapped
+from ema.model.window import window_from_dict
+from tests.foreign import servo as foreign
+
+EMPS = Path(__file__).resolve().parents[2] / "examples" / "emps"
+FOREIGN = actuator_from_dict(foreign.DOCUMENT)
+
+
+@pytest.fixture(scope="module")
+def emps():
+    return window_from_dict(read_mapped(EMPS / "DATA_EMPS.mat", read_logmap(EMPS / "log-map.json")))
+
+
+@pytest.fixture(scope="module")
+def foreign_estimates():
+    load = foreign.Load()
+    return load, [estimate(window_from_dict(foreign.draw(seed, load)), actuator=FOREIGN) for seed in range(6)]
+
+
+def test_every_stage_runs_and_fdj_is_in_newtons(foreign_estimates):
+    _, results = foreign_estimates
+    for result in results:
+        assert result.stages == dict.fromkeys(STAGES, "run")
+        assert all(getattr(result.timings_s, stage) > 0 for stage in ("simulate", "learn", "assess", "check"))
+        assert result.estimates.FDJ.unit == "N" and result.estimates.eta_O is None
+        assert {c.unit for c in result.estimates.constants.values()} <= {"kg", "N·s/m", "N"}
+
+
+def test_fdj_mass_and_viscous_friction_hold_the_truth_within_two_stds(foreign_estimates):
+    load, results = foreign_estimates
+    truth = {"fdj_n": load.fdj_n, "mass_kg": load.mass_kg, "viscous_ns_per_m": load.viscous_up_ns_per_m}
+    inside = []
+    for result in results:
+        values = {"fdj_n": result.estimates.FDJ, **result.estimates.constants}
+        inside += [abs(values[name].value - truth[name]) <= 2 * values[name].std for name in truth]
+    assert np.mean(inside) >= 0.9  # 18 readings, ±2 std: 95 % expected
+
+
+def test_the_foreign_windows_are_reproduced_and_raise_no_misfit(foreign_estimates):
+    _, results = foreign_estimates
+    assert all(r.fit_check.reproduced for r in results)
+    assert sum(any(n.code == "model_misfit" for n in r.notes) for r in results) <= 1  # a 1 % test on six
+
+
+def test_the_physics_stage_reproduces_the_benchmarks_identification(emps):
+    prepared = prepare_servo(emps, read_actuator(EMPS / "actuator.json"))
+    fit = fit_inverse(prepared.force_n, inverse_columns(prepared.motion), prepared.motion)
+    published = {"mass_kg": 95.1089, "viscous_ns_per_m": 203.5034, "fdj_n": 20.3935, "offset_n": -3.1648}
+    tolerance = {"mass_kg": 0.01, "viscous_ns_per_m": 0.02, "fdj_n": 0.02, "offset_n": 0.05}
+    for name, value in published.items():  # its IDIM-LS, less the filters' end transients and the rests
+        assert fit.values[name] == pytest.approx(value, rel=tolerance[name])
+    assert fit.error_pct == pytest.approx(4.08, abs=0.1)
+    assert prepared.loop.resolution_m == pytest.approx(5e-8, rel=1e-3)  # the encoder's step, read from the log
+
+
+def test_the_emps_log_is_estimated_within_its_own_length(emps):
+    result = estimate(emps, actuator=read_actuator(EMPS / "actuator.json"))
+    assert result.stages == dict.fromkeys(STAGES, "run")
+    assert result.timings_s.total < emps.duration_s
+    fdj = result.estimates.FDJ
+    assert fdj.value == pytest.approx(20.39, rel=0.03) and 0 < fdj.std < 0.05 * fdj.value
+    assert result.fit_check.output_error_pct["drive_force_n"] < 5.85  # the benchmark's own closed loop
+
+
+def test_a_controller_the_log_does_not_follow_is_said(emps):
+    document = read_actuator(EMPS / "actuator.json").model_dump(by_alias=True)
+    document["servo"]["speed_filter"] = [1.0]
+    prepared = prepare_servo(emps, actuator_from_dict(document))
+    assert [n.code for n in prepared.notes if n.code == "controller_mismatch"]
+
+
+def test_a_gain_the_log_and_the_document_give_differently_is_refused(emps):
+    document = read_actuator(EMPS / "actuator.json").model_dump(by_alias=True)
+    document["servo"]["position_gain_per_s"] = 150.0
+    with pytest.raises(InputError) as error:
+        prepare_servo(emps, actuator_from_dict(document))
+    assert error.value.field == "window.constants.position_gain_per_s"
+
+
+def test_a_gain_neither_gives_is_refused_naming_the_documents_field():
+    document = dict(foreign.DOCUMENT)
+    window = foreign.draw(0, seconds=3.0)
+    del window["constants"]["speed_gain_per_mps"]
+    with pytest.raises(InputError) as error:
+        estimate(window_from_dict(window), actuator=actuator_from_dict(document))
+    assert error.value.field == "actuator.servo.speed_gain_per_mps"

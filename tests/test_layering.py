@@ -1,0 +1,42 @@
+"""The package's layers import one way (the README's table): model ← estimate ← calibration, prognosis ← kinds ←
+history ← service ← cli. A module may import its own layer or a lower one, never a higher one, at module level or
+inside a function."""
+
+import ast
+from pathlib import Path
+
+PACKAGE = Path(__file__).resolve().parents[1] / "ema"
+RANKS = {"model": 0, "estimate": 1, "calibration": 2, "prognosis": 2, "kinds": 3, "history": 4, "service": 5, "cli": 6}
+
+
+def _layer(module: str) -> str | None:
+    parts = module.split(".")
+    return parts[1] if len(parts) > 1 and parts[0] == "ema" and parts[1] in RANKS else None
+
+
+def _imported(path: Path) -> set[str]:
+    found = set()
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.ImportFrom) and node.module:
+            found |= {node.module} | {f"{node.module}.{a.name}" for a in node.names if node.module == "ema"}
+        elif isinstance(node, ast.Import):
+            found |= {alias.name for alias in node.names}
+    return found
+
+
+def test_every_layer_imports_only_its_own_or_lower_ones():
+    upward = []
+    for path in PACKAGE.rglob("*.py"):
+        layer = _layer("ema." + ".".join(path.relative_to(PACKAGE).parts))
+        if layer is None:
+            continue
+        for target in _imported(path):
+            other = _layer(target)
+            if other is not None and RANKS[other] > RANKS[layer]:
+                upward.append(f"{path.relative_to(PACKAGE.parent)} -> {target}")
+    assert upward == []
+
+
+def test_every_subpackage_has_a_layer():
+    packages = {p.name for p in PACKAGE.iterdir() if (p / "__init__.py").exists()}
+    assert packages == set(RANKS)
