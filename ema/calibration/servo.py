@@ -4,9 +4,11 @@ add it, and report the error before and after.
 1. **Learn.** Eq. 5.1 in the load frame (``ema.estimate.physics.inverse``) over every window at once: M, C,
    FDJ and the offset, each with its Newey–West std and unit (``learned``); the model's error is the
    identification benchmarks' own, 100·‖y − ŷ‖/‖y‖ on the decimated force.
-2. **Find**, where there is something to find: the windows' residual must stand beyond what noise alone leaves,
-   the same fit on ``COPIES`` noise-only copies (each window simulated in closed loop at the learned constants,
-   its sensor read at another phase of its step), at a 1 % false alarm (``misfit_limit``). Then each effect of
+2. **Find**, where there is something to find: rows where a force the log lacks disturbs the fit are left out
+   (``ema.estimate.physics.inverse.disturbed_rows``), and the windows' residual must stand beyond what noise
+   alone leaves, the same fit on ``COPIES`` noise-only copies (each window simulated in closed loop at the learned
+   constants, its sensor read at another phase of its step), at a 1 % false alarm (``misfit_limit``). Then each
+   effect of
    ``ema.calibration.servo_effects`` is fitted on four fifths of every window and
    predicts the fifth left out, in turn (its nonlinear constant chosen the same way). An effect is taken only
    where it is physical (its constants' signs), predicts every fold better (a real effect shows in each part
@@ -44,6 +46,8 @@ from ema.estimate.physics.inverse import (
     UNITS,
     decimated,
     decimated_problem,
+    disturbed_rows,
+    fit_inverse,
     inverse_columns,
     load_motion,
     newey_west_lags,
@@ -86,7 +90,7 @@ def problem(prepared: Sequence[ServoPrepared], model: dict[str, float]) -> Probl
     """The stacked problem of ``model`` (effect name -> its nonlinear constant) over the windows."""
     ys, xs, folds, windows = [], [], [], []
     for i, p in enumerate(prepared):
-        y, x = decimated_problem(p.force_n, inverse_columns(p.motion, model), p.motion)
+        y, x = decimated_problem(p.force_n, inverse_columns(p.motion, model), p.motion, p.disturbed)
         xs.append(x)
         ys.append(y)
         folds.append(np.minimum(np.arange(len(y)) * FOLDS // len(y), FOLDS - 1))
@@ -155,15 +159,24 @@ def _candidate(effect: ServoEffect, value: float, fit: Fitted, base: Fitted) -> 
     return candidate, plausible and every_fold and drop >= MIN_HELD_OUT_DROP
 
 
-def noise_floor(prepared: Sequence[ServoPrepared], base: Fitted, model: dict[str, float]) -> tuple[float, float]:
-    """(the windows' residual RMS over the noise-only copies' median, the ratio a clean log exceeds 1 % of the
-    time): the copies are the windows simulated at the ``base`` constants, their sensor read at other phases."""
-    copies = []
+@dataclass(frozen=True)
+class Copies:
+    """What noise alone leaves: each window simulated at the base constants, its sensor read at ``COPIES`` phases."""
+
+    rms: np.ndarray  # (COPIES,) the stacked problem's residual RMS, one per phase
+    by_row: list[np.ndarray]  # per window, (COPIES, rows): its copies' residual by decimated row
+
+
+def noise_copies(prepared: Sequence[ServoPrepared], base: Fitted, model: dict[str, float]) -> Copies:
+    rms: list[float] = []
+    by_row: list[list[np.ndarray]] = [[] for _ in prepared]
     for phase in np.linspace(0.0, 1.0, COPIES, endpoint=False):
         twins = [_simulated(p, base.values, model, phase) for p in prepared]
-        copies.append(float(np.sqrt(np.mean(fitted(problem(twins, model)).residual ** 2))))
-    rms = float(np.sqrt(np.mean(base.residual**2)))
-    return rms / float(np.median(copies)), misfit_limit(np.array(copies))
+        rms.append(float(np.sqrt(np.mean(fitted(problem(twins, model)).residual ** 2))))
+        for i, twin in enumerate(twins):
+            fit = fit_inverse(twin.force_n, inverse_columns(twin.motion, model), twin.motion)
+            by_row[i].append(fit.residual_by_row)
+    return Copies(np.array(rms), [np.array(rows) for rows in by_row])
 
 
 def _simulated(p: ServoPrepared, values: dict[str, float], model: dict[str, float], phase: float) -> ServoPrepared:
@@ -172,10 +185,18 @@ def _simulated(p: ServoPrepared, values: dict[str, float], model: dict[str, floa
     start = (float(s["position_m"][0]), float((s["position_m"][1] - s["position_m"][0]) * p.window.sample_rate_hz))
     lane = lane_parameters(values, model)[None, :]
     run = simulate_servo(s["set_point_m"], lane, p.loop, load_n=s.get("load_n"), start=start, phase=np.array([phase]))
-    rate = p.window.sample_rate_hz
-    motion = load_motion(run.position_m[0], rate, p.bandwidth_hz, p.loop.resolution_m)
+    motion = load_motion(run.position_m[0], p.window.sample_rate_hz, p.bandwidth_hz, p.loop.resolution_m)
     force = (run.drive_force_n[0] - s.get("load_n", 0.0))[motion.samples]
     return replace(p, motion=motion, force_n=force)
+
+
+def undisturbed(prepared: Sequence[ServoPrepared], copies: Copies, model: dict[str, float]) -> list[ServoPrepared]:
+    """Each window with the rows a force its log lacks disturbs (``disturbed_rows``) left out of every fit."""
+    out = []
+    for p, by_row in zip(prepared, copies.by_row, strict=True):
+        fit = fit_inverse(p.force_n, inverse_columns(p.motion, model), p.motion)
+        out.append(replace(p, disturbed=disturbed_rows(fit.residual_by_row, by_row)))
+    return out
 
 
 def select(prepared: Sequence[ServoPrepared], base_model: dict[str, float]) -> tuple[dict[str, float], list, list]:
@@ -312,8 +333,11 @@ def calibrate_servo(
     started = time.perf_counter()
     prepared = [prepare_servo(w, actuator) for w in windows]
     base_model = document_effects(prepared[0].servo)
+    copies = noise_copies(prepared, fitted(problem(prepared, base_model)), base_model)
+    prepared = undisturbed(prepared, copies, base_model)
     base = fitted(problem(prepared, base_model))
-    ratio, limit = noise_floor(prepared, base, base_model)
+    ratio = float(np.sqrt(np.mean(base.residual**2))) / float(np.median(copies.rms))
+    limit = misfit_limit(copies.rms)
     if ratio > limit:
         model, candidates, steps = select(prepared, base_model)
     else:

@@ -37,7 +37,15 @@ from ema.estimate.documents import (
 from ema.estimate.documents.window import WindowInfo
 from ema.estimate.learn.estimator import NetworkRegressor
 from ema.estimate.learn.network import TrainConfig
-from ema.estimate.physics.inverse import UNITS, InverseFit, decimated, fit_inverse, inverse_columns, load_motion
+from ema.estimate.physics.inverse import (
+    UNITS,
+    InverseFit,
+    decimated,
+    disturbed_rows,
+    fit_inverse,
+    inverse_columns,
+    load_motion,
+)
 from ema.estimate.physics.scenario import MAX_RATIO
 from ema.estimate.prepare.servo import ServoPrepared, prepare_servo
 from ema.estimate.simulate.servo import ServoData, lane_parameters, simulate_servo_dataset
@@ -57,22 +65,42 @@ NOMINAL_FIELDS = {  # a constant of the inverse model -> the servo section's fie
 }
 
 
-def physics_of(prepared: ServoPrepared) -> InverseFit:
-    """Eq. 5.1 fitted to the window with the document's effects."""
-    columns = inverse_columns(prepared.motion, prepared.effects)
-    return fit_inverse(prepared.force_n, columns, prepared.motion)
+def physics_of(prepared: ServoPrepared, left_out: np.ndarray | None = None) -> InverseFit:
+    """Eq. 5.1 fitted to the window with the document's effects (less the ``left_out`` rows)."""
+    return fit_inverse(prepared.force_n, inverse_columns(prepared.motion, prepared.effects), prepared.motion, left_out)
 
 
-def held_out_physics(prepared: ServoPrepared, data: ServoData, n: int) -> tuple[np.ndarray, np.ndarray]:
-    """(K, T) the physics fit of each held-out simulation, and (K,) its residual RMS."""
-    rate, values, residuals = prepared.window.sample_rate_hz, [], []
+def held_out_physics(prepared: ServoPrepared, data: ServoData, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(K, T) the physics fit of each held-out simulation, (K,) its residual RMS and (K, rows) its residual by
+    decimated row."""
+    rate, values, rms, by_row = prepared.window.sample_rate_hz, [], [], []
+    load = prepared.window.signals.get("load_n")
     for position, force in zip(data.runs.position_m[n:], data.runs.drive_force_n[n:], strict=True):
         motion = load_motion(position, rate, prepared.bandwidth_hz, prepared.loop.resolution_m)
-        load = prepared.window.signals.get("load_n", np.zeros(len(position)))
-        fit = fit_inverse((force - load)[motion.samples], inverse_columns(motion, prepared.effects), motion)
+        pushed = force if load is None else force - load
+        fit = fit_inverse(pushed[motion.samples], inverse_columns(motion, prepared.effects), motion)
         values.append([fit.values[name] for name in data.targets])
-        residuals.append(fit.residual_rms_n)
-    return np.array(values), np.array(residuals)
+        rms.append(fit.residual_rms_n)
+        by_row.append(fit.residual_by_row)
+    return np.array(values), np.array(rms), np.array(by_row)
+
+
+def undisturbed(
+    prepared: ServoPrepared, physics: InverseFit, simulated_by_row: np.ndarray
+) -> tuple[InverseFit, Note | None]:
+    """The physics fit again without the rows a force the log does not carry disturbs (``disturbed_rows``: the
+    window's residual beyond what its simulations leave there), and a note saying how long they last."""
+    disturbed = disturbed_rows(physics.residual_by_row, simulated_by_row)
+    if not disturbed.any():
+        return physics, None
+    seconds = int(disturbed.sum()) * prepared.motion.decimation / prepared.window.sample_rate_hz
+    note = Note(
+        code="unlogged_force",
+        parameter="drive_force_n",
+        text=f"{seconds:.2f} s of the window hold a force far beyond what the model leaves there, which the log does "
+        "not carry (a push on the load, a disturbance in the drive): left out of Eq. 5.1",
+    )
+    return physics_of(prepared, disturbed), note
 
 
 def learned(data: ServoData, config: PipelineConfig) -> NetworkRegressor:
@@ -83,9 +111,11 @@ def learned(data: ServoData, config: PipelineConfig) -> NetworkRegressor:
 
 def weighed(
     prepared: ServoPrepared, physics: InverseFit, data: ServoData, network: NetworkRegressor, n: int
-) -> tuple[Assessed, float, float]:
-    """The assessed answer, the window's equation error over the held-out simulations' median, and its limit."""
-    check_physics, check_rms = held_out_physics(prepared, data, n)
+) -> tuple[Assessed, float, float, InverseFit]:
+    """The assessed answer, the window's equation error over the held-out simulations' median, its limit, and the
+    physics fit the answer read (without the rows a force the log lacks disturbs; a note says so)."""
+    check_physics, check_rms, check_by_row = held_out_physics(prepared, data, n)
+    physics, disturbed = undisturbed(prepared, physics, check_by_row)
     unit = network.predict_unit(np.vstack([data.inputs[n:], data.window_inputs]))
     values = data.denormalize(unit)
     names = data.targets
@@ -102,7 +132,10 @@ def weighed(
     )
     ratio = physics.residual_rms_n / float(np.median(check_rms))
     limit = misfit_limit(check_rms)
-    return assess(candidates, ratio, limit), ratio, limit
+    answer = assess(candidates, ratio, limit)
+    if disturbed is not None:
+        answer = replace(answer, notes=[disturbed, *answer.notes])
+    return answer, ratio, limit, physics
 
 
 def _relative_error_pct(measured: np.ndarray, simulated: np.ndarray) -> float:
@@ -254,7 +287,7 @@ def estimate_servo(
     with watch("learn", f"training {config.members} network(s) of {config.hidden_units} neurons"):
         network = learned(data, config)
     with watch("assess", "weighing the estimators on held-out simulations"):
-        answer, ratio, limit = weighed(prepared, physics, data, network, n)
+        answer, ratio, limit, physics = weighed(prepared, physics, data, network, n)
     with watch("check", "simulating the window at the answer"):
         check = closed_loop_check(prepared, answer, ratio, limit)
     with watch("report", "writing the report"):

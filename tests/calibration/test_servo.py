@@ -71,3 +71,10 @@ def test_the_completed_document_reads_the_log_closer(emps):
     assert after.estimates.FDJ.nominal == pytest.approx(calibrated.completed.nominal.fdj_n)
     again = _calibrated([window], calibrated.completed).report
     assert again.model_error_pct_document["drive_force_n"] <= before.fit_check.output_error_pct["drive_force_n"]
+
+
+def test_unlogged_pulses_do_not_hide_or_fake_an_effect():
+    for load, named in ((foreign.Load(), []), (foreign.Load(viscous_down_ns_per_m=240.0), ["viscous_down"])):
+        report = _calibrated([window_from_dict(foreign.draw(1, load, pushed=True))], FOREIGN).report
+        assert report.selected_effects == named
+        assert {e.name: e.value for e in report.learned}["FDJ"] == pytest.approx(load.fdj_n, rel=0.01)

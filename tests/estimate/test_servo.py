@@ -98,3 +98,14 @@ def test_a_gain_neither_gives_is_refused_naming_the_documents_field():
     with pytest.raises(InputError) as error:
         estimate(window_from_dict(window), actuator=actuator_from_dict(document))
     assert error.value.field == "actuator.servo.speed_gain_per_mps"
+
+
+def test_force_pulses_the_log_does_not_carry_are_left_out_and_said():
+    load = foreign.Load()
+    for seed in range(3):
+        result = estimate(window_from_dict(foreign.draw(seed, load, pushed=True)), actuator=FOREIGN)
+        fdj = result.estimates.FDJ
+        assert abs(fdj.value - load.fdj_n) <= max(2 * fdj.std, 0.01 * load.fdj_n)
+        assert [n for n in result.notes if n.code == "unlogged_force"]
+        clean = estimate(window_from_dict(foreign.draw(seed, load)), actuator=FOREIGN)
+        assert not [n for n in clean.notes if n.code == "unlogged_force"]

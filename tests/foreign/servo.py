@@ -59,8 +59,20 @@ def _slide(v: float, force: float, load: Load, dt: float) -> tuple[float, float,
     return travel, (0.0 if span < dt else speed), span
 
 
-def simulate(reference: np.ndarray, load: Load, phase: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
-    """(position as the encoder read it [m], the drive's force [N]) at each controller sample."""
+def pulses(seed: int, n: int, height_n: float = 80.0, count: int = 6) -> np.ndarray:
+    """A force pushing on the load in ``count`` pulses of 20–60 ms, either way, at random times [N]."""
+    rng = np.random.default_rng(seed + 100)
+    out = np.zeros(n)
+    for start in rng.integers(n // 10, n - n // 10, size=count):
+        out[start : start + int(rng.integers(20, 60))] = height_n * rng.choice([-1.0, 1.0])
+    return out
+
+
+def simulate(
+    reference: np.ndarray, load: Load, phase: float = 0.0, push_n: np.ndarray | None = None
+) -> tuple[np.ndarray, np.ndarray]:
+    """(position as the encoder read it [m], the drive's force [N]) at each controller sample; ``push_n`` a force
+    on the load the log does not carry."""
     dt = 1.0 / RATE_HZ
     x, v = float(reference[0]), 0.0
     previous = [x, x]
@@ -71,7 +83,7 @@ def simulate(reference: np.ndarray, load: Load, phase: float = 0.0) -> tuple[np.
         u = min(max(KV * (KP * (r - q) - (filtered - filtered_before) / dt), -LIMIT), LIMIT)
         previous = [q, previous[0]]
         positions[k], forces[k] = q, GAIN * u
-        net, left = GAIN * u - load.offset_n, dt
+        net, left = GAIN * u - load.offset_n + (0.0 if push_n is None else push_n[k]), dt
         while left > 1e-12:
             if v == 0.0:
                 if abs(net) <= load.fdj_n:
@@ -83,10 +95,12 @@ def simulate(reference: np.ndarray, load: Load, phase: float = 0.0) -> tuple[np.
     return positions, forces
 
 
-def draw(seed: int, load: Load = Load(), seconds: float = 12.0) -> dict:
-    """An ``ema-window/1`` document of a servo with ``load``, its controller's constants in it."""
+def draw(seed: int, load: Load = Load(), seconds: float = 12.0, pushed: bool = False) -> dict:
+    """An ``ema-window/1`` document of a servo with ``load``, its controller's constants in it; ``pushed``: with
+    force pulses on the load that the log does not carry."""
     reference = set_point(seed, seconds)
-    position, force = simulate(reference, load, phase=float(np.random.default_rng(seed + 1).uniform()))
+    push = pulses(seed, len(reference)) if pushed else None
+    position, force = simulate(reference, load, phase=float(np.random.default_rng(seed + 1).uniform()), push_n=push)
     return {
         "schema": "ema-window/1",
         "actuator_id": "foreign/servo",

@@ -47,6 +47,7 @@ NoteCode = Literal[
     "current_at_zero_torque",
     "current_per_nm",
     "controller_mismatch",
+    "unlogged_force",
     "command_saturated",
     # how the answer was reached, and how far to trust it
     "network_absent",

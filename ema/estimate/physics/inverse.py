@@ -17,6 +17,12 @@ The residual is not white (a misfit at each reversal spans many decimated sample
 std would claim several times what a second run of the same machine can confirm; the std here is
 Newey–West's, which weighs the residual's own correlation (``NEWEY_WEST_LAGS``).
 
+A force the log does not carry (a push on the load, a disturbance injected into the drive) shows as residual far
+beyond what the model leaves at that sample: more than ``DISTURBANCE_SIGMAS`` times the larger of the window's
+own robust noise and the RMS residual its simulations leave at that row (they share its command, so they show
+where the model itself struggles: a break-away, a reversal). Those rows, and their neighbours within the
+decimation filter's reach, are left out (``disturbed_rows``).
+
 Columns beyond the four (a viscous coefficient per direction, a Stribeck term) are the model's effects
 (``inverse_columns``), named as the calibration names them.
 """
@@ -39,6 +45,8 @@ EDGE_CUTOFF_PERIODS = 5.0  # the filters' transients at either end, left out of 
 REST_STEPS_PER_SAMPLE = 2.0  # a filtered speed under this many sensor steps a sample: the load rests (dithers)
 REST_SHARE_OF_TOP = 0.002  # the same, for a sensor without a step: this share of the top speed
 REST_MARGIN_DECIMATIONS = 2  # a decimated row this near a rest (in decimation factors) is left out too
+DISTURBANCE_SIGMAS = 8.0  # a residual this far past what the model leaves there is a force the log lacks
+DISTURBANCE_MARGIN_ROWS = 3  # its neighbours, which the decimation filter smeared it into
 POLYNOMIAL_ORDER = 3  # an effect along the stroke: Legendre polynomials up to this order
 BASE = ("mass_kg", "viscous_ns_per_m", "fdj_n", "offset_n")
 UNITS = {
@@ -185,6 +193,7 @@ class InverseFit:
     error_pct: float  # 100·‖y − ŷ‖/‖y‖ on the decimated force
     residual_rms_n: float  # RMS of that residual
     samples: int  # decimated samples fitted
+    residual_by_row: np.ndarray  # (rows,) over every decimated row: the residual where fitted, NaN elsewhere
 
 
 def newey_west_lags(n: int) -> int:
@@ -205,17 +214,38 @@ def newey_west_std(x: np.ndarray, residual: np.ndarray, lags: int) -> np.ndarray
 
 
 def decimated_problem(
-    force_n: np.ndarray, columns: Mapping[str, np.ndarray], motion: Motion
+    force_n: np.ndarray, columns: Mapping[str, np.ndarray], motion: Motion, left_out: np.ndarray | None = None
 ) -> tuple[np.ndarray, dict[str, np.ndarray]]:
-    """The force and every column decimated alike, on the rows where the load slides."""
-    rows = motion.sliding
+    """The force and every column decimated alike, on the rows where the load slides (less ``left_out``)."""
+    rows = motion.sliding if left_out is None else motion.sliding & ~left_out
     y = decimated(force_n, motion.decimation)[rows]
     return y, {name: decimated(column, motion.decimation)[rows] for name, column in columns.items()}
 
 
-def fit_inverse(force_n: np.ndarray, columns: Mapping[str, np.ndarray], motion: Motion) -> InverseFit:
-    """Least squares of the force on ``columns`` (full rate, one length), both decimated, on the sliding rows."""
-    y, decimated_columns = decimated_problem(force_n, columns, motion)
+def disturbed_rows(residual_by_row: np.ndarray, simulated_by_row: np.ndarray) -> np.ndarray:
+    """(rows,) bool: where a window's residual (``InverseFit.residual_by_row``) exceeds ``DISTURBANCE_SIGMAS`` times
+    the larger of its robust noise and its simulations' RMS residual at the row (``simulated_by_row``, (K, rows)),
+    and the rows beside them (module docstring)."""
+    fitted = np.isfinite(residual_by_row)
+    r = residual_by_row[fitted]
+    noise = 1.4826 * float(np.median(np.abs(r - np.median(r)))) if len(r) else 0.0
+    envelope = np.zeros(len(residual_by_row))
+    if len(simulated_by_row):
+        seen = np.isfinite(simulated_by_row).any(
+            axis=0
+        )  # a row no simulation fitted has no envelope: the noise sets it
+        envelope[seen] = np.sqrt(np.nanmean(simulated_by_row[:, seen] ** 2, axis=0))
+    scale = np.fmax(envelope, noise)
+    far = fitted & (np.abs(np.nan_to_num(residual_by_row)) > DISTURBANCE_SIGMAS * np.maximum(scale, 1e-300))
+    return np.convolve(far, np.ones(2 * DISTURBANCE_MARGIN_ROWS + 1), mode="same") > 0
+
+
+def fit_inverse(
+    force_n: np.ndarray, columns: Mapping[str, np.ndarray], motion: Motion, left_out: np.ndarray | None = None
+) -> InverseFit:
+    """Least squares of the force on ``columns`` (full rate, one length), both decimated, on the rows where the
+    load slides, less ``left_out`` (a disturbance's: ``disturbed_rows``)."""
+    y, decimated_columns = decimated_problem(force_n, columns, motion, left_out)
     names = list(decimated_columns)
     x = np.column_stack([decimated_columns[name] for name in names])
     if len(y) < 4 * len(names):
@@ -223,10 +253,13 @@ def fit_inverse(force_n: np.ndarray, columns: Mapping[str, np.ndarray], motion: 
     beta, *_ = np.linalg.lstsq(x, y, rcond=None)
     residual = y - x @ beta
     stds = newey_west_std(x, residual, newey_west_lags(len(y)))
+    by_row = np.full(len(motion.sliding), np.nan)
+    by_row[motion.sliding if left_out is None else motion.sliding & ~left_out] = residual
     return InverseFit(
         values=dict(zip(names, beta.tolist(), strict=True)),
         stds=dict(zip(names, stds.tolist(), strict=True)),
         error_pct=float(100.0 * np.linalg.norm(residual) / max(float(np.linalg.norm(y)), 1e-300)),
         residual_rms_n=float(np.sqrt(np.mean(residual**2))),
         samples=len(y),
+        residual_by_row=by_row,
     )

@@ -43,6 +43,7 @@ class ServoPrepared:
     bandwidth_hz: float
     effects: dict[str, float]  # the document's adopted effects (name -> its nonlinear constant)
     notes: list[Note]
+    disturbed: np.ndarray | None = None  # (rows,) the decimated rows a force the log lacks disturbs (calibration's)
 
 
 def completed(actuator: ActuatorDocument, window: Window) -> Servo:
