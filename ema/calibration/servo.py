@@ -56,6 +56,7 @@ from ema.estimate.physics.inverse import (
 from ema.estimate.prepare.servo import ServoPrepared, document_effects, prepare_servo
 from ema.estimate.simulate.servo import lane_parameters
 from ema.model.actuator import ActuatorDocument, Nominal
+from ema.model.checks import InputError
 from ema.model.servo_sim import simulate_servo
 from ema.model.window import Window
 
@@ -266,9 +267,26 @@ def closed_loop_error_pct(
     return float(100.0 * np.sqrt(errors / norms))
 
 
+def model_errors_pct(
+    prepared: Sequence[ServoPrepared], values: dict[str, float], effects: dict[str, float]
+) -> dict[str, float]:
+    """The error of a model whose constants are fixed (``values`` with ``effects``), as the benchmarks state it:
+    the inverse model's reconstruction of the decimated force, and the closed loop's of the logged force."""
+    p = problem(prepared, effects)
+    names = [name for name in p.x if name in values]
+    missing = set(p.x) - set(names)
+    if missing:
+        raise InputError("values", f"the model with {', '.join(effects) or 'no effect'} needs {', '.join(missing)}")
+    residual = p.y - p.design(names) @ np.array([values[name] for name in names])
+    return {
+        "drive_force_n": float(100.0 * np.linalg.norm(residual) / np.linalg.norm(p.y)),
+        "drive_force_n_closed_loop": closed_loop_error_pct(prepared, values, effects),
+    }
+
+
 def _document_check(prepared: Sequence[ServoPrepared], actuator: ActuatorDocument) -> dict[str, float] | None:
     """The error of the document's own model as it stands (its load's constants fixed), inverse and closed loop;
-    None where the document does not hold them."""
+    None where the document does not hold them, or holds an effect whose constants it does not keep."""
     servo, nominal = prepared[0].servo, actuator.nominal
     if servo.mass_kg is None or servo.viscous_ns_per_m is None or nominal is None or nominal.fdj_n is None:
         return None
@@ -277,12 +295,11 @@ def _document_check(prepared: Sequence[ServoPrepared], actuator: ActuatorDocumen
         values["viscous_ns_per_m"] = servo.viscous_ns_per_m
     else:
         values |= {"viscous_up_ns_per_m": servo.viscous_ns_per_m, "viscous_down_ns_per_m": servo.viscous_down_ns_per_m}
-    p = problem(prepared, {"viscous_down": 1.0} if servo.viscous_down_ns_per_m is not None else {})
-    residual = p.y - p.design(list(values)) @ np.array(list(values.values()))
-    return {
-        "drive_force_n": float(100.0 * np.linalg.norm(residual) / np.linalg.norm(p.y)),
-        "drive_force_n_closed_loop": closed_loop_error_pct(prepared, values, document_effects(servo)),
-    }
+    values |= servo.effect_constants
+    try:
+        return model_errors_pct(prepared, values, document_effects(servo))
+    except InputError:
+        return None
 
 
 def completed(
@@ -305,6 +322,7 @@ def completed(
             "force_offset_std_n": sd["offset_n"],
             "bandwidth_hz": prepared.bandwidth_hz,
             "effects": {name: value for name, value in model.items() if name != "viscous_down"},
+            "effect_constants": {name: v[name] for name in v if name not in LEARNED_NAMES},
         }
     )
     nominal = Nominal(fdj_n=round(v["fdj_n"], 6), eta_o=actuator.nominal.eta_o if actuator.nominal else None)

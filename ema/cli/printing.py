@@ -150,10 +150,13 @@ def print_calibration(report: dict[str, Any]) -> None:
     for when in ("before", "after", "document"):
         errors = report.get(f"model_error_pct_{when}")
         if errors:
-            said = ", ".join(f"{name.replace('_', ' ')} {pct:.2f} %" for name, pct in errors.items())
+            said = ", ".join(f"{ERROR_WORDS.get(name, name)} {pct:.2f} %" for name, pct in errors.items())
             click.echo(f"model error {when}: {said}  (100·‖y − ŷ‖/‖y‖)")
     if report.get("figure"):
         click.echo(f"figure: {report['figure']}")
+
+
+ERROR_WORDS = {"drive_force_n": "force, inverse model", "drive_force_n_closed_loop": "force, closed loop"}
 
 
 def _print_drive(drive: dict[str, Any]) -> None:

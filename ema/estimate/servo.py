@@ -197,7 +197,8 @@ def _estimates(actuator: ActuatorDocument, prepared: ServoPrepared, physics: Inv
     for name in values:
         if name == FDJ:
             continue
-        document = getattr(prepared.servo, NOMINAL_FIELDS.get(name, ""), None)
+        servo = prepared.servo
+        document = getattr(servo, NOMINAL_FIELDS.get(name, ""), None) or servo.effect_constants.get(name)
         constants[name] = parameter(values[name], stds[name], document, unit=UNITS[name])
     return Estimates(
         FDJ=parameter(answer.values[FDJ], answer.stds[FDJ], nominal, unit=UNITS[FDJ]),

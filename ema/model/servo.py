@@ -88,6 +88,11 @@ class Servo(Document):
         description="the effects ema calibrate adopted into this servo's model, each with its nonlinear constant "
         f"(1 where it has none): any of {', '.join(SERVO_EFFECTS)}",
     )
+    effect_constants: dict[str, Number] = Field(
+        default_factory=dict,
+        description="the adopted effects' fitted constants, in the inverse model's names (presliding_n: the friction "
+        "short of FDJ right after a reversal [N])",
+    )
     repeatability_n: Number | None = Field(
         None, ge=0, le=1e6, description="the run-to-run std of FDJ beyond each run's own noise (learned)"
     )

@@ -4,9 +4,11 @@ and the friction rising in its prognosis and on the operator's page."""
 from fastapi.testclient import TestClient
 
 from ema.calibration.linear_report import calibrate_linear
+from ema.model.actuator import read_actuator
+from ema.model.logmap import read_logmap, read_mapped
 from ema.model.params import HealthParams
 from ema.model.synthetic import synthetic_window
-from ema.model.window import window_to_dict
+from ema.model.window import window_from_dict, window_to_dict
 from ema.service.main import create_app
 from tests.estimate.test_ballscrew import DOCUMENT, runs
 from tests.service.conftest import LOCAL, settings_for
@@ -60,3 +62,16 @@ def test_windows_of_another_kind_than_the_document_are_a_422_naming_the_signals(
         answer = client.post("/v1/calibrate", json={"windows": [window_to_dict(rotary)]})
         assert answer.status_code == 422, answer.text
         assert answer.json()["detail"][0]["loc"] == ["body", "windows", "0", "signals"]
+
+
+def test_the_service_answers_a_servo_log_within_its_budget(tmp_path):
+    """A 24.8 s log at 1 kHz: over the window limit in seconds, but its simulations' work is what is counted."""
+    from tests.estimate.test_servo import EMPS
+
+    window = window_from_dict(read_mapped(EMPS / "DATA_EMPS.mat", read_logmap(EMPS / "log-map.json")))
+    with TestClient(create_app(settings_for(tmp_path, max_window_s=4.0)), base_url=LOCAL) as client:
+        document = read_actuator(EMPS / "actuator.json").model_dump(mode="json", by_alias=True)
+        assert client.put(f"/v1/actuators/{window.actuator_id}", json=document).is_success
+        answer = client.post("/v1/estimate", json=window_to_dict(window))
+        assert answer.status_code == 200, answer.text
+        assert set(answer.json()["stages"].values()) == {"run"} and answer.json()["estimates"]["FDJ"]["unit"] == "N"
