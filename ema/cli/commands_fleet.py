@@ -12,6 +12,7 @@ from ema.cli.options import (
     NothingAnsweredError,
     actuator,
     as_json,
+    database_setting,
     emit,
     log_map,
     log_map_document,
@@ -42,6 +43,7 @@ ARCHIVE = click.Path(exists=True, path_type=Path)
 @click.option(
     "--database",
     default=None,
+    callback=database_setting,
     help="also store every answer in this history: an SQLite file or a postgresql:// address (the service's)",
 )
 @actuator

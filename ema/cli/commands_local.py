@@ -237,13 +237,16 @@ def calibrate(
     emit({**calibrated.report.model_dump(mode="json", by_alias=True), **written}, as_json, print_calibration)
 
 
+REPOSITORY_SCHEMAS = Path(__file__).resolve().parents[2] / "docs" / "schemas"  # an editable install's
+
+
 @click.command()
 @click.option(
     "--out",
     type=click.Path(file_okay=False, path_type=Path),
     default=None,
-    help="folder to write the JSON Schemas to (with --check: to compare; default docs/schemas, where the "
-    "repository keeps them)",
+    help="folder to write the JSON Schemas to (with --check: to compare; default: the repository's docs/schemas, "
+    "where this ema was installed from)",
 )
 @click.option("--check", is_flag=True, help="exit 1 if the files there differ from the code (writes nothing)")
 def schemas(out: Path | None, check: bool) -> None:
@@ -253,7 +256,10 @@ def schemas(out: Path | None, check: bool) -> None:
 
     if out is None and not check:
         raise InputError("--out", "name the folder to write the schemas to (the repository's: --out docs/schemas)")
-    out = out or Path("docs/schemas")
+    if out is None:
+        out = REPOSITORY_SCHEMAS
+        if not out.is_dir():
+            raise InputError("--out", "this ema was not installed from a repository: name the folder to check")
     stale = export(out, check=check)
     if check and stale:
         raise click.ClickException(f"stale or missing in {out}: {', '.join(stale)} (run: ema schemas --out {out})")

@@ -118,14 +118,19 @@ def report_log(read: Any) -> None:
         print(f"{window_id}: the last {dropped} sample(s) after it do not fill a window", file=sys.stderr)
 
 
+def _number(value: float | None, width: int, digits: str) -> str:
+    return f"{'—':>{width}}" if value is None else f"{value:>{width}{digits}}"
+
+
 def _print_replay(result: dict[str, Any]) -> None:
-    click.echo(f"{'window':<36}{'FDJ [N·m]':>12}{'η_O':>9}{'η_A':>9}{'total [s]':>11}")
+    click.echo(f"{'window':<36}{'FDJ':>12} {'unit':<5}{'η_O':>9}{'η_A':>9}{'total [s]':>11}")
     for row in result["rows"]:
         if row.get("error"):
             click.echo(f"{row['window_id']:<36}  refused: {row['error']}")
             continue
         click.echo(
-            f"{row['window_id']:<36}{row['FDJ']:>12.5f}{row['eta_O']:>9.4f}{row['eta_A']:>9.4f}{row['total_s']:>11.2f}"
+            f"{row['window_id']:<36}{_number(row['FDJ'], 12, '.5g')} {row.get('FDJ_unit') or '':<5}"
+            f"{_number(row['eta_O'], 9, '.4f')}{_number(row['eta_A'], 9, '.4f')}{_number(row['total_s'], 11, '.2f')}"
         )
     skipped = f", {len(result['bad_files'])} unreadable file(s) skipped" if result["bad_files"] else ""
     click.echo(

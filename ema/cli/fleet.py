@@ -259,12 +259,14 @@ def _stored(store: Any, row: dict[str, Any], answer: dict[str, Any]) -> dict[str
     """``row`` once its answer is in the history, or refused where the history holds another window's content
     under its window_id (``ema.history.errors.ConflictError``)."""
     from ema.estimate.documents import Estimate
-    from ema.history.errors import ConflictError
+    from ema.history.errors import ConflictError, WithdrawnError
 
     try:
         store.add(Estimate.model_validate(answer))
     except ConflictError as exc:
         return {"actuator_id": row["actuator_id"], "window_id": row["window_id"], "error": f"conflict: {exc}"}
+    except WithdrawnError as exc:
+        return {"actuator_id": row["actuator_id"], "window_id": row["window_id"], "error": f"withdrawn: {exc}"}
     return row
 
 
@@ -280,8 +282,13 @@ def _stored_documents(store: Any, documents: Documents, actuator_ids: set[str]) 
 
 
 def _store(database: str | Path | None) -> Any:
+    """The history ``--database`` names (None: none); a setting that names none is bad input naming the flag."""
     if database is None:
         return None
-    from ema.history.open import open_history
+    from ema.history.open import open_history, setting_error
+    from ema.model.checks import InputError
 
+    error = setting_error(str(database))
+    if error is not None:
+        raise InputError("--database", error)
     return open_history(database)

@@ -139,3 +139,16 @@ def emit(result: Any, as_json_flag: bool, show: Callable[[Any], None]) -> None:
         sys.stdout.flush()
     except BrokenPipeError:
         raise PipeClosedError from None
+
+
+def database_setting(_: click.Context, parameter: click.Parameter, value: str | None) -> str | None:
+    """A history setting checked as the flag is read: a malformed address is exit 2 naming the flag, before any
+    work (``ema.history.open.setting_error``)."""
+    if value is None:
+        return None
+    from ema.history.open import setting_error
+
+    error = setting_error(value)
+    if error is not None:
+        raise click.BadParameter(error, param=parameter)
+    return value

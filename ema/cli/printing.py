@@ -87,19 +87,24 @@ def check_line(check: Any) -> str:
 
 def print_simulate(result: dict[str, Any]) -> None:
     summary = result["summary"]
+    count = len(result["windows"])
+    where = result["window"] if count == 1 else f"{count} windows to {result['window']}"
     click.echo(
-        f"wrote {result['window']}: {summary['n_samples']} samples, {summary['duration_s']:g} s at "
-        f"{summary['sample_rate_hz']:g} Hz, {result['command']} command"
+        f"wrote {where}: {summary['n_samples']} samples, {summary['duration_s']:g} s at "
+        f"{summary['sample_rate_hz']:g} Hz each, {result['command']} command"
     )
-    truth = result["truth"]
-    click.echo(
-        f"truth: FDJ {truth['FDJ']:.4f} N·m  η_O {truth['eta_O']:.4f}  η_A {truth['eta_A']:.4f}  "
-        f"FSJ {truth['FSJ']:.4f} N·m"
-    )
+    truths = result["truth"] if isinstance(result["truth"], list) else [result["truth"]]
+    for i, truth in enumerate(truths):
+        hours = "" if truth.get("flight_hours") is None else f"  at {truth['flight_hours']:g} flight hours"
+        label = "truth" if len(truths) == 1 else f"window {i}"
+        click.echo(
+            f"{label}: FDJ {truth['FDJ']:.4f} N·m  η_O {truth['eta_O']:.4f}  η_A {truth['eta_A']:.4f}  "
+            f"FSJ {truth['FSJ']:.4f} N·m{hours}"
+        )
     click.echo(
         f"effects: {result['effects'] or 'none'}   noise: {'none' if result['noise'] == 'none' else 'realistic'}"
     )
-    click.echo(f"{'signal':<22}{'min':>12}{'max':>12}")
+    click.echo(f"{'signal':<22}{'min':>12}{'max':>12}" + ("  (the last window)" if len(truths) > 1 else ""))
     for name, (low, high) in summary["ranges"].items():
         click.echo(f"{name:<22}{low:>12.4g}{high:>12.4g}")
     click.echo(f"moving {summary['moving_fraction']:.0%} of the window")
@@ -119,8 +124,11 @@ def print_calibration(report: dict[str, Any]) -> None:
     for c in sorted(report["candidates"], key=lambda c: -c["score"])[:8]:
         parameters = ", ".join(f"{k}={v:.4g}" for k, v in list(c["parameters"].items())[:4])
         click.echo(f"{c['effect']:<28}{c['score']:>9.1f}{c['held_out_drop']:>14.1%}  {parameters}")
-    for step in report["selection_steps"]:
-        click.echo(f"{'named ' + step['selected'] if step['selected'] else 'nothing named'}: {step['reason']}")
+    for i, step in enumerate(report["selection_steps"]):
+        said = (
+            f"named {step['selected']}" if step["selected"] else "nothing named" if i == 0 else "nothing further named"
+        )
+        click.echo(f"{said}: {step['reason']}")
     if report["unexplained"]:
         click.echo(f"unexplained: {report['unexplained']['description']}")
     if report.get("ambiguity"):

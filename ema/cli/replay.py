@@ -76,6 +76,12 @@ def refusal_text(status: int, body: str) -> str:
     return ("conflict: " if status == 409 else "") + "; ".join(parts)
 
 
+def answered(row: dict) -> str:
+    """A stored answer in a few words: FDJ, and η_O where the window read it."""
+    eta = "η_O not read" if row.get("eta_O") is None else f"η_O {row['eta_O']:.4f}"
+    return f"FDJ {row['FDJ']:.5g}  {eta}"
+
+
 def replay(windows: list[Window], url: str, out: Path, api_key: str | None = None) -> list[dict[str, Any]]:
     """Post every window not yet in ``out``, appending each answer as it comes; returns the new rows."""
     done = done_windows(out, answered_only=True)
@@ -89,7 +95,7 @@ def replay(windows: list[Window], url: str, out: Path, api_key: str | None = Non
             row = row_of(window.actuator_id, window.window_id, post_window(url, window, api_key))
             writer.write(row)
             rows.append(row)
-            status = f"refused: {row['error']}" if row.get("error") else f"FDJ {row['FDJ']:.5f}  η_O {row['eta_O']:.4f}"
+            status = f"refused: {row['error']}" if row.get("error") else answered(row)
             elapsed = time.perf_counter() - started
             eta = elapsed / index * (len(todo) - index)
             print(

@@ -19,6 +19,7 @@ COLUMNS = (
     "window_id",
     "FDJ",
     "FDJ_std",
+    "FDJ_unit",
     "eta_O",
     "eta_O_std",
     "eta_A",
@@ -44,6 +45,7 @@ def row_of(actuator_id: str, window_id: str, answer: dict[str, Any]) -> dict[str
     for name in ("FDJ", "eta_O", "eta_A", "FSJ"):
         entry = answer["estimates"][name]
         row[name], row[f"{name}_std"] = (None, None) if entry is None else (entry["value"], entry["std"])
+    row["FDJ_unit"] = answer["estimates"]["FDJ"].get("unit")
     timings = answer["timings_s"]
     aliases = {"learn": "train", "assess": "predict"}  # an answer of a service of the first stage names
     row.update(

@@ -11,6 +11,7 @@ import re
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Protocol
+from urllib.parse import urlsplit
 
 from ema.calibration.documents import CalibrationReport
 from ema.estimate.documents import Estimate
@@ -53,15 +54,34 @@ def is_address(setting: str | Path) -> bool:
     return SCHEME.match(str(setting)) is not None
 
 
+def setting_error(setting: str) -> str | None:
+    """Why ``setting`` names no history ema opens (a scheme it does not open, an address it cannot parse), or
+    None: checked where the setting is read, so a malformed address is bad input, never a crash at start."""
+    if not setting.strip():
+        return "is empty: give a file path or a postgresql:// address"
+    scheme = SCHEME.match(setting)
+    if scheme is None:
+        return None
+    if scheme.group(1).lower() not in POSTGRES:
+        return f"{scheme.group(1)}:// is no database ema opens: give a file path or a postgresql:// address"
+    parts = urlsplit(setting)
+    try:
+        parts.port  # noqa: B018  # parsing it is the check
+    except ValueError:
+        port = parts.netloc.rsplit(":", 1)[-1]
+        return f"{parts.hostname}:{port}: the port is not a number (postgresql://user:password@host:port/database)"
+    if not parts.hostname and "host=" not in parts.query:
+        return "names no host (postgresql://user:password@host:port/database)"
+    return None
+
+
 def open_history(setting: str | Path, min_free_bytes: int | None = None) -> History:
     """The history ``setting`` names; StorageError naming it where it cannot be opened."""
     text = str(setting)
-    scheme = SCHEME.match(text)
-    if scheme is not None:
-        if scheme.group(1).lower() not in POSTGRES:
-            raise StorageError(
-                text.split("@")[-1], f"{scheme.group(1)}:// is no database ema opens (a file path, or postgresql://)"
-            )
+    error = setting_error(text)
+    if error is not None:
+        raise StorageError(text.split("@")[-1], error)
+    if is_address(text):
         from ema.history.postgres import open_postgres  # psycopg: only where PostgreSQL is asked for
 
         return open_postgres(text)

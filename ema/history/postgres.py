@@ -10,7 +10,7 @@ from __future__ import annotations
 import sqlalchemy as sa
 
 from ema.history.errors import StorageError
-from ema.history.schema import upgrade
+from ema.history.schema import ForeignTablesError, upgrade
 from ema.history.sql import SqlHistory
 
 
@@ -29,6 +29,9 @@ def open_postgres(address: str) -> SqlHistory:
     engine = sa.create_engine(url, pool_pre_ping=True, pool_size=8, max_overflow=8)
     try:
         upgrade(engine)
+    except ForeignTablesError as exc:
+        engine.dispose()
+        raise StorageError(location, str(exc)) from None
     except sa.exc.SQLAlchemyError as exc:
         engine.dispose()
         reason = str(getattr(exc, "orig", exc)).strip().splitlines()[0]

@@ -26,6 +26,10 @@ def _config(connection: sa.Connection) -> Config:
     return config
 
 
+class ForeignTablesError(Exception):
+    """The database holds tables of another program's under ema's names."""
+
+
 def upgrade(engine: sa.Engine) -> None:
     """Migrate ``engine``'s history to the latest revision (a new history is created)."""
     with engine.connect() as connection:
@@ -35,6 +39,7 @@ def upgrade(engine: sa.Engine) -> None:
         try:
             tables = set(sa.inspect(connection).get_table_names())
             if "alembic_version" not in tables and "estimates" in tables:
+                _ours_from_round_three(connection)
                 _round_three(connection, tables)
                 connection.commit()
                 command.stamp(_config(connection), FIRST_REVISION)
@@ -45,6 +50,17 @@ def upgrade(engine: sa.Engine) -> None:
             if engine.dialect.name == "postgresql":
                 connection.execute(sa.text("SELECT pg_advisory_unlock(:key)"), {"key": LOCK_KEY})
                 connection.commit()
+
+
+def _ours_from_round_three(connection: sa.Connection) -> None:
+    """A table ``estimates`` without migrations is an SQLite history of ema's from before them, else another
+    program's: refused (``ForeignTablesError``), never altered. PostgreSQL histories were migrated from the start."""
+    columns = {column["name"] for column in sa.inspect(connection).get_columns("estimates")}
+    if connection.dialect.name != "sqlite" or not {"actuator_id", "window_id", "result"} <= columns:
+        connection.rollback()
+        raise ForeignTablesError(
+            "holds a table 'estimates' that is not an ema history's: give ema a database of its own"
+        )
 
 
 def _round_three(connection: sa.Connection, tables: set[str]) -> None:

@@ -6,12 +6,15 @@
 - Committed before the answer leaves (SQLite: ``synchronous=FULL``; PostgreSQL commits durably).
 - Actuator documents are versioned 1, 2, …; two replicas allocating a version at once collide on
   the key, and the later one takes the next.
-- A withdrawn window leaves the history but not the database: its row moves to ``withdrawals``.
+- A withdrawn window leaves the history but not the database: its row moves to ``withdrawals``, and its key is
+  retired: posted again, it is refused with its withdrawal (``WithdrawnError``), never estimated anew.
 """
 
 from __future__ import annotations
 
 import json
+import random
+import time
 from collections.abc import Sequence
 from typing import Any
 
@@ -23,12 +26,13 @@ from ema.estimate.documents import Estimate
 from ema.estimate.documents.window import HistoryReadings, InertiaReading, SensorZero
 from ema.estimate.history import lent
 from ema.history.connection import SqlStore, now
-from ema.history.errors import ConflictError, StorageError
+from ema.history.errors import ConflictError, VersionContentionError, WithdrawnError
 from ema.history.tables import actuators, calibrations, estimates, summaries, withdrawals
 from ema.model.actuator import ActuatorDocument
 from ema.prognosis.documents import Stored, StoredActuator, Withdrawal
 
 VERSION_ATTEMPTS = 20  # replicas racing for an actuator's next document version
+BACKOFF_S = 0.005  # the first retry's longest wait; it doubles with each attempt
 
 
 class SqlHistory(SqlStore):
@@ -36,7 +40,7 @@ class SqlHistory(SqlStore):
 
     def add(self, result: Estimate) -> Stored:
         """Store one result; where its (actuator_id, window_id) is stored already from the same content, that row,
-        marked as a replay (ConflictError where from other content)."""
+        marked as a replay (ConflictError where from other content; WithdrawnError where it was withdrawn)."""
         stored_at, document, info = now(), result.model_dump_json(by_alias=True), result.window
         row = {
             "actuator_id": result.actuator_id,
@@ -50,6 +54,7 @@ class SqlHistory(SqlStore):
         }
         statement = self._insert(estimates).values(**row).on_conflict_do_nothing().returning(estimates.c.id)
         with self._writing() as connection:
+            self._refuse_withdrawn(connection, result.actuator_id, result.window_id)
             new_id = connection.execute(statement).scalar_one_or_none()
         if new_id is None:
             found = self.get(result.actuator_id, result.window_id, info.content_sha256)
@@ -59,18 +64,31 @@ class SqlHistory(SqlStore):
 
     def get(self, actuator_id: str, window_id: str, digest: str | None = None) -> Stored | None:
         """The stored answer for this window, marked as a replay, or None; ConflictError where it was stored
-        from content other than ``digest`` (a row stored before digests is taken for the same window)."""
+        from content other than ``digest`` (a row stored before digests is taken for the same window), WithdrawnError
+        where it was withdrawn."""
         query = sa.select(estimates.c.id, estimates.c.stored_at, estimates.c.result, estimates.c.content_sha256)
         with self._reading() as connection:
             row = connection.execute(
                 query.where(estimates.c.actuator_id == actuator_id, estimates.c.window_id == window_id)
             ).first()
-        if row is None:
-            return None
+            if row is None:
+                self._refuse_withdrawn(connection, actuator_id, window_id)
+                return None
         stored = Stored(**json.loads(row.result), id=row.id, stored_at=row.stored_at, replay=True)
         if digest is not None and row.content_sha256 is not None and row.content_sha256 != digest:
             raise ConflictError(stored, digest)
         return stored
+
+    def _refuse_withdrawn(self, connection: sa.Connection, actuator_id: str, window_id: str) -> None:
+        """WithdrawnError where an operator withdrew this window: its key stays retired."""
+        columns = [withdrawals.c[name] for name in Withdrawal.model_fields if name != "actuator_id"]
+        found = connection.execute(
+            sa.select(*columns)
+            .where(withdrawals.c.actuator_id == actuator_id, withdrawals.c.window_id == window_id)
+            .order_by(withdrawals.c.id.desc())
+        ).first()
+        if found is not None:
+            raise WithdrawnError(Withdrawal(actuator_id=actuator_id, **found._mapping))
 
     def withdraw(self, actuator_id: str, window_id: str, reason: str) -> Withdrawal | None:
         """Take a stored window out of the history, keeping it and why in ``withdrawals``; None where none is
@@ -115,35 +133,51 @@ class SqlHistory(SqlStore):
 
     def put_actuator(self, actuator_id: str, document: ActuatorDocument) -> StoredActuator:
         """Store ``document`` as the actuator's next version (the latest version itself where it is the same
-        document: a PUT repeated stores nothing new). Earlier versions stay, as do the estimates read with them."""
+        document: a PUT repeated stores nothing new). Earlier versions stay, as do the estimates read with them.
+
+        Writers of one actuator's documents take turns (PostgreSQL: a lock of that actuator for the transaction;
+        SQLite writes one at a time), so replicas racing for a version wait rather than fail; a version taken
+        meanwhile all the same is retried after a random backoff, and ``VersionContentionError`` (409) only past
+        ``VERSION_ATTEMPTS``."""
         text = document.model_dump_json(by_alias=True)
-        for _ in range(VERSION_ATTEMPTS):
-            latest = self._latest_document(actuator_id)
-            if latest is not None and latest.document == text:
-                return StoredActuator(
-                    actuator_id=actuator_id, version=latest.version, stored_at=latest.stored_at, document=document
-                )
-            version, stored_at = 1 if latest is None else latest.version + 1, now()
+        for attempt in range(VERSION_ATTEMPTS):
             try:
                 with self._writing() as connection:
-                    connection.execute(
-                        actuators.insert().values(
-                            actuator_id=actuator_id, version=version, stored_at=stored_at, document=text
+                    self._take_turn(connection, actuator_id)
+                    latest = self._latest_document(actuator_id, connection)
+                    if latest is not None and latest.document == text:
+                        return StoredActuator(
+                            actuator_id=actuator_id,
+                            version=latest.version,
+                            stored_at=latest.stored_at,
+                            document=document,
                         )
-                    )
+                    version, stored_at = 1 if latest is None else latest.version + 1, now()
+                    row = {"actuator_id": actuator_id, "version": version, "stored_at": stored_at, "document": text}
+                    connection.execute(actuators.insert().values(**row))
             except sa.exc.IntegrityError:
-                continue  # another replica took this version a moment ago: read again
+                time.sleep(random.uniform(0.0, BACKOFF_S * 2 ** min(attempt, 6)))  # another writer took it: again
+                continue
             return StoredActuator(actuator_id=actuator_id, version=version, stored_at=stored_at, document=document)
-        raise StorageError(self.location, f"no free document version for {actuator_id!r} after {VERSION_ATTEMPTS}")
+        raise VersionContentionError(actuator_id, VERSION_ATTEMPTS)
 
-    def _latest_document(self, actuator_id: str) -> Any:
-        with self._reading() as connection:
-            return connection.execute(
-                sa.select(actuators.c.version, actuators.c.stored_at, actuators.c.document)
-                .where(actuators.c.actuator_id == actuator_id)
-                .order_by(actuators.c.version.desc())
-                .limit(1)
-            ).first()
+    def _take_turn(self, connection: sa.Connection, actuator_id: str) -> None:
+        """On PostgreSQL, hold this actuator's document lock until the transaction ends."""
+        if self.engine.dialect.name == "postgresql":
+            key = {"key": f"ema-actuator:{actuator_id}"}
+            connection.execute(sa.text("SELECT pg_advisory_xact_lock(hashtextextended(:key, 0))"), key)
+
+    def _latest_document(self, actuator_id: str, connection: sa.Connection | None = None) -> Any:
+        query = (
+            sa.select(actuators.c.version, actuators.c.stored_at, actuators.c.document)
+            .where(actuators.c.actuator_id == actuator_id)
+            .order_by(actuators.c.version.desc())
+            .limit(1)
+        )
+        if connection is not None:
+            return connection.execute(query).first()
+        with self._reading() as reading:
+            return reading.execute(query).first()
 
     def get_actuator(self, actuator_id: str) -> StoredActuator | None:
         """The actuator's latest stored document, or None where it has none."""

@@ -22,7 +22,7 @@ from typing import Any
 import sqlalchemy as sa
 
 from ema.history.errors import StorageError
-from ema.history.schema import upgrade
+from ema.history.schema import ForeignTablesError, upgrade
 from ema.history.sql import SqlHistory
 
 log = logging.getLogger("ema.history")
@@ -101,6 +101,9 @@ def open_sqlite(path: Path, min_free_bytes: int = MIN_FREE_BYTES) -> SqlHistory:
             _check_tables(engine, path)
         _private(path)
         upgrade(engine)
+    except ForeignTablesError as exc:
+        engine.dispose()
+        raise StorageError(path, str(exc)) from None
     except sa.exc.SQLAlchemyError as exc:
         engine.dispose()
         raise StorageError(path, f"is not a usable SQLite database ({getattr(exc, 'orig', exc)})") from None

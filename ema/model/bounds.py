@@ -5,8 +5,19 @@ from __future__ import annotations
 import datetime as dt
 
 IDENTIFIER = r"^[!-~](?:[ -~]{0,198}[!-~])?$"  # printable ASCII, no surrounding blanks: safe in a URL and a CSV
+ROUTE_SEGMENTS = ("estimates", "prognosis")  # the service's routes below an actuator: no id may end in one
 # Times a trend computes with, bounded where they enter: no airframe flies a million hours, no log predates
 # 2000 or is stamped more than a day ahead of the clock that receives it.
 MAX_FLIGHT_HOURS = 1_000_000.0
 EARLIEST_RECORDED_AT = dt.datetime(2000, 1, 1, tzinfo=dt.UTC)
 CLOCK_SKEW = dt.timedelta(days=1)
+
+
+def route_collision(actuator_id: str) -> str | None:
+    """Why ``actuator_id`` would be read as another route of the service (``/v1/actuators/{id}/estimates``), or
+    None: no segment of it after the first may be a route's name."""
+    segments = actuator_id.split("/")[1:]
+    clash = next((segment for segment in segments if segment in ROUTE_SEGMENTS), None)
+    if clash is None:
+        return None
+    return f"has a segment {clash!r} after its first: /v1/actuators/{{id}}/{clash} is a route of its own"

@@ -93,8 +93,9 @@ def from_validation(exc: Any, prefix: str = "") -> InputError:
     first = exc.errors()[0]
     names = [str(part) for part in first["loc"] if not isinstance(part, int)]
     indices = [part for part in first["loc"] if isinstance(part, int)]
-    message = first["msg"] if not indices else f"sample {indices[0]}: {first['msg']}"
-    head, _, rest = message.removeprefix("Value error, ").partition(": ")
+    said = first["msg"].removeprefix("Value error, ")
+    message = said if not indices else f"sample {indices[0]}: {said}"
+    head, _, rest = message.partition(": ")
     if first["type"] == "value_error" and rest and head.replace("_", "").replace(".", "").isalnum():
         names, message = [*names, head], rest
     return InputError(prefix + (".".join(names) or "document"), message)

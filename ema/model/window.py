@@ -27,7 +27,7 @@ from pydantic import (
 )
 
 from ema.model.aircraft import AIRSPEED_RANGE_MPS, ALTITUDE_RANGE_M, FlightCondition
-from ema.model.bounds import CLOCK_SKEW, EARLIEST_RECORDED_AT, IDENTIFIER, MAX_FLIGHT_HOURS
+from ema.model.bounds import CLOCK_SKEW, EARLIEST_RECORDED_AT, IDENTIFIER, MAX_FLIGHT_HOURS, route_collision
 from ema.model.checks import InputError, read_document, validated
 from ema.model.document import Number
 from ema.model.kinds import ALL_SIGNALS, DEFAULT_KIND, KINDS, kind_of_signals, nearest_kind
@@ -161,6 +161,14 @@ class WindowDocument(_Contract):
         description="constants the log recorded beside its signals, under the names of the actuator document's "
         "section (a servo's controller gains): read with the document, which must agree where it gives them too",
     )
+
+    @field_validator("actuator_id")
+    @classmethod
+    def _no_route(cls, actuator_id: str) -> str:
+        clash = route_collision(actuator_id)
+        if clash is not None:
+            raise ValueError(clash)
+        return actuator_id
 
     @field_validator("recorded_at")
     @classmethod

@@ -85,9 +85,6 @@ class Settings(BaseSettings):
         512_000_000, ge=1000, description="bytes of all bodies being received at once (beyond: 503)"
     )
     ui_page_size: int = Field(50, ge=1, le=1000, description="actuators per page of /ui")
-    ui_budget_s: float = Field(
-        3.0, gt=0, le=600, description="seconds one /ui request may spend bringing prognoses up to date"
-    )
     allowed_origins: tuple[str, ...] = Field(
         (), description="origins (scheme://host:port) of web pages allowed to write besides the service's own"
     )
@@ -100,15 +97,11 @@ class Settings(BaseSettings):
         setting = str(setting) if isinstance(setting, Path) else setting
         if not isinstance(setting, str):
             raise ValueError("must be a file path or a postgresql:// address")
-        from ema.history.open import POSTGRES, SCHEME
+        from ema.history.open import setting_error
 
-        scheme = SCHEME.match(setting)
-        if scheme is not None and scheme.group(1).lower() not in POSTGRES:
-            raise ValueError(
-                f"{scheme.group(1)}:// is no database ema opens: give a file path or a postgresql:// address"
-            )
-        if not setting.strip():
-            raise ValueError("is empty: give a file path or a postgresql:// address")
+        error = setting_error(setting)
+        if error is not None:
+            raise ValueError(error)
         return setting
 
     @field_validator("api_key")

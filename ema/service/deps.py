@@ -17,7 +17,7 @@ from ema.estimate.config import PipelineConfig, validated
 from ema.estimate.documents import Note
 from ema.history.open import History
 from ema.model.actuator import THESIS, ActuatorDocument
-from ema.model.bounds import IDENTIFIER
+from ema.model.bounds import IDENTIFIER, route_collision
 from ema.model.checks import InputError
 from ema.prognosis.documents import Prognosis, Stored
 from ema.prognosis.prognose import prognose
@@ -49,6 +49,9 @@ def path_actuator_id(actuator_id: Annotated[str, Path(description="as in the win
     if not 1 <= len(actuator_id) <= 200 or not IDENTIFIER_RE.match(actuator_id):
         shown = actuator_id[:40].encode("unicode_escape").decode()
         raise InputError("path.actuator_id", f"{shown!r} is not an actuator id (1–200 printable ASCII characters)")
+    clash = route_collision(actuator_id)
+    if clash is not None:
+        raise InputError("path.actuator_id", f"{actuator_id!r} {clash}")
     return actuator_id
 
 

@@ -8,7 +8,7 @@ from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse
 from starlette.requests import ClientDisconnect
 
-from ema.history.errors import ConflictError, StorageError
+from ema.history.errors import ConflictError, StorageError, VersionContentionError, WithdrawnError
 from ema.model.checks import InputError
 from ema.service.jobs import CancelledError, OverloadedError
 
@@ -44,6 +44,20 @@ async def conflict(request: Request, exc: Exception) -> JSONResponse:
     """Another window under a stored key: 409, never the stored window's answer."""
     assert isinstance(exc, ConflictError)
     detail = [{"loc": ["body", "window_id"], "msg": str(exc), "type": "conflict"}]
+    return JSONResponse({"detail": detail}, status_code=status.HTTP_409_CONFLICT)
+
+
+async def withdrawn(request: Request, exc: Exception) -> JSONResponse:
+    """A withdrawn window posted again: 410, naming its withdrawal."""
+    assert isinstance(exc, WithdrawnError)
+    detail = [{"loc": ["body", "window_id"], "msg": str(exc), "type": "withdrawn"}]
+    body = {"detail": detail, "withdrawal": exc.withdrawal.model_dump()}
+    return JSONResponse(body, status_code=status.HTTP_410_GONE)
+
+
+async def contended(request: Request, exc: Exception) -> JSONResponse:
+    """Other writers of the actuator's document kept taking its version: 409, put it again."""
+    detail = [{"loc": ["path", "actuator_id"], "msg": str(exc), "type": "conflict"}]
     return JSONResponse({"detail": detail}, status_code=status.HTTP_409_CONFLICT)
 
 
@@ -83,6 +97,8 @@ def install(app: FastAPI) -> None:
     app.add_exception_handler(InputError, input_error)
     app.add_exception_handler(OverloadedError, overloaded)
     app.add_exception_handler(ConflictError, conflict)
+    app.add_exception_handler(WithdrawnError, withdrawn)
+    app.add_exception_handler(VersionContentionError, contended)
     app.add_exception_handler(NotStoredError, not_stored)
     app.add_exception_handler(StorageError, storage)
     app.add_exception_handler(CancelledError, cancelled)

@@ -126,8 +126,11 @@ class JobRunner:
 
     def _full(self) -> None:
         if self.admitted >= self.slots + self.max_queue:
+            places = self.slots + self.max_queue
             raise OverloadedError(
-                f"{self.running} running, {self.queued} waiting (max {self.max_queue})", self.retry_after_s()
+                f"all {places} places are taken: {self.running} job(s) running, {self.queued} waiting for a slot or "
+                f"storing an answer (EMA_MAX_QUEUE {self.max_queue})",
+                self.retry_after_s(),
             )
 
     def admit(self) -> Ticket:

@@ -25,6 +25,7 @@ from ema.service.guard import BodyLimits, Guard
 from ema.service.jobs import JobRunner
 from ema.service.routes import actuators, calibrate, estimate, health, ui
 from ema.service.schemas import CalibrateIn
+from ema.service.view import LineKeeper
 from ema.service.warmup import warm_up
 
 log = logging.getLogger("ema.service")
@@ -67,6 +68,7 @@ def create_app(settings: Settings) -> FastAPI:
         app.state.store = open_history(settings.database, settings.min_free_bytes)
         slots = settings.ray_jobs if settings.backend == "ray" else 1
         app.state.runner = JobRunner(settings.max_queue, settings.queue_timeout_s, slots)
+        app.state.keeper = LineKeeper(app.state.store, app.state.runner)
         if settings.backend == "ray":
             from ema.kinds.remote import connect
 
@@ -75,7 +77,9 @@ def create_app(settings: Settings) -> FastAPI:
             await asyncio.get_running_loop().run_in_executor(app.state.runner._executor, warm_up)
             log.info("kernels warm")
         app.state.warm.set()
+        app.state.keeper.start()
         yield
+        app.state.keeper.stop()
         app.state.runner.shutdown()
         sim_runtime.shutdown()
         app.state.store.close()

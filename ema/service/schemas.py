@@ -57,6 +57,7 @@ def responses(*codes: int) -> dict[int | str, dict[str, Any]]:
         403: {"model": ErrorOut, "description": "a write from a page of another origin (a browser's Origin header)"},
         404: {"model": ErrorOut, "description": "nothing stored under the path's actuator_id"},
         409: {"model": ErrorOut, "description": "another window's content under a stored (actuator_id, window_id)"},
+        410: {"model": ErrorOut, "description": "a window an operator withdrew, posted again: it stays withdrawn"},
         413: {"model": ErrorOut, "description": "the body exceeds EMA_MAX_BODY_BYTES"},
         415: {"model": ErrorOut, "description": "the body is not application/json"},
         422: {"model": ErrorOut, "description": "bad input or over the request budget; `loc` names the field"},

@@ -1,22 +1,22 @@
-"""The fleet view's lines (``/ui``, ``GET /v1/actuators``): kept in the history, brought up to date on demand.
+"""The fleet view's lines (``/ui``, ``GET /v1/actuators``): kept in the history, brought up to date by a worker of
+their own.
 
 Each actuator's line (``ema.prognosis.status.summary``) is kept with the state of the history it was
 computed from (its windows' count and last row, its document's version), so a line is recomputed only
-after its actuator stored a window or a document, and a replica reads what another computed. Bringing
-lines up to date is a job like an estimate: admitted through the queue, stopped between actuators
-when its client leaves, and bounded in time (``ui_budget_s``). Lines it did not reach are shown as
-they were, or as pending: a page never waits on a thousand prognoses. An actuator with fewer windows
-than a forecast needs gets its line without one.
+after its actuator stored a window or a document, and a replica reads what another computed. A page
+only reads the kept lines (those out of date shown as they were, or as pending): it never computes, so
+people looking at the fleet take nothing from the estimates. The ``LineKeeper`` brings lines up to date
+on a thread of its own, woken when a window or a document is stored (and every ``KEEPER_PERIOD_S``, for
+what another replica or ``ema fleet`` stored), one actuator at a time, and only while no job runs or waits
+in the queue. An actuator with fewer windows than a forecast needs gets its line without one.
 """
 
 from __future__ import annotations
 
+import logging
 import threading
 import time
-from collections.abc import Awaitable, Callable
 from dataclasses import dataclass
-
-from starlette.concurrency import run_in_threadpool
 
 from ema.history.open import History
 from ema.model.actuator import THESIS
@@ -24,7 +24,11 @@ from ema.prognosis.documents import ActuatorSummary, Prognosis, Stored
 from ema.prognosis.rul import MIN_WINDOWS as FORECAST_WINDOWS
 from ema.prognosis.status import URGENCY, failed, summary
 from ema.service.deps import safe_prognosis
-from ema.service.jobs import JobRunner, OverloadedError
+from ema.service.jobs import JobRunner
+
+log = logging.getLogger("ema.service")
+KEEPER_PERIOD_S = 5.0  # the keeper looks for lines out of date at least this often
+IDLE_POLL_S = 0.05  # how often a keeper that yielded looks whether the queue is empty again
 
 
 @dataclass(frozen=True)
@@ -43,14 +47,14 @@ def _unit_of(latest: Stored | None) -> str:
     return "days" if latest.window.recorded_at is not None else "windows"
 
 
-def refreshed(store: History, stale: list[tuple[str, str, int]], budget_s: float, cancel: threading.Event) -> set[str]:
-    """Bring the lines of ``stale`` (actuator, state, windows) up to date within ``budget_s``, until ``cancel``;
-    the actuators reached."""
+def refreshed(store: History, stale: list[tuple[str, str, int]], cancel: threading.Event) -> set[str]:
+    """Bring the lines of ``stale`` (actuator, state, windows) up to date, until ``cancel``; the actuators
+    reached."""
     ids = [actuator_id for actuator_id, _, _ in stale]
     latest, documents = store.latest(ids), store.latest_documents(ids)
-    deadline, done = time.monotonic() + budget_s, set()
+    done = set()
     for actuator_id, state, windows in stale:
-        if cancel.is_set() or time.monotonic() > deadline:
+        if cancel.is_set():
             break
         stored = documents.get(actuator_id)
         actuator, version = (THESIS, None) if stored is None else (stored.document, stored.version)
@@ -84,17 +88,9 @@ def kept_lines(store: History) -> tuple[dict[str, ActuatorSummary], list[tuple[s
     return lines, stale
 
 
-async def fleet_lines(store: History, runner: JobRunner, budget_s: float, gone: Callable[[], Awaitable[bool]]) -> Lines:
-    """Every actuator's line, those out of date brought up to date first as far as the budget goes (as a job
-    of the queue; where the queue is full, the lines as kept)."""
-    lines, stale = await run_in_threadpool(kept_lines, store)
-    if stale:
-        try:
-            with runner.admit() as ticket:
-                await runner.run(ticket, gone, refreshed, store, stale, budget_s, ticket.cancel)
-        except OverloadedError:
-            pass  # the queue is full: the page shows what is kept, the rest pending
-        lines, stale = await run_in_threadpool(kept_lines, store)
+def fleet_lines(store: History) -> Lines:
+    """Every actuator's line as kept, those out of date marked pending (the ``LineKeeper`` is at them)."""
+    lines, stale = kept_lines(store)
     for actuator_id, _, windows in stale:
         was = lines.get(actuator_id)
         reason = "its prognosis is being brought up to date: reload in a moment"
@@ -104,6 +100,45 @@ async def fleet_lines(store: History, runner: JobRunner, budget_s: float, gone: 
             else was.model_copy(update={"status": "pending", "reason": f"{reason} (was: {was.status})"})
         )
     return Lines(sorted(lines.values(), key=urgency), [actuator_id for actuator_id, _, _ in stale])
+
+
+class LineKeeper:
+    """The fleet's lines brought up to date on a thread of its own, yielding to every job (module docstring)."""
+
+    def __init__(self, store: History, runner: JobRunner) -> None:
+        self.store, self.runner = store, runner
+        self._wake, self._stop = threading.Event(), threading.Event()
+        self._thread = threading.Thread(target=self._loop, name="ema-lines", daemon=True)
+
+    def start(self) -> None:
+        self._wake.set()  # a pass at start: lines a restart left stale
+        self._thread.start()
+
+    def poke(self) -> None:
+        """A window or a document was stored: its actuator's line is out of date."""
+        self._wake.set()
+
+    def stop(self) -> None:
+        self._stop.set()
+        self._wake.set()
+        self._thread.join(timeout=10)
+
+    def _loop(self) -> None:
+        while not self._stop.is_set():
+            self._wake.wait(KEEPER_PERIOD_S)
+            self._wake.clear()
+            try:
+                self._pass()
+            except Exception:  # a history that cannot be read now: the next wake tries again
+                log.warning("the fleet's lines could not be brought up to date", exc_info=True)
+
+    def _pass(self) -> None:
+        for item in kept_lines(self.store)[1]:
+            while self.runner.admitted and not self._stop.is_set():
+                time.sleep(IDLE_POLL_S)  # a job runs or waits: it has the cores
+            if self._stop.is_set():
+                return
+            refreshed(self.store, [item], self._stop)
 
 
 def urgency(line: ActuatorSummary) -> tuple[int, float, str]:

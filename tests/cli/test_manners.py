@@ -101,3 +101,61 @@ def test_simulate_refuses_a_linear_actuator_naming_the_flag(tmp_path, capsys):
     rig = Path(__file__).parents[2] / "examples" / "ballscrew-rig" / "actuator.json"
     assert main(["simulate", "--out", str(tmp_path / "w.json"), "--actuator", str(rig)]) == EXIT_BAD_INPUT
     assert "--actuator" in capsys.readouterr().err and not (tmp_path / "w.json").exists()
+
+
+def test_the_readmes_series_step_prints_every_window(tmp_path, capsys):
+    out = tmp_path / "degrading"
+    command = ["simulate", "--out", str(out), "--series", "3", "--every", "25", "--fdj-end", "0.07"]
+    assert main([*command, "--duration", "0.1", "--actuator-id", "tail-7/elevator-left"]) == EXIT_OK
+    printed = capsys.readouterr().out
+    assert "wrote 3 windows" in printed and "window 2: FDJ 0.0700" in printed and len(list(out.iterdir())) == 3
+
+
+def test_a_replayed_answer_without_eta_o_is_printed_with_a_dash():
+    from ema.cli.commands_remote import _print_replay
+    from ema.cli.replay import answered
+
+    row = {"window_id": "rig-1", "FDJ": 0.81, "FDJ_unit": "N·m", "eta_O": None, "eta_A": None, "total_s": 0.01}
+    assert answered(row) == "FDJ 0.81  η_O not read"
+    _print_replay({"rows": [row], "bad_files": {}, "posted": 1, "answered": 1, "refused": 0, "csv": "r.csv"})
+
+
+def test_a_malformed_database_address_exits_2_naming_the_flag(tmp_path, capsys):
+    address = "postgresql://u:p@host:notaport/db"
+    assert main(["serve", "--database", address]) == EXIT_BAD_INPUT
+    assert "--database" in capsys.readouterr().err
+    assert main(["fleet", str(tmp_path), "--out", str(tmp_path / "r.csv"), "--database", address]) == EXIT_BAD_INPUT
+    assert "'--database': host:notaport: the port is not a number" in capsys.readouterr().err
+
+
+def test_schemas_check_outside_the_repository_checks_the_repositorys(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    assert main(["schemas", "--check"]) == EXIT_OK
+    assert json.loads(capsys.readouterr().out)["folder"].endswith("docs/schemas") and not list(tmp_path.iterdir())
+
+
+def test_a_rig_calibration_writes_its_figure(tmp_path, capsys):
+    rig = Path(__file__).resolve().parents[2] / "examples" / "ballscrew-rig"
+    runs = [str(p) for p in sorted((rig / "runs").glob("normal_load*_run00[1-3].csv"))]
+    command = ["calibrate", *runs, "--actuator", str(rig / "actuator.json"), "--log-map", str(rig / "log-map.json")]
+    assert main([*command, "--figure", str(tmp_path / "rig.png")]) == EXIT_OK
+    assert (tmp_path / "rig.png").stat().st_size > 0 and "figure:" in capsys.readouterr().out
+
+
+def test_a_second_step_naming_nothing_does_not_contradict_the_first(capsys):
+    from ema.cli.printing import print_calibration
+
+    step = {"selected": "current_sensor_offset", "reason": "it explains the windows"}
+    report = {
+        "noise_floor": {"copies": 0, "equation_error_ratio": 1.0},
+        "candidates": [],
+        "selection_steps": [step, {"selected": None, "reason": "nothing beyond it"}],
+        "unexplained": None,
+        "held_out": {"note": "five folds"},
+        "estimates_before": {},
+        "estimates_after": {},
+    }
+    print_calibration(report)
+    printed = capsys.readouterr().out
+    assert "named current_sensor_offset" in printed and "nothing further named" in printed
+    assert "\nnothing named" not in printed

@@ -395,3 +395,15 @@ def test_the_check_reuses_the_simulation_at_the_physics_answer_with_the_same_res
     alone = _estimate(drawn)
     assert own_runs == [1]
     assert reused.fit_check == alone.fit_check and reused.estimates == alone.estimates
+
+
+@pytest.mark.parametrize("field", ["backlash_rad", "viscous_nms"])
+def test_a_document_at_zero_where_its_schema_allows_zero_is_read(field):
+    """backlash_rad 0 had made a geometric grid of the dead band start at 0, viscous_nms 0 a note divide by it."""
+    from ema.model.actuator import actuator_from_dict
+
+    document = THESIS.model_dump(by_alias=True)
+    document["drive"][field] = 0.0
+    window = synthetic_window(HealthParams.single(), seed=5, duration_s=0.2)
+    result = estimate_window(window, SMALL, actuator=actuator_from_dict(document))
+    assert result.estimates.FDJ.value > 0 and np.isfinite(result.estimates.FDJ.std)

@@ -1,9 +1,7 @@
-"""A history of each kind for the contract tests: SQLite in a file, PostgreSQL on a server the session starts."""
+"""A history of each kind for the contract tests: SQLite in a file, PostgreSQL on the session's server
+(``tests/conftest.py``)."""
 
-import shutil
-import tempfile
 import uuid
-from pathlib import Path
 
 import pytest
 
@@ -12,26 +10,7 @@ from ema.history.open import open_history
 from ema.model.actuator import THESIS
 from ema.model.params import HealthParams
 from ema.model.synthetic import synthetic_window
-from tests.servers import PostgresServer
 from tests.service.conftest import SMALL
-
-
-@pytest.fixture(scope="session")
-def postgres():
-    """A PostgreSQL server for the session, or a skip saying why none can start here."""
-    why = PostgresServer.unavailable()
-    if why is not None:
-        pytest.skip(why)
-    folder = Path(tempfile.mkdtemp(prefix="ema-pg-"))  # outside pytest's folder: the server's user must enter it
-    server = PostgresServer(folder)
-    try:
-        server.start()
-    except Exception as exc:  # a machine that cannot run one: said, not failed
-        shutil.rmtree(folder, ignore_errors=True)
-        pytest.skip(f"PostgreSQL could not start here: {exc}")
-    yield server
-    server.stop()
-    shutil.rmtree(folder, ignore_errors=True)
 
 
 @pytest.fixture(params=["sqlite", "postgres"])

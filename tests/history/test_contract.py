@@ -39,12 +39,12 @@ def test_the_same_window_stored_at_once_from_many_threads_is_one_row(history, re
     assert len(history.history(result.actuator_id)[0]) == 1
 
 
-def test_document_versions_never_collide(history):
-    documents = [THESIS.model_copy(update={"name": f"variant {i}"}) for i in range(6)]
-    with concurrent.futures.ThreadPoolExecutor(6) as pool:
+def test_document_versions_never_collide_and_sixteen_writers_all_land(history):
+    documents = [THESIS.model_copy(update={"name": f"variant {i}"}) for i in range(64)]
+    with concurrent.futures.ThreadPoolExecutor(16) as pool:
         versions = [s.version for s in pool.map(lambda d: history.put_actuator("a/1", d), documents)]
-    assert sorted(versions) == [1, 2, 3, 4, 5, 6]
-    assert history.put_actuator("a/1", history.get_actuator("a/1").document).version == 6  # the same: no new one
+    assert sorted(versions) == list(range(1, 65))
+    assert history.put_actuator("a/1", history.get_actuator("a/1").document).version == 64  # the same: no new one
 
 
 def test_a_withdrawn_window_leaves_the_history_and_its_record_stays(history, result):
@@ -54,6 +54,18 @@ def test_a_withdrawn_window_leaves_the_history_and_its_record_stays(history, res
     assert history.history(result.actuator_id)[0] == [] and history.withdraw(result.actuator_id, "x", "") is None
     assert [w.window_id for w in history.withdrawals(result.actuator_id)] == [result.window_id]
     assert result.actuator_id in history.actuator_ids()
+
+
+def test_a_withdrawn_window_stays_withdrawn(history, result):
+    from ema.history.errors import WithdrawnError
+
+    history.add(result)
+    history.withdraw(result.actuator_id, result.window_id, "bad sensor")
+    for again in (lambda: history.add(result), lambda: history.get(result.actuator_id, result.window_id)):
+        with pytest.raises(WithdrawnError) as refused:
+            again()
+        assert refused.value.withdrawal.reason == "bad sensor" and "withdrawn" in str(refused.value)
+    assert history.history(result.actuator_id)[0] == []
 
 
 def test_the_sensor_zero_lent_is_the_most_precise_of_the_actuators_flight(history, result):
@@ -95,3 +107,18 @@ def test_a_setting_that_is_neither_path_nor_address_is_refused_naming_it(tmp_pat
 
 def test_a_history_is_healthy_until_its_storage_goes(history):
     assert history.healthy() == (True, "ok")
+
+
+def test_another_programs_estimates_table_is_refused_naming_the_database_never_altered(setting):
+    import sqlalchemy as sa
+
+    url = setting if "://" in setting else f"sqlite:///{setting}"
+    engine = sa.create_engine(url.replace("postgresql://", "postgresql+psycopg://"))
+    with engine.begin() as connection:
+        connection.exec_driver_sql("CREATE TABLE estimates (id INTEGER PRIMARY KEY, price REAL)")
+    with pytest.raises(StorageError) as refused:
+        open_history(setting)
+    assert "not an ema history" in refused.value.reason
+    with engine.connect() as connection:  # the other program's table is as it was
+        assert {c["name"] for c in sa.inspect(connection).get_columns("estimates")} == {"id", "price"}
+    engine.dispose()

@@ -1,4 +1,5 @@
 import copy
+import time
 
 import pytest
 from fastapi.testclient import TestClient
@@ -13,6 +14,14 @@ from ema.service.main import create_app
 SMALL = PipelineConfig(n_simulations=16, check_windows=8, n_timesteps=50, hidden_units=8)
 KEY = "a-key-of-sixteen-characters"
 LOCAL = "http://127.0.0.1"  # without a key the service answers loopback hosts only
+
+
+def settled(client: TestClient, timeout_s: float = 120.0) -> None:
+    """Wait until the service's keeper has brought every fleet line up to date (none pending)."""
+    deadline = time.monotonic() + timeout_s
+    while any(line["status"] == "pending" for line in client.get("/v1/actuators").json()):
+        assert time.monotonic() < deadline, "the fleet's lines were not brought up to date"
+        time.sleep(0.1)
 
 
 def settings_for(tmp_path, **overrides) -> Settings:
@@ -39,6 +48,3 @@ def settings(tmp_path) -> Settings:
 def client(settings):
     with TestClient(create_app(settings), base_url=LOCAL) as test_client:
         yield test_client
-
-
-from tests.history.conftest import postgres  # noqa: E402,F401  (the replicas' server, started once a session)

@@ -18,7 +18,7 @@ def test_runs_posted_in_order_show_the_friction_rising(tmp_path):
     _, learned, _ = calibrate_linear(runs("normal", 20, range(5)) + runs("normal", 40, range(5)), DOCUMENT)
     assert learned is not None
     ordered = runs("normal", 20, range(5, 10)) + runs("lackLubrication1", 20, range(10))
-    with TestClient(create_app(settings_for(tmp_path, ui_budget_s=60.0)), base_url=LOCAL) as client:
+    with TestClient(create_app(settings_for(tmp_path)), base_url=LOCAL) as client:
         actuator_id = ordered[0].actuator_id
         stored = client.put(f"/v1/actuators/{actuator_id}", json=learned.model_dump(mode="json", by_alias=True))
         assert stored.status_code == 200, stored.text

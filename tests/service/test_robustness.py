@@ -15,7 +15,7 @@ from ema.model.actuator import THESIS
 from ema.model.params import HealthParams
 from ema.model.synthetic import synthetic_window
 from ema.service.main import create_app
-from tests.service.conftest import LOCAL, SMALL, settings_for
+from tests.service.conftest import LOCAL, SMALL, settings_for, settled
 
 
 @pytest.fixture(scope="module")
@@ -38,7 +38,7 @@ def test_times_a_trend_cannot_use_are_refused_at_intake(client, document):
 
 
 def test_one_actuators_failed_prognosis_is_its_own_row_not_the_fleets_500(tmp_path, base):
-    settings = settings_for(tmp_path, ui_budget_s=120.0)
+    settings = settings_for(tmp_path)
     store = open_history(settings.database)
     for i, hours in enumerate([0.0, 1e150, 2e150, 3e150, 4e150]):  # stored past the intake's bounds
         store.add(_copy(base, "broken/elevator", f"w{i}", hours))
@@ -46,6 +46,7 @@ def test_one_actuators_failed_prognosis_is_its_own_row_not_the_fleets_500(tmp_pa
         store.add(_copy(base, "fine/elevator", f"w{i}", 20.0 * i))
     store.close()
     with TestClient(create_app(settings), base_url=LOCAL) as client:
+        settled(client)
         page = client.get("/ui")
         assert page.status_code == 200 and "fine/elevator" in page.text and "prognosis failed" in page.text
         listed = {line["actuator_id"]: line["status"] for line in client.get("/v1/actuators").json()}
@@ -62,6 +63,10 @@ def test_a_stored_window_is_withdrawn_and_the_record_of_it_kept(client, document
     assert client.delete(path).status_code == 404
     history = client.get(f"/v1/actuators/{document['actuator_id']}/estimates").json()
     assert history["estimates"] == [] and [w["window_id"] for w in history["withdrawn"]] == [document["window_id"]]
+    again = client.post("/v1/estimate", json=document)  # a retry, a replay: the window stays withdrawn
+    assert again.status_code == 410 and again.json()["withdrawal"]["reason"] == "logged on the wrong actuator"
+    history = client.get(f"/v1/actuators/{document['actuator_id']}/estimates").json()
+    assert history["estimates"] == [] and len(history["withdrawn"]) == 1
 
 
 @pytest.fixture
@@ -135,6 +140,7 @@ def test_links_carry_the_id_url_encoded(tmp_path, base):
     store.add(_copy(base, "tail-1/elev?x=1#top", "w0", 0.0))
     store.close()
     with TestClient(create_app(settings), base_url=LOCAL) as client:
+        settled(client)
         page = client.get("/ui").text
         assert 'href="/ui/actuators/tail-1/elev%3Fx%3D1%23top"' in page
         assert client.get("/ui/actuators/tail-1/elev%3Fx%3D1%23top").status_code == 200
@@ -148,8 +154,8 @@ def test_a_compressed_body_is_refused_as_such(client, document):
 
 
 def test_the_fleet_page_is_served_from_kept_lines_a_page_at_a_time(tmp_path, base, monkeypatch):
-    """600 actuators of 2 windows: the first load computes every line (cheaply: too few windows for a forecast),
-    the next computes none; the lines are paged. (The probe's timings: ``benchmarks.robustness_probe``.)"""
+    """600 actuators of 2 windows: the keeper computes every line once, in the background, one at a time; a page
+    never computes one; the lines are paged. (The probe's timings: ``benchmarks.robustness_probe``.)"""
     import ema.service.view as view
 
     settings = settings_for(tmp_path)
@@ -164,10 +170,56 @@ def test_the_fleet_page_is_served_from_kept_lines_a_page_at_a_time(tmp_path, bas
         view, "refreshed", lambda store, stale, *rest: computed.append(len(stale)) or original(store, stale, *rest)
     )
     with TestClient(create_app(settings), base_url=LOCAL) as client:
+        settled(client)
         first = client.get("/ui")
         again = client.get("/ui", params={"page": 3})
         tail = client.get("/ui", params={"tail": "tail-7/", "status": "not enough history"})
-    assert computed == [600]
+    assert computed == [1] * 600
     assert first.status_code == again.status_code == 200 and "600 actuator(s)" in first.text
     assert 'class="pending"' not in again.text and "page 3 of 12" in again.text
     assert "4 actuator(s)" in tail.text and "tail-7/ema-3" in tail.text
+
+
+def test_a_route_shaped_actuator_id_is_refused_before_it_can_be_stored(client, document):
+    put = client.put("/v1/actuators/sh/estimates", json=THESIS.model_dump(by_alias=True))
+    assert put.status_code == 422 and put.json()["detail"][0]["loc"] == ["path", "actuator_id"]
+    posted = client.post("/v1/estimate", json={**document, "actuator_id": "sh/prognosis"})
+    assert posted.status_code == 422 and posted.json()["detail"][0]["loc"] == ["body", "actuator_id"]
+
+
+def test_the_keeper_yields_every_line_to_a_job_in_the_queue(tmp_path, base):
+    """The fleet's lines are the keeper's work, done only while no job runs or waits (docs/service.md)."""
+    import threading
+
+    from ema.service.jobs import JobRunner
+    from ema.service.view import LineKeeper, kept_lines
+
+    store = open_history(tmp_path / "h.sqlite3")
+    store.add(_copy(base, "tail-1/elevator", "w0", 0.0))
+    runner = JobRunner(max_queue=1, queue_timeout_s=1.0)
+    runner.admitted = 1  # a job holds its place
+    keeper = LineKeeper(store, runner)
+    keeper.start()
+    try:
+        threading.Event().wait(0.5)
+        assert kept_lines(store)[1] != []  # nothing computed beside the job
+        runner.admitted = 0
+        deadline = threading.Event()
+        for _ in range(100):
+            if not kept_lines(store)[1]:
+                break
+            deadline.wait(0.05)
+        assert kept_lines(store)[1] == []
+    finally:
+        keeper.stop()
+        store.close()
+
+
+def test_a_full_queue_says_what_holds_its_places():
+    from ema.service.jobs import JobRunner, OverloadedError
+
+    runner = JobRunner(max_queue=4, queue_timeout_s=1.0)
+    runner.admitted = 5
+    with pytest.raises(OverloadedError) as full:
+        runner.admit()
+    assert "all 5 places are taken: 0 job(s) running, 5 waiting for a slot or storing an answer" in str(full.value)

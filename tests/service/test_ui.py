@@ -11,7 +11,7 @@ from ema.model.actuator import THESIS
 from ema.model.params import HealthParams
 from ema.model.synthetic import synthetic_window
 from ema.service.main import create_app
-from tests.service.conftest import KEY, LOCAL, SMALL, settings_for
+from tests.service.conftest import KEY, LOCAL, SMALL, settings_for, settled
 from tests.service.fleet import FLEET, store_fleet
 
 
@@ -22,7 +22,7 @@ def base():
 
 @pytest.fixture
 def fleet_settings(tmp_path, base):
-    settings = settings_for(tmp_path, ui_budget_s=300.0)  # every line computed on the first load
+    settings = settings_for(tmp_path)
     store = open_history(settings.database)
     store_fleet(store, base)
     store.close()
@@ -31,6 +31,7 @@ def fleet_settings(tmp_path, base):
 
 def test_the_fleet_page_lists_every_actuator_most_urgent_first(fleet_settings):
     with TestClient(create_app(fleet_settings), base_url=LOCAL) as client:
+        settled(client)
         page = client.get("/ui")
     assert page.status_code == 200 and page.headers["content-type"].startswith("text/html")
     order = sorted(FLEET, key=page.text.index)

@@ -112,8 +112,11 @@ def travel_gain(window: Window, actuator: DriveConstants) -> float | None:
     rate, position = window.sample_rate_hz, np.radians(window.signals["position_deg"])
     travel = np.cumsum(window.signals["motor_speed_radps"]) / rate / actuator.gear_ratio
     y = position - position.mean()
-    widest = max(np.ptp(travel), actuator.backlash_rad)
-    coarse = np.concatenate([[0.0], np.geomspace(0.05 * actuator.backlash_rad, widest, BAND_GRID - 1)]) / 2
+    widest = max(float(np.ptp(travel)), actuator.backlash_rad)
+    if widest <= 0.0:
+        return None  # the motor never turned: no travel to read a gain from
+    narrowest = 0.05 * (actuator.backlash_rad if actuator.backlash_rad > 0 else 0.01 * widest)  # a band new or worn
+    coarse = np.concatenate([[0.0], np.geomspace(narrowest, widest, BAND_GRID - 1)]) / 2
     at = _best_band(travel, y, coarse)[2]
     fine = np.linspace(coarse[max(0, at - 1)], coarse[min(len(coarse) - 1, at + 1)], BAND_GRID)
     explained, gain, _ = _best_band(travel, y, fine)

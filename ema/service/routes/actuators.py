@@ -10,7 +10,7 @@ from starlette.concurrency import run_in_threadpool
 
 from ema.model.actuator import ActuatorDocument
 from ema.prognosis.documents import ActuatorSummary, History, Prognosis, StoredActuator, Withdrawal
-from ema.service.deps import ActuatorId, RunnerDep, SettingsDep, StoreDep, prognosis_now
+from ema.service.deps import ActuatorId, RunnerDep, StoreDep, prognosis_now
 from ema.service.errors import NotStoredError
 from ema.service.parsing import read_body
 from ema.service.schemas import json_body, responses
@@ -20,12 +20,10 @@ router = APIRouter(prefix="/actuators", tags=["actuators"])
 
 
 @router.get("", response_model=list[ActuatorSummary], responses=responses(401, 503))
-async def actuators(
-    request: Request, settings: SettingsDep, store: StoreDep, runner: RunnerDep
-) -> list[ActuatorSummary]:
+async def actuators(store: StoreDep) -> list[ActuatorSummary]:
     """Every actuator with a stored window or document, most urgent first, with its latest status (``/ui``'s
-    lines; those not brought up to date within the budget as they were last computed)."""
-    found = await fleet_lines(store, runner, settings.ui_budget_s, request.is_disconnected)
+    lines; those the service's keeper has not brought up to date yet as they were last computed, pending)."""
+    found = await run_in_threadpool(fleet_lines, store)
     return found.lines
 
 
@@ -51,6 +49,7 @@ async def history(actuator_id: ActuatorId, store: StoreDep) -> History:
 async def withdraw(
     actuator_id: ActuatorId,
     window_id: str,
+    request: Request,
     store: StoreDep,
     reason: Annotated[str, Query(max_length=500, description="why, for the record")] = "none given",
 ) -> Withdrawal:
@@ -59,6 +58,7 @@ async def withdraw(
     found = await run_in_threadpool(store.withdraw, actuator_id, window_id, reason)
     if found is None:
         raise NotStoredError(actuator_id, f"no window {window_id!r} is stored for it")
+    request.app.state.keeper.poke()
     return found
 
 
@@ -86,7 +86,9 @@ async def put_actuator(actuator_id: ActuatorId, request: Request, store: StoreDe
     stored keep the version they were read with). The same document again stores nothing new."""
     document = await read_body(request, runner, ActuatorDocument, lambda d: d)
     await run_in_threadpool(store.probe)
-    return await run_in_threadpool(store.put_actuator, actuator_id, document)
+    stored = await run_in_threadpool(store.put_actuator, actuator_id, document)
+    request.app.state.keeper.poke()
+    return stored
 
 
 @router.get(

@@ -36,7 +36,7 @@ def _window_and_digest(document: WindowDocument) -> tuple[Window, str]:
     "/estimate",
     response_model=Stored,
     response_model_by_alias=True,
-    responses=responses(401, 409, 413, 415, 422, 503),
+    responses=responses(401, 409, 410, 413, 415, 422, 503),
     openapi_extra=json_body(WindowDocument, "one ema-window/1 window"),
 )
 async def estimate(
@@ -53,7 +53,8 @@ async def estimate(
     """Estimate FDJ, η_O, η_A (FSJ where the window shows it) of one window; store and answer.
 
     A window already stored for its (actuator_id, window_id) is answered from the history
-    (``replay: true``) without recomputing; other content under a stored key is another window: 409.
+    (``replay: true``) without recomputing; other content under a stored key is another window: 409; a window an
+    operator withdrew stays withdrawn: 410, naming the withdrawal.
     What the stored windows of the actuator read that this one may not (its ``flight_id``'s sensor
     zero, the actuator's J_M: ``ema.estimate.history``) is read with it, and so is the actuator's latest
     ``ema-actuator/1`` document (the default where it has none; the answer records which).
@@ -81,6 +82,7 @@ async def estimate(
             result = await runner.run(ticket, shared.gone(request.is_disconnected), job)
             stored = await run_in_threadpool(store.add, result)  # committed (fsync) before the answer leaves
             await run_in_threadpool(store.probe)  # the file it went to is still the history: else no 200
+            request.app.state.keeper.poke()  # its actuator's fleet line is out of date
             return stored
 
 

@@ -25,17 +25,15 @@ async def root() -> RedirectResponse:
 
 @router.get("/ui", response_class=HTMLResponse)
 async def fleet(
-    request: Request,
     *,
     settings: SettingsDep,
     store: StoreDep,
-    runner: RunnerDep,
     status: Annotated[StatusFilter | None, Query()] = None,
     tail: Annotated[str | None, Query(max_length=200, description="actuator ids starting with it")] = None,
     page: Annotated[int, Query(ge=1, le=1_000_000)] = 1,
 ) -> HTMLResponse:
     """The actuators most urgent first, ``ui_page_size`` a page, filtered by status and by tail."""
-    found = await fleet_lines(store, runner, settings.ui_budget_s, request.is_disconnected)
+    found = await run_in_threadpool(fleet_lines, store)
     lines = [
         line
         for line in found.lines

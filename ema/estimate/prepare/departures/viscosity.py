@@ -167,10 +167,10 @@ def viscosity_note(viscosity: Viscosity) -> list[Note]:
         return [
             Note(
                 code="viscosity_leaning",
-                text=f"friction follows the speed as a viscous coefficient {viscosity.leaning_factor:.2f} times the "
-                "document's would, and as a current read a few per cent off would (at top speed the speed falls as "
-                "the load grows): the window cannot tell them apart; read with the document's coefficient, the stds "
-                "include what the other reading would change",
+                text="friction follows the speed as a viscous coefficient of "
+                f"{_against(viscosity, viscosity.leaning_nms)} would, and as a current read a few per cent off "
+                "would (at top speed the speed falls as the load grows): the window cannot tell them apart; read "
+                "with the document's coefficient, the stds include what the other reading would change",
             )
         ]
     if not viscosity.change_nms:
@@ -178,13 +178,22 @@ def viscosity_note(viscosity: Viscosity) -> list[Note]:
     return [
         Note(
             code="viscosity",
-            text=f"the viscous coefficient reads {viscosity.factor:.2f} "
-            f"± {viscosity.change_std_nms / viscosity.spec_nms:.2f} "
-            "times the document's (a cold or aged grease): every estimator of this window used it, and the stds "
+            text=f"the viscous coefficient reads {_against(viscosity, viscosity.change_nms, viscosity.change_std_nms)} "
+            "(a cold or aged grease): every estimator of this window used it, and the stds "
             "include "
             "its uncertainty; read with the document's, C·|ω| would have passed for friction",
         )
     ]
+
+
+def _against(viscosity: Viscosity, change_nms: float, std_nms: float | None = None) -> str:
+    """A coefficient the window reads, against the document's: as a factor of it, or where the document's is 0,
+    in N·m·s/rad."""
+    if viscosity.spec_nms > 0:
+        spread = "" if std_nms is None else f" ± {std_nms / viscosity.spec_nms:.2f}"
+        return f"{1.0 + change_nms / viscosity.spec_nms:.2f}{spread} times the document's"
+    spread = "" if std_nms is None else f" ± {std_nms:.3g}"
+    return f"{change_nms:.3g}{spread} N·m·s/rad where the document's is 0"
 
 
 def _leaning_note(viscosity: Viscosity) -> list[Note]:
@@ -193,8 +202,7 @@ def _leaning_note(viscosity: Viscosity) -> list[Note]:
     return [
         Note(
             code="viscosity_leaning",
-            text=f"the viscous coefficient leans to {viscosity.leaning_factor:.2f} times the "
-            f"document's, "
+            text=f"the viscous coefficient leans to {_against(viscosity, viscosity.leaning_nms)}, "
             f"too unclear to read (weight {viscosity.leaning_weight:.2f}); read with the document's, the stds include "
             "what that "
             "coefficient would change",
