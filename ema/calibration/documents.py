@@ -78,6 +78,12 @@ class DriveLearned(Document):
     eta_o: float | None = Field(description="the nominal η_O (null: runs at one load size cannot read it)")
     eta_o_std: float | None
     repeatability_nm: float = Field(description="the run-to-run std of FDJ beyond each run's own noise")
+    run_to_run_nm: float | None = Field(
+        None, description="the sd of one run's FDJ within a set of one load (null: one load size)"
+    )
+    healthy_set_nm: float | None = Field(
+        None, description="how far a healthy set's mean sits off the nominal (null: one load size)"
+    )
     not_separable: list[str] = Field(description="constants these runs cannot tell apart, and how they were read")
 
 
@@ -95,6 +101,7 @@ class Change(Document):
     """A parameter of faulted runs against the calibrated document's nominal."""
 
     parameter: str
+    load_n: float | None = Field(None, description="the load the runs were logged at [N], where read per load")
     nominal: float
     value: float
     std: float = Field(description="of the runs' combined value (their repeatability included)")

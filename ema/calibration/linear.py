@@ -1,7 +1,7 @@
 """Calibration of a linear actuator's drive on its own runs: what the document lacks, learned; what changed, said.
 
 A stepper's drive has no data-sheet current per N·m. At constant speed its current is I = I0 + c·τ, τ the
-motor's torque along the motion (``ema.estimate.quasistatic``), I0 the current at zero torque, which the
+motor's torque along the motion (``ema.estimate.quasistatic.stretches``), I0 the current at zero torque, which the
 drive also draws to hold the motor at rest. At constant speed I0 and c·FDJ are one number: no run tells
 them apart, and the runs' mean current at rest anchors I0 (FDJ is read against it; the report says so).
 Over runs at two loads or more:
@@ -30,7 +30,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ema.estimate.quasistatic import ETA_GRID, Stretch, set_point_motion, stretches
+from ema.estimate.quasistatic.stretches import ETA_GRID, Stretch, set_point_motion, stretches
 from ema.estimate.stats import rms
 from ema.model.actuator import ActuatorDocument
 from ema.model.checks import InputError
@@ -77,6 +77,16 @@ def stroke_profile(window: Window, found: list[Stretch]) -> np.ndarray:
 
 
 @dataclass(frozen=True)
+class HealthySpread:
+    """How healthy runs read with the learned document scatter: what a comparison of windows, or of a set with
+    the nominal, must allow (``ema.estimate.quasistatic.stretches``)."""
+
+    run_to_run_nm: float  # the sd of one run's FDJ within a set (one load, one session), pooled over the sets
+    run_noise_nm: float  # the typical std of one run's own noise (the median over the runs)
+    set_nm: float  # how far a healthy set's mean sits off the nominal: the sets' RMS, never below run_to_run_nm
+
+
+@dataclass(frozen=True)
 class DriveFit:
     """What healthy runs say of the drive and of the actuator new."""
 
@@ -89,9 +99,11 @@ class DriveFit:
     eta_o: float | None
     eta_o_std: float | None
     repeatability_nm: float
+    spread: HealthySpread | None  # None: the runs keep one load size (no nominal to compare with)
     residual_before_a: float  # RMS of the stretches' current about the document's model (I0 alone where it has none)
     residual_after_a: float
     loads_n: list[float]
+    signed_loads_n: list[float]  # each healthy set's load [N], its sign its direction
     profile: np.ndarray  # (2, PROFILE_BINS): the runs' mean current along each stroke (``Run.profile``)
     profile_std: np.ndarray  # its run-to-run std per bin
     stretch_load_nm: np.ndarray  # (S,) each stretch's load torque at the motor, + pushing towards increasing position
@@ -138,6 +150,7 @@ def fit_drive(runs: list[Run], actuator: ActuatorDocument) -> DriveFit:
     eta_std = float(np.ptp(ETA_GRID[chi2 <= chi2_min + birge**2]) / 2) or float(ETA_GRID[1] - ETA_GRID[0])
     per_run = [_run_fdj(run, c, float(ETA_GRID[best]), actuator) for run in runs]
     repeat = _excess_std(np.array([f for f, _ in per_run]), np.array([s for _, s in per_run]))
+    anchored = [_run_fdj(run, c, float(ETA_GRID[best]), actuator, float(rests.mean())) for run in runs]
     return DriveFit(
         current_per_nm_a=float(c),
         current_per_nm_std_a=c_std,
@@ -148,12 +161,14 @@ def fit_drive(runs: list[Run], actuator: ActuatorDocument) -> DriveFit:
         eta_o=float(ETA_GRID[best]) if separable else None,
         eta_o_std=eta_std if separable else None,
         repeatability_nm=repeat,
+        spread=healthy_spread(runs, anchored, float(fdj)) if separable else None,
         residual_before_a=rms(y - _predicted_before(runs, actuator)),
         residual_after_a=rms(y - x @ np.array([c, c_fdj])),
         stretch_load_nm=np.array([s.load_nm for run in runs for s in run.stretches]),
         stretch_residual_before_a=y - _predicted_before(runs, actuator),
         stretch_residual_after_a=y - x @ np.array([c, c_fdj]),
         loads_n=[round(size * actuator.gear_ratio, 3) for size in sizes],
+        signed_loads_n=signed_loads(runs, actuator.gear_ratio),
         profile=np.nanmean([run.profile for run in runs], axis=0),
         profile_std=np.nanstd([run.profile for run in runs], axis=0, ddof=1)
         if len(runs) > 1
@@ -161,12 +176,51 @@ def fit_drive(runs: list[Run], actuator: ActuatorDocument) -> DriveFit:
     )
 
 
-def _run_fdj(run: Run, c: float, eta: float, actuator: ActuatorDocument) -> tuple[float, float]:
-    """One run's FDJ (and its std) at ``c`` and ``eta``: the stretches' mean of (I − I0)/c − g."""
+def _run_fdj(
+    run: Run, c: float, eta: float, actuator: ActuatorDocument, rest_a: float | None = None
+) -> tuple[float, float]:
+    """One run's FDJ (and its std) at ``c`` and ``eta``: the stretches' mean of (I − I0)/c − g, I0 the run's own
+    current at rest, or ``rest_a`` (the document's: as an estimate reads the run)."""
     x, y, w = _design([run], eta, actuator)
+    if rest_a is not None:
+        y = y + run.rest_a - rest_a
     values = y / c - x[:, 0]
     weights = w * c**2
     return float(np.sum(weights * values) / np.sum(weights)), float(1.0 / np.sqrt(np.sum(weights)))
+
+
+def run_load_n(run: Run, gear_ratio: float) -> float:
+    """A run's load [N], its sign its direction (the load holds one size through a run)."""
+    return float(np.median([s.load_nm for s in run.stretches])) * gear_ratio
+
+
+def signed_loads(runs: list[Run], gear_ratio: float) -> list[float]:
+    """The distinct loads the runs were logged at [N], signed."""
+    loads: list[float] = []
+    for load in sorted(run_load_n(run, gear_ratio) for run in runs):
+        if not loads or abs(load - loads[-1]) > 0.1 * max(abs(load), abs(loads[-1])):
+            loads.append(round(load, 3))
+    return loads
+
+
+def healthy_spread(runs: list[Run], per_run: list[tuple[float, float]], nominal_fdj_nm: float) -> HealthySpread:
+    """The runs' FDJ (as an estimate reads each, the document's I0) grouped into sets of one load size: their
+    pooled run-to-run sd, their typical own noise, and the sets' RMS off the nominal. A set logged on another day
+    may sit off the nominal by as much as one run scatters (the drive's current at zero torque drifts from one
+    day to the next), so that spread is never taken below the run-to-run sd."""
+    groups: dict[float, list[float]] = {}
+    for run, (value, _) in zip(runs, per_run, strict=True):
+        size = float(np.median([abs(s.load_nm) for s in run.stretches]))
+        key = next((k for k in groups if abs(k - size) <= 0.1 * max(k, size)), size)
+        groups.setdefault(key, []).append(value)
+    deviations = [np.asarray(v) - np.mean(v) for v in groups.values() if len(v) > 1]
+    dof = sum(len(d) - 1 for d in deviations)
+    run_to_run = (
+        float(np.sqrt(sum(float(d @ d) for d in deviations) / dof)) if dof else float(np.std([v for v, _ in per_run]))
+    )
+    sets = float(np.sqrt(np.mean([(np.mean(v) - nominal_fdj_nm) ** 2 for v in groups.values()])))
+    noise = float(np.median([std for _, std in per_run]))
+    return HealthySpread(run_to_run_nm=run_to_run, run_noise_nm=noise, set_nm=max(sets, run_to_run))
 
 
 def _excess_std(values: np.ndarray, stds: np.ndarray) -> float:

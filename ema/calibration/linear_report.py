@@ -3,7 +3,7 @@
 Learning (the document lacks c or a nominal health; ``ema.calibration.linear.fit_drive``): the report's
 ``drive`` holds what was learned, the residual of the runs' current before (the document's model) and
 after, and a leave-one-run-out check; ``completed`` is the document with it. Comparing (a calibrated
-document): each run read with it (``ema.estimate.low_rate``), FDJ (and η_O where the runs' loads
+document): each run read with it (``ema.estimate.quasistatic.pipeline``), FDJ (and η_O where the runs' loads
 differ) set against the nominal in ``changes``, and the current along the stroke against the healthy
 profile, named ``position_friction`` only beyond ``MIN_Z``.
 """
@@ -18,18 +18,16 @@ import numpy as np
 from ema.calibration.documents import (
     CalibrationReport,
     Candidate,
-    Change,
     DriveLearned,
     HeldOut,
     Learned,
     NoiseFloor,
     Step,
 )
-from ema.calibration.linear import MIN_Z, DriveFit, Run, fit_drive, profile_change, read_run
+from ema.calibration.linear import DriveFit, Run, fit_drive, read_run
+from ema.calibration.linear_changes import baseline, compared
 from ema.calibration.plot import ResidualPlot, Series
-from ema.estimate.config import PipelineConfig
-from ema.estimate.documents import DIMENSIONLESS, ActuatorRead
-from ema.estimate.low_rate import STEPPER_READING, estimate_low_rate
+from ema.estimate.documents import DIMENSIONLESS
 from ema.model.actuator import ActuatorDocument, Nominal
 from ema.model.params import load_factors
 from ema.model.window import Window
@@ -51,7 +49,7 @@ def calibrate_linear(
     if screw.current_per_nm_a is None or actuator.nominal is None:
         fit = fit_drive(runs, actuator)
         return _learned(runs, fit, actuator, started), completed(actuator, fit), _drive_plot(fit)
-    return _compared(windows, runs, actuator, started), None, _stroke_plot(runs, actuator)
+    return compared(windows, runs, actuator), None, _stroke_plot(runs, actuator)
 
 
 def _drive_plot(fit: DriveFit) -> ResidualPlot:
@@ -69,13 +67,13 @@ def _drive_plot(fit: DriveFit) -> ResidualPlot:
 
 def _stroke_plot(runs: list[Run], actuator: ActuatorDocument) -> ResidualPlot:
     """The current along each stroke, less its mean: the healthy runs' (the document's) and these runs'."""
-    baseline, _ = _baseline(actuator)
+    healthy, _ = baseline(actuator)
     mean = np.nanmean([run.profile for run in runs], axis=0)
     bins = mean.shape[1]
     along = ((np.arange(bins) + 0.5) / bins).tolist()
     series = [Series(f"these runs, {way}", along, mean[row].tolist()) for row, way in enumerate(("up", "down"))]
-    if np.isfinite(baseline).all() and baseline.shape == mean.shape:
-        series += [Series(f"healthy, {way}", along, baseline[row].tolist()) for row, way in enumerate(("up", "down"))]
+    if np.isfinite(healthy).all() and healthy.shape == mean.shape:
+        series += [Series(f"healthy, {way}", along, healthy[row].tolist()) for row, way in enumerate(("up", "down"))]
     return ResidualPlot(
         title="calibration: the current along the stroke",
         x_label="share of the stroke",
@@ -105,6 +103,8 @@ def _learned(runs: list[Run], fit: DriveFit, actuator: ActuatorDocument, started
         eta_o=fit.eta_o,
         eta_o_std=fit.eta_o_std,
         repeatability_nm=fit.repeatability_nm,
+        run_to_run_nm=None if fit.spread is None else fit.spread.run_to_run_nm,
+        healthy_set_nm=None if fit.spread is None else fit.spread.set_nm,
         not_separable=unread,
     )
     before = {} if actuator.nominal is None else {"FDJ": actuator.nominal.fdj, "eta_O": actuator.nominal.eta_o}
@@ -137,7 +137,11 @@ def _learned(runs: list[Run], fit: DriveFit, actuator: ActuatorDocument, started
             Learned(name="FDJ", value=fit.fdj_nm, std=fit.fdj_std_nm, unit="N·m"),
             Learned(name="eta_O", value=fit.eta_o, std=fit.eta_o_std, unit=DIMENSIONLESS),
         ]
-    learned.append(Learned(name="repeatability", value=fit.repeatability_nm, std=0.0, unit="N·m"))
+    if fit.spread is not None:
+        learned += [
+            Learned(name="run_to_run", value=fit.spread.run_to_run_nm, std=0.0, unit="N·m"),
+            Learned(name="healthy_set", value=fit.spread.set_nm, std=0.0, unit="N·m"),
+        ]
     return report.model_copy(update={"drive": drive, "learned": learned})
 
 
@@ -152,6 +156,10 @@ def completed(actuator: ActuatorDocument, fit: DriveFit) -> ActuatorDocument:
             "current_at_zero_torque_std_a": fit.current_at_zero_torque_std_a,
             "eta_o_std": fit.eta_o_std,
             "repeatability_nm": fit.repeatability_nm,
+            "run_to_run_nm": None if fit.spread is None else round(fit.spread.run_to_run_nm, 6),
+            "run_noise_nm": None if fit.spread is None else round(fit.spread.run_noise_nm, 6),
+            "healthy_set_nm": None if fit.spread is None else round(fit.spread.set_nm, 6),
+            "calibrated_loads_n": fit.signed_loads_n,
             "stroke_profile_a": np.nan_to_num(fit.profile).round(5).tolist(),
             "stroke_profile_std_a": np.nan_to_num(fit.profile_std).round(5).tolist(),
         }
@@ -190,78 +198,6 @@ def _leave_one_out(runs: list[Run], actuator: ActuatorDocument) -> HeldOut:
         note=f"each run predicted by the drive learned on the other {len(runs) - 1}: the residual of its "
         f"stretches' current {np.sqrt(before / max(len(runs), 1)):.3f} → {np.sqrt(after / len(runs)):.3f} A",
     )
-
-
-def _compared(
-    windows: Sequence[Window], runs: list[Run], actuator: ActuatorDocument, started: float
-) -> CalibrationReport:
-    read_with = ActuatorRead(name=actuator.name)
-    results = [
-        estimate_low_rate(w, PipelineConfig(), reading=STEPPER_READING, actuator=actuator, read_with=read_with)
-        for w in windows
-    ]
-    values = np.array([r.estimates.FDJ.value for r in results])
-    stds = np.array([r.estimates.FDJ.std or np.inf for r in results])
-    weights = 1.0 / stds**2
-    fdj, fdj_std = float(np.sum(weights * values) / np.sum(weights)), float(np.median(stds))
-    nominal = actuator.health
-    z = (fdj - nominal.fdj) / fdj_std
-    said = (
-        f"FDJ rose by {fdj - nominal.fdj:+.3f} N·m ({z:+.1f} stds of one run): a friction rise"
-        if z > 2
-        else f"FDJ moved {fdj - nominal.fdj:+.3f} N·m, {z:+.1f} stds of one run: within what runs of one state show"
-    )
-    changes = [Change(parameter="FDJ", nominal=nominal.fdj, value=fdj, std=fdj_std, z=z, said=said)]
-    baseline = _baseline(actuator)
-    profile_z, departure = profile_change(runs, *baseline)
-    named = profile_z >= MIN_Z
-    candidate = Candidate(
-        effect="position_friction",
-        follows="position_mm",
-        named=True,
-        parameters={f"bin_{i}": float(v) for i, v in enumerate(np.nan_to_num(departure).ravel())},
-        rms_reduction=0.0,
-        held_out_drop=0.0,
-        score=profile_z,
-        plausible=True,
-    )
-    reason = (
-        f"the current along the stroke departs from the healthy runs' by {profile_z:.1f} run-to-run stds: a "
-        "friction that changes along the stroke (a local defect)"
-        if named
-        else f"nothing beyond FDJ stands above the runs' noise along the stroke (z = {profile_z:.1f} < {MIN_Z:g}): a "
-        "local defect such as a spall may well be invisible in a current logged at 25 Hz"
-        if np.isfinite(baseline[1]).any()
-        else "the stroke is not compared: the document holds no healthy profile along it with its run-to-run spread "
-        "(learn the drive again with ema calibrate on healthy runs)"
-    )
-    report = _report(
-        len(runs),
-        0.0,
-        0.0,
-        {"FDJ": nominal.fdj},
-        {"FDJ": fdj},
-        steps=[Step(selected="position_friction" if named else None, reason=reason)],
-        held=HeldOut(rss_before=0.0, rss_after=0.0, adopted=False, note="runs read with the document"),
-        started=started,
-        candidates=[candidate],
-    )
-    return report.model_copy(
-        update={
-            "changes": changes,
-            "selected_effect": "position_friction" if named else None,
-            "selected_effects": ["position_friction"] if named else [],
-        }
-    )
-
-
-def _baseline(actuator: ActuatorDocument) -> tuple[np.ndarray, np.ndarray]:
-    """The healthy runs' profile along the stroke and its run-to-run std; NaN where the document lacks either (one
-    learned before the std was kept: the runs' own scatter alone would take a load's profile for a defect)."""
-    screw = actuator.screw
-    if screw is None or not screw.stroke_profile_a or not screw.stroke_profile_std_a:
-        return np.full((2, 1), np.nan), np.full((2, 1), np.nan)
-    return np.array(screw.stroke_profile_a, dtype=float), np.array(screw.stroke_profile_std_a, dtype=float)
 
 
 def _report(

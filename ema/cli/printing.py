@@ -180,7 +180,11 @@ def _print_drive(drive: dict[str, Any]) -> None:
     if drive["fdj_nm"] is not None:
         click.echo(f"  nominal FDJ             {drive['fdj_nm']:.4f} ± {drive['fdj_std_nm']:.4f} N·m")
         click.echo(f"  nominal η_O             {drive['eta_o']:.3f} ± {drive['eta_o_std']:.3f}")
-    click.echo(f"  repeatability of FDJ    {drive['repeatability_nm']:.4f} N·m beyond each run's own noise")
+    if drive.get("run_to_run_nm") is not None:
+        click.echo(f"  a healthy run's FDJ     scatters by {drive['run_to_run_nm']:.4f} N·m within a set (one load)")
+        click.echo(f"  a healthy set's mean    sits within {drive['healthy_set_nm']:.4f} N·m of the nominal")
+    else:
+        click.echo(f"  repeatability of FDJ    {drive['repeatability_nm']:.4f} N·m beyond each run's own noise")
     for unread in drive["not_separable"]:
         click.echo(f"  not separable: {unread}")
 

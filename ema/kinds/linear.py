@@ -1,6 +1,6 @@
 """The linear kind: a ball screw turned by a stepper, logged by a rig at its own rate.
 
-Its windows are read quasi-statically at any rate (``ema.estimate.low_rate``: the stepper's drive is no
+Its windows are read quasi-statically at any rate (``ema.estimate.quasistatic.pipeline``: the stepper's drive is no
 current loop ema can simulate), its torque from the drive's current as ``ema calibrate`` learned it
 (``ema.calibration.linear``): healthy runs teach the drive, faulted runs are compared with it.
 """
@@ -13,7 +13,8 @@ from dataclasses import dataclass
 from ema.calibration.linear_report import calibrate_linear
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import Estimate
-from ema.estimate.low_rate import QUASI_STATIC, STEPPER_READING, estimate_low_rate
+from ema.estimate.quasistatic.drive import STEPPER_READING
+from ema.estimate.quasistatic.pipeline import QUASI_STATIC, estimate_low_rate
 from ema.kinds.base import Calibrated, CalibrationRequest, Cost, Request
 from ema.model.kinds import KINDS, KindFacts
 from ema.model.window import Window

@@ -1,7 +1,7 @@
 """The rotary kind: the thesis's elevator EMA, a current-piloted motor and a gear train to a surface.
 
 A window at 1 kHz or more goes through the whole pipeline (``ema.estimate.pipeline``), one logged slower is
-read quasi-statically (``ema.estimate.low_rate``); its calibration is the loop of ``ema.calibration.calibrate``,
+read quasi-statically (``ema.estimate.quasistatic``); its calibration is the loop of ``ema.calibration.calibrate``,
 which reads windows at 1 kHz or more.
 """
 
@@ -16,8 +16,9 @@ from ema.calibration.calibrate import Calibrator
 from ema.calibration.plot import ResidualPlot, Series
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import STAGES, Estimate
-from ema.estimate.low_rate import MOTOR_READING, QUASI_STATIC, estimate_low_rate
 from ema.estimate.pipeline import estimate_window
+from ema.estimate.quasistatic.drive import MOTOR_READING
+from ema.estimate.quasistatic.pipeline import QUASI_STATIC, estimate_low_rate
 from ema.kinds.base import Calibrated, CalibrationRequest, Cost, Request
 from ema.model.checks import InputError
 from ema.model.kinds import KINDS, KindFacts

@@ -38,7 +38,28 @@ class Screw(Document):
     )
     eta_o_std: Number | None = Field(None, ge=0, lt=1, description="the std of the nominal η_O as learned")
     repeatability_nm: Number | None = Field(
-        None, ge=0, le=100, description="the run-to-run std of FDJ beyond each run's own noise, as learned"
+        None,
+        ge=0,
+        le=100,
+        description="the run-to-run std of FDJ beyond each run's own noise, over every load as learned (documents "
+        "learned before run_to_run_nm was kept)",
+    )
+    run_to_run_nm: Number | None = Field(
+        None, ge=0, le=100, description="the sd of one healthy run's FDJ within a set of one load, as learned"
+    )
+    run_noise_nm: Number | None = Field(
+        None, ge=0, le=100, description="the typical std of one healthy run's own noise, as learned"
+    )
+    healthy_set_nm: Number | None = Field(
+        None,
+        ge=0,
+        le=100,
+        description="how far a healthy set's mean FDJ sits off the nominal (its loads, its day), as learned",
+    )
+    calibrated_loads_n: list[Annotated[Number, Field(ge=-1e6, le=1e6)]] | None = Field(
+        None,
+        description="the loads [N] the healthy runs were learned at, signed as load_n (beyond them the nominal "
+        "extrapolates)",
     )
     stroke_profile_a: list[list[Number]] | None = Field(
         None, description="the healthy runs' current along each stroke (up, then down; less its mean), binned"

@@ -37,7 +37,7 @@ SIGNALS = KINDS[DEFAULT_KIND].signals  # a rotary window's, the layout a CSV or 
 MIN_SAMPLES = 100
 MAX_SAMPLES = 1_000_000
 # A window may be logged at 10 Hz (a test rig's logger) to 100 kHz; below HIGH_RATE_HZ it is read quasi-statically
-# (``ema.estimate.quasistatic``), at or above it through the whole pipeline.
+# (``ema.estimate.quasistatic.stretches``), at or above it through the whole pipeline.
 WINDOW_RATE_RANGE_HZ = (10.0, 100_000.0)
 HIGH_RATE_HZ = 1_000.0
 # Physical plausibility: beyond these a sample is a sensor fault or a unit error, not a state.

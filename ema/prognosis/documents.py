@@ -232,6 +232,12 @@ class ActuatorSummary(Document):
     stds: dict[str, float | None] = Field(default_factory=dict)
     nominal: dict[str, float] = Field(default_factory=dict)
     thresholds: dict[str, Threshold] = Field(default_factory=dict)
+    thresholds_below: dict[str, Threshold] = Field(
+        default_factory=dict, description="a parameter's lower level where the document gives one beside its upper"
+    )
+    repeatability_stds: dict[str, float | None] = Field(
+        default_factory=dict, description="the latest estimate's repeatability stds, what changes are judged on"
+    )
     reproduced: bool | None = Field(None, description="the model reproduced the latest window")
     document: str = Field(description="the name of the ema-actuator/1 document it is read with")
     document_version: int | None = Field(None, description="its stored version (null: the default document)")

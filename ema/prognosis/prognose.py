@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import datetime as dt
+import math
 from collections.abc import Sequence
 from dataclasses import replace
 
@@ -12,7 +13,7 @@ from ema.estimate.documents import Note
 from ema.estimate.history import combined_inertia, inertia_change_note
 from ema.model.actuator import ActuatorDocument, Airframe
 from ema.prognosis.backtest import backtest
-from ema.prognosis.documents import MIN_SPAN, PARAMETERS, Prognosis, Stored, TimeUnit, Trend
+from ema.prognosis.documents import MIN_SPAN, PARAMETERS, Prognosis, RemainingLife, Stored, TimeUnit, Trend
 from ema.prognosis.outlook import Outlook, outlook
 from ema.prognosis.trend import fit_trend
 
@@ -79,23 +80,34 @@ def prognose(
 def _outlook(
     name: str, stored: Sequence[Stored], times: np.ndarray, actuator: ActuatorDocument, unit: TimeUnit, backtested: bool
 ) -> Outlook | None:
-    """``name``'s outlook over the windows that read it, or None where none did."""
+    """``name``'s outlook over the windows that read it, or None where none did: against the level it crosses first
+    where the document gives two (FDJ above and below), its changes judged on each window's repeatability std."""
     read = [(t, e, s.window_id) for t, s in zip(times, stored, strict=True) if (e := getattr(s.estimates, name))]
     if not read:
         return None
     values = np.array([e.value for _, e, _ in read])
-    stds = np.array([np.nan if e.std is None else e.std for _, e, _ in read])
+    stds = np.array([np.nan if (std := e.repeatability_std or e.std) is None else std for _, e, _ in read])
     times_read, ids = np.array([t for t, _, _ in read]), [i for _, _, i in read]
-    threshold, direction = actuator.threshold(name)
-    seen = outlook(
-        name, times_read, values, stds, ids, threshold=threshold, direction=direction, min_span=MIN_SPAN[unit]
-    )
+    limits = actuator.limits(name)
+    if not limits:
+        return None
+    span = MIN_SPAN[unit]
+    each = {
+        (level, way): outlook(name, times_read, values, stds, ids, threshold=level, direction=way, min_span=span)
+        for level, way in limits
+    }
+    (threshold, direction), seen = min(each.items(), key=lambda item: _urgency(item[1].life))
     if not backtested:
         return seen
     tested = backtest(
         name, times_read, values, stds, ids, threshold=threshold, direction=direction, min_span=MIN_SPAN[unit]
     )
     return replace(seen, backtest=tested)
+
+
+def _urgency(life: RemainingLife) -> tuple[int, float]:
+    """Which of a parameter's levels (above, below) comes first: one crossed, then the soonest predicted."""
+    return (0 if life.status == "already crossed" else 1, life.rul if life.rul is not None else math.inf)
 
 
 def speeding_note(name: str) -> Note:

@@ -97,6 +97,7 @@ def summary(
     status, soonest, reason = status_of(latest, prognosis, actuator, windows)
     names = ("FDJ", "eta_O", "eta_A")
     entries = {} if latest is None else {name: getattr(latest.estimates, name) for name in names}
+    levels = {name: limits for name in names if (limits := actuator.limits(name))}
     return ActuatorSummary(
         actuator_id=actuator_id,
         status=status,
@@ -109,9 +110,11 @@ def summary(
         latest_when=None if latest is None else when(latest),
         estimates={name: None if e is None else e.value for name, e in entries.items()},
         stds={name: None if e is None else e.std for name, e in entries.items()},
+        repeatability_stds={name: None if e is None else e.repeatability_std for name, e in entries.items()},
         nominal={name: e.nominal for name, e in entries.items() if e is not None},
-        thresholds={
-            name: Threshold(level=level, direction=way) for name in names for level, way in [actuator.threshold(name)]
+        thresholds={name: Threshold(level=limits[0][0], direction=limits[0][1]) for name, limits in levels.items()},
+        thresholds_below={
+            name: Threshold(level=level, direction=way) for name, limits in levels.items() for level, way in limits[1:]
         },
         reproduced=None if latest is None else latest.fit_check.reproduced,
         document=actuator.name,

@@ -50,13 +50,13 @@ def _cell(line: ActuatorSummary, name: str) -> str:
     value = line.estimates.get(name)
     if value is None:
         return "—"
-    std = line.stds.get(name)
+    std = line.repeatability_stds.get(name) or line.stds.get(name)  # a change between windows is judged on it
     shown = f"{value:.4g}" + ("" if std is None else f" ± {std:.2g}")
-    threshold = line.thresholds.get(name)
     nominal = line.nominal.get(name)
     limits = [] if nominal is None else [f"nominal {nominal:.3g}"]
-    if threshold is not None:
-        limits.append(f"fails {'>' if threshold.direction == 'above' else '<'} {threshold.level:.3g}")
+    for threshold in (line.thresholds.get(name), line.thresholds_below.get(name)):
+        if threshold is not None:
+            limits.append(f"fails {'>' if threshold.direction == 'above' else '<'} {threshold.level:.3g}")
     return f"{shown} <small>({html.escape(', '.join(limits))})</small>"
 
 

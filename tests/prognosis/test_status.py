@@ -12,7 +12,7 @@ from ema.model.params import HealthParams
 from ema.model.synthetic import synthetic_window
 from ema.prognosis.documents import Stored
 from ema.prognosis.prognose import prognose
-from ema.prognosis.status import status_of
+from ema.prognosis.status import status_of, summary
 from tests.service.conftest import SMALL
 
 
@@ -64,3 +64,19 @@ def test_a_spread_of_flight_hours_earns_a_forecast(base):
     prognosis = prognose("a", stored, THESIS)
     assert prognosis.remaining_life["FDJ"].status == "crossing predicted"
     assert status_of(stored[-1], prognosis, THESIS, len(stored))[0] in ("watch", "due")
+
+
+def test_a_friction_that_falls_past_a_lower_level_is_due_and_both_levels_are_shown(base):
+    """A screw losing its preload: FDJ falling through the document's lower level is a crossing like a rise."""
+    from ema.model.actuator import actuator_from_dict
+
+    document = THESIS.model_dump(by_alias=True)
+    document["thresholds"] = {"fdj_above_nm": 0.075, "fdj_below_nm": 0.035}
+    actuator = actuator_from_dict(document)
+    fdjs = [0.05 - 0.003 * i for i in range(8)]  # 0.050 down to 0.029
+    stored = _history(base, fdjs, flight_hours=[10.0 * i for i in range(8)])
+    prognosis = prognose("a/1", stored, actuator)
+    assert prognosis.remaining_life["FDJ"].threshold == 0.035 and prognosis.remaining_life["FDJ"].direction == "below"
+    line = summary(prognosis, stored[-1], len(stored), actuator, None)
+    assert line.status == "due" and line.thresholds_below["FDJ"].level == 0.035
+    assert line.thresholds["FDJ"].level == 0.075 and line.repeatability_stds["FDJ"] is not None

@@ -48,6 +48,8 @@ NoteCode = Literal[
     "current_per_nm",
     "controller_mismatch",
     "unlogged_force",
+    "fdj_departed",
+    "load_extrapolated",
     "command_saturated",
     # how the answer was reached, and how far to trust it
     "network_absent",
@@ -107,6 +109,9 @@ DIMENSIONLESS = "1"  # η's unit
 
 
 class ParameterEstimate(Document):
+    """One parameter of the window, with its uncertainty: ``std`` the whole of it, ``repeatability_std`` the part
+    a comparison of windows read with one document judges a change on."""
+
     value: float
     std: float | None = Field(description="one standard deviation, in the parameter's unit; null: not assessed")
     nominal: float | None = Field(description="the actuator's value new (null: its document has none yet)")
@@ -115,6 +120,12 @@ class ParameterEstimate(Document):
         None,
         description="the value's unit: N·m for a friction at the motor shaft, N for one on the load (a servo), 1 for "
         "an efficiency (null: stored before units were given)",
+    )
+    repeatability_std: float | None = Field(
+        None,
+        description="the part of std a second window read with the same document would not share (the window's "
+        "own noise and the run-to-run scatter of the state, not the document's constants): what a trend, a status "
+        "and a comparison of windows judge a change on (null: stored before it was given; std then)",
     )
     weakly_determined: bool = Field(
         default=False,
@@ -275,7 +286,24 @@ class Estimate(Document):
 
 
 def parameter(
-    value: float, std: float | None, nominal: float | None, weak: bool = False, *, unit: str | None
+    value: float,
+    std: float | None,
+    nominal: float | None,
+    weak: bool = False,
+    *,
+    unit: str | None,
+    repeatability_std: float | None = None,
 ) -> ParameterEstimate:
+    """One parameter's estimate; its repeatability std is the whole std unless the document's constants share a
+    part of it (a stepper's: ``ema.estimate.quasistatic.stretches``)."""
     drift = None if nominal is None or nominal == 0 else 100.0 * (value - nominal) / nominal
-    return ParameterEstimate(value=value, std=std, nominal=nominal, drift_pct=drift, weakly_determined=weak, unit=unit)
+    repeatable = std if repeatability_std is None else repeatability_std
+    return ParameterEstimate(
+        value=value,
+        std=std,
+        nominal=nominal,
+        drift_pct=drift,
+        weakly_determined=weak,
+        unit=unit,
+        repeatability_std=repeatable,
+    )

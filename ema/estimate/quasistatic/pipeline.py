@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
 
 import numpy as np
 
@@ -28,15 +27,14 @@ from ema.estimate.documents import (
     parameter,
 )
 from ema.estimate.documents.window import WindowInfo
-from ema.estimate.quasistatic import (
+from ema.estimate.quasistatic.departure import DEPARTURE_Z, departure, inside
+from ema.estimate.quasistatic.drive import QuasiStaticReading
+from ema.estimate.quasistatic.stretches import (
     MIN_STRETCH_S,
     QuasiStaticFit,
-    Rest,
     Stretch,
     TorqueReading,
     fit_stretches,
-    logged_motion,
-    set_point_motion,
     stretches,
 )
 from ema.estimate.report import weakly_determined
@@ -53,62 +51,6 @@ SKIPPED = {
     "check": "no simulation of the window at the answer: the stretches' fit to Eq. 5.1 is the check",
 }
 QUASI_STATIC = tuple(stage for stage in STAGES if stage not in SKIPPED)  # the stages a low-rate window runs
-
-
-REST_DEPARTURE = 4.0  # a window's current at rest this many day-to-day spreads off the document's: said
-
-
-def motor_torque(actuator: ActuatorDocument, rest: Rest | None) -> tuple[TorqueReading, Note | None]:
-    """A current-piloted motor's torque: k_T·I, signed."""
-    return TorqueReading(1.0 / actuator.params.torque_constant_nm_per_a, 0.0, 0.0, 0.0, signed=True), None
-
-
-def stepper_torque(actuator: ActuatorDocument, rest: Rest | None) -> tuple[TorqueReading, Note | None]:
-    """A stepper drive's torque along the motion, (I − I0)/c, and a note where the window's current at rest
-    departs from the document's current at zero torque.
-
-    Its current at zero torque is the document's, learned over healthy runs, its std their spread: a window's own
-    reading at rest scatters by more than its noise from one stop to the next (where the motor comes to rest
-    within a step) and tells nothing of its current while it moves, so it only checks the document (a drive
-    whose zero-torque current moved: recalibrate)."""
-    screw = actuator.screw
-    if screw is None or screw.current_per_nm_a is None or screw.current_at_zero_torque_a is None:
-        raise InputError(
-            "actuator.screw.current_per_nm_a",
-            "is not known yet: a stepper's current per N·m and its "
-            "current at zero torque are on no data sheet; run ema calibrate on healthy runs at two loads "
-            "(--out-actuator) and read with that document",
-        )
-    spread = screw.current_at_zero_torque_std_a or 0.0
-    reading = TorqueReading(
-        screw.current_per_nm_a, screw.current_per_nm_std_a or 0.0, screw.current_at_zero_torque_a, spread, signed=False
-    )
-    if rest is None or abs(rest.current_a - screw.current_at_zero_torque_a) <= REST_DEPARTURE * max(spread, 1e-9):
-        return reading, None
-    note = Note(
-        code="current_at_zero_torque",
-        parameter="current_a",
-        text=(
-            f"at rest the drive draws {rest.current_a:.3f} A, {REST_DEPARTURE:g} or more of its day-to-day spreads "
-            f"from the {screw.current_at_zero_torque_a:.3f} ± {spread:.3f} A the document learned: its zero-torque "
-            "current may have moved (another day, another drive setting); FDJ counts it as friction until ema "
-            "calibrate is rerun on healthy runs"
-        ),
-    )
-    return reading, note
-
-
-@dataclass(frozen=True)
-class QuasiStaticReading:
-    """What a kind reads a slow window by: its motion and load (``ema.estimate.quasistatic``), and what its
-    drive's current says of the torque."""
-
-    motion: Callable[[Window, float], tuple[np.ndarray, np.ndarray]]
-    torque: Callable[[ActuatorDocument, Rest | None], tuple[TorqueReading, Note | None]]
-
-
-MOTOR_READING = QuasiStaticReading(motion=logged_motion, torque=motor_torque)  # the logged speed, k_T·I
-STEPPER_READING = QuasiStaticReading(motion=set_point_motion, torque=stepper_torque)  # the set point, (I − I0)/c
 
 
 def estimate_low_rate(
@@ -139,14 +81,18 @@ def estimate_low_rate(
     nominal = actuator.health
     screw = actuator.screw
     eta_std = (screw.eta_o_std if screw is not None else None) or 0.0
-    repeat = (screw.repeatability_nm if screw is not None else None) or 0.0
     fit = fit_stretches(
-        found, torque, actuator.gear_ratio, eta_o_document=(nominal.efficiency, eta_std), repeatability_nm=repeat
+        found,
+        torque,
+        actuator.gear_ratio,
+        eta_o_document=(nominal.efficiency, eta_std),
+        repeatability=reading.spread(actuator),
     )
     seconds["physics"] = time.perf_counter() - started - seconds["prepare"]
     announce("writing the report")
     document = _document(window, actuator, fit, found, torque, digest=digest, read_with=read_with, config=config)
-    notes = [n for n in (rest_note, *_notes(window, actuator, fit, torque)) if n is not None]
+    notes = [n for n in (rest_note, *_notes(window, actuator, fit, torque), *departure_notes(actuator, fit, load))]
+    notes = [n for n in notes if n is not None]
     seconds["report"] = time.perf_counter() - started - seconds["prepare"] - seconds["physics"]
     return document.model_copy(
         update={"notes": [*document.notes, *notes], "timings_s": Timings(**seconds, total=sum(seconds.values()))}
@@ -162,8 +108,11 @@ def _estimates(actuator: ActuatorDocument, fit: QuasiStaticFit) -> Estimates:
     nominal_eta_a = None if nominal.eta_o is None else float(actuator.eta_a(nominal.eta_o))
     eta_a_entry = parameter(eta_a, abs(slope) * fit.eta_o_std, nominal_eta_a, weak_eta, unit=DIMENSIONLESS)
     weak_fdj = weakly_determined("FDJ", fit.fdj_std_nm, ranges)
+    fdj = parameter(
+        fit.fdj_nm, fit.fdj_std_nm, nominal.fdj, weak_fdj, unit=friction, repeatability_std=fit.fdj_repeatability_std_nm
+    )
     return Estimates(
-        FDJ=parameter(fit.fdj_nm, fit.fdj_std_nm, nominal.fdj, weak_fdj, unit=friction),
+        FDJ=fdj,
         eta_O=eta_o if fit.eta_o_read else None,
         eta_A=eta_a_entry if fit.eta_o_read else None,
         FSJ=None,
@@ -223,6 +172,51 @@ def _document(
         ),
         config=config,
     )
+
+
+def departure_notes(actuator: ActuatorDocument, fit: QuasiStaticFit, load_nm: np.ndarray) -> list[Note]:
+    """Where the window's FDJ departs from the nominal beyond what healthy runs allow (``departure``), either way,
+    and where its load (``load_nm`` at the motor) lies outside those the healthy runs were learned at: said."""
+    screw = actuator.screw
+    if screw is None or screw.healthy_set_nm is None:
+        return []
+    load = float(np.mean(load_nm)) * actuator.gear_ratio
+    shared = float(np.sqrt(max(fit.fdj_std_nm**2 - fit.fdj_repeatability_std_nm**2, 0.0)))
+    seen = departure(
+        fit.fdj_nm,
+        actuator.health.fdj,
+        repeatability_std=fit.fdj_repeatability_std_nm,
+        shared_std=shared,
+        healthy_set=screw.healthy_set_nm,
+        extrapolated=not inside(load, screw.calibrated_loads_n),
+    )
+    notes = []
+    if seen.extrapolated:
+        learned = ", ".join(f"{n:.0f}" for n in screw.calibrated_loads_n or [])
+        notes.append(
+            Note(
+                code="load_extrapolated",
+                parameter="FDJ",
+                text=f"the window's load, {load:.0f} N, lies outside those the healthy runs were learned at "
+                f"({learned} N): the nominal is extrapolated here, and a change of FDJ within "
+                f"±{DEPARTURE_Z * seen.allowed:.3f} N·m is not shown",
+            )
+        )
+    if seen.departed:
+        way = FELL if seen.change < 0 else ROSE
+        notes.append(
+            Note(
+                code="fdj_departed",
+                parameter="FDJ",
+                text=f"FDJ reads {seen.change:+.3f} N·m off the nominal, {seen.z:+.1f} times what healthy readings "
+                f"allow: {way}",
+            )
+        )
+    return notes
+
+
+FELL = "friction lost (a ball screw losing its preload: a spalled track, smaller balls)"
+ROSE = "friction gained (grease lost, a seal tightened, a track roughened)"
 
 
 def _notes(window: Window, actuator: ActuatorDocument, fit: QuasiStaticFit, reading: TorqueReading) -> list[Note]:

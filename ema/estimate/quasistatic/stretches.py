@@ -14,11 +14,17 @@ What the current says of τ is the kind's (``TorqueReading``): a current-piloted
 stepper drive's (I − I0)/c, its current at zero torque I0 read at rest in this window (it drifts from
 one day to the next; a window that never rests takes the document's, with its day-to-day spread).
 
-The std is honest about repeatability: each stretch's mean carries its noise (a block estimate: the
-current is correlated over samples), and the document's run-to-run spread (``screw.repeatability_nm``,
-learned by ``ema calibrate``) is added, so the same state logged again lands within ±2 std. The stages that
-need a high rate (the window's own simulations, the network, the check against a 1 µs simulation) are
-skipped, and the estimate says so (``stages``).
+Two stds, for two questions. ``repeatability_std`` is what a second window read with the same document would
+not share: the run-to-run scatter of one state as ``ema calibrate`` measured it on healthy runs
+(``screw.run_to_run_nm``: each run's own noise and the day's drift of the drive's current at zero torque
+within it), widened where this window is noisier than those runs were (its stretches' block-estimated noise
+beyond ``screw.run_noise_nm``). It is what a trend, a status or a comparison of two windows judges a change
+on. ``std`` adds what every window read with the document shares: the learned η_O's std (through the load
+term) and c's (every torque scales with it). A document learned before the run-to-run sd was kept has the
+runs' excess scatter over every load instead (``screw.repeatability_nm``), and its I0 spread is added apart.
+
+The stages that need a high rate (the window's own simulations, the network, the check against a 1 µs
+simulation) are skipped, and the estimate says so (``stages``).
 """
 
 from __future__ import annotations
@@ -117,9 +123,19 @@ class TorqueReading:
 
 
 @dataclass(frozen=True)
+class Repeatability:
+    """What the document says of how one state's runs scatter (``ema.calibration.linear.HealthySpread``)."""
+
+    run_to_run_nm: float | None = None  # the healthy runs' sd within a set (null: not learned)
+    run_noise_nm: float = 0.0  # their typical own noise
+    excess_nm: float = 0.0  # an older document's: the runs' scatter beyond their noise, over every load
+
+
+@dataclass(frozen=True)
 class QuasiStaticFit:
     fdj_nm: float
     fdj_std_nm: float
+    fdj_repeatability_std_nm: float  # what a second window read with the document would not share
     eta_o: float
     eta_o_std: float
     eta_o_read: bool  # False: held at the document's (one load)
@@ -134,7 +150,7 @@ def fit_stretches(
     gear_ratio: float,
     *,
     eta_o_document: tuple[float, float],
-    repeatability_nm: float = 0.0,
+    repeatability: Repeatability = Repeatability(),
 ) -> QuasiStaticFit:
     """FDJ (and η_O where the loads differ enough) from ``found`` stretches: y = τ + s·T_L = FDJ + k·|T_L|."""
     torques = np.array([reading.torque(s) for s in found])
@@ -163,10 +179,19 @@ def fit_stretches(
     slope = float(np.mean(np.where(opposing, 1.0 / eta**2, -_eta_a_slope(eta, gear_ratio)) * size))  # ∂FDJ/∂η_O
     within = float(1.0 / np.sqrt(np.sum(weight)))
     scale = float(np.mean(np.abs(tau))) * _rel(reading)  # every torque scales with c: FDJ's share of it
-    offset = reading.offset_std_a / reading.per_nm_a  # I0's spread moves every torque, so FDJ, alike
-    fdj_std = float(np.sqrt(within**2 + (slope * eta_std) ** 2 + repeatability_nm**2 + scale**2 + offset**2))
+    repeatable, shared = _repeatable_and_shared(within, repeatability, reading)
+    fdj_std = float(np.sqrt(repeatable**2 + (slope * eta_std) ** 2 + scale**2 + shared**2))
     per_nm = _per_nm_read(found, reading, eta, gear_ratio)
-    return QuasiStaticFit(fdj, fdj_std, eta, eta_std, read, chi2_min / dof, *per_nm)
+    return QuasiStaticFit(fdj, fdj_std, repeatable, eta, eta_std, read, chi2_min / dof, *per_nm)
+
+
+def _repeatable_and_shared(within: float, repeatability: Repeatability, reading: TorqueReading) -> tuple[float, float]:
+    """(the repeatability std, what else an older document leaves every window sharing) of FDJ (module docstring)."""
+    if repeatability.run_to_run_nm is not None:
+        noisier = max(within**2 - repeatability.run_noise_nm**2, 0.0)
+        return float(np.sqrt(repeatability.run_to_run_nm**2 + noisier)), 0.0
+    offset = reading.offset_std_a / reading.per_nm_a  # I0's spread moves every torque, so FDJ, alike
+    return float(np.hypot(within, repeatability.excess_nm)), offset
 
 
 def _rel(reading: TorqueReading) -> float:
