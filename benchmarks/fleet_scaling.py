@@ -1,18 +1,19 @@
-"""ema fleet's throughput against Ray workers, start-up apart from steady state, beside the warm service's.
+"""ema fleet end to end, as a user waits for it, with 1 worker and with every core (2 here), beside the service.
 
-An archive of 80 windows from 8 actuators (0.5 s, 10 kHz, realistic noise) goes through
-``ema.cli.fleet.run_fleet`` with 1 worker and with every core (2 here), each on a fresh local Ray:
+An archive of 80 windows from 8 actuators (0.5 s, 10 kHz, realistic noise) is written as files, and the
+``ema fleet`` command runs on it as a user types it (a fresh process, ``--json``), with 1 worker (in this
+process) and with local worker processes, alternately, ``--repeats`` times each:
 
-- **end to end**: the archive's windows per second with Ray's start-up included, as ``ema fleet`` pays it;
-- **steady state**: the same archive again on the Ray already up and warm, in windows per core-second
-  (windows per second over the cores the workers hold): the cost that matters over a large archive;
+- **end to end**: the command's wall time, from its start to its exit, and the speed-up over 1 worker;
+- **how it splits**: start-up (to the first answer: reading the archive, starting and warming the workers),
+  windows, and the rate of the windows phase per worker (the cost that matters over a large archive);
 - beside them, in the same run, a warm ``ema serve`` answering the same windows one after another, in
   windows per CPU-second of the service process (``/proc``), its every thread counted.
 
 The projection: 100 aircraft x 2 elevator EMAs x a window every 20 s over 10 flight hours = 360 000 windows a
 day. Figures are compared within one run (this machine's speed drifts ~2x from day to day).
 
-    python -m benchmarks.fleet_scaling [--windows 80] [--docs]
+    python -m benchmarks.fleet_scaling [--windows 80] [--repeats 3] [--docs]
 """
 
 from __future__ import annotations
@@ -20,6 +21,9 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import statistics
+import subprocess
+import sys
 import tempfile
 import time
 from pathlib import Path
@@ -28,9 +32,7 @@ import httpx
 
 from benchmarks.real_time import cpu_seconds
 from benchmarks.service_overhead import free_port, serve
-from ema.cli.fleet import run_fleet
 from ema.cli.report import write_section
-from ema.estimate.config import PipelineConfig
 from ema.model.params import HealthParams
 from ema.model.runtime import available_cores
 from ema.model.synthetic import synthetic_window
@@ -49,20 +51,34 @@ def archive(n: int, tag: str = "") -> list[Window]:
     ]
 
 
-def timed(windows: list[Window], workers: int, folder: Path) -> tuple[float, float]:
-    """(windows per second with Ray's start-up included, windows per core-second at steady state)."""
-    import ray
+def written(windows: list[Window], folder: Path) -> Path:
+    """The archive as a folder of ema-window/1 files, as an export would leave it."""
+    archive_folder = folder / "archive"
+    archive_folder.mkdir()
+    for window in windows:
+        (archive_folder / f"{window.window_id}.json").write_text(json.dumps(window_to_dict(window)))
+    return archive_folder
 
-    config = PipelineConfig()
+
+def timed(archive_folder: Path, workers: int, out: Path) -> tuple[float, dict[str, float]]:
+    """(the command's wall time in s, its phases) for ``ema fleet`` with ``workers`` workers, a fresh output."""
+    out.unlink(missing_ok=True)
+    command = [
+        sys.executable,
+        "-m",
+        "ema.cli.main",
+        "fleet",
+        str(archive_folder),
+        "--out",
+        str(out),
+        "--workers",
+        str(workers),
+        "--json",
+    ]
     started = time.perf_counter()
-    run_fleet(windows, folder / f"first-{workers}.csv", config=config, workers=workers, address=None, threads=1)
-    end_to_end = len(windows) / (time.perf_counter() - started)
-    again = [w.__class__(**{**w.__dict__, "window_id": f"{w.window_id}-again"}) for w in windows]
-    started = time.perf_counter()
-    run_fleet(again, folder / f"again-{workers}.csv", config=config, workers=workers, address=None, threads=1)
-    steady = len(windows) / (time.perf_counter() - started) / workers
-    ray.shutdown()
-    return end_to_end, steady
+    finished = subprocess.run(command, capture_output=True, text=True, check=True)
+    wall = time.perf_counter() - started
+    return wall, json.loads(finished.stdout)["phases_s"]
 
 
 def service_per_cpu_second(windows: list[Window], folder: Path) -> float:
@@ -86,41 +102,62 @@ def service_per_cpu_second(windows: list[Window], folder: Path) -> float:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--windows", type=int, default=80)
+    parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--docs", action="store_true")
     args = parser.parse_args()
     windows = archive(args.windows)
     cores = available_cores()
+    counts = sorted({1, 2, cores})
+    runs: dict[int, list[tuple[float, dict[str, float]]]] = {w: [] for w in counts}
     with tempfile.TemporaryDirectory() as folder:
-        rows = {workers: timed(windows, workers, Path(folder)) for workers in sorted({1, 2, cores})}
+        archive_folder = written(windows, Path(folder))
+        for _ in range(args.repeats):  # alternately: a drift of the machine's speed reaches every count alike
+            for workers in counts:
+                runs[workers].append(timed(archive_folder, workers, Path(folder) / "results.csv"))
         service = service_per_cpu_second(windows, Path(folder))
-    one = rows[1][0]
-    lines = [
-        f"| {w} | {end:.2f} | {end / one:.2f}x | {steady:.2f} | {steady * w:.2f} |" for w, (end, steady) in rows.items()
-    ]
-    best = max(steady for _, steady in rows.values())
-    body = "\n".join(
+    body = report(runs, service, n_windows=args.windows, cores=cores)
+    print(body)
+    if args.docs:
+        write_section("Fleet throughput (ema fleet, end to end)", "python -m benchmarks.fleet_scaling --docs", body)
+
+
+def report(runs: dict[int, list[tuple[float, dict[str, float]]]], service: float, *, n_windows: int, cores: int) -> str:
+    """The table: per worker count, the median wall time and phases over the repeats, the speed-up over 1."""
+    median = {w: statistics.median(wall for wall, _ in r) for w, r in runs.items()}
+    lines = []
+    for workers, r in runs.items():
+        start_up = statistics.median(p["start-up"] for _, p in r)
+        phase = statistics.median(p["windows"] for _, p in r)
+        spread = f"{min(wall for wall, _ in r):.1f}-{max(wall for wall, _ in r):.1f}"
+        lines.append(
+            f"| {workers} | {median[workers]:.1f} ({spread}) | {median[1] / median[workers]:.2f}x | {start_up:.1f} "
+            f"| {phase:.1f} | {n_windows / phase / workers:.2f} |"
+        )
+    best = max(n_windows / statistics.median(p["windows"] for _, p in r) / w for w, r in runs.items())
+    return "\n".join(
         [
-            f"{args.windows} windows from {ACTUATORS} actuators (0.5 s at 10 kHz, realistic noise), default pipeline "
-            f"sizes, on {cores} cores; each worker is one core (a task reserves and pins one thread); a fresh local "
-            "Ray per row. *End to end* includes Ray's start-up, as `ema fleet` pays it; *steady state* is the same "
-            "archive again on the Ray already up.",
+            f"{n_windows} windows from {ACTUATORS} actuators (0.5 s at 10 kHz, realistic noise, one JSON file each), "
+            f"default pipeline sizes, on {cores} cores: `ema fleet ARCHIVE --out X.csv --workers N --json` run as "
+            f"a user runs it, {len(next(iter(runs.values())))} times per worker count, alternately; medians, the "
+            "wall's range in brackets. One worker runs in the command's process; more are local processes, each "
+            "a core (a task pins one thread).",
             "",
-            "| workers | end to end, windows/s | vs 1 worker | steady state, windows per core-second "
-            "| steady, windows/s |",
-            "|---:|---:|---:|---:|---:|",
+            "| workers | wall, s | vs 1 worker | start-up, s | windows, s | windows per worker-second |",
+            "|---:|---:|---:|---:|---:|---:|",
             *lines,
             "",
             f"The warm service, same windows, same run: **{service:.2f} windows per CPU-second** of its process "
-            f"(every thread counted), against the fleet's {best:.2f} windows per core-second.",
+            f"(every thread counted), against the fleet's {best:.2f} windows per worker-second.",
             "",
             f"Projection: a fleet-day of {FLEET_DAY:,} windows (100 aircraft x 2 EMAs x a window every 20 s over 10 "
-            f"flight hours) needs {FLEET_DAY / 86_400:.1f} windows/s: at {best:.2f} windows per core-second, "
-            f"**{math.ceil(FLEET_DAY / 86_400 / best)} cores** working around the clock.",
+            f"flight hours) needs {FLEET_DAY / 86_400:.1f} windows/s: at {best:.2f} windows per worker-second, "
+            f"**{_cores(math.ceil(FLEET_DAY / 86_400 / best))}** working around the clock.",
         ]
     )
-    print(body)
-    if args.docs:
-        write_section("Fleet throughput (Ray)", "python -m benchmarks.fleet_scaling --docs", body)
+
+
+def _cores(count: int) -> str:
+    return f"{count} core" if count == 1 else f"{count} cores"
 
 
 if __name__ == "__main__":

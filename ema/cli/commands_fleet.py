@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import sys
+import time
 from pathlib import Path
 
 import click
@@ -31,7 +32,7 @@ ARCHIVE = click.Path(exists=True, path_type=Path)
     type=click.Path(dir_okay=False, path_type=Path),
     help="results CSV, one row per window (a rerun resumes from it)",
 )
-@click.option("--workers", type=click.IntRange(1, 4096), default=2, help="Ray workers (windows at a time)")
+@click.option("--workers", type=click.IntRange(1, 4096), default=2, help="worker processes (windows at a time)")
 @click.option("--threads", type=click.IntRange(1, 256), default=1, help="threads (CPUs) each worker reserves")
 @click.option("--ray-address", default=None, help="'auto' or HOST:PORT of a cluster [default: a local Ray]")
 @click.option(
@@ -46,6 +47,7 @@ ARCHIVE = click.Path(exists=True, path_type=Path)
     callback=database_setting,
     help="also store every answer in this history: an SQLite file or a postgresql:// address (the service's)",
 )
+@click.option("--verbose", is_flag=True, help="also print how the wall time splits: start-up, windows, writing")
 @actuator
 @log_map
 @sizes
@@ -61,25 +63,35 @@ def fleet(
     database: str | None,
     actuator_file: Path | None,
     log_map_file: Path | None,
+    verbose: bool,
     as_json: bool,
     **size_values: int,
 ) -> None:
-    """Reprocess an archive (folder, NPZ, CSV or JSON logs) on Ray workers; one CSV row per window.
+    """Reprocess an archive (folder, NPZ, CSV, MATLAB or JSON logs) on worker processes; one CSV row per window.
 
-    Each window is read with its actuator's document: the archive folder's actuators.json maps actuator_ids to
-    ema-actuator/1 documents; the others take --actuator (the thesis's where none is given). Without Ray
-    (``pip install 'ema[fleet]'``) one worker runs in this process. Exit status 2 when no window was
-    answered; a folder's unreadable files are skipped and listed."""
+    Workers are local processes (warmed while the archive is read), one in this process with --workers 1, or a
+    Ray cluster's with --ray-address (``pip install 'ema[fleet]'``). Each window is read with its actuator's
+    document: the archive folder's actuators.json maps actuator_ids to ema-actuator/1 documents; the others
+    take --actuator (the thesis's where none is given). Exit status 2 when no window was answered; a folder's
+    unreadable files are skipped and listed."""
     from ema.cli.commands_remote import report_log
-    from ema.cli.fleet import Documents, check_engine, run_fleet
+    from ema.cli.fleet import check_engine, run_fleet
     from ema.cli.logs import read_actuators, read_log
+    from ema.cli.workers import Documents, LocalWorkers
     from ema.model.actuator import read_actuator
 
-    config = pipeline_config(size_values)
+    started = time.perf_counter()
     check_engine(workers, ray_address)
-    documents = Documents(read_actuators(archive), None if actuator_file is None else read_actuator(actuator_file))
-    mapping = log_map_document(log_map_file)
-    read = read_log(archive, window_s or (None if mapping else DEFAULT_WINDOW_S), log_map=mapping)
+    pool = LocalWorkers(workers, threads) if workers > 1 and ray_address is None else None  # warming meanwhile
+    try:
+        config = pipeline_config(size_values)
+        documents = Documents(read_actuators(archive), None if actuator_file is None else read_actuator(actuator_file))
+        mapping = log_map_document(log_map_file)
+        read = read_log(archive, window_s or (None if mapping else DEFAULT_WINDOW_S), log_map=mapping)
+    except BaseException:
+        if pool is not None:
+            pool.close()
+        raise
     report_log(read)
     print(f"ema fleet: {len(read.windows)} window(s) from {archive}, {workers} worker(s)", file=sys.stderr)
     run = run_fleet(
@@ -91,11 +103,23 @@ def fleet(
         threads=threads,
         database=database,
         documents=documents,
+        pool=pool,
+        started=started,
     )
     result = {**run, "bad_files": read.bad_files}
-    emit(result, as_json, _print_fleet)
+    emit(result, as_json, _print_fleet_verbose if verbose else _print_fleet)
     if result["answered"] + result["skipped"] == 0 and result["refused"]:
         raise NothingAnsweredError(f"none of the {result['refused']} window(s) was answered (see {out})")
+
+
+def _print_fleet_verbose(result: dict) -> None:
+    _print_fleet(result)
+    phases = result["phases_s"]
+    click.echo(
+        f"time: start-up {phases['start-up']:.1f} s (reading the archive, starting the workers, the first window), "
+        f"windows {phases['windows']:.1f} s, of which writing rows {phases['writing']:.1f} s; total "
+        f"{result['seconds']:.1f} s"
+    )
 
 
 def _print_fleet(result: dict) -> None:
@@ -114,7 +138,12 @@ def _print_fleet(result: dict) -> None:
     default=None,
     help="also write the figures as bench.json in this folder  [default: print them, write nothing]",
 )
-@click.option("--repeats", type=click.IntRange(1, 1000), default=10, help="windows per duration")
+@click.option(
+    "--repeats",
+    type=click.IntRange(1, 1000),
+    default=45,
+    help="windows per duration (the verdict on a p95 needs 45 or more to say 'met')",
+)
 @click.option("--durations", default="0.5,2", help="window durations [s], comma-separated")
 @click.option(
     "--under-load",

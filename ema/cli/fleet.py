@@ -1,16 +1,14 @@
-"""``ema fleet``: an archive of windows through the pipeline on Ray workers, streamed into a results CSV.
+"""``ema fleet``: an archive of windows through the pipeline on workers (``ema.cli.workers``), streamed into a
+results CSV.
 
-Ray schedules (no home-made scheduler): each window is a task that reserves and pins its own
-thread budget (one thread by default: a worker is a core, so throughput grows with workers),
-results are written as they complete (``ray.wait``), the CSV is
-the checkpoint (a rerun skips what it holds, so a crash never duplicates a window), and the same
-rows can go into a service's SQLite history (idempotent as well). Without Ray and with one
-worker the archive is processed in this process, one window after another. A window that lacks
-what other windows of its actuator read (its flight's sensor zero, where it moved one way or read its
+Results are written as they complete, the CSV is the checkpoint (a rerun skips what it holds, so a crash never
+duplicates a window), and the same rows can go into a service's history (idempotent as well). A window that
+lacks what other windows of its actuator read (its flight's sensor zero, where it moved one way or read its
 own less precisely; J_M, where it could not tell a heavier rotor from a weaker motor) is answered again
 at the end with what they read (``ema.estimate.history``), as the service answers it from its history. A
 window of a named flight is written once its flight's windows are answered (a recording's pieces come
-together), one that could not tell J_M at the end of the run.
+together), one that could not tell J_M at the end of the run. The answer says how the wall time split:
+start-up (from the command's start to the first answer), windows, and of those, writing rows.
 """
 
 from __future__ import annotations
@@ -24,11 +22,9 @@ from pathlib import Path
 from typing import Any
 
 from ema.cli.results import ResultsWriter, done_windows, row_of
+from ema.cli.workers import Answer, Documents, Job, LocalWorkers, in_process, on_ray
 from ema.estimate.config import PipelineConfig
-from ema.model.window import Window, window_to_dict
-
-IN_FLIGHT_PER_WORKER = 2  # tasks queued per worker: enough to keep it busy, few enough to stop quickly
-NODE_LOSSES = 3  # a window whose task died with its node this often (past Ray's retries) fails the run
+from ema.model.window import Window
 
 
 @dataclass
@@ -37,6 +33,7 @@ class Progress:
     done: int = 0
     refused: int = 0
     started: float = 0.0
+    first_at: float | None = None  # when the first answer came
 
     def tick(self, row: dict[str, Any]) -> None:
         self.done += 1
@@ -48,74 +45,6 @@ class Progress:
             f"{rate:.2f} windows/s, {(self.total - self.done) / rate:.0f} s left",
             file=sys.stderr,
         )
-
-
-Job = tuple[Window, dict[str, Any] | None]  # a window and what other windows of its actuator read (HistoryReadings)
-Answer = tuple[Window, dict]  # a window and its ema-estimate/1 document (or {"error": ...})
-
-
-@dataclass(frozen=True)
-class Documents:
-    """The actuators' ema-actuator/1 documents a run reads its windows with (by actuator_id; the rest with
-    ``default``, the thesis's where none is given), and the versions a history stored them under."""
-
-    by_actuator: dict[str, Any] = field(default_factory=dict)  # actuator_id -> ema.model.actuator.ActuatorDocument
-    default: Any = None  # an Actuator, or None: the thesis's (the answer then says so)
-    versions: dict[str, int] = field(default_factory=dict)
-
-    def task_arguments(self, window: Window) -> tuple[dict[str, Any] | None, int | None]:
-        """(the document as JSON, its version) for ``window``'s task (None: the default,
-        ``ema.model.actuator.THESIS``)."""
-        document = self.by_actuator.get(window.actuator_id, self.default)
-        if document is None:
-            return None, None
-        return document.model_dump(mode="json", by_alias=True), self.versions.get(window.actuator_id)
-
-
-def _in_process(jobs: list[Job], config: PipelineConfig, threads: int, documents: Documents) -> Iterator[Answer]:
-    from ema.kinds.remote import estimate_document
-
-    for window, history in jobs:
-        actuator, version = documents.task_arguments(window)
-        yield (
-            window,
-            estimate_document(window_to_dict(window), config.model_dump(), threads, history, actuator, version),
-        )
-
-
-def _on_ray(
-    jobs: list[Job], config: PipelineConfig, workers: int, threads: int, address: str | None, documents: Documents
-) -> Iterator[Answer]:
-    """Each job's answer as Ray returns it. A task lost with its node (past Ray's own retries) is submitted
-    again, up to ``NODE_LOSSES`` times: a node that dies mid-run loses no window, and each is answered once."""
-    import ray
-
-    from ema.kinds.remote import connect, ray_task
-
-    connect(address, workers * threads)
-    task = ray_task(threads)
-    pending: dict[Any, Job] = {}
-    losses: dict[str, int] = {}
-    queue = list(reversed(jobs))
-    while queue or pending:
-        while queue and len(pending) < IN_FLIGHT_PER_WORKER * workers:
-            window, history = job = queue.pop()
-            actuator, version = documents.task_arguments(window)
-            reference = task.remote(window_to_dict(window), config.model_dump(), threads, history, actuator, version)
-            pending[reference] = job
-        ready, _ = ray.wait(list(pending), num_returns=1)
-        for reference in ready:
-            job = pending.pop(reference)
-            try:
-                answer = ray.get(reference)
-            except (ray.exceptions.WorkerCrashedError, ray.exceptions.NodeDiedError, ray.exceptions.ObjectLostError):
-                key = job[0].window_id
-                losses[key] = losses.get(key, 0) + 1
-                if losses[key] > NODE_LOSSES:
-                    raise
-                queue.append(job)
-                continue
-            yield job[0], answer
 
 
 @dataclass
@@ -198,54 +127,83 @@ def run_fleet(
     address: str | None,
     threads: int = 1,
     database: str | Path | None = None,
-    documents: Documents = Documents(),
+    documents: Documents | None = None,
+    pool: LocalWorkers | None = None,
+    started: float | None = None,
 ) -> dict[str, Any]:
-    """Every window of ``windows`` not yet in ``out``, on ``workers`` Ray workers of ``threads`` threads each
-    (in-process with one worker and no Ray), each read with its actuator's document; with a ``database``, the
-    documents go into that history first, and the answers record the versions they got there."""
+    """Every window of ``windows`` not yet in ``out``, on ``workers`` workers of ``threads`` threads each (a Ray
+    cluster's with an ``address``, else a local pool: ``pool`` where one was started already, in this process with
+    one worker), each read with its actuator's document; with a ``database``, the documents go into that history
+    first, and the answers record the versions they got there. ``started``: when the command began (the phases
+    the answer gives count from it)."""
+    began = time.perf_counter() if started is None else started
+    documents = Documents() if documents is None else documents
     done = done_windows(out)
     todo = [w for w in windows if (w.actuator_id, w.window_id) not in done]
     progress = Progress(len(todo), started=time.perf_counter())
-    in_process = workers == 1 and address is None and not ray_installed()
+    engine_name = "ray" if address is not None else "in-process" if workers == 1 else "local processes"
+    if engine_name == "local processes" and pool is None:
+        pool = LocalWorkers(workers, threads)
     store = _store(database)
     if store is not None:
         documents = _stored_documents(store, documents, {w.actuator_id for w in todo})
 
     def engine(jobs: list[Job]) -> Iterator[Answer]:
-        if in_process:
-            return _in_process(jobs, config, threads, documents)
-        return _on_ray(jobs, config, workers, threads, address, documents)
+        if pool is not None:
+            return pool.answers(jobs, config, documents)
+        if address is None:
+            return in_process(jobs, config, threads, documents)
+        return on_ray(jobs, config, workers, threads, address, documents)
 
-    results = _with_history(todo, engine([(w, None) for w in todo]), engine)
-    with ResultsWriter(out) as writer:
-        for window, answer in results:
-            row = row_of(window.actuator_id, window.window_id, answer)
-            if store is not None and "error" not in answer:
-                row = _stored(store, row, answer)
-            writer.write(row)
-            progress.tick(row)
-    seconds = time.perf_counter() - progress.started
+    try:
+        writing = _written(_with_history(todo, engine([(w, None) for w in todo]), engine), out, store, progress)
+    finally:
+        if pool is not None:
+            pool.close()
+    ended = time.perf_counter()
     return {
         "csv": str(out),
         "skipped": len(done & {(w.actuator_id, w.window_id) for w in windows}),
         "answered": progress.done - progress.refused,
         "refused": progress.refused,
-        "seconds": seconds,
-        "windows_per_s": progress.done / seconds if seconds > 0 else 0.0,
+        "seconds": ended - began,
+        "windows_per_s": progress.done / (ended - began) if ended > began else 0.0,
         "workers": workers,
-        "engine": "in-process" if in_process else "ray",
+        "engine": engine_name,
+        "phases_s": {
+            "start-up": (progress.first_at or ended) - began,
+            "windows": ended - (progress.first_at or ended),
+            "writing": writing,
+        },
     }
 
 
+def _written(results: Iterator[Answer], out: Path, store: Any, progress: Progress) -> float:
+    """Each answer into the CSV (and the history) as it comes; the seconds spent writing."""
+    writing = 0.0
+    with ResultsWriter(out) as writer:
+        for window, answer in results:
+            if progress.first_at is None:
+                progress.first_at = time.perf_counter()
+            begun = time.perf_counter()
+            row = row_of(window.actuator_id, window.window_id, answer)
+            if store is not None and "error" not in answer:
+                row = _stored(store, row, answer)
+            writer.write(row)
+            writing += time.perf_counter() - begun
+            progress.tick(row)
+    return writing
+
+
 def check_engine(workers: int, address: str | None) -> None:
-    """InputError naming the flag where it asks for Ray and Ray is not installed (before any file is written)."""
-    if ray_installed() or (workers == 1 and address is None):
+    """InputError naming the flag where it asks for a Ray cluster and Ray is not installed (before any file is
+    written): local workers need nothing beyond the standard library."""
+    if address is None or ray_installed():
         return
     from ema.model.checks import InputError
 
-    flag = "--ray-address" if address is not None else "--workers"
     raise InputError(
-        flag, "needs Ray, an optional extra: pip install 'ema[fleet]' (or run one worker in this process: --workers 1)"
+        "--ray-address", "needs Ray, an optional extra: pip install 'ema[fleet]' (or run on local workers: --workers N)"
     )
 
 

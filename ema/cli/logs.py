@@ -55,7 +55,7 @@ def cut(window: Window, window_s: float) -> tuple[list[Window], int]:
 
 
 def _from_json(path: Path) -> list[Window]:
-    document = json.loads(path.read_text())
+    document = load_json(path)
     documents = document if isinstance(document, list) else [document]
     return [window_from_dict(d) for d in documents]
 

@@ -5,6 +5,11 @@ The simulator runs its groups on ``threads`` threads of its own (``ema.model.run
 shared computer a team whose member the OS has parked stalls at every barrier (training went
 from 0.7 s to 19 s beside another CPU-bound job). So torch gets one intra-op and one inter-op
 thread, and the budget goes to the simulator.
+
+torch's optimizers mark a few of their methods "never compile" through a wrapper that imports torch's compiler
+(``torch._dynamo``: a second of imports, paid by every process at its first optimizer) on its first call. ema never
+compiles, so the set-up hands each wrapper the plain method as its already-disabled form: the same call, without
+the import.
 """
 
 from __future__ import annotations
@@ -36,8 +41,22 @@ def configure(threads: int | None = None) -> int:
     import torch
 
     count = sim_runtime.configure(budget(threads))
+    _without_compiler_import()
     if torch.get_num_threads() != 1:
         torch.set_num_threads(1)
     with contextlib.suppress(RuntimeError):  # set once already: torch allows it only before any parallel work
         torch.set_num_interop_threads(1)
     return count
+
+
+COMPILER_GUARDED = ("add_param_group", "zero_grad", "state_dict", "load_state_dict")  # torch.optim.Optimizer's
+
+
+def _without_compiler_import() -> None:
+    """Each guarded optimizer method's cached "disabled" form set to the method itself (module docstring)."""
+    from torch.optim.optimizer import Optimizer
+
+    for name in COMPILER_GUARDED:
+        plain = getattr(getattr(Optimizer, name), "__wrapped__", None)
+        if plain is not None and getattr(plain, "__dynamo_disable", None) is None:
+            setattr(plain, "__dynamo_disable", plain)

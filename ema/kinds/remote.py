@@ -1,4 +1,5 @@
-"""One window as a self-contained task: what a Ray worker (or any other process) runs.
+"""One window as a self-contained task: what a worker process runs (a local pool's or a Ray cluster's), and how a
+process is warmed before its first.
 
 The task carries the window as its ``ema-window/1`` JSON and the config as a dict, pins its own
 thread budget (``ema.estimate.runtime``) before it computes, and returns the ``ema-estimate/1``
@@ -9,15 +10,19 @@ only when asked for: it is an optional extra (``pip install -e '.[fleet]'``).
 
 from __future__ import annotations
 
+import gc
 from typing import Any
 
 from ema.estimate import runtime
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import Estimate
 from ema.estimate.documents.window import HistoryReadings
+from ema.estimate.pipeline import estimate_window
 from ema.kinds import estimate
 from ema.model.actuator import THESIS, ActuatorDocument, actuator_from_dict
 from ema.model.checks import InputError
+from ema.model.params import HealthParams
+from ema.model.synthetic import synthetic_window
 from ema.model.window import Window, window_from_dict, window_to_dict
 
 
@@ -42,6 +47,24 @@ def estimate_document(
     except InputError as exc:
         return {"error": {"field": exc.field, "message": exc.message}}
     return result.model_dump(mode="json", by_alias=True)
+
+
+WARM_UP = PipelineConfig(n_simulations=16, check_windows=8, n_timesteps=20, hidden_units=4)
+
+
+def warm_up() -> None:
+    """A tiny pipeline run: simulation kernels, residual, network and the physics fit all exercised once (loaded
+    from the cache or compiled), so that the first window a process answers costs what any other does."""
+    estimate_window(synthetic_window(HealthParams.single(), seed=0, duration_s=0.05), WARM_UP, actuator=THESIS)
+
+
+def warm(threads: int) -> None:
+    """A worker process made ready before its first window: its thread budget pinned, its kernels loaded, and what
+    it loaded (torch's modules, the kernels: it lives as long as the process) never walked by the cyclic collector
+    again, at a window's collections or at the process's end."""
+    runtime.configure(threads)
+    warm_up()
+    gc.freeze()
 
 
 def ray_task(threads: int) -> Any:

@@ -51,6 +51,7 @@ class Ticket:
 
     def __exit__(self, *_: object) -> None:
         self.runner.admitted -= 1
+        self.runner.last_busy = time.monotonic()
 
 
 class Shared:
@@ -114,12 +115,17 @@ class JobRunner:
         self._slot = asyncio.Semaphore(slots)
         self.admitted = 0  # running + waiting
         self.running = 0
+        self.last_busy = -math.inf  # time.monotonic() when the last request gave its place back
         self.sharing = Sharing()  # on the event loop only
         self._mean_job_s = 1.0  # until measured
 
     @property
     def queued(self) -> int:
         return self.admitted - self.running
+
+    def quiet_for(self) -> float:
+        """Seconds since the last request ended, with none running or waiting (0 while one does)."""
+        return 0.0 if self.admitted else time.monotonic() - self.last_busy
 
     def retry_after_s(self) -> int:
         return max(1, math.ceil(self._mean_job_s * max(self.admitted, 1) / self.slots))

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import asyncio
+import gc
 import logging
 import threading
 from collections.abc import AsyncIterator
@@ -15,6 +16,7 @@ from fastapi_offline import FastAPIOffline
 
 from ema.estimate import runtime
 from ema.history.open import open_history
+from ema.kinds.remote import warm_up
 from ema.model import runtime as sim_runtime
 from ema.model.actuator import ActuatorDocument
 from ema.model.window import WindowDocument
@@ -26,7 +28,6 @@ from ema.service.jobs import JobRunner
 from ema.service.routes import actuators, calibrate, estimate, health, ui
 from ema.service.schemas import CalibrateIn
 from ema.service.view import LineKeeper
-from ema.service.warmup import warm_up
 
 log = logging.getLogger("ema.service")
 
@@ -75,6 +76,7 @@ def create_app(settings: Settings) -> FastAPI:
             connect(settings.ray_address, threads)
         if settings.warm_up:
             await asyncio.get_running_loop().run_in_executor(app.state.runner._executor, warm_up)
+            gc.freeze()  # what the warm-up loaded lives as long as the service: no full collection walks it again
             log.info("kernels warm")
         app.state.warm.set()
         app.state.keeper.start()

@@ -7,8 +7,11 @@ after its actuator stored a window or a document, and a replica reads what anoth
 only reads the kept lines (those out of date shown as they were, or as pending): it never computes, so
 people looking at the fleet take nothing from the estimates. The ``LineKeeper`` brings lines up to date
 on a thread of its own, woken when a window or a document is stored (and every ``KEEPER_PERIOD_S``, for
-what another replica or ``ema fleet`` stored), one actuator at a time, and only while no job runs or waits
-in the queue. An actuator with fewer windows than a forecast needs gets its line without one.
+what another replica or ``ema fleet`` stored), one actuator at a time, and only once no job has run or waited
+for ``KEEPER_QUIET_S``: a client posting windows one after another finds the cores as the last post left
+them, not shared with a line of the window just stored. Under a stream without such a pause, one line is
+brought up to date every ``KEEPER_MAX_WAIT_S``, so that the view is never further behind. An actuator with
+fewer windows than a forecast needs gets its line without one.
 """
 
 from __future__ import annotations
@@ -28,7 +31,9 @@ from ema.service.jobs import JobRunner
 
 log = logging.getLogger("ema.service")
 KEEPER_PERIOD_S = 5.0  # the keeper looks for lines out of date at least this often
-IDLE_POLL_S = 0.05  # how often a keeper that yielded looks whether the queue is empty again
+KEEPER_QUIET_S = 0.5  # a line waits until no job has run or waited for this long
+KEEPER_MAX_WAIT_S = 30.0  # ... or until it has waited this long for such a pause
+IDLE_POLL_S = 0.05  # how often a keeper that yielded looks whether the service is quiet again
 
 
 @dataclass(frozen=True)
@@ -134,8 +139,11 @@ class LineKeeper:
 
     def _pass(self) -> None:
         for item in kept_lines(self.store)[1]:
-            while self.runner.admitted and not self._stop.is_set():
-                time.sleep(IDLE_POLL_S)  # a job runs or waits: it has the cores
+            waiting_since = time.monotonic()
+            while not self._stop.is_set() and self.runner.quiet_for() < KEEPER_QUIET_S:
+                if time.monotonic() - waiting_since >= KEEPER_MAX_WAIT_S:
+                    break  # a stream without a pause: this line now, beside it
+                time.sleep(IDLE_POLL_S)  # jobs run or ran a moment ago: they have the cores
             if self._stop.is_set():
                 return
             refreshed(self.store, [item], self._stop)

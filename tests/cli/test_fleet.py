@@ -35,23 +35,23 @@ def _rows(path):
         return list(csv.DictReader(handle))
 
 
-@pytest.mark.slow
-def test_a_local_ray_run_answers_every_window_once_and_resumes(archive, tmp_path, capsys):
+def test_local_workers_answer_every_window_once_resume_and_say_where_the_time_went(archive, tmp_path, capsys):
     out, database = tmp_path / "results.csv", tmp_path / "history.sqlite3"
     arguments = ["fleet", str(archive), "--out", str(out), "--workers", "2", "--database", str(database), *SIZES]
     assert main([*arguments, "--json"]) == EXIT_OK
     summary = json.loads(capsys.readouterr().out)
-    assert summary["engine"] == "ray" and summary["answered"] == 6 and summary["refused"] == 1
+    assert summary["engine"] == "local processes" and summary["answered"] == 6 and summary["refused"] == 1
+    phases = summary["phases_s"]
+    assert phases["start-up"] > 0 and phases["windows"] >= phases["writing"] >= 0
+    assert abs(phases["start-up"] + phases["windows"] - summary["seconds"]) < 1e-6
     rows = _rows(out)
     assert len(rows) == 7 and len({(r["actuator_id"], r["window_id"]) for r in rows}) == 7
-    assert main([*arguments, "--json"]) == EXIT_OK  # rerun: nothing twice
-    assert json.loads(capsys.readouterr().out)["skipped"] == 7 and len(_rows(out)) == 7
+    assert main([*arguments, "--verbose"]) == EXIT_OK  # rerun: nothing twice
+    printed = capsys.readouterr().out
+    assert "7 already in" in printed and "time: start-up" in printed and len(_rows(out)) == 7
 
 
-def test_one_worker_without_ray_runs_in_process_and_skips_a_bad_file(archive, tmp_path, capsys, monkeypatch):
-    from ema.cli import fleet
-
-    monkeypatch.setattr(fleet, "ray_installed", lambda: False)
+def test_one_worker_runs_in_process_and_skips_a_bad_file(archive, tmp_path, capsys):
     (archive / "5-broken.json").write_text("{not json")
     out = tmp_path / "results.csv"
     assert main(["fleet", str(archive), "--out", str(out), "--workers", "1", "--json", *SIZES]) == EXIT_OK
@@ -62,26 +62,60 @@ def test_one_worker_without_ray_runs_in_process_and_skips_a_bad_file(archive, tm
     assert "[7/7]" in captured.err and "windows/s" in captured.err  # progress: done, rate, time left
 
 
-def test_more_workers_without_ray_say_how_to_install_it_and_write_nothing(archive, tmp_path, capsys, monkeypatch):
+def test_a_cluster_without_ray_says_how_to_install_it_and_writes_nothing(archive, tmp_path, capsys, monkeypatch):
     from ema.cli import fleet
 
     monkeypatch.setattr(fleet, "ray_installed", lambda: False)
     out = tmp_path / "results.csv"
-    assert main(["fleet", str(archive), "--out", str(out), "--workers", "2"]) == EXIT_BAD_INPUT
-    assert "--workers" in (err := capsys.readouterr().err) and "pip install 'ema[fleet]'" in err
+    assert main(["fleet", str(archive), "--out", str(out), "--ray-address", "auto"]) == EXIT_BAD_INPUT
+    assert "--ray-address" in (err := capsys.readouterr().err) and "pip install 'ema[fleet]'" in err
     assert not out.exists()
 
 
-def test_windows_wanting_what_others_read_are_answered_with_it(tmp_path, capsys, monkeypatch):
+@pytest.mark.slow
+def test_a_local_worker_killed_mid_run_loses_no_window_and_duplicates_none(tmp_path):
+    """Two local worker processes; one is killed once two windows are answered: its windows go to a new pool."""
+    import os
+    import signal
+    import threading
+    import time
+
+    from ema.cli.fleet import run_fleet
+    from ema.cli.workers import LocalWorkers
+    from ema.estimate.config import PipelineConfig
+
+    windows = [
+        synthetic_window(HealthParams.single(), seed=i, duration_s=0.1, actuator_id=f"tail-{i % 2}", window_id=f"w{i}")
+        for i in range(12)
+    ]
+    out, pool = tmp_path / "results.csv", LocalWorkers(2, 1)
+    killed_at: list[int] = []
+
+    def kill_when_two_answered() -> None:
+        while not out.exists() or len(_rows(out)) < 2:
+            time.sleep(0.02)
+        killed_at.append(len(_rows(out)))
+        os.kill(next(iter(pool.pool._processes)), signal.SIGKILL)
+
+    killer = threading.Thread(target=kill_when_two_answered, daemon=True)
+    killer.start()
+    small = PipelineConfig(n_simulations=16, check_windows=8, n_timesteps=50, hidden_units=8)
+    summary = run_fleet(windows, out, config=small, workers=2, address=None, pool=pool)
+    killer.join(timeout=5)
+    assert killed_at and killed_at[0] < len(windows)  # the worker died with windows still to answer
+    rows = _rows(out)
+    assert sorted(r["window_id"] for r in rows) == sorted(w.window_id for w in windows)  # each once
+    assert summary["answered"] == len(windows)
+
+
+def test_windows_wanting_what_others_read_are_answered_with_it(tmp_path, capsys):
     """Their files first in the archive: a 0.1 s gust moving one way (current 0.2 A off) waits for the cruise
     window of its flight (a window of another flight does not take that zero), and so does one moving both ways
     that reads the zero less precisely (0.10 A alone), as the service answers it; a doublet that cannot tell
     J_M 1.08x from a weaker motor waits for the thesis window of its actuator."""
-    from ema.cli import fleet
     from ema.history.open import open_history
     from tests.foreign.windows import Effects, draw, of_the_same_flight
 
-    monkeypatch.setattr(fleet, "ray_installed", lambda: False)
     folder, database = tmp_path / "archive", tmp_path / "history.sqlite3"
     folder.mkdir()
     one_way = draw(318, "gust", duration_s=0.1, effects=Effects(current_bias_a=0.2))
@@ -171,15 +205,13 @@ def test_a_flights_windows_are_given_out_once_the_flight_is_answered_not_at_the_
     ]
 
 
-def test_an_archive_carries_its_actuators_documents(tmp_path, capsys, monkeypatch):
+def test_an_archive_carries_its_actuators_documents(tmp_path, capsys):
     """actuators.json maps an actuator to its document: its windows are read with it (and the history stores
     it, versioned); an actuator it does not list is read with the default, and said so."""
-    from ema.cli import fleet
     from ema.history.open import open_history
     from tests.foreign.actuators import DRIVES, NOMINAL, document
     from tests.foreign.windows import Ground, draw
 
-    monkeypatch.setattr(fleet, "ray_installed", lambda: False)
     folder, database = tmp_path / "archive", tmp_path / "history.sqlite3"
     folder.mkdir()
     bench = draw(31, "sweep", drive=DRIVES["smaller"], nominal=NOMINAL["smaller"], flight=Ground(-100.0, 500.0))

@@ -1,0 +1,156 @@
+"""Where a window's task runs in ``ema fleet``: the engines, each yielding (window, answer) as answers come.
+
+- ``in_process``: one window after another in this process (one worker);
+- ``LocalWorkers``: a pool of local processes (the standard library's executor), started before the archive is
+  read; each process warms itself meanwhile (its thread budget pinned, its kernels loaded:
+  ``ema.kinds.remote.warm``), and the driver, which only reads and writes, never loads torch or the kernels;
+- ``on_ray``: a Ray cluster's workers (``--ray-address``).
+
+Each window is a task that pins its own thread budget (one thread by default: a worker is a core, so throughput
+grows with workers). A task lost with its process or node is submitted again, ``NODE_LOSSES`` times at most: no
+window is lost and none is answered twice.
+"""
+
+from __future__ import annotations
+
+import multiprocessing
+from collections import Counter
+from collections.abc import Iterator
+from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
+from concurrent.futures.process import BrokenProcessPool
+from dataclasses import dataclass, field
+from typing import Any
+
+from ema.estimate.config import PipelineConfig
+from ema.model.window import Window, window_to_dict
+
+IN_FLIGHT_PER_WORKER = 2  # tasks queued per worker: enough to keep it busy, few enough to stop quickly
+NODE_LOSSES = 3  # a window whose task died with its node this often (past Ray's retries) fails the run
+
+
+Job = tuple[Window, dict[str, Any] | None]  # a window and what other windows of its actuator read (HistoryReadings)
+Answer = tuple[Window, dict]  # a window and its ema-estimate/1 document (or {"error": ...})
+
+
+@dataclass(frozen=True)
+class Documents:
+    """The actuators' ema-actuator/1 documents a run reads its windows with (by actuator_id; the rest with
+    ``default``, the thesis's where none is given), and the versions a history stored them under."""
+
+    by_actuator: dict[str, Any] = field(default_factory=dict)  # actuator_id -> ema.model.actuator.ActuatorDocument
+    default: Any = None  # an Actuator, or None: the thesis's (the answer then says so)
+    versions: dict[str, int] = field(default_factory=dict)
+
+    def task_arguments(self, window: Window) -> tuple[dict[str, Any] | None, int | None]:
+        """(the document as JSON, its version) for ``window``'s task (None: the default,
+        ``ema.model.actuator.THESIS``)."""
+        document = self.by_actuator.get(window.actuator_id, self.default)
+        if document is None:
+            return None, None
+        return document.model_dump(mode="json", by_alias=True), self.versions.get(window.actuator_id)
+
+
+class LocalWorkers:
+    """A pool of local worker processes, each warmed as it starts (module docstring); start it before the archive
+    is read. A process lost mid-run (killed) loses no window: its jobs go to a new pool, ``NODE_LOSSES`` times
+    at most."""
+
+    def __init__(self, workers: int, threads: int) -> None:
+        self.workers, self.threads = workers, threads
+        self.pool = self._started()
+
+    def _started(self) -> ProcessPoolExecutor:
+        context = multiprocessing.get_context("spawn")  # never a fork of a process that may hold threads
+        pool = ProcessPoolExecutor(self.workers, mp_context=context, initializer=_warmed, initargs=(self.threads,))
+        for _ in range(self.workers):
+            pool.submit(int)  # a process per worker, warming now
+        return pool
+
+    def answers(self, jobs: list[Job], config: PipelineConfig, documents: Documents) -> Iterator[Answer]:
+        queue, pending, losses = list(reversed(jobs)), dict[Future, Job](), Counter[str]()
+        while queue or pending:
+            while queue and len(pending) < IN_FLIGHT_PER_WORKER * self.workers:
+                window, history = job = queue.pop()
+                actuator, version = documents.task_arguments(window)
+                arguments = (window_to_dict(window), config.model_dump(), self.threads, history, actuator, version)
+                pending[self.pool.submit(_answered, *arguments)] = job
+            done, _ = wait(pending, return_when=FIRST_COMPLETED)
+            for future in done:
+                job = pending.pop(future)
+                try:
+                    yield job[0], future.result()
+                except BrokenProcessPool:
+                    losses[job[0].window_id] += 1
+                    if losses[job[0].window_id] > NODE_LOSSES:
+                        raise
+                    queue.append(job)
+            if not pending and queue and self.pool._broken:  # a process died: the rest go to a new pool
+                self.pool = self._started()
+
+    def close(self) -> None:
+        self.pool.shutdown(wait=True, cancel_futures=True)
+
+
+def _warmed(threads: int) -> None:
+    """A local worker's initializer, ``ema.kinds.remote.warm``, imported in the worker: the driver that only reads
+    and writes never loads torch or the kernels (a second of a core the workers need at start-up)."""
+    import sys
+    import time
+
+    print("child up", time.time(), file=sys.stderr)
+    from ema.kinds.remote import warm
+
+    warm(threads)
+
+
+def _answered(*arguments: Any) -> dict[str, Any]:
+    """``ema.kinds.remote.estimate_document`` on a local worker, imported there (``_warmed``)."""
+    from ema.kinds.remote import estimate_document
+
+    return estimate_document(*arguments)
+
+
+def in_process(jobs: list[Job], config: PipelineConfig, threads: int, documents: Documents) -> Iterator[Answer]:
+    from ema.kinds.remote import estimate_document
+
+    for window, history in jobs:
+        actuator, version = documents.task_arguments(window)
+        yield (
+            window,
+            estimate_document(window_to_dict(window), config.model_dump(), threads, history, actuator, version),
+        )
+
+
+def on_ray(
+    jobs: list[Job], config: PipelineConfig, workers: int, threads: int, address: str | None, documents: Documents
+) -> Iterator[Answer]:
+    """Each job's answer as Ray returns it. A task lost with its node (past Ray's own retries) is submitted
+    again, up to ``NODE_LOSSES`` times: a node that dies mid-run loses no window, and each is answered once."""
+    import ray
+
+    from ema.kinds.remote import connect, ray_task
+
+    connect(address, workers * threads)
+    task = ray_task(threads)
+    pending: dict[Any, Job] = {}
+    losses: dict[str, int] = {}
+    queue = list(reversed(jobs))
+    while queue or pending:
+        while queue and len(pending) < IN_FLIGHT_PER_WORKER * workers:
+            window, history = job = queue.pop()
+            actuator, version = documents.task_arguments(window)
+            reference = task.remote(window_to_dict(window), config.model_dump(), threads, history, actuator, version)
+            pending[reference] = job
+        ready, _ = ray.wait(list(pending), num_returns=1)
+        for reference in ready:
+            job = pending.pop(reference)
+            try:
+                answer = ray.get(reference)
+            except (ray.exceptions.WorkerCrashedError, ray.exceptions.NodeDiedError, ray.exceptions.ObjectLostError):
+                key = job[0].window_id
+                losses[key] = losses.get(key, 0) + 1
+                if losses[key] > NODE_LOSSES:
+                    raise
+                queue.append(job)
+                continue
+            yield job[0], answer
