@@ -16,7 +16,7 @@ from benchmarks.foreign_accuracy import RESULTS_MD, run_one
 from benchmarks.foreign_groups import group_seed, groups
 from benchmarks.tails import BOUND
 from ema.cli.report import write_section
-from ema.model import runtime
+from ema.estimate import runtime
 from tests.foreign.careless import SLIPS, Slip, exported
 from tests.foreign.windows import Draw
 

@@ -24,10 +24,10 @@ from benchmarks.accuracy_by_wear import wear_figure, wear_table
 from benchmarks.foreign_groups import group_seed, groups
 from benchmarks.tails import BOUND, FIRST_NOISE_SEED, expected_over
 from ema.cli.report import write_section
+from ema.estimate import runtime
 from ema.estimate.documents.window import HistoryReadings
 from ema.estimate.pipeline import estimate_window
 from ema.estimate.report import WEAK_SHARE_OF_RANGE, share_of_range
-from ema.model import runtime
 from ema.model.actuator import THESIS
 from ema.model.checks import InputError
 from ema.model.window import window_from_dict

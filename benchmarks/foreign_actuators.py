@@ -21,8 +21,8 @@ from typing import Any
 import numpy as np
 
 from ema.cli.report import write_section
+from ema.estimate import runtime
 from ema.estimate.pipeline import estimate_window
-from ema.model import runtime
 from ema.model.actuator import THESIS, actuator_from_dict
 from ema.model.checks import InputError
 from ema.model.window import window_from_dict

@@ -22,10 +22,10 @@ import numpy as np
 from benchmarks.tails import BOUND
 from benchmarks.wearing_fleet import KINDS_OF_WEAR, Thresholds, Wear, flights, logged_window, wear
 from ema.cli.report import write_section
+from ema.estimate import runtime
 from ema.estimate.history import readings_of
 from ema.estimate.pipeline import estimate_window
 from ema.estimate.report import share_of_range
-from ema.model import runtime
 from ema.model.actuator import THESIS
 from ema.model.checks import InputError
 from ema.model.window import window_from_dict

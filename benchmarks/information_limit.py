@@ -37,11 +37,11 @@ from benchmarks.foreign_accuracy import RESULTS_MD
 from benchmarks.foreign_groups import group_seed, groups
 from benchmarks.tails import expected_over
 from ema.cli.report import write_section
+from ema.estimate import runtime
 from ema.estimate.physics.features import as_read
 from ema.estimate.physics.friction import FitSettings, fit_friction, regressors
 from ema.estimate.prepare.conditioning import prepare
 from ema.estimate.report import healthy_range
-from ema.model import runtime
 from ema.model.actuator import THESIS
 from ema.model.hinge import HINGE_SMOOTHING_S, local_line
 from ema.model.params import DriveConstants, eta_a_from_eta_o

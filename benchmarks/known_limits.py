@@ -14,9 +14,9 @@ from typing import Any
 from benchmarks.foreign_accuracy import RESULTS_MD, run_one, summarize, table
 from benchmarks.foreign_groups import FAMILIES, drive_off, off_zero, viscous
 from ema.cli.report import write_section
+from ema.estimate import runtime
 from ema.estimate.history import readings_of
 from ema.estimate.pipeline import estimate_window
-from ema.model import runtime
 from ema.model.actuator import THESIS
 from ema.model.window import window_from_dict
 from tests.foreign.windows import Draw, Effects, draw, filter_widths, of_the_same_flight, through_filters

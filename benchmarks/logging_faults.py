@@ -15,8 +15,8 @@ from typing import Any
 from benchmarks.foreign_accuracy import RESULTS_MD, run_one, summarize, table
 from benchmarks.foreign_groups import group_seed, groups
 from ema.cli.report import write_section
+from ema.estimate import runtime
 from ema.estimate.prepare.stale import stale_runs
-from ema.model import runtime
 from ema.model.actuator import THESIS
 from ema.model.window import window_from_dict
 from tests.foreign.faults import FAULTS, with_fault

@@ -16,9 +16,9 @@ import numpy as np
 
 from ema.cli.printing import check_line
 from ema.cli.report import write_section
+from ema.estimate import runtime
 from ema.estimate.assess.weighing import MISFIT_FALSE_ALARM
 from ema.estimate.pipeline import estimate_window
-from ema.model import runtime
 from ema.model.actuator import THESIS
 from ema.model.window import window_from_dict
 from tests.foreign.windows import draw

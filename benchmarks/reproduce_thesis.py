@@ -21,12 +21,12 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from ema.cli.report import write_section
-from ema.estimate.learn.network import TrainConfig, fit, predict
+from ema.estimate import runtime
+from ema.estimate.learn.network import LearnConfig, fit, predict
 from ema.estimate.physics.features import features
 from ema.estimate.physics.friction import fit_window
 from ema.estimate.physics.scenario import Scenario
 from ema.estimate.simulate.design import Box
-from ema.model import runtime
 from ema.model.aircraft import FlightCondition, GroundLoad
 from ema.model.commands import random_command_knots
 from ema.model.noise import NO_NOISE, SensorNoise, add_sensor_noise
@@ -49,7 +49,7 @@ class Case:
     noise: SensorNoise = NO_NOISE
     inputs: str = "residual_torque"
     per_sim_command: bool = False
-    train: TrainConfig = TrainConfig()
+    train: LearnConfig = LearnConfig()
 
 
 def cases(quick: bool) -> list[Case]:
@@ -69,7 +69,7 @@ def cases(quick: bool) -> list[Case]:
             100,
             "(thesis architecture on noisy data)",
             noise=SensorNoise(),
-            train=TrainConfig(components=None),
+            train=LearnConfig(components=None),
         ),
         Case(
             "1B noisy, Adam",
@@ -78,7 +78,7 @@ def cases(quick: bool) -> list[Case]:
             100,
             "(optimizer comparison)",
             noise=SensorNoise(),
-            train=TrainConfig(optimizer="adam", learning_rate=3e-3),
+            train=LearnConfig(optimizer="adam", learning_rate=3e-3),
         ),
         Case(
             "1A constant load",
@@ -249,7 +249,7 @@ def main() -> None:
     args = parser.parse_args()
     runtime.configure()
     rng = np.random.default_rng(0)  # warm torch and the kernels: no start-up cost in the first row's times
-    fit(rng.normal(size=(60, 50)), rng.uniform(size=(60, 2)), TrainConfig(hidden=8, max_epochs=5))
+    fit(rng.normal(size=(60, 50)), rng.uniform(size=(60, 2)), LearnConfig(hidden=8, max_epochs=5))
     Scenario(random_command_knots(50, RATE_HZ, rng)[0]).simulate(HealthParams.single())
     results = []
     for index, case in enumerate(cases(args.quick)):

@@ -48,7 +48,7 @@ PARTS = (  # (stage, "module:function" as the stage calls it, what the step does
     ("simulate", "ema.estimate.simulate.dataset:as_read", "the simulations read as the window is"),
     ("simulate", "ema.estimate.simulate.dataset:residual_torque_nm", "T_R of the simulations and the window"),
     ("simulate", "ema.estimate.simulate.dataset:sliding_features", "the network's inputs"),
-    ("learn", "ema.estimate.pipeline:train_network", "the network trained"),
+    ("learn", "ema.estimate.pipeline:learned", "the network trained"),
     ("assess", "ema.estimate.pipeline:fit_friction", "Eq. 5.1 on the held-out simulations"),
     ("assess", "ema.estimate.learn.estimator:NetworkEstimator.predict_unit", "the network on them and the window"),
     ("assess", "ema.estimate.pipeline:assess", "the estimators weighed and blended"),

@@ -16,7 +16,7 @@ import time
 import numpy as np
 
 from ema.cli.report import write_section
-from ema.model import runtime
+from ema.estimate import runtime
 from ema.model.actuator import THESIS
 from ema.model.aircraft import FlightCondition, load_model
 from ema.model.batch import default_lanes, kernel_constants, simulate_batch

@@ -19,10 +19,10 @@ import numpy as np
 
 from benchmarks.foreign_groups import group_seed, groups
 from ema.cli.report import write_section
+from ema.estimate import runtime
 from ema.estimate.config import PipelineConfig
 from ema.estimate.pipeline import estimate_window
 from ema.estimate.report import share_of_range
-from ema.model import runtime
 from ema.model.actuator import THESIS
 from ema.model.checks import InputError
 from ema.model.window import window_from_dict

@@ -38,12 +38,12 @@ from benchmarks.foreign_groups import group_seed, groups
 from benchmarks.information_limit import GROUPS, SENSORS, noise_levels
 from benchmarks.tails import expected_over
 from ema.cli.report import write_section
+from ema.estimate import runtime
 from ema.estimate.physics.features import as_read
 from ema.estimate.physics.friction import fit_friction
 from ema.estimate.physics.scenario import scenario_from_window
 from ema.estimate.prepare.conditioning import prepare
 from ema.estimate.report import healthy_range
-from ema.model import runtime
 from ema.model.actuator import THESIS
 from ema.model.params import HealthParams
 from ema.model.window import Window, window_from_dict

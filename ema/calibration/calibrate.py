@@ -45,6 +45,7 @@ from ema.estimate.pipeline import estimate_window
 from ema.estimate.prepare.conditioning import prepare
 from ema.estimate.report import healthy_range
 from ema.model.actuator import ActuatorDocument
+from ema.model.bounds import DEFAULT_SAMPLE_RATE_HZ
 from ema.model.checks import InputError
 from ema.model.noise import SensorNoise
 from ema.model.params import HealthRanges
@@ -135,7 +136,9 @@ class Calibrator:
         # what departs is named, not taken off
         prepared = [prepare(w, self.actuator, spec_only=True).window for w in windows]
         if len({w.sample_rate_hz for w in prepared}) > 1:
-            raise InputError("windows", "must share one sample rate (after averaging to at most 10 kHz)")
+            raise InputError(
+                "windows", f"must share one sample rate (after averaging to at most {DEFAULT_SAMPLE_RATE_HZ:g} Hz)"
+            )
         return prepared
 
     def fit(

@@ -31,7 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ema.estimate.quasistatic.stretches import ETA_GRID, Stretch, set_point_motion, stretches
-from ema.estimate.stats import rms
+from ema.estimate.stats import rms, weighted_least_squares
 from ema.model.actuator import ActuatorDocument
 from ema.model.checks import InputError
 from ema.model.params import load_factors
@@ -126,16 +126,9 @@ def _design(runs: list[Run], eta: float, actuator: ActuatorDocument) -> tuple[np
     return np.array(rows), np.array(y), np.array(w)
 
 
-def _solve(x: np.ndarray, y: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
-    gram = x.T @ (w[:, None] * x)
-    covariance = np.linalg.pinv(gram)
-    beta = covariance @ x.T @ (w * y)
-    return beta, covariance, float(np.sum(w * (y - x @ beta) ** 2))
-
-
 def fit_drive(runs: list[Run], actuator: ActuatorDocument) -> DriveFit:
     """c, I0, and (at two load sizes or more) the nominal FDJ and η_O, from healthy ``runs`` (module docstring)."""
-    profiles = [_solve(*_design(runs, float(eta), actuator)) for eta in ETA_GRID]
+    profiles = [weighted_least_squares(*_design(runs, float(eta), actuator)) for eta in ETA_GRID]
     chi2 = np.array([p[2] for p in profiles])
     best = int(np.argmin(chi2))
     (c, c_fdj), covariance, chi2_min = profiles[best]
@@ -218,7 +211,7 @@ def healthy_spread(runs: list[Run], per_run: list[tuple[float, float]], nominal_
     run_to_run = (
         float(np.sqrt(sum(float(d @ d) for d in deviations) / dof)) if dof else float(np.std([v for v, _ in per_run]))
     )
-    sets = float(np.sqrt(np.mean([(np.mean(v) - nominal_fdj_nm) ** 2 for v in groups.values()])))
+    sets = rms(np.array([np.mean(v) - nominal_fdj_nm for v in groups.values()]))
     noise = float(np.median([std for _, std in per_run]))
     return HealthySpread(run_to_run_nm=run_to_run, run_noise_nm=noise, set_nm=max(sets, run_to_run))
 

@@ -55,7 +55,7 @@ def reading(measured: Equations, terms: Sequence[Chosen], bias: Mapping[str, flo
     return corrected(fit_with(measured, terms).values, bias)
 
 
-def tell_apart(names: Sequence[str]) -> str:
+def what_tells_apart(names: Sequence[str]) -> str:
     return TELL_APART.get(frozenset(names[:2]), DEFAULT_TELL_APART)
 
 
@@ -96,7 +96,7 @@ def _ambiguity(
         effects=names,
         readings=readings,
         stds_after=widened,
-        tell_apart=tell_apart(names),
+        tell_apart=what_tells_apart(names),
         reason=f"{' and '.join(names)} read the windows about as well and put FDJ or η_O more than "
         f"{AMBIGUOUS_STDS:g} stds apart: neither is adopted, the base estimates are kept with stds that hold both",
     )

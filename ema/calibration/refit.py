@@ -17,7 +17,7 @@ import numpy as np
 
 from ema.calibration.equations import FOLDS, Equations
 from ema.calibration.selection import Chosen
-from ema.estimate.physics.eta_search import ETA_O_SEARCH, GRID_POINTS, REFINEMENTS
+from ema.estimate.physics.eta_search import coarse_to_fine
 from ema.model.params import load_factors
 
 MIN_HELD_OUT_GAIN = 0.01  # a model with an effect must cut the held-out residual by at least 1 % to be adopted
@@ -75,15 +75,13 @@ def fit_with(e: Equations, chosen: Sequence[Chosen], rows: np.ndarray | None = N
     parts = np.column_stack([y, loads])  # (m, 3): y, a, o
     coefficients = np.linalg.lstsq(design, parts, rcond=None)[0]  # (k, 3)
     residuals = parts - design @ coefficients
-    low, high = ETA_O_SEARCH
-    for _ in range(REFINEMENTS):
-        grid = np.linspace(low, high, GRID_POINTS)
-        mixes = np.vstack([np.ones(GRID_POINTS), *(-k for k in load_factors(grid, e.gear_ratio))])  # (3, G)
-        best = int(np.argmin(np.sum((residuals @ mixes) ** 2, axis=0)))
-        step = grid[1] - grid[0]
-        low, high = max(grid[best] - step, ETA_O_SEARCH[0]), min(grid[best] + step, ETA_O_SEARCH[1])
-    beta = coefficients @ mixes[:, best]
-    return TiedFit(float(beta[0]), float(grid[best]), beta)
+
+    def mixes(grid: np.ndarray) -> np.ndarray:  # (3, G): y − k_aid·a − k_opp·o at each η_O
+        return np.vstack([np.ones(len(grid)), *(-k for k in load_factors(grid, e.gear_ratio))])
+
+    eta_o, grid, best = coarse_to_fine(lambda grid: np.sum((residuals @ mixes(grid)) ** 2, axis=0))
+    beta = coefficients @ mixes(grid)[:, best]
+    return TiedFit(float(beta[0]), eta_o, beta)
 
 
 def held_out_rss(e: Equations, chosen: Sequence[Chosen]) -> float:

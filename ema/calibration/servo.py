@@ -55,6 +55,7 @@ from ema.estimate.physics.inverse import (
 )
 from ema.estimate.prepare.servo import ServoPrepared, document_effects, prepare_servo
 from ema.estimate.simulate.servo import lane_parameters
+from ema.estimate.stats import rms
 from ema.model.actuator import ActuatorDocument, Nominal
 from ema.model.checks import InputError
 from ema.model.servo_sim import simulate_servo
@@ -169,15 +170,15 @@ class Copies:
 
 
 def noise_copies(prepared: Sequence[ServoPrepared], base: Fitted, model: dict[str, float]) -> Copies:
-    rms: list[float] = []
+    misfits: list[float] = []
     by_row: list[list[np.ndarray]] = [[] for _ in prepared]
     for phase in np.linspace(0.0, 1.0, COPIES, endpoint=False):
         twins = [_simulated(p, base.values, model, phase) for p in prepared]
-        rms.append(float(np.sqrt(np.mean(fitted(problem(twins, model)).residual ** 2))))
+        misfits.append(rms(fitted(problem(twins, model)).residual))
         for i, twin in enumerate(twins):
             fit = fit_inverse(twin.force_n, inverse_columns(twin.motion, model), twin.motion)
             by_row[i].append(fit.residual_by_row)
-    return Copies(np.array(rms), [np.array(rows) for rows in by_row])
+    return Copies(np.array(misfits), [np.array(rows) for rows in by_row])
 
 
 def _simulated(p: ServoPrepared, values: dict[str, float], model: dict[str, float], phase: float) -> ServoPrepared:
@@ -354,7 +355,7 @@ def calibrate_servo(
     copies = noise_copies(prepared, fitted(problem(prepared, base_model)), base_model)
     prepared = undisturbed(prepared, copies, base_model)
     base = fitted(problem(prepared, base_model))
-    ratio = float(np.sqrt(np.mean(base.residual**2))) / float(np.median(copies.rms))
+    ratio = rms(base.residual) / float(np.median(copies.rms))
     limit = misfit_limit(copies.rms)
     if ratio > limit:
         model, candidates, steps = select(prepared, base_model)
@@ -376,8 +377,8 @@ def calibrate_servo(
     report = CalibrationReport(
         n_windows=len(windows),
         noise_floor=NoiseFloor(copies=COPIES, equation_error_ratio=ratio),
-        residual_rms_before={"drive_force_n": float(np.sqrt(np.mean(base.residual**2)))},
-        residual_rms_after={"drive_force_n": float(np.sqrt(np.mean(after.residual**2)))},
+        residual_rms_before={"drive_force_n": rms(base.residual)},
+        residual_rms_after={"drive_force_n": rms(after.residual)},
         candidates=candidates,
         selected_effect=adopted[0] if adopted else None,
         selected_effects=adopted,

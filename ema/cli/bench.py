@@ -35,6 +35,7 @@ from ema.estimate.pipeline import estimate_window
 from ema.estimate.report import share_of_range
 from ema.model.actuator import THESIS
 from ema.model.batch import default_lanes, simulate_batch
+from ema.model.bounds import DEFAULT_SAMPLE_RATE_HZ
 from ema.model.commands import random_command_knots
 from ema.model.params import DEFAULT_RANGES, HealthParams
 from ema.model.synthetic import synthetic_window
@@ -86,7 +87,7 @@ def time_windows(config: PipelineConfig, duration_s: float, repeats: int, seed: 
 
 def references() -> dict[str, float]:
     """The yardstick's seconds and our kernel's ns per simulation-step on the same ``SIMS`` × 0.5 s, this run."""
-    rate_hz, steps_per_sample = 10_000.0, 100
+    rate_hz, steps_per_sample = DEFAULT_SAMPLE_RATE_HZ, 100
     samples = round(DURATION_S * rate_hz)
     rng = np.random.default_rng(0)
     health = HealthParams.uniform(SIMS, DEFAULT_RANGES, rng)

@@ -20,6 +20,7 @@ from ema.cli.options import (
     pipeline_config,
     sizes,
 )
+from ema.model.bounds import MAX_THREADS
 
 ARCHIVE = click.Path(exists=True, path_type=Path)
 
@@ -33,7 +34,7 @@ ARCHIVE = click.Path(exists=True, path_type=Path)
     help="results CSV, one row per window (a rerun resumes from it)",
 )
 @click.option("--workers", type=click.IntRange(1, 4096), default=2, help="worker processes (windows at a time)")
-@click.option("--threads", type=click.IntRange(1, 256), default=1, help="threads (CPUs) each worker reserves")
+@click.option("--threads", type=click.IntRange(1, MAX_THREADS), default=1, help="threads (CPUs) each worker reserves")
 @click.option("--ray-address", default=None, help="'auto' or HOST:PORT of a cluster [default: a local Ray]")
 @click.option(
     "--window-s",

@@ -25,8 +25,8 @@ from ema.cli.options import (
     sizes,
     threads,
 )
-from ema.model.bounds import MAX_FLIGHT_HOURS
-from ema.model.envelope import DEFAULT_AIRSPEED_MPS
+from ema.model.bounds import DEFAULT_SAMPLE_RATE_HZ, MAX_FLIGHT_HOURS, SAMPLE_RATE_RANGE_HZ
+from ema.model.envelope import AIRSPEED_RANGE_MPS, ALTITUDE_RANGE_M, DEFAULT_AIRSPEED_MPS
 
 FAMILIES = ("thesis", "cruise", "gust", "doublet", "steps")  # ema.model.commands.FAMILIES, without importing numpy here
 SIMULATE_FLAGS = {
@@ -65,6 +65,11 @@ def history_of(window: Any, paths: tuple[Path, ...]) -> Any:
             )
         results.append(result)
     return readings_of([result.window for result in results], window.flight_id)
+
+
+def _span(bounds: tuple[float, float]) -> str:
+    """A range for the help, as the model bounds it: "90–215"."""
+    return "–".join(f"{bound:g}" for bound in bounds)
 
 
 @click.command()
@@ -115,15 +120,19 @@ def estimate(
 @click.option("--fdj", type=float, default=None, help="dynamic friction FDJ [N·m]  [default: the actuator's nominal]")
 @click.option("--eta-o", "eta_o", type=float, default=None, help="opposing efficiency η_O  [default: nominal]")
 @click.option("--fsj", type=float, default=None, help="static friction FSJ [N·m]  [default: nominal]")
-@click.option("--airspeed", type=float, default=DEFAULT_AIRSPEED_MPS, help="true airspeed [m/s], 90–215")
-@click.option("--altitude", type=float, default=0.0, help="altitude [m], 0–10000")
+@click.option(
+    "--airspeed", type=float, default=DEFAULT_AIRSPEED_MPS, help=f"true airspeed [m/s], {_span(AIRSPEED_RANGE_MPS)}"
+)
+@click.option("--altitude", type=float, default=0.0, help=f"altitude [m], {_span(ALTITUDE_RANGE_M)}")
 @click.option("--ground", is_flag=True, help="on the ground: a load cell's load (--load, --load-ramp), no aircraft")
 @click.option("--load", "load_nm", type=float, default=0.0, help="with --ground: the hinge moment at t = 0 [N·m]")
 @click.option("--load-ramp", "load_ramp_nmps", type=float, default=0.0, help="with --ground: its rate [N·m/s]")
 @click.option("--command", type=click.Choice(FAMILIES), default="thesis", help="the command's family")
 @click.option("--seed", type=int, default=0, help="seed of the command and the noise")
 @click.option("--duration", type=click.FloatRange(0.01, 60.0), default=0.5, help="window length [s]")
-@click.option("--rate", type=float, default=10_000.0, help="log rate [Hz], 1000–100000")
+@click.option(
+    "--rate", type=float, default=DEFAULT_SAMPLE_RATE_HZ, help=f"log rate [Hz], {_span(SAMPLE_RATE_RANGE_HZ)}"
+)
 @click.option("--clean", is_flag=True, help="no sensor noise")
 @click.option(
     "--effect",

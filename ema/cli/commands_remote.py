@@ -12,6 +12,7 @@ from typing import Any
 import click
 
 from ema.cli.options import EXISTING, NothingAnsweredError, as_json, emit, flags_named, log_map, log_map_document
+from ema.model.bounds import DEFAULT_SAMPLE_RATE_HZ
 from ema.model.envelope import DEFAULT_AIRSPEED_MPS
 
 URL = "http://127.0.0.1:8000"
@@ -44,7 +45,9 @@ def api_key(path: Path | None) -> str | None:
 )
 @click.option("--api-key-file", type=EXISTING, default=None, help="file holding the API key [default: EMA_API_KEY]")
 @click.option("--actuator-id", default="unknown", help="for CSV/NPZ logs that carry none")
-@click.option("--rate", type=float, default=10_000.0, help="sample rate [Hz] for CSV/NPZ logs that carry none")
+@click.option(
+    "--rate", type=float, default=DEFAULT_SAMPLE_RATE_HZ, help="sample rate [Hz] for CSV/NPZ logs that carry none"
+)
 @click.option("--airspeed", type=float, default=DEFAULT_AIRSPEED_MPS, help="[m/s] for CSV/NPZ logs that carry none")
 @click.option("--altitude", type=float, default=0.0, help="[m] for CSV/NPZ logs that carry none")
 @log_map
@@ -154,12 +157,12 @@ def history(
     from ema.cli.printing import print_prognosis
     from ema.cli.replay import ServiceError, refusal_text, request
     from ema.model.checks import InputError
-    from ema.prognosis.documents import History, Prognosis
+    from ema.prognosis.documents import EstimateHistory, Prognosis
 
     key = api_key(api_key_file)
     base = f"{url.rstrip('/')}/v1/actuators/{urllib.parse.quote(actuator_id, safe='/')}"
     try:
-        stored = History.model_validate(request(f"{base}/estimates", key, timeout=60))
+        stored = EstimateHistory.model_validate(request(f"{base}/estimates", key, timeout=60))
     except urllib.error.HTTPError as error:
         if error.code in (404, 422):
             raise InputError(

@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 
 from ema.model.actuator import ActuatorDocument, actuator_from_dict
+from ema.model.bounds import DEFAULT_SAMPLE_RATE_HZ
 from ema.model.checks import InputError, load_json
 from ema.model.envelope import DEFAULT_AIRSPEED_MPS
 from ema.model.logmap import LogMap, read_mapped
@@ -31,7 +32,7 @@ class Defaults:
     """Metadata for formats that may lack it (CSV, NPZ): flags of ``ema replay``."""
 
     actuator_id: str = "unknown"
-    sample_rate_hz: float = 10_000.0
+    sample_rate_hz: float = DEFAULT_SAMPLE_RATE_HZ
     airspeed_mps: float = DEFAULT_AIRSPEED_MPS
     altitude_m: float = 0.0
 

@@ -12,6 +12,7 @@ from typing import Any, TypeVar
 import click
 
 from ema.estimate.sizes import SIZES as PIPELINE_SIZES
+from ema.model.bounds import MAX_THREADS
 
 F = TypeVar("F", bound=Callable[..., Any])
 EXISTING = click.Path(exists=True, dir_okay=False, path_type=Path)  # a file that must be there
@@ -77,16 +78,20 @@ def as_json(function: F) -> F:
 
 def threads(function: F) -> F:
     return click.option(
-        "--threads", type=click.IntRange(1, 256), default=None, help="thread budget [default: EMA_THREADS, else cores]"
+        "--threads",
+        type=click.IntRange(1, MAX_THREADS),
+        default=None,
+        help="thread budget [default: EMA_THREADS, else cores]",
     )(function)
 
 
 def pipeline_config(values: Mapping[str, Any]) -> Any:
     """The PipelineConfig from a command's size options; a bad value names its flag."""
-    from ema.estimate.config import PipelineConfig, validated
+    from ema.estimate.config import PipelineConfig
+    from ema.model.checks import validated
 
     with flags_named(SIZE_FLAGS):
-        return validated(PipelineConfig, {field: values[field] for field in SIZES.values()})
+        return validated(PipelineConfig, {field: values[field] for field in SIZES.values()}, "sizes")
 
 
 @contextlib.contextmanager

@@ -15,7 +15,7 @@ def documents() -> dict[str, type[BaseModel]]:
     from ema.model.actuator import ActuatorDocument
     from ema.model.logmap import LogMap
     from ema.model.window import WindowDocument
-    from ema.prognosis.documents import ActuatorSummary, History, Prognosis, StoredActuator, Withdrawal
+    from ema.prognosis.documents import ActuatorSummary, EstimateHistory, Prognosis, StoredActuator, Withdrawal
 
     return {
         "ema-actuator-1": ActuatorDocument,
@@ -24,7 +24,7 @@ def documents() -> dict[str, type[BaseModel]]:
         "ema-logmap-1": LogMap,
         "ema-estimate-1": Estimate,
         "ema-calibration-1": CalibrationReport,
-        "history": History,
+        "history": EstimateHistory,
         "prognosis": Prognosis,
         "actuator-summary": ActuatorSummary,
         "withdrawal": Withdrawal,

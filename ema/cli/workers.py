@@ -104,20 +104,20 @@ def _warmed(threads: int) -> None:
 
 
 def _answered(*arguments: Any) -> dict[str, Any]:
-    """``ema.kinds.remote.estimate_document`` on a local worker, imported there (``_warmed``)."""
-    from ema.kinds.remote import estimate_document
+    """``ema.kinds.remote.estimate_json`` on a local worker, imported there (``_warmed``)."""
+    from ema.kinds.remote import estimate_json
 
-    return estimate_document(*arguments)
+    return estimate_json(*arguments)
 
 
 def in_process(jobs: list[Job], config: PipelineConfig, threads: int, documents: Documents) -> Iterator[Answer]:
-    from ema.kinds.remote import estimate_document
+    from ema.kinds.remote import estimate_json
 
     for window, history in jobs:
         actuator, version = documents.task_arguments(window)
         yield (
             window,
-            estimate_document(window_to_dict(window), config.model_dump(), threads, history, actuator, version),
+            estimate_json(window_to_dict(window), config.model_dump(), threads, history, actuator, version),
         )
 
 

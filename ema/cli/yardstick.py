@@ -21,11 +21,13 @@ import time
 import numpy as np
 from numba import get_num_threads, njit, prange, set_num_threads
 
+from ema.model.bounds import DEFAULT_SAMPLE_RATE_HZ
+
 SIMS = 500
 LANES = 16
 DURATION_S = 0.5
 STEP_S = 1e-6
-RATE_HZ = 10_000.0
+RATE_HZ = DEFAULT_SAMPLE_RATE_HZ
 # Table 3.1's drive (the yardstick needs numbers, not our document types)
 G_P, GAP, R, L, K_T, T_MAX, V_MAX, I_MAX, N, J, C = (
     1e5,

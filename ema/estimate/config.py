@@ -6,13 +6,11 @@ config it ran with) read this model; nothing restates a default or a bound.
 
 from __future__ import annotations
 
-from typing import Any, TypeVar
+from typing import Any
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError
+from pydantic import BaseModel, ConfigDict, Field
 
 from ema.estimate.sizes import SIZES
-
-Model = TypeVar("Model", bound=BaseModel)
 
 
 def _field(name: str) -> Any:
@@ -35,16 +33,6 @@ class PipelineConfig(BaseModel):
     @property
     def total_simulations(self) -> int:
         return self.n_simulations + self.check_windows
-
-
-def validated(model: type[Model], values: dict[str, Any], prefix: str = "") -> Model:
-    """``model(**values)``, its first error as an InputError naming the field (``prefix`` + name)."""
-    from ema.model.checks import from_validation  # numpy: kept out of this module's import (the CLI's help reads it)
-
-    try:
-        return model(**values)
-    except ValidationError as exc:
-        raise from_validation(exc, prefix) from None
 
 
 def bounds(name: str) -> tuple[int, int]:

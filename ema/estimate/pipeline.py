@@ -8,11 +8,12 @@ The thesis's §6.3 proposal, made to hold on data our simulator did not draw:
 3. **simulate**: a Case-1B dataset of the window's own command, logged load and first state, its
    health drawn in a box around the physics estimate (``ema.estimate.simulate.design``: no fixed range, so no
    cap on a worn actuator), with the window's own sensor noise;
-4. **train**: the shallow network on the residual torque of the sliding samples;
-5. **assess**: both estimators scored on held-out simulations, blended per parameter, checked
-   against the window itself (``ema.estimate.assess.weighing``) and by simulating it at the answer
-   (``ema.estimate.assess.reproduction``);
-6. **FSJ** where the window shows a quasi-static break-away (``ema.estimate.physics.static_friction``).
+4. **learn**: the shallow network on the residual torque of the sliding samples (``learned``);
+5. **assess**: both estimators scored on held-out simulations and blended per parameter, checked against the
+   window itself (``assessed``, ``ema.estimate.assess.weighing``);
+6. **check**: the window simulated at the answer (``checked``, ``ema.estimate.assess.reproduction``);
+7. **report**: FSJ where the window shows a quasi-static break-away (``ema.estimate.physics.static_friction``),
+   and the document.
 """
 
 from __future__ import annotations
@@ -29,7 +30,7 @@ from ema.estimate.documents import ActuatorRead, Estimate, FitCheck, Note
 from ema.estimate.documents.window import HistoryReadings
 from ema.estimate.history import known_from
 from ema.estimate.learn.estimator import NetworkEstimator
-from ema.estimate.learn.network import TrainConfig
+from ema.estimate.learn.network import LearnConfig
 from ema.estimate.physics.features import as_read
 from ema.estimate.physics.friction import FIT_ARRAYS, FrictionFit, fit_friction, fit_window
 from ema.estimate.physics.scenario import MAX_RATIO, inside
@@ -37,6 +38,7 @@ from ema.estimate.physics.static_friction import read_static_friction
 from ema.estimate.prepare.conditioning import Prepared, prepare, widened
 from ema.estimate.report import estimate_document
 from ema.estimate.simulate.dataset import Data, simulate_dataset
+from ema.estimate.stats import rms
 from ema.estimate.stopwatch import Stopwatch
 from ema.model.actuator import THESIS, ActuatorDocument
 from ema.model.window import Window
@@ -44,12 +46,12 @@ from ema.model.window import Window
 # On a few dozen noisy simulations the network stops improving within a few epochs, and the physics fit
 # carries most of the answer (ema.estimate.assess.weighing): the thesis's 12 failures and 1000 epochs made its time
 # the pipeline's least predictable.
-PIPELINE_TRAINING = TrainConfig(max_epochs=60, max_validation_failures=6)
+PIPELINE_LEARNING = LearnConfig(max_epochs=60, max_validation_failures=6)
 
 
-def train_network(data: Data, config: PipelineConfig) -> NetworkEstimator:
+def learned(data: Data, config: PipelineConfig) -> NetworkEstimator:
     n = config.n_simulations
-    train = replace(PIPELINE_TRAINING, hidden=config.hidden_units, seed=config.seed)
+    train = replace(PIPELINE_LEARNING, hidden=config.hidden_units, seed=config.seed)
     health = data.sims.health
     return NetworkEstimator(train, config.members).fit(data.inputs[:n], health.fdj_nm[:n], health.eta_o[:n], data.box)
 
@@ -79,14 +81,14 @@ def candidates(
     ), check_physics
 
 
-def fit_check(
+def checked(
     window: Window, data: Data, answer: Assessed, equation_ratio: float, n: int, nominal_fdj_nm: float
 ) -> FitCheck:
     """Simulate the window at the answer and compare (``ema.estimate.assess.reproduction``). Where the answer is the
     point the noise was measured at (the physics estimate, when it carries the answer), that simulation is
     the one: a lane of the dataset's batch, the same numbers as a run of its own."""
     health = inside(answer.values["FDJ"], answer.values["eta_O"], nominal_fdj_nm)
-    floor = float(np.sqrt(np.mean((data.sims.residual_nm[n:] - data.sims.clean_residual_nm)[:, data.sliding] ** 2)))
+    floor = rms((data.sims.residual_nm[n:] - data.sims.clean_residual_nm)[:, data.sliding])
     known = data.sims.reference_signals if health.identical(data.sims.reference) else None
     ratios = output_error_ratios(
         window,
@@ -120,7 +122,7 @@ def fit_check(
     )
 
 
-def weighed(
+def assessed(
     window: Window, physics: FrictionFit, data: Data, network: NetworkEstimator, *, prepared: Prepared, n: int
 ) -> tuple[Assessed, float, float]:
     """The assessed answer (its stds widened by what prepare left undecided), the window's equation error over
@@ -167,11 +169,11 @@ def estimate_window(
             w, seen, physics, config, document=actuator, actuator=prepared.drive_as_read, effects=effects
         )
     with watch("learn", f"training {config.members} network(s) of {config.hidden_units} neurons"):
-        network = train_network(data, config)
+        network = learned(data, config)
     with watch("assess", "weighing the estimators on held-out simulations"):
-        answer, equation_ratio, limit = weighed(w, physics, data, network, prepared=prepared, n=n)
+        answer, equation_ratio, limit = assessed(w, physics, data, network, prepared=prepared, n=n)
     with watch("check", "checking the answer against the window"):
-        check = fit_check(seen, data, answer, equation_ratio, n, actuator.health.fdj)
+        check = checked(seen, data, answer, equation_ratio, n, actuator.health.fdj)
         check = check.model_copy(update={"equation_error_limit": limit})
     with watch("report", "reading FSJ at the answer, writing the report"):
         fsj = read_static_friction(

@@ -27,11 +27,12 @@ from ema.estimate.documents import (
 )
 from ema.estimate.documents.window import InertiaReading, SensorZero, WindowInfo
 from ema.estimate.learn.estimator import NetworkEstimator
-from ema.estimate.physics.friction import FitSettings, FrictionFit
+from ema.estimate.physics.friction import FrictionFit, sliding_mask
 from ema.estimate.physics.static_friction import StaticFriction
 from ema.estimate.prepare.conditioning import Prepared, conditioning_done, conditioning_notes
 from ema.estimate.prepare.departures.drive_constants import KERNEL_FREE_RATE_HZ
 from ema.estimate.simulate.dataset import Data
+from ema.estimate.stats import rms
 from ema.model.actuator import ActuatorDocument
 from ema.model.hinge import denoised_hinge_nm
 from ema.model.params import HealthRanges
@@ -158,10 +159,10 @@ def carries_load(prepared: Prepared) -> bool:
     if not w.on_ground:
         return True
     load_nm = denoised_hinge_nm(w.signals["hinge_moment_nm"], w.signals["position_deg"], w.sample_rate_hz)
-    sliding = np.abs(w.signals["motor_speed_radps"]) > FitSettings().sliding_speed_radps(document.params)
+    sliding = sliding_mask(w.signals, w.sample_rate_hz, document.params)
     if not np.any(sliding):
         return True  # nothing slides: the physics fit refuses the window, not this rule
-    term = (1.0 / document.health.efficiency - 1.0) * np.sqrt(np.mean((load_nm[sliding] / document.gear_ratio) ** 2))
+    term = (1.0 / document.health.efficiency - 1.0) * rms(load_nm[sliding] / document.gear_ratio)
     return bool(term >= NO_LOAD_SHARE * document.health.fdj)
 
 

@@ -18,6 +18,7 @@ import contextlib
 import os
 
 from ema.model import runtime as sim_runtime
+from ema.model.bounds import MAX_THREADS
 
 ENVIRONMENT = "EMA_THREADS"
 
@@ -30,8 +31,8 @@ def budget(threads: int | None = None) -> int | None:
     if text:
         from ema.model.checks import InputError
 
-        if not text.isdigit() or int(text) < 1:
-            raise InputError(ENVIRONMENT, f"must be a positive integer, got {text!r}")
+        if not text.isdigit() or not 1 <= int(text) <= MAX_THREADS:
+            raise InputError(ENVIRONMENT, f"must be an integer in [1, {MAX_THREADS}], got {text!r}")
         return int(text)
     return None
 
@@ -40,7 +41,7 @@ def configure(threads: int | None = None) -> int:
     """Set the budget for this process; returns the simulator's thread count."""
     import torch
 
-    count = sim_runtime.configure(budget(threads))
+    count = sim_runtime.configure_simulator(budget(threads))
     _without_compiler_import()
     if torch.get_num_threads() != 1:
         torch.set_num_threads(1)

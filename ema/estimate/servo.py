@@ -36,7 +36,7 @@ from ema.estimate.documents import (
 )
 from ema.estimate.documents.window import WindowInfo
 from ema.estimate.learn.estimator import NetworkRegressor
-from ema.estimate.learn.network import TrainConfig
+from ema.estimate.learn.network import LearnConfig
 from ema.estimate.physics.inverse import (
     UNITS,
     InverseFit,
@@ -49,12 +49,13 @@ from ema.estimate.physics.inverse import (
 from ema.estimate.physics.scenario import MAX_RATIO
 from ema.estimate.prepare.servo import ServoPrepared, prepare_servo
 from ema.estimate.simulate.servo import ServoData, lane_parameters, simulate_servo_dataset
+from ema.estimate.stats import rms
 from ema.estimate.stopwatch import Stopwatch
 from ema.model.actuator import ActuatorDocument
 from ema.model.servo_sim import simulate_servo
 from ema.model.window import Window
 
-SERVO_TRAINING = TrainConfig(max_epochs=60, max_validation_failures=6)  # as the rotary pipeline's (a few dozen runs)
+SERVO_TRAINING = LearnConfig(max_epochs=60, max_validation_failures=6)  # as the rotary pipeline's (a few dozen runs)
 FDJ = "fdj_n"
 NOMINAL_FIELDS = {  # a constant of the inverse model -> the servo section's field of its nominal value
     "mass_kg": "mass_kg",
@@ -109,7 +110,7 @@ def learned(data: ServoData, config: PipelineConfig) -> NetworkRegressor:
     return NetworkRegressor(train, config.members).fit(data.inputs[:n], data.normalize(data.truth[:n]))
 
 
-def weighed(
+def assessed(
     prepared: ServoPrepared, physics: InverseFit, data: ServoData, network: NetworkRegressor, n: int
 ) -> tuple[Assessed, float, float, InverseFit]:
     """The assessed answer, the window's equation error over the held-out simulations' median, its limit, and the
@@ -154,7 +155,7 @@ def closed_loop_check(prepared: ServoPrepared, answer: Assessed, ratio: float, l
     measured, simulated = s["drive_force_n"][kept], run.drive_force_n[0, kept]
     factor = prepared.motion.decimation
     noise = np.hypot(_above_band(measured, factor), _above_band(simulated, factor))
-    force_ratio = float(np.sqrt(np.mean((measured - simulated) ** 2)) / max(noise, 1e-300))
+    force_ratio = rms(measured - simulated) / max(noise, 1e-300)
     reproduced = force_ratio <= MAX_RATIO
     notes = list(answer.notes)
     if not reproduced:
@@ -185,7 +186,7 @@ def _above_band(force: np.ndarray, factor: int) -> float:
     slow = decimated(force, factor)
     grid = np.arange(len(force))
     kept = grid[len(force) - 1 - (len(slow) - 1) * factor :: factor] if factor > 1 else grid
-    return float(np.sqrt(np.mean((force - np.interp(grid, kept, slow)) ** 2)))
+    return rms(force - np.interp(grid, kept, slow))
 
 
 def _estimates(actuator: ActuatorDocument, prepared: ServoPrepared, physics: InverseFit, answer: Assessed) -> Estimates:
@@ -288,7 +289,7 @@ def estimate_servo(
     with watch("learn", f"training {config.members} network(s) of {config.hidden_units} neurons"):
         network = learned(data, config)
     with watch("assess", "weighing the estimators on held-out simulations"):
-        answer, ratio, limit, physics = weighed(prepared, physics, data, network, n)
+        answer, ratio, limit, physics = assessed(prepared, physics, data, network, n)
     with watch("check", "simulating the window at the answer"):
         check = closed_loop_check(prepared, answer, ratio, limit)
     with watch("report", "writing the report"):

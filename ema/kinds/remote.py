@@ -26,7 +26,7 @@ from ema.model.synthetic import synthetic_window
 from ema.model.window import Window, window_from_dict, window_to_dict
 
 
-def estimate_document(
+def estimate_json(
     window: dict[str, Any],
     config: dict[str, Any],
     threads: int,
@@ -68,10 +68,10 @@ def warm(threads: int) -> None:
 
 
 def ray_task(threads: int) -> Any:
-    """``estimate_document`` as a Ray remote function that reserves ``threads`` CPUs per task."""
+    """``estimate_json`` as a Ray remote function that reserves ``threads`` CPUs per task."""
     import ray
 
-    return ray.remote(num_cpus=threads, max_retries=2)(estimate_document)
+    return ray.remote(num_cpus=threads, max_retries=2)(estimate_json)
 
 
 def connect(address: str | None, cpus: int) -> None:

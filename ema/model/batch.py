@@ -9,12 +9,11 @@ import numpy as np
 
 from ema.model import kernels, runtime
 from ema.model.aircraft import FlightCondition, HingeGeometry, Load, load_model
+from ema.model.bounds import DEFAULT_SAMPLE_RATE_HZ, SAMPLE_RATE_RANGE_HZ
 from ema.model.checks import InputError, finite_array, in_range
 from ema.model.effects import TABLE_VARIABLES, EffectSet
 from ema.model.params import DriveConstants, HealthParams, load_factors
 
-DEFAULT_SAMPLE_RATE_HZ = 10_000.0
-SAMPLE_RATE_RANGE_HZ = (1_000.0, 100_000.0)
 VECTOR_LANES = 8  # float64 in one AVX-512 register
 LANE_MULTIPLE = VECTOR_LANES * runtime.INTERLEAVE  # one iteration of the vectorized lane loop
 MAX_LANES = 3 * LANE_MULTIPLE  # simulations advanced in lock-step; fewer lanes pay more per-step loop overhead

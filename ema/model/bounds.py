@@ -11,6 +11,11 @@ ROUTE_SEGMENTS = ("estimates", "prognosis")  # the service's routes below an act
 MAX_FLIGHT_HOURS = 1_000_000.0
 EARLIEST_RECORDED_AT = dt.datetime(2000, 1, 1, tzinfo=dt.UTC)
 CLOCK_SKEW = dt.timedelta(days=1)
+# The thesis's logging rate: a window's rate where its log names none, and the highest the pipeline reads a
+# window at (a faster log is averaged down to it).
+DEFAULT_SAMPLE_RATE_HZ = 10_000.0
+SAMPLE_RATE_RANGE_HZ = (1_000.0, 100_000.0)  # the rates the simulator draws a window at
+MAX_THREADS = 256  # a thread budget's ceiling: more than any onboard computer or server has cores
 
 
 def route_collision(actuator_id: str) -> str | None:

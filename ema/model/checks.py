@@ -44,15 +44,16 @@ def read_document(path: str | Path, parse: Callable[[Any], Parsed]) -> Parsed:
         raise InputError(f"{path}: {exc.field}", exc.message) from None
 
 
-def validated(model: type[Model], document: Any, what: str) -> Model:
+def validated(model: type[Model], document: Any, what: str, prefix: str = "") -> Model:
     """``document`` (a dict) validated as ``model``; anything else, or a field it refuses, is an InputError naming
-    it (``what``: the document's name where the whole is wrong)."""
+    it (``what``: the document's name where the whole is wrong; ``prefix`` before a field's name: where it came
+    from, ``query.``)."""
     if not isinstance(document, dict):
         raise InputError(what, f"must be a JSON object, got {type(document).__name__}")
     try:
         return model.model_validate(document)
     except ValidationError as exc:
-        raise from_validation(exc) from None
+        raise from_validation(exc, prefix) from None
 
 
 def finite_array(field: str, values: object, ndim: int | None = None) -> np.ndarray:

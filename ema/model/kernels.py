@@ -5,7 +5,7 @@ Pure functions of their arguments: ``ema.model.batch`` validates, packs the cons
 written once (:func:`advance`) and every loop uses it, so the vectorized lock-step path and the
 one-lane path run the same arithmetic. The branches in :func:`advance` are simple enough for
 LLVM to turn into selects; that is what lets the lane loop in :func:`_advance_lanes` vectorize
-across simulations, three vectors of lanes an iteration once ``ema.model.runtime.configure`` has run
+across simulations, three vectors of lanes an iteration once ``ema.model.runtime.configure_simulator`` has run
 (*Interleaving* there): a step's dependent chain is long, and three independent ones keep the
 core busy. The loop vectorizes only in exactly this form (a loop over a slice of the lanes, or two
 lanes an iteration, ran scalar at 3x the cost).

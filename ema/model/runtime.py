@@ -11,7 +11,7 @@
   on a core a simulation group needs.
 - **Vector width.** LLVM tunes AVX-512 CPUs to prefer 256-bit vectors; the lane loop is
   instruction-bound and measured ~1.5x faster with 512-bit ones (docs/benchmarks.md). Numba reads
-  this when it first compiles or loads a kernel, so :func:`configure` must run before that; a
+  this when it first compiles or loads a kernel, so :func:`configure_simulator` must run before that; a
   user's own NUMBA_CPU_FEATURES wins.
 - **Interleaving.** One step of a lane is a chain of dependent operations (controller, current,
   friction, speed, position: ~100 cycles). With one vector of lanes per iteration of the lane loop
@@ -35,9 +35,9 @@ from collections.abc import Callable, Sequence
 from concurrent.futures import Future, ThreadPoolExecutor
 from typing import TypeVar
 
+from ema.model.bounds import MAX_THREADS
 from ema.model.checks import InputError
 
-MAX_THREADS = 256
 INTERLEAVE = 3  # independent vectors per iteration of a vectorized loop (module docstring)
 T = TypeVar("T")
 R = TypeVar("R")
@@ -175,7 +175,7 @@ def prefer_wide_vectors() -> None:
         config.CPU_FEATURES = features.flatten() + ",-prefer-256-bit"  # type: ignore[attr-defined]
 
 
-def configure(threads: int | None = None) -> int:
+def configure_simulator(threads: int | None = None) -> int:
     """The entry points' one call: vector width and interleaving, BLAS on one thread, then the thread budget
     (default: the usable cores)."""
     compiler_options()

@@ -9,6 +9,7 @@ import numpy as np
 from ema.model.actuator import THESIS, ActuatorDocument
 from ema.model.aircraft import FlightCondition, GroundLoad
 from ema.model.batch import InitialState, simulate_batch
+from ema.model.bounds import DEFAULT_SAMPLE_RATE_HZ
 from ema.model.commands import family_knots
 from ema.model.effects import EffectSet
 from ema.model.noise import SensorNoise, add_sensor_noise
@@ -22,7 +23,7 @@ def synthetic_window(
     *,
     seed: int = 0,
     duration_s: float = 0.5,
-    sample_rate_hz: float = 10_000.0,
+    sample_rate_hz: float = DEFAULT_SAMPLE_RATE_HZ,
     noise: SensorNoise = SensorNoise(),
     effects: EffectSet = EffectSet(),
     actuator_id: str = "synthetic/elevator",

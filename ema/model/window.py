@@ -27,7 +27,14 @@ from pydantic import (
 )
 
 from ema.model.aircraft import AIRSPEED_RANGE_MPS, ALTITUDE_RANGE_M, FlightCondition
-from ema.model.bounds import CLOCK_SKEW, EARLIEST_RECORDED_AT, IDENTIFIER, MAX_FLIGHT_HOURS, route_collision
+from ema.model.bounds import (
+    CLOCK_SKEW,
+    DEFAULT_SAMPLE_RATE_HZ,
+    EARLIEST_RECORDED_AT,
+    IDENTIFIER,
+    MAX_FLIGHT_HOURS,
+    route_collision,
+)
 from ema.model.checks import InputError, read_document, validated
 from ema.model.document import Number
 from ema.model.kinds import ALL_SIGNALS, DEFAULT_KIND, KINDS, kind_of_signals, nearest_kind
@@ -207,7 +214,7 @@ class Window:
     on the ground)."""
 
     signals: dict[str, np.ndarray]
-    sample_rate_hz: float = 10_000.0
+    sample_rate_hz: float = DEFAULT_SAMPLE_RATE_HZ
     flight_condition: FlightCondition | None = field(default_factory=FlightCondition)
     actuator_id: str = "unknown"
     window_id: str = "unknown"

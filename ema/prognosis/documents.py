@@ -1,6 +1,6 @@
 """The history and prognosis documents (``docs/prognosis.md``): one definition each.
 
-``GET /v1/actuators/{id}/estimates`` answers :class:`History`, ``.../prognosis`` answers
+``GET /v1/actuators/{id}/estimates`` answers :class:`EstimateHistory`, ``.../prognosis`` answers
 :class:`Prognosis`, ``ema history`` prints and plots them, and docs/schemas/ holds their JSON
 Schemas.
 """
@@ -194,7 +194,7 @@ class Prognosis(Document):
     )
 
 
-class History(Document):
+class EstimateHistory(Document):
     actuator_id: str
     estimates: list[Stored] = Field(description="oldest first; one per (actuator_id, window_id)")
     legacy: list[dict[str, Any]] = Field(

@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ema.estimate.stats import weighted_least_squares
 from ema.prognosis.documents import BacktestPoint, ForecastPoint, RemainingLife, Trend
 from ema.prognosis.forecast import Forecast, forecast
 from ema.prognosis.laws import LAWS, fit_law
@@ -71,9 +72,8 @@ def speeding_up(times: np.ndarray, values: np.ndarray, weight: np.ndarray, sign:
 
 
 def _slope(t: np.ndarray, y: np.ndarray, w: np.ndarray) -> tuple[float, float]:
-    design = np.column_stack([np.ones_like(t), t - t.mean()])
-    covariance = np.linalg.pinv(design.T @ (w[:, None] * design))
-    return float((covariance @ design.T @ (w * y))[1]), float(covariance[1, 1])
+    beta, covariance, _ = weighted_least_squares(np.column_stack([np.ones_like(t), t - t.mean()]), y, w)
+    return float(beta[1]), float(covariance[1, 1])
 
 
 def band(fc: Forecast, life: RemainingLife, span: float) -> list[ForecastPoint]:

@@ -19,7 +19,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ema.estimate.stats import odds_weight
+from ema.estimate.stats import odds_weight, weighted_least_squares
 from ema.prognosis.documents import Curved, Point, Trend
 
 HUBER_C = 2.5
@@ -30,10 +30,8 @@ MIN_CURVED = 6  # windows from which a quadratic is fitted beside the line
 
 def _wls(x: np.ndarray, y: np.ndarray, w: np.ndarray, degree: int) -> tuple[np.ndarray, np.ndarray]:
     """(coefficients (level, slope[, curvature]), covariance) of weighted least squares, w = 1/variance."""
-    design = np.vander(x, degree + 1, increasing=True)
-    gram = design.T @ (w[:, None] * design)
-    covariance = np.linalg.pinv(gram)
-    return covariance @ design.T @ (w * y), covariance
+    beta, covariance, _ = weighted_least_squares(np.vander(x, degree + 1, increasing=True), y, w)
+    return beta, covariance
 
 
 def excess_variance(residual: np.ndarray, variance: np.ndarray, robust: np.ndarray, dof: int) -> float:

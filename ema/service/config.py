@@ -15,6 +15,7 @@ from pydantic import Field, SecretStr, field_validator, model_validator
 from pydantic_settings import BaseSettings, SettingsConfigDict
 
 from ema.estimate.config import PipelineConfig
+from ema.model.bounds import MAX_THREADS
 
 LOOPBACK_NAMES = ("localhost", "127.0.0.1", "::1")
 MIN_KEY_CHARACTERS = 16
@@ -88,7 +89,7 @@ class Settings(BaseSettings):
     allowed_origins: tuple[str, ...] = Field(
         (), description="origins (scheme://host:port) of web pages allowed to write besides the service's own"
     )
-    threads: int | None = Field(None, ge=1, le=256, description="the thread budget; default: the usable cores")
+    threads: int | None = Field(None, ge=1, le=MAX_THREADS, description="the thread budget; default: the usable cores")
     warm_up: bool = True
 
     @field_validator("database", mode="before")

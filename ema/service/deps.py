@@ -13,12 +13,12 @@ from typing import Annotated
 from fastapi import Depends, Path, Request
 from starlette.concurrency import run_in_threadpool
 
-from ema.estimate.config import PipelineConfig, validated
+from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import Note
 from ema.history.open import History
 from ema.model.actuator import THESIS, ActuatorDocument
 from ema.model.bounds import IDENTIFIER, route_collision
-from ema.model.checks import InputError
+from ema.model.checks import InputError, validated
 from ema.prognosis.documents import Prognosis, Stored
 from ema.prognosis.prognose import prognose
 from ema.service.config import Settings
@@ -70,7 +70,7 @@ def request_config(settings: Settings, **overrides: int | None) -> PipelineConfi
         ceiling = getattr(settings, CEILINGS.get(name, ""), None)
         if ceiling is not None and value > ceiling:
             raise InputError(f"query.{name}", f"{value} exceeds this service's limit of {ceiling}")
-    return validated(PipelineConfig, {**settings.pipeline.model_dump(), **given}, prefix="query.")
+    return validated(PipelineConfig, {**settings.pipeline.model_dump(), **given}, "query", prefix="query.")
 
 
 def document_of(store: History, actuator_id: str) -> tuple[ActuatorDocument, int | None]:

@@ -32,6 +32,7 @@ import json
 import math
 import time
 from dataclasses import dataclass
+from typing import Any
 
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
@@ -61,11 +62,18 @@ class UploadsFullError(Exception):
 
 @dataclass(frozen=True)
 class BodyLimits:
+    """The body limits of the service's ``Settings`` (where each is defined, with its default and bound)."""
+
     max_body_bytes: int
-    body_timeout_s: float = 60.0
-    body_grace_s: float = 5.0
-    min_body_rate_bps: float = 1000.0
-    max_upload_bytes: int = 512_000_000
+    body_timeout_s: float
+    body_grace_s: float
+    min_body_rate_bps: float
+    max_upload_bytes: int
+
+    @classmethod
+    def of(cls, settings: Any) -> BodyLimits:
+        """The limits ``settings`` (an ``ema.service.config.Settings``) sets."""
+        return cls(**{name: getattr(settings, name) for name in cls.__dataclass_fields__})
 
 
 def error_body(loc: list[str], message: str, kind: str) -> bytes:

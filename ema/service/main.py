@@ -92,13 +92,7 @@ def create_app(settings: Settings) -> FastAPI:
     app.state.prognoses = Prognoses()
     app.openapi = lambda: _openapi(app)  # type: ignore[method-assign]
     errors.install(app)
-    limits = BodyLimits(
-        max_body_bytes=settings.max_body_bytes,
-        body_timeout_s=settings.body_timeout_s,
-        body_grace_s=settings.body_grace_s,
-        min_body_rate_bps=settings.min_body_rate_bps,
-        max_upload_bytes=settings.max_upload_bytes,
-    )
+    limits = BodyLimits.of(settings)
     app.add_middleware(
         Guard,
         key=settings.key_bytes(),

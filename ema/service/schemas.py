@@ -1,7 +1,7 @@
 """The service's own request and response models; the documents themselves are defined once, below:
 ``ema.model.window.WindowDocument``, ``ema.estimate.documents.Estimate``,
 ``ema.calibration.documents.CalibrationReport``,
-``ema.prognosis.documents.History`` and ``Prognosis``."""
+``ema.prognosis.documents.EstimateHistory`` and ``Prognosis``."""
 
 from __future__ import annotations
 

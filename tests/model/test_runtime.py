@@ -13,7 +13,7 @@ def test_configure_puts_every_blas_numpy_loaded_on_one_thread():
     script = (
         "import numpy as np; from threadpoolctl import threadpool_info; from ema.model import runtime; "
         "np.linalg.lstsq(np.eye(3), np.ones(3), rcond=None); "
-        "runtime.configure(2); "
+        "runtime.configure_simulator(2); "
         "blas = [p for p in threadpool_info() if p['user_api'] == 'blas']; "
         "print(len(blas), max(p['num_threads'] for p in blas), runtime.threads())"
     )
@@ -79,14 +79,15 @@ def test_work_the_pool_runs_may_use_the_pool_again_without_waiting_for_ever():
 
 @pytest.mark.slow
 def test_the_interleaved_lane_loop_computes_what_the_plain_one_does():
-    """``configure`` has LLVM interleave three vectors of lanes an iteration: the same arithmetic per lane, so
+    """``configure_simulator`` has LLVM interleave three vectors of lanes an iteration: the same arithmetic per lane, so
     48 lanes record what one lane at a time records, and what a kernel compiled without the option records
     (each process compiles afresh in a cache of its own: the plain kernel never reaches the shared cache)."""
     script = (
         "import sys, numpy as np; from ema.model import runtime; from ema.model.actuator import THESIS; "
         "from ema.model.batch import simulate_batch; from ema.model.commands import random_command_knots; "
         "from ema.model.params import DEFAULT_RANGES, HealthParams; "
-        "runtime.configure(1) if sys.argv[1] == 'configured' else setattr(runtime._BUDGET, 'compiler_set', True); "
+        "runtime.configure_simulator(1) if sys.argv[1] == 'configured' "
+        "else setattr(runtime._BUDGET, 'compiler_set', True); "
         "rng = np.random.default_rng(5); health = HealthParams.uniform(48, DEFAULT_RANGES, rng); "
         "knots = random_command_knots(300, 10_000.0, rng)[0]; "
         "runs = [simulate_batch(knots, health, lanes=k, actuator=THESIS.params) for k in (48, 1)]; "

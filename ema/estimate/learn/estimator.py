@@ -13,7 +13,7 @@ from dataclasses import replace
 import numpy as np
 import torch
 
-from ema.estimate.learn.network import FitResult, TrainConfig, fit
+from ema.estimate.learn.network import FitResult, LearnConfig, fit
 from ema.estimate.simulate.design import Box
 from ema.model.checks import InputError
 
@@ -22,15 +22,15 @@ class NetworkRegressor:
     """Networks from inputs to targets already in box units (0 and 1 at the box's edges): the members' mean,
     unclipped. scikit-learn shape: settings in ``__init__``, ``fit`` returns self, learned values end in ``_``."""
 
-    def __init__(self, train: TrainConfig = TrainConfig(), members: int = 1) -> None:
-        self.train = train
+    def __init__(self, learn: LearnConfig = LearnConfig(), members: int = 1) -> None:
+        self.learn = learn
         self.members = members
 
     def fit(self, inputs: np.ndarray, unit_targets: np.ndarray) -> NetworkRegressor:
         if not 1 <= self.members <= 20:
             raise InputError("members", f"must be in [1, 20], got {self.members}")
         self.fits_: list[FitResult] = [
-            fit(inputs, unit_targets, replace(self.train, seed=self.train.seed + member))
+            fit(inputs, unit_targets, replace(self.learn, seed=self.learn.seed + member))
             for member in range(self.members)
         ]
         return self
@@ -45,12 +45,12 @@ class NetworkRegressor:
 class NetworkEstimator:
     """FDJ and η_O through a ``Box`` (the rotary pipeline's targets), by a ``NetworkRegressor``."""
 
-    def __init__(self, train: TrainConfig = TrainConfig(), members: int = 1) -> None:
-        self.train = train
+    def __init__(self, learn: LearnConfig = LearnConfig(), members: int = 1) -> None:
+        self.learn = learn
         self.members = members
 
     def fit(self, inputs: np.ndarray, fdj_nm: np.ndarray, eta_o: np.ndarray, box: Box) -> NetworkEstimator:
-        self.regressor_ = NetworkRegressor(self.train, self.members).fit(inputs, box.normalize(fdj_nm, eta_o))
+        self.regressor_ = NetworkRegressor(self.learn, self.members).fit(inputs, box.normalize(fdj_nm, eta_o))
         self.fits_ = self.regressor_.fits_
         self.box_ = box
         return self

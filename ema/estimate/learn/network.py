@@ -31,7 +31,7 @@ OPTIMIZERS = ("lbfgs", "adam")
 
 
 @dataclass(frozen=True)
-class TrainConfig:
+class LearnConfig:
     hidden: int = 100  # hidden neurons
     max_epochs: int = 1000
     max_validation_failures: int = 12
@@ -136,7 +136,7 @@ def _mse(model: ShallowNet, z: torch.Tensor, y: torch.Tensor) -> float:
         return float(torch.mean((model.head(z) - y) ** 2))
 
 
-def _optimizer(model: ShallowNet, config: TrainConfig) -> torch.optim.Optimizer:
+def _optimizer(model: ShallowNet, config: LearnConfig) -> torch.optim.Optimizer:
     if config.optimizer == "adam":
         return torch.optim.Adam(model.parameters(), lr=config.learning_rate)
     return torch.optim.LBFGS(
@@ -157,7 +157,7 @@ def _snapshot(model: nn.Module) -> dict[str, torch.Tensor]:
     return {name: value.detach().clone() for name, value in model.state_dict().items()}
 
 
-def fit(inputs: np.ndarray, targets: np.ndarray, config: TrainConfig) -> FitResult:
+def fit(inputs: np.ndarray, targets: np.ndarray, config: LearnConfig) -> FitResult:
     """Train one network on (N, F) inputs and (N, T) targets in [0, 1]; seeded end to end."""
     start = time.perf_counter()
     torch.manual_seed(config.seed)

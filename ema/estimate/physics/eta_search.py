@@ -10,21 +10,44 @@ form it must equal.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 from numba import njit
 from numba.extending import register_jitable
 
 from ema.model.params import eta_a_of, load_factors
 
-ETA_O_SEARCH = (0.20, 0.999)  # η_O searched over; Case 1C reaches 0.44
+ETA_O_SEARCH = (0.20, 0.999)  # η_O searched over, by every search and profile of it in ema; Case 1C reaches 0.44
 GRID_POINTS = 41
 REFINEMENTS = 3  # coarse-to-fine passes: η_O to ~1e-5
+PROFILE_STEP = 0.005  # a likelihood profile over η_O (its width gives the std) is drawn at this step
 # An offset needs motion both ways: with fewer than this share of the samples in the rarer direction,
 # it cannot be told from FDJ and is not fitted. ΔC, γ and ΔJ need columns that vary: a coefficient of
 # variation below this, and they cannot be told from FDJ either.
 MIN_OFFSET_BALANCE = 0.05
 MIN_VARIATION = 0.05
 RIDGE = 1e-12  # relative: two nuisances nearly dependent (speeds set by the direction) stay solvable
+
+
+def coarse_to_fine(score: Callable[[np.ndarray], np.ndarray]) -> tuple[float, np.ndarray, int]:
+    """(best η_O, the last grid, the best's index in it) of ``score`` (G,) -> (G,), minimized over ``GRID_POINTS``
+    points of ``ETA_O_SEARCH``, ``REFINEMENTS`` times, each grid spanning ± one step around the last one's best
+    (the score is smooth and unimodal in η_O). ``_search`` runs the same schedule compiled, row by row."""
+    low, high = ETA_O_SEARCH
+    for _ in range(REFINEMENTS):
+        grid = np.linspace(low, high, GRID_POINTS)
+        best = int(np.argmin(score(grid)))
+        step = grid[1] - grid[0]
+        low, high = max(grid[best] - step, ETA_O_SEARCH[0]), min(grid[best] + step, ETA_O_SEARCH[1])
+    return float(grid[best]), grid, best
+
+
+def profile_grid() -> np.ndarray:
+    """η_O every ``PROFILE_STEP`` over ``ETA_O_SEARCH``: where a likelihood profile is drawn whole (the
+    quasi-static reading's, the drive fit's), its width being the std."""
+    low, high = ETA_O_SEARCH
+    return low + PROFILE_STEP * np.arange(int((high - low) / PROFILE_STEP + 1e-9) + 1)
 
 
 def fitted_terms(stats: np.ndarray, nuisances: tuple[str, ...]) -> np.ndarray:

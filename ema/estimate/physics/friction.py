@@ -113,6 +113,19 @@ class FrictionFit:
         return {"FDJ": self.fdj_nm[row], "eta_O": self.eta_o[row]}
 
 
+def sliding_mask(
+    signals: Mapping[str, np.ndarray], rate: float, actuator: DriveConstants, settings: FitSettings = FitSettings()
+) -> np.ndarray:
+    """The samples Eq. 5.1 reads, shaped as the speed given ((n,) or (N, n)): the shaft past the sliding speed
+    throughout a reconstruction kernel (one sign of the speed, so one sign of its friction), away from the end
+    stops. Every rule that counts or weighs sliding samples reads this one."""
+    speed = np.asarray(signals["motor_speed_radps"])
+    width = kernel_samples(rate, settings.derivative_window_s)
+    mask = above_throughout(np.abs(np.atleast_2d(speed)), settings.sliding_speed_radps(actuator), width)
+    mask &= np.abs(np.atleast_2d(signals["position_deg"])) < actuator.end_stop_deg - END_STOP_MARGIN_DEG
+    return mask if speed.ndim > 1 else mask[0]
+
+
 def regressors(
     signals: Mapping[str, np.ndarray],
     rate: float,
@@ -131,9 +144,7 @@ def regressors(
         residual_nm = residual_torque_nm(current, speed, hinge, rate, actuator, window_s)
     residual = np.atleast_2d(residual_nm)
     load = smoothed(np.atleast_2d(signals["hinge_moment_nm"]) / actuator.gear_ratio, rate, window_s)
-    width = kernel_samples(rate, window_s)
-    sliding = above_throughout(np.abs(speed), settings.sliding_speed_radps(actuator), width)  # one sign throughout
-    sliding &= np.abs(np.atleast_2d(signals["position_deg"])) < actuator.end_stop_deg - END_STOP_MARGIN_DEG
+    sliding = np.atleast_2d(sliding_mask(signals, rate, actuator, settings))
     direction = np.sign(speed)
     aiding = load * direction > 0
     aid = smoothed(np.abs(load) * aiding, rate, window_s)

@@ -34,6 +34,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ema.estimate.stats import rms
 from ema.model.checks import InputError
 
 FILTER_ORDER = 4  # the position's Butterworth low-pass
@@ -259,7 +260,7 @@ def fit_inverse(
         values=dict(zip(names, beta.tolist(), strict=True)),
         stds=dict(zip(names, stds.tolist(), strict=True)),
         error_pct=float(100.0 * np.linalg.norm(residual) / max(float(np.linalg.norm(y)), 1e-300)),
-        residual_rms_n=float(np.sqrt(np.mean(residual**2))),
+        residual_rms_n=rms(residual),
         samples=len(y),
         residual_by_row=by_row,
     )

@@ -14,6 +14,7 @@ import numpy as np
 from ema.estimate.stats import rms
 from ema.model.aircraft import FlightCondition, HingeGeometry, Load, LoggedLoad
 from ema.model.batch import BatchResult, InitialState, simulate_batch
+from ema.model.bounds import DEFAULT_SAMPLE_RATE_HZ
 from ema.model.commands import knots_from_samples
 from ema.model.effects import EffectSet
 from ema.model.noise import SensorNoise
@@ -44,7 +45,7 @@ class Scenario:
     command_knots_deg: np.ndarray  # (n_samples + 1,) one command (Case 1) or (n_sims, n_samples + 1) (Case 2)
     load: Load = field(default_factory=FlightCondition)
     initial: InitialState = field(default_factory=InitialState)
-    sample_rate_hz: float = 10_000.0
+    sample_rate_hz: float = DEFAULT_SAMPLE_RATE_HZ
     effects: EffectSet = field(default_factory=EffectSet)
 
     @property

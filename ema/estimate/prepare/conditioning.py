@@ -50,11 +50,12 @@ from ema.estimate.prepare.step_lag import StepLag, step_lag, step_lag_note
 from ema.estimate.prepare.verdict import check_consistency, kinematics_note
 from ema.model.actuator import ActuatorDocument
 from ema.model.batch import COMMAND_MARGIN_DEG
+from ema.model.bounds import DEFAULT_SAMPLE_RATE_HZ
 from ema.model.noise import NOISY_SIGNALS
 from ema.model.params import DriveConstants
 from ema.model.window import Window
 
-MAX_RATE_HZ = 10_000.0
+MAX_RATE_HZ = DEFAULT_SAMPLE_RATE_HZ
 MAX_SAMPLES = int(10.0 * KERNEL_FREE_RATE_HZ)  # a 10 s window (0.1–10 s are answered) at the unbiased rate
 GLITCH_STDS = 30.0
 GLITCH_ACTIVITY = 5.0

@@ -20,6 +20,7 @@ import numpy as np
 
 from ema.estimate.documents import Note
 from ema.estimate.physics.inverse import Motion, fit_inverse, inverse_columns, load_motion
+from ema.estimate.stats import rms
 from ema.model.actuator import ActuatorDocument
 from ema.model.checks import InputError
 from ema.model.servo import Servo
@@ -85,8 +86,8 @@ def _controller_note(servo: Servo, window: Window) -> Note | None:
     assert gain is not None  # completed
     logged = s["drive_force_n"] / gain
     rate = window.sample_rate_hz
-    off = np.sqrt(np.mean((logged[1:] - commanded(servo, s["set_point_m"], s["position_m"], rate)[1:]) ** 2))
-    share = float(off / max(np.sqrt(np.mean(logged**2)), 1e-300))
+    off = rms(logged[1:] - commanded(servo, s["set_point_m"], s["position_m"], rate)[1:])
+    share = float(off / max(rms(logged), 1e-300))
     if share <= CONTROLLER_TOLERANCE:
         return None
     return Note(

@@ -39,7 +39,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ema.estimate.documents import Note
-from ema.estimate.physics.friction import MIN_SLIDING_KERNELS, FitSettings
+from ema.estimate.physics.friction import MIN_SLIDING_KERNELS, FitSettings, sliding_mask
 from ema.estimate.physics.noise import white_noise_std
 from ema.model.checks import InputError
 from ema.model.noise import NOISY_SIGNALS
@@ -180,7 +180,7 @@ def best_stretch(window: Window, runs: tuple[StaleRun, ...], actuator: DriveCons
     for run in runs:
         free[run.start : run.stop] = False
     starts, stops = edges(free)
-    moving = np.abs(window.signals["motor_speed_radps"]) > FitSettings().sliding_speed_radps(actuator)
+    moving = sliding_mask(window.signals, window.sample_rate_hz, actuator)
     sliding = np.cumsum(np.concatenate([[0], moving & free]))
     if not len(starts):
         return 0, 0, 0

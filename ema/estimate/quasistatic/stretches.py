@@ -33,6 +33,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ema.estimate.physics.eta_search import profile_grid
+from ema.estimate.stats import rms
 from ema.model.params import eta_a_of, load_factors
 from ema.model.window import Window
 
@@ -41,7 +43,7 @@ SETTLE_S = 0.4  # after a change of speed, the drive settles this long before a 
 REST_SETTLE_S = 1.5  # after the motion stops, the drive's current settles this long before it reads I0
 MIN_STRETCH_S = 1.0  # a stretch at constant speed, or at rest, this long at least (after settling)
 SPEED_TOLERANCE = 0.02  # constant speed: within this share of the stretch's own speed
-ETA_GRID = np.linspace(0.30, 0.99, 139)
+ETA_GRID = profile_grid()  # η_O's profile, over the search's range
 MIN_LOAD_SPREAD = 0.2  # |T_L| must vary by this share of its mean for a window to read η_O beside FDJ
 
 
@@ -223,7 +225,7 @@ def _per_nm_read(
         return None, None
     gap = float(np.mean(along[opposing]) - np.mean(along[~opposing]))
     torque_gap = float(np.mean(np.abs(load)) * (1.0 / eta + eta_a_of(eta, gear_ratio)))
-    gap_std = float(np.hypot(np.sqrt(np.mean(stds[opposing] ** 2)), np.sqrt(np.mean(stds[~opposing] ** 2))))
+    gap_std = float(np.hypot(rms(stds[opposing]), rms(stds[~opposing])))
     return gap / torque_gap, gap_std / torque_gap
 
 

@@ -9,7 +9,7 @@ from fastapi import APIRouter, Query, Request
 from starlette.concurrency import run_in_threadpool
 
 from ema.model.actuator import ActuatorDocument
-from ema.prognosis.documents import ActuatorSummary, History, Prognosis, StoredActuator, Withdrawal
+from ema.prognosis.documents import ActuatorSummary, EstimateHistory, Prognosis, StoredActuator, Withdrawal
 from ema.service.deps import ActuatorId, RunnerDep, StoreDep, prognosis_now
 from ema.service.errors import NotStoredError
 from ema.service.parsing import read_body
@@ -32,13 +32,13 @@ async def _known(store: StoreDep, actuator_id: str) -> None:
         raise NotStoredError(actuator_id, "no window or document is stored for it")
 
 
-@router.get("/{actuator_id:path}/estimates", response_model=History, responses=responses(401, 404, 422))
-async def history(actuator_id: ActuatorId, store: StoreDep) -> History:
+@router.get("/{actuator_id:path}/estimates", response_model=EstimateHistory, responses=responses(401, 404, 422))
+async def history(actuator_id: ActuatorId, store: StoreDep) -> EstimateHistory:
     """Every stored estimate of the actuator, oldest first, one per window; withdrawn ones apart."""
     await _known(store, actuator_id)
     current, legacy = await run_in_threadpool(store.history, actuator_id)
     withdrawn = await run_in_threadpool(store.withdrawals, actuator_id)
-    return History(actuator_id=actuator_id, estimates=current, legacy=legacy, withdrawn=withdrawn)
+    return EstimateHistory(actuator_id=actuator_id, estimates=current, legacy=legacy, withdrawn=withdrawn)
 
 
 @router.delete(

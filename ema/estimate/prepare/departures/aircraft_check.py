@@ -150,7 +150,7 @@ def check_against_aircraft(window: Window, hinge: HingeGeometry | None, toleranc
         f"its part that follows the deflection is {read.ratio:.3g} ± {read.ratio_std:.2g}x the aircraft's at "
         f"{condition.airspeed_mps:g} m/s, {condition.altitude_m:g} m (q̄·S_e·c_e·C_hδ = {per_deg:.3g} N·m/deg)"
     )
-    shifted = out_of_step(bands, noise_var, per_deg, rate, correlation, span=span, tolerance=tolerance)
+    shifted = lag_against_aircraft(bands, noise_var, per_deg, rate, correlation, span=span, tolerance=tolerance)
     if shifted is not None:
         lag_s, at_lag, unexplained = shifted
         raise InputError(
@@ -169,7 +169,7 @@ def check_against_aircraft(window: Window, hinge: HingeGeometry | None, toleranc
     return read
 
 
-def out_of_step(
+def lag_against_aircraft(
     bands: tuple[np.ndarray, np.ndarray],
     noise_var: float,
     per_deg: float,

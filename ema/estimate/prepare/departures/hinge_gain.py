@@ -31,7 +31,7 @@ from ema.estimate.documents import Note
 from ema.estimate.physics.features import as_read, fit_as_read
 from ema.estimate.physics.friction import MIN_SLIDING_KERNELS, FitSettings, nuisance_columns, regressors
 from ema.estimate.prepare.departures.drive_constants import BESIDE, FIELDS
-from ema.estimate.stats import DECISIVE_Z, JACKKNIFE_BLOCKS, jackknife_std, rms_log_likelihood_ratio
+from ema.estimate.stats import DECISIVE_Z, JACKKNIFE_BLOCKS, jackknife_std, rms, rms_log_likelihood_ratio
 from ema.model.params import DriveConstants
 from ema.model.residual import DEFAULT_DERIVATIVE_WINDOW_S, kernel_samples
 from ema.model.window import Window
@@ -90,8 +90,8 @@ def free_load_fit(
     keep = [sliding] + [sliding & (blocks != b) for b in range(JACKKNIFE_BLOCKS)]
     betas = np.array([np.linalg.lstsq(columns[k], t[k], rcond=None)[0] for k in keep])
     eta_o = eta_o_from_product((1 - betas[:, 1]) / (1 + betas[:, 2]), actuator.gear_ratio)
-    rms = float(np.sqrt(np.mean((t[sliding] - columns[sliding] @ betas[0]) ** 2)))
-    return 1.0 / ((1 + betas[:, 2]) * eta_o), rms, used
+    misfit = rms(t[sliding] - columns[sliding] @ betas[0])
+    return 1.0 / ((1 + betas[:, 2]) * eta_o), misfit, used
 
 
 def _margin(window: Window, actuator: DriveConstants, free_rms: float, used: int, rivals: list[FitSettings]) -> float:
