@@ -20,6 +20,7 @@ import numpy as np
 
 from ema.cli.report import write_section
 from ema.prognosis.outlook import outlook
+from ema.prognosis.trend import Series
 from tests.prognosis.histories import LAWS, THRESHOLD, history
 
 PROGNOSIS_MD = Path(__file__).resolve().parent.parent / "docs" / "prognosis.md"
@@ -36,9 +37,8 @@ def score(law: str, n: int, std: float, histories: int) -> dict[str, float]:
     errors = []
     for seed in range(histories):
         h = history(law, 9000 + seed, n=n, std=std)
-        life = outlook(
-            "FDJ", h.hours, h.values, h.stds, [str(i) for i in range(n)], threshold=THRESHOLD, direction="above"
-        ).life
+        series = Series("FDJ", h.hours, h.values, h.stds, [str(i) for i in range(n)])
+        life = outlook(series, threshold=THRESHOLD, direction="above").life
         if law == "steady":
             alarms += life.status == "crossing predicted"
             continue

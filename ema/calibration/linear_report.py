@@ -91,18 +91,10 @@ def _learned(runs: list[Run], fit: DriveFit, actuator: ActuatorDocument, started
             "second load"
         ]
     )
+    fitted = {name: getattr(fit, name) for name in DriveLearned.model_fields if hasattr(fit, name)}  # c, I0, FDJ, …
     drive = DriveLearned(
+        **fitted,
         runs=len(runs),
-        loads_n=fit.loads_n,
-        current_per_nm_a=fit.current_per_nm_a,
-        current_per_nm_std_a=fit.current_per_nm_std_a,
-        current_at_zero_torque_a=fit.current_at_zero_torque_a,
-        current_at_zero_torque_std_a=fit.current_at_zero_torque_std_a,
-        fdj_nm=fit.fdj_nm,
-        fdj_std_nm=fit.fdj_std_nm,
-        eta_o=fit.eta_o,
-        eta_o_std=fit.eta_o_std,
-        repeatability_nm=fit.repeatability_nm,
         run_to_run_nm=None if fit.spread is None else fit.spread.run_to_run_nm,
         healthy_set_nm=None if fit.spread is None else fit.spread.set_nm,
         not_separable=unread,

@@ -27,6 +27,7 @@ from ema.estimate.documents import (
 )
 from ema.estimate.documents.window import InertiaReading, SensorZero, WindowInfo
 from ema.estimate.learn.estimator import NetworkEstimator
+from ema.estimate.learn.network import FitResult
 from ema.estimate.physics.friction import FrictionFit, sliding_mask
 from ema.estimate.physics.static_friction import StaticFriction
 from ema.estimate.prepare.conditioning import Prepared, conditioning_done, conditioning_notes
@@ -180,20 +181,30 @@ def _window_info(prepared: Prepared, data: Data, digest: str) -> WindowInfo:
     if drive.inertia_kgm2 and not prepared.departures.inertia_from and not offset.one_way and unbiased:
         std = drive.stds["inertia_kgm2"] / drive.spec.inertia_kgm2
         inertia = InertiaReading(factor=drive.inertia_factor, std=std, window_ids=[w.window_id])
-    return WindowInfo(
-        content_sha256=digest,
-        n_samples=prepared.original_samples,
+    return WindowInfo.logged(
+        w,
+        digest,
+        n_samples=prepared.original_samples,  # as logged, before averaging
         duration_s=prepared.original_samples / prepared.original_rate_hz,
         sample_rate_hz=prepared.original_rate_hz,
         processed_rate_hz=w.sample_rate_hz,
         **conditioning_done(prepared),
         sliding_fraction=float(np.mean(data.sliding)),
-        recorded_at=w.recorded_at,
-        flight_hours=w.flight_hours,
-        flight_id=w.flight_id,
         sensor_zero=zero if offset.read else None,
         sensor_zero_from=offset.carried_from,
         inertia_read=inertia,
+    )
+
+
+def training_info(fit: FitResult, config: PipelineConfig) -> TrainingInfo:
+    """The network's training as an answer reports it: ``fit``, the first member's ``FitResult``."""
+    return TrainingInfo(
+        epochs=fit.epochs,
+        stop_reason=fit.stop_reason,
+        val_mse=fit.val_mse,
+        test_mse=fit.test_mse,
+        members=config.members,
+        hidden_units=config.hidden_units,
     )
 
 
@@ -239,14 +250,7 @@ def estimate_document(
             noise_estimated=data.noise.as_dict(),
             box={"FDJ": data.box.fdj_nm, "eta_O": data.box.eta_o},
         ),
-        training=TrainingInfo(
-            epochs=first.epochs,
-            stop_reason=first.stop_reason,
-            val_mse=first.val_mse,
-            test_mse=first.test_mse,
-            members=config.members,
-            hidden_units=config.hidden_units,
-        ),
+        training=training_info(first, config),
         methods=answer.methods,
         fit_check=check,
         window=_window_info(prepared, data, digest),

@@ -31,7 +31,6 @@ from ema.estimate.documents import (
     FitCheck,
     Note,
     Timings,
-    TrainingInfo,
     parameter,
 )
 from ema.estimate.documents.window import WindowInfo
@@ -48,6 +47,7 @@ from ema.estimate.physics.inverse import (
 )
 from ema.estimate.physics.scenario import MAX_RATIO
 from ema.estimate.prepare.servo import ServoPrepared, prepare_servo
+from ema.estimate.report import training_info
 from ema.estimate.simulate.servo import ServoData, lane_parameters, simulate_servo_dataset
 from ema.estimate.stats import rms
 from ema.estimate.stopwatch import Stopwatch
@@ -244,27 +244,15 @@ def _report(
             noise_estimated={"position_resolution_m": prepared.loop.resolution_m},
             box={name: (float(lo), float(hi)) for name, lo, hi in zip(data.targets, data.low, data.high, strict=True)},
         ),
-        training=TrainingInfo(
-            epochs=fit.epochs,
-            stop_reason=fit.stop_reason,
-            val_mse=fit.val_mse,
-            test_mse=fit.test_mse,
-            members=config.members,
-            hidden_units=config.hidden_units,
-        ),
+        training=training_info(fit, config),
         methods={"FDJ" if name == FDJ else name: report for name, report in answer.methods.items()},
         fit_check=check,
-        window=WindowInfo(
-            content_sha256=window.content_sha256(),
-            n_samples=window.n_samples,
-            duration_s=window.duration_s,
-            sample_rate_hz=window.sample_rate_hz,
+        window=WindowInfo.logged(
+            window,
+            window.content_sha256(),
             processed_rate_hz=window.sample_rate_hz / prepared.motion.decimation,
             command_clipped_fraction=0.0,
             sliding_fraction=float(np.mean(prepared.motion.sliding)),
-            recorded_at=window.recorded_at,
-            flight_hours=window.flight_hours,
-            flight_id=window.flight_id,
         ),
         config=config,
     )

@@ -10,7 +10,7 @@ from __future__ import annotations
 import sqlalchemy as sa
 
 from ema.history.errors import StorageError
-from ema.history.schema import ForeignTablesError, upgrade
+from ema.history.schema import opening, upgrade
 from ema.history.sql import SqlHistory
 
 
@@ -27,15 +27,8 @@ def open_postgres(address: str) -> SqlHistory:
         raise StorageError(address.split("@")[-1], f"is not a database address ({exc})") from None
     location = shown(url)
     engine = sa.create_engine(url, pool_pre_ping=True, pool_size=8, max_overflow=8)
-    try:
+    with opening(engine, location, "cannot be opened"):
         upgrade(engine)
-    except ForeignTablesError as exc:
-        engine.dispose()
-        raise StorageError(location, str(exc)) from None
-    except sa.exc.SQLAlchemyError as exc:
-        engine.dispose()
-        reason = str(getattr(exc, "orig", exc)).strip().splitlines()[0]
-        raise StorageError(location, f"cannot be opened ({reason})") from None
 
     def probe() -> None:
         try:

@@ -8,6 +8,8 @@ migrated like any other. Replicas that start together on one PostgreSQL migrate 
 
 from __future__ import annotations
 
+import contextlib
+from collections.abc import Iterator
 from pathlib import Path
 
 import sqlalchemy as sa
@@ -100,3 +102,21 @@ def _round_three(connection: sa.Connection, tables: set[str]) -> None:
             "CREATE TABLE actuators (actuator_id TEXT NOT NULL, version INTEGER NOT NULL, stored_at TEXT NOT NULL, "
             "document TEXT NOT NULL, PRIMARY KEY (actuator_id, version))"
         )
+
+
+@contextlib.contextmanager
+def opening(engine: sa.Engine, location: object, unusable: str) -> Iterator[None]:
+    """The steps that open a history (its tables checked, upgraded): where one fails, the engine is let go and a
+    StorageError names ``location``, another program's tables as such, a database error as ``unusable`` with
+    its reason's first line."""
+    from ema.history.errors import StorageError
+
+    try:
+        yield
+    except ForeignTablesError as exc:
+        engine.dispose()
+        raise StorageError(location, str(exc)) from None
+    except sa.exc.SQLAlchemyError as exc:
+        engine.dispose()
+        reason = str(getattr(exc, "orig", exc)).strip().splitlines()[0]
+        raise StorageError(location, f"{unusable} ({reason})") from None

@@ -102,25 +102,16 @@ class SqlHistory(SqlStore):
             ).first()
             if row is None:
                 return None
-            connection.execute(
-                withdrawals.insert().values(
-                    actuator_id=actuator_id,
-                    window_id=window_id,
-                    withdrawn_at=withdrawn_at,
-                    reason=reason,
-                    stored_at=row.stored_at,
-                    content_sha256=row.content_sha256,
-                    result=row.result,
-                )
+            withdrawal = Withdrawal(
+                actuator_id=actuator_id,
+                window_id=window_id,
+                withdrawn_at=withdrawn_at,
+                reason=reason,
+                stored_at=row.stored_at,
+                content_sha256=row.content_sha256,
             )
-        return Withdrawal(
-            actuator_id=actuator_id,
-            window_id=window_id,
-            withdrawn_at=withdrawn_at,
-            reason=reason,
-            stored_at=row.stored_at,
-            content_sha256=row.content_sha256,
-        )
+            connection.execute(withdrawals.insert().values(**withdrawal.model_dump(), result=row.result))
+        return withdrawal
 
     def withdrawals(self, actuator_id: str) -> list[Withdrawal]:
         """The actuator's withdrawn windows, oldest withdrawal first."""

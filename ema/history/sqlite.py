@@ -22,7 +22,7 @@ from typing import Any
 import sqlalchemy as sa
 
 from ema.history.errors import StorageError
-from ema.history.schema import ForeignTablesError, upgrade
+from ema.history.schema import opening, upgrade
 from ema.history.sql import SqlHistory
 
 log = logging.getLogger("ema.history")
@@ -97,16 +97,11 @@ def open_sqlite(path: Path, min_free_bytes: int = MIN_FREE_BYTES) -> SqlHistory:
     engine = sa.create_engine(f"sqlite:///{path}", connect_args={"check_same_thread": False, "timeout": 30})
     sa.event.listen(engine, "connect", _pragmas)
     try:
-        if path.exists() and path.stat().st_size:
-            _check_tables(engine, path)
-        _private(path)
-        upgrade(engine)
-    except ForeignTablesError as exc:
-        engine.dispose()
-        raise StorageError(path, str(exc)) from None
-    except sa.exc.SQLAlchemyError as exc:
-        engine.dispose()
-        raise StorageError(path, f"is not a usable SQLite database ({getattr(exc, 'orig', exc)})") from None
+        with opening(engine, path, "is not a usable SQLite database"):
+            if path.exists() and path.stat().st_size:
+                _check_tables(engine, path)
+            _private(path)
+            upgrade(engine)
     except OSError as exc:
         engine.dispose()
         raise StorageError(path, f"cannot be opened ({exc.strerror})") from None

@@ -12,6 +12,8 @@ from ema.calibration.plot import ResidualPlot
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import ActuatorRead, Estimate
 from ema.estimate.documents.window import HistoryReadings
+from ema.estimate.quasistatic.drive import QuasiStaticReading
+from ema.estimate.quasistatic.pipeline import estimate_low_rate
 from ema.model.actuator import THESIS, ActuatorDocument
 from ema.model.kinds import KindFacts
 from ema.model.window import Window
@@ -61,6 +63,19 @@ class Cost:
 
     simulated_s: float
     window_s: float
+
+
+def read_quasi_statically(window: Window, request: Request, reading: QuasiStaticReading) -> Estimate:
+    """``window`` read at constant-speed stretches, a drive's current as torque by ``reading``
+    (``ema.estimate.quasistatic``): a kind's low-rate reading, as ``request`` asks it."""
+    return estimate_low_rate(
+        window,
+        request.config,
+        reading=reading,
+        actuator=request.actuator,
+        read_with=request.read_with,
+        on_stage=request.on_stage,
+    )
 
 
 class ActuatorKind(Protocol):

@@ -14,8 +14,8 @@ from ema.calibration.linear_report import calibrate_linear
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import Estimate
 from ema.estimate.quasistatic.drive import STEPPER_READING
-from ema.estimate.quasistatic.pipeline import QUASI_STATIC, estimate_low_rate
-from ema.kinds.base import Calibrated, CalibrationRequest, Cost, Request
+from ema.estimate.quasistatic.pipeline import QUASI_STATIC
+from ema.kinds.base import Calibrated, CalibrationRequest, Cost, Request, read_quasi_statically
 from ema.model.kinds import KINDS, KindFacts
 from ema.model.window import Window
 
@@ -28,14 +28,7 @@ class Linear:
         return QUASI_STATIC
 
     def estimate(self, window: Window, request: Request) -> Estimate:
-        return estimate_low_rate(
-            window,
-            request.config,
-            reading=STEPPER_READING,
-            actuator=request.actuator,
-            read_with=request.read_with,
-            on_stage=request.on_stage,
-        )
+        return read_quasi_statically(window, request, STEPPER_READING)
 
     def calibrate(self, windows: Sequence[Window], request: CalibrationRequest) -> Calibrated:
         report, completed, plot = calibrate_linear(windows, request.actuator, request.truth)

@@ -18,8 +18,8 @@ from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import STAGES, Estimate
 from ema.estimate.pipeline import estimate_window
 from ema.estimate.quasistatic.drive import MOTOR_READING
-from ema.estimate.quasistatic.pipeline import QUASI_STATIC, estimate_low_rate
-from ema.kinds.base import Calibrated, CalibrationRequest, Cost, Request
+from ema.estimate.quasistatic.pipeline import QUASI_STATIC
+from ema.kinds.base import Calibrated, CalibrationRequest, Cost, Request, read_quasi_statically
 from ema.model.checks import InputError
 from ema.model.kinds import KINDS, KindFacts
 from ema.model.window import HIGH_RATE_HZ, Window
@@ -44,14 +44,7 @@ class Rotary:
 
     def estimate(self, window: Window, request: Request) -> Estimate:
         if not window.high_rate:
-            return estimate_low_rate(
-                window,
-                request.config,
-                reading=MOTOR_READING,
-                actuator=request.actuator,
-                read_with=request.read_with,
-                on_stage=request.on_stage,
-            )
+            return read_quasi_statically(window, request, MOTOR_READING)
         return estimate_window(
             window,
             request.config,

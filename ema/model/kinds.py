@@ -34,14 +34,21 @@ class Role:
 class KindFacts:
     name: str
     summary: str
-    signals: tuple[str, ...]  # a window's signals, in order
     section: str  # the actuator document's field that holds this kind's constants
     friction_unit: str  # the unit FDJ is read in: "N·m" at the motor shaft, "N" on the load
     roles: Mapping[str, Role]  # log-map role -> signal; "position" may be given as "error" (set point less it)
-    optional_signals: tuple[str, ...] = ()
     nominal_given: bool = False  # the document's author gives the nominal health (else ema calibrate learns it)
     static_friction: bool = False  # a window can show a break-away (FSJ)
     load_side: bool = False  # the log is on the load side: FDJ is the load's friction force
+
+    @property
+    def signals(self) -> tuple[str, ...]:
+        """A window's signals, in order: its required roles'."""
+        return tuple(role.signal for role in self.roles.values() if role.required)
+
+    @property
+    def optional_signals(self) -> tuple[str, ...]:
+        return tuple(role.signal for role in self.roles.values() if not role.required)
 
     @property
     def all_signals(self) -> tuple[str, ...]:
@@ -57,7 +64,6 @@ FRICTION_SUFFIX = MappingProxyType({"N·m": "nm", "N": "n"})
 _ROTARY = KindFacts(
     name="rotary",
     summary="a current-piloted motor and a gear train to a surface",
-    signals=("command_deg", "position_deg", "motor_speed_radps", "current_a", "hinge_moment_nm"),
     section="drive",
     friction_unit="N·m",
     roles=MappingProxyType(
@@ -75,7 +81,6 @@ _ROTARY = KindFacts(
 _LINEAR = KindFacts(
     name="linear",
     summary="a ball screw turned by a stepper, its current read through what ema calibrate learned",
-    signals=("command_mm", "position_mm", "current_a", "load_n"),
     section="screw",
     friction_unit="N·m",
     roles=MappingProxyType(
@@ -90,8 +95,6 @@ _LINEAR = KindFacts(
 _SERVO = KindFacts(
     name="servo",
     summary="a linear axis driven by a force command from a known position controller, logged on the load side",
-    signals=("set_point_m", "position_m", "drive_force_n"),
-    optional_signals=("load_n",),
     section="servo",
     friction_unit="N",
     roles=MappingProxyType(

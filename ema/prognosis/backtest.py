@@ -11,48 +11,27 @@ crossing dates keep moving in, less.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-
 import numpy as np
 
 from ema.prognosis.documents import BacktestPoint, ForecastPoint
 from ema.prognosis.outlook import outlook
 from ema.prognosis.rul import MIN_WINDOWS
+from ema.prognosis.trend import Series
 
 SHARES = (0.5, 0.65, 0.8)
 Z_90 = 1.645
 
 
-def backtest(
-    parameter: str,
-    times: np.ndarray,
-    values: np.ndarray,
-    stds: np.ndarray,
-    window_ids: Sequence[str],
-    *,
-    threshold: float,
-    direction: str,
-    min_span: float = 0.0,
-) -> list[BacktestPoint]:
+def backtest(series: Series, *, threshold: float, direction: str, min_span: float = 0.0) -> list[BacktestPoint]:
     """The prognosis at ``SHARES`` of the history (in time order), each against the windows after it."""
-    order = np.argsort(times, kind="stable")
-    times, values, stds = times[order], values[order], stds[order]
-    ids = [window_ids[i] for i in order]
+    series = series.in_time_order()
+    times, values, stds, ids = series.times, series.values, series.stds, series.window_ids
     points = []
     for share in SHARES:
         k = round(share * len(times))
         if k < MIN_WINDOWS or k >= len(times) or np.ptp(times[:k]) <= 0:
             continue
-        then = outlook(
-            parameter,
-            times[:k],
-            values[:k],
-            stds[:k],
-            ids[:k],
-            threshold=threshold,
-            direction=direction,
-            min_span=min_span,
-        )
+        then = outlook(series.first(k), threshold=threshold, direction=direction, min_span=min_span)
         life = then.life
         inside = _inside(then.trend.forecast, times[k:], values[k:], stds[k:])
         points.append(

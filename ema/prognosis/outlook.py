@@ -9,7 +9,6 @@ for scatter as a line would.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -19,7 +18,7 @@ from ema.prognosis.documents import BacktestPoint, ForecastPoint, RemainingLife,
 from ema.prognosis.forecast import Forecast, forecast
 from ema.prognosis.laws import LAWS, fit_law
 from ema.prognosis.rul import MIN_WINDOWS, remaining_life
-from ema.prognosis.trend import HUBER_C, excess_variance, fit_trend, robust_fit
+from ema.prognosis.trend import HUBER_C, Series, excess_variance, fit_trend, robust_fit
 from ema.prognosis.weigh import MIN_WINDOWS as MIN_LAW_WINDOWS
 from ema.prognosis.weigh import weigh
 
@@ -90,20 +89,11 @@ def band(fc: Forecast, life: RemainingLife, span: float) -> list[ForecastPoint]:
     ]
 
 
-def outlook(
-    parameter: str,
-    times: np.ndarray,
-    values: np.ndarray,
-    stds: np.ndarray,
-    window_ids: Sequence[str],
-    *,
-    threshold: float,
-    direction: str,
-    min_span: float = 0.0,
-) -> Outlook:
+def outlook(series: Series, *, threshold: float, direction: str, min_span: float = 0.0) -> Outlook:
     """The trend and remaining life of one parameter's history (times in the prognosis's unit); no forecast
     where fewer than ``MIN_WINDOWS`` windows, or windows spanning less than ``min_span``, read it."""
-    trend = fit_trend(parameter, times, values, stds, window_ids)
+    parameter, times, values, stds = series.parameter, series.times, series.values, series.stds
+    trend = fit_trend(series)
     if trend.n < MIN_WINDOWS or trend.slope_std is None:
         return Outlook(trend, remaining_life(parameter, None, threshold, direction))
     if float(np.ptp(times)) < min_span:

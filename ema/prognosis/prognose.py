@@ -15,7 +15,7 @@ from ema.model.actuator import ActuatorDocument, Airframe
 from ema.prognosis.backtest import backtest
 from ema.prognosis.documents import MIN_SPAN, PARAMETERS, Prognosis, RemainingLife, Stored, TimeUnit, Trend
 from ema.prognosis.outlook import Outlook, outlook
-from ema.prognosis.trend import fit_trend
+from ema.prognosis.trend import Series, fit_trend
 
 AIRFRAME_TOLERANCE = Airframe.model_fields["tolerance"].default
 SENSOR_STDS = 3.0  # stds by which a sensor's level or drift must stand out to be said
@@ -92,16 +92,12 @@ def _outlook(
     if not limits:
         return None
     span = MIN_SPAN[unit]
-    each = {
-        (level, way): outlook(name, times_read, values, stds, ids, threshold=level, direction=way, min_span=span)
-        for level, way in limits
-    }
+    series = Series(name, times_read, values, stds, ids)
+    each = {(level, way): outlook(series, threshold=level, direction=way, min_span=span) for level, way in limits}
     (threshold, direction), seen = min(each.items(), key=lambda item: _urgency(item[1].life))
     if not backtested:
         return seen
-    tested = backtest(
-        name, times_read, values, stds, ids, threshold=threshold, direction=direction, min_span=MIN_SPAN[unit]
-    )
+    tested = backtest(series, threshold=threshold, direction=direction, min_span=span)
     return replace(seen, backtest=tested)
 
 
@@ -136,7 +132,9 @@ def sensor_trends(
     if len(read) < 2:
         return {}, []
     t, values, stds, ids = zip(*read, strict=True)
-    trend = fit_trend("hinge_aircraft_ratio", np.array(t), np.array(values), np.array(stds, dtype=float), list(ids))
+    trend = fit_trend(
+        Series("hinge_aircraft_ratio", np.array(t), np.array(values), np.array(stds, dtype=float), list(ids))
+    )
     notes = []
     if abs(trend.level - 1.0) > tolerance + SENSOR_STDS * trend.level_std:
         notes.append(

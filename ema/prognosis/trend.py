@@ -16,6 +16,7 @@ bends. Which law to extrapolate is ``ema.prognosis.weigh``'s question.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -88,10 +89,30 @@ def curved(x: np.ndarray, values: np.ndarray, variance: np.ndarray, line: dict[s
     )
 
 
-def fit_trend(
-    parameter: str, times: np.ndarray, values: np.ndarray, stds: np.ndarray, window_ids: Sequence[str]
-) -> Trend:
-    """The trend of one parameter (times in the prognosis's unit; stds may hold NaN for "unknown")."""
+@dataclass(frozen=True)
+class Series:
+    """One parameter's readings, window by window: what a trend, an outlook and a backtest read (times in the
+    prognosis's unit; stds may hold NaN for "unknown")."""
+
+    parameter: str
+    times: np.ndarray
+    values: np.ndarray
+    stds: np.ndarray
+    window_ids: Sequence[str]
+
+    def in_time_order(self) -> Series:
+        order = np.argsort(self.times, kind="stable")
+        ids = [self.window_ids[i] for i in order]
+        return Series(self.parameter, self.times[order], self.values[order], self.stds[order], ids)
+
+    def first(self, k: int) -> Series:
+        """The first ``k`` readings."""
+        return Series(self.parameter, self.times[:k], self.values[:k], self.stds[:k], self.window_ids[:k])
+
+
+def fit_trend(series: Series) -> Trend:
+    """The trend of one parameter's ``series``."""
+    times, values, stds = series.times, series.values, series.stds
     x = times - times.max()
     known = np.isfinite(stds) & (stds > 0)
     variance = np.where(known, stds, np.median(stds[known]) if known.any() else 0.0) ** 2
@@ -100,29 +121,16 @@ def fit_trend(
     beta, covariance, z = line["beta"], line["covariance"], line["z"]
     points = [
         Point(window_id=w, time=float(t), value=float(v), std=float(s) if k else None, outlier=bool(zz > OUTLIER_Z))
-        for w, t, v, s, k, zz in zip(window_ids, times, values, stds, known, z, strict=True)
+        for w, t, v, s, k, zz in zip(series.window_ids, times, values, stds, known, z, strict=True)
     ]
+    level = {"parameter": series.parameter, "n": len(x), "level": float(beta[0]), "points": points}
+    level |= {"level_std": float(np.sqrt(covariance[0, 0])), "excess_std": float(np.sqrt(line["tau2"]))}
     if not spans_time:  # one time holds no slope: the level alone, said so by a null slope_std
-        level_std = float(np.sqrt(covariance[0, 0]))
-        return Trend(
-            parameter=parameter,
-            n=len(x),
-            level=float(beta[0]),
-            level_std=level_std,
-            slope_per_unit=0.0,
-            slope_std=None,
-            excess_std=float(np.sqrt(line["tau2"])),
-            points=points,
-        )
+        return Trend(**level, slope_per_unit=0.0, slope_std=None)
     return Trend(
-        parameter=parameter,
-        n=len(x),
-        level=float(beta[0]),
-        level_std=float(np.sqrt(covariance[0, 0])),
+        **level,
         slope_per_unit=float(beta[1]),
         slope_std=float(np.sqrt(covariance[1, 1])),
         level_slope_correlation=float(np.clip(covariance[0, 1] / np.sqrt(covariance[0, 0] * covariance[1, 1]), -1, 1)),
-        excess_std=float(np.sqrt(line["tau2"])),
-        points=points,
         curved=curved(x, values, variance, line),
     )

@@ -6,7 +6,7 @@ import pytest
 from ema.model.actuator import THESIS
 from ema.prognosis.backtest import backtest
 from ema.prognosis.outlook import outlook
-from ema.prognosis.trend import fit_trend
+from ema.prognosis.trend import Series, fit_trend
 from tests.prognosis.histories import History, history
 
 THRESHOLD = 0.075  # FDJ +50 % of nominal
@@ -14,9 +14,8 @@ LAWS_SEEN = ("line", "doubling", "cube", "onset", "sinh")  # tests/prognosis/his
 
 
 def _outlook(h: History):
-    return outlook(
-        "FDJ", h.hours, h.values, h.stds, [str(i) for i in range(len(h.hours))], threshold=THRESHOLD, direction="above"
-    )
+    series = Series("FDJ", h.hours, h.values, h.stds, [str(i) for i in range(len(h.hours))])
+    return outlook(series, threshold=THRESHOLD, direction="above")
 
 
 def _held(h: History, life) -> bool:
@@ -64,15 +63,8 @@ def test_outliers_do_not_move_the_outlook():
 
 
 def test_too_few_windows_and_a_crossed_threshold():
-    few = outlook(
-        "FDJ",
-        np.array([0.0, 1.0]),
-        np.array([0.05, 0.051]),
-        np.array([1e-4, 1e-4]),
-        ["a", "b"],
-        threshold=THRESHOLD,
-        direction="above",
-    ).life
+    two = Series("FDJ", np.array([0.0, 1.0]), np.array([0.05, 0.051]), np.array([1e-4, 1e-4]), ["a", "b"])
+    few = outlook(two, threshold=THRESHOLD, direction="above").life
     assert few.status == "too few windows"
     h = history("line", 3400)
     crossed = _outlook(History(h.hours, h.values + 0.03, h.stds, 0.0)).life
@@ -81,9 +73,8 @@ def test_too_few_windows_and_a_crossed_threshold():
 
 def test_the_backtest_shows_past_forecasts_against_the_windows_since():
     h = history("cube", 3500, n=40)
-    points = backtest(
-        "FDJ", h.hours, h.values, h.stds, [f"w{i}" for i in range(40)], threshold=THRESHOLD, direction="above"
-    )
+    series = Series("FDJ", h.hours, h.values, h.stds, [f"w{i}" for i in range(40)])
+    points = backtest(series, threshold=THRESHOLD, direction="above")
     assert [p.windows for p in points] == [20, 26, 32] and points[-1].later_windows == 8
     assert all(p.later_inside is not None and p.later_inside >= 0.7 for p in points)
     truth = h.hours[-1] + h.true_life  # the crossing dates move in on it as the windows come
@@ -171,16 +162,13 @@ def test_the_actuators_j_m_is_its_windows_readings_and_a_replaced_part_is_said(o
 @pytest.mark.parametrize("times", [[5.0], [5.0, 5.0], [5.0, 5.0, 5.0, 5.0]])
 def test_windows_at_one_time_are_a_level_with_no_slope(times):
     n = len(times)
-    trend = fit_trend("FDJ", np.array(times), np.full(n, 0.06), np.full(n, 1e-3), [str(i) for i in range(n)])
+    series = Series("FDJ", np.array(times), np.full(n, 0.06), np.full(n, 1e-3), [str(i) for i in range(n)])
+    trend = fit_trend(series)
     assert trend.level == pytest.approx(0.06) and trend.slope_std is None
     assert trend.level_std == pytest.approx(1e-3 / np.sqrt(n))
     assert (
         outlook(
-            "FDJ",
-            np.array(times),
-            np.full(n, 0.06),
-            np.full(n, 1e-3),
-            [str(i) for i in range(n)],
+            series,
             threshold=THRESHOLD,
             direction="above",
         ).life.status

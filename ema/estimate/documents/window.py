@@ -8,6 +8,7 @@ from __future__ import annotations
 from pydantic import Field
 
 from ema.model.document import Document
+from ema.model.window import Window
 
 
 class SensorZero(Document):
@@ -128,3 +129,20 @@ class WindowInfo(Document):
         default=None,
         description="it could not tell a heavier rotor from a weaker motor: the windows whose J_M (history) decided",
     )
+
+    @classmethod
+    def logged(cls, window: Window, digest: str, **read: object) -> WindowInfo:
+        """The window's own facts (its rate, length, times and flight) and what reading it did (``read``: the
+        processed rate, the sliding share, and whatever else a kind's reading reports)."""
+        return cls.model_validate(
+            {
+                "content_sha256": digest,
+                "n_samples": window.n_samples,
+                "duration_s": window.duration_s,
+                "sample_rate_hz": window.sample_rate_hz,
+                "recorded_at": window.recorded_at,
+                "flight_hours": window.flight_hours,
+                "flight_id": window.flight_id,
+                **read,
+            }
+        )

@@ -32,14 +32,3 @@ def shifted_fits(
         batch["position_deg"] = np.broadcast_to(signals["position_deg"], batch[name].shape)
     read = dict(as_read(batch, sample_rate_hz), position_deg=signals["position_deg"])
     return fit_friction(read, sample_rate_hz, actuator, settings)
-
-
-def equation_errors(
-    signals: dict[str, np.ndarray],
-    sample_rate_hz: float,
-    lags: np.ndarray,
-    actuator: DriveConstants,
-    name: str = "current_a",
-) -> np.ndarray:
-    """The physics fit's equation error with signal ``name`` read ``lags`` samples later."""
-    return shifted_fits(signals, sample_rate_hz, lags, actuator, name).residual_rms_nm

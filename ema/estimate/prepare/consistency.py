@@ -43,7 +43,7 @@ import numpy as np
 
 from ema.estimate.physics.features import as_read
 from ema.estimate.physics.friction import fit_friction
-from ema.estimate.physics.shifts import equation_errors
+from ema.estimate.physics.shifts import shifted_fits
 from ema.estimate.prepare.departures.zero_offset import OFFSET_FIT
 from ema.model.dead_band import dead_band_paths
 from ema.model.params import DriveConstants
@@ -181,7 +181,7 @@ def out_of_step(window: Window, actuator: DriveConstants) -> tuple[str, float, f
         return None
     logged = float(fit_friction(as_read(signals, rate), rate, actuator).residual_rms_nm[0])
     for name in ("current_a", "hinge_moment_nm"):
-        errors = equation_errors(dict(signals), rate, lags, actuator, name)
+        errors = shifted_fits(dict(signals), rate, lags, actuator, name).residual_rms_nm
         best = int(np.nanargmin(errors)) if np.any(np.isfinite(errors)) else -1
         if best >= 0 and logged >= MIN_BETTER * errors[best]:
             return name, float(lags[best] / rate), logged / float(errors[best])

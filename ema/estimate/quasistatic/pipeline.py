@@ -158,17 +158,12 @@ def _document(
             output_error_ratio={"current_a": ratio},
             uncertainty_inflation=1.0,
         ),
-        window=WindowInfo(
-            content_sha256=digest,
-            n_samples=window.n_samples,
-            duration_s=window.duration_s,
-            sample_rate_hz=rate,
+        window=WindowInfo.logged(
+            window,
+            digest,
             processed_rate_hz=rate,
             command_clipped_fraction=0.0,
             sliding_fraction=used / window.n_samples,
-            recorded_at=window.recorded_at,
-            flight_hours=window.flight_hours,
-            flight_id=window.flight_id,
         ),
         config=config,
     )
