@@ -25,6 +25,8 @@ from typing import Any
 
 import numpy as np
 
+from ema.estimate.stats import weighted_least_squares
+
 # Shapes on grids fine enough that a precise history's posterior does not sit on a neighbour of the truth (on
 # a grid of 4 and 6, histories doubling every 4.6 spans read 4, and crossed 6-20 % late).
 EXPONENTIAL_RATES = (-4.0, -3.0, -2.0, -1.5, -1.0, -0.5, *np.round(np.arange(0.25, 10.01, 0.25), 2))
@@ -99,10 +101,7 @@ def fit_law(law: Law, s: np.ndarray, y: np.ndarray, weight: np.ndarray) -> LawFi
     n_eff = max(float(np.sum(weight > 0)), 2.0)
     for theta in law.shapes:
         phi = law.columns(s, theta)
-        gram = phi.T @ (weight[:, None] * phi)
-        covariance = np.linalg.pinv(gram)
-        beta = covariance @ phi.T @ (weight * y)
-        chi2 = float(np.sum(weight * (y - phi @ beta) ** 2))
+        beta, covariance, chi2 = weighted_least_squares(phi, y, weight)
         betas.append(beta)
         covariances.append(covariance)
         scores.append(-0.5 * chi2 - 0.5 * phi.shape[1] * np.log(n_eff))

@@ -122,3 +122,39 @@ def test_another_programs_estimates_table_is_refused_naming_the_database_never_a
     with engine.connect() as connection:  # the other program's table is as it was
         assert {c["name"] for c in sa.inspect(connection).get_columns("estimates")} == {"id", "price"}
     engine.dispose()
+
+
+def test_what_was_stored_is_all_there_after_the_history_is_opened_again(setting, result):
+    """Nothing a user stored is lost: windows (as stored, oldest first), documents and their versions, withdrawals
+    and the kept fleet lines come back from another opening of the same database."""
+    store = open_history(setting)
+    stored = [store.add(_as(result, "tail-1", f"w{i}", recorded_at=f"2026-01-0{i + 1}T00:00:00Z")) for i in range(3)]
+    store.put_actuator("tail-1", THESIS)
+    second = store.put_actuator("tail-1", THESIS.model_copy(update={"name": "overhauled"}))
+    store.withdraw("tail-1", "w1", "logged on the wrong aircraft")
+    store.put_summary("tail-1", "2:3:2", 1, 40.0, '{"status": "healthy"}')
+    store.close()
+    again = open_history(setting)
+    try:
+        current, legacy = again.history("tail-1")
+        assert [s.window_id for s in current] == ["w0", "w2"] and legacy == []
+        assert [s.model_dump(exclude={"replay"}) for s in current] == [
+            s.model_dump(exclude={"replay"}) for s in (stored[0], stored[2])
+        ]
+        assert again.get_actuator("tail-1") == second and second.version == 2
+        assert [w.reason for w in again.withdrawals("tail-1")] == ["logged on the wrong aircraft"]
+        assert again.summaries()["tail-1"] == ("2:3:2", '{"status": "healthy"}')
+        assert again.versions()["tail-1"][0] == 2  # windows now held
+    finally:
+        again.close()
+
+
+def test_the_latest_window_and_document_of_each_actuator_answer_together(history, result):
+    for actuator_id, n in (("a/1", 3), ("b/2", 1)):
+        for i in range(n):
+            history.add(_as(result, actuator_id, f"w{i}"))
+    history.put_actuator("a/1", THESIS)
+    latest = history.latest(["a/1", "b/2", "c/3"])
+    assert {k: v.window_id for k, v in latest.items()} == {"a/1": "w2", "b/2": "w0"}  # none for an unknown one
+    assert set(history.latest_documents(["a/1", "b/2"])) == {"a/1"}
+    assert sorted(history.actuator_ids()) == ["a/1", "b/2"]
