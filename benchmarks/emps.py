@@ -17,14 +17,11 @@ each model's error on it with its constants fixed: ema's learned ones and the pu
 from __future__ import annotations
 
 import argparse
-import json
-import subprocess
-import sys
-import time
 from pathlib import Path
 
 import numpy as np
 
+from benchmarks.as_user import run_ema
 from benchmarks.foreign_accuracy import RESULTS_MD
 from ema.calibration.servo import model_errors_pct
 from ema.cli.report import write_section
@@ -68,21 +65,7 @@ def read(path: Path, mapping: Path) -> Window:
 
 def cli_seconds(path: Path, mapping: Path, actuator: Path) -> tuple[float, dict]:
     """``ema estimate`` as a user types it: its wall time and its answer."""
-    command = [
-        sys.executable,
-        "-m",
-        "ema.cli.main",
-        "estimate",
-        str(path),
-        "--log-map",
-        str(mapping),
-        "--actuator",
-        str(actuator),
-        "--json",
-    ]
-    started = time.perf_counter()
-    done = subprocess.run(command, capture_output=True, text=True, check=True)
-    return time.perf_counter() - started, json.loads(done.stdout)
+    return run_ema("estimate", str(path), "--log-map", str(mapping), "--actuator", str(actuator))
 
 
 def identification_table(learned: dict, base: dict) -> str:

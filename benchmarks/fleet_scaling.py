@@ -22,14 +22,12 @@ import argparse
 import json
 import math
 import statistics
-import subprocess
-import sys
 import tempfile
-import time
 from pathlib import Path
 
 import httpx
 
+from benchmarks.as_user import run_ema
 from benchmarks.real_time import cpu_seconds
 from benchmarks.service_overhead import free_port, serve
 from ema.cli.report import write_section
@@ -63,22 +61,8 @@ def written(windows: list[Window], folder: Path) -> Path:
 def timed(archive_folder: Path, workers: int, out: Path) -> tuple[float, dict[str, float]]:
     """(the command's wall time in s, its phases) for ``ema fleet`` with ``workers`` workers, a fresh output."""
     out.unlink(missing_ok=True)
-    command = [
-        sys.executable,
-        "-m",
-        "ema.cli.main",
-        "fleet",
-        str(archive_folder),
-        "--out",
-        str(out),
-        "--workers",
-        str(workers),
-        "--json",
-    ]
-    started = time.perf_counter()
-    finished = subprocess.run(command, capture_output=True, text=True, check=True)
-    wall = time.perf_counter() - started
-    return wall, json.loads(finished.stdout)["phases_s"]
+    wall, answer = run_ema("fleet", str(archive_folder), "--out", str(out), "--workers", str(workers))
+    return wall, answer["phases_s"]
 
 
 def service_per_cpu_second(windows: list[Window], folder: Path) -> float:
