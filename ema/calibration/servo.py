@@ -27,7 +27,6 @@ from __future__ import annotations
 
 import time
 from collections.abc import Sequence
-from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -41,17 +40,11 @@ from ema.calibration.documents import (
 )
 from ema.calibration.plot import ResidualPlot, Series
 from ema.calibration.servo_effects import EFFECTS, ServoEffect
+from ema.calibration.servo_fit import COPIES, FOLDS, Fitted, fitted, noise_copies, problem, undisturbed
 from ema.estimate.assess.weighing import misfit_limit
 from ema.estimate.physics.inverse import (
     UNITS,
     decimated,
-    decimated_problem,
-    disturbed_rows,
-    fit_inverse,
-    inverse_columns,
-    load_motion,
-    newey_west_lags,
-    newey_west_std,
 )
 from ema.estimate.prepare.servo import ServoPrepared, document_effects, prepare_servo
 from ema.estimate.simulate.servo import lane_parameters
@@ -61,8 +54,6 @@ from ema.model.checks import InputError
 from ema.model.servo_sim import simulate_servo
 from ema.model.window import Window
 
-FOLDS = 5
-COPIES = 8
 MIN_HELD_OUT_DROP = 0.05  # of the held-out residual sum of squares
 MAX_EFFECTS = 2
 LEARNED_NAMES = {
@@ -73,66 +64,6 @@ LEARNED_NAMES = {
     "viscous_down_ns_per_m": "viscous_down",
     "offset_n": "offset",
 }
-
-
-@dataclass(frozen=True)
-class Problem:
-    """Every window's decimated force and columns, stacked, and each row's fold."""
-
-    y: np.ndarray
-    x: dict[str, np.ndarray]
-    fold: np.ndarray
-    window: np.ndarray  # each row's window
-
-    def design(self, names: Sequence[str]) -> np.ndarray:
-        return np.column_stack([self.x[name] for name in names])
-
-
-def problem(prepared: Sequence[ServoPrepared], model: dict[str, float]) -> Problem:
-    """The stacked problem of ``model`` (effect name -> its nonlinear constant) over the windows."""
-    ys, xs, folds, windows = [], [], [], []
-    for i, p in enumerate(prepared):
-        y, x = decimated_problem(p.force_n, inverse_columns(p.motion, model), p.motion, p.disturbed)
-        xs.append(x)
-        ys.append(y)
-        folds.append(np.minimum(np.arange(len(y)) * FOLDS // len(y), FOLDS - 1))
-        windows.append(np.full(len(y), i))
-    names = list(xs[0])
-    return Problem(
-        np.concatenate(ys),
-        {name: np.concatenate([x[name] for x in xs]) for name in names},
-        np.concatenate(folds),
-        np.concatenate(windows),
-    )
-
-
-@dataclass(frozen=True)
-class Fitted:
-    values: dict[str, float]
-    stds: dict[str, float]
-    error_pct: float
-    held_out_rss: np.ndarray  # (FOLDS,) each fold's residual sum of squares, predicted by the other folds
-    residual: np.ndarray
-
-
-def fitted(p: Problem) -> Fitted:
-    names = list(p.x)
-    x = p.design(names)
-    beta, *_ = np.linalg.lstsq(x, p.y, rcond=None)
-    residual = p.y - x @ beta
-    stds = newey_west_std(x, residual, newey_west_lags(len(p.y)))
-    held = np.zeros(FOLDS)
-    for k in range(FOLDS):
-        out = p.fold == k
-        b, *_ = np.linalg.lstsq(x[~out], p.y[~out], rcond=None)
-        held[k] = float(np.sum((p.y[out] - x[out] @ b) ** 2))
-    return Fitted(
-        dict(zip(names, beta.tolist(), strict=True)),
-        dict(zip(names, stds.tolist(), strict=True)),
-        float(100.0 * np.linalg.norm(residual) / np.linalg.norm(p.y)),
-        held,
-        residual,
-    )
 
 
 def _best_of(effect: ServoEffect, prepared: Sequence[ServoPrepared], model: dict[str, float]) -> tuple[float, Fitted]:
@@ -159,46 +90,6 @@ def _candidate(effect: ServoEffect, value: float, fit: Fitted, base: Fitted) -> 
         plausible=plausible,
     )
     return candidate, plausible and every_fold and drop >= MIN_HELD_OUT_DROP
-
-
-@dataclass(frozen=True)
-class Copies:
-    """What noise alone leaves: each window simulated at the base constants, its sensor read at ``COPIES`` phases."""
-
-    rms: np.ndarray  # (COPIES,) the stacked problem's residual RMS, one per phase
-    by_row: list[np.ndarray]  # per window, (COPIES, rows): its copies' residual by decimated row
-
-
-def noise_copies(prepared: Sequence[ServoPrepared], base: Fitted, model: dict[str, float]) -> Copies:
-    misfits: list[float] = []
-    by_row: list[list[np.ndarray]] = [[] for _ in prepared]
-    for phase in np.linspace(0.0, 1.0, COPIES, endpoint=False):
-        twins = [_simulated(p, base.values, model, phase) for p in prepared]
-        misfits.append(rms(fitted(problem(twins, model)).residual))
-        for i, twin in enumerate(twins):
-            fit = fit_inverse(twin.force_n, inverse_columns(twin.motion, model), twin.motion)
-            by_row[i].append(fit.residual_by_row)
-    return Copies(np.array(misfits), [np.array(rows) for rows in by_row])
-
-
-def _simulated(p: ServoPrepared, values: dict[str, float], model: dict[str, float], phase: float) -> ServoPrepared:
-    """``p`` with its window's position and force as the closed loop at ``values`` logs them."""
-    s = p.window.signals
-    start = (float(s["position_m"][0]), float((s["position_m"][1] - s["position_m"][0]) * p.window.sample_rate_hz))
-    lane = lane_parameters(values, model)[None, :]
-    run = simulate_servo(s["set_point_m"], lane, p.loop, load_n=s.get("load_n"), start=start, phase=np.array([phase]))
-    motion = load_motion(run.position_m[0], p.window.sample_rate_hz, p.bandwidth_hz, p.loop.resolution_m)
-    force = (run.drive_force_n[0] - s.get("load_n", 0.0))[motion.samples]
-    return replace(p, motion=motion, force_n=force)
-
-
-def undisturbed(prepared: Sequence[ServoPrepared], copies: Copies, model: dict[str, float]) -> list[ServoPrepared]:
-    """Each window with the rows a force its log lacks disturbs (``disturbed_rows``) left out of every fit."""
-    out = []
-    for p, by_row in zip(prepared, copies.by_row, strict=True):
-        fit = fit_inverse(p.force_n, inverse_columns(p.motion, model), p.motion)
-        out.append(replace(p, disturbed=disturbed_rows(fit.residual_by_row, by_row)))
-    return out
 
 
 def select(prepared: Sequence[ServoPrepared], base_model: dict[str, float]) -> tuple[dict[str, float], list, list]:

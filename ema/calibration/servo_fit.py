@@ -1,0 +1,129 @@
+"""A servo calibration's two measures of a fit over every window at once: the stacked inverse problem fitted
+(Eq. 5.1 in the load frame on each window's decimated force, Newey–West stds, each fold predicted by the others)
+and what noise alone leaves in it (each window simulated in closed loop at the fitted constants, its sensor read
+at ``COPIES`` phases of its step), from which the rows a force the log lacks disturbs are told.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from ema.estimate.physics.inverse import (
+    decimated_problem,
+    disturbed_rows,
+    fit_inverse,
+    inverse_columns,
+    load_motion,
+    newey_west_lags,
+    newey_west_std,
+)
+from ema.estimate.prepare.servo import ServoPrepared
+from ema.estimate.simulate.servo import lane_parameters
+from ema.estimate.stats import rms
+from ema.model.servo_sim import simulate_servo
+
+FOLDS = 5
+COPIES = 8
+
+
+@dataclass(frozen=True)
+class Problem:
+    """Every window's decimated force and columns, stacked, and each row's fold."""
+
+    y: np.ndarray
+    x: dict[str, np.ndarray]
+    fold: np.ndarray
+    window: np.ndarray  # each row's window
+
+    def design(self, names: Sequence[str]) -> np.ndarray:
+        return np.column_stack([self.x[name] for name in names])
+
+
+def problem(prepared: Sequence[ServoPrepared], model: dict[str, float]) -> Problem:
+    """The stacked problem of ``model`` (effect name -> its nonlinear constant) over the windows."""
+    ys, xs, folds, windows = [], [], [], []
+    for i, p in enumerate(prepared):
+        y, x = decimated_problem(p.force_n, inverse_columns(p.motion, model), p.motion, p.disturbed)
+        xs.append(x)
+        ys.append(y)
+        folds.append(np.minimum(np.arange(len(y)) * FOLDS // len(y), FOLDS - 1))
+        windows.append(np.full(len(y), i))
+    names = list(xs[0])
+    return Problem(
+        np.concatenate(ys),
+        {name: np.concatenate([x[name] for x in xs]) for name in names},
+        np.concatenate(folds),
+        np.concatenate(windows),
+    )
+
+
+@dataclass(frozen=True)
+class Fitted:
+    values: dict[str, float]
+    stds: dict[str, float]
+    error_pct: float
+    held_out_rss: np.ndarray  # (FOLDS,) each fold's residual sum of squares, predicted by the other folds
+    residual: np.ndarray
+
+
+def fitted(p: Problem) -> Fitted:
+    names = list(p.x)
+    x = p.design(names)
+    beta, *_ = np.linalg.lstsq(x, p.y, rcond=None)
+    residual = p.y - x @ beta
+    stds = newey_west_std(x, residual, newey_west_lags(len(p.y)))
+    held = np.zeros(FOLDS)
+    for k in range(FOLDS):
+        out = p.fold == k
+        b, *_ = np.linalg.lstsq(x[~out], p.y[~out], rcond=None)
+        held[k] = float(np.sum((p.y[out] - x[out] @ b) ** 2))
+    return Fitted(
+        dict(zip(names, beta.tolist(), strict=True)),
+        dict(zip(names, stds.tolist(), strict=True)),
+        float(100.0 * np.linalg.norm(residual) / np.linalg.norm(p.y)),
+        held,
+        residual,
+    )
+
+
+@dataclass(frozen=True)
+class Copies:
+    """What noise alone leaves: each window simulated at the base constants, its sensor read at ``COPIES`` phases."""
+
+    rms: np.ndarray  # (COPIES,) the stacked problem's residual RMS, one per phase
+    by_row: list[np.ndarray]  # per window, (COPIES, rows): its copies' residual by decimated row
+
+
+def noise_copies(prepared: Sequence[ServoPrepared], base: Fitted, model: dict[str, float]) -> Copies:
+    misfits: list[float] = []
+    by_row: list[list[np.ndarray]] = [[] for _ in prepared]
+    for phase in np.linspace(0.0, 1.0, COPIES, endpoint=False):
+        twins = [_simulated(p, base.values, model, phase) for p in prepared]
+        misfits.append(rms(fitted(problem(twins, model)).residual))
+        for i, twin in enumerate(twins):
+            fit = fit_inverse(twin.force_n, inverse_columns(twin.motion, model), twin.motion)
+            by_row[i].append(fit.residual_by_row)
+    return Copies(np.array(misfits), [np.array(rows) for rows in by_row])
+
+
+def _simulated(p: ServoPrepared, values: dict[str, float], model: dict[str, float], phase: float) -> ServoPrepared:
+    """``p`` with its window's position and force as the closed loop at ``values`` logs them."""
+    s = p.window.signals
+    start = (float(s["position_m"][0]), float((s["position_m"][1] - s["position_m"][0]) * p.window.sample_rate_hz))
+    lane = lane_parameters(values, model)[None, :]
+    run = simulate_servo(s["set_point_m"], lane, p.loop, load_n=s.get("load_n"), start=start, phase=np.array([phase]))
+    motion = load_motion(run.position_m[0], p.window.sample_rate_hz, p.bandwidth_hz, p.loop.resolution_m)
+    force = (run.drive_force_n[0] - s.get("load_n", 0.0))[motion.samples]
+    return replace(p, motion=motion, force_n=force)
+
+
+def undisturbed(prepared: Sequence[ServoPrepared], copies: Copies, model: dict[str, float]) -> list[ServoPrepared]:
+    """Each window with the rows a force its log lacks disturbs (``disturbed_rows``) left out of every fit."""
+    out = []
+    for p, by_row in zip(prepared, copies.by_row, strict=True):
+        fit = fit_inverse(p.force_n, inverse_columns(p.motion, model), p.motion)
+        out.append(replace(p, disturbed=disturbed_rows(fit.residual_by_row, by_row)))
+    return out
