@@ -49,6 +49,12 @@ class Documents:
             return None, None
         return document.model_dump(mode="json", by_alias=True), self.versions.get(window.actuator_id)
 
+    def task(self, job: Job, config: PipelineConfig, threads: int) -> tuple[Any, ...]:
+        """``ema.kinds.remote.estimate_json``'s arguments for ``job``: all of it JSON-able, for any process."""
+        window, history = job
+        actuator, version = self.task_arguments(window)
+        return window_to_dict(window), config.model_dump(), threads, history, actuator, version
+
 
 class LocalWorkers:
     """A pool of local worker processes, each warmed as it starts (module docstring); start it before the archive
@@ -69,11 +75,9 @@ class LocalWorkers:
     def answers(self, jobs: list[Job], config: PipelineConfig, documents: Documents) -> Iterator[Answer]:
         queue, pending, losses = list(reversed(jobs)), dict[Future, Job](), Counter[str]()
         while queue or pending:
-            while queue and len(pending) < IN_FLIGHT_PER_WORKER * self.workers:
-                window, history = job = queue.pop()
-                actuator, version = documents.task_arguments(window)
-                arguments = (window_to_dict(window), config.model_dump(), self.threads, history, actuator, version)
-                pending[self.pool.submit(_answered, *arguments)] = job
+            while queue and len(pending) < IN_FLIGHT_PER_WORKER * self.workers and not self.pool._broken:
+                job = queue.pop()
+                pending[self.pool.submit(_answered, *documents.task(job, config, self.threads))] = job
             done, _ = wait(pending, return_when=FIRST_COMPLETED)
             for future in done:
                 job = pending.pop(future)
@@ -94,10 +98,6 @@ class LocalWorkers:
 def _warmed(threads: int) -> None:
     """A local worker's initializer, ``ema.kinds.remote.warm``, imported in the worker: the driver that only reads
     and writes never loads torch or the kernels (a second of a core the workers need at start-up)."""
-    import sys
-    import time
-
-    print("child up", time.time(), file=sys.stderr)
     from ema.kinds.remote import warm
 
     warm(threads)
@@ -113,12 +113,8 @@ def _answered(*arguments: Any) -> dict[str, Any]:
 def in_process(jobs: list[Job], config: PipelineConfig, threads: int, documents: Documents) -> Iterator[Answer]:
     from ema.kinds.remote import estimate_json
 
-    for window, history in jobs:
-        actuator, version = documents.task_arguments(window)
-        yield (
-            window,
-            estimate_json(window_to_dict(window), config.model_dump(), threads, history, actuator, version),
-        )
+    for job in jobs:
+        yield job[0], estimate_json(*documents.task(job, config, threads))
 
 
 def on_ray(
@@ -137,10 +133,8 @@ def on_ray(
     queue = list(reversed(jobs))
     while queue or pending:
         while queue and len(pending) < IN_FLIGHT_PER_WORKER * workers:
-            window, history = job = queue.pop()
-            actuator, version = documents.task_arguments(window)
-            reference = task.remote(window_to_dict(window), config.model_dump(), threads, history, actuator, version)
-            pending[reference] = job
+            job = queue.pop()
+            pending[task.remote(*documents.task(job, config, threads))] = job
         ready, _ = ray.wait(list(pending), num_returns=1)
         for reference in ready:
             job = pending.pop(reference)
