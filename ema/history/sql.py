@@ -4,8 +4,7 @@
   stored twice, by one process or by replicas racing, is one row, and both get that row's answer.
   Another body under a stored key is a :class:`ConflictError`.
 - Committed before the answer leaves (SQLite: ``synchronous=FULL``; PostgreSQL commits durably).
-- Actuator documents are versioned 1, 2, …; two replicas allocating a version at once collide on
-  the key, and the later one takes the next.
+- Actuator documents are versioned 1, 2, … (``ema.history.versions``).
 - A withdrawn window leaves the history but not the database: its row moves to ``withdrawals``, and its key is
   retired: posted again, it is refused with its withdrawal (``WithdrawnError``), never estimated anew.
 """
@@ -13,8 +12,6 @@
 from __future__ import annotations
 
 import json
-import random
-import time
 from collections.abc import Sequence
 from typing import Any
 
@@ -25,17 +22,14 @@ from ema.calibration.documents import CalibrationReport
 from ema.estimate.documents import Estimate
 from ema.estimate.documents.window import HistoryReadings, InertiaReading, SensorZero
 from ema.estimate.history import lent
-from ema.history.connection import SqlStore, now
-from ema.history.errors import ConflictError, VersionContentionError, WithdrawnError
+from ema.history.connection import now
+from ema.history.errors import ConflictError, WithdrawnError
 from ema.history.tables import actuators, calibrations, estimates, summaries, withdrawals
-from ema.model.actuator import ActuatorDocument
-from ema.prognosis.documents import Stored, StoredActuator, Withdrawal
-
-VERSION_ATTEMPTS = 20  # replicas racing for an actuator's next document version
-BACKOFF_S = 0.005  # the first retry's longest wait; it doubles with each attempt
+from ema.history.versions import VersionedDocuments
+from ema.prognosis.documents import Stored, Withdrawal
 
 
-class SqlHistory(SqlStore):
+class SqlHistory(VersionedDocuments):
     """An actuator history on ``engine``; ``probe()`` raises StorageError where a write cannot be taken now."""
 
     def add(self, result: Estimate) -> Stored:
@@ -122,62 +116,6 @@ class SqlHistory(SqlStore):
             ).all()
         return [Withdrawal(actuator_id=actuator_id, **row._mapping) for row in rows]
 
-    def put_actuator(self, actuator_id: str, document: ActuatorDocument) -> StoredActuator:
-        """Store ``document`` as the actuator's next version (the latest version itself where it is the same
-        document: a PUT repeated stores nothing new). Earlier versions stay, as do the estimates read with them.
-
-        Writers of one actuator's documents take turns (PostgreSQL: a lock of that actuator for the transaction;
-        SQLite writes one at a time), so replicas racing for a version wait rather than fail; a version taken
-        meanwhile all the same is retried after a random backoff, and ``VersionContentionError`` (409) only past
-        ``VERSION_ATTEMPTS``."""
-        text = document.model_dump_json(by_alias=True)
-        for attempt in range(VERSION_ATTEMPTS):
-            try:
-                with self._writing() as connection:
-                    self._take_turn(connection, actuator_id)
-                    latest = self._latest_document(actuator_id, connection)
-                    if latest is not None and latest.document == text:
-                        return StoredActuator(
-                            actuator_id=actuator_id,
-                            version=latest.version,
-                            stored_at=latest.stored_at,
-                            document=document,
-                        )
-                    version, stored_at = 1 if latest is None else latest.version + 1, now()
-                    row = {"actuator_id": actuator_id, "version": version, "stored_at": stored_at, "document": text}
-                    connection.execute(actuators.insert().values(**row))
-            except sa.exc.IntegrityError:
-                time.sleep(random.uniform(0.0, BACKOFF_S * 2 ** min(attempt, 6)))  # another writer took it: again
-                continue
-            return StoredActuator(actuator_id=actuator_id, version=version, stored_at=stored_at, document=document)
-        raise VersionContentionError(actuator_id, VERSION_ATTEMPTS)
-
-    def _take_turn(self, connection: sa.Connection, actuator_id: str) -> None:
-        """On PostgreSQL, hold this actuator's document lock until the transaction ends."""
-        if self.engine.dialect.name == "postgresql":
-            key = {"key": f"ema-actuator:{actuator_id}"}
-            connection.execute(sa.text("SELECT pg_advisory_xact_lock(hashtextextended(:key, 0))"), key)
-
-    def _latest_document(self, actuator_id: str, connection: sa.Connection | None = None) -> Any:
-        query = (
-            sa.select(actuators.c.version, actuators.c.stored_at, actuators.c.document)
-            .where(actuators.c.actuator_id == actuator_id)
-            .order_by(actuators.c.version.desc())
-            .limit(1)
-        )
-        if connection is not None:
-            return connection.execute(query).first()
-        with self._reading() as reading:
-            return reading.execute(query).first()
-
-    def get_actuator(self, actuator_id: str) -> StoredActuator | None:
-        """The actuator's latest stored document, or None where it has none."""
-        row = self._latest_document(actuator_id)
-        if row is None:
-            return None
-        document = ActuatorDocument.model_validate_json(row.document)
-        return StoredActuator(actuator_id=actuator_id, version=row.version, stored_at=row.stored_at, document=document)
-
     def add_calibration(self, actuator_id: str, report: CalibrationReport) -> None:
         """Keep a calibration report of the actuator's windows (the operator's page lists them)."""
         report_text = report.model_dump_json(by_alias=True)
@@ -238,29 +176,6 @@ class SqlHistory(SqlStore):
                 continue  # an earlier format's row: no line of the view is built from it
             found[stored.actuator_id] = stored
         return found
-
-    def latest_documents(self, actuator_ids: Sequence[str]) -> dict[str, StoredActuator]:
-        """The latest document of each of ``actuator_ids`` that has one (one query)."""
-        newest = (
-            sa.select(actuators.c.actuator_id, sa.func.max(actuators.c.version).label("version"))
-            .where(actuators.c.actuator_id.in_(actuator_ids))
-            .group_by(actuators.c.actuator_id)
-            .subquery()
-        )
-        query = sa.select(actuators).join(
-            newest, sa.and_(actuators.c.actuator_id == newest.c.actuator_id, actuators.c.version == newest.c.version)
-        )
-        with self._reading() as connection:
-            rows = connection.execute(query).all()
-        return {
-            row.actuator_id: StoredActuator(
-                actuator_id=row.actuator_id,
-                version=row.version,
-                stored_at=row.stored_at,
-                document=ActuatorDocument.model_validate_json(row.document),
-            )
-            for row in rows
-        }
 
     def readings(self, actuator_id: str, flight_id: str | None) -> HistoryReadings:
         """What the stored windows of this actuator lend a window of ``flight_id`` (``ema.estimate.history.lent``)."""

@@ -10,65 +10,63 @@ from sqlalchemy import Column, Float, Index, Integer, MetaData, PrimaryKeyConstr
 
 metadata = MetaData()
 
-estimates = Table(
+
+def _required(name: str, kind: type[Integer] | type[Text] = Text) -> Column:
+    return Column(name, kind, nullable=False)
+
+
+def _per_actuator(name: str, *columns: Column | UniqueConstraint) -> Table:
+    """A table of rows appended per actuator: an id in the order they were stored, the actuator_id, ``columns``;
+    indexed to be read by actuator in that order."""
+    table = Table(
+        name,
+        metadata,
+        Column("id", Integer, primary_key=True, autoincrement=True),
+        _required("actuator_id"),
+        *columns,
+        sqlite_autoincrement=True,
+    )
+    Index(f"{name}_by_actuator", table.c.actuator_id, table.c.id)
+    return table
+
+
+estimates = _per_actuator(
     "estimates",
-    metadata,
-    Column("id", Integer, primary_key=True, autoincrement=True),
-    Column("actuator_id", Text, nullable=False),
-    Column("window_id", Text, nullable=False),
-    Column("stored_at", Text, nullable=False),
-    Column("result", Text, nullable=False),
+    _required("window_id"),
+    _required("stored_at"),
+    _required("result"),
     Column("content_sha256", Text),
     Column("flight_id", Text),
     Column("sensor_zero", Text),
     Column("inertia_read", Text),
     UniqueConstraint("actuator_id", "window_id", name="estimates_actuator_window"),
-    sqlite_autoincrement=True,
 )
-Index("estimates_by_actuator", estimates.c.actuator_id, estimates.c.id)
-
-calibrations = Table(
-    "calibrations",
-    metadata,
-    Column("id", Integer, primary_key=True, autoincrement=True),
-    Column("actuator_id", Text, nullable=False),
-    Column("stored_at", Text, nullable=False),
-    Column("report", Text, nullable=False),
-    sqlite_autoincrement=True,
+Index("estimates_by_flight", estimates.c.actuator_id, estimates.c.flight_id)  # a flight's sensor zero, lent
+calibrations = _per_actuator("calibrations", _required("stored_at"), _required("report"))
+withdrawals = _per_actuator(
+    "withdrawals",
+    _required("window_id"),
+    _required("withdrawn_at"),
+    _required("reason"),
+    _required("stored_at"),
+    Column("content_sha256", Text),
+    _required("result"),
 )
-Index("calibrations_by_actuator", calibrations.c.actuator_id, calibrations.c.id)
-
 actuators = Table(
     "actuators",
     metadata,
-    Column("actuator_id", Text, nullable=False),
-    Column("version", Integer, nullable=False),
-    Column("stored_at", Text, nullable=False),
-    Column("document", Text, nullable=False),
+    _required("actuator_id"),
+    _required("version", Integer),
+    _required("stored_at"),
+    _required("document"),
     PrimaryKeyConstraint("actuator_id", "version", name="actuators_version"),
 )
-
-withdrawals = Table(
-    "withdrawals",
-    metadata,
-    Column("id", Integer, primary_key=True, autoincrement=True),
-    Column("actuator_id", Text, nullable=False),
-    Column("window_id", Text, nullable=False),
-    Column("withdrawn_at", Text, nullable=False),
-    Column("reason", Text, nullable=False),
-    Column("stored_at", Text, nullable=False),
-    Column("content_sha256", Text),
-    Column("result", Text, nullable=False),
-    sqlite_autoincrement=True,
-)
-Index("withdrawals_by_actuator", withdrawals.c.actuator_id, withdrawals.c.id)
-
 summaries = Table(
     "summaries",
     metadata,
     Column("actuator_id", Text, primary_key=True),
-    Column("state", Text, nullable=False),
-    Column("urgency", Integer, nullable=False),
+    _required("state"),
+    _required("urgency", Integer),
     Column("soonest", Float),
-    Column("row", Text, nullable=False),
+    _required("row"),
 )

@@ -158,3 +158,25 @@ def test_the_latest_window_and_document_of_each_actuator_answer_together(history
     assert {k: v.window_id for k, v in latest.items()} == {"a/1": "w2", "b/2": "w0"}  # none for an unknown one
     assert set(history.latest_documents(["a/1", "b/2"])) == {"a/1"}
     assert sorted(history.actuator_ids()) == ["a/1", "b/2"]
+
+
+def test_the_migrations_build_exactly_the_tables_the_code_declares(setting):
+    """Alembic's comparison of a new history's tables with ``ema.history.tables``: no column, index or key
+    that one has and the other lacks (the migrations are frozen; the declarations must follow them)."""
+    import sqlalchemy as sa
+    from alembic.migration import MigrationContext
+
+    from ema.history.schema import upgrade
+    from ema.history.tables import metadata
+
+    address = setting if "://" in setting else f"sqlite:///{setting}"
+    engine = sa.create_engine(address.replace("postgresql://", "postgresql+psycopg://", 1))
+    try:
+        upgrade(engine)
+        with engine.connect() as connection:
+            from alembic.autogenerate import compare_metadata
+
+            differences = compare_metadata(MigrationContext.configure(connection), metadata)
+    finally:
+        engine.dispose()
+    assert differences == []
