@@ -123,6 +123,8 @@ def main() -> None:
     report = calibrated.report
     learned = {e.name: e.model_dump() for e in report.learned}
     base = _base_model(window, document)
+    before, after = report.model_error_pct_before, report.model_error_pct_after
+    assert before is not None and after is not None, "a servo's calibration reports its model error"
     lines = [
         CITATION,
         "",
@@ -142,10 +144,10 @@ def main() -> None:
         "| model | inverse (IDIM) error | closed-loop force error |",
         "|---|---:|---:|",
         f"| the benchmark's symmetric model, its report | {PUBLISHED_ERROR_PCT:.2f} % | 5.85 % (its Simulink) |",
-        f"| ema, before (M, C, FDJ, offset) | {report.model_error_pct_before['drive_force_n']:.2f} % | "
-        f"{report.model_error_pct_before['drive_force_n_closed_loop']:.2f} % |",
-        f"| ema, after ({', '.join(report.selected_effects)}) | {report.model_error_pct_after['drive_force_n']:.2f} % "
-        f"| {report.model_error_pct_after['drive_force_n_closed_loop']:.2f} % |",
+        f"| ema, before (M, C, FDJ, offset) | {before['drive_force_n']:.2f} % | "
+        f"{before['drive_force_n_closed_loop']:.2f} % |",
+        f"| ema, after ({', '.join(report.selected_effects)}) | {after['drive_force_n']:.2f} % "
+        f"| {after['drive_force_n_closed_loop']:.2f} % |",
     ]
     lines += ["", reading(answer, base)]
     if args.held_out is not None:

@@ -57,7 +57,7 @@ def run_one(name: str, condition: str, seed: int) -> dict[str, Any]:
     fdj_error = fdj.value - drawn.truth["FDJ"]
     row: dict[str, Any] = {
         "fdj_relative": fdj_error / drawn.truth["FDJ"],
-        "fdj_z": fdj_error / fdj.std,
+        "fdj_z": fdj_error / fdj.std if fdj.std else float("nan"),
         "eta_read": eta_o is not None,
     }
     if eta_o is not None and eta_o.std:

@@ -68,7 +68,9 @@ def history(
     refused is left out of the history, as the service stores none); ``alone``: each window read without
     what earlier ones read."""
     hours, flight_ids, offsets = flights(actuator, truth, n_windows)
-    stored, weak, over, unsaid, refused, undecided, decided, zeroed = [], 0, 0, 0, [], 0, 0, 0
+    stored: list[Any] = []
+    refused: list[Any] = []
+    weak, over, unsaid, undecided, decided, zeroed = 0, 0, 0, 0, 0, 0
     for j, (h, flight_id) in enumerate(zip(hours, flight_ids, strict=True)):
         drawn = logged_window(actuator, j, float(h), truth, thresholds, float(offsets[j]))
         if flight_id is not None:

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -27,7 +28,7 @@ RESULTS_MD = Path(__file__).resolve().parent.parent / "docs" / "results.md"
 FAMILIES = ("thesis", "cruise", "gust", "doublet", "steps")
 
 
-def measure(windows: int, seed: int) -> dict[str, object]:
+def measure(windows: int, seed: int) -> dict[str, Any]:
     ratios, limits, flagged, contradictions = [], [], 0, 0
     for i in range(windows):
         drawn = draw(seed + i, FAMILIES[i % len(FAMILIES)])

@@ -82,9 +82,9 @@ def today(paths: list[Path]) -> list[dict[str, float]]:
     out = []
     for path in paths:
         result = estimate_window(read_window(path), actuator=THESIS)
-        out.append(
-            {"total": result.timings_s.total, "FDJ": result.estimates.FDJ.value, "eta_O": result.estimates.eta_O.value}
-        )
+        eta_o = result.estimates.eta_O
+        assert eta_o is not None, "a window in flight is loaded: eta_O is read"
+        out.append({"total": result.timings_s.total, "FDJ": result.estimates.FDJ.value, "eta_O": eta_o.value})
     return out
 
 

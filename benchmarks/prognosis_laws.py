@@ -42,7 +42,9 @@ def score(law: str, n: int, std: float, histories: int) -> dict[str, float]:
         if law == "steady":
             alarms += life.status == "crossing predicted"
             continue
-        held += life.status == "crossing predicted" and life.rul_low <= h.true_life <= (life.rul_high or np.inf)
+        held += life.status == "crossing predicted" and (life.rul_low or 0.0) <= h.true_life <= (
+            life.rul_high or np.inf
+        )
         if life.rul is not None:
             errors.append(abs(life.rul / h.true_life - 1.0))
             close += errors[-1] <= 0.35

@@ -191,7 +191,7 @@ def big_fleet(folder: Path) -> str:
         started = time.perf_counter()
         post(url, window("alone", actuator_id="probe/alone"))
         alone = time.perf_counter() - started
-        stop, pages = threading.Event(), []
+        stop, pages = threading.Event(), list[float]()
         viewers = [threading.Thread(target=_viewer, args=(url, stop, pages)) for _ in range(5)]
         for viewer in viewers:
             viewer.start()

@@ -104,7 +104,8 @@ class PostgresServer:
         deadline = time.monotonic() + 60
         while subprocess.run(ready, capture_output=True).returncode != 0:
             if time.monotonic() > deadline or self.process.poll() is not None:
-                raise RuntimeError(f"PostgreSQL did not start: {self.process.stderr.read().decode()[-500:]}")
+                said = self.process.stderr.read().decode() if self.process.stderr is not None else ""
+                raise RuntimeError(f"PostgreSQL did not start: {said[-500:]}")
             time.sleep(0.2)
         return self.address()
 

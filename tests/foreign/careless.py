@@ -6,15 +6,16 @@ field the product should refuse it by.
 
 from __future__ import annotations
 
+import dataclasses
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 
 @dataclass(frozen=True)
 class Slip:
     factors: dict[str, float]  # signal name (or "sample_rate_hz") -> what the export multiplied it by
     field: str  # the field a refusal should name
-    early_s: dict[str, float] = field(default_factory=dict)  # signal name -> how early the export logged it
+    early_s: dict[str, float] = dataclasses.field(default_factory=dict)  # signal name -> how early the export logged it
 
 
 SLIPS: dict[str, Slip] = {
