@@ -135,7 +135,7 @@ def our_rms(clean: Window, truth: dict[str, float], levels: dict[str, float], dr
     signals = {name: np.repeat(values[None], draws, axis=0) for name, values in clean.signals.items()}
     for name in SENSORS:
         signals[name] = signals[name] + levels[name] * rng.standard_normal(signals[name].shape)
-    fit = fit_friction(as_read(signals, clean.sample_rate_hz), clean.sample_rate_hz, actuator=THESIS.params)
+    fit = fit_friction(as_read(signals, clean.sample_rate_hz), clean.sample_rate_hz, drive=THESIS.params)
     errors = np.stack([fit.fdj_nm - truth["FDJ"], fit.eta_o - truth["eta_O"]])
     return np.sqrt(np.nanmean(errors**2, axis=1)) / np.array(
         [np.ptp(healthy_range(k, THESIS.ranges)) for k in ("FDJ", "eta_O")]

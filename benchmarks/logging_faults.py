@@ -73,8 +73,7 @@ def main() -> None:
         for label, fault in FAULTS.items():
             logged = replace(drawn, document=with_fault(drawn.document, fault, seed))
             found[label] += any(
-                run.signal == fault.signal
-                for run in stale_runs(window_from_dict(logged.document), actuator=THESIS.params)
+                run.signal == fault.signal for run in stale_runs(window_from_dict(logged.document), drive=THESIS.params)
             )
             rows[label].append(run_one(logged))
         print(i, name, flush=True)

@@ -22,7 +22,7 @@ import numpy as np
 
 from ema.cli.report import write_section
 from ema.estimate import runtime
-from ema.estimate.learn.network import LearnConfig, fit, predict
+from ema.estimate.learn.network import LearnConfig, predict, train
 from ema.estimate.physics.features import features
 from ema.estimate.physics.friction import fit_window
 from ema.estimate.physics.scenario import Scenario
@@ -115,7 +115,7 @@ def thesis_dataset(case: Case, scenario: Scenario, n: int, seed: int) -> tuple[n
     rng = np.random.default_rng(seed)
     health = HealthParams.uniform(n, case.ranges, rng)
     signals = add_sensor_noise(scenario.simulate(health).signals, case.noise, rng)
-    inputs = features(signals, RATE_HZ, case.timesteps, case.inputs)
+    inputs = features(signals, RATE_HZ, case.timesteps, THESIS.params, case.inputs)
     box = Box(fdj_nm=case.ranges.fdj_nm, eta_o=case.ranges.eta_o)
     return inputs, box.normalize(health.fdj_nm, health.eta_o)
 
@@ -124,12 +124,12 @@ def run_case(case: Case, index: int) -> dict:
     rng = np.random.default_rng(1000 + index)
     n_knots = case.sims + 100 if case.per_sim_command else 1
     knots = random_command_knots(SAMPLES, RATE_HZ, rng, n_commands=n_knots)
-    scenario = Scenario(knots if case.per_sim_command else knots[0], case.load)
+    scenario = Scenario(THESIS.params, knots if case.per_sim_command else knots[0], case.load)
     started = time.perf_counter()
     inputs, targets = thesis_dataset(case, scenario, case.sims + 100, seed=index)
     simulate_s = time.perf_counter() - started
     train_x, train_y = inputs[: case.sims], targets[: case.sims]  # the last 100: reserved
-    result = fit(train_x, train_y, replace(case.train, hidden=case.neurons))
+    result = train(train_x, train_y, replace(case.train, hidden=case.neurons))
     reserved = predict(result.model, inputs[case.sims :])
     truth = targets[case.sims :]
     return {
@@ -169,9 +169,11 @@ def baseline_comparison(n_windows: int) -> list[str]:
         truth = np.array([health.fdj_nm[0], health.eta_o[0]])
         methods = result.methods
         errors["network"].append(np.array([methods["FDJ"].network, methods["eta_O"].network]) / truth - 1)
-        base = fit_window(window.signals, window.sample_rate_hz, actuator=THESIS.params)
+        base = fit_window(window.signals, window.sample_rate_hz, drive=THESIS.params)
         errors["baseline"].append(np.array([base.fdj_nm[0], base.eta_o[0]]) / truth - 1)
-        errors["blend"].append(np.array([result.estimates.FDJ.value, result.estimates.eta_O.value]) / truth - 1)
+        fdj, eta_o = result.estimates.FDJ, result.estimates.eta_O
+        assert eta_o is not None, "a window in flight is loaded: eta_O is read"
+        errors["blend"].append(np.array([fdj.value, eta_o.value]) / truth - 1)
     for name, values in errors.items():
         mean_abs = 100 * np.mean(np.abs(values), axis=0)
         rows.append(f"| {name} | {mean_abs[0]:.3f} % | {mean_abs[1]:.3f} % |")
@@ -249,8 +251,8 @@ def main() -> None:
     args = parser.parse_args()
     runtime.configure()
     rng = np.random.default_rng(0)  # warm torch and the kernels: no start-up cost in the first row's times
-    fit(rng.normal(size=(60, 50)), rng.uniform(size=(60, 2)), LearnConfig(hidden=8, max_epochs=5))
-    Scenario(random_command_knots(50, RATE_HZ, rng)[0]).simulate(HealthParams.single())
+    train(rng.normal(size=(60, 50)), rng.uniform(size=(60, 2)), LearnConfig(hidden=8, max_epochs=5))
+    Scenario(THESIS.params, random_command_knots(50, RATE_HZ, rng)[0]).simulate(HealthParams.single())
     results = []
     for index, case in enumerate(cases(args.quick)):
         results.append(run_case(case, index))

@@ -54,8 +54,8 @@ def lane_sweep(health: HealthParams, knots: np.ndarray, samples: int, repeats: i
     ]
     for lanes in LANE_SWEEP:
         one = HealthParams(*(getattr(health, name)[:lanes] for name in ("fsj_nm", "fdj_nm", "eta_o")))
-        simulate_batch(knots[:11], one, lanes=lanes, actuator=THESIS.params)
-        run = functools.partial(simulate_batch, knots[: samples + 1], one, lanes=lanes, actuator=THESIS.params)
+        simulate_batch(knots[:11], one, lanes=lanes, drive=THESIS.params)
+        run = functools.partial(simulate_batch, knots[: samples + 1], one, lanes=lanes, drive=THESIS.params)
         seconds = best_of(repeats, run)
         lines.append(f"| {lanes} | {seconds / (lanes * samples * STEPS_PER_SAMPLE) * 1e9:.3g} |")
     return lines
@@ -74,14 +74,14 @@ def main() -> None:
     rng = np.random.default_rng(0)
     health = HealthParams.uniform(args.sims, DEFAULT_RANGES, rng)
     knots = random_command_knots(args.samples, RATE_HZ, rng)[0]
-    simulate_batch(knots[:11], health, actuator=THESIS.params)  # JIT (or cache load) outside the timing
-    simulate_batch(knots[:11], health, lanes=1, actuator=THESIS.params)
+    simulate_batch(knots[:11], health, drive=THESIS.params)  # JIT (or cache load) outside the timing
+    simulate_batch(knots[:11], health, lanes=1, drive=THESIS.params)
     steps = args.sims * args.samples * STEPS_PER_SAMPLE
 
-    fast_s = best_of(args.repeats, lambda: simulate_batch(knots, health, actuator=THESIS.params))
+    fast_s = best_of(args.repeats, lambda: simulate_batch(knots, health, drive=THESIS.params))
     short = args.samples // 10
     scalar_s = (
-        best_of(1, lambda: simulate_batch(knots[: short + 1], health, lanes=1, actuator=THESIS.params))
+        best_of(1, lambda: simulate_batch(knots[: short + 1], health, lanes=1, drive=THESIS.params))
         * args.samples
         / short
     )

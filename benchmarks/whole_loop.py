@@ -88,7 +88,7 @@ def _as_window(window: Draw, signals: dict[str, np.ndarray]) -> Window:
 def our_simulator_bias(window: Draw, clean: dict[str, np.ndarray], levels: dict[str, float]) -> np.ndarray:
     """(2,) first-order bias of a whole-loop reading that simulates the window with *our* simulator
     (``ema.estimate.simulate.dataset``'s scenario of the noise-free window: its command, start and logged load)."""
-    scenario = scenario_from_window(_as_window(window, clean), actuator=THESIS.params, hinge=THESIS.hinge)
+    scenario = scenario_from_window(_as_window(window, clean), drive=THESIS.params, hinge=THESIS.hinge)
     truth, (d_fdj, d_eta) = window.truth, STEP * WIDTH
     fdj, eta_o = truth["FDJ"] + np.array([0, d_fdj, -d_fdj, 0, 0]), truth["eta_O"] + np.array([0, 0, 0, d_eta, -d_eta])
     signals = scenario.simulate(HealthParams(fsj_nm=np.full(5, truth["FSJ"]), fdj_nm=fdj, eta_o=eta_o)).signals
@@ -101,7 +101,7 @@ def our_fit(window: Draw, signals: dict[str, np.ndarray]) -> np.ndarray:
     """(2,) FDJ and η_O of the Eq. 5.1 fit on these signals, as shares of the range."""
     prepared = prepare(_as_window(window, signals), actuator=THESIS).window
     rate = prepared.sample_rate_hz
-    fit = fit_friction(as_read({k: v[None] for k, v in prepared.signals.items()}, rate), rate, actuator=THESIS.params)
+    fit = fit_friction(as_read({k: v[None] for k, v in prepared.signals.items()}, rate), rate, drive=THESIS.params)
     return np.array([fit.fdj_nm[0], fit.eta_o[0]]) / WIDTH
 
 

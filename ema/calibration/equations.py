@@ -102,45 +102,45 @@ def cogging_columns(
 STOP_MARGIN_DEG = 1.0  # within this of an end stop the stop, not the dead band, sets where the elevator is
 
 
-def engaged(position_deg: np.ndarray, speed_radps: np.ndarray, rate: float, actuator: DriveConstants) -> np.ndarray:
+def engaged(position_deg: np.ndarray, speed_radps: np.ndarray, rate: float, drive: DriveConstants) -> np.ndarray:
     """1 where the motor drives the elevator (it moves with the motor, at least half its speed on the
     motor side), 0 where the motor crosses the dead band after a reversal and the elevator waits, and 0 by an
     end stop, where the stop holds the elevator and the motor's angle says nothing of the band."""
-    elevator = actuator.gear_ratio * smooth_derivative(np.radians(position_deg), rate)
-    free = np.abs(position_deg) < actuator.end_stop_deg - STOP_MARGIN_DEG
+    elevator = drive.gear_ratio * smooth_derivative(np.radians(position_deg), rate)
+    free = np.abs(position_deg) < drive.end_stop_deg - STOP_MARGIN_DEG
     return ((elevator * np.sign(speed_radps) > 0.5 * np.abs(speed_radps)) & free).astype(float)
 
 
 def _one_window(
-    signals: Mapping[str, np.ndarray], rate: float, actuator: DriveConstants, orders: Sequence[float], index: int
+    signals: Mapping[str, np.ndarray], rate: float, drive: DriveConstants, orders: Sequence[float], index: int
 ) -> Equations:
     signals = as_read(signals, rate)  # the hinge moment as the estimators read it
-    t, a, o, mask = (x[0] for x in regressors(signals, rate, actuator, FitSettings()))
+    t, a, o, mask = (x[0] for x in regressors(signals, rate, drive, FitSettings()))
     speed = smoothed(signals["motor_speed_radps"], rate)
     sign = np.sign(speed)
-    angle = motor_angle_rad(signals["motor_speed_radps"], signals["position_deg"], rate, actuator.gear_ratio)
+    angle = motor_angle_rad(signals["motor_speed_radps"], signals["position_deg"], rate, drive.gear_ratio)
     block = max(1, round(FOLD_BLOCK_S * rate))
     variables = {
         "speed_radps": np.abs(speed),
         "position_rad": np.radians(smoothed(signals["position_deg"], rate)),
         "time_s": np.arange(len(speed)) / rate,
-        "load_nm": smoothed(signals["hinge_moment_nm"], rate) / actuator.gear_ratio * sign,  # > 0: aiding
+        "load_nm": smoothed(signals["hinge_moment_nm"], rate) / drive.gear_ratio * sign,  # > 0: aiding
         "current_a": sign * smoothed(signals["current_a"], rate),
         "current_unsigned_a": smoothed(signals["current_a"], rate),
         "acceleration_radps2": sign * smooth_derivative(signals["motor_speed_radps"], rate),  # as T_R reads it
         "direction": sign,
         "motor_angle_rad": angle,
-        "engaged": engaged(signals["position_deg"], speed, rate, actuator),
+        "engaged": engaged(signals["position_deg"], speed, rate, drive),
     }
     return Equations(
         y=t[mask],
         base=np.stack([np.ones(mask.sum()), a[mask], o[mask]], axis=1),
         variables={k: v[mask] for k, v in variables.items()},
         cogging={p: c[mask] * sign[mask, None] for p, c in cogging_columns(angle, speed, rate, orders).items()},
-        kinematic=smoothed(angle / actuator.gear_ratio - np.radians(signals["position_deg"]), rate)[mask],
+        kinematic=smoothed(angle / drive.gear_ratio - np.radians(signals["position_deg"]), rate)[mask],
         folds=(np.arange(len(t)) // block % FOLDS)[mask],
         window=np.full(int(mask.sum()), index),
-        gear_ratio=actuator.gear_ratio,
+        gear_ratio=drive.gear_ratio,
     )
 
 
@@ -148,10 +148,10 @@ def equations(
     windows: Sequence[Mapping[str, np.ndarray]],
     rate: float,
     orders: Sequence[float],
-    actuator: DriveConstants,
+    drive: DriveConstants,
 ) -> Equations:
     """The stacked equation-error problem of ``windows`` (each a dict of signals at ``rate``)."""
-    parts = [_one_window(signals, rate, actuator, orders, i) for i, signals in enumerate(windows)]
+    parts = [_one_window(signals, rate, drive, orders, i) for i, signals in enumerate(windows)]
     first = parts[0]
     # Grouped by fold (stable: in time within a fold), so that each fold is a slice of every column.
     order = np.argsort(np.concatenate([p.folds for p in parts]), kind="stable")

@@ -43,7 +43,7 @@ def noise_copies(
     rate: float,
     orders: Sequence[float],
     seed: int,
-    actuator: DriveConstants,
+    drive: DriveConstants,
     *,
     copies: int = COPIES,
     on_copy: Callable[[], None] | None = None,
@@ -57,4 +57,4 @@ def noise_copies(
         if on_copy is not None:
             on_copy()
         drawn.append([add_sensor_noise(signals, level, rng, rate) for signals, level in zip(clean, noise, strict=True)])
-    return runtime.map_on_pool(lambda noisy: equations(noisy, rate, orders, actuator), drawn)
+    return runtime.map_on_pool(lambda noisy: equations(noisy, rate, orders, drive), drawn)

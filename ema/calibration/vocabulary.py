@@ -13,6 +13,8 @@ leaves sgn(ω)·b/n, an inertia ΔJ beyond J_M leaves sgn(ω)·ΔJ·dω/dt.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 
 from ema.calibration.equations import Equations
@@ -82,16 +84,16 @@ def _gain_term(effect: str, gain: float) -> EffectSet | None:
     return EffectSet({effect: {"gain": gain}}) if 0.7 <= gain <= 1.3 else None
 
 
-def _torque_shift(e: Equations, true_over_logged: np.ndarray, actuator: DriveConstants) -> np.ndarray:
+def _torque_shift(e: Equations, true_over_logged: np.ndarray, drive: DriveConstants) -> np.ndarray:
     """(m, G): what T_R takes for friction when the motor's true torque is sat(r·k_T·I) and the model
     assumes sat(k_T·I), for each ratio r of a grid, as t sees it (times sgn ω). Linear in the
     current until the saturation, which a current-sensor gain below 1 reaches (the loop holds the
     *logged* current at I_max: the true one is above it)."""
-    limit, k_t = actuator.max_motor_torque_nm, actuator.torque_constant_nm_per_a
-    drive = k_t * e.variables["current_unsigned_a"][:, None]
-    shift = drive * true_over_logged[None, :]  # the true torque, then the shift: one (m, G) array
+    limit, k_t = drive.max_motor_torque_nm, drive.torque_constant_nm_per_a
+    torque = k_t * e.variables["current_unsigned_a"][:, None]
+    shift = torque * true_over_logged[None, :]  # the true torque, then the shift: one (m, G) array
     np.clip(shift, -limit, limit, out=shift)
-    np.subtract(np.clip(drive, -limit, limit), shift, out=shift)
+    np.subtract(np.clip(torque, -limit, limit), shift, out=shift)
     return np.multiply(shift, e.variables["direction"][:, None], out=shift)
 
 
@@ -102,11 +104,11 @@ def _offset_term(offset_a: float) -> EffectSet | None:
     return EffectSet({"current_sensor_offset": {"offset_a": offset_a}}) if abs(offset_a) <= 5.0 else None
 
 
-def _offset_shift(e: Equations, offsets_a: np.ndarray, actuator: DriveConstants) -> np.ndarray:
+def _offset_shift(e: Equations, offsets_a: np.ndarray, drive: DriveConstants) -> np.ndarray:
     """(m, G): what T_R takes for friction when the current sensor reads o too high, for each o of a grid, as t
     sees it (times sgn ω): the true current is the logged one less o, and the motor's torque is cut at its
     peak (the loop holds the *logged* current at I_max)."""
-    limit, k_t = actuator.max_motor_torque_nm, actuator.torque_constant_nm_per_a
+    limit, k_t = drive.max_motor_torque_nm, drive.torque_constant_nm_per_a
     current = e.variables["current_unsigned_a"][:, None]
     shift = current - offsets_a[None, :]  # the true current, then its torque, then the shift: one (m, G) array
     np.multiply(k_t, shift, out=shift)
@@ -159,9 +161,9 @@ def _cogging_parameters(b: np.ndarray, order: float) -> dict[str, float]:
     }
 
 
-def named_families(measured: Equations, actuator: DriveConstants) -> list[Family]:
+def named_families(measured: Equations, drive: DriveConstants) -> list[Family]:
     """The vocabulary, shaped on the measured window (a bump's centres span what it visited)."""
-    return _speed_families() + _drive_families(actuator) + _where_families(measured, actuator.gear_ratio)
+    return _speed_families() + _drive_families(drive) + _where_families(measured, drive.gear_ratio)
 
 
 def _speed_families() -> list[Family]:
@@ -188,57 +190,65 @@ def _speed_families() -> list[Family]:
     ]
 
 
-def _drive_families(actuator: DriveConstants) -> list[Family]:
+def _drive_families(drive: DriveConstants) -> list[Family]:
     """What the drive's constants or its current sensor may differ by: k_T, a gain or an offset of the
     sensor, the inertia."""
     return [
-        Family(
+        _sized(
             "torque_constant",
             "current_a",
-            True,
-            lambda e, g: _torque_shift(e, np.array([g]), actuator),
-            lambda b, g: {"gain": g},
-            lambda b, g: _gain_term("torque_constant", g),
-            GAINS,
-            sized=True,
-            stacked=lambda e: _torque_shift(e, np.array(GAINS), actuator)[..., None],
-            offset=True,
+            lambda e, ratios: _torque_shift(e, ratios, drive),
+            (GAINS, "gain"),
+            lambda g: _gain_term("torque_constant", g),
         ),
-        Family(
+        _sized(
             "current_sensor_gain",
             "current_a",
-            True,
-            lambda e, g: _torque_shift(e, np.array([1.0 / g]), actuator),
-            lambda b, g: {"gain": g},
-            lambda b, g: _gain_term("current_sensor_gain", g),
-            GAINS,
-            sized=True,
-            stacked=lambda e: _torque_shift(e, 1.0 / np.array(GAINS), actuator)[..., None],
-            offset=True,
+            lambda e, gains: _torque_shift(e, 1.0 / gains, drive),
+            (GAINS, "gain"),
+            lambda g: _gain_term("current_sensor_gain", g),
         ),
-        Family(
+        _sized(
             "current_sensor_offset",
             "direction",
-            True,
-            lambda e, g: _offset_shift(e, np.array([g]), actuator),
-            lambda b, g: {"offset_a": g},
-            lambda b, g: _offset_term(g),
-            CURRENT_OFFSETS_A,
-            sized=True,
-            stacked=lambda e: _offset_shift(e, np.array(CURRENT_OFFSETS_A), actuator)[..., None],
-            offset=True,
+            lambda e, offsets: _offset_shift(e, offsets, drive),
+            (CURRENT_OFFSETS_A, "offset_a"),
+            _offset_term,
         ),
         Family(
             "inertia",
             "acceleration_radps2",
             True,
             lambda e, g: e.variables["acceleration_radps2"][:, None],
-            lambda b, g: {"factor": 1.0 + float(b[0]) / actuator.inertia_kgm2},
-            lambda b, g: EffectSet(
-                {"inertia": {"factor": float(np.clip(1.0 + b[0] / actuator.inertia_kgm2, 0.5, 2.0))}}
-            ),
+            lambda b, g: {"factor": 1.0 + float(b[0]) / drive.inertia_kgm2},
+            lambda b, g: EffectSet({"inertia": {"factor": float(np.clip(1.0 + b[0] / drive.inertia_kgm2, 0.5, 2.0))}}),
         ),
     ]
+
+
+def _sized(
+    name: str,
+    follows: str,
+    shift: Callable[[Equations, np.ndarray], np.ndarray],
+    grid: tuple[tuple[float, ...], str],
+    term: Callable[[float], EffectSet | None],
+) -> Family:
+    """A family whose grid value is the effect's size and whose trace the physics fixes (it enters with
+    coefficient 1): ``shift`` maps an array of sizes to the (m, G) shifts, ``grid`` is (the sizes, the
+    parameter's name in the report)."""
+    sizes, parameter = grid
+    return Family(
+        name,
+        follows,
+        True,
+        lambda e, g: shift(e, np.array([g])),
+        lambda b, g: {parameter: g},
+        lambda b, g: term(g),
+        sizes,
+        sized=True,
+        stacked=lambda e: shift(e, np.array(sizes))[..., None],
+        offset=True,
+    )
 
 
 def _where_families(measured: Equations, n: float) -> list[Family]:

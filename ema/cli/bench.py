@@ -92,11 +92,11 @@ def references() -> dict[str, float]:
     rng = np.random.default_rng(0)
     health = HealthParams.uniform(SIMS, DEFAULT_RANGES, rng)
     knots = random_command_knots(samples, rate_hz, rng)[0]
-    simulate_batch(knots[:11], health, actuator=THESIS.params)  # compiled or loaded outside the timing
+    simulate_batch(knots[:11], health, drive=THESIS.params)  # compiled or loaded outside the timing
     best = np.inf
     for _ in range(2):
         started = time.perf_counter()
-        simulate_batch(knots, health, actuator=THESIS.params)
+        simulate_batch(knots, health, drive=THESIS.params)
         best = min(best, time.perf_counter() - started)
     steps = SIMS * samples * steps_per_sample
     return {

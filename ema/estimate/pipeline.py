@@ -97,7 +97,7 @@ def checked(
         noise=data.noise,
         residual_floor_nm=floor,
         sliding=data.sliding,
-        actuator=data.drive_as_read,
+        drive=data.drive_as_read,
         simulated_at_health=known,
     )
     reproduced = ratios["residual_torque"] <= MAX_RATIO
@@ -166,7 +166,7 @@ def estimate_window(
     with watch("simulate", f"simulating {config.total_simulations} windows around the physics estimate"):
         effects = prepared.departures.viscosity.effects()
         data = simulate_dataset(
-            w, seen, physics, config, document=actuator, actuator=prepared.drive_as_read, effects=effects
+            w, seen, physics, config, document=actuator, drive=prepared.drive_as_read, effects=effects
         )
     with watch("learn", f"training {config.members} network(s) of {config.hidden_units} neurons"):
         network = learned(data, config)

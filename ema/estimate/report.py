@@ -27,7 +27,7 @@ from ema.estimate.documents import (
 )
 from ema.estimate.documents.window import InertiaReading, SensorZero, WindowInfo
 from ema.estimate.learn.estimator import NetworkEstimator
-from ema.estimate.learn.network import FitResult
+from ema.estimate.learn.network import Trained
 from ema.estimate.physics.friction import FrictionFit, sliding_mask
 from ema.estimate.physics.static_friction import StaticFriction
 from ema.estimate.prepare.conditioning import Prepared, conditioning_done, conditioning_notes
@@ -196,13 +196,13 @@ def _window_info(prepared: Prepared, data: Data, digest: str) -> WindowInfo:
     )
 
 
-def training_info(fit: FitResult, config: PipelineConfig) -> TrainingInfo:
-    """The network's training as an answer reports it: ``fit``, the first member's ``FitResult``."""
+def training_info(trained: Trained, config: PipelineConfig) -> TrainingInfo:
+    """The network's training as an answer reports it: ``trained``, the first member's."""
     return TrainingInfo(
-        epochs=fit.epochs,
-        stop_reason=fit.stop_reason,
-        val_mse=fit.val_mse,
-        test_mse=fit.test_mse,
+        epochs=trained.epochs,
+        stop_reason=trained.stop_reason,
+        val_mse=trained.val_mse,
+        test_mse=trained.test_mse,
         members=config.members,
         hidden_units=config.hidden_units,
     )
@@ -227,7 +227,7 @@ def estimate_document(
     w = prepared.window
     loaded = carries_load(prepared)
     estimates = _estimates(answer, fsj, bool(physics.at_search_edge[0]), prepared.document, loaded)
-    first = network.fits_[0]
+    first = network.members_[0]
     notes = _notes(prepared, physics, estimates, check)
     if read_with.default:
         text = f"read with the default actuator ({read_with.name}): no ema-actuator/1 document was given for "

@@ -20,19 +20,9 @@ from dataclasses import replace
 
 import numpy as np
 
+from ema.estimate import documents as doc
 from ema.estimate.assess.weighing import Assessed, Candidates, assess, misfit_limit
 from ema.estimate.config import PipelineConfig
-from ema.estimate.documents import (
-    STAGES,
-    ActuatorRead,
-    DatasetInfo,
-    Estimate,
-    Estimates,
-    FitCheck,
-    Note,
-    Timings,
-    parameter,
-)
 from ema.estimate.documents.window import WindowInfo
 from ema.estimate.learn.estimator import NetworkRegressor
 from ema.estimate.learn.network import LearnConfig
@@ -88,14 +78,14 @@ def held_out_physics(prepared: ServoPrepared, data: ServoData, n: int) -> tuple[
 
 def undisturbed(
     prepared: ServoPrepared, physics: InverseFit, simulated_by_row: np.ndarray
-) -> tuple[InverseFit, Note | None]:
+) -> tuple[InverseFit, doc.Note | None]:
     """The physics fit again without the rows a force the log does not carry disturbs (``disturbed_rows``: the
     window's residual beyond what its simulations leave there), and a note saying how long they last."""
     disturbed = disturbed_rows(physics.residual_by_row, simulated_by_row)
     if not disturbed.any():
         return physics, None
     seconds = int(disturbed.sum()) * prepared.motion.decimation / prepared.window.sample_rate_hz
-    note = Note(
+    note = doc.Note(
         code="unlogged_force",
         parameter="drive_force_n",
         text=f"{seconds:.2f} s of the window hold a force far beyond what the model leaves there, which the log does "
@@ -105,9 +95,9 @@ def undisturbed(
 
 
 def learned(data: ServoData, config: PipelineConfig) -> NetworkRegressor:
-    train = replace(SERVO_TRAINING, hidden=config.hidden_units, seed=config.seed)
+    settings = replace(SERVO_TRAINING, hidden=config.hidden_units, seed=config.seed)
     n = config.n_simulations
-    return NetworkRegressor(train, config.members).fit(data.inputs[:n], data.normalize(data.truth[:n]))
+    return NetworkRegressor(settings, config.members).fit(data.inputs[:n], data.normalize(data.truth[:n]))
 
 
 def assessed(
@@ -143,7 +133,7 @@ def _relative_error_pct(measured: np.ndarray, simulated: np.ndarray) -> float:
     return float(100.0 * np.linalg.norm(measured - simulated) / max(float(np.linalg.norm(measured)), 1e-300))
 
 
-def closed_loop_check(prepared: ServoPrepared, answer: Assessed, ratio: float, limit: float) -> FitCheck:
+def closed_loop_check(prepared: ServoPrepared, answer: Assessed, ratio: float, limit: float) -> doc.FitCheck:
     """The window simulated in closed loop at the answer: its force and position against the log's, in %, and the
     force's misfit over its noise floor (the part of both forces above the inverse model's band, which no model
     of the motion follows)."""
@@ -160,14 +150,14 @@ def closed_loop_check(prepared: ServoPrepared, answer: Assessed, ratio: float, l
     notes = list(answer.notes)
     if not reproduced:
         notes.append(
-            Note(
+            doc.Note(
                 code="not_reproduced",
                 text=f"simulated in closed loop at these estimates, the drive's force differs from the log's by "
                 f"{force_ratio:.1f}x its noise floor: the model lacks something this window holds (ema calibrate "
                 "traces it)",
             )
         )
-    return FitCheck(
+    return doc.FitCheck(
         reproduced=reproduced,
         equation_error_ratio=ratio,
         equation_error_limit=limit,
@@ -189,7 +179,9 @@ def _above_band(force: np.ndarray, factor: int) -> float:
     return rms(force - np.interp(grid, kept, slow))
 
 
-def _estimates(actuator: ActuatorDocument, prepared: ServoPrepared, physics: InverseFit, answer: Assessed) -> Estimates:
+def _estimates(
+    actuator: ActuatorDocument, prepared: ServoPrepared, physics: InverseFit, answer: Assessed
+) -> doc.Estimates:
     """FDJ in N against the document's nominal (none before ema calibrate), the other constants beside it (an
     effect's that the simulator lacks as the physics fit read it)."""
     nominal = None if actuator.nominal is None else actuator.nominal.fdj
@@ -200,9 +192,9 @@ def _estimates(actuator: ActuatorDocument, prepared: ServoPrepared, physics: Inv
             continue
         servo = prepared.servo
         document = getattr(servo, NOMINAL_FIELDS.get(name, ""), None) or servo.effect_constants.get(name)
-        constants[name] = parameter(values[name], stds[name], document, unit=UNITS[name])
-    return Estimates(
-        FDJ=parameter(answer.values[FDJ], answer.stds[FDJ], nominal, unit=UNITS[FDJ]),
+        constants[name] = doc.parameter(values[name], stds[name], document, unit=UNITS[name])
+    return doc.Estimates(
+        FDJ=doc.parameter(answer.values[FDJ], answer.stds[FDJ], nominal, unit=UNITS[FDJ]),
         eta_O=None,
         eta_A=None,
         FSJ=None,
@@ -216,27 +208,27 @@ def _report(
     data: ServoData,
     network: NetworkRegressor,
     answer: Assessed,
-    check: FitCheck,
+    check: doc.FitCheck,
     *,
     actuator: ActuatorDocument,
-    read_with: ActuatorRead,
+    read_with: doc.ActuatorRead,
     config: PipelineConfig,
-) -> Estimate:
-    window, fit = prepared.window, network.fits_[0]
-    return Estimate(
+) -> doc.Estimate:
+    window, first = prepared.window, network.members_[0]
+    return doc.Estimate(
         actuator_id=window.actuator_id,
         window_id=window.window_id,
         actuator=read_with,
         estimates=_estimates(actuator, prepared, physics, answer),
-        fsj_note=Note(
+        fsj_note=doc.Note(
             code="fsj_no_break_away",
             text="a servo's static friction is not read: its drive never lets the load rest under a rising force",
         ),
         irreversible=False,
         notes=[*prepared.notes, *check.notes],
-        timings_s=Timings(total=0.0),  # the caller's stopwatch sets them
-        stages=dict.fromkeys(STAGES, "run"),
-        dataset=DatasetInfo(
+        timings_s=doc.Timings(total=0.0),  # the caller's stopwatch sets them
+        stages=dict.fromkeys(doc.STAGES, "run"),
+        dataset=doc.DatasetInfo(
             n_simulations=config.n_simulations,
             n_timesteps=data.inputs.shape[1],
             inputs=["drive_force_n"],
@@ -244,7 +236,7 @@ def _report(
             noise_estimated={"position_resolution_m": prepared.loop.resolution_m},
             box={name: (float(lo), float(hi)) for name, lo, hi in zip(data.targets, data.low, data.high, strict=True)},
         ),
-        training=training_info(fit, config),
+        training=training_info(first, config),
         methods={"FDJ" if name == FDJ else name: report for name, report in answer.methods.items()},
         fit_check=check,
         window=WindowInfo.logged(
@@ -263,9 +255,9 @@ def estimate_servo(
     config: PipelineConfig,
     *,
     actuator: ActuatorDocument,
-    read_with: ActuatorRead,
+    read_with: doc.ActuatorRead,
     on_stage: Callable[[str], None] | None = None,
-) -> Estimate:
+) -> doc.Estimate:
     """The ``ema-estimate/1`` result of a servo's window, every stage run and timed (module docstring)."""
     watch, n = Stopwatch(on_stage), config.n_simulations
     with watch("prepare", "completing the document from the log, checking its controller"):

@@ -20,9 +20,10 @@ from ema.estimate.pipeline import estimate_window
 from ema.estimate.quasistatic.drive import MOTOR_READING
 from ema.estimate.quasistatic.pipeline import QUASI_STATIC
 from ema.kinds.base import Calibrated, CalibrationRequest, Cost, Request, read_quasi_statically
+from ema.model.bounds import HIGH_RATE_HZ
 from ema.model.checks import InputError
 from ema.model.kinds import KINDS, KindFacts
-from ema.model.window import HIGH_RATE_HZ, Window
+from ema.model.window import Window
 
 VARIABLES = {
     "speed_radps": "motor speed |ω| [rad/s]",

@@ -58,40 +58,40 @@ class BatchResult:
         return {name: values[index] for name, values in self.signals.items()}
 
 
-def kernel_constants(actuator: DriveConstants, effects: EffectSet) -> kernels.KernelConstants:
+def kernel_constants(drive: DriveConstants, effects: EffectSet) -> kernels.KernelConstants:
     """The step's constants with the effects folded in (derived once per batch)."""
     gain = effects.get("torque_constant", "gain")
     sensor_gain = effects.get("current_sensor_gain", "gain")
     stribeck_speed = effects.get("stribeck", "speed_radps")
     table = effects.table
-    h_over_l = actuator.step_s / actuator.inductance_h
+    h_over_l = drive.step_s / drive.inductance_h
     return kernels.KernelConstants(
-        step_s=actuator.step_s,
-        step_over_gear=actuator.step_s / actuator.gear_ratio,
-        position_gain=actuator.position_gain_per_s,
-        max_speed_ref=actuator.max_motor_speed_radps,
-        speed_gain_over_kt=actuator.speed_gain_nms / actuator.torque_constant_nm_per_a / sensor_gain,
-        max_current=actuator.max_current_a / sensor_gain,
-        voltage_step=h_over_l * actuator.supply_voltage_v,
-        current_decay=1.0 - h_over_l * actuator.resistance_ohm,
-        back_emf_step=h_over_l * gain * actuator.torque_constant_nm_per_a,
-        torque_constant=gain * actuator.torque_constant_nm_per_a,
-        max_torque=actuator.max_motor_torque_nm,
-        inverse_gear=1.0 / actuator.gear_ratio,
-        gear=actuator.gear_ratio,
-        step_over_inertia=actuator.step_s / (actuator.inertia_kgm2 * effects.get("inertia", "factor")),
-        viscous=actuator.viscous_nms + effects.get("viscous", "coefficient_nms"),
-        half_backlash=0.5 * (actuator.backlash_rad + effects.get("backlash", "extra_rad")),
-        end_stop=float(np.radians(actuator.end_stop_deg)),
+        step_s=drive.step_s,
+        step_over_gear=drive.step_s / drive.gear_ratio,
+        position_gain=drive.position_gain_per_s,
+        max_speed_ref=drive.max_motor_speed_radps,
+        speed_gain_over_kt=drive.speed_gain_nms / drive.torque_constant_nm_per_a / sensor_gain,
+        max_current=drive.max_current_a / sensor_gain,
+        voltage_step=h_over_l * drive.supply_voltage_v,
+        current_decay=1.0 - h_over_l * drive.resistance_ohm,
+        back_emf_step=h_over_l * gain * drive.torque_constant_nm_per_a,
+        torque_constant=gain * drive.torque_constant_nm_per_a,
+        max_torque=drive.max_motor_torque_nm,
+        inverse_gear=1.0 / drive.gear_ratio,
+        gear=drive.gear_ratio,
+        step_over_inertia=drive.step_s / (drive.inertia_kgm2 * effects.get("inertia", "factor")),
+        viscous=drive.viscous_nms + effects.get("viscous", "coefficient_nms"),
+        half_backlash=0.5 * (drive.backlash_rad + effects.get("backlash", "extra_rad")),
+        end_stop=float(np.radians(drive.end_stop_deg)),
         current_sensor_gain=sensor_gain,
         current_sensor_offset=effects.get("current_sensor_offset", "offset_a"),
         current_ref_shift=effects.get("current_sensor_offset", "offset_a") / sensor_gain,
         hinge_sensor_bias=effects.get("hinge_moment_bias", "bias_nm"),
         stribeck_amplitude=effects.get("stribeck", "amplitude_nm"),
         stribeck_inverse_speed=1.0 / stribeck_speed,
-        position_friction=effects.get("position_friction", "amplitude_nm") / np.radians(actuator.end_stop_deg),
+        position_friction=effects.get("position_friction", "amplitude_nm") / np.radians(drive.end_stop_deg),
         cogging_amplitude=effects.get("cogging", "amplitude_nm"),
-        cogging_wavenumber=effects.get("cogging", "periods_per_rev") * actuator.gear_ratio,
+        cogging_wavenumber=effects.get("cogging", "periods_per_rev") * drive.gear_ratio,
         cogging_phase=effects.get("cogging", "phase_rad"),
         table_variable=0 if table is None else TABLE_VARIABLES[table.variable],
         table_start=0.0 if table is None else table.start,
@@ -103,13 +103,13 @@ def kernel_constants(actuator: DriveConstants, effects: EffectSet) -> kernels.Ke
     )
 
 
-def interval_steps(n_samples: int, sample_rate_hz: float, actuator: DriveConstants) -> np.ndarray:
+def interval_steps(n_samples: int, sample_rate_hz: float, drive: DriveConstants) -> np.ndarray:
     """(n_samples,) steps of h in each log interval: interval k spans steps round(k/(f·h)) to round((k+1)/(f·h)).
 
     Any rate is exact: at 3 kHz the intervals hold 333 or 334 steps, as a logger's clock would.
     """
     rate = in_range("sample_rate_hz", sample_rate_hz, *SAMPLE_RATE_RANGE_HZ, "Hz")
-    edges = np.round(np.arange(n_samples + 1) / (rate * actuator.step_s)).astype(np.int64)
+    edges = np.round(np.arange(n_samples + 1) / (rate * drive.step_s)).astype(np.int64)
     return np.diff(edges)
 
 
@@ -126,10 +126,10 @@ def clipped_knots(command_knots_deg: np.ndarray, n_health: int, end_stop_deg: fl
     return np.clip(knots, -limit, limit)
 
 
-def _checked_initial(initial: InitialState, actuator: DriveConstants) -> InitialState:
+def _checked_initial(initial: InitialState, drive: DriveConstants) -> InitialState:
     """``initial``, within the end stops and ``INITIAL_MARGIN`` of the drive's speed and current saturations."""
-    stop = actuator.end_stop_deg
-    speed, current = (INITIAL_MARGIN * limit for limit in (actuator.max_motor_speed_radps, actuator.max_current_a))
+    stop = drive.end_stop_deg
+    speed, current = (INITIAL_MARGIN * limit for limit in (drive.max_motor_speed_radps, drive.max_current_a))
     in_range("initial.position_deg", initial.position_deg, -stop, stop, "deg")
     in_range("initial.motor_speed_radps", initial.motor_speed_radps, -speed, speed, "rad/s")
     in_range("initial.current_a", initial.current_a, -current, current, "A")
@@ -199,7 +199,7 @@ def simulate_batch(
     sample_rate_hz: float = DEFAULT_SAMPLE_RATE_HZ,
     effects: EffectSet = EffectSet(),
     *,
-    actuator: DriveConstants,
+    drive: DriveConstants,
     hinge: HingeGeometry | None = None,
     lanes: int | None = None,
     reuse_output: bool = False,
@@ -218,25 +218,25 @@ def simulate_batch(
     if not isinstance(health, HealthParams):
         raise InputError("health", f"must be HealthParams, got {type(health).__name__}")
     n_sims = len(health)
-    knots = clipped_knots(command_knots_deg, n_sims, actuator.end_stop_deg)
-    _checked_initial(initial, actuator)
+    knots = clipped_knots(command_knots_deg, n_sims, drive.end_stop_deg)
+    _checked_initial(initial, drive)
     if not isinstance(effects, EffectSet):
         raise InputError("effects", f"must be an EffectSet, got {type(effects).__name__}")
     lanes = default_lanes(n_sims) if lanes is None else lanes
     if not 1 <= lanes <= 512:
         raise InputError("lanes", f"must be in [1, 512], got {lanes}")
     n_samples = knots.shape[1] - 1
-    steps = interval_steps(n_samples, sample_rate_hz, actuator)
+    steps = interval_steps(n_samples, sample_rate_hz, drive)
     loads = load_model(load, 1.0 / sample_rate_hz, hinge)
     if len(loads.slow_table_nm) not in (0, n_samples):
         raise InputError("load", f"a logged load needs {n_samples} values, got {len(loads.slow_table_nm)}")
 
-    k_aid, k_opp = load_factors(health.eta_o, actuator.gear_ratio)
+    k_aid, k_opp = load_factors(health.eta_o, drive.gear_ratio)
     per_sim = _padded(np.stack([health.fdj_nm, health.fsj_nm, k_aid, k_opp]), lanes)
     start = [np.radians(initial.position_deg), initial.motor_speed_radps, initial.current_a]
     initial_rows = np.repeat(np.array(start)[:, None], per_sim.shape[1], axis=1)
     out = _recording((kernels.N_RECORDED, per_sim.shape[1], n_samples), reuse_output)
-    constants = kernel_constants(actuator, effects)
+    constants = kernel_constants(drive, effects)
     knots_rad = np.ascontiguousarray(np.radians(knots))
     table_nm = np.zeros(2) if effects.table is None else np.array(effects.table.values_nm)
     run_groups((constants, (table_nm, loads, per_sim, knots_rad, steps, initial_rows)), out, lanes)

@@ -16,6 +16,27 @@ CLOCK_SKEW = dt.timedelta(days=1)
 DEFAULT_SAMPLE_RATE_HZ = 10_000.0
 SAMPLE_RATE_RANGE_HZ = (1_000.0, 100_000.0)  # the rates the simulator draws a window at
 MAX_THREADS = 256  # a thread budget's ceiling: more than any onboard computer or server has cores
+MIN_SAMPLES = 100
+MAX_SAMPLES = 1_000_000
+# A window may be logged at 10 Hz (a test rig's logger) to 100 kHz; below HIGH_RATE_HZ it is read quasi-statically
+# (``ema.estimate.quasistatic.stretches``), at or above it through the whole pipeline.
+WINDOW_RATE_RANGE_HZ = (10.0, 100_000.0)
+HIGH_RATE_HZ = 1_000.0
+# Physical plausibility: beyond these a sample is a sensor fault or a unit error, not a state.
+SIGNAL_LIMITS = {
+    "command_deg": (-90.0, 90.0),  # a reference, not a measurement: only a unit error is refused
+    "position_deg": (-35.0, 35.0),
+    "motor_speed_radps": (-2_000.0, 2_000.0),
+    "current_a": (-60.0, 60.0),
+    "hinge_moment_nm": (-5_000.0, 5_000.0),
+    "command_mm": (-10_000.0, 10_000.0),
+    "position_mm": (-10_000.0, 10_000.0),
+    "load_n": (-1e6, 1e6),
+    "set_point_m": (-100.0, 100.0),
+    "position_m": (-100.0, 100.0),
+    "drive_force_n": (-1e6, 1e6),
+}
+CONSTANT_NAME = r"^[a-z][a-z0-9_]{0,63}$"
 
 
 def route_collision(actuator_id: str) -> str | None:

@@ -182,7 +182,7 @@ def residual_torque_nm(
     motor_speed_radps: np.ndarray,
     hinge_moment_nm: np.ndarray,
     sample_rate_hz: float,
-    actuator: DriveConstants,
+    drive: DriveConstants,
     derivative_window_s: float = DEFAULT_DERIVATIVE_WINDOW_S,
 ) -> np.ndarray:
     """T_R [N·m] at the motor shaft, one value per sample; works on one window or a batch (last axis = time)."""
@@ -198,7 +198,7 @@ def residual_torque_nm(
     rate = in_range("sample_rate_hz", sample_rate_hz, 100.0, 1e6, "Hz")
     half = _half_width(speed, rate, derivative_window_s)
     i, w, h = (np.ascontiguousarray(np.broadcast_to(x, shape).reshape(-1, shape[-1])) for x in (current, speed, hinge))
-    a = actuator
+    a = drive
     constants = (a.torque_constant_nm_per_a, a.max_motor_torque_nm, a.gear_ratio, a.inertia_kgm2)
     smoothing, derivative = smoothing_weights(half), derivative_weights(half, rate)
     out = np.empty(i.shape)

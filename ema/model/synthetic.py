@@ -46,7 +46,7 @@ def synthetic_window(
     stop = actuator.params.end_stop_deg - 1.0
     start = InitialState(position_deg=float(np.clip(knots[0], -stop, stop)))
     result = simulate_batch(
-        knots, health, condition, start, sample_rate_hz, effects, actuator=actuator.params, hinge=actuator.hinge
+        knots, health, condition, start, sample_rate_hz, effects, drive=actuator.params, hinge=actuator.hinge
     )
     signals = add_sensor_noise(result.simulation(0), noise, rng)
     flight = condition if isinstance(condition, FlightCondition) else None

@@ -15,10 +15,11 @@ from pathlib import Path
 
 import numpy as np
 
+from ema.model.bounds import MAX_SAMPLES
 from ema.model.checks import InputError
 
 MAX_LOG_BYTES = 256 * 2**20  # a logged file's size limit: ~4x the largest window's CSV
-MAX_ROWS = 1_000_000  # a window's samples at most (ema.model.window.MAX_SAMPLES)
+MAX_ROWS = MAX_SAMPLES  # as many rows as a window's samples at most
 TABLE_SUFFIXES = (".csv", ".mat", ".npz")
 
 

@@ -29,39 +29,24 @@ from pydantic import (
 from ema.model.aircraft import AIRSPEED_RANGE_MPS, ALTITUDE_RANGE_M, FlightCondition
 from ema.model.bounds import (
     CLOCK_SKEW,
+    CONSTANT_NAME,
     DEFAULT_SAMPLE_RATE_HZ,
     EARLIEST_RECORDED_AT,
+    HIGH_RATE_HZ,
     IDENTIFIER,
     MAX_FLIGHT_HOURS,
+    MAX_SAMPLES,
+    MIN_SAMPLES,
+    SIGNAL_LIMITS,
+    WINDOW_RATE_RANGE_HZ,
     route_collision,
 )
 from ema.model.checks import InputError, read_document, validated
-from ema.model.document import Number
+from ema.model.document import Number, refused_by
 from ema.model.kinds import ALL_SIGNALS, DEFAULT_KIND, KINDS, kind_of_signals, nearest_kind
 
 SCHEMA = "ema-window/1"
 SIGNALS = KINDS[DEFAULT_KIND].signals  # a rotary window's, the layout a CSV or NPZ log without a map is read in
-MIN_SAMPLES = 100
-MAX_SAMPLES = 1_000_000
-# A window may be logged at 10 Hz (a test rig's logger) to 100 kHz; below HIGH_RATE_HZ it is read quasi-statically
-# (``ema.estimate.quasistatic.stretches``), at or above it through the whole pipeline.
-WINDOW_RATE_RANGE_HZ = (10.0, 100_000.0)
-HIGH_RATE_HZ = 1_000.0
-# Physical plausibility: beyond these a sample is a sensor fault or a unit error, not a state.
-SIGNAL_LIMITS = {
-    "command_deg": (-90.0, 90.0),  # a reference, not a measurement: only a unit error is refused
-    "position_deg": (-35.0, 35.0),
-    "motor_speed_radps": (-2_000.0, 2_000.0),
-    "current_a": (-60.0, 60.0),
-    "hinge_moment_nm": (-5_000.0, 5_000.0),
-    "command_mm": (-10_000.0, 10_000.0),
-    "position_mm": (-10_000.0, 10_000.0),
-    "load_n": (-1e6, 1e6),
-    "set_point_m": (-100.0, 100.0),
-    "position_m": (-100.0, 100.0),
-    "drive_force_n": (-1e6, 1e6),
-}
-CONSTANT_NAME = r"^[a-z][a-z0-9_]{0,63}$"
 
 Samples = Annotated[list[Number], Field(min_length=MIN_SAMPLES, max_length=MAX_SAMPLES)]
 
@@ -135,7 +120,9 @@ class WindowDocument(_Contract):
     """``ema-window/1``."""
 
     schema_: Literal["ema-window/1"] = Field(alias="schema")
-    actuator_id: str = Field(min_length=1, max_length=200, pattern=IDENTIFIER, examples=["tail-123/elevator-left"])
+    actuator_id: Annotated[str, refused_by(route_collision)] = Field(
+        min_length=1, max_length=200, pattern=IDENTIFIER, examples=["tail-123/elevator-left"]
+    )
     window_id: str = Field(min_length=1, max_length=200, pattern=IDENTIFIER, examples=["2026-11-21T10:00:00Z#17"])
     sample_rate_hz: Number = Field(ge=WINDOW_RATE_RANGE_HZ[0], le=WINDOW_RATE_RANGE_HZ[1])
     flight_condition: FlightConditionDocument | None = Field(
@@ -168,14 +155,6 @@ class WindowDocument(_Contract):
         description="constants the log recorded beside its signals, under the names of the actuator document's "
         "section (a servo's controller gains): read with the document, which must agree where it gives them too",
     )
-
-    @field_validator("actuator_id")
-    @classmethod
-    def _no_route(cls, actuator_id: str) -> str:
-        clash = route_collision(actuator_id)
-        if clash is not None:
-            raise ValueError(clash)
-        return actuator_id
 
     @field_validator("recorded_at")
     @classmethod

@@ -9,13 +9,14 @@ from __future__ import annotations
 import ipaddress
 import os
 from pathlib import Path
-from typing import Literal
+from typing import Annotated, Literal
 
-from pydantic import Field, SecretStr, field_validator, model_validator
+from pydantic import BeforeValidator, Field, SecretStr, field_validator, model_validator
 from pydantic_settings import BaseSettings, SettingsConfigDict
 
 from ema.estimate.config import PipelineConfig
 from ema.model.bounds import MAX_THREADS
+from ema.model.document import refused_by
 
 LOOPBACK_NAMES = ("localhost", "127.0.0.1", "::1")
 MIN_KEY_CHARACTERS = 16
@@ -36,6 +37,19 @@ def default_database() -> Path:
     return Path(home) / "ema" / "history.sqlite3"
 
 
+def _text_setting(setting: object) -> str:
+    setting = str(setting) if isinstance(setting, Path) else setting
+    if not isinstance(setting, str):
+        raise ValueError("must be a file path or a postgresql:// address")
+    return setting
+
+
+def _setting_error(setting: str) -> str | None:
+    from ema.history.open import setting_error  # the history's rule, loaded when a setting is read
+
+    return setting_error(setting)
+
+
 def _read_key(path: Path) -> str:
     try:
         return path.read_text().strip()
@@ -51,7 +65,7 @@ class Settings(BaseSettings):
     api_key: SecretStr | None = Field(None, description="every /v1 request must carry it in X-API-Key")
     api_key_file: Path | None = Field(None, description="a file holding the key (kept out of the environment)")
     api_prefix: str = Field("/v1", pattern=r"^/[a-z0-9]+$")
-    database: str = Field(
+    database: Annotated[str, BeforeValidator(_text_setting), refused_by(_setting_error)] = Field(
         default_factory=lambda: str(default_database()),
         description="the history: an SQLite file's path, or a postgresql://user@host:port/db address",
     )
@@ -91,19 +105,6 @@ class Settings(BaseSettings):
     )
     threads: int | None = Field(None, ge=1, le=MAX_THREADS, description="the thread budget; default: the usable cores")
     warm_up: bool = True
-
-    @field_validator("database", mode="before")
-    @classmethod
-    def _database_is_a_path_or_an_address(cls, setting: object) -> str:
-        setting = str(setting) if isinstance(setting, Path) else setting
-        if not isinstance(setting, str):
-            raise ValueError("must be a file path or a postgresql:// address")
-        from ema.history.open import setting_error
-
-        error = setting_error(setting)
-        if error is not None:
-            raise ValueError(error)
-        return setting
 
     @field_validator("api_key")
     @classmethod

@@ -31,7 +31,7 @@ def test_a_cogging_column_carries_the_logs_interval_mean_attenuation():
 
 def test_the_dead_band_width_is_read_from_the_windows_own_angles():
     window = synthetic_window(HealthParams.single(), seed=3, noise=NO_NOISE)
-    problem = equations([window.signals], window.sample_rate_hz, [], actuator=THESIS.params)
+    problem = equations([window.signals], window.sample_rate_hz, [], drive=THESIS.params)
     # BLK of Table 3.1, within the few % that smoothing over the reversals takes (the noise floor's
     # copies carry the same, so ema.calibration.backlash reads extra width against them, not against BLK)
     assert width_rad(problem) == pytest.approx(5e-3, rel=0.1)
@@ -48,7 +48,7 @@ def test_the_tied_base_holds_eq_3_4_near_the_windows_efficiency(gear_ratio, eta_
     from ema.model.params import load_factors
 
     rng = np.random.default_rng(7)
-    e = equations([synthetic_window(HealthParams.single(), seed=1).signals], 10_000.0, [], actuator=THESIS.params)
+    e = equations([synthetic_window(HealthParams.single(), seed=1).signals], 10_000.0, [], drive=THESIS.params)
     a, o = rng.uniform(0, 0.1, e.m) * (rng.random(e.m) < 0.5), rng.uniform(0, 0.1, e.m)
     k_aid, k_opp = load_factors(eta_o, gear_ratio)
     base = np.column_stack([np.ones(e.m), a, o])

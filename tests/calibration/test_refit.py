@@ -38,7 +38,7 @@ def _measured(case: str, seed: int) -> Equations:
     """A foreign window with ``case`` in the foreign simulator's own form, as calibration reads it."""
     drawn = draw(seed, "thesis", effects=CASES[case](np.random.default_rng(seed), 1.0))
     window = window_from_dict(drawn.document)
-    return equations([window.signals], window.sample_rate_hz, [], actuator=THESIS.params)
+    return equations([window.signals], window.sample_rate_hz, [], drive=THESIS.params)
 
 
 @pytest.mark.parametrize(

@@ -31,8 +31,8 @@ def test_stuck_below_the_break_away_load_and_slips_above_it(nominal):
     # Command = position = 0: the controller asks for nothing, so only the load drives the shaft.
     # Stuck, the load aids the drive, so it breaks away when η_A·|T_ext| > FSJ.
     threshold_nm = 0.10 / float(eta_a_from_eta_o(0.85, 500.0)) * 500.0
-    below = simulate_batch(np.zeros(301), nominal, GroundLoad(0.8 * threshold_nm), actuator=THESIS.params)
-    above = simulate_batch(np.zeros(301), nominal, GroundLoad(1.25 * threshold_nm), actuator=THESIS.params)
+    below = simulate_batch(np.zeros(301), nominal, GroundLoad(0.8 * threshold_nm), drive=THESIS.params)
+    above = simulate_batch(np.zeros(301), nominal, GroundLoad(1.25 * threshold_nm), drive=THESIS.params)
     assert np.all(below.signals["motor_speed_radps"] == 0.0)
     assert np.all(below.signals["position_deg"] == 0.0)
     assert np.abs(above.signals["motor_speed_radps"]).max() > 1.0
@@ -41,7 +41,7 @@ def test_stuck_below_the_break_away_load_and_slips_above_it(nominal):
 @pytest.mark.parametrize(("load_nm", "kind"), [(-100.0, "opposing"), (100.0, "aiding")])
 def test_steady_sliding_loss_is_fdj_plus_load_part_plus_viscous(load_nm, kind):
     health = HealthParams.single(fdj_nm=0.045, eta_o=0.8)
-    result = simulate_batch(ramp_knots(0.0, 10.0, 3000), health, GroundLoad(load_nm), actuator=THESIS.params)
+    result = simulate_batch(ramp_knots(0.0, 10.0, 3000), health, GroundLoad(load_nm), drive=THESIS.params)
     steady = slice(1000, 3000)
     speed = result.signals["motor_speed_radps"][0, steady]
     assert speed.mean() == pytest.approx(np.radians(10.0) * 500, rel=0.01)
@@ -55,7 +55,7 @@ def test_steady_sliding_loss_is_fdj_plus_load_part_plus_viscous(load_nm, kind):
         result.signals["motor_speed_radps"],
         result.signals["hinge_moment_nm"],
         RATE,
-        actuator=THESIS.params,
+        drive=THESIS.params,
     )[0, steady]
     assert residual.mean() == pytest.approx(expected.mean(), rel=0.02)
 
@@ -63,7 +63,7 @@ def test_steady_sliding_loss_is_fdj_plus_load_part_plus_viscous(load_nm, kind):
 def test_elevator_follows_a_slow_command(nominal):
     t = np.arange(5001) / RATE
     command = 5.0 * np.sin(2 * np.pi * 1.0 * t)
-    result = simulate_batch(command, nominal, FlightCondition(), actuator=THESIS.params)
+    result = simulate_batch(command, nominal, FlightCondition(), drive=THESIS.params)
     error = result.signals["position_deg"][0, 200:] - result.signals["command_deg"][0, 200:]
     assert np.abs(error).max() < 0.5  # P-loop lag + half the 0.29° dead band
     assert np.abs(result.signals["command_deg"][0] - 0.5 * (command[1:] + command[:-1])).max() < 1e-3
@@ -71,7 +71,7 @@ def test_elevator_follows_a_slow_command(nominal):
 
 def test_end_stops_hold(nominal):
     result = simulate_batch(
-        np.full(2001, 35.0), nominal, FlightCondition(), InitialState(position_deg=28.0), actuator=THESIS.params
+        np.full(2001, 35.0), nominal, FlightCondition(), InitialState(position_deg=28.0), drive=THESIS.params
     )
     position = result.signals["position_deg"][0]
     assert position.max() <= 30.0
@@ -83,13 +83,13 @@ def test_batch_equals_single_simulations_and_lanes_do_not_change_results():
     rng = np.random.default_rng(7)
     health = HealthParams.uniform(5, DEFAULT_RANGES, rng)
     knots = random_command_knots(400, RATE, rng)[0]
-    batch = simulate_batch(knots, health, actuator=THESIS.params)
-    plain = simulate_batch(knots, health, lanes=1, actuator=THESIS.params)  # one lane: the scalar path
+    batch = simulate_batch(knots, health, drive=THESIS.params)
+    plain = simulate_batch(knots, health, lanes=1, drive=THESIS.params)  # one lane: the scalar path
     for name in batch.signals:
         np.testing.assert_array_equal(batch.signals[name], plain.signals[name])
     for i in (0, 3):
         single = simulate_batch(
-            knots, HealthParams.single(health.fsj_nm[i], health.fdj_nm[i], health.eta_o[i]), actuator=THESIS.params
+            knots, HealthParams.single(health.fsj_nm[i], health.fdj_nm[i], health.eta_o[i]), drive=THESIS.params
         )
         for name in batch.signals:
             np.testing.assert_array_equal(batch.signals[name][i], single.signals[name][0])
@@ -99,10 +99,10 @@ def test_one_command_per_simulation_case_2():
     rng = np.random.default_rng(8)
     health = HealthParams.uniform(3, DEFAULT_RANGES, rng)
     knots = random_command_knots(300, RATE, rng, n_commands=3)
-    batch = simulate_batch(knots, health, actuator=THESIS.params)
+    batch = simulate_batch(knots, health, drive=THESIS.params)
     for i in range(3):
         single = simulate_batch(
-            knots[i], HealthParams.single(health.fsj_nm[i], health.fdj_nm[i], health.eta_o[i]), actuator=THESIS.params
+            knots[i], HealthParams.single(health.fsj_nm[i], health.fdj_nm[i], health.eta_o[i]), drive=THESIS.params
         )
         np.testing.assert_array_equal(batch.signals["position_deg"][i], single.signals["position_deg"][0])
 
@@ -122,7 +122,7 @@ def test_kernel_matches_the_plain_numpy_model(effects):
     health = HealthParams.uniform(4, DEFAULT_RANGES, rng)
     knots = random_command_knots(30, RATE, rng)[0]
     initial = InitialState(position_deg=0.3, motor_speed_radps=50.0, current_a=2.0)
-    fast = simulate_batch(knots, health, initial=initial, effects=effects, actuator=THESIS.params)
+    fast = simulate_batch(knots, health, initial=initial, effects=effects, drive=THESIS.params)
     c = kernel_constants(DriveConstants(), effects)
     eta_a = health.eta_a(500.0)
     per_sim = np.stack([health.fdj_nm, health.fsj_nm, 1 - eta_a, 1 / health.eta_o - 1])
@@ -139,7 +139,7 @@ def test_kernel_matches_the_plain_numpy_model(effects):
 def test_any_log_rate_is_exact_intervals_of_whole_steps(nominal):
     # A 3 kHz log holds intervals of 333 or 334 steps; each recorded value is the mean of the
     # 1 µs values inside it, so it equals the step-weighted mean of a log taken every step.
-    assert list(interval_steps(3, 3_000.0, actuator=THESIS.params)) == [333, 334, 333]
+    assert list(interval_steps(3, 3_000.0, drive=THESIS.params)) == [333, 334, 333]
     c = kernel_constants(DriveConstants(), EffectSet())
     load = load_model(FlightCondition(), 1 / 3_000.0)
     per_sim = np.tile(np.array([[0.05], [0.1], [1 - float(eta_a_from_eta_o(0.85, 500.0))], [1 / 0.85 - 1]]), (1, 8))
@@ -150,7 +150,7 @@ def test_any_log_rate_is_exact_intervals_of_whole_steps(nominal):
     kernels.run_group(c, (np.zeros(2), frozen, per_sim, knots, np.ones(1000, np.int64), initial), 0, 8, every_step)
     logged = np.empty((6, 8, 3))
     three = knots[:, [0, 333, 667, 1000]]
-    steps = interval_steps(3, 3_000.0, actuator=THESIS.params)
+    steps = interval_steps(3, 3_000.0, drive=THESIS.params)
     kernels.run_group(c, (np.zeros(2), frozen, per_sim, three, steps, initial), 0, 8, logged)
     for k, (lo, hi) in enumerate([(0, 333), (333, 667), (667, 1000)]):
         for row in (kernels.SPEED, kernels.CURRENT):
@@ -160,21 +160,21 @@ def test_any_log_rate_is_exact_intervals_of_whole_steps(nominal):
 def test_a_command_past_the_end_stops_acts_as_one_just_beyond_them(nominal):
     # Beyond ω_max/G_P ≈ 0.37° past the stops the speed reference is saturated: 45° and 31° are one command.
     far = simulate_batch(
-        np.full(1001, 45.0), nominal, FlightCondition(), InitialState(position_deg=25.0), actuator=THESIS.params
+        np.full(1001, 45.0), nominal, FlightCondition(), InitialState(position_deg=25.0), drive=THESIS.params
     )
     near = simulate_batch(
-        np.full(1001, 31.0), nominal, FlightCondition(), InitialState(position_deg=25.0), actuator=THESIS.params
+        np.full(1001, 31.0), nominal, FlightCondition(), InitialState(position_deg=25.0), drive=THESIS.params
     )
     np.testing.assert_array_equal(far.signals["position_deg"], near.signals["position_deg"])
 
 
 def test_a_logged_load_reproduces_the_aircraft_that_logged_it(nominal):
     knots = random_command_knots(3000, RATE, np.random.default_rng(12))[0]
-    flown = simulate_batch(knots, nominal, FlightCondition(120.0, 2000.0), actuator=THESIS.params)
+    flown = simulate_batch(knots, nominal, FlightCondition(120.0, 2000.0), drive=THESIS.params)
     logged = LoggedLoad(
         FlightCondition(120.0, 2000.0), flown.signals["hinge_moment_nm"][0], flown.signals["position_deg"][0]
     )
-    replayed = simulate_batch(knots, nominal, logged, actuator=THESIS.params)
+    replayed = simulate_batch(knots, nominal, logged, drive=THESIS.params)
     # The slow part is held per interval from the log, the δ term applied every step as in flight.
     assert np.abs(replayed.signals["hinge_moment_nm"] - flown.signals["hinge_moment_nm"]).max() < 0.5
     assert np.abs(replayed.signals["position_deg"] - flown.signals["position_deg"]).max() < 0.01
@@ -189,9 +189,9 @@ def test_thread_budget_does_not_change_results(nominal):
     before = runtime.threads()
     try:
         runtime.set_threads(1)
-        one = simulate_batch(knots, health, lanes=8, actuator=THESIS.params)
+        one = simulate_batch(knots, health, lanes=8, drive=THESIS.params)
         runtime.set_threads(2)
-        two = simulate_batch(knots, health, lanes=8, actuator=THESIS.params)
+        two = simulate_batch(knots, health, lanes=8, drive=THESIS.params)
     finally:
         runtime.set_threads(before)
     np.testing.assert_array_equal(one.signals["current_a"], two.signals["current_a"])
@@ -200,18 +200,18 @@ def test_thread_budget_does_not_change_results(nominal):
 def test_a_kept_recording_buffer_gives_the_fresh_results_and_is_reused():
     knots = random_command_knots(200, RATE, np.random.default_rng(3))[0]
     first, second = (HealthParams.uniform(30, DEFAULT_RANGES, np.random.default_rng(seed)) for seed in (4, 5))
-    kept = simulate_batch(knots, first, actuator=THESIS.params, reuse_output=True).signals["current_a"].copy()
-    np.testing.assert_array_equal(kept, simulate_batch(knots, first, actuator=THESIS.params).signals["current_a"])
-    a = simulate_batch(knots, first, actuator=THESIS.params, reuse_output=True).signals["current_a"]
-    b = simulate_batch(knots, second, actuator=THESIS.params, reuse_output=True).signals["current_a"]
+    kept = simulate_batch(knots, first, drive=THESIS.params, reuse_output=True).signals["current_a"].copy()
+    np.testing.assert_array_equal(kept, simulate_batch(knots, first, drive=THESIS.params).signals["current_a"])
+    a = simulate_batch(knots, first, drive=THESIS.params, reuse_output=True).signals["current_a"]
+    b = simulate_batch(knots, second, drive=THESIS.params, reuse_output=True).signals["current_a"]
     assert np.shares_memory(a, b)  # the documented contract: the next such call overwrites the last
 
 
 def test_simulation_is_deterministic(nominal):
     knots = random_command_knots(200, RATE, np.random.default_rng(3))[0]
     a, b = (
-        simulate_batch(knots, nominal, actuator=THESIS.params),
-        simulate_batch(knots, nominal, actuator=THESIS.params),
+        simulate_batch(knots, nominal, drive=THESIS.params),
+        simulate_batch(knots, nominal, drive=THESIS.params),
     )
     np.testing.assert_array_equal(a.signals["current_a"], b.signals["current_a"])
 
@@ -219,9 +219,9 @@ def test_simulation_is_deterministic(nominal):
 def test_aircraft_on_the_log_step_is_indistinguishable_from_a_finer_one(nominal):
     # The aircraft advances once per log interval; halving that interval must not move the outputs.
     knots = random_command_knots(1000, RATE, np.random.default_rng(4))[0]
-    coarse = simulate_batch(knots, nominal, sample_rate_hz=RATE, actuator=THESIS.params)
+    coarse = simulate_batch(knots, nominal, sample_rate_hz=RATE, drive=THESIS.params)
     fine_knots = np.interp(np.arange(2001) / 2, np.arange(1001), knots)
-    fine = simulate_batch(fine_knots, nominal, sample_rate_hz=2 * RATE, actuator=THESIS.params)
+    fine = simulate_batch(fine_knots, nominal, sample_rate_hz=2 * RATE, drive=THESIS.params)
     fine_hinge = fine.signals["hinge_moment_nm"][0].reshape(-1, 2).mean(axis=1)
     assert np.abs(fine_hinge - coarse.signals["hinge_moment_nm"][0]).max() < 0.5  # of ~100 N·m
     fine_position = fine.signals["position_deg"][0].reshape(-1, 2).mean(axis=1)
@@ -248,7 +248,7 @@ def test_bad_input_names_the_argument(kwargs, field):
     }
     arguments.update(kwargs)
     with pytest.raises(InputError) as error:
-        simulate_batch(**arguments, actuator=THESIS.params)
+        simulate_batch(**arguments, drive=THESIS.params)
     assert error.value.field == field
 
 

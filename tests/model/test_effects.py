@@ -18,7 +18,7 @@ LOAD = GroundLoad(-100.0)
 
 
 def run(effects: EffectSet = EffectSet()):
-    return simulate_batch(KNOTS, NOMINAL, LOAD, effects=effects, actuator=THESIS.params)
+    return simulate_batch(KNOTS, NOMINAL, LOAD, effects=effects, drive=THESIS.params)
 
 
 @pytest.fixture(scope="module")
@@ -95,7 +95,7 @@ def test_a_current_sensor_offset_is_held_by_a_stuck_shaft():
         NOMINAL,
         GroundLoad(0.0),
         effects=EffectSet({"current_sensor_offset": {"offset_a": offset}}),
-        actuator=THESIS.params,
+        drive=THESIS.params,
     )
     late = slice(1000, 2000)
     assert abs(result.signals["current_a"][0, late].mean()) < 0.02  # the loop's view
@@ -106,9 +106,9 @@ def test_a_current_sensor_offset_is_held_by_a_stuck_shaft():
 
 def test_backlash_delays_the_elevator_at_a_reversal():
     knots = np.concatenate([ramp_knots(0.0, 10.0, 1500), ramp_knots(1.5, -10.0, 1500)[1:]])
-    base = simulate_batch(knots, NOMINAL, LOAD, actuator=THESIS.params)
+    base = simulate_batch(knots, NOMINAL, LOAD, drive=THESIS.params)
     wide = simulate_batch(
-        knots, NOMINAL, LOAD, effects=EffectSet({"backlash": {"extra_rad": 0.01}}), actuator=THESIS.params
+        knots, NOMINAL, LOAD, effects=EffectSet({"backlash": {"extra_rad": 0.01}}), drive=THESIS.params
     )
     lag = np.abs(wide.signals["position_deg"][0] - base.signals["position_deg"][0]).max()
     assert lag > np.degrees(0.01) / 4

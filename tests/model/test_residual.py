@@ -53,10 +53,10 @@ def test_the_compiled_filters_equal_a_plain_correlation_of_the_reflected_rows():
 
 def test_residual_torque_reconstructs_the_true_loss_on_clean_data():
     knots = random_command_knots(3000, RATE, np.random.default_rng(11))[0]
-    result = simulate_batch(knots, HealthParams.single(), GroundLoad(-60.0, 100.0), actuator=THESIS.params)
+    result = simulate_batch(knots, HealthParams.single(), GroundLoad(-60.0, 100.0), drive=THESIS.params)
     signals = result.simulation(0)
     residual = residual_torque_nm(
-        signals["current_a"], signals["motor_speed_radps"], signals["hinge_moment_nm"], RATE, actuator=THESIS.params
+        signals["current_a"], signals["motor_speed_radps"], signals["hinge_moment_nm"], RATE, drive=THESIS.params
     )
     truth = smoothed(result.loss_torque_nm[0], RATE)  # the same kernel: T_R is the true loss seen through it
     moving = np.abs(signals["motor_speed_radps"]) > 20
@@ -67,12 +67,12 @@ def test_residual_torque_reconstructs_the_true_loss_on_clean_data():
 def test_filter_cuts_speed_noise_below_fdj():
     rng = np.random.default_rng(1)
     knots = random_command_knots(5000, RATE, rng)[0]
-    clean = simulate_batch(knots, HealthParams.single(), actuator=THESIS.params).simulation(0)
+    clean = simulate_batch(knots, HealthParams.single(), drive=THESIS.params).simulation(0)
     noisy = add_sensor_noise(clean, SensorNoise(), rng)
 
     def reconstruct(signals):
         return residual_torque_nm(
-            signals["current_a"], signals["motor_speed_radps"], signals["hinge_moment_nm"], RATE, actuator=THESIS.params
+            signals["current_a"], signals["motor_speed_radps"], signals["hinge_moment_nm"], RATE, drive=THESIS.params
         )
 
     difference = reconstruct(noisy) - reconstruct(clean)
@@ -82,10 +82,8 @@ def test_filter_cuts_speed_noise_below_fdj():
 def test_batch_and_single_reconstruction_agree():
     rng = np.random.default_rng(2)
     current, speed, hinge = rng.normal(size=(3, 4, 500))
-    batch = residual_torque_nm(current, speed, hinge, RATE, actuator=THESIS.params)
-    np.testing.assert_allclose(
-        batch[2], residual_torque_nm(current[2], speed[2], hinge[2], RATE, actuator=THESIS.params)
-    )
+    batch = residual_torque_nm(current, speed, hinge, RATE, drive=THESIS.params)
+    np.testing.assert_allclose(batch[2], residual_torque_nm(current[2], speed[2], hinge[2], RATE, drive=THESIS.params))
 
 
 def test_the_one_pass_reconstruction_equals_its_steps_on_a_batch_split_over_threads(threads):
@@ -95,21 +93,21 @@ def test_the_one_pass_reconstruction_equals_its_steps_on_a_batch_split_over_thre
     a = THESIS.params
     motor = np.clip(a.torque_constant_nm_per_a * current, -a.max_motor_torque_nm, a.max_motor_torque_nm)
     plain = smoothed(motor + hinge / a.gear_ratio, RATE) - a.inertia_kgm2 * smooth_derivative(speed, RATE)
-    np.testing.assert_array_equal(residual_torque_nm(current, speed, hinge, RATE, actuator=a), plain)
+    np.testing.assert_array_equal(residual_torque_nm(current, speed, hinge, RATE, drive=a), plain)
     # one signal of a batch against one window of the others
     np.testing.assert_array_equal(
-        residual_torque_nm(current, speed[0], hinge[0], RATE, actuator=a)[3],
-        residual_torque_nm(current[3], speed[0], hinge[0], RATE, actuator=a),
+        residual_torque_nm(current, speed[0], hinge[0], RATE, drive=a)[3],
+        residual_torque_nm(current[3], speed[0], hinge[0], RATE, drive=a),
     )
 
 
 def test_bad_inputs_are_named():
     with pytest.raises(InputError, match="motor_speed_radps"):
-        residual_torque_nm(np.zeros(100), np.full(100, np.nan), np.zeros(100), RATE, actuator=THESIS.params)
+        residual_torque_nm(np.zeros(100), np.full(100, np.nan), np.zeros(100), RATE, drive=THESIS.params)
     with pytest.raises(InputError, match="shapes differ"):
-        residual_torque_nm(np.zeros(100), np.zeros(99), np.zeros(100), RATE, actuator=THESIS.params)
+        residual_torque_nm(np.zeros(100), np.zeros(99), np.zeros(100), RATE, drive=THESIS.params)
     with pytest.raises(InputError, match="need more than"):
-        residual_torque_nm(np.zeros(10), np.zeros(10), np.zeros(10), RATE, actuator=THESIS.params)
+        residual_torque_nm(np.zeros(10), np.zeros(10), np.zeros(10), RATE, drive=THESIS.params)
 
 
 def test_sliding_mask_leaves_out_the_edges_where_the_kernel_is_padded():
@@ -120,7 +118,7 @@ def test_sliding_mask_leaves_out_the_edges_where_the_kernel_is_padded():
     noisy = speed + np.random.default_rng(3).normal(0.0, 0.5, (2000, t.size))
     current = np.full_like(noisy, 5.0)
     hinge = np.full_like(noisy, -40.0)
-    spread = residual_torque_nm(current, noisy, hinge, RATE, actuator=THESIS.params).std(axis=0)
+    spread = residual_torque_nm(current, noisy, hinge, RATE, drive=THESIS.params).std(axis=0)
     kept = above_throughout(speed, 30.0, kernel_samples(RATE))
     assert not kept[: kernel_samples(RATE) // 2].any() and not kept[-(kernel_samples(RATE) // 2) :].any()
     assert spread[kept].max() < 1.15 * np.median(spread)

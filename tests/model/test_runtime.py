@@ -90,7 +90,7 @@ def test_the_interleaved_lane_loop_computes_what_the_plain_one_does():
         "else setattr(runtime._BUDGET, 'compiler_set', True); "
         "rng = np.random.default_rng(5); health = HealthParams.uniform(48, DEFAULT_RANGES, rng); "
         "knots = random_command_knots(300, 10_000.0, rng)[0]; "
-        "runs = [simulate_batch(knots, health, lanes=k, actuator=THESIS.params) for k in (48, 1)]; "
+        "runs = [simulate_batch(knots, health, lanes=k, drive=THESIS.params) for k in (48, 1)]; "
         "np.save(sys.argv[2], np.stack([np.stack([r.loss_torque_nm, *r.signals.values()]) for r in runs]))"
     )
     import numpy as np

@@ -33,7 +33,7 @@ def output_error_ratios(
     noise: SensorNoise,
     residual_floor_nm: float,
     sliding: np.ndarray,
-    actuator: DriveConstants,
+    drive: DriveConstants,
     simulated_at_health: Mapping[str, np.ndarray] | None = None,
 ) -> dict[str, float]:
     """Per signal, RMS(measured − simulated at ``health``) over its noise-only floor; the measured T_R
@@ -53,11 +53,11 @@ def output_error_ratios(
     ratios = {
         name: rms(measured[name][keep] - simulated[name][keep]) / max(floor, 1e-12) for name, floor in floors.items()
     }
-    torque = _residual(measured, rate, actuator) - _residual(simulated, rate, scenario.actuator)
+    torque = _residual(measured, rate, drive) - _residual(simulated, rate, scenario.drive)
     ratios["residual_torque"] = rms(torque[keep & sliding]) / max(residual_floor_nm, 1e-12)
     return ratios
 
 
-def _residual(signals: Mapping[str, np.ndarray], rate: float, actuator: DriveConstants) -> np.ndarray:
+def _residual(signals: Mapping[str, np.ndarray], rate: float, drive: DriveConstants) -> np.ndarray:
     current, speed, hinge = signals["current_a"], signals["motor_speed_radps"], signals["hinge_moment_nm"]
-    return residual_torque_nm(current, speed, hinge, rate, actuator)
+    return residual_torque_nm(current, speed, hinge, rate, drive)

@@ -13,7 +13,7 @@ from dataclasses import replace
 import numpy as np
 import torch
 
-from ema.estimate.learn.network import FitResult, LearnConfig, fit
+from ema.estimate.learn.network import LearnConfig, Trained, train
 from ema.estimate.simulate.design import Box
 from ema.model.checks import InputError
 
@@ -29,8 +29,8 @@ class NetworkRegressor:
     def fit(self, inputs: np.ndarray, unit_targets: np.ndarray) -> NetworkRegressor:
         if not 1 <= self.members <= 20:
             raise InputError("members", f"must be in [1, 20], got {self.members}")
-        self.fits_: list[FitResult] = [
-            fit(inputs, unit_targets, replace(self.learn, seed=self.learn.seed + member))
+        self.members_: list[Trained] = [
+            train(inputs, unit_targets, replace(self.learn, seed=self.learn.seed + member))
             for member in range(self.members)
         ]
         return self
@@ -39,7 +39,7 @@ class NetworkRegressor:
         """(N, T) the targets in box units, the members' mean, unclipped."""
         x = torch.as_tensor(np.atleast_2d(inputs), dtype=torch.float64)
         with torch.no_grad():
-            return np.mean([f.model.eval()(x).numpy() for f in self.fits_], axis=0)
+            return np.mean([f.model.eval()(x).numpy() for f in self.members_], axis=0)
 
 
 class NetworkEstimator:
@@ -51,7 +51,7 @@ class NetworkEstimator:
 
     def fit(self, inputs: np.ndarray, fdj_nm: np.ndarray, eta_o: np.ndarray, box: Box) -> NetworkEstimator:
         self.regressor_ = NetworkRegressor(self.learn, self.members).fit(inputs, box.normalize(fdj_nm, eta_o))
-        self.fits_ = self.regressor_.fits_
+        self.members_ = self.regressor_.members_
         self.box_ = box
         return self
 

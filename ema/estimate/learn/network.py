@@ -109,7 +109,7 @@ def input_transform(x_train: torch.Tensor, components: int | None) -> tuple[torc
 
 
 @dataclass
-class FitResult:
+class Trained:
     model: ShallowNet
     epochs: int
     stop_reason: str  # "validation", "goal" or "max_epochs"
@@ -157,7 +157,7 @@ def _snapshot(model: nn.Module) -> dict[str, torch.Tensor]:
     return {name: value.detach().clone() for name, value in model.state_dict().items()}
 
 
-def fit(inputs: np.ndarray, targets: np.ndarray, config: LearnConfig) -> FitResult:
+def train(inputs: np.ndarray, targets: np.ndarray, config: LearnConfig) -> Trained:
     """Train one network on (N, F) inputs and (N, T) targets in [0, 1]; seeded end to end."""
     start = time.perf_counter()
     torch.manual_seed(config.seed)
@@ -196,7 +196,7 @@ def fit(inputs: np.ndarray, targets: np.ndarray, config: LearnConfig) -> FitResu
             stop_reason = "goal"
             break
     model.load_state_dict(best_state)
-    return FitResult(
+    return Trained(
         model=model,
         epochs=len(history),
         stop_reason=stop_reason,

@@ -37,11 +37,11 @@ def as_read(signals: Mapping[str, np.ndarray], sample_rate_hz: float) -> dict[st
 def fit_as_read(
     signals: Mapping[str, np.ndarray],
     sample_rate_hz: float,
-    actuator: DriveConstants,
+    drive: DriveConstants,
     settings: FitSettings = FitSettings(),
 ) -> FrictionFit:
     """Eq. 5.1's fit (``ema.estimate.physics.friction``) of a window's signals read as every estimator reads them."""
-    return fit_friction(as_read(signals, sample_rate_hz), sample_rate_hz, actuator, settings)
+    return fit_friction(as_read(signals, sample_rate_hz), sample_rate_hz, drive, settings)
 
 
 def bin_means(values: np.ndarray, n_bins: int) -> np.ndarray:
@@ -92,7 +92,7 @@ def features(
     signals: Mapping[str, np.ndarray],
     sample_rate_hz: float,
     n_timesteps: int,
-    actuator: DriveConstants,
+    drive: DriveConstants,
     input_set: str = "residual_torque",
 ) -> np.ndarray:
     """Network inputs from window signals: (n_windows, n_channels · n_timesteps), channels side by side.
@@ -102,6 +102,6 @@ def features(
     current = np.atleast_2d(signals["current_a"])
     speed = np.atleast_2d(signals["motor_speed_radps"])
     hinge = np.atleast_2d(signals["hinge_moment_nm"])
-    residual = residual_torque_nm(current, speed, hinge, sample_rate_hz, actuator)
+    residual = residual_torque_nm(current, speed, hinge, sample_rate_hz, drive)
     beside = {"motor_speed_radps": speed, "hinge_moment_nm": hinge}
     return features_from_residual(residual, beside, n_timesteps, input_set)

@@ -66,9 +66,9 @@ class FitSettings:
     def nuisances(self) -> tuple[str, ...]:
         return tuple(name for name in NUISANCES if getattr(self, name))
 
-    def sliding_speed_radps(self, actuator: DriveConstants) -> float:
+    def sliding_speed_radps(self, drive: DriveConstants) -> float:
         """The |ω| past which the shaft slides, for Eq. 5.1, on ``actuator``."""
-        return self.min_speed_share * actuator.max_motor_speed_radps
+        return self.min_speed_share * drive.max_motor_speed_radps
 
 
 FIT_ARRAYS = (
@@ -114,22 +114,22 @@ class FrictionFit:
 
 
 def sliding_mask(
-    signals: Mapping[str, np.ndarray], rate: float, actuator: DriveConstants, settings: FitSettings = FitSettings()
+    signals: Mapping[str, np.ndarray], rate: float, drive: DriveConstants, settings: FitSettings = FitSettings()
 ) -> np.ndarray:
     """The samples Eq. 5.1 reads, shaped as the speed given ((n,) or (N, n)): the shaft past the sliding speed
     throughout a reconstruction kernel (one sign of the speed, so one sign of its friction), away from the end
     stops. Every rule that counts or weighs sliding samples reads this one."""
     speed = np.asarray(signals["motor_speed_radps"])
     width = kernel_samples(rate, settings.derivative_window_s)
-    mask = above_throughout(np.abs(np.atleast_2d(speed)), settings.sliding_speed_radps(actuator), width)
-    mask &= np.abs(np.atleast_2d(signals["position_deg"])) < actuator.end_stop_deg - END_STOP_MARGIN_DEG
+    mask = above_throughout(np.abs(np.atleast_2d(speed)), settings.sliding_speed_radps(drive), width)
+    mask &= np.abs(np.atleast_2d(signals["position_deg"])) < drive.end_stop_deg - END_STOP_MARGIN_DEG
     return mask if speed.ndim > 1 else mask[0]
 
 
 def regressors(
     signals: Mapping[str, np.ndarray],
     rate: float,
-    actuator: DriveConstants,
+    drive: DriveConstants,
     settings: FitSettings,
     residual_nm: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -141,29 +141,29 @@ def regressors(
     speed = np.atleast_2d(signals["motor_speed_radps"])
     if residual_nm is None:
         current, hinge = np.atleast_2d(signals["current_a"]), np.atleast_2d(signals["hinge_moment_nm"])
-        residual_nm = residual_torque_nm(current, speed, hinge, rate, actuator, window_s)
+        residual_nm = residual_torque_nm(current, speed, hinge, rate, drive, window_s)
     residual = np.atleast_2d(residual_nm)
-    load = smoothed(np.atleast_2d(signals["hinge_moment_nm"]) / actuator.gear_ratio, rate, window_s)
-    sliding = np.atleast_2d(sliding_mask(signals, rate, actuator, settings))
+    load = smoothed(np.atleast_2d(signals["hinge_moment_nm"]) / drive.gear_ratio, rate, window_s)
+    sliding = np.atleast_2d(sliding_mask(signals, rate, drive, settings))
     direction = np.sign(speed)
     aiding = load * direction > 0
     aid = smoothed(np.abs(load) * aiding, rate, window_s)
     opp = smoothed(np.abs(load) * ~aiding, rate, window_s)
-    target = direction * (residual - actuator.viscous_nms * smoothed(speed, rate, window_s))
+    target = direction * (residual - drive.viscous_nms * smoothed(speed, rate, window_s))
     return target, aid, opp, sliding
 
 
 def nuisance_columns(
-    signals: Mapping[str, np.ndarray], rate: float, actuator: DriveConstants, settings: FitSettings
+    signals: Mapping[str, np.ndarray], rate: float, drive: DriveConstants, settings: FitSettings
 ) -> list[np.ndarray]:
     """The columns of ``settings.nuisances``, each (N, n) and, like the target, signed by the direction s:
     s itself (a constant torque), |ω| smoothed (ΔC), −k_T·I smoothed where the motor is not saturated (γ:
     T_R misses γ·k_T·I there; where k_T·I is cut at the peak torque, it misses nothing), and the
     reconstruction's dω/dt (ΔJ: T_R holds ΔJ·dω/dt too much)."""
-    window_s, peak = settings.derivative_window_s, actuator.max_motor_torque_nm
+    window_s, peak = settings.derivative_window_s, drive.max_motor_torque_nm
     speed = np.atleast_2d(signals["motor_speed_radps"])
     direction = np.sign(speed)
-    motor = actuator.torque_constant_nm_per_a * np.atleast_2d(signals["current_a"])
+    motor = drive.torque_constant_nm_per_a * np.atleast_2d(signals["current_a"])
     columns = {
         "offset": lambda: direction,
         "viscous": lambda: direction * smoothed(speed, rate, window_s),
@@ -202,18 +202,18 @@ def _block_sums(columns, mask, edges, out):
 def fit_friction(
     signals: Mapping[str, np.ndarray],
     rate: float,
-    actuator: DriveConstants,
+    drive: DriveConstants,
     settings: FitSettings = FitSettings(),
     residual_nm: np.ndarray | None = None,
 ) -> FrictionFit:
     """Fit every window of a batch (signals (N, n), or (n,) for one; or one signal (N, n) against the
     others of one window, each (n,)); windows with too little sliding motion get NaN (``fit_window``
     turns that into an error naming the signals)."""
-    t, a, o, mask = regressors(signals, rate, actuator, settings, residual_nm)
-    columns = [t, a, o, *nuisance_columns(signals, rate, actuator, settings)]
+    t, a, o, mask = regressors(signals, rate, drive, settings, residual_nm)
+    columns = [t, a, o, *nuisance_columns(signals, rate, drive, settings)]
     blocks = block_statistics(columns, mask, settings.blocks)  # (N, B, P, P)
     total = blocks.sum(axis=1)
-    model = (actuator.gear_ratio, settings.nuisances)
+    model = (drive.gear_ratio, settings.nuisances)
     beta, eta_o, sse = solve(total, *model)
     left_out = (total[:, None] - blocks).reshape(-1, *total.shape[1:])
     beta_b, eta_b = (x.reshape(len(total), blocks.shape[1], -1) for x in solve(left_out, *model)[:2])
@@ -238,14 +238,14 @@ def fit_friction(
     )
 
 
-def fit_window(signals: Mapping[str, np.ndarray], rate: float, actuator: DriveConstants) -> FrictionFit:
+def fit_window(signals: Mapping[str, np.ndarray], rate: float, drive: DriveConstants) -> FrictionFit:
     """One window's fit; a window that never slides long enough is bad input naming its signals."""
-    fitted = fit_friction(signals, rate, actuator)
+    fitted = fit_friction(signals, rate, drive)
     if np.isnan(fitted.fdj_nm[0]):
         raise InputError(
             "signals",
             f"too little sliding motion to estimate friction: {int(fitted.n_sliding[0])} samples with "
-            f"|motor speed| > {FitSettings().sliding_speed_radps(actuator):.3g} rad/s away from the end stops "
+            f"|motor speed| > {FitSettings().sliding_speed_radps(drive):.3g} rad/s away from the end stops "
             "(a held or barely moving elevator carries no friction information)",
         )
     return fitted

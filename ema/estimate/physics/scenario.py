@@ -41,7 +41,7 @@ def physical_fdj_nm(nominal_fdj_nm: float) -> tuple[float, float]:
 class Scenario:
     """What every simulation of a dataset shares: the actuator, the command, the load, the start, the rate."""
 
-    actuator: DriveConstants  # the drive's constants the simulations run with
+    drive: DriveConstants  # the constants the simulations run with
     command_knots_deg: np.ndarray  # (n_samples + 1,) one command (Case 1) or (n_sims, n_samples + 1) (Case 2)
     load: Load = field(default_factory=FlightCondition)
     initial: InitialState = field(default_factory=InitialState)
@@ -60,13 +60,13 @@ class Scenario:
             self.initial,
             self.sample_rate_hz,
             self.effects,
-            actuator=self.actuator,
+            drive=self.drive,
             lanes=lanes,
             reuse_output=reuse_output,
         )
 
 
-def initial_state(window: Window, actuator: DriveConstants) -> InitialState:
+def initial_state(window: Window, drive: DriveConstants) -> InitialState:
     """The state at t = 0: a parabola through the first samples (at their interval centres), taken at 0.
 
     Not the first sample: the fit averages the sensor noise down, and a parabola follows the motor,
@@ -78,11 +78,9 @@ def initial_state(window: Window, actuator: DriveConstants) -> InitialState:
     def at_zero(values: np.ndarray) -> float:
         return float(np.polyfit(centres, values[:n], 2)[-1])
 
-    speed, current = actuator.max_motor_speed_radps, actuator.max_current_a
+    speed, current = drive.max_motor_speed_radps, drive.max_current_a
     return InitialState(
-        position_deg=float(
-            np.clip(at_zero(window.signals["position_deg"]), -actuator.end_stop_deg, actuator.end_stop_deg)
-        ),
+        position_deg=float(np.clip(at_zero(window.signals["position_deg"]), -drive.end_stop_deg, drive.end_stop_deg)),
         motor_speed_radps=float(np.clip(at_zero(window.signals["motor_speed_radps"]), -speed, speed)),
         current_a=float(np.clip(at_zero(window.signals["current_a"]), -current, current)),
     )
@@ -102,14 +100,14 @@ def logged_load(window: Window, hinge: HingeGeometry | None, sensor_bias_nm: flo
 
 
 def scenario_from_window(
-    window: Window, actuator: DriveConstants, hinge: HingeGeometry | None, effects: EffectSet = EffectSet()
+    window: Window, drive: DriveConstants, hinge: HingeGeometry | None, effects: EffectSet = EffectSet()
 ) -> Scenario:
     """Case 1B for a logged window: its actuator, its command, its logged load, its first state."""
     return Scenario(
-        actuator=actuator,
+        drive=drive,
         command_knots_deg=knots_from_samples(window.signals["command_deg"])[0],
         load=logged_load(window, hinge, effects.get("hinge_moment_bias", "bias_nm")),
-        initial=initial_state(window, actuator),
+        initial=initial_state(window, drive),
         sample_rate_hz=window.sample_rate_hz,
         effects=effects,
     )

@@ -22,7 +22,7 @@ def shifted_fits(
     signals: dict[str, np.ndarray],
     sample_rate_hz: float,
     lags: np.ndarray,
-    actuator: DriveConstants,
+    drive: DriveConstants,
     name: str = "current_a",
     settings: FitSettings = FitSettings(),
 ) -> FrictionFit:
@@ -31,4 +31,4 @@ def shifted_fits(
     if name == "hinge_moment_nm":  # its reading leans on the deflection, row by row
         batch["position_deg"] = np.broadcast_to(signals["position_deg"], batch[name].shape)
     read = dict(as_read(batch, sample_rate_hz), position_deg=signals["position_deg"])
-    return fit_friction(read, sample_rate_hz, actuator, settings)
+    return fit_friction(read, sample_rate_hz, drive, settings)

@@ -124,34 +124,32 @@ def _scatter(drive_nm: np.ndarray, begin: int, peak: int) -> float:
     return float(np.sqrt(np.sum(residual**2) / (len(t) - 3)))
 
 
-def _traces(signals: Mapping[str, np.ndarray], rate: float, actuator: DriveConstants, noise: SensorNoise) -> _Traces:
-    """The drive and speed with the per-sample std that *white* noise would need to scatter their means as
+def _traces(signals: Mapping[str, np.ndarray], rate: float, drive: DriveConstants, noise: SensorNoise) -> _Traces:
+    """The torque and speed with the per-sample std that *white* noise would need to scatter their means as
     much as this window's does: a sensor filter correlates the noise, and its means scatter more. Read
-    white, a filtered drive's noise looks like build-ups, and each reads as a low FSJ."""
-    drive = actuator.torque_constant_nm_per_a * signals["current_a"] + signals["hinge_moment_nm"] / actuator.gear_ratio
+    white, a filtered torque's noise looks like build-ups, and each reads as a low FSJ."""
+    torque = drive.torque_constant_nm_per_a * signals["current_a"] + signals["hinge_moment_nm"] / drive.gear_ratio
     speed = signals["motor_speed_radps"]
-    drive_noise = max(white_noise_std(drive), actuator.torque_constant_nm_per_a * noise.current_a)
+    drive_noise = max(white_noise_std(torque), drive.torque_constant_nm_per_a * noise.current_a)
     speed_noise = max(white_noise_std(speed), noise.motor_speed_radps, 0.01)  # a noiseless log still has a resolution
     rho_speed = noise.correlation("motor_speed_radps", rate)
     return _Traces(
-        drive_nm=np.abs(np.convolve(drive, np.ones(3) / 3, mode="same")),
+        drive_nm=np.abs(np.convolve(torque, np.ones(3) / 3, mode="same")),
         drive_noise_nm=drive_noise * float(np.sqrt(3 * ar1_mean_variance(noise.correlation("current_a", rate), 3))),
         speed_radps=speed,
         speed_noise_radps=speed_noise * float(np.sqrt((1 + rho_speed) / (1 - rho_speed))),  # of long means
         position_deg=signals["position_deg"],
-        signed_drive_nm=drive,
+        signed_drive_nm=torque,
     )
 
 
-def _events(
-    signals: Mapping[str, np.ndarray], rate: float, actuator: DriveConstants, noise: SensorNoise
-) -> list[_Event]:
+def _events(signals: Mapping[str, np.ndarray], rate: float, drive: DriveConstants, noise: SensorNoise) -> list[_Event]:
     """Each quasi-static break-away: a rest of ≥ 1 ms, then motion of ≥ 1 ms."""
     run = max(2, round(MIN_RUN_S * rate))
-    traces = _traces(signals, rate, actuator, noise)
+    traces = _traces(signals, rate, drive, noise)
     events = []
     for rest in _rests(np.abs(smoothed(traces.speed_radps, rate)), run):
-        peak = _break_away(traces, rest, run, actuator.end_stop_deg)
+        peak = _break_away(traces, rest, run, drive.end_stop_deg)
         if peak is not None:
             scatter = _scatter(traces.signed_drive_nm, _lookback_start(rest, run), peak)
             events.append(_Event(peak, float(traces.drive_nm[peak]), scatter))
@@ -163,12 +161,12 @@ def read_static_friction(
     rate: float,
     fdj_nm: float,
     eta_o: float,
-    actuator: DriveConstants,
+    drive: DriveConstants,
     noise: SensorNoise = NO_NOISE,
 ) -> StaticFriction:
     """FSJ from the quasi-static break-aways of a window, given its dynamic-friction estimates and its
     measured sensor noise (``NO_NOISE``: the traces' own white-noise level alone)."""
-    events = _events(signals, rate, actuator, noise)
+    events = _events(signals, rate, drive, noise)
     if not events:
         return StaticFriction(
             None,
@@ -184,9 +182,9 @@ def read_static_friction(
                 ),
             ),
         )
-    load = smoothed(signals["hinge_moment_nm"] / actuator.gear_ratio, rate)
+    load = smoothed(signals["hinge_moment_nm"] / drive.gear_ratio, rate)
     direction = np.sign(smoothed(signals["motor_speed_radps"], rate))
-    k_aid, k_opp = (float(k) for k in load_factors(float(eta_o), actuator.gear_ratio))
+    k_aid, k_opp = (float(k) for k in load_factors(float(eta_o), drive.gear_ratio))
     levels = []
     for event in events:
         moving = direction[min(event.index + round(MIN_RUN_S * rate), len(direction) - 1)]
@@ -208,7 +206,7 @@ def read_static_friction(
             ),
         )
     current_noise = max(white_noise_std(signals["current_a"]) / np.sqrt(3), noise.mean_std("current_a", 3, rate))
-    sensor = actuator.torque_constant_nm_per_a * current_noise
+    sensor = drive.torque_constant_nm_per_a * current_noise
     floor = max(sensor, DITHER_STDS * float(np.median([event.scatter_nm for event in events])))
     if len(levels) >= MIN_EVENTS_FOR_STD:
         spread = 1.2533 * float(np.std(levels, ddof=1)) / np.sqrt(len(levels))  # std of a median

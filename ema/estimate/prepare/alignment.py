@@ -38,23 +38,23 @@ MIN_GAIN = 0.05  # the least relative drop of the equation error a lag must brin
 LAG_FIT = FitSettings(torque_scale=True, inertia=True)
 
 
-def _errors(signals: dict[str, np.ndarray], rate: float, lags: np.ndarray, actuator: DriveConstants) -> np.ndarray:
-    return shifted_fits(signals, rate, lags, actuator, settings=LAG_FIT).residual_rms_nm
+def _errors(signals: dict[str, np.ndarray], rate: float, lags: np.ndarray, drive: DriveConstants) -> np.ndarray:
+    return shifted_fits(signals, rate, lags, drive, settings=LAG_FIT).residual_rms_nm
 
 
-def current_lag_samples(signals: dict[str, np.ndarray], sample_rate_hz: float, actuator: DriveConstants) -> float:
+def current_lag_samples(signals: dict[str, np.ndarray], sample_rate_hz: float, drive: DriveConstants) -> float:
     """How many samples the logged current trails the logged speed (negative: the speed trails), 0
     unless that lag lowers the window's equation error by ``MIN_GAIN`` inside ``MAX_LAG_S``: whole samples
     first, then half a sample either side of the best, then the parabola's vertex. A best shift at the end
     of the search is no minimum: the shift trades with the free drive constants there, and none is made."""
     reach = max(1.0, np.floor(MAX_LAG_S * sample_rate_hz))
     grid = np.arange(-reach, reach + 0.5)
-    coarse = _errors(signals, sample_rate_hz, grid, actuator)
+    coarse = _errors(signals, sample_rate_hz, grid, drive)
     if not np.all(np.isfinite(coarse)):
         return 0.0  # too little sliding motion: the physics fit says so next
     near = grid[int(np.argmin(coarse))] + np.array([-HALF_STEP, HALF_STEP])
     errors = dict(zip(grid, coarse, strict=True)) | dict(
-        zip(near, _errors(signals, sample_rate_hz, near, actuator), strict=True)
+        zip(near, _errors(signals, sample_rate_hz, near, drive), strict=True)
     )
     best = min(errors, key=errors.__getitem__)
     if errors[best] >= (1.0 - MIN_GAIN) * errors[0.0] or abs(best) >= reach:
@@ -77,15 +77,15 @@ class Lags:
     hinge_weight: float = 0.0  # how likely the moment is late at all (not only its noise filtered)
 
 
-def aligned(window: Window, actuator: DriveConstants) -> tuple[Window, Lags]:
+def aligned(window: Window, drive: DriveConstants) -> tuple[Window, Lags]:
     """``window`` with the later of its current and speed advanced onto the other and its hinge moment
     advanced by its lag's posterior mean (``ema.estimate.prepare.hinge_lag``), and those lags."""
     rate, signals = window.sample_rate_hz, dict(window.signals)
-    current = current_lag_samples(signals, rate, actuator)
+    current = current_lag_samples(signals, rate, drive)
     if current != 0.0:
         late = "current_a" if current > 0 else "motor_speed_radps"
         signals[late] = advanced(signals[late], abs(current))
-    hinge = hinge_lag(signals, rate, actuator, in_flight=not window.on_ground)
+    hinge = hinge_lag(signals, rate, drive, in_flight=not window.on_ground)
     if hinge.advance != 0.0:
         signals["hinge_moment_nm"] = advanced(signals["hinge_moment_nm"], hinge.advance)
     if current == 0.0 and hinge.filter_delay == 0.0:

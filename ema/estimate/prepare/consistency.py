@@ -103,19 +103,19 @@ def _best_band(travel: np.ndarray, y: np.ndarray, halves: np.ndarray) -> tuple[f
     return float(explained[best]), float(slope), best % len(halves)
 
 
-def travel_gain(window: Window, actuator: DriveConstants) -> float | None:
+def travel_gain(window: Window, drive: DriveConstants) -> float | None:
     """The drive's kinematic gain g: the least-squares slope (with an intercept) of the position (rad) on
     the speed's integral / n carried through a dead band (``ema.model.dead_band``) whose width (any the travel
     shows: a worn band too; a coarse grid, then a fine one about the best) and start the least squares
     choose; None where that explains under ``MIN_EXPLAINED`` of the position's variance (a surface that
     hardly moves, or not with the motor)."""
     rate, position = window.sample_rate_hz, np.radians(window.signals["position_deg"])
-    travel = np.cumsum(window.signals["motor_speed_radps"]) / rate / actuator.gear_ratio
+    travel = np.cumsum(window.signals["motor_speed_radps"]) / rate / drive.gear_ratio
     y = position - position.mean()
-    widest = max(float(np.ptp(travel)), actuator.backlash_rad)
+    widest = max(float(np.ptp(travel)), drive.backlash_rad)
     if widest <= 0.0:
         return None  # the motor never turned: no travel to read a gain from
-    narrowest = 0.05 * (actuator.backlash_rad if actuator.backlash_rad > 0 else 0.01 * widest)  # a band new or worn
+    narrowest = 0.05 * (drive.backlash_rad if drive.backlash_rad > 0 else 0.01 * widest)  # a band new or worn
     coarse = np.concatenate([[0.0], np.geomspace(narrowest, widest, BAND_GRID - 1)]) / 2
     at = _best_band(travel, y, coarse)[2]
     fine = np.linspace(coarse[max(0, at - 1)], coarse[min(len(coarse) - 1, at + 1)], BAND_GRID)
@@ -123,33 +123,31 @@ def travel_gain(window: Window, actuator: DriveConstants) -> float | None:
     return gain if explained >= MIN_EXPLAINED * (y @ y) > 0.0 else None
 
 
-def reaction_s(actuator: DriveConstants) -> float:
+def reaction_s(drive: DriveConstants) -> float:
     """How long the drive takes to turn from full speed one way to full speed the other, with a margin (the
     thesis's: 19 ms, taken as 25)."""
-    turn = actuator.inertia_kgm2 * 2 * actuator.max_motor_speed_radps / actuator.max_motor_torque_nm
+    turn = drive.inertia_kgm2 * 2 * drive.max_motor_speed_radps / drive.max_motor_torque_nm
     return REACTION_MARGIN * turn
 
 
-def following(window: Window, actuator: DriveConstants) -> float | None:
+def following(window: Window, drive: DriveConstants) -> float | None:
     """The share of ``FOLLOW_STEP_S`` steps, begun over ``FOLLOW_GAP_DEG`` from the command (clipped to the
     end stops) on the side it has stood for the drive's reaction time (``reaction_s``) and moving, that move
     toward it; None where they
     last under ``MIN_FOLLOW_S`` in all."""
     position, rate = window.signals["position_deg"], window.sample_rate_hz
-    command = np.clip(window.signals["command_deg"], -actuator.end_stop_deg, actuator.end_stop_deg)
+    command = np.clip(window.signals["command_deg"], -drive.end_stop_deg, drive.end_stop_deg)
     lag = max(1, round(FOLLOW_STEP_S * rate))
     step, gap = position[lag:] - position[:-lag], (command - position)[:-lag]
     side, at = np.sign(gap), np.arange(len(gap))
     since = at - np.maximum.accumulate(np.where(np.diff(side, prepend=side[0]) != 0, at, 0))  # on this side
-    judged = (
-        (np.abs(gap) > FOLLOW_GAP_DEG) & (np.abs(step) > FOLLOW_MIN_STEP_DEG) & (since >= reaction_s(actuator) * rate)
-    )
+    judged = (np.abs(gap) > FOLLOW_GAP_DEG) & (np.abs(step) > FOLLOW_MIN_STEP_DEG) & (since >= reaction_s(drive) * rate)
     if judged.sum() < MIN_FOLLOW_S * rate:
         return None
     return float(np.mean(np.sign(step[judged]) == side[judged]))
 
 
-def better_reading(window: Window, actuator: DriveConstants) -> tuple[str, float] | None:
+def better_reading(window: Window, drive: DriveConstants) -> tuple[str, float] | None:
     """The reading of ``READINGS`` that fits Eq. 5.1 best, with how many times its equation error is below
     the window's as logged, if by ``MIN_BETTER``; one batched fit of the window and its readings."""
     signals, rate = window.signals, window.sample_rate_hz
@@ -159,7 +157,7 @@ def better_reading(window: Window, actuator: DriveConstants) -> tuple[str, float
             batch[name][row] = signals[name] * factor
     batch["position_deg"] = np.broadcast_to(signals["position_deg"], batch["current_a"].shape)
     read = dict(as_read(dict(signals, **batch), rate), position_deg=signals["position_deg"])
-    errors = fit_friction(read, rate, actuator, OFFSET_FIT).residual_rms_nm
+    errors = fit_friction(read, rate, drive, OFFSET_FIT).residual_rms_nm
     gains = errors[0] / errors[1:]
     best = int(np.nanargmax(gains)) if np.any(np.isfinite(gains)) else -1
     if best < 0 or not gains[best] >= MIN_BETTER:
@@ -173,21 +171,21 @@ def step_lags(window: Window) -> np.ndarray:
     return lags[np.abs(lags) < window.n_samples / 4]
 
 
-def out_of_step(window: Window, actuator: DriveConstants) -> tuple[str, float, float] | None:
+def out_of_step(window: Window, drive: DriveConstants) -> tuple[str, float, float] | None:
     """The channel (current or hinge moment), its lag [s] and how many times better Eq. 5.1 fits with it,
     where a lag of ``STEP_LAGS_S`` fits ``MIN_BETTER`` times better than none; else None."""
     signals, rate, lags = window.signals, window.sample_rate_hz, step_lags(window)
     if not len(lags):
         return None
-    logged = float(fit_friction(as_read(signals, rate), rate, actuator).residual_rms_nm[0])
+    logged = float(fit_friction(as_read(signals, rate), rate, drive).residual_rms_nm[0])
     for name in ("current_a", "hinge_moment_nm"):
-        errors = shifted_fits(dict(signals), rate, lags, actuator, name).residual_rms_nm
+        errors = shifted_fits(dict(signals), rate, lags, drive, name).residual_rms_nm
         best = int(np.nanargmin(errors)) if np.any(np.isfinite(errors)) else -1
         if best >= 0 and logged >= MIN_BETTER * errors[best]:
             return name, float(lags[best] / rate), logged / float(errors[best])
     return None
 
 
-def consistency(window: Window, actuator: DriveConstants) -> Consistency:
+def consistency(window: Window, drive: DriveConstants) -> Consistency:
     """The three relations of the module docstring, read off ``window``."""
-    return Consistency(travel_gain(window, actuator), following(window, actuator), better_reading(window, actuator))
+    return Consistency(travel_gain(window, drive), following(window, drive), better_reading(window, drive))

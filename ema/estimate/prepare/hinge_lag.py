@@ -101,7 +101,7 @@ def band_log_likelihood(
 
 
 def hinge_lag(
-    signals: dict[str, np.ndarray], sample_rate_hz: float, actuator: DriveConstants, in_flight: bool = True
+    signals: dict[str, np.ndarray], sample_rate_hz: float, drive: DriveConstants, in_flight: bool = True
 ) -> HingeLag:
     """The hinge moment's lag, where its noise shows a filter: the model average of the module docstring (on
     the ground the moment follows no deflection, and the band reads no lag)."""
@@ -115,12 +115,12 @@ def hinge_lag(
     if delay == 0.0:
         return HingeLag()
     lags, prior = lag_grid(delay, sample_rate_hz)
-    fits = shifted_fits(signals, sample_rate_hz, lags, actuator, "hinge_moment_nm")
-    rms = shifted_fits(signals, sample_rate_hz, lags, actuator, "hinge_moment_nm", DEPARTURES_FREE).residual_rms_nm
+    fits = shifted_fits(signals, sample_rate_hz, lags, drive, "hinge_moment_nm")
+    rms = shifted_fits(signals, sample_rate_hz, lags, drive, "hinge_moment_nm", DEPARTURES_FREE).residual_rms_nm
     if not np.all(np.isfinite(rms)):
         return HingeLag(delay)  # too little sliding motion: the physics fit says so next
     equation = [rms_log_likelihood_ratio(rms[0], r, float(fits.n_sliding[0]), sample_rate_hz) for r in rms]
-    band = band_log_likelihood(signals, sample_rate_hz, lags, actuator.gear_ratio) if in_flight else 0.0
+    band = band_log_likelihood(signals, sample_rate_hz, lags, drive.gear_ratio) if in_flight else 0.0
     log_posterior = np.log(prior) + band + np.array(equation)
     weight = np.exp(log_posterior - log_posterior.max())
     weight /= weight.sum()

@@ -132,13 +132,13 @@ def stands_off(values: np.ndarray, run: StaleRun, jump: float) -> bool:
     return bool(min(abs(values[run.start - 1] - run.value), abs(values[run.stop] - run.value)) > jump)
 
 
-def slides_during(window: Window, actuator: DriveConstants, run: StaleRun) -> bool:
+def slides_during(window: Window, drive: DriveConstants, run: StaleRun) -> bool:
     """Whether the shaft slides during ``run`` of a motion sensor by the other one (module docstring, 3): the
     speed past the sliding speed (``FitSettings.sliding_speed_radps``) for the position; for the speed, its
     frozen value past it, or the position
     travelling ``TRAVEL_STDS`` of its noise at that mean speed or faster. True for a torque sensor."""
     signals, rate = window.signals, window.sample_rate_hz
-    sliding_radps = FitSettings().sliding_speed_radps(actuator)
+    sliding_radps = FitSettings().sliding_speed_radps(drive)
     if run.signal in ("current_a", "hinge_moment_nm"):
         return True
     if run.signal == "position_deg":
@@ -150,11 +150,11 @@ def slides_during(window: Window, actuator: DriveConstants, run: StaleRun) -> bo
     around = position[max(0, run.start - width // 2) : run.stop + width // 2]
     means = np.convolve(around, np.ones(width) / width, mode="valid") if len(around) > width else np.zeros(1)
     travel_deg = float(np.ptp(means))
-    mean_speed = np.deg2rad(travel_deg) * actuator.gear_ratio * rate / (run.stop - run.start)
+    mean_speed = np.deg2rad(travel_deg) * drive.gear_ratio * rate / (run.stop - run.start)
     return travel_deg > TRAVEL_STDS * white_noise_std(position) / math.sqrt(width) and mean_speed > sliding_radps
 
 
-def stale_runs(window: Window, actuator: DriveConstants) -> tuple[StaleRun, ...]:
+def stale_runs(window: Window, drive: DriveConstants) -> tuple[StaleRun, ...]:
     """Every sensor's stale runs (module docstring), in the order of the samples."""
     n, found = window.n_samples, []
     for name in NOISY_SIGNALS:
@@ -168,19 +168,19 @@ def stale_runs(window: Window, actuator: DriveConstants) -> tuple[StaleRun, ...]
         for start, stop in zip(starts[long], stops[long], strict=True):
             run = StaleRun(name, int(start), int(stop), float(values[start]))
             unlikely = improbable(run.stop - run.start - 1, repeats, n - 1) or stands_off(values, run, jump)
-            if unlikely and slides_during(window, actuator, run):
+            if unlikely and slides_during(window, drive, run):
                 found.append(run)
     return tuple(sorted(found, key=lambda r: r.start))
 
 
-def best_stretch(window: Window, runs: tuple[StaleRun, ...], actuator: DriveConstants) -> tuple[int, int, int]:
+def best_stretch(window: Window, runs: tuple[StaleRun, ...], drive: DriveConstants) -> tuple[int, int, int]:
     """(start, stop, sliding samples) of the stretch free of ``runs`` with the most sliding samples by the
     speed (the longest of equals)."""
     free = np.ones(window.n_samples, dtype=bool)
     for run in runs:
         free[run.start : run.stop] = False
     starts, stops = edges(free)
-    moving = sliding_mask(window.signals, window.sample_rate_hz, actuator)
+    moving = sliding_mask(window.signals, window.sample_rate_hz, drive)
     sliding = np.cumsum(np.concatenate([[0], moving & free]))
     if not len(starts):
         return 0, 0, 0
@@ -188,11 +188,11 @@ def best_stretch(window: Window, runs: tuple[StaleRun, ...], actuator: DriveCons
     return int(starts[best]), int(stops[best]), int(sliding[stops[best]] - sliding[starts[best]])
 
 
-def without_stale(window: Window, actuator: DriveConstants) -> tuple[Window, Stale]:
+def without_stale(window: Window, drive: DriveConstants) -> tuple[Window, Stale]:
     """``window`` with its short stale runs bridged and cut to its best stretch free of the long ones, and
     what was found; InputError naming the sensor where too little sliding motion is left (module docstring)."""
     rate, n = window.sample_rate_hz, window.n_samples
-    runs = stale_runs(window, actuator)
+    runs = stale_runs(window, drive)
     if not runs:
         return window, Stale(rate_hz=rate)
     short = tuple(r for r in runs if r.stop - r.start <= kernel_samples(rate) and r.start > 0 and r.stop < n)
@@ -202,7 +202,7 @@ def without_stale(window: Window, actuator: DriveConstants) -> tuple[Window, Sta
     cut = tuple(r for r in runs if r not in short)
     if not cut:
         return replace(window, signals=signals), Stale(short, rate_hz=rate)
-    start, stop, sliding = best_stretch(window, cut, actuator)
+    start, stop, sliding = best_stretch(window, cut, drive)
     needed = MIN_SLIDING_KERNELS * kernel_samples(rate)
     if sliding < needed:
         worst = max(cut, key=lambda r: r.stop - r.start)

@@ -53,18 +53,18 @@ class StepLag:
     spread: dict[str, float] = field(default_factory=dict)  # per target, the std the story adds
 
 
-def step_lag(window: Window, actuator: DriveConstants) -> StepLag:
+def step_lag(window: Window, drive: DriveConstants) -> StepLag:
     """The hinge moment's out-of-step story on ``window`` (its departures taken off, ``actuator`` as read)."""
     rate, lags = window.sample_rate_hz, np.concatenate([[0.0], step_lags(window)])
     if len(lags) == 1:
         return StepLag()
-    fits = shifted_fits(dict(window.signals), rate, lags, actuator, "hinge_moment_nm")
+    fits = shifted_fits(dict(window.signals), rate, lags, drive, "hinge_moment_nm")
     errors = fits.residual_rms_nm
     if not np.all(np.isfinite(errors)):
         return StepLag()  # too little sliding motion: the physics fit says so next
     best = 1 + int(np.argmin(errors[1:]))
     flying = not window.on_ground  # on the ground the moment follows no deflection: the band reads no lag
-    band = band_log_likelihood(dict(window.signals), rate, lags[[0, best]], actuator.gear_ratio) if flying else [0, 0]
+    band = band_log_likelihood(dict(window.signals), rate, lags[[0, best]], drive.gear_ratio) if flying else [0, 0]
     log_ratio = rms_log_likelihood_ratio(errors[0], errors[best], float(fits.n_sliding[0]), rate) + band[1] - band[0]
     weight = odds_weight(log_ratio + PRIOR_LOG_ODDS)
     spread = {

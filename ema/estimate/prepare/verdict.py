@@ -66,7 +66,7 @@ def kinematics_note(found: Consistency) -> list[Note]:
 
 
 def _travel_error(
-    gain: float, reading: tuple[str, float] | None, loop: str, window: Window, actuator: DriveConstants
+    gain: float, reading: tuple[str, float] | None, loop: str, window: Window, drive: DriveConstants
 ) -> InputError:
     """The error for a travel gain outside ``TRAVEL_GAIN``, naming the field it points to: for a sign, the
     speed where Eq. 5.1 reads the torques against the motion (24–940x better flipped), else the position
@@ -74,7 +74,7 @@ def _travel_error(
     sample rate."""
     travel = (
         f"the position's travel is {gain:.3g}x the speed's integral over the window / gear ratio "
-        f"{actuator.gear_ratio:g} (1 in a working drive){loop}"
+        f"{drive.gear_ratio:g} (1 in a working drive){loop}"
     )
     if gain < 0 and reading is not None and reading[0] in AGAINST_THE_MOTION:
         return InputError("signals.motor_speed_radps", f"runs against position_deg and the torques: {travel}: a sign?")
@@ -101,17 +101,17 @@ def _travel_error(
         )
     return InputError(
         "actuator.drive.gear_ratio",
-        f"{travel}: the drive that logged this window turns as a gear ratio of {actuator.gear_ratio / gain:.4g} "
+        f"{travel}: the drive that logged this window turns as a gear ratio of {drive.gear_ratio / gain:.4g} "
         f"would; is the actuator's document the right one (its gear ratio, k_T, end stops)? Else the sample rate "
         f"is off (at {rate / gain:.6g} Hz instead of {rate:.6g} it would be 1) or motor_speed_radps is in other "
         "units",
     )
 
 
-def check_consistency(window: Window, actuator: DriveConstants) -> Consistency:
+def check_consistency(window: Window, drive: DriveConstants) -> Consistency:
     """``window``'s relations, or an InputError naming the field the failing ones point to."""
     check_logged(window)
-    found = consistency(window, actuator)
+    found = consistency(window, drive)
     gain, follows, reading = found.travel_gain, found.following, found.better_reading
     lost = follows is not None and follows < MIN_FOLLOWING
     loop = (
@@ -121,7 +121,7 @@ def check_consistency(window: Window, actuator: DriveConstants) -> Consistency:
         f"steps begun over {FOLLOW_GAP_DEG:g}° from it (97–100 % in a working closed loop)"
     )
     if gain is not None and not TRAVEL_GAIN[0] <= gain <= TRAVEL_GAIN[1]:
-        raise _travel_error(gain, reading, loop, window, actuator)
+        raise _travel_error(gain, reading, loop, window, drive)
     if lost and reading is not None and reading[0] in AGAINST_THE_MOTION:
         raise InputError(
             "signals.position_deg",
@@ -132,7 +132,7 @@ def check_consistency(window: Window, actuator: DriveConstants) -> Consistency:
             "signals.command_deg",
             f"the position does not follow it{loop}: a command in other units, of the other sign or of another window?",
         )
-    shifted = out_of_step(window, actuator)
+    shifted = out_of_step(window, drive)
     if shifted is not None:
         name, lag_s, better = shifted
         raise InputError(

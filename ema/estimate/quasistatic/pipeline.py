@@ -39,8 +39,9 @@ from ema.estimate.quasistatic.stretches import (
 )
 from ema.estimate.report import weakly_determined
 from ema.model.actuator import ActuatorDocument
+from ema.model.bounds import HIGH_RATE_HZ
 from ema.model.checks import InputError
-from ema.model.window import HIGH_RATE_HZ, Window
+from ema.model.window import Window
 
 MAX_CHI2 = 4.0  # the stretches about the model, per degree of freedom, beyond which it does not reproduce them
 SKIPPED = {

@@ -59,7 +59,7 @@ def simulate_noisy(
     noisy = add_seeded_noise(clean, noise, seed, rate)
 
     def residual(s: dict[str, np.ndarray]) -> np.ndarray:
-        return residual_torque_nm(s["current_a"], s["motor_speed_radps"], s["hinge_moment_nm"], rate, scenario.actuator)
+        return residual_torque_nm(s["current_a"], s["motor_speed_radps"], s["hinge_moment_nm"], rate, scenario.drive)
 
     seen = as_read(noisy, rate)
     tail = as_read({name: values[len(health) - clean_last :] for name, values in clean.items()}, rate)
@@ -87,7 +87,7 @@ def simulate_dataset(
     config: PipelineConfig,
     *,
     document: ActuatorDocument,
-    actuator: DriveConstants,
+    drive: DriveConstants,
     effects: EffectSet,
 ) -> Data:
     """The box around the physics estimate, the window's sensor noise (measured on ``window`` as logged),
@@ -101,10 +101,10 @@ def simulate_dataset(
     sims = simulate_noisy(scenario, health, window, design.centre(box), config.seed + 1, config.check_windows)
     rate = window.sample_rate_hz
     residual = residual_torque_nm(
-        seen.signals["current_a"], seen.signals["motor_speed_radps"], seen.signals["hinge_moment_nm"], rate, actuator
+        seen.signals["current_a"], seen.signals["motor_speed_radps"], seen.signals["hinge_moment_nm"], rate, drive
     )
-    sliding = regressors(seen.signals, rate, actuator, FitSettings(), residual_nm=residual)[3][0]
+    sliding = regressors(seen.signals, rate, drive, FitSettings(), residual_nm=residual)[3][0]
     n_timesteps = min(config.n_timesteps, window.n_samples)
     inputs = sliding_features(sims.residual_nm, sliding, n_timesteps)
     features = sliding_features(residual, sliding, n_timesteps)
-    return Data(scenario, box, sims.noise, sims, sliding, inputs, features, actuator)
+    return Data(scenario, box, sims.noise, sims, sliding, inputs, features, drive)

@@ -47,7 +47,7 @@ def test_reading_the_hinge_along_the_deflection_lowers_the_fit_error_on_foreign_
         batch = [noisy(dict(signals), np.random.default_rng(k), 1.0) for k in range(40)]
         stacked = {name: np.stack([b[name] for b in batch]) for name in signals}
         for label, read in (("logged", stacked), ("read", as_read(stacked, 10_000.0))):
-            fit = fit_friction(read, 10_000.0, actuator=THESIS.params)
+            fit = fit_friction(read, 10_000.0, drive=THESIS.params)
             # η_O in FDJ units of range (0.30 against 0.02 N·m)
             error = np.hypot(fit.fdj_nm - clean.truth["FDJ"], (fit.eta_o - clean.truth["eta_O"]) / 15)
             squares[label].append(np.mean(error**2))

@@ -18,7 +18,7 @@ from tests.foreign.windows import draw
 @pytest.mark.parametrize(("noise", "tolerance"), [(NO_NOISE, 0.004), (SensorNoise(), 0.015)])
 def test_recovers_fdj_and_eta_o_from_an_in_flight_window(noise, tolerance):
     window = synthetic_window(HealthParams.single(0.1, 0.057, 0.74), seed=9, noise=noise)
-    fitted = fit_window(window.signals, window.sample_rate_hz, actuator=THESIS.params)
+    fitted = fit_window(window.signals, window.sample_rate_hz, drive=THESIS.params)
     assert fitted.fdj_nm[0] == pytest.approx(0.057, rel=tolerance)
     assert fitted.eta_o[0] == pytest.approx(0.74, rel=tolerance)
 
@@ -27,7 +27,7 @@ def test_recovers_fdj_and_eta_o_from_an_in_flight_window(noise, tolerance):
 def test_recovers_the_truth_of_foreign_windows_within_a_few_jackknife_stds(seed):
     window = draw(seed, ("doublet", "cruise", "steps")[seed % 3])
     signals = window_from_dict(window.document).signals
-    fitted = fit_window(signals, 10_000.0, actuator=THESIS.params)
+    fitted = fit_window(signals, 10_000.0, drive=THESIS.params)
     assert abs(fitted.fdj_nm[0] - window.truth["FDJ"]) < 5 * fitted.fdj_std_nm[0]
     assert abs(fitted.eta_o[0] - window.truth["eta_O"]) < 5 * fitted.eta_o_std[0]
     assert fitted.fdj_nm[0] == pytest.approx(window.truth["FDJ"], rel=0.02)
@@ -38,10 +38,10 @@ def test_a_batch_fits_each_window_as_alone_and_jackknife_stds_are_honest():
     window = synthetic_window(HealthParams.single(0.1, 0.052, 0.8), seed=4)
     from ema.estimate.physics.scenario import scenario_from_window
 
-    clean = scenario_from_window(window, actuator=THESIS.params, hinge=THESIS.hinge).simulate(health).signals
+    clean = scenario_from_window(window, drive=THESIS.params, hinge=THESIS.hinge).simulate(health).signals
     noisy = add_sensor_noise(clean, SensorNoise(), np.random.default_rng(1))
-    batch = fit_friction(noisy, 10_000.0, actuator=THESIS.params)
-    single = fit_friction({k: v[3] for k, v in noisy.items()}, 10_000.0, actuator=THESIS.params)
+    batch = fit_friction(noisy, 10_000.0, drive=THESIS.params)
+    single = fit_friction({k: v[3] for k, v in noisy.items()}, 10_000.0, drive=THESIS.params)
     assert batch.fdj_nm[3] == pytest.approx(single.fdj_nm[0], rel=1e-12)
     # The spread of estimates over noise draws and the jackknife std agree within a factor of two.
     spread = np.std(batch.fdj_nm)
@@ -49,10 +49,10 @@ def test_a_batch_fits_each_window_as_alone_and_jackknife_stds_are_honest():
 
 
 def test_too_little_motion_is_refused_naming_the_signals():
-    result = simulate_batch(np.zeros(1001), HealthParams.single(), GroundLoad(0.0), actuator=THESIS.params)
+    result = simulate_batch(np.zeros(1001), HealthParams.single(), GroundLoad(0.0), drive=THESIS.params)
     signals = add_sensor_noise(result.simulation(0), SensorNoise(), np.random.default_rng(0))
     with pytest.raises(InputError) as error:
-        fit_window(signals, 10_000.0, actuator=THESIS.params)
+        fit_window(signals, 10_000.0, drive=THESIS.params)
     assert error.value.field == "signals" and "sliding" in error.value.message
 
 
@@ -65,23 +65,22 @@ def test_a_constant_torque_is_fitted_beside_friction_and_moves_nothing_else():
     """A current i₀ off zero adds exactly k_T·i₀ to T_R: the offset fit reads it and FDJ, η_O stay put."""
     window = synthetic_window(HealthParams.single(0.1, 0.052, 0.8), seed=5, noise=SensorNoise())
     settings = FitSettings(offset=True)
-    plain = fit_friction(window.signals, 10_000.0, settings=settings, actuator=THESIS.params)
+    plain = fit_friction(window.signals, 10_000.0, settings=settings, drive=THESIS.params)
     shifted = dict(window.signals, current_a=window.signals["current_a"] + 0.1)
-    off = fit_friction(shifted, 10_000.0, settings=settings, actuator=THESIS.params)
+    off = fit_friction(shifted, 10_000.0, settings=settings, drive=THESIS.params)
     # exactly, but for the few samples where k_T·I is clipped at the motor's peak torque
     assert off.term("offset")[0] - plain.term("offset")[0] == pytest.approx(0.1 * 0.0752, rel=5e-3)
     assert off.fdj_nm[0] == pytest.approx(plain.fdj_nm[0], rel=1e-3)
     assert off.eta_o[0] == pytest.approx(plain.eta_o[0], rel=1e-3)
     assert abs(plain.term("offset")[0]) < 3 * plain.term_std("offset")[0]  # none there: zero within its std
-    assert fit_friction(shifted, 10_000.0, actuator=THESIS.params).term("offset")[0] == 0.0  # not asked: not fitted
+    assert fit_friction(shifted, 10_000.0, drive=THESIS.params).term("offset")[0] == 0.0  # not asked: not fitted
 
 
 def test_an_offset_is_not_fitted_where_the_motion_goes_one_way():
     window = synthetic_window(HealthParams.single(0.1, 0.052, 0.8), seed=5)
     one_way = dict(window.signals, motor_speed_radps=np.abs(window.signals["motor_speed_radps"]))
     assert (
-        fit_friction(one_way, 10_000.0, settings=FitSettings(offset=True), actuator=THESIS.params).term("offset")[0]
-        == 0.0
+        fit_friction(one_way, 10_000.0, settings=FitSettings(offset=True), drive=THESIS.params).term("offset")[0] == 0.0
     )
 
 

@@ -21,9 +21,9 @@ SENSORS = ("position_deg", "motor_speed_radps", "current_a", "hinge_moment_nm")
 def _measured_and_realized(seed: int, family: str, widths: dict[str, int]):
     d = draw(seed, family, filter_samples=widths)
     window = window_from_dict(d.document)
-    physics = fit_window(as_read(window.signals, RATE), RATE, actuator=THESIS.params)
+    physics = fit_window(as_read(window.signals, RATE), RATE, drive=THESIS.params)
     at = HealthParams.single(fdj_nm=float(physics.fdj_nm[0]), eta_o=float(physics.eta_o[0]))
-    scenario = scenario_from_window(window, actuator=THESIS.params, hinge=THESIS.hinge)
+    scenario = scenario_from_window(window, drive=THESIS.params, hinge=THESIS.hinge)
     measured = simulate_noisy(scenario, at, window, at, seed=0, clean_last=1).noise  # read against the clean lane
     clean = d.clean_signals()
     return measured, {name: window.signals[name] - clean[name] for name in SENSORS}

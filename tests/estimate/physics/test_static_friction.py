@@ -51,7 +51,7 @@ def _foreign_reading(seed: int, family: str, rate: float, effects: Effects | Non
 def test_a_drive_that_creeps_up_to_the_break_away_reads_its_level(seed):
     level_a = 1.4  # FSJ = k_T · 1.4 A ≈ 0.105 N·m (no load)
     window = trace(0.0, np.linspace(0.4, level_a, 400), 0.7, seed)
-    found = read_static_friction(window, RATE, 0.05, 0.85, actuator=THESIS.params)
+    found = read_static_friction(window, RATE, 0.05, 0.85, drive=THESIS.params)
     assert found.value_nm is not None and found.std_nm is not None
     assert abs(found.value_nm - KT * level_a) < 2 * found.std_nm
 
@@ -60,7 +60,7 @@ def test_a_drive_that_creeps_up_to_the_break_away_reads_its_level(seed):
 def test_a_hold_then_a_jump_in_drive_is_not_a_break_away(seed):
     # Held still at a drive below the static level, then stepped: the hold only bounds FSJ from below.
     window = trace(0.0, np.full(400, 0.8), 15.0, seed)
-    found = read_static_friction(window, RATE, 0.05, 0.85, actuator=THESIS.params)
+    found = read_static_friction(window, RATE, 0.05, 0.85, drive=THESIS.params)
     assert found.value_nm is None and found.reason.code == "fsj_no_break_away"
 
 
@@ -68,16 +68,16 @@ def test_a_hold_then_a_jump_in_drive_is_not_a_break_away(seed):
 def test_a_shaft_creeping_under_dynamic_friction_is_not_stuck(seed):
     # 0.3 rad/s passes for rest in a 0.5 rad/s-noisy log; its drive rises, but it never stuck.
     window = trace(0.3, np.linspace(0.4, 1.4, 400), 0.7, seed)
-    assert read_static_friction(window, RATE, 0.05, 0.85, actuator=THESIS.params).value_nm is None
+    assert read_static_friction(window, RATE, 0.05, 0.85, drive=THESIS.params).value_nm is None
 
 
 @pytest.mark.parametrize("fsj", [0.085, 0.115])
 def test_reads_fsj_at_a_quasi_static_break_away(fsj):
     # On ground with a rising load and the command held, the shaft rests until the load breaks it away.
     result = simulate_batch(
-        np.zeros(3001), HealthParams.single(fsj, 0.05, 0.85), GroundLoad(-20.0, -600.0), actuator=THESIS.params
+        np.zeros(3001), HealthParams.single(fsj, 0.05, 0.85), GroundLoad(-20.0, -600.0), drive=THESIS.params
     )
-    found = read_static_friction(result.simulation(0), 10_000.0, 0.05, 0.85, actuator=THESIS.params)
+    found = read_static_friction(result.simulation(0), 10_000.0, 0.05, 0.85, drive=THESIS.params)
     assert found.value_nm == pytest.approx(fsj, rel=0.02)
     assert found.std_nm is not None and found.std_nm > 0
 
@@ -101,11 +101,11 @@ def test_noisy_ground_ramps_read_fsj_within_their_std(fsj):
             np.zeros(3001),
             HealthParams.single(fsj, 0.05, 0.85),
             GroundLoad(-20.0, rate_nm_per_s),
-            actuator=THESIS.params,
+            drive=THESIS.params,
         )
         for seed in range(5):
             noisy = add_sensor_noise(clean.simulation(0), SensorNoise(), np.random.default_rng(seed))
-            found = read_static_friction(noisy, RATE, 0.05, 0.85, actuator=THESIS.params)
+            found = read_static_friction(noisy, RATE, 0.05, 0.85, drive=THESIS.params)
             if found.value_nm is not None and found.std_nm is not None:
                 answered += 1
                 z.append((found.value_nm - fsj) / found.std_nm)

@@ -40,12 +40,12 @@ def _window(seed: int, filters: dict):
 @pytest.mark.parametrize("seed", range(5))
 def test_a_filtered_current_or_speed_is_read_late_by_its_filters_delay(seed):
     width = 2 + seed  # 0.5–2.5 samples of delay
-    _, lags = aligned(_window(seed, {"current_a": lambda x: moving_average(x, width)}), actuator=THESIS.params)
+    _, lags = aligned(_window(seed, {"current_a": lambda x: moving_average(x, width)}), drive=THESIS.params)
     assert lags.current_s * RATE == pytest.approx((width - 1) / 2, abs=0.1)
-    _, lags = aligned(_window(seed, {"motor_speed_radps": lambda x: moving_average(x, width)}), actuator=THESIS.params)
+    _, lags = aligned(_window(seed, {"motor_speed_radps": lambda x: moving_average(x, width)}), drive=THESIS.params)
     assert lags.current_s * RATE == pytest.approx(-(width - 1) / 2, abs=0.1)
     tau, a = 1.0 + seed, np.exp(-1.0 / (1.0 + seed))
-    _, lags = aligned(_window(seed, {"current_a": lambda x: first_order(x, tau)}), actuator=THESIS.params)
+    _, lags = aligned(_window(seed, {"current_a": lambda x: first_order(x, tau)}), drive=THESIS.params)
     # an RC filter delays fast content less than slow; Eq. 5.1 reads it at the accelerations
     assert lags.current_s * RATE == pytest.approx(a / (1 - a), rel=0.1)
 
@@ -58,7 +58,7 @@ def test_a_filtered_hinge_moment_is_read_late_by_about_its_filters_delay():
     for seed in range(5):
         width = 10 + 7 * seed  # 0.45–1.8 ms late
         _, lags = aligned(
-            _window(seed, {"hinge_moment_nm": lambda x, w=width: moving_average(x, w)}), actuator=THESIS.params
+            _window(seed, {"hinge_moment_nm": lambda x, w=width: moving_average(x, w)}), drive=THESIS.params
         )
         read.append(lags.hinge_filter_s * RATE / ((width - 1) / 2))
         weights.append(lags.hinge_weight)
@@ -74,7 +74,7 @@ def test_noise_correlated_after_an_unfiltered_moment_is_mostly_not_taken_for_its
     weights = []
     for seed in range(12):
         drawn = draw(seed, FAMILIES[seed % 5], filter_samples={"hinge_moment_nm": 10 + 3 * seed})
-        _, lags = aligned(window_from_dict(drawn.document), actuator=THESIS.params)
+        _, lags = aligned(window_from_dict(drawn.document), drive=THESIS.params)
         if lags.hinge_filter_s:
             weights.append(lags.hinge_weight)
             if 0.05 < lags.hinge_weight < 0.95:
@@ -85,15 +85,15 @@ def test_noise_correlated_after_an_unfiltered_moment_is_mostly_not_taken_for_its
 def test_unfiltered_sensors_are_left_as_logged():
     for seed in range(5, 15):
         window = _window(seed, {})
-        out, lags = aligned(window, actuator=THESIS.params)
+        out, lags = aligned(window, drive=THESIS.params)
         assert lags == Lags() and out is window, seed
 
 
 def test_the_hinge_lags_read_uncertainty_is_carried_as_a_spread_only_where_one_is_read():
     """Behind a 30-sample filter FDJ moves with the lag; its ±15 % band goes into the stds."""
-    _, lags = aligned(_window(3, {"hinge_moment_nm": lambda x: moving_average(x, 30)}), actuator=THESIS.params)
+    _, lags = aligned(_window(3, {"hinge_moment_nm": lambda x: moving_average(x, 30)}), drive=THESIS.params)
     assert lags.hinge_s > 0 and 0.0 < lags.spread["FDJ"] < 2e-3 and lags.spread["eta_O"] >= 0.0
-    assert aligned(_window(3, {}), actuator=THESIS.params)[1] == Lags()
+    assert aligned(_window(3, {}), drive=THESIS.params)[1] == Lags()
 
 
 @pytest.mark.parametrize(
@@ -111,4 +111,4 @@ def test_a_drive_constant_off_the_documents_is_not_read_as_a_lag(seed, effects):
     ΔJ·dω/dt then look like a shifted current (a 6 % gain was read 5 samples late, a rotor 20 % light 9 samples
     early); each shift is fitted with both free, and no lag is left."""
     drawn = draw(seed, "stops", effects=effects, duration_s=1.5, flight=Flight(airspeed_mps=100.0, altitude_m=5000.0))
-    assert aligned(window_from_dict(drawn.document), actuator=THESIS.params)[1].current_s == 0.0
+    assert aligned(window_from_dict(drawn.document), drive=THESIS.params)[1].current_s == 0.0

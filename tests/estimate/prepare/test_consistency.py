@@ -32,7 +32,7 @@ def _windows(seed: int) -> list[dict]:
 @pytest.mark.parametrize("seed", SEEDS)
 def test_windows_of_a_working_drive_pass_with_their_travel_and_loop_in_agreement(seed):
     for document in _windows(seed):
-        found = check_consistency(window_from_dict(document), actuator=THESIS.params)
+        found = check_consistency(window_from_dict(document), drive=THESIS.params)
         assert found.better_reading is None
         assert found.travel_gain is None or 0.98 < found.travel_gain < 1.02, found
         assert found.following is None or found.following > 0.97, found
@@ -44,7 +44,7 @@ def test_a_dead_band_of_any_width_is_no_unit_error(width):
     for seed in SEEDS:
         found = check_consistency(
             window_from_dict(draw(seed, "thesis", effects=Effects(backlash_factor=width)).document),
-            actuator=THESIS.params,
+            drive=THESIS.params,
         )
         assert found.travel_gain is None or 0.98 < found.travel_gain < 1.02, (width, found)
 
@@ -75,7 +75,7 @@ def test_a_careless_export_is_refused_naming_its_field(slip):
     for seed in SEEDS:
         try:
             check_consistency(
-                window_from_dict(exported(draw(seed, FAMILIES[seed % 5]).document, SLIPS[slip])), actuator=THESIS.params
+                window_from_dict(exported(draw(seed, FAMILIES[seed % 5]).document, SLIPS[slip])), drive=THESIS.params
             )
         except InputError as refused:
             named.append(refused.field)
@@ -94,7 +94,7 @@ def test_the_travel_gain_follows_a_misstated_sample_rate():
     for factor in (0.8, 1.0, 1.25):
         window = window_from_dict(exported(document, Slip({"sample_rate_hz": factor}, "sample_rate_hz")))
         try:
-            gains.append(check_consistency(window, actuator=THESIS.params).travel_gain)
+            gains.append(check_consistency(window, drive=THESIS.params).travel_gain)
         except InputError as refused:
             gains.append(float(refused.message.split("travel is ")[1].split("x")[0]))
     assert np.allclose(np.array(gains) / gains[1], [0.8, 1.0, 1.25], rtol=1e-3)
@@ -118,5 +118,5 @@ def test_a_sensor_stuck_at_one_value_is_refused_naming_it(name):
     document = draw(4413, "doublet").document
     stuck = {**document, "signals": {**document["signals"], name: [document["signals"][name][100]] * 5000}}
     with pytest.raises(InputError, match="stuck") as refused:
-        check_consistency(window_from_dict(stuck), actuator=THESIS.params)
+        check_consistency(window_from_dict(stuck), drive=THESIS.params)
     assert refused.value.field == f"signals.{name}"

@@ -40,7 +40,7 @@ def test_a_filter_that_delays_the_moment_is_advanced_and_its_spread_is_small():
         width = 20 + 2 * seed
         drawn = through_filters(draw(200 + seed, FAMILIES[seed % 5]), {"hinge_moment_nm": width})
         signals = {k: np.asarray(v) for k, v in drawn.document["signals"].items()}
-        found.append((hinge_lag(signals, 10_000.0, actuator=THESIS.params), (width - 1) / 2))
+        found.append((hinge_lag(signals, 10_000.0, drive=THESIS.params), (width - 1) / 2))
     late = [lag.late for lag, _ in found]
     assert np.mean(late) > 0.75, late
     for lag, delay in found:
@@ -51,7 +51,7 @@ def test_a_filter_that_delays_the_moment_is_advanced_and_its_spread_is_small():
 def test_white_noise_reads_no_filter_and_leaves_the_moment():
     drawn = draw(300, "gust")
     signals = {k: np.asarray(v) for k, v in drawn.document["signals"].items()}
-    assert hinge_lag(signals, 10_000.0, actuator=THESIS.params) == HingeLag()
+    assert hinge_lag(signals, 10_000.0, drive=THESIS.params) == HingeLag()
 
 
 @pytest.mark.parametrize("seed", [500026, 500056, 500053, 500059])
@@ -63,4 +63,4 @@ def test_a_grease_off_the_specs_does_not_pass_for_a_late_moment(seed):
     factor = float(np.random.default_rng(seed).uniform(1.2, 2.0))
     drawn = draw(seed, FAMILIES[seed % 5], effects=Effects(viscous_factor=factor), sample_rate_hz=2_000.0)
     signals = {k: np.asarray(v) for k, v in drawn.document["signals"].items()}
-    assert hinge_lag(signals, 2_000.0, actuator=THESIS.params).advance < 1e-3 * 2_000.0 / 2  # under 0.5 ms
+    assert hinge_lag(signals, 2_000.0, drive=THESIS.params).advance < 1e-3 * 2_000.0 / 2  # under 0.5 ms

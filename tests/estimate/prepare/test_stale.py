@@ -39,7 +39,7 @@ def _fault(seed: int) -> Fault:
 def test_no_working_sensor_of_a_foreign_window_is_taken_for_a_stale_one(group):
     make = groups()[group]
     for seed in range(5200, 5206):
-        assert stale_runs(window_from_dict(make(seed).document), actuator=THESIS.params) == ()
+        assert stale_runs(window_from_dict(make(seed).document), drive=THESIS.params) == ()
 
 
 def test_a_frozen_or_dropped_out_sensor_is_cut_out_and_the_rest_read_within_its_std():
@@ -66,7 +66,7 @@ def test_a_sensor_quantized_coarser_than_its_noise_is_not_taken_for_a_frozen_one
     document["signals"]["current_a"] = [round(i / 0.5) * 0.5 for i in document["signals"]["current_a"]]
     window = window_from_dict(document)
     assert np.max(np.diff(np.flatnonzero(np.diff(window.signals["current_a"]) != 0))) > 20  # long flat runs
-    assert stale_runs(window, actuator=THESIS.params) == ()
+    assert stale_runs(window, drive=THESIS.params) == ()
 
 
 def test_a_speed_reading_exactly_zero_at_rest_is_no_frozen_sensor():
@@ -79,7 +79,7 @@ def test_a_speed_reading_exactly_zero_at_rest_is_no_frozen_sensor():
     window = window_from_dict(document)
     longest = max(len(run) for run in np.split(speed, np.flatnonzero(np.diff(speed != 0)) + 1) if run[0] == 0)
     assert longest > 100 * MIN_STALE_SAMPLES  # rests long enough to be taken for one
-    assert stale_runs(window, actuator=THESIS.params) == ()
+    assert stale_runs(window, drive=THESIS.params) == ()
 
 
 def test_a_window_with_too_little_sliding_left_is_refused_naming_the_sensor():
@@ -112,4 +112,4 @@ def test_a_chance_run_of_a_quantized_position_is_no_stale_run():
     window = window_from_dict(groups()["cruise"](group_seed("cruise", 0)).document)
     starts, stops = equal_runs(window.signals["position_deg"])
     assert (stops - starts).max() == 8
-    assert stale_runs(window, actuator=THESIS.params) == ()
+    assert stale_runs(window, drive=THESIS.params) == ()

@@ -35,7 +35,7 @@ def test_a_moment_in_step_adds_next_to_nothing():
 
 def test_a_moment_20_ms_early_is_read_out_of_step_by_that_lag():
     steps = [
-        step_lag(window_from_dict(logged_early(draw(seed, FAMILIES[seed % 5]).document, 0.02)), actuator=THESIS.params)
+        step_lag(window_from_dict(logged_early(draw(seed, FAMILIES[seed % 5]).document, 0.02)), drive=THESIS.params)
         for seed in range(10)
     ]
     assert sum(step.weight > 0.9 and step.lag_s == pytest.approx(-0.02) for step in steps) >= 9, steps
@@ -61,10 +61,10 @@ def test_on_2_khz_logs_5_ms_out_of_step_the_band_decides_what_eq_5_1_cannot(monk
         window_from_dict(logged_early(draw(seed, FAMILIES[seed % 5], sample_rate_hz=2_000.0).document, 0.005))
         for seed in range(12, 36)
     ]
-    with_band = [step_lag(window, actuator=THESIS.params).weight for window in windows]
+    with_band = [step_lag(window, drive=THESIS.params).weight for window in windows]
     monkeypatch.setattr(step_lag_module, "band_log_likelihood", lambda signals, rate, lags, gear: np.zeros(len(lags)))
     undecided = [
-        w for w, window in zip(with_band, windows, strict=True) if step_lag(window, actuator=THESIS.params).weight < 0.1
+        w for w, window in zip(with_band, windows, strict=True) if step_lag(window, drive=THESIS.params).weight < 0.1
     ]
     assert len(undecided) >= 8
     assert sum(w > 0.5 for w in undecided) >= 2 / 3 * len(undecided), undecided

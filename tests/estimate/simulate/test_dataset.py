@@ -15,7 +15,7 @@ from tests.foreign.windows import draw
 def test_a_clean_window_is_reproduced_by_its_own_scenario():
     truth = HealthParams.single(0.11, 0.055, 0.8)
     window = synthetic_window(truth, seed=4, duration_s=0.1, noise=NO_NOISE)
-    replay = scenario_from_window(window, actuator=THESIS.params, hinge=THESIS.hinge).simulate(truth).simulation(0)
+    replay = scenario_from_window(window, drive=THESIS.params, hinge=THESIS.hinge).simulate(truth).simulation(0)
     # Command through knots and back, the start through a parabola, the load from the log: tiny differences.
     assert np.abs(replay["position_deg"] - window.signals["position_deg"]).max() < 0.02
     assert np.abs(replay["current_a"] - window.signals["current_a"]).mean() < 0.2
@@ -24,7 +24,7 @@ def test_a_clean_window_is_reproduced_by_its_own_scenario():
 
 def test_initial_state_is_read_through_the_noise():
     window = synthetic_window(HealthParams.single(), seed=5, duration_s=0.05)
-    state = initial_state(window, actuator=THESIS.params)
+    state = initial_state(window, drive=THESIS.params)
     assert state.position_deg == pytest.approx(0.0, abs=0.02)
     assert state.motor_speed_radps == pytest.approx(0.0, abs=2.0)
     assert isinstance(state, InitialState)
@@ -32,7 +32,7 @@ def test_initial_state_is_read_through_the_noise():
 
 def _noise_read_at(window, health: HealthParams) -> SensorNoise:
     """The window's noise as the dataset reads it: against the batch's clean lane at ``health``."""
-    scenario = scenario_from_window(window, actuator=THESIS.params, hinge=THESIS.hinge)
+    scenario = scenario_from_window(window, drive=THESIS.params, hinge=THESIS.hinge)
     return simulate_noisy(scenario, health, window, health, seed=0, clean_last=1).noise
 
 
@@ -49,7 +49,7 @@ def test_window_noise_is_estimated_against_the_clean_model():
 
 def test_noisy_simulations_are_seeded_and_keep_their_clean_residual():
     window = synthetic_window(HealthParams.single(), seed=7, duration_s=0.05)
-    scenario = scenario_from_window(window, actuator=THESIS.params, hinge=THESIS.hinge)
+    scenario = scenario_from_window(window, drive=THESIS.params, hinge=THESIS.hinge)
     health = HealthParams(np.full(8, 0.1), np.linspace(0.04, 0.06, 8), np.full(8, 0.85))
     a = simulate_noisy(scenario, health, window, HealthParams.single(), 3, 2)
     b = simulate_noisy(scenario, health, window, HealthParams.single(), 3, 2)
@@ -62,7 +62,7 @@ def test_noisy_simulations_are_seeded_and_keep_their_clean_residual():
 def test_the_reference_lane_is_its_own_one_lane_run_to_the_bit():
     """What lets the answer's check reuse it: a lane of the batch equals a run of its own (a foreign window)."""
     window = window_from_dict(draw(11, "gust").document)
-    scenario = scenario_from_window(window, actuator=THESIS.params, hinge=THESIS.hinge)
+    scenario = scenario_from_window(window, drive=THESIS.params, hinge=THESIS.hinge)
     health = HealthParams(np.full(40, 0.1), np.linspace(0.04, 0.06, 40), np.linspace(0.7, 0.95, 40))
     reference = HealthParams.single(0.1, 0.052, 0.83)
     kept = simulate_noisy(scenario, health, window, reference, 3, 2)

@@ -203,7 +203,7 @@ def divided_out(read: AircraftCheck) -> AircraftCheck:
     return replace(read, factor=read.ratio) if read.decisive and read.beyond(DEPART_STDS) else read
 
 
-def banded(read: AircraftCheck, window: Window, gain: float, actuator: DriveConstants) -> AircraftCheck:
+def banded(read: AircraftCheck, window: Window, gain: float, drive: DriveConstants) -> AircraftCheck:
     """``read`` with the stds it adds to FDJ and η_O of ``window`` (its ratio divided out already, where
     it departs) where the window's own loads read no ``gain`` (``ema.estimate.prepare.departures.hinge_gain``); as it is
     otherwise. Divided out: half of what the ends of the ratio's band move them (the tolerance and the
@@ -212,18 +212,18 @@ def banded(read: AircraftCheck, window: Window, gain: float, actuator: DriveCons
     if gain != 1.0 or read.factor == 1.0 or not read.beyond(SUSPECT_STDS):
         return read
     band = math.hypot(read.tolerance, read.ratio_std / read.ratio)
-    fitted = free_load_fit(window, actuator, BESIDE)
+    fitted = free_load_fit(window, drive, BESIDE)
     if fitted is not None:
         own, own_std = float(fitted[0][0]), float(jackknife_std(fitted[0][None, 1:])[0])
         if np.isfinite(own) and own_std > 0.0 and abs(own - 1.0) <= 2.0 * own_std:
             band = 1.0 / math.hypot(1.0 / band, 1.0 / own_std)
-    return replace(read, spread=_moved(window, actuator, 1.0 - band, 1.0 + band, 0.5))
+    return replace(read, spread=_moved(window, drive, 1.0 - band, 1.0 + band, 0.5))
 
 
-def _moved(window: Window, actuator: DriveConstants, first: float, second: float, share: float) -> dict[str, float]:
+def _moved(window: Window, drive: DriveConstants, first: float, second: float, share: float) -> dict[str, float]:
     """``share`` of how far FDJ and η_O of Eq. 5.1's fit move between the hinge moment divided by
     ``first`` and by ``second``."""
-    ends = [fit_as_read(divided_hinge(window, g).signals, window.sample_rate_hz, actuator) for g in (first, second)]
+    ends = [fit_as_read(divided_hinge(window, g).signals, window.sample_rate_hz, drive) for g in (first, second)]
     return {
         "FDJ": share * abs(float(ends[1].fdj_nm[0] - ends[0].fdj_nm[0])),
         "eta_O": share * abs(float(ends[1].eta_o[0] - ends[0].eta_o[0])),

@@ -104,35 +104,35 @@ class DriveReading:
         return replace(window, signals=dict(window.signals, current_a=self.torque_factor * window.signals["current_a"]))
 
 
-def _fit(window: Window, actuator: DriveConstants, settings: FitSettings) -> FrictionFit:
-    return fit_as_read(window.signals, window.sample_rate_hz, actuator, settings)
+def _fit(window: Window, drive: DriveConstants, settings: FitSettings) -> FrictionFit:
+    return fit_as_read(window.signals, window.sample_rate_hz, drive, settings)
 
 
-def read_drive_constants(window: Window, actuator: DriveConstants) -> DriveReading:
+def read_drive_constants(window: Window, drive: DriveConstants) -> DriveReading:
     """γ or ΔJ where it stands out (module docstring), with FDJ's and η_O's change across it ± its std. Where
     both do, the likelier if the window decides (``DECISIVE``); else γ, with ΔJ beside it as the
     ``alternative`` (``ema.estimate.prepare.departures.read`` replays both, or widens the stds by their gap)."""
     rate = window.sample_rate_hz
-    plain = _fit(window, actuator, BESIDE)
-    alone = {name: _fit(window, actuator, replace(BESIDE, **{name: True})) for name in FIELDS}
+    plain = _fit(window, drive, BESIDE)
+    alone = {name: _fit(window, drive, replace(BESIDE, **{name: True})) for name in FIELDS}
     gamma = beyond_any_motor(plain, alone["torque_scale"], rate)
-    refusal = no_drive_error(gamma, alone["inertia"], actuator)
+    refusal = no_drive_error(gamma, alone["inertia"], drive)
     if refusal is not None:
         raise refusal
-    read = _read_constants(window, actuator, plain, alone)
+    read = _read_constants(window, drive, plain, alone)
     if read.alternative is not None:
         read = replace(read, alternative=unit_story(read.alternative, gamma, plain, alone))
     return unit_story(read, gamma, plain, alone)
 
 
 def _read_constants(
-    window: Window, actuator: DriveConstants, plain: FrictionFit, alone: dict[str, FrictionFit]
+    window: Window, drive: DriveConstants, plain: FrictionFit, alone: dict[str, FrictionFit]
 ) -> DriveReading:
     rate = window.sample_rate_hz
-    found = [name for name in FIELDS if _stands_out(plain, alone[name], name, rate, actuator)]
-    readings = {name: _reading(window, actuator, name, alone[name]) for name in found}
+    found = [name for name in FIELDS if _stands_out(plain, alone[name], name, rate, drive)]
+    readings = {name: _reading(window, drive, name, alone[name]) for name in found}
     if not readings:
-        return DriveReading(spec=actuator)
+        return DriveReading(spec=drive)
     if len(readings) == 1:
         return _with_spread(window, next(iter(readings.values()))[0])
     (scale, scale_fit), (inertia, inertia_fit) = readings["torque_scale"], readings["inertia"]
@@ -193,14 +193,12 @@ def _stands_out(plain: FrictionFit, alone: FrictionFit, name: str, rate: float, 
     )
 
 
-def _reading(
-    window: Window, actuator: DriveConstants, name: str, first: FrictionFit
-) -> tuple[DriveReading, FrictionFit]:
+def _reading(window: Window, drive: DriveConstants, name: str, first: FrictionFit) -> tuple[DriveReading, FrictionFit]:
     """Constant ``name``, refitted on the corrected window until nothing is left, its std ΔJ's with the
     kernel's (``kernel_inertia_std``); and the last fit (its likelihood)."""
     settings, std = replace(BESIDE, **{name: True}), float(first.term_std(name)[0])
-    kernel = kernel_inertia_std(window.sample_rate_hz, actuator) if name == "inertia" else 0.0
-    read, left = DriveReading(spec=actuator, stds={FIELDS[name]: float(np.hypot(std, kernel))}), first
+    kernel = kernel_inertia_std(window.sample_rate_hz, drive) if name == "inertia" else 0.0
+    read, left = DriveReading(spec=drive, stds={FIELDS[name]: float(np.hypot(std, kernel))}), first
     for _ in range(ITERATIONS + 1):
         read = read.added(left)
         left = _fit(read.corrected(window), read.drive_as_read, settings)

@@ -72,7 +72,7 @@ def eta_o_from_product(product: np.ndarray, gear: float) -> np.ndarray:
 
 
 def free_load_fit(
-    window: Window, actuator: DriveConstants, beside: FitSettings = FitSettings()
+    window: Window, drive: DriveConstants, beside: FitSettings = FitSettings()
 ) -> tuple[np.ndarray, float, int] | None:
     """The least squares of t on (1, a, o) and ``beside``'s nuisance columns over the sliding samples: g
     from the whole window and from each jackknife block left out ((B + 1,), the whole first), the RMS
@@ -80,51 +80,49 @@ def free_load_fit(
     (``MIN_SLIDING_KERNELS``)."""
     rate = window.sample_rate_hz
     seen = as_read(window.signals, rate)
-    t, a, o, sliding = (x[0] for x in regressors(seen, rate, actuator, beside))
+    t, a, o, sliding = (x[0] for x in regressors(seen, rate, drive, beside))
     used = int(sliding.sum())
     if used < MIN_SLIDING_KERNELS * kernel_samples(rate, DEFAULT_DERIVATIVE_WINDOW_S):
         return None
     blocks = np.minimum(np.arange(len(t)) * JACKKNIFE_BLOCKS // len(t), JACKKNIFE_BLOCKS - 1)
-    nuisances = [column[0] for column in nuisance_columns(seen, rate, actuator, beside)]
+    nuisances = [column[0] for column in nuisance_columns(seen, rate, drive, beside)]
     columns = np.column_stack([np.ones_like(t), a, o, *nuisances])
     keep = [sliding] + [sliding & (blocks != b) for b in range(JACKKNIFE_BLOCKS)]
     betas = np.array([np.linalg.lstsq(columns[k], t[k], rcond=None)[0] for k in keep])
-    eta_o = eta_o_from_product((1 - betas[:, 1]) / (1 + betas[:, 2]), actuator.gear_ratio)
+    eta_o = eta_o_from_product((1 - betas[:, 1]) / (1 + betas[:, 2]), drive.gear_ratio)
     misfit = rms(t[sliding] - columns[sliding] @ betas[0])
     return 1.0 / ((1 + betas[:, 2]) * eta_o), misfit, used
 
 
-def _margin(window: Window, actuator: DriveConstants, free_rms: float, used: int, rivals: list[FitSettings]) -> float:
+def _margin(window: Window, drive: DriveConstants, free_rms: float, used: int, rivals: list[FitSettings]) -> float:
     """ln LR by which the free load fit explains ``window`` better than the best of Eq. 5.1's fits with
     g = 1 and ``rivals``' terms (−inf where one cannot be compared)."""
     rate = window.sample_rate_hz
-    best = min(float(fit_as_read(window.signals, rate, actuator, rival).residual_rms_nm[0]) for rival in rivals)
+    best = min(float(fit_as_read(window.signals, rate, drive, rival).residual_rms_nm[0]) for rival in rivals)
     if not (np.isfinite(best) and free_rms > 0):
         return -np.inf
     return rms_log_likelihood_ratio(best, free_rms, used, rate)
 
 
-def read_hinge_gain(window: Window, actuator: DriveConstants, leading: bool = False) -> HingeGain:
+def read_hinge_gain(window: Window, drive: DriveConstants, leading: bool = False) -> HingeGain:
     """g where it stands out and is plausible (module docstring), with FDJ's and η_O's change across g ± its
     std; ``leading``: only where it also explains the window ``DECISIVE`` (ln LR) better than γ or ΔJ alone,
     each beside an offset and ΔC, to be read before them (which would each take a part of it)."""
-    fitted = free_load_fit(window, actuator, BESIDE)
+    fitted = free_load_fit(window, drive, BESIDE)
     if fitted is None:
         return HingeGain()
     gain, free_rms, used = fitted
     plausible = np.all(np.isfinite(gain)) and PLAUSIBLE[0] <= gain[0] <= PLAUSIBLE[1]
     if not (plausible and abs(gain[0] - 1.0) >= MIN_CHANGE):
         return HingeGain()
-    if not 2.0 * _margin(window, actuator, free_rms, used, [BESIDE]) > DECISIVE_Z**2:
+    if not 2.0 * _margin(window, drive, free_rms, used, [BESIDE]) > DECISIVE_Z**2:
         return HingeGain()
     rivals = [replace(BESIDE, **{name: True}) for name in FIELDS]  # γ alone, ΔJ alone
-    if leading and not _margin(window, actuator, free_rms, used, rivals) > DECISIVE:
+    if leading and not _margin(window, drive, free_rms, used, rivals) > DECISIVE:
         return HingeGain()
     std = float(jackknife_std(gain[None, 1:])[0])
     rate = window.sample_rate_hz
-    low, high = (
-        fit_as_read(HingeGain(float(gain[0]) + d).corrected(window).signals, rate, actuator) for d in (-std, std)
-    )
+    low, high = (fit_as_read(HingeGain(float(gain[0]) + d).corrected(window).signals, rate, drive) for d in (-std, std))
     spread = {
         "FDJ": abs(float(high.fdj_nm[0] - low.fdj_nm[0])) / 2,
         "eta_O": abs(float(high.eta_o[0] - low.eta_o[0])) / 2,

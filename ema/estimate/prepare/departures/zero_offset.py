@@ -82,14 +82,14 @@ def _shifted(signals: dict[str, np.ndarray], hinge_nm: float = 0.0, current_a: f
 
 
 def sensor_offset(
-    signals: dict[str, np.ndarray], rate: float, torque_nm: float, sensor: str, actuator: DriveConstants
+    signals: dict[str, np.ndarray], rate: float, torque_nm: float, sensor: str, drive: DriveConstants
 ) -> float:
     """The offset of ``sensor`` (``hinge_nm`` or ``current_a``) that leaves no constant in T_R: from the
     shaft's c in the sensor's unit, refitted as the reading moves (``ITERATIONS``)."""
-    per_nm = actuator.gear_ratio if sensor == "hinge_nm" else 1.0 / actuator.torque_constant_nm_per_a
+    per_nm = drive.gear_ratio if sensor == "hinge_nm" else 1.0 / drive.torque_constant_nm_per_a
     offset = per_nm * torque_nm
     for _ in range(ITERATIONS):
-        left = fit_as_read(_shifted(signals, **{sensor: offset}), rate, actuator, OFFSET_FIT).term("offset")[0]
+        left = fit_as_read(_shifted(signals, **{sensor: offset}), rate, drive, OFFSET_FIT).term("offset")[0]
         if not np.isfinite(left):
             break
         offset += per_nm * float(left)
@@ -114,34 +114,32 @@ def second_weight(first: FrictionFit, second: FrictionFit, rate: float) -> float
     return odds_weight(log_likelihood_ratio(first, second, rate))
 
 
-def read_zero_offset(window: Window, actuator: DriveConstants, carried: ZeroOffset | None = None) -> ZeroOffset:
+def read_zero_offset(window: Window, drive: DriveConstants, carried: ZeroOffset | None = None) -> ZeroOffset:
     """The window's constant torque beyond friction, where the fit with it explains the window ``DECISIVE_Z``
     stds better, and the two readings of it (module docstring) weighed; the zero ``carried`` from a window
     of the same flight where it is the more precise and holds here (``flight_zero``); where the motion goes
     one way, the carried zero, or the note that none is known."""
     rate, signals = window.sample_rate_hz, dict(window.signals)
-    found = fit_as_read(signals, rate, actuator, OFFSET_FIT)
+    found = fit_as_read(signals, rate, drive, OFFSET_FIT)
     if float(found.term_std("offset")[0]) == 0.0:  # too little motion the other way (``eta_search.MIN_OFFSET_BALANCE``)
-        unseen = UNSEEN_CURRENT_OFFSET_A * actuator.torque_constant_nm_per_a
+        unseen = UNSEEN_CURRENT_OFFSET_A * drive.torque_constant_nm_per_a
         known = carried or ZeroOffset(zero_std_nm=unseen)
         return replace(known, one_way=True, spread={"FDJ": known.zero_std_nm})
-    own = own_reading(signals, rate, actuator, found)
+    own = own_reading(signals, rate, drive, found)
     if carried is None or carried.zero_std_nm >= own.zero_std_nm:
         return own
-    return flight_zero(signals, rate, actuator, carried, own)
+    return flight_zero(signals, rate, drive, carried, own)
 
 
-def own_reading(
-    signals: dict[str, np.ndarray], rate: float, actuator: DriveConstants, found: FrictionFit
-) -> ZeroOffset:
+def own_reading(signals: dict[str, np.ndarray], rate: float, drive: DriveConstants, found: FrictionFit) -> ZeroOffset:
     """The offset the window reads itself from ``found``, Eq. 5.1's fit with one (module docstring)."""
     torque, std = float(found.term("offset")[0]), float(found.term_std("offset")[0])
-    if not (np.isfinite(torque) and equation_z(fit_as_read(signals, rate, actuator), found, rate) > DECISIVE_Z):
+    if not (np.isfinite(torque) and equation_z(fit_as_read(signals, rate, drive), found, rate) > DECISIVE_Z):
         return ZeroOffset(zero_std_nm=float(np.hypot(std, torque)) if np.isfinite(torque) else 0.0)
-    current_a = sensor_offset(signals, rate, torque, "current_a", actuator)
-    hinge_nm = sensor_offset(signals, rate, torque, "hinge_nm", actuator)
-    as_current = fit_as_read(_shifted(signals, current_a=current_a), rate, actuator)
-    as_hinge = fit_as_read(_shifted(signals, hinge_nm=hinge_nm), rate, actuator)
+    current_a = sensor_offset(signals, rate, torque, "current_a", drive)
+    hinge_nm = sensor_offset(signals, rate, torque, "hinge_nm", drive)
+    as_current = fit_as_read(_shifted(signals, current_a=current_a), rate, drive)
+    as_hinge = fit_as_read(_shifted(signals, hinge_nm=hinge_nm), rate, drive)
     share = second_weight(as_current, as_hinge, rate)
     apart = {
         "FDJ": float(as_hinge.fdj_nm[0] - as_current.fdj_nm[0]),
@@ -160,11 +158,11 @@ def own_reading(
 
 
 def flight_zero(
-    signals: dict[str, np.ndarray], rate: float, actuator: DriveConstants, carried: ZeroOffset, own: ZeroOffset
+    signals: dict[str, np.ndarray], rate: float, drive: DriveConstants, carried: ZeroOffset, own: ZeroOffset
 ) -> ZeroOffset:
     """The flight's zero ``carried``, where it holds on this window (taken off, the constant left lies within
     ``HOLDS_Z`` stds of none); else the window's ``own`` reading, with how far the flight's is off."""
-    left = fit_as_read(_shifted(signals, carried.hinge_nm, carried.current_a), rate, actuator, OFFSET_FIT)
+    left = fit_as_read(_shifted(signals, carried.hinge_nm, carried.current_a), rate, drive, OFFSET_FIT)
     z = abs(float(left.term("offset")[0])) / float(np.hypot(left.term_std("offset")[0], carried.zero_std_nm))
     if not z <= HOLDS_Z:
         return replace(own, unheld_from=carried.carried_from, unheld_z=z)

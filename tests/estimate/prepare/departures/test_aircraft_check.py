@@ -112,9 +112,9 @@ def test_the_aircrafts_gain_is_divided_out_and_its_band_covers_the_true_moments_
         and aircraft_note(read)[0].code == "hinge_vs_aircraft"
     )
     corrected = read.corrected(slipped)
-    read = banded(read, corrected, gain=1.0, actuator=THESIS.params)
-    fitted = fit_as_read(corrected.signals, slipped.sample_rate_hz, actuator=THESIS.params)
-    answer = fit_as_read(true.signals, true.sample_rate_hz, actuator=THESIS.params)
+    read = banded(read, corrected, gain=1.0, drive=THESIS.params)
+    fitted = fit_as_read(corrected.signals, slipped.sample_rate_hz, drive=THESIS.params)
+    answer = fit_as_read(true.signals, true.sample_rate_hz, drive=THESIS.params)
     assert abs(fitted.eta_o[0] - answer.eta_o[0]) <= 2 * np.hypot(read.spread["eta_O"], fitted.eta_o_std[0])
     assert abs(fitted.fdj_nm[0] - answer.fdj_nm[0]) <= 2 * np.hypot(read.spread["FDJ"], fitted.fdj_std_nm[0])
     assert (
@@ -122,7 +122,7 @@ def test_the_aircrafts_gain_is_divided_out_and_its_band_covers_the_true_moments_
             divided_out(check_against_aircraft(slipped, hinge=THESIS.hinge)),
             corrected,
             gain=0.98,
-            actuator=THESIS.params,
+            drive=THESIS.params,
         ).spread
         == {}
     )  # loads read one

@@ -23,9 +23,7 @@ def test_eta_o_from_the_product_inverts_eq_3_4():
 @pytest.mark.parametrize("gain", [0.74, 0.9, 1.1])
 def test_a_hinge_moment_logged_off_gain_is_read_within_its_std(gain):
     drawn = [
-        read_hinge_gain(
-            window_from_dict(with_hinge_gain(draw(s, FAMILIES[s % 5]), gain).document), actuator=THESIS.params
-        )
+        read_hinge_gain(window_from_dict(with_hinge_gain(draw(s, FAMILIES[s % 5]), gain).document), drive=THESIS.params)
         for s in SEEDS
     ]
     read = [r for r in drawn if r.gain != 1.0]  # one steps window at 1.1x does not stand out beside an offset
@@ -35,7 +33,7 @@ def test_a_hinge_moment_logged_off_gain_is_read_within_its_std(gain):
 
 def test_a_true_hinge_moment_is_left_as_logged():
     windows = [draw(s, FAMILIES[s % 5]) for s in SEEDS] + [worn(s, family=FAMILIES[s % 5]) for s in SEEDS]
-    assert [read_hinge_gain(window_from_dict(w.document), actuator=THESIS.params).gain for w in windows] == [1.0] * len(
+    assert [read_hinge_gain(window_from_dict(w.document), drive=THESIS.params).gain for w in windows] == [1.0] * len(
         windows
     )
 
@@ -53,7 +51,7 @@ def test_the_pipeline_reads_the_gain_and_answers_as_with_the_true_moment():
 
 def test_the_gain_leads_the_drive_constants_only_where_it_explains_the_window_better():
     def lead(drawn) -> bool:
-        return read_hinge_gain(window_from_dict(drawn.document), leading=True, actuator=THESIS.params).gain != 1.0
+        return read_hinge_gain(window_from_dict(drawn.document), leading=True, drive=THESIS.params).gain != 1.0
 
     assert all(lead(with_hinge_gain(draw(s, FAMILIES[s % 5]), 0.8)) for s in SEEDS)
     drive_off = [Effects(torque_constant_gain=0.95), Effects(current_sensor_gain=1.03), Effects(inertia_factor=1.08)]
