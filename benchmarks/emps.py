@@ -132,7 +132,7 @@ def main() -> None:
         "stages " + ", ".join(f"{stage} {stages[stage]:.2f} s" for stage in STAGES) + ".",
         f"It reads FDJ {answer['estimates']['FDJ']['value']:.3f} ± {answer['estimates']['FDJ']['std']:.3f} N; the "
         f"closed loop at its answer follows the logged force within "
-        f"{answer['fit_check']['output_error_pct']['drive_force_n']:.2f} % (the benchmark's Simulink model at its "
+        f"{answer['check']['output_error_pct']['drive_force_n']:.2f} % (the benchmark's Simulink model at its "
         "constants: 5.85 %).",
         "",
         identification_table(learned, base),

@@ -33,7 +33,7 @@ def measure(windows: int, seed: int) -> dict[str, Any]:
     for i in range(windows):
         drawn = draw(seed + i, FAMILIES[i % len(FAMILIES)])
         result = estimate_window(window_from_dict(drawn.document), actuator=THESIS)
-        check = result.fit_check
+        check = result.check
         said = any(note.code == "model_misfit" for note in result.notes)
         flagged += said
         ratios.append(check.equation_error_ratio)

@@ -44,7 +44,7 @@ def print_estimate(result: Any) -> None:
         click.echo(_row(name, entry))
     if result.estimates.FSJ is None:
         click.echo(f"FSJ: not estimated: {result.fsj_note.text}")
-    click.echo(check_line(result.fit_check))
+    click.echo(check_line(result.check))
     for note in result.notes:
         click.echo(f"note [{note.code}]: {note.text}")
     ran = [

@@ -54,7 +54,7 @@ def row_of(actuator_id: str, window_id: str, answer: dict[str, Any]) -> dict[str
             for stage in ("simulate", "learn", "assess", "total")
         }
     )
-    row["reproduced"] = answer["fit_check"]["reproduced"]
+    row["reproduced"] = (answer.get("check") or answer["fit_check"])["reproduced"]  # a first-stage service: fit_check
     row["replay"] = answer.get("replay", False)
     return row
 

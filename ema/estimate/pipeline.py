@@ -26,7 +26,7 @@ import numpy as np
 from ema.estimate.assess.reproduction import output_error_ratios
 from ema.estimate.assess.weighing import Assessed, Candidates, assess, misfit_limit
 from ema.estimate.config import PipelineConfig
-from ema.estimate.documents import ActuatorRead, Estimate, FitCheck, Note
+from ema.estimate.documents import ActuatorRead, Check, Estimate, Note
 from ema.estimate.documents.window import HistoryReadings
 from ema.estimate.history import known_from
 from ema.estimate.learn.estimator import NetworkEstimator
@@ -83,7 +83,7 @@ def candidates(
 
 def checked(
     window: Window, data: Data, answer: Assessed, equation_ratio: float, n: int, nominal_fdj_nm: float
-) -> FitCheck:
+) -> Check:
     """Simulate the window at the answer and compare (``ema.estimate.assess.reproduction``). Where the answer is the
     point the noise was measured at (the physics estimate, when it carries the answer), that simulation is
     the one: a lane of the dataset's batch, the same numbers as a run of its own."""
@@ -113,7 +113,7 @@ def checked(
                 ),
             )
         )
-    return FitCheck(
+    return Check(
         reproduced=reproduced,
         equation_error_ratio=equation_ratio,
         output_error_ratio=ratios,

@@ -15,10 +15,10 @@ from ema.estimate.documents import (
     STAGES,
     TARGETS,
     ActuatorRead,
+    Check,
     DatasetInfo,
     Estimate,
     Estimates,
-    FitCheck,
     Note,
     RatioEstimate,
     Timings,
@@ -96,7 +96,7 @@ def _estimates(
     )
 
 
-def _notes(prepared: Prepared, physics: FrictionFit, estimates: Estimates, check: FitCheck) -> list[Note]:
+def _notes(prepared: Prepared, physics: FrictionFit, estimates: Estimates, check: Check) -> list[Note]:
     notes = [*check.notes, *conditioning_notes(prepared)]
     ranges = prepared.document.ranges
     for name in TARGETS:
@@ -140,7 +140,7 @@ def _notes(prepared: Prepared, physics: FrictionFit, estimates: Estimates, check
             )
         )
     if estimates.FDJ.value <= 0:
-        text = "FDJ ≤ 0 is not a friction: the model does not describe this window (see fit_check)"
+        text = "FDJ ≤ 0 is not a friction: the model does not describe this window (see check)"
         notes.append(Note(code="fdj_not_friction", parameter="FDJ", text=text))
     if estimates.eta_A is not None and estimates.eta_A.value < 0:
         text = "η_A < 0: the transmission is irreversible (the load cannot back-drive it; thesis Case 1C)"
@@ -215,7 +215,7 @@ def estimate_document(
     data: Data,
     network: NetworkEstimator,
     answer: Assessed,
-    check: FitCheck,
+    check: Check,
     fsj: StaticFriction,
     config: PipelineConfig,
     digest: str,
@@ -252,7 +252,7 @@ def estimate_document(
         ),
         training=training_info(first, config),
         methods=answer.methods,
-        fit_check=check,
+        check=check,
         window=_window_info(prepared, data, digest),
         config=config,
     )

@@ -133,7 +133,7 @@ def _relative_error_pct(measured: np.ndarray, simulated: np.ndarray) -> float:
     return float(100.0 * np.linalg.norm(measured - simulated) / max(float(np.linalg.norm(measured)), 1e-300))
 
 
-def closed_loop_check(prepared: ServoPrepared, answer: Assessed, ratio: float, limit: float) -> doc.FitCheck:
+def closed_loop_check(prepared: ServoPrepared, answer: Assessed, ratio: float, limit: float) -> doc.Check:
     """The window simulated in closed loop at the answer: its force and position against the log's, in %, and the
     force's misfit over its noise floor (the part of both forces above the inverse model's band, which no model
     of the motion follows)."""
@@ -157,7 +157,7 @@ def closed_loop_check(prepared: ServoPrepared, answer: Assessed, ratio: float, l
                 "traces it)",
             )
         )
-    return doc.FitCheck(
+    return doc.Check(
         reproduced=reproduced,
         equation_error_ratio=ratio,
         equation_error_limit=limit,
@@ -208,7 +208,7 @@ def _report(
     data: ServoData,
     network: NetworkRegressor,
     answer: Assessed,
-    check: doc.FitCheck,
+    check: doc.Check,
     *,
     actuator: ActuatorDocument,
     read_with: doc.ActuatorRead,
@@ -238,7 +238,7 @@ def _report(
         ),
         training=training_info(first, config),
         methods={"FDJ" if name == FDJ else name: report for name, report in answer.methods.items()},
-        fit_check=check,
+        check=check,
         window=WindowInfo.logged(
             window,
             window.content_sha256(),

@@ -49,7 +49,7 @@ def off_healthy(latest: Stored | None, actuator: ActuatorDocument) -> bool:
     fdj, eta_o = latest.estimates.FDJ.value, latest.estimates.eta_O
     outside = not ranges.fdj_nm[0] <= fdj <= ranges.fdj_nm[1]
     outside |= eta_o is not None and not ranges.eta_o[0] <= eta_o.value <= ranges.eta_o[1]
-    return outside or not latest.fit_check.reproduced
+    return outside or not latest.check.reproduced
 
 
 def status_of(
@@ -116,7 +116,7 @@ def summary(
         thresholds_below={
             name: Threshold(level=level, direction=way) for name, limits in levels.items() for level, way in limits[1:]
         },
-        reproduced=None if latest is None else latest.fit_check.reproduced,
+        reproduced=None if latest is None else latest.check.reproduced,
         document=actuator.name,
         document_version=version,
     )

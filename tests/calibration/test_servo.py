@@ -66,11 +66,11 @@ def test_the_completed_document_reads_the_log_closer(emps):
     window, calibrated = emps
     before = estimate(window, actuator=read_actuator(EMPS / "actuator.json"))
     after = estimate(window, actuator=calibrated.completed)
-    assert after.fit_check.equation_error_ratio < before.fit_check.equation_error_ratio
-    assert after.fit_check.output_error_pct["drive_force_n"] < before.fit_check.output_error_pct["drive_force_n"]
+    assert after.check.equation_error_ratio < before.check.equation_error_ratio
+    assert after.check.output_error_pct["drive_force_n"] < before.check.output_error_pct["drive_force_n"]
     assert after.estimates.FDJ.nominal == pytest.approx(calibrated.completed.nominal.fdj_n)
     again = _calibrated([window], calibrated.completed).report
-    assert again.model_error_pct_document["drive_force_n"] <= before.fit_check.output_error_pct["drive_force_n"]
+    assert again.model_error_pct_document["drive_force_n"] <= before.check.output_error_pct["drive_force_n"]
 
 
 def test_unlogged_pulses_do_not_hide_or_fake_an_effect():

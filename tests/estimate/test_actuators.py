@@ -68,4 +68,4 @@ def test_a_document_whose_k_t_is_another_drives_says_so_or_is_not_reproduced():
     wrong["drive"]["torque_constant_nm_per_a"] = 0.0752  # the thesis's motor, not this one's
     result = estimate_window(window_from_dict(drawn.document), SMALL, actuator=actuator_from_dict(wrong))
     current = [note for note in result.notes if note.code == "current_units"]
-    assert not result.fit_check.reproduced and current and "k_T of 0.12" in current[0].text
+    assert not result.check.reproduced and current and "k_T of 0.12" in current[0].text

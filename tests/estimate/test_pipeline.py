@@ -53,7 +53,7 @@ def test_every_command_family_is_answered_within_its_stated_uncertainty(family):
     for name, (of_range, z) in _errors(result, drawn.truth).items():
         assert of_range < 10.0, name
         assert z < 3.5, name  # a single draw: ±2 std holds 95 % of them, ±3.5 std practically all
-    assert result.fit_check.output_error_ratio["residual_torque"] < 2.0
+    assert result.check.output_error_ratio["residual_torque"] < 2.0
     assert (
         result.estimates.FSJ is None
         or abs(result.estimates.FSJ.value - drawn.truth["FSJ"]) < 3 * result.estimates.FSJ.std
@@ -349,7 +349,10 @@ def test_the_result_is_the_typed_contract_and_carries_its_config():
     document = result.model_dump(by_alias=True)
     assert document["schema"] == "ema-estimate/1"
     assert set(document["timings_s"]) >= {"simulate", "train", "predict", "total"}
+    assert document["check"] == document["fit_check"]  # the check under its stage's name, and as first published
     assert Estimate.model_validate(document) == result
+    first_published = {key: value for key, value in document.items() if key != "check"}
+    assert Estimate.model_validate(first_published).check == result.check
     assert result.config == SMALL
     assert result.estimates.FDJ.drift_pct == pytest.approx(100 * (result.estimates.FDJ.value / 0.05 - 1))
 
@@ -394,7 +397,7 @@ def test_the_check_reuses_the_simulation_at_the_physics_answer_with_the_same_res
     monkeypatch.setattr(HealthParams, "identical", lambda self, other: False)
     alone = _estimate(drawn)
     assert own_runs == [1]
-    assert reused.fit_check == alone.fit_check and reused.estimates == alone.estimates
+    assert reused.check == alone.check and reused.estimates == alone.estimates
 
 
 @pytest.mark.parametrize("field", ["backlash_rad", "viscous_nms"])

@@ -52,7 +52,7 @@ def test_fdj_mass_and_viscous_friction_hold_the_truth_within_two_stds(foreign_es
 
 def test_the_foreign_windows_are_reproduced_and_raise_no_misfit(foreign_estimates):
     _, results = foreign_estimates
-    assert all(r.fit_check.reproduced for r in results)
+    assert all(r.check.reproduced for r in results)
     assert sum(any(n.code == "model_misfit" for n in r.notes) for r in results) <= 1  # a 1 % test on six
 
 
@@ -73,7 +73,7 @@ def test_the_emps_log_is_estimated_within_its_own_length(emps):
     assert result.timings_s.total < emps.duration_s
     fdj = result.estimates.FDJ
     assert fdj.value == pytest.approx(20.39, rel=0.03) and 0 < fdj.std < 0.05 * fdj.value
-    assert result.fit_check.output_error_pct["drive_force_n"] < 5.85  # the benchmark's own closed loop
+    assert result.check.output_error_pct["drive_force_n"] < 5.85  # the benchmark's own closed loop
 
 
 def test_a_controller_the_log_does_not_follow_is_said(emps):

@@ -121,8 +121,8 @@ class MethodReport(Document):
     network_note: OptionalNote = Field(None, description="why the network's answer was not used, or not alone")
 
 
-class FitCheck(Document):
-    """The answer checked against the measured window itself."""
+class Check(Document):
+    """The check stage: the answer checked against the measured window itself."""
 
     reproduced: bool = Field(description="the model at these estimates reproduces the window within its noise")
     equation_error_ratio: float = Field(
@@ -194,9 +194,22 @@ class Estimate(Document):
     dataset: DatasetInfo | None = Field(description="the window's own simulations (null: skipped, see stages)")
     training: TrainingInfo | None = Field(description="the network's training (null: skipped, see stages)")
     methods: dict[str, MethodReport]
-    fit_check: FitCheck
+    check: Check = Field(description="the window simulated at the answer, against the log (the check stage)")
+    fit_check: Check | None = Field(None, description="deprecated alias of check (ema-estimate/1 as first published)")
     window: WindowInfo
     config: PipelineConfig
+
+    @model_validator(mode="before")
+    @classmethod
+    def _check_under_its_stage(cls, values: Any) -> Any:
+        """The check under its stage's name; a result stored as first published (``fit_check``) read as such, and
+        the old name given beside the new one for one schema version."""
+        if isinstance(values, dict):
+            values = dict(values)
+            values.setdefault("check", values.get("fit_check"))
+            if values.get("fit_check") is None:
+                values["fit_check"] = values["check"]
+        return values
 
 
 def parameter(

@@ -19,9 +19,9 @@ from ema.estimate.documents import (
     DIMENSIONLESS,
     STAGES,
     ActuatorRead,
+    Check,
     Estimate,
     Estimates,
-    FitCheck,
     Note,
     Timings,
     parameter,
@@ -153,7 +153,7 @@ def _document(
         dataset=None,
         training=None,
         methods={},
-        fit_check=FitCheck(
+        check=Check(
             reproduced=fit.chi2_per_dof <= MAX_CHI2,
             equation_error_ratio=ratio,
             output_error_ratio={"current_a": ratio},
