@@ -208,7 +208,7 @@ def simulate_batch(
 
     ``command_knots_deg`` is the command at the log-interval boundaries (see ``ema.model.commands``):
     (n_samples + 1,) shared by the batch (Case 1) or (n_simulations, n_samples + 1) (Case 2).
-    ``actuator``: the drive's constants; ``hinge``: the airframe's hinge-moment model where ``load`` is a
+    ``drive``: the drive's constants; ``hinge``: the airframe's hinge-moment model where ``load`` is a
     flight condition (the thesis's elevator by default). The 1 µs trajectory is never stored.
     Deterministic: the same inputs give the same output, whatever ``lanes`` (simulations per lock-step
     group; by default as many as keep every thread busy, up to 64) and whatever the thread budget.

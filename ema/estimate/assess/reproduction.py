@@ -37,7 +37,7 @@ def output_error_ratios(
     simulated_at_health: Mapping[str, np.ndarray] | None = None,
 ) -> dict[str, float]:
     """Per signal, RMS(measured − simulated at ``health``) over its noise-only floor; the measured T_R
-    reconstructed with ``actuator`` (as the window is read), the simulated with the drive it is drawn with.
+    reconstructed with ``drive`` (as the window is read), the simulated with the drive it is drawn with.
     ``simulated_at_health``: the scenario's clean simulation at ``health`` where one was run already."""
     rate = window.sample_rate_hz
     if simulated_at_health is None:

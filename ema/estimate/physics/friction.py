@@ -67,7 +67,7 @@ class FitSettings:
         return tuple(name for name in NUISANCES if getattr(self, name))
 
     def sliding_speed_radps(self, drive: DriveConstants) -> float:
-        """The |ω| past which the shaft slides, for Eq. 5.1, on ``actuator``."""
+        """The |ω| past which the shaft slides, for Eq. 5.1, on ``drive``."""
         return self.min_speed_share * drive.max_motor_speed_radps
 
 

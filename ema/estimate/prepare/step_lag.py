@@ -54,7 +54,7 @@ class StepLag:
 
 
 def step_lag(window: Window, drive: DriveConstants) -> StepLag:
-    """The hinge moment's out-of-step story on ``window`` (its departures taken off, ``actuator`` as read)."""
+    """The hinge moment's out-of-step story on ``window`` (its departures taken off, ``drive`` as read)."""
     rate, lags = window.sample_rate_hz, np.concatenate([[0.0], step_lags(window)])
     if len(lags) == 1:
         return StepLag()

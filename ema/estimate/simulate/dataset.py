@@ -92,7 +92,7 @@ def simulate_dataset(
 ) -> Data:
     """The box around the physics estimate, the window's sensor noise (measured on ``window`` as logged),
     the simulations (the ``document``'s drive with ``effects``: the window's viscous coefficient), and the
-    features of both (the window read as ``seen``: through ``as_read``, its T_R with ``actuator``, the
+    features of both (the window read as ``seen``: through ``as_read``, its T_R with ``drive``, the
     document's drive with J_M and C as the window shows them)."""
     fdj, eta_o = physics.fdj_nm[0], physics.eta_o[0]
     box = design.box_around(fdj, physics.fdj_std_nm[0], eta_o, physics.eta_o_std[0], document.health.fdj)
