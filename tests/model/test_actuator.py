@@ -20,6 +20,16 @@ def test_the_thesis_actuator_ships_as_the_example_and_is_table_3_1():
     assert THESIS.threshold("FDJ") == (0.075, "above") and THESIS.threshold("eta_O") == (0.70, "below")
 
 
+def test_the_documents_drive_names_every_constant_the_simulator_takes_but_its_step():
+    """The document's Drive and the simulator's DriveConstants declare the same constants: one added to the
+    simulator and not to the document would be read at its default from every document, silently."""
+    from dataclasses import fields
+
+    from ema.model.drive import Drive
+
+    assert set(Drive.model_fields) == {f.name for f in fields(DriveConstants)} - {"step_s"}
+
+
 def test_eq_3_4_and_the_thresholds_follow_the_documents_gear_ratio_and_nominal():
     document = json.loads(EXAMPLE.read_text())
     document["drive"]["gear_ratio"] = 320.0
