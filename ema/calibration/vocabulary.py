@@ -191,29 +191,31 @@ def _speed_families() -> list[Family]:
 
 
 def _drive_families(drive: DriveConstants) -> list[Family]:
-    """What the drive's constants or its current sensor may differ by: k_T, a gain or an offset of the
-    sensor, the inertia."""
+    """What the drive's constants or its current sensor may differ by: k_T, the sensor's gain or offset, J_M."""
     return [
         _sized(
             "torque_constant",
             "current_a",
             lambda e, ratios: _torque_shift(e, ratios, drive),
-            (GAINS, "gain"),
-            lambda g: _gain_term("torque_constant", g),
+            sizes=GAINS,
+            parameter="gain",
+            term=lambda g: _gain_term("torque_constant", g),
         ),
         _sized(
             "current_sensor_gain",
             "current_a",
             lambda e, gains: _torque_shift(e, 1.0 / gains, drive),
-            (GAINS, "gain"),
-            lambda g: _gain_term("current_sensor_gain", g),
+            sizes=GAINS,
+            parameter="gain",
+            term=lambda g: _gain_term("current_sensor_gain", g),
         ),
         _sized(
             "current_sensor_offset",
             "direction",
             lambda e, offsets: _offset_shift(e, offsets, drive),
-            (CURRENT_OFFSETS_A, "offset_a"),
-            _offset_term,
+            sizes=CURRENT_OFFSETS_A,
+            parameter="offset_a",
+            term=_offset_term,
         ),
         Family(
             "inertia",
@@ -230,13 +232,13 @@ def _sized(
     name: str,
     follows: str,
     shift: Callable[[Equations, np.ndarray], np.ndarray],
-    grid: tuple[tuple[float, ...], str],
+    *,
+    sizes: tuple[float, ...],
+    parameter: str,
     term: Callable[[float], EffectSet | None],
 ) -> Family:
-    """A family whose grid value is the effect's size and whose trace the physics fixes (it enters with
-    coefficient 1): ``shift`` maps an array of sizes to the (m, G) shifts, ``grid`` is (the sizes, the
-    parameter's name in the report)."""
-    sizes, parameter = grid
+    """A family whose grid is the effect's ``sizes`` (the report's ``parameter``) and whose trace the physics fixes
+    (coefficient 1): ``shift`` maps an array of sizes to the (m, G) shifts."""
     return Family(
         name,
         follows,
