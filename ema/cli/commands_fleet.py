@@ -75,16 +75,18 @@ def fleet(
     document: the archive folder's actuators.json maps actuator_ids to ema-actuator/1 documents; the others
     take --actuator (the thesis's where none is given). Exit status 2 when no window was answered; a folder's
     unreadable files are skipped and listed."""
-    from ema.cli.commands_remote import report_log
-    from ema.cli.fleet import check_engine, run_fleet
-    from ema.cli.logs import read_actuators, read_log
-    from ema.cli.workers import Documents, LocalWorkers
-    from ema.model.actuator import read_actuator
+    from ema.cli.pool import LocalWorkers
 
     started = time.perf_counter()
-    check_engine(workers, ray_address)
     pool = LocalWorkers(workers, threads) if workers > 1 and ray_address is None else None  # warming meanwhile
     try:
+        from ema.cli.commands_remote import report_log
+        from ema.cli.fleet import check_engine, run_fleet
+        from ema.cli.logs import read_actuators, read_log
+        from ema.cli.workers import Documents
+        from ema.model.actuator import read_actuator
+
+        check_engine(workers, ray_address)
         config = pipeline_config(size_values)
         documents = Documents(read_actuators(archive), None if actuator_file is None else read_actuator(actuator_file))
         mapping = log_map_document(log_map_file)

@@ -21,8 +21,9 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
+from ema.cli.pool import LocalWorkers
 from ema.cli.results import ResultsWriter, done_windows, row_of
-from ema.cli.workers import Answer, Documents, Job, LocalWorkers, in_process, on_ray
+from ema.cli.workers import Answer, Documents, Job, in_process, on_ray
 from ema.estimate.config import PipelineConfig
 from ema.model.window import Window
 

@@ -1,9 +1,8 @@
 """Where a window's task runs in ``ema fleet``: the engines, each yielding (window, answer) as answers come.
 
 - ``in_process``: one window after another in this process (one worker);
-- ``LocalWorkers``: a pool of local processes (the standard library's executor), started before the archive is
-  read; each process warms itself meanwhile (its thread budget pinned, its kernels loaded:
-  ``ema.kinds.remote.warm``), and the driver, which only reads and writes, never loads torch or the kernels;
+- ``ema.cli.pool.LocalWorkers``: a pool of local processes (the standard library's executor), started first
+  thing, each warming itself while the driver reads the archive;
 - ``on_ray``: a Ray cluster's workers (``--ray-address``).
 
 Each window is a task that pins its own thread budget (one thread by default: a worker is a core, so throughput
@@ -13,20 +12,13 @@ window is lost and none is answered twice.
 
 from __future__ import annotations
 
-import multiprocessing
-from collections import Counter
 from collections.abc import Iterator
-from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
-from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass, field
 from typing import Any
 
+from ema.cli.pool import IN_FLIGHT_PER_WORKER, NODE_LOSSES
 from ema.estimate.config import PipelineConfig
 from ema.model.window import Window, window_to_dict
-
-IN_FLIGHT_PER_WORKER = 2  # tasks queued per worker: enough to keep it busy, few enough to stop quickly
-NODE_LOSSES = 3  # a window whose task died with its node this often (past Ray's retries) fails the run
-
 
 Job = tuple[Window, dict[str, Any] | None]  # a window and what other windows of its actuator read (HistoryReadings)
 Answer = tuple[Window, dict]  # a window and its ema-estimate/1 document (or {"error": ...})
@@ -54,60 +46,6 @@ class Documents:
         window, history = job
         actuator, version = self.task_arguments(window)
         return window_to_dict(window), config.model_dump(), threads, history, actuator, version
-
-
-class LocalWorkers:
-    """A pool of local worker processes, each warmed as it starts (module docstring); start it before the archive
-    is read. A process lost mid-run (killed) loses no window: its jobs go to a new pool, ``NODE_LOSSES`` times
-    at most."""
-
-    def __init__(self, workers: int, threads: int) -> None:
-        self.workers, self.threads = workers, threads
-        self.pool = self._started()
-
-    def _started(self) -> ProcessPoolExecutor:
-        context = multiprocessing.get_context("spawn")  # never a fork of a process that may hold threads
-        pool = ProcessPoolExecutor(self.workers, mp_context=context, initializer=_warmed, initargs=(self.threads,))
-        for _ in range(self.workers):
-            pool.submit(int)  # a process per worker, warming now
-        return pool
-
-    def answers(self, jobs: list[Job], config: PipelineConfig, documents: Documents) -> Iterator[Answer]:
-        queue, pending, losses = list(reversed(jobs)), dict[Future, Job](), Counter[str]()
-        while queue or pending:
-            while queue and len(pending) < IN_FLIGHT_PER_WORKER * self.workers and not self.pool._broken:
-                job = queue.pop()
-                pending[self.pool.submit(_answered, *documents.task(job, config, self.threads))] = job
-            done, _ = wait(pending, return_when=FIRST_COMPLETED)
-            for future in done:
-                job = pending.pop(future)
-                try:
-                    yield job[0], future.result()
-                except BrokenProcessPool:
-                    losses[job[0].window_id] += 1
-                    if losses[job[0].window_id] > NODE_LOSSES:
-                        raise
-                    queue.append(job)
-            if not pending and queue and self.pool._broken:  # a process died: the rest go to a new pool
-                self.pool = self._started()
-
-    def close(self) -> None:
-        self.pool.shutdown(wait=True, cancel_futures=True)
-
-
-def _warmed(threads: int) -> None:
-    """A local worker's initializer, ``ema.kinds.remote.warm``, imported in the worker: the driver that only reads
-    and writes never loads torch or the kernels (a second of a core the workers need at start-up)."""
-    from ema.kinds.remote import warm
-
-    warm(threads)
-
-
-def _answered(*arguments: Any) -> dict[str, Any]:
-    """``ema.kinds.remote.estimate_json`` on a local worker, imported there (``_warmed``)."""
-    from ema.kinds.remote import estimate_json
-
-    return estimate_json(*arguments)
 
 
 def in_process(jobs: list[Job], config: PipelineConfig, threads: int, documents: Documents) -> Iterator[Answer]:

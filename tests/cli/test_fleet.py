@@ -81,7 +81,7 @@ def test_a_local_worker_killed_mid_run_loses_no_window_and_duplicates_none(tmp_p
     import time
 
     from ema.cli.fleet import run_fleet
-    from ema.cli.workers import LocalWorkers
+    from ema.cli.pool import LocalWorkers
     from ema.estimate.config import PipelineConfig
 
     windows = [
