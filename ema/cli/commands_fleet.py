@@ -8,7 +8,6 @@ from pathlib import Path
 
 import click
 
-from ema.cli.commands_remote import DEFAULT_WINDOW_S
 from ema.cli.options import (
     NothingAnsweredError,
     actuator,
@@ -19,6 +18,8 @@ from ema.cli.options import (
     log_map_document,
     pipeline_config,
     sizes,
+    window_length,
+    window_s,
 )
 from ema.model.bounds import MAX_THREADS
 
@@ -36,12 +37,7 @@ ARCHIVE = click.Path(exists=True, path_type=Path)
 @click.option("--workers", type=click.IntRange(1, 4096), default=2, help="worker processes (windows at a time)")
 @click.option("--threads", type=click.IntRange(1, MAX_THREADS), default=1, help="threads (CPUs) each worker reserves")
 @click.option("--ray-address", default=None, help="'auto' or HOST:PORT of a cluster [default: a local Ray]")
-@click.option(
-    "--window-s",
-    type=click.FloatRange(0.1, 3600.0),
-    default=None,
-    help="cut recordings into windows of this length [s]  [default: 0.5; with --log-map, a file is one window]",
-)
+@window_s
 @click.option(
     "--database",
     default=None,
@@ -90,7 +86,7 @@ def fleet(
         config = pipeline_config(size_values)
         documents = Documents(read_actuators(archive), None if actuator_file is None else read_actuator(actuator_file))
         mapping = log_map_document(log_map_file)
-        read = read_log(archive, window_s or (None if mapping else DEFAULT_WINDOW_S), log_map=mapping)
+        read = read_log(archive, window_length(window_s, mapping), log_map=mapping)
     except BaseException:
         if pool is not None:
             pool.close()

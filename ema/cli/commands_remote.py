@@ -11,12 +11,21 @@ from typing import Any
 
 import click
 
-from ema.cli.options import EXISTING, NothingAnsweredError, as_json, emit, flags_named, log_map, log_map_document
+from ema.cli.options import (
+    EXISTING,
+    NothingAnsweredError,
+    as_json,
+    emit,
+    flags_named,
+    log_map,
+    log_map_document,
+    window_length,
+    window_s,
+)
 from ema.model.bounds import DEFAULT_SAMPLE_RATE_HZ
 from ema.model.envelope import DEFAULT_AIRSPEED_MPS
 
 URL = "http://127.0.0.1:8000"
-DEFAULT_WINDOW_S = 0.5
 LOG = click.Path(exists=True, path_type=Path)
 
 
@@ -37,12 +46,7 @@ def api_key(path: Path | None) -> str | None:
     help="CSV the answers are appended to (a rerun resumes from it)  [default: one per log and service in "
     "$XDG_STATE_HOME/ema/replay, said where]",
 )
-@click.option(
-    "--window-s",
-    type=click.FloatRange(0.1, 3600.0),
-    default=None,
-    help="cut recordings into windows of this length [s]  [default: 0.5; with --log-map, a file is one window]",
-)
+@window_s
 @click.option("--api-key-file", type=EXISTING, default=None, help="file holding the API key [default: EMA_API_KEY]")
 @click.option("--actuator-id", default="unknown", help="for CSV/NPZ logs that carry none")
 @click.option(
@@ -75,7 +79,7 @@ def replay(
     defaults = Defaults(actuator_id, rate, airspeed, altitude)
     with flags_named({"sample_rate_hz": "--rate", "airspeed_mps": "--airspeed", "altitude_m": "--altitude"}):
         mapping = log_map_document(log_map_file)
-        read = read_log(log, window_s or (None if mapping else DEFAULT_WINDOW_S), defaults, mapping)
+        read = read_log(log, window_length(window_s, mapping), defaults, mapping)
     report_log(read)
     key = api_key(api_key_file)
     check_service(url, key)  # a service that is not there: said now, and no file written

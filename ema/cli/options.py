@@ -65,6 +65,28 @@ def log_map(function: F) -> F:
     )(function)
 
 
+DEFAULT_WINDOW_S = 0.5  # a recording is cut into windows this long, unless a log map makes each file one window
+WINDOW_S_RANGE = (0.1, 3600.0)
+
+
+def window_s(function: F) -> F:
+    return click.option(
+        "--window-s",
+        type=click.FloatRange(*WINDOW_S_RANGE),
+        default=None,
+        help=f"cut recordings into windows of this length [s]  [default: {DEFAULT_WINDOW_S:g}; with --log-map, a file "
+        "is one window]",
+    )(function)
+
+
+def window_length(window_s: float | None, log_map: Any) -> float | None:
+    """The length a recording is cut into: the flag's, else none under a log map (a file is one window), else
+    ``DEFAULT_WINDOW_S``."""
+    if window_s is not None:
+        return window_s
+    return None if log_map is not None else DEFAULT_WINDOW_S
+
+
 def log_map_document(path: Path | None) -> Any:
     """The log map in ``path``, or None."""
     from ema.model.logmap import read_logmap
