@@ -80,8 +80,17 @@ def bump_grid(position_rad: np.ndarray) -> tuple[tuple[float, float], ...]:
 GAINS = tuple(float(g) for g in np.round(np.arange(0.70, 1.3025, 0.005), 3))
 
 
-def _gain_term(effect: str, gain: float) -> EffectSet | None:
-    return EffectSet({effect: {"gain": gain}}) if 0.7 <= gain <= 1.3 else None
+def _gain_family(name: str, true_over_logged: Callable[[np.ndarray], np.ndarray], drive: DriveConstants) -> Family:
+    """A gain on the current the model reads as torque, k_T's or the current sensor's: one family each, the
+    grid's gains mapped by ``true_over_logged`` to the true torque's ratio to the model's."""
+
+    def shift(e: Equations, gains: np.ndarray) -> np.ndarray:
+        return _torque_shift(e, true_over_logged(gains), drive)
+
+    def term(gain: float) -> EffectSet | None:
+        return EffectSet({name: {"gain": gain}}) if 0.7 <= gain <= 1.3 else None
+
+    return _sized(name, "current_a", shift, sizes=GAINS, parameter="gain", term=term)
 
 
 def _torque_shift(e: Equations, true_over_logged: np.ndarray, drive: DriveConstants) -> np.ndarray:
@@ -193,22 +202,8 @@ def _speed_families() -> list[Family]:
 def _drive_families(drive: DriveConstants) -> list[Family]:
     """What the drive's constants or its current sensor may differ by: k_T, the sensor's gain or offset, J_M."""
     return [
-        _sized(
-            "torque_constant",
-            "current_a",
-            lambda e, ratios: _torque_shift(e, ratios, drive),
-            sizes=GAINS,
-            parameter="gain",
-            term=lambda g: _gain_term("torque_constant", g),
-        ),
-        _sized(
-            "current_sensor_gain",
-            "current_a",
-            lambda e, gains: _torque_shift(e, 1.0 / gains, drive),
-            sizes=GAINS,
-            parameter="gain",
-            term=lambda g: _gain_term("current_sensor_gain", g),
-        ),
+        _gain_family("torque_constant", lambda gains: gains, drive),
+        _gain_family("current_sensor_gain", lambda gains: 1.0 / gains, drive),
         _sized(
             "current_sensor_offset",
             "direction",
