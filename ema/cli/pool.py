@@ -30,7 +30,7 @@ class LocalWorkers:
 
     def __init__(self, workers: int, threads: int) -> None:
         self.workers, self.threads = workers, threads
-        self.pool = self._started()
+        self.pool, self.used = self._started(), False
 
     def _started(self) -> ProcessPoolExecutor:
         context = multiprocessing.get_context("spawn")  # never a fork of a process that may hold threads
@@ -45,7 +45,7 @@ class LocalWorkers:
         pending: dict[Future, Job] = {}
         while queue or pending:
             while queue and len(pending) < IN_FLIGHT_PER_WORKER * self.workers and not self.pool._broken:
-                job = queue.pop()
+                job, self.used = queue.pop(), True
                 pending[self.pool.submit(_answered, *documents.task(job, config, self.threads))] = job
             done, _ = wait(pending, return_when=FIRST_COMPLETED)
             for future in done:
@@ -61,6 +61,11 @@ class LocalWorkers:
                 self.pool = self._started()
 
     def close(self) -> None:
+        """The processes stopped: once idle after their last answer, or at once where they never had a job (nothing
+        left to answer, or the archive could not be read): a user waits for no warming that serves nothing."""
+        if not self.used:
+            for process in list(self.pool._processes.values()):
+                process.terminate()
         self.pool.shutdown(wait=True, cancel_futures=True)
 
 

@@ -49,6 +49,9 @@ class Documents:
 
 
 def in_process(jobs: list[Job], config: PipelineConfig, threads: int, documents: Documents) -> Iterator[Answer]:
+    """Each job's answer from this process, one after another (torch and the kernels loaded only for a job)."""
+    if not jobs:
+        return
     from ema.kinds.remote import estimate_json
 
     for job in jobs:

@@ -62,6 +62,24 @@ def test_one_worker_runs_in_process_and_skips_a_bad_file(archive, tmp_path, caps
     assert "[7/7]" in captured.err and "windows/s" in captured.err  # progress: done, rate, time left
 
 
+def test_a_pool_that_never_had_a_job_stops_without_finishing_its_warming():
+    """Nothing left to answer, or an archive that cannot be read: the user waits for no warming (processes
+    stopped as they are, not after loading torch and the kernels); the one-worker path loads nothing."""
+    import signal
+    import subprocess
+    import sys
+
+    from ema.cli.pool import LocalWorkers
+
+    pool = LocalWorkers(2, 1)
+    processes = list(pool.pool._processes.values())
+    pool.close()
+    assert len(processes) == 2 and all(p.exitcode == -signal.SIGTERM for p in processes)
+    nothing = "from ema.cli.workers import in_process; import sys; list(in_process([], None, 1, None)); "
+    loaded = subprocess.run([sys.executable, "-c", nothing + "print('torch' in sys.modules)"], capture_output=True)
+    assert loaded.stdout.decode().strip() == "False"
+
+
 def test_a_cluster_without_ray_says_how_to_install_it_and_writes_nothing(archive, tmp_path, capsys, monkeypatch):
     from ema.cli import fleet
 
