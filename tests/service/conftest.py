@@ -1,5 +1,6 @@
 import copy
 import time
+from collections.abc import Callable
 
 import pytest
 from fastapi.testclient import TestClient
@@ -18,8 +19,14 @@ LOCAL = "http://127.0.0.1"  # without a key the service answers loopback hosts o
 
 def settled(client: TestClient, timeout_s: float = 120.0) -> None:
     """Wait until the service's keeper has brought every fleet line up to date (none pending)."""
+    settled_lines(lambda: client.get("/v1/actuators").json(), timeout_s)
+
+
+def settled_lines(read_lines: Callable[[], list[dict]], timeout_s: float = 120.0) -> None:
+    """Wait until none of the fleet's lines ``read_lines`` returns (``GET /v1/actuators``) is pending: the keeper
+    computes them after a start or a store, and a page read before then shows them pending."""
     deadline = time.monotonic() + timeout_s
-    while any(line["status"] == "pending" for line in client.get("/v1/actuators").json()):
+    while any(line["status"] == "pending" for line in read_lines()):
         assert time.monotonic() < deadline, "the fleet's lines were not brought up to date"
         time.sleep(0.1)
 

@@ -4,6 +4,8 @@ its own (copies of one real estimate with FDJ and η_O replaced), and the truth 
 from __future__ import annotations
 
 import contextlib
+import json
+import urllib.request
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -16,7 +18,7 @@ from ema.model.actuator import THESIS
 from ema.model.params import HealthParams
 from ema.model.synthetic import synthetic_window
 from tests.servers import free_port, start_server
-from tests.service.conftest import SMALL
+from tests.service.conftest import SMALL, settled_lines
 
 # actuator -> (FDJ at 0 h [N·m], FDJ per flight hour, curvature per h², what its page must say)
 FLEET = {
@@ -51,15 +53,22 @@ def store_fleet(store: History, base: Estimate, windows: int = 20, seed: int = 0
 @contextlib.contextmanager
 def served_fleet(database: Path) -> Iterator[str]:
     """The URL of a service on a free port whose store (``database``) holds the fleet, copies of one small real
-    estimate; the service is stopped on leaving."""
+    estimate, once its keeper has computed every actuator's line; the service is stopped on leaving."""
     base = estimate_window(synthetic_window(HealthParams.single(), seed=1, duration_s=0.1), SMALL, actuator=THESIS)
     store = open_history(database)
     store_fleet(store, base)
     store.close()
     port = free_port()
     server = start_server(port, database)
+    url = f"http://127.0.0.1:{port}"
     try:
-        yield f"http://127.0.0.1:{port}"
+        settled_lines(lambda: _json(f"{url}/v1/actuators"))
+        yield url
     finally:
         server.terminate()
         server.wait(timeout=30)
+
+
+def _json(url: str) -> list[dict]:
+    with urllib.request.urlopen(url, timeout=30) as response:
+        return json.loads(response.read())
