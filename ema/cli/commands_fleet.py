@@ -18,10 +18,11 @@ from ema.cli.options import (
     log_map_document,
     pipeline_config,
     sizes,
+    span,
     window_length,
     window_s,
 )
-from ema.model.bounds import MAX_THREADS
+from ema.model.bounds import DURATION_RANGE_S, MAX_THREADS
 
 ARCHIVE = click.Path(exists=True, path_type=Path)
 
@@ -143,7 +144,9 @@ def _print_fleet(result: dict) -> None:
     default=45,
     help="windows per duration (the verdict on a p95 needs 45 or more to say 'met')",
 )
-@click.option("--durations", default="0.5,2", help="window durations [s], comma-separated")
+@click.option(
+    "--durations", default="0.5,2", help=f"window durations [s], comma-separated, each {span(DURATION_RANGE_S)}"
+)
 @click.option(
     "--under-load",
     type=click.IntRange(0, 64),
@@ -158,12 +161,9 @@ def bench(
 ) -> None:
     """Latency of one window -> estimates: p50/p95 per stage, real-time factor, accuracy (idle, and under load)."""
     from ema.cli.bench import run_bench
-    from ema.model.checks import InputError
+    from ema.model.checks import in_range
 
-    try:
-        seconds = [float(d) for d in durations.split(",")]
-    except ValueError:
-        raise InputError("--durations", f"must be numbers separated by commas, got {durations!r}") from None
+    seconds = [in_range("--durations", d, *DURATION_RANGE_S, "s") for d in durations.split(",")]  # at 10 kHz
     result = run_bench(
         pipeline_config(size_values), seconds, repeats=repeats, under_load=under_load, out=out, docs=docs
     )

@@ -23,9 +23,10 @@ from ema.cli.options import (
     pipeline_config,
     progress,
     sizes,
+    span,
     threads,
 )
-from ema.model.bounds import DEFAULT_SAMPLE_RATE_HZ, MAX_FLIGHT_HOURS, SAMPLE_RATE_RANGE_HZ
+from ema.model.bounds import DEFAULT_SAMPLE_RATE_HZ, DURATION_RANGE_S, MAX_FLIGHT_HOURS, SAMPLE_RATE_RANGE_HZ
 from ema.model.envelope import AIRSPEED_RANGE_MPS, ALTITUDE_RANGE_M, DEFAULT_AIRSPEED_MPS
 
 FAMILIES = ("thesis", "cruise", "gust", "doublet", "steps")  # ema.model.commands.FAMILIES, without importing numpy here
@@ -36,6 +37,7 @@ SIMULATE_FLAGS = {
     "fdj_nm": "--fdj",
     "eta_o": "--eta-o",
     "sample_rate_hz": "--rate",
+    "duration_s": "--duration",
     "command": "--command",
     "effects": "--effect",
     "ground_load.constant_nm": "--load",
@@ -65,11 +67,6 @@ def history_of(window: Any, paths: tuple[Path, ...]) -> Any:
             )
         results.append(result)
     return readings_of([result.window for result in results], window.flight_id)
-
-
-def _span(bounds: tuple[float, float]) -> str:
-    """A range for the help, as the model bounds it: "90–215"."""
-    return "–".join(f"{bound:g}" for bound in bounds)
 
 
 @click.command()
@@ -121,18 +118,16 @@ def estimate(
 @click.option("--eta-o", "eta_o", type=float, default=None, help="opposing efficiency η_O  [default: nominal]")
 @click.option("--fsj", type=float, default=None, help="static friction FSJ [N·m]  [default: nominal]")
 @click.option(
-    "--airspeed", type=float, default=DEFAULT_AIRSPEED_MPS, help=f"true airspeed [m/s], {_span(AIRSPEED_RANGE_MPS)}"
+    "--airspeed", type=float, default=DEFAULT_AIRSPEED_MPS, help=f"true airspeed [m/s], {span(AIRSPEED_RANGE_MPS)}"
 )
-@click.option("--altitude", type=float, default=0.0, help=f"altitude [m], {_span(ALTITUDE_RANGE_M)}")
+@click.option("--altitude", type=float, default=0.0, help=f"altitude [m], {span(ALTITUDE_RANGE_M)}")
 @click.option("--ground", is_flag=True, help="on the ground: a load cell's load (--load, --load-ramp), no aircraft")
 @click.option("--load", "load_nm", type=float, default=0.0, help="with --ground: the hinge moment at t = 0 [N·m]")
 @click.option("--load-ramp", "load_ramp_nmps", type=float, default=0.0, help="with --ground: its rate [N·m/s]")
 @click.option("--command", type=click.Choice(FAMILIES), default="thesis", help="the command's family")
 @click.option("--seed", type=int, default=0, help="seed of the command and the noise")
-@click.option("--duration", type=click.FloatRange(0.01, 60.0), default=0.5, help="window length [s]")
-@click.option(
-    "--rate", type=float, default=DEFAULT_SAMPLE_RATE_HZ, help=f"log rate [Hz], {_span(SAMPLE_RATE_RANGE_HZ)}"
-)
+@click.option("--duration", type=click.FloatRange(*DURATION_RANGE_S), default=0.5, help="window length [s]")
+@click.option("--rate", type=float, default=DEFAULT_SAMPLE_RATE_HZ, help=f"log rate [Hz], {span(SAMPLE_RATE_RANGE_HZ)}")
 @click.option("--clean", is_flag=True, help="no sensor noise")
 @click.option(
     "--effect",

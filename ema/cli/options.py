@@ -65,6 +65,11 @@ def log_map(function: F) -> F:
     )(function)
 
 
+def span(bounds: tuple[float, float]) -> str:
+    """A range for the help, as the model bounds it: "90–215"."""
+    return "–".join(f"{bound:g}" for bound in bounds)
+
+
 DEFAULT_WINDOW_S = 0.5  # a recording is cut into windows this long, unless a log map makes each file one window
 WINDOW_S_RANGE = (0.1, 3600.0)
 

@@ -15,6 +15,7 @@ CLOCK_SKEW = dt.timedelta(days=1)
 # window at (a faster log is averaged down to it).
 DEFAULT_SAMPLE_RATE_HZ = 10_000.0
 SAMPLE_RATE_RANGE_HZ = (1_000.0, 100_000.0)  # the rates the simulator draws a window at
+DURATION_RANGE_S = (0.01, 60.0)  # the lengths the simulator draws a window at (its samples bounded as well)
 MAX_THREADS = 256  # a thread budget's ceiling: more than any onboard computer or server has cores
 MIN_SAMPLES = 100
 MAX_SAMPLES = 1_000_000

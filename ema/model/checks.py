@@ -70,8 +70,9 @@ def finite_array(field: str, values: object, ndim: int | None = None) -> np.ndar
     return array
 
 
-def in_range(field: str, value: float, low: float, high: float, unit: str = "") -> float:
-    """Return ``value`` as a float if it lies in [low, high], else raise naming the field."""
+def in_range(field: str, value: float | str, low: float, high: float, unit: str = "") -> float:
+    """Return ``value`` (a number, or text that reads as one) as a float if it lies in [low, high], else raise
+    naming the field."""
     try:
         number = float(value)
     except (TypeError, ValueError):

@@ -9,7 +9,14 @@ import numpy as np
 from ema.model.actuator import THESIS, ActuatorDocument
 from ema.model.aircraft import FlightCondition, GroundLoad
 from ema.model.batch import InitialState, simulate_batch
-from ema.model.bounds import DEFAULT_SAMPLE_RATE_HZ
+from ema.model.bounds import (
+    DEFAULT_SAMPLE_RATE_HZ,
+    DURATION_RANGE_S,
+    MAX_SAMPLES,
+    MIN_SAMPLES,
+    SAMPLE_RATE_RANGE_HZ,
+)
+from ema.model.checks import InputError, in_range
 from ema.model.commands import family_knots
 from ema.model.effects import EffectSet
 from ema.model.noise import SensorNoise, add_sensor_noise
@@ -40,8 +47,8 @@ def synthetic_window(
     the window is named by its content (``synthetic-`` and its digest), so two different windows never
     share a name.
     """
+    n_samples = window_samples(duration_s, sample_rate_hz)
     rng = np.random.default_rng(seed)
-    n_samples = round(duration_s * sample_rate_hz)
     knots = family_knots(command, n_samples, sample_rate_hz, rng)
     stop = actuator.params.end_stop_deg - 1.0
     start = InitialState(position_deg=float(np.clip(knots[0], -stop, stop)))
@@ -52,3 +59,18 @@ def synthetic_window(
     flight = condition if isinstance(condition, FlightCondition) else None
     window = Window(signals, sample_rate_hz, flight, actuator_id, window_id or "synthetic")
     return window if window_id else replace(window, window_id=f"synthetic-{window.content_sha256()[:16]}")
+
+
+def window_samples(duration_s: float, sample_rate_hz: float) -> int:
+    """The samples a window of ``duration_s`` at ``sample_rate_hz`` holds; an InputError naming the field where
+    either is out of its range or the count is one no window may hold (``ema-window/1``'s bounds): a command
+    drawn over no time has no shape, and one ema would refuse to read is no window to write."""
+    rate = in_range("sample_rate_hz", sample_rate_hz, *SAMPLE_RATE_RANGE_HZ, "Hz")
+    duration = in_range("duration_s", duration_s, *DURATION_RANGE_S, "s")
+    n_samples = round(duration * rate)
+    if not MIN_SAMPLES <= n_samples <= MAX_SAMPLES:
+        raise InputError(
+            "duration_s",
+            f"{duration:g} s at {rate:g} Hz is {n_samples} samples; a window holds {MIN_SAMPLES} to {MAX_SAMPLES}",
+        )
+    return n_samples

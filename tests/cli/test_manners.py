@@ -4,6 +4,7 @@ import json
 from pathlib import Path
 
 import numpy as np
+import pytest
 from fastapi.testclient import TestClient
 
 from ema.cli.main import EXIT_BAD_INPUT, EXIT_OK, main
@@ -101,6 +102,20 @@ def test_simulate_refuses_a_linear_actuator_naming_the_flag(tmp_path, capsys):
     rig = Path(__file__).parents[2] / "examples" / "ballscrew-rig" / "actuator.json"
     assert main(["simulate", "--out", str(tmp_path / "w.json"), "--actuator", str(rig)]) == EXIT_BAD_INPUT
     assert "--actuator" in capsys.readouterr().err and not (tmp_path / "w.json").exists()
+
+
+def test_simulate_refuses_a_window_too_short_for_its_rate_naming_the_flag(tmp_path, capsys):
+    """0.01 s at 1 kHz is 10 samples: a window ema itself would refuse to read is never written."""
+    out = tmp_path / "w.json"
+    assert main(["simulate", "--out", str(out), "--duration", "0.01", "--rate", "1000"]) == EXIT_BAD_INPUT
+    assert "--duration" in capsys.readouterr().err and not out.exists()
+
+
+@pytest.mark.parametrize("durations", ["0.5,-1", "nan"])
+def test_bench_refuses_a_duration_of_no_window_naming_the_flag(durations, capsys):
+    """Checked before any window is timed (a window of 0 s once drew its command forever)."""
+    assert main(["bench", "--durations", durations, "--repeats", "1"]) == EXIT_BAD_INPUT
+    assert f"--durations: {durations.split(',')[-1]} is outside" in capsys.readouterr().err
 
 
 def test_the_readmes_series_step_prints_every_window(tmp_path, capsys):

@@ -29,6 +29,17 @@ def test_synthetic_windows_are_seeded(document):
     assert again == document
 
 
+@pytest.mark.parametrize(
+    ("duration_s", "rate_hz", "field"),
+    [(0.005, 10_000.0, "duration_s"), (20.0, 100_000.0, "duration_s"), (0.5, float("nan"), "sample_rate_hz")],
+)
+def test_a_synthetic_window_no_window_could_hold_is_refused_naming_the_field(duration_s, rate_hz, field):
+    """50 samples, 2 000 000 samples (ema-window/1 holds 100 to 1 000 000), a rate that is no number."""
+    with pytest.raises(InputError) as refused:
+        synthetic_window(HealthParams.single(), duration_s=duration_s, sample_rate_hz=rate_hz)
+    assert refused.value.field == field
+
+
 def _broken(document, path, value):
     broken = copy.deepcopy(document)
     target = broken
