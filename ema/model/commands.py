@@ -18,6 +18,7 @@ COMMAND_POINTS = 5
 # between its nodes, one in ten ±42°. A flight-control computer never commands past the travel,
 # so such draws are rejected (and redrawn) rather than driven into the 30° end stops.
 COMMAND_LIMIT_DEG = 28.0
+MAX_DRAWS = 1000  # two draws in three pass: a thousand misses in a row mean a span no command can be drawn over
 
 
 def random_command_coefficients(duration_s: float, rng: np.random.Generator) -> np.ndarray:
@@ -36,16 +37,22 @@ def random_command_coefficients(duration_s: float, rng: np.random.Generator) -> 
 def random_command_knots(
     n_samples: int, sample_rate_hz: float, rng: np.random.Generator, n_commands: int = 1
 ) -> np.ndarray:
-    """(n_commands, n_samples + 1) knots [deg] of independent §5.6 commands (Case 2 uses one per simulation)."""
+    """(n_commands, n_samples + 1) knots [deg] of independent §5.6 commands (Case 2 uses one per simulation);
+    an InputError, never an endless redraw, where ``MAX_DRAWS`` draws per command all overshoot (no time span)."""
     duration_s = n_samples / sample_rate_hz
     times = np.arange(n_samples + 1) / sample_rate_hz
     dense = np.linspace(0.0, duration_s, 2001)  # fine enough to see any overshoot between knots
     commands: list[np.ndarray] = []
-    while len(commands) < n_commands:
+    for _ in range(MAX_DRAWS * n_commands + 1):
+        if len(commands) == n_commands:
+            return np.stack(commands)
         coefficients = random_command_coefficients(duration_s, rng)
         if np.max(np.abs(np.polyval(coefficients, dense))) <= COMMAND_LIMIT_DEG:
             commands.append(np.polyval(coefficients, times))
-    return np.stack(commands)
+    raise InputError(
+        "n_samples",
+        f"no command over {duration_s:g} s stayed within ±{COMMAND_LIMIT_DEG:g}° in {MAX_DRAWS} draws a command",
+    )
 
 
 def _sines(times: np.ndarray, rng: np.random.Generator) -> np.ndarray:

@@ -1,3 +1,5 @@
+import signal
+
 import numpy as np
 import pytest
 
@@ -28,6 +30,21 @@ def test_commands_are_seeded_and_within_the_travel_limit():
     assert a.shape == (20, 5001)
     assert np.abs(a).max() <= COMMAND_LIMIT_DEG
     assert len({tuple(row[::500]) for row in a}) == 20  # Case 2: every command differs
+
+
+def test_a_command_over_no_time_is_refused_not_redrawn_forever():
+    def endless(*_):
+        raise AssertionError("still redrawing after 20 s")
+
+    previous = signal.signal(signal.SIGALRM, endless)
+    signal.alarm(20)
+    try:
+        with pytest.warns(RuntimeWarning), pytest.raises(InputError) as refused:
+            random_command_knots(0, 10_000.0, np.random.default_rng(0))
+    finally:
+        signal.alarm(0)
+        signal.signal(signal.SIGALRM, previous)
+    assert refused.value.field == "n_samples"
 
 
 def test_knots_from_samples_recovers_a_smooth_command_from_its_interval_means():
