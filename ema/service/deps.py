@@ -73,6 +73,12 @@ def request_config(settings: Settings, **overrides: int | None) -> PipelineConfi
     return validated(PipelineConfig, {**settings.pipeline.model_dump(), **given}, "query", prefix="query.")
 
 
+async def is_stored(store: History, actuator_id: str) -> bool:
+    """Whether a window or a document of ``actuator_id`` is stored: where none is, its history and its page are a
+    404 (an id mistyped is never shown as an actuator with no windows)."""
+    return actuator_id in await run_in_threadpool(store.actuator_ids)
+
+
 def document_of(store: History, actuator_id: str) -> tuple[ActuatorDocument, int | None]:
     """The actuator's latest stored document and its version, or the default (``ema.model.actuator.THESIS``, no
     version) where it has none: its windows are then read with the default, and their answers say so."""

@@ -40,6 +40,15 @@ def _page(title: str, body: str) -> str:
     )
 
 
+def missing_page(actuator_id: str) -> str:
+    """The page of an actuator nothing is stored of (a 404): said, with the way back to the fleet."""
+    body = (
+        f"<h1>{html.escape(actuator_id)}</h1><p>No window or document is stored for this actuator: check its id "
+        'against the fleet.</p><p><a href="/ui">all actuators</a></p>'
+    )
+    return _page(f"ema: {actuator_id}: not found", body)
+
+
 def actuator_link(actuator_id: str) -> str:
     """The link to an actuator's page: its id URL-encoded in the path (a ``?`` or ``#`` stays the id's)."""
     path = "/ui/actuators/" + urllib.parse.quote(actuator_id, safe="/")

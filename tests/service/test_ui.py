@@ -48,6 +48,15 @@ def test_an_actuator_page_plots_each_parameter_with_its_outlook(fleet_settings):
     assert 'class="threshold"' in page.text and 'class="rul"' in page.text and "backtest" in page.text
 
 
+def test_an_actuator_nothing_is_stored_of_is_a_404_page_not_an_empty_history(fleet_settings):
+    """A mistyped id must not read as an actuator with no windows (the API answers it 404 as well)."""
+    with TestClient(create_app(fleet_settings), base_url=LOCAL) as client:
+        page = client.get("/ui/actuators/tail-1/elevator-rigth")
+        api = client.get("/v1/actuators/tail-1/elevator-rigth/prognosis")
+    assert page.status_code == 404 == api.status_code and page.headers["content-type"].startswith("text/html")
+    assert "No window or document is stored" in page.text and 'href="/ui"' in page.text and "<svg" not in page.text
+
+
 def test_with_a_key_the_pages_ask_for_it_as_a_password(tmp_path, base):
     settings = settings_for(tmp_path, api_key=KEY)
     with TestClient(create_app(settings), base_url="http://ema.example") as client:

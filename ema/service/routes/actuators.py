@@ -10,7 +10,7 @@ from starlette.concurrency import run_in_threadpool
 
 from ema.model.actuator import ActuatorDocument
 from ema.prognosis.documents import ActuatorSummary, EstimateHistory, Prognosis, StoredActuator, Withdrawal
-from ema.service.deps import ActuatorId, RunnerDep, StoreDep, prognosis_now
+from ema.service.deps import ActuatorId, RunnerDep, StoreDep, is_stored, prognosis_now
 from ema.service.errors import NotStoredError
 from ema.service.parsing import read_body
 from ema.service.schemas import json_body, responses
@@ -28,7 +28,7 @@ async def actuators(store: StoreDep) -> list[ActuatorSummary]:
 
 
 async def _known(store: StoreDep, actuator_id: str) -> None:
-    if actuator_id not in await run_in_threadpool(store.actuator_ids):
+    if not await is_stored(store, actuator_id):
         raise NotStoredError(actuator_id, "no window or document is stored for it")
 
 

@@ -9,8 +9,8 @@ from fastapi import APIRouter, Query, Request
 from fastapi.responses import HTMLResponse, RedirectResponse
 from starlette.concurrency import run_in_threadpool
 
-from ema.service.deps import ActuatorId, RunnerDep, SettingsDep, StoreDep, prognosis_now
-from ema.service.pages import actuator_page, fleet_page
+from ema.service.deps import ActuatorId, RunnerDep, SettingsDep, StoreDep, is_stored, prognosis_now
+from ema.service.pages import actuator_page, fleet_page, missing_page
 from ema.service.view import fleet_lines
 
 router = APIRouter(tags=["ui"], include_in_schema=False)
@@ -50,7 +50,10 @@ async def fleet(
 
 @router.get("/ui/actuators/{actuator_id:path}", response_class=HTMLResponse)
 async def actuator(actuator_id: ActuatorId, request: Request, store: StoreDep, runner: RunnerDep) -> HTMLResponse:
-    """One actuator's plots, notes, backtest, calibrations and document (its prognosis a job of the queue)."""
+    """One actuator's plots, notes, backtest, calibrations and document (its prognosis a job of the queue); a 404
+    page where nothing of it is stored."""
+    if not await is_stored(store, actuator_id):
+        return HTMLResponse(missing_page(actuator_id), status_code=404)
     with runner.admit() as ticket:
         prognosis, history = await runner.run(
             ticket, request.is_disconnected, prognosis_now, request.app.state.prognoses, store, actuator_id
