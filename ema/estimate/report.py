@@ -6,6 +6,8 @@ result, the CLI's table and the benchmarks read them.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from ema.estimate.assess.weighing import Assessed
@@ -26,8 +28,6 @@ from ema.estimate.documents import (
     parameter,
 )
 from ema.estimate.documents.window import InertiaReading, SensorZero, WindowInfo
-from ema.estimate.learn.estimator import NetworkEstimator
-from ema.estimate.learn.network import Trained
 from ema.estimate.physics.friction import FrictionFit, sliding_mask
 from ema.estimate.physics.static_friction import StaticFriction
 from ema.estimate.prepare.conditioning import Prepared, conditioning_done, conditioning_notes
@@ -37,6 +37,10 @@ from ema.estimate.stats import rms
 from ema.model.actuator import ActuatorDocument
 from ema.model.hinge import denoised_hinge_nm
 from ema.model.params import HealthRanges
+
+if TYPE_CHECKING:  # torch's: a window read without a network (quasi-static) never loads it
+    from ema.estimate.learn.estimator import NetworkEstimator
+    from ema.estimate.learn.network import Trained
 
 # ±2 std wider than this share of the healthy range: the window is said to determine the parameter weakly.
 WEAK_SHARE_OF_RANGE = 0.10

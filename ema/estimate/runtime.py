@@ -16,11 +16,15 @@ from __future__ import annotations
 
 import contextlib
 import os
+import sys
+import threading
 
 from ema.model import runtime as sim_runtime
 from ema.model.bounds import MAX_THREADS
 
 ENVIRONMENT = "EMA_THREADS"
+_TORCH_LOCK = threading.Lock()
+_torch_pending = False  # a budget was set whose torch part is not applied yet (torch not loaded then)
 
 
 def budget(threads: int | None = None) -> int | None:
@@ -38,16 +42,33 @@ def budget(threads: int | None = None) -> int | None:
 
 
 def configure(threads: int | None = None) -> int:
-    """Set the budget for this process; returns the simulator's thread count."""
-    import torch
-
+    """Set the budget for this process; returns the simulator's thread count. torch's part is set here where torch
+    is loaded already, else when the learn stage loads it (``torch_ready``): a process that reads only windows no
+    network learns from (a slow log, a ball screw's) never loads torch."""
+    global _torch_pending
     count = sim_runtime.configure_simulator(budget(threads))
-    _without_compiler_import()
-    if torch.get_num_threads() != 1:
-        torch.set_num_threads(1)
-    with contextlib.suppress(RuntimeError):  # set once already: torch allows it only before any parallel work
-        torch.set_num_interop_threads(1)
+    _torch_pending = True
+    if "torch" in sys.modules:
+        torch_ready()
     return count
+
+
+def torch_ready() -> None:
+    """torch's part of a budget ``configure`` set, once: one intra-op and one inter-op thread, its optimizers
+    without the compiler import (module docstring). Called by the learn stage before it trains; nothing where no
+    budget was set (a library's caller keeps torch as it had it)."""
+    global _torch_pending
+    with _TORCH_LOCK:
+        if not _torch_pending:
+            return
+        import torch
+
+        _without_compiler_import()
+        if torch.get_num_threads() != 1:
+            torch.set_num_threads(1)
+        with contextlib.suppress(RuntimeError):  # set once already: torch allows it only before any parallel work
+            torch.set_num_interop_threads(1)
+        _torch_pending = False
 
 
 COMPILER_GUARDED = ("add_param_group", "zero_grad", "state_dict", "load_state_dict")  # torch.optim.Optimizer's

@@ -2,21 +2,22 @@
 
 A window at 1 kHz or more goes through the whole pipeline (``ema.estimate.pipeline``), one logged slower is
 read quasi-statically (``ema.estimate.quasistatic``); its calibration is the loop of ``ema.calibration.calibrate``,
-which reads windows at 1 kHz or more.
+which reads windows at 1 kHz or more. The pipeline and the loop train networks: each is imported by the method
+that runs it, so that a process that reads only slow logs, or another kind's, never loads torch (most of a
+one-shot command's second).
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ema.calibration.calibrate import Calibrator
 from ema.calibration.plot import ResidualPlot, Series
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import STAGES, Estimate
-from ema.estimate.pipeline import estimate_window
 from ema.estimate.quasistatic.drive import MOTOR_READING
 from ema.estimate.quasistatic.pipeline import QUASI_STATIC
 from ema.kinds.base import Calibrated, CalibrationRequest, Cost, Request, read_quasi_statically
@@ -24,6 +25,9 @@ from ema.model.bounds import HIGH_RATE_HZ
 from ema.model.checks import InputError
 from ema.model.kinds import KINDS, KindFacts
 from ema.model.window import Window
+
+if TYPE_CHECKING:
+    from ema.calibration.calibrate import Calibrator
 
 VARIABLES = {
     "speed_radps": "motor speed |ω| [rad/s]",
@@ -46,6 +50,8 @@ class Rotary:
     def estimate(self, window: Window, request: Request) -> Estimate:
         if not window.high_rate:
             return read_quasi_statically(window, request, MOTOR_READING)
+        from ema.estimate.pipeline import estimate_window  # torch's (module docstring)
+
         return estimate_window(
             window,
             request.config,
@@ -64,6 +70,8 @@ class Rotary:
                     f"{window.sample_rate_hz:g} Hz: a rotary actuator's calibration simulates its windows and reads "
                     f"them at {HIGH_RATE_HZ:g} Hz or more",
                 )
+        from ema.calibration.calibrate import Calibrator  # torch's (module docstring)
+
         config = request.config
         calibrator = Calibrator(config, copies=request.copies, seed=config.seed, actuator=request.actuator)
         calibrator.fit(windows, request.truth, on_stage=request.on_stage, checkpoint=request.checkpoint)

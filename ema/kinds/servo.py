@@ -15,7 +15,6 @@ from dataclasses import dataclass
 from ema.calibration.servo import calibrate_servo
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import STAGES, Estimate
-from ema.estimate.servo import estimate_servo
 from ema.kinds.base import Calibrated, CalibrationRequest, Cost, Request
 from ema.model.kinds import KINDS, KindFacts
 from ema.model.params import DriveConstants
@@ -33,6 +32,8 @@ class Servo:
         return STAGES
 
     def estimate(self, window: Window, request: Request) -> Estimate:
+        from ema.estimate.servo import estimate_servo  # torch's: loaded by the kind's first window (ema.kinds.rotary)
+
         return estimate_servo(
             window, request.config, actuator=request.actuator, read_with=request.read_with, on_stage=request.on_stage
         )

@@ -42,3 +42,24 @@ def test_the_documents_kind_field_lists_every_kind():
     for model in (ActuatorDocument, LogMap):
         schema = model.model_json_schema()["properties"]["kind"]
         assert set(schema["enum"]) == set(facts.KINDS)
+
+
+QUICK = (
+    "import glob, sys; from ema.cli.main import main; rig, learned = sys.argv[1:]; "
+    "runs = sorted(glob.glob(rig + '/runs/normal_load[24]0_*.csv')); "
+    "given = ['--log-map', rig + '/log-map.json', '--json']; "
+    "codes = [main(['calibrate', *runs, '--actuator', rig + '/actuator.json', '--out-actuator', learned, *given]), "
+    "main(['estimate', rig + '/runs/lackLubrication1_load20_run001.csv', '--actuator', learned, *given])]; "
+    "print(*codes, 'torch' in sys.modules, file=sys.stderr)"
+)
+
+
+def test_a_window_no_network_learns_from_never_loads_torch(tmp_path):
+    """A ball screw's windows are read quasi-statically: its calibration and its estimate answer without torch's
+    second of loading."""
+    import subprocess
+    import sys
+
+    rig, learned = str(PACKAGE.parent / "examples" / "ballscrew-rig"), str(tmp_path / "rig.json")
+    done = subprocess.run([sys.executable, "-c", QUICK, rig, learned], capture_output=True, text=True, check=True)
+    assert done.stderr.splitlines()[-1] == "0 0 False"

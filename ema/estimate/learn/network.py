@@ -25,6 +25,7 @@ import numpy as np
 import torch
 from torch import nn
 
+from ema.estimate import runtime
 from ema.model.checks import InputError
 
 OPTIMIZERS = ("lbfgs", "adam")
@@ -160,6 +161,7 @@ def _snapshot(model: nn.Module) -> dict[str, torch.Tensor]:
 def train(inputs: np.ndarray, targets: np.ndarray, config: LearnConfig) -> Trained:
     """Train one network on (N, F) inputs and (N, T) targets in [0, 1]; seeded end to end."""
     start = time.perf_counter()
+    runtime.torch_ready()  # the process's budget, where one was set before torch was loaded
     torch.manual_seed(config.seed)
     parts = split_indices(len(inputs), config.split, np.random.default_rng(config.seed))
     x = torch.as_tensor(inputs, dtype=torch.float64)  # (N, F)
