@@ -143,7 +143,12 @@ def run_fleet(
     todo = [w for w in windows if (w.actuator_id, w.window_id) not in done]
     progress = Progress(len(todo), started=time.perf_counter())
     engine_name = "ray" if address is not None else "in-process" if workers == 1 else "local processes"
-    if engine_name == "local processes" and pool is None:
+    if engine_name == "local processes" and not _any_learns(todo):  # ms a window: no process pays its start-up
+        engine_name = "in-process: no window learns a network"
+        if pool is not None:
+            pool.close()
+        pool = None
+    elif engine_name == "local processes" and pool is None:
         pool = LocalWorkers(workers, threads)
     store = _store(database)
     if store is not None:
@@ -177,6 +182,13 @@ def run_fleet(
             "writing": writing,
         },
     }
+
+
+def _any_learns(windows: list[Window]) -> bool:
+    """Whether any of ``windows`` trains a network (``ema.kinds.learns``); the others are read in milliseconds."""
+    from ema.kinds import learns
+
+    return any(learns(window) for window in windows)
 
 
 def _written(results: Iterator[Answer], out: Path, store: Any, progress: Progress) -> float:

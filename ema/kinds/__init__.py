@@ -39,6 +39,7 @@ __all__ = [
     "cost",
     "estimate",
     "kind_of",
+    "learns",
 ]
 
 
@@ -92,6 +93,12 @@ def calibrate(windows: Sequence[Window], request: CalibrationRequest) -> Calibra
                 f"({windows[0].actuator_id!r})",
             )
     return kind_of(request.actuator).calibrate(windows, request)
+
+
+def learns(window: Window) -> bool:
+    """Whether reading ``window`` trains a network, by its signals' kind (its ``stages``): a process that reads
+    only windows that do not never loads torch."""
+    return "learn" in KINDS[window.kind].stages(window)
 
 
 def cost(window: Window, config: PipelineConfig) -> Cost:

@@ -17,7 +17,6 @@ from ema.estimate import runtime
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import Estimate
 from ema.estimate.documents.window import HistoryReadings
-from ema.estimate.pipeline import estimate_window
 from ema.kinds import estimate
 from ema.model.actuator import THESIS, ActuatorDocument, actuator_from_dict
 from ema.model.checks import InputError
@@ -55,6 +54,8 @@ WARM_UP = PipelineConfig(n_simulations=16, check_windows=8, n_timesteps=20, hidd
 def warm_up() -> None:
     """A tiny pipeline run: simulation kernels, residual, network and the physics fit all exercised once (loaded
     from the cache or compiled), so that the first window a process answers costs what any other does."""
+    from ema.estimate.pipeline import estimate_window  # torch's: a task of a kind that learns nothing never loads it
+
     estimate_window(synthetic_window(HealthParams.single(), seed=0, duration_s=0.05), WARM_UP, actuator=THESIS)
 
 

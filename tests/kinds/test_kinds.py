@@ -1,9 +1,13 @@
 """Each kind is declared in one place: its facts in ema.model.kinds, its method in its module of ema.kinds; nothing
-else compares a kind with a literal or tells one by a signal's name."""
+else compares a kind with a literal or tells one by a signal's name; and a kind whose windows train no network
+never has torch loaded for them."""
 
 import ast
+import csv
+import json
 from pathlib import Path
 
+from ema.cli.main import EXIT_OK, main
 from ema.kinds import KINDS
 from ema.model import kinds as facts
 
@@ -63,3 +67,30 @@ def test_a_window_no_network_learns_from_never_loads_torch(tmp_path):
     rig, learned = str(PACKAGE.parent / "examples" / "ballscrew-rig"), str(tmp_path / "rig.json")
     done = subprocess.run([sys.executable, "-c", QUICK, rig, learned], capture_output=True, text=True, check=True)
     assert done.stderr.splitlines()[-1] == "0 0 False"
+
+
+def test_an_archive_no_network_learns_from_is_read_in_process_whatever_the_workers(tmp_path, capsys):
+    """A ball screw's runs are read in milliseconds: no worker process is kept to load torch for them, and the
+    rows are those one worker writes."""
+    rig = PACKAGE.parent / "examples" / "ballscrew-rig"
+    given = ["--log-map", str(rig / "log-map.json")]
+    learned = tmp_path / "rig.json"
+    healthy = sorted(str(p) for p in (rig / "runs").glob("normal_load[24]0_*.csv"))
+    calibrate = ["calibrate", *healthy, "--actuator", str(rig / "actuator.json"), "--out-actuator", str(learned)]
+    assert main([*calibrate, *given]) == EXIT_OK
+    folder = tmp_path / "runs"
+    folder.mkdir()
+    for run in sorted((rig / "runs").glob("*_run00[12].csv"))[:6]:
+        (folder / run.name).write_bytes(run.read_bytes())
+    capsys.readouterr()
+    rows, engines = {}, {}
+    for workers in ("2", "1"):
+        out = tmp_path / f"{workers}.csv"
+        arguments = ["fleet", str(folder), "--out", str(out), "--workers", workers, "--actuator", str(learned)]
+        assert main([*arguments, *given, "--json"]) == EXIT_OK
+        summary = json.loads(capsys.readouterr().out)
+        with out.open() as handle:
+            rows[workers] = sorted((r["window_id"], r["FDJ"]) for r in csv.DictReader(handle))
+        engines[workers] = summary["engine"]
+        assert summary["answered"] == 6
+    assert engines == {"2": "in-process: no window learns a network", "1": "in-process"} and rows["2"] == rows["1"]
