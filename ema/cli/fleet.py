@@ -143,7 +143,7 @@ def run_fleet(
     todo = [w for w in windows if (w.actuator_id, w.window_id) not in done]
     progress = Progress(len(todo), started=time.perf_counter())
     engine_name = "ray" if address is not None else "in-process" if workers == 1 else "local processes"
-    if engine_name == "local processes" and not _any_learns(todo):  # ms a window: no process pays its start-up
+    if engine_name == "local processes" and todo and not _any_learns(todo):  # ms a window: no process start-up
         engine_name = "in-process: no window learns a network"
         if pool is not None:
             pool.close()
