@@ -12,20 +12,19 @@ from typing import Any
 import click
 
 from ema.cli.options import (
-    EXISTING,
     NothingAnsweredError,
     as_json,
     emit,
     flags_named,
     log_map,
     log_map_document,
+    service,
     window_length,
     window_s,
 )
 from ema.model.bounds import DEFAULT_SAMPLE_RATE_HZ
 from ema.model.envelope import DEFAULT_AIRSPEED_MPS
 
-URL = "http://127.0.0.1:8000"
 LOG = click.Path(exists=True, path_type=Path)
 
 
@@ -38,7 +37,7 @@ def api_key(path: Path | None) -> str | None:
 
 @click.command()
 @click.argument("log", type=LOG)
-@click.option("--url", default=URL, help="the service")
+@service
 @click.option(
     "--out",
     type=click.Path(dir_okay=False, path_type=Path),
@@ -47,7 +46,6 @@ def api_key(path: Path | None) -> str | None:
     "$XDG_STATE_HOME/ema/replay, said where]",
 )
 @window_s
-@click.option("--api-key-file", type=EXISTING, default=None, help="file holding the API key [default: EMA_API_KEY]")
 @click.option("--actuator-id", default="unknown", help="for CSV/NPZ logs that carry none")
 @click.option(
     "--rate", type=float, default=DEFAULT_SAMPLE_RATE_HZ, help="sample rate [Hz] for CSV/NPZ logs that carry none"
@@ -111,10 +109,21 @@ def default_results(log: Path, url: str) -> Path:
 
 
 def check_service(url: str, key: str | None) -> None:
-    """ServiceError where nothing answers at ``url`` (before any file is written)."""
-    from ema.cli.replay import request
+    """ServiceError where nothing answers at ``url`` or the service fails; an InputError naming the flag where
+    what answers is no ema service's root (a path such as /v1 added) or wants a key: said before any file is
+    written, and before a 404 could be read as the actuator's."""
+    from ema.cli.replay import ServiceError, request
+    from ema.model.checks import InputError
 
-    request(f"{url.rstrip('/')}/healthz", key, timeout=10)
+    try:
+        request(f"{url}/healthz", key, timeout=10)
+    except urllib.error.HTTPError as error:
+        said = f"{url}/healthz answered HTTP {error.code}"
+        if error.code == 401:
+            raise InputError("--api-key-file", f"{said}: the service wants its key (or EMA_API_KEY)") from None
+        if error.code < 500:
+            raise InputError("--url", f"{said}: no ema service's root address answers so") from None
+        raise ServiceError(f"{said}: the service failed") from None
 
 
 def report_log(read: Any) -> None:
@@ -148,8 +157,7 @@ def _print_replay(result: dict[str, Any]) -> None:
 
 @click.command()
 @click.argument("actuator_id")
-@click.option("--url", default=URL, help="the service")
-@click.option("--api-key-file", type=EXISTING, default=None, help="file holding the API key [default: EMA_API_KEY]")
+@service
 @click.option("--plot", type=click.Path(dir_okay=False, path_type=Path), default=None, help="PNG of the prognosis")
 @click.option("--parameter", type=click.Choice(["FDJ", "eta_O", "eta_A"]), default="FDJ", help="what --plot draws")
 @as_json
@@ -164,7 +172,8 @@ def history(
     from ema.prognosis.documents import EstimateHistory, Prognosis
 
     key = api_key(api_key_file)
-    base = f"{url.rstrip('/')}/v1/actuators/{urllib.parse.quote(actuator_id, safe='/')}"
+    check_service(url, key)
+    base = f"{url}/v1/actuators/{urllib.parse.quote(actuator_id, safe='/')}"
     try:
         stored = EstimateHistory.model_validate(request(f"{base}/estimates", key, timeout=60))
     except urllib.error.HTTPError as error:

@@ -173,6 +173,27 @@ def emit(result: Any, as_json_flag: bool, show: Callable[[Any], None]) -> None:
         raise PipeClosedError from None
 
 
+SERVICE_URL = "http://127.0.0.1:8000"  # where ema serve listens by default
+
+
+def service(function: F) -> F:
+    """``--url``, the service's root address (checked as the flag is read: an http(s) address with a host), and
+    ``--api-key-file``, its key."""
+    keyed = click.option(
+        "--api-key-file", type=EXISTING, default=None, help="file holding the API key [default: EMA_API_KEY]"
+    )(function)
+    return click.option("--url", default=SERVICE_URL, callback=_http_address, help="the service's root address")(keyed)
+
+
+def _http_address(_: click.Context, parameter: click.Parameter, value: str) -> str:
+    import urllib.parse
+
+    parts = urllib.parse.urlsplit(value)
+    if parts.scheme not in ("http", "https") or not parts.hostname:
+        raise click.BadParameter(f"{value!r} is not an http(s) address such as {SERVICE_URL}", param=parameter)
+    return value.rstrip("/")
+
+
 def database_setting(_: click.Context, parameter: click.Parameter, value: str | None) -> str | None:
     """A history setting checked as the flag is read: a malformed address is exit 2 naming the flag, before any
     work (``ema.history.open.setting_error``)."""

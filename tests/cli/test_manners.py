@@ -74,11 +74,12 @@ def test_an_unknown_actuator_exits_2(capsys):
     from threading import Thread
 
     class Handler(BaseHTTPRequestHandler):
-        def do_GET(self):
-            body = json.dumps({"detail": [{"loc": ["path", "actuator_id"], "msg": "nothing stored"}]}).encode()
-            self.send_response(404)
+        def do_GET(self):  # a service that is up (its /healthz) and stores nothing
+            healthy = self.path == "/healthz"
+            detail = {"detail": [{"loc": ["path", "actuator_id"], "msg": "nothing stored"}]}
+            self.send_response(200 if healthy else 404)
             self.end_headers()
-            self.wfile.write(body)
+            self.wfile.write(json.dumps({"status": "ok"} if healthy else detail).encode())
 
         def log_message(self, *args):
             pass

@@ -224,3 +224,30 @@ def test_a_service_that_dies_mid_request_is_named_as_such(capsys, log_folder):
     listener.close()
     err = capsys.readouterr().err
     assert status != EXIT_OK and "stopped answering" in err and "internal error" not in err
+
+
+@pytest.mark.parametrize("command", ["replay", "history"])
+def test_an_address_that_is_no_services_root_exits_2_naming_the_flag(command, tmp_path, capsys, log_folder):
+    """Another web server there, or the service's address with /v1 added (404 at /healthz): no file written and
+    no actuator blamed; an address with no scheme is refused as the flag is read."""
+
+    class NotFound(BaseHTTPRequestHandler):
+        def do_GET(self):
+            self.send_response(404)
+            self.end_headers()
+
+        def log_message(self, *args):
+            pass
+
+    server = HTTPServer(("127.0.0.1", 0), NotFound)
+    threading.Thread(target=server.serve_forever, daemon=True).start()
+    out = tmp_path / "answers.csv"
+    target = [str(log_folder / "b_window.csv"), "--out", str(out)] if command == "replay" else ["tail-1"]
+    try:
+        assert main([command, *target, "--url", f"http://127.0.0.1:{server.server_port}/v1"]) == EXIT_BAD_INPUT
+    finally:
+        server.shutdown()
+    said = capsys.readouterr().err
+    assert "--url" in said and "HTTP 404" in said and "ACTUATOR_ID" not in said and not out.exists()
+    assert main([command, *target, "--url", "127.0.0.1:8000"]) == EXIT_BAD_INPUT
+    assert "--url" in capsys.readouterr().err
