@@ -102,7 +102,8 @@ def main() -> None:
     body = report(runs, service, n_windows=args.windows, cores=cores)
     print(body)
     if args.docs:
-        write_section("Fleet throughput (ema fleet, end to end)", "python -m benchmarks.fleet_scaling --docs", body)
+        command = f"python -m benchmarks.fleet_scaling --windows {args.windows} --repeats {args.repeats} --docs"
+        write_section("Fleet throughput (ema fleet, end to end)", command, body)
 
 
 def report(runs: dict[int, list[tuple[float, dict[str, float]]]], service: float, *, n_windows: int, cores: int) -> str:
