@@ -15,7 +15,7 @@ from dataclasses import replace
 from benchmarks.foreign_accuracy import RESULTS_MD, run_one
 from benchmarks.foreign_groups import group_seed, groups
 from benchmarks.tails import BOUND
-from ema.cli.report import write_section
+from ema.cli.report import typed_command, write_section
 from ema.estimate import runtime
 from tests.foreign.careless import SLIPS, Slip, exported
 from tests.foreign.windows import Draw
@@ -55,7 +55,7 @@ def main() -> None:
     body = report(counts, args.per_slip, time.perf_counter() - started)
     print(body)
     if args.docs:
-        write_section("Careless exports", "python -m benchmarks.careless_exports --docs", body, RESULTS_MD)
+        write_section("Careless exports", typed_command(), body, RESULTS_MD)
 
 
 def report(counts: dict[str, Counter], per_slip: int, seconds: float) -> str:

@@ -24,7 +24,7 @@ import numpy as np
 from benchmarks.as_user import run_ema
 from benchmarks.foreign_accuracy import RESULTS_MD
 from ema.calibration.servo import model_errors_pct
-from ema.cli.report import write_section
+from ema.cli.report import typed_command, write_section
 from ema.estimate import runtime
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import STAGES
@@ -156,7 +156,7 @@ def main() -> None:
     body = "\n".join(lines)
     print(body)
     if args.docs:
-        write_section("A real EMA at 1 kHz: the EMPS benchmark", "python -m benchmarks.emps --docs", body, RESULTS_MD)
+        write_section("A real EMA at 1 kHz: the EMPS benchmark", typed_command(), body, RESULTS_MD)
 
 
 def reading(answer: dict, base: dict[str, dict]) -> str:

@@ -30,7 +30,7 @@ import httpx
 from benchmarks.as_user import run_ema
 from benchmarks.real_time import cpu_seconds
 from benchmarks.service_overhead import free_port, serve
-from ema.cli.report import write_section
+from ema.cli.report import typed_command, write_section
 from ema.model.params import HealthParams
 from ema.model.runtime import available_cores
 from ema.model.synthetic import synthetic_window
@@ -102,8 +102,7 @@ def main() -> None:
     body = report(runs, service, n_windows=args.windows, cores=cores)
     print(body)
     if args.docs:
-        command = f"python -m benchmarks.fleet_scaling --windows {args.windows} --repeats {args.repeats} --docs"
-        write_section("Fleet throughput (ema fleet, end to end)", command, body)
+        write_section("Fleet throughput (ema fleet, end to end)", typed_command(), body)
 
 
 def report(runs: dict[int, list[tuple[float, dict[str, float]]]], service: float, *, n_windows: int, cores: int) -> str:

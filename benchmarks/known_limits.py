@@ -13,7 +13,7 @@ from typing import Any
 
 from benchmarks.foreign_accuracy import RESULTS_MD, run_one, summarize, table
 from benchmarks.foreign_groups import FAMILIES, drive_off, off_zero, viscous
-from ema.cli.report import write_section
+from ema.cli.report import typed_command, write_section
 from ema.estimate import runtime
 from ema.estimate.history import readings_of
 from ema.estimate.pipeline import estimate_window
@@ -143,7 +143,7 @@ def main() -> None:
     )
     print(body)
     if args.docs:
-        write_section("Where it is still wrong", "python -m benchmarks.known_limits --docs", body, RESULTS_MD)
+        write_section("Where it is still wrong", typed_command(), body, RESULTS_MD)
 
 
 if __name__ == "__main__":

@@ -14,7 +14,7 @@ from typing import Any
 
 from benchmarks.foreign_accuracy import RESULTS_MD, run_one, summarize, table
 from benchmarks.foreign_groups import group_seed, groups
-from ema.cli.report import write_section
+from ema.cli.report import typed_command, write_section
 from ema.estimate import runtime
 from ema.estimate.prepare.stale import stale_runs
 from ema.model.actuator import THESIS
@@ -80,7 +80,7 @@ def main() -> None:
     body = report(rows, found, args.per_fault, time.perf_counter() - started)
     print(body)
     if args.docs:
-        write_section("Logging faults", "python -m benchmarks.logging_faults --docs", body, RESULTS_MD)
+        write_section("Logging faults", typed_command(), body, RESULTS_MD)
 
 
 if __name__ == "__main__":

@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ema.cli.report import write_section
+from ema.cli.report import typed_command, write_section
 from ema.estimate import runtime
 from ema.estimate.pipeline import estimate_window
 from ema.estimate.report import share_of_range
@@ -127,7 +127,7 @@ def main() -> None:
     )
     print(body)
     if args.docs:
-        write_section("Speed-up over round 1, side by side", "python -m benchmarks.pipeline_speedup --docs", body)
+        write_section("Speed-up over round 1, side by side", typed_command(), body)
 
 
 if __name__ == "__main__":

@@ -15,7 +15,7 @@ import time
 
 import numpy as np
 
-from ema.cli.report import write_section
+from ema.cli.report import typed_command, write_section
 from ema.estimate import runtime
 from ema.model.actuator import THESIS
 from ema.model.aircraft import FlightCondition, load_model
@@ -116,7 +116,7 @@ def main() -> None:
     body = "\n".join(lines)
     print(body)
     if args.docs:
-        write_section("Simulator speed", "python -m benchmarks.sim_speed --docs", body)
+        write_section("Simulator speed", typed_command(), body)
 
 
 if __name__ == "__main__":

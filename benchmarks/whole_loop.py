@@ -37,7 +37,7 @@ from benchmarks.foreign_accuracy import RESULTS_MD
 from benchmarks.foreign_groups import group_seed, groups
 from benchmarks.information_limit import GROUPS, SENSORS, noise_levels
 from benchmarks.tails import expected_over
-from ema.cli.report import write_section
+from ema.cli.report import typed_command, write_section
 from ema.estimate import runtime
 from ema.estimate.physics.features import as_read
 from ema.estimate.physics.friction import fit_friction
@@ -206,7 +206,7 @@ def main() -> None:
     body = report(rows)
     print(body)
     if args.docs:
-        write_section("Reading the whole loop instead", "python -m benchmarks.whole_loop --docs", body, RESULTS_MD)
+        write_section("Reading the whole loop instead", typed_command(), body, RESULTS_MD)
 
 
 if __name__ == "__main__":

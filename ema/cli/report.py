@@ -6,6 +6,8 @@ import datetime as dt
 import os
 import platform
 import re
+import shlex
+import sys
 from pathlib import Path
 
 BENCHMARKS_MD = Path("docs/benchmarks.md")  # relative to the checkout the benchmark runs in
@@ -25,6 +27,12 @@ def machine() -> str:
     except OSError:
         pass
     return f"{model}, {os.cpu_count()} cores, Python {platform.python_version()}"
+
+
+def typed_command() -> str:
+    """This process's command line as typed (``python -m benchmarks.x --flag v --docs``): the figures' section says
+    the arguments they came from, never a fixed text that omits some."""
+    return shlex.join(["python", *sys.orig_argv[1:]])
 
 
 def write_section(title: str, command: str, body: str, path: Path = BENCHMARKS_MD) -> None:
