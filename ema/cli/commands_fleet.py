@@ -9,6 +9,7 @@ from pathlib import Path
 import click
 
 from ema.cli.options import (
+    OUTPUT_FILE,
     NothingAnsweredError,
     actuator,
     as_json,
@@ -32,7 +33,7 @@ ARCHIVE = click.Path(exists=True, path_type=Path)
 @click.option(
     "--out",
     required=True,
-    type=click.Path(dir_okay=False, path_type=Path),
+    type=OUTPUT_FILE,
     help="results CSV, one row per window (a rerun resumes from it)",
 )
 @click.option("--workers", type=click.IntRange(1, 4096), default=2, help="worker processes (windows at a time)")

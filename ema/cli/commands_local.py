@@ -12,6 +12,7 @@ import click
 
 from ema.cli.options import (
     EXISTING,
+    OUTPUT_FILE,
     about_file,
     actuator,
     actuator_document,
@@ -113,7 +114,7 @@ def estimate(
 
 
 @click.command()
-@click.option("--out", required=True, type=click.Path(dir_okay=False, path_type=Path), help="window JSON to write")
+@click.option("--out", required=True, type=OUTPUT_FILE, help="window JSON to write")
 @click.option("--fdj", type=float, default=None, help="dynamic friction FDJ [N·m]  [default: the actuator's nominal]")
 @click.option("--eta-o", "eta_o", type=float, default=None, help="opposing efficiency η_O  [default: nominal]")
 @click.option("--fsj", type=float, default=None, help="static friction FSJ [N·m]  [default: nominal]")
@@ -137,7 +138,7 @@ def estimate(
     help="an effect the base model lacks, e.g. cogging:amplitude_nm=0.02 (repeatable)",
 )
 @click.option("--actuator-id", default="synthetic/elevator", help="actuator_id written to the window")
-@click.option("--truth-out", type=click.Path(dir_okay=False, path_type=Path), help="also write the truth as JSON")
+@click.option("--truth-out", type=OUTPUT_FILE, help="also write the truth as JSON")
 @click.option(
     "--recorded-at",
     type=click.DateTime(formats=["%Y-%m-%dT%H:%M:%S%z", "%Y-%m-%dT%H:%M:%S", "%Y-%m-%d"]),
@@ -179,14 +180,14 @@ def simulate(as_json: bool, **options: Any) -> None:
 @click.option("--truth", type=EXISTING, help='JSON {"FDJ": ..., "eta_O": ...} of synthetic windows')
 @click.option(
     "--figure",
-    type=click.Path(dir_okay=False, path_type=Path),
+    type=OUTPUT_FILE,
     default=None,
     help="also write a PNG of the residual before and after",
 )
 @click.option("--copies", type=click.IntRange(8, 500), default=30, help="noise-only copies behind the noise floor")
 @click.option(
     "--out-actuator",
-    type=click.Path(dir_okay=False, path_type=Path),
+    type=OUTPUT_FILE,
     default=None,
     metavar="A2.json",
     help="a linear actuator: write its document completed with what healthy runs taught (c, I0, the nominal)",

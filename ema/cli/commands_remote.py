@@ -12,6 +12,7 @@ from typing import Any
 import click
 
 from ema.cli.options import (
+    OUTPUT_FILE,
     NothingAnsweredError,
     as_json,
     emit,
@@ -40,7 +41,7 @@ def api_key(path: Path | None) -> str | None:
 @service
 @click.option(
     "--out",
-    type=click.Path(dir_okay=False, path_type=Path),
+    type=OUTPUT_FILE,
     default=None,
     help="CSV the answers are appended to (a rerun resumes from it)  [default: one per log and service in "
     "$XDG_STATE_HOME/ema/replay, said where]",
@@ -158,7 +159,7 @@ def _print_replay(result: dict[str, Any]) -> None:
 @click.command()
 @click.argument("actuator_id")
 @service
-@click.option("--plot", type=click.Path(dir_okay=False, path_type=Path), default=None, help="PNG of the prognosis")
+@click.option("--plot", type=OUTPUT_FILE, default=None, help="PNG of the prognosis")
 @click.option("--parameter", type=click.Choice(["FDJ", "eta_O", "eta_A"]), default="FDJ", help="what --plot draws")
 @as_json
 def history(

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import contextlib
 import json
+import os
 import sys
 from collections.abc import Callable, Iterator, Mapping
 from pathlib import Path
@@ -16,6 +17,22 @@ from ema.model.bounds import MAX_THREADS
 
 F = TypeVar("F", bound=Callable[..., Any])
 EXISTING = click.Path(exists=True, dir_okay=False, path_type=Path)  # a file that must be there
+
+
+class _OutputFile(click.Path):
+    """A file the command writes: its folder made as the flag is read (as a results CSV's always was), so that a
+    folder that cannot be made is said naming the flag before any work, never after a calibration's minutes."""
+
+    def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
+        path = super().convert(value, param, ctx)
+        try:
+            Path(os.fsdecode(path)).parent.mkdir(parents=True, exist_ok=True)
+        except OSError as error:
+            self.fail(f"{value}: its folder cannot be made ({error.strerror})", param, ctx)
+        return path
+
+
+OUTPUT_FILE = _OutputFile(dir_okay=False, path_type=Path)
 SIZES = {  # flag -> PipelineConfig field
     "--sims": "n_simulations",
     "--checks": "check_windows",

@@ -285,5 +285,8 @@ def write_window(window: Window, path: str | Path) -> None:
     """Write ``window`` as JSON, atomically (a reader never sees half a file)."""
     path = Path(path)
     temporary = path.with_name(path.name + ".tmp")
-    temporary.write_text(json.dumps(window_to_dict(window)))
+    try:
+        temporary.write_text(json.dumps(window_to_dict(window)))
+    except OSError as error:  # said of the file asked for, not of its temporary twin
+        raise OSError(error.errno, error.strerror, str(path)) from None
     temporary.replace(path)

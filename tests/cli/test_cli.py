@@ -106,11 +106,6 @@ def test_bad_input_exits_2_naming_the_flag_typed(tmp_path, capsys, arguments, na
     assert named in capsys.readouterr().err
 
 
-def test_a_missing_folder_exits_2_naming_the_file(tmp_path, capsys):
-    assert main(["simulate", "--out", str(tmp_path / "missing" / "w.json"), "--duration", "0.05"]) == EXIT_BAD_INPUT
-    assert "missing" in capsys.readouterr().err
-
-
 def test_estimate_prints_one_json_document_and_progress_on_stderr(tmp_path, capsys):
     window = tmp_path / "w.json"
     assert main(["simulate", "--out", str(window), "--duration", "0.1", "--fdj", "0.056"]) == EXIT_OK

@@ -175,3 +175,16 @@ def test_a_second_step_naming_nothing_does_not_contradict_the_first(capsys):
     printed = capsys.readouterr().out
     assert "named current_sensor_offset" in printed and "nothing further named" in printed
     assert "\nnothing named" not in printed
+
+
+def test_an_output_whose_folder_cannot_be_made_is_refused_before_any_work(tmp_path, capsys):
+    """A file in the way of the folder: said naming the flag as it is read, not after the calibration's work; a
+    folder that is not there yet is made, as a results CSV's is."""
+    blocker = tmp_path / "taken"
+    blocker.write_text("a file, not a folder")
+    window = Path(__file__).parents[2] / "examples" / "calibration-window.json"
+    assert main(["calibrate", str(window), "--figure", str(blocker / "f.png")]) == EXIT_BAD_INPUT
+    said = capsys.readouterr()
+    assert "--figure" in said.err and "its folder cannot be made" in said.err and "ema: " not in said.err
+    nested = tmp_path / "new" / "folder" / "w.json"
+    assert main(["simulate", "--out", str(nested), "--duration", "0.05"]) == EXIT_OK and nested.exists()
