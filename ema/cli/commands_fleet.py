@@ -70,10 +70,9 @@ def fleet(
 
     Workers are local processes (warmed while the archive is read), one in this process with --workers 1 or where
     no window trains a network (a ball screw's, a slow log's: milliseconds each), or a Ray cluster's with
-    --ray-address (``pip install 'ema[fleet]'``). Each window is read with its actuator's
-    document: the archive folder's actuators.json maps actuator_ids to ema-actuator/1 documents; the others
-    take --actuator (the thesis's where none is given). Exit status 2 when no window was answered; a folder's
-    unreadable files are skipped and listed."""
+    --ray-address (``pip install 'ema[fleet]'``). Each window is read with its actuator's document: the archive
+    folder's actuators.json maps actuator_ids to ema-actuator/1 documents; the others take --actuator (the
+    thesis's where none is given). Exit status 2 when no window was answered; unreadable files are skipped, listed."""
     from ema.cli.pool import LocalWorkers
 
     started = time.perf_counter()

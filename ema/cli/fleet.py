@@ -142,14 +142,7 @@ def run_fleet(
     done = done_windows(out)
     todo = [w for w in windows if (w.actuator_id, w.window_id) not in done]
     progress = Progress(len(todo), started=time.perf_counter())
-    engine_name = "ray" if address is not None else "in-process" if workers == 1 else "local processes"
-    if engine_name == "local processes" and todo and not _any_learns(todo):  # ms a window: no process start-up
-        engine_name = "in-process: no window learns a network"
-        if pool is not None:
-            pool.close()
-        pool = None
-    elif engine_name == "local processes" and pool is None:
-        pool = LocalWorkers(workers, threads)
+    engine_name, pool = _engine(todo, workers=workers, threads=threads, address=address, pool=pool)
     store = _store(database)
     if store is not None:
         documents = _stored_documents(store, documents, {w.actuator_id for w in todo})
@@ -184,11 +177,23 @@ def run_fleet(
     }
 
 
-def _any_learns(windows: list[Window]) -> bool:
-    """Whether any of ``windows`` trains a network (``ema.kinds.learns``); the others are read in milliseconds."""
+def _engine(
+    todo: list[Window], *, workers: int, threads: int, address: str | None, pool: LocalWorkers | None
+) -> tuple[str, LocalWorkers | None]:
+    """(the engine's name, the local pool or None): Ray with an address; this process for one worker, or where no
+    window trains a network (``ema.kinds.learns``: milliseconds a window, less than a process's start-up, the
+    pool started meanwhile stopped); else the local pool, started here if the command did not."""
+    if address is not None:
+        return "ray", pool
+    if workers == 1:
+        return "in-process", pool
     from ema.kinds import learns
 
-    return any(learns(window) for window in windows)
+    if todo and not any(learns(window) for window in todo):
+        if pool is not None:
+            pool.close()
+        return "in-process: no window learns a network", None
+    return "local processes", LocalWorkers(workers, threads) if pool is None else pool
 
 
 def _written(results: Iterator[Answer], out: Path, store: Any, progress: Progress) -> float:
