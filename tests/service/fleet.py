@@ -4,11 +4,10 @@ its own (copies of one real estimate with FDJ and η_O replaced), and the truth 
 from __future__ import annotations
 
 import contextlib
-import json
-import urllib.request
 from collections.abc import Iterator
 from pathlib import Path
 
+import httpx
 import numpy as np
 
 from ema.estimate.documents import Estimate, parameter
@@ -62,13 +61,8 @@ def served_fleet(database: Path) -> Iterator[str]:
     server = start_server(port, database)
     url = f"http://127.0.0.1:{port}"
     try:
-        settled_lines(lambda: _json(f"{url}/v1/actuators"))
+        settled_lines(lambda: httpx.get(f"{url}/v1/actuators", timeout=30).json())
         yield url
     finally:
         server.terminate()
         server.wait(timeout=30)
-
-
-def _json(url: str) -> list[dict]:
-    with urllib.request.urlopen(url, timeout=30) as response:
-        return json.loads(response.read())
