@@ -68,15 +68,16 @@ def fleet(
 ) -> None:
     """Reprocess an archive (folder, NPZ, CSV, MATLAB or JSON logs) on worker processes; one CSV row per window.
 
-    Workers are local processes (warmed while the archive is read), one in this process with --workers 1 or where
-    no window trains a network (a ball screw's, a slow log's: milliseconds each), or a Ray cluster's with
-    --ray-address (``pip install 'ema[fleet]'``). Each window is read with its actuator's document: the archive
-    folder's actuators.json maps actuator_ids to ema-actuator/1 documents; the others take --actuator (the
-    thesis's where none is given). Exit status 2 when no window was answered; unreadable files are skipped, listed."""
+    Workers are local processes (forked from one that loads torch as the archive is read), one in this process
+    with --workers 1 or where no window trains a network (a ball screw's, a slow log's: milliseconds each), or a
+    Ray cluster's with --ray-address (``pip install 'ema[fleet]'``). Each window is read with its actuator's
+    document: the archive folder's actuators.json maps actuator_ids to ema-actuator/1 documents; the others take
+    --actuator (the thesis's where none is given). Exit status 2 when no window was answered; unreadable files
+    are skipped, listed."""
     from ema.cli.pool import LocalWorkers
 
     started = time.perf_counter()
-    pool = LocalWorkers(workers, threads) if workers > 1 and ray_address is None else None  # warming meanwhile
+    pool = LocalWorkers(workers, threads) if workers > 1 and ray_address is None else None  # loading meanwhile
     try:
         from ema.cli.commands_remote import report_log
         from ema.cli.fleet import check_engine, run_fleet

@@ -1,15 +1,21 @@
-"""The local worker processes of ``ema fleet --workers N``: a pool of spawned processes, each warmed as it starts
-(its thread budget pinned, its kernels loaded: ``ema.kinds.remote.warm``).
+"""The local worker processes of ``ema fleet --workers N``: a pool of processes forked from a fork server that has
+loaded torch and the kernels' modules once, each warmed as it starts (its thread budget pinned, its kernels
+loaded: ``ema.kinds.remote.warm``).
 
-This module imports nothing of ema's at its top: the command starts the pool before it imports what reads the
-archive, so that the processes load torch and the kernels while the driver is still loading its own modules
-(a worker's loading is the part of the run more workers cannot share). The driver, which only reads and
-writes, never loads torch or the kernels.
+This module imports nothing of ema's at its top: the command starts the fork server before it imports what reads
+the archive, so that the server loads torch while the driver is still loading its own modules and reading, on the
+other core. The workers fork from that clean, single-purpose process (no thread of the driver's, nothing of a
+window's run yet: the only threads there are the BLAS pool's, which stops itself at a fork), so no worker loads
+torch again; the driver, which only reads and writes, never loads it.
 """
 
 from __future__ import annotations
 
+import contextlib
 import multiprocessing
+import multiprocessing.forkserver
+import os
+import signal
 from collections import Counter
 from collections.abc import Iterator
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
@@ -20,24 +26,25 @@ if TYPE_CHECKING:
     from ema.cli.workers import Answer, Documents, Job
     from ema.estimate.config import PipelineConfig
 
+PRELOADED = ("ema.estimate.pipeline", "ema.kinds.remote")  # what every worker imports: torch, the kernels' modules
 IN_FLIGHT_PER_WORKER = 2  # tasks queued per worker: enough to keep it busy, few enough to stop quickly
 NODE_LOSSES = 3  # a window whose task died with its process or node this often fails the run
 
 
 class LocalWorkers:
-    """A pool of local worker processes, each warmed as it starts (module docstring); start it first thing. A
-    process lost mid-run (killed) loses no window: its jobs go to a new pool, ``NODE_LOSSES`` times at most."""
+    """A pool of local worker processes, each warmed as it starts (module docstring); start it first thing: its fork
+    server starts loading then, and the processes fork from it at the first job. A process lost mid-run (killed)
+    loses no window: its jobs go to a new pool, ``NODE_LOSSES`` times at most."""
 
     def __init__(self, workers: int, threads: int) -> None:
         self.workers, self.threads = workers, threads
-        self.pool, self.used = self._started(), False
+        self.pool = self._started()
 
     def _started(self) -> ProcessPoolExecutor:
-        context = multiprocessing.get_context("spawn")  # never a fork of a process that may hold threads
-        pool = ProcessPoolExecutor(self.workers, mp_context=context, initializer=_warmed, initargs=(self.threads,))
-        for _ in range(self.workers):
-            pool.submit(int)  # a process per worker, warming now
-        return pool
+        context = multiprocessing.get_context("forkserver")  # never a fork of the driver, which may hold threads
+        context.set_forkserver_preload(list(PRELOADED))
+        multiprocessing.forkserver.ensure_running()  # loading now; a process's start waits for it
+        return ProcessPoolExecutor(self.workers, mp_context=context, initializer=_warmed, initargs=(self.threads,))
 
     def answers(self, jobs: list[Job], config: PipelineConfig, documents: Documents) -> Iterator[Answer]:
         """Each job's (window, answer) as a process returns it, ``IN_FLIGHT_PER_WORKER`` jobs per process queued."""
@@ -45,7 +52,7 @@ class LocalWorkers:
         pending: dict[Future, Job] = {}
         while queue or pending:
             while queue and len(pending) < IN_FLIGHT_PER_WORKER * self.workers and not self.pool._broken:
-                job, self.used = queue.pop(), True
+                job = queue.pop()
                 pending[self.pool.submit(_answered, *documents.task(job, config, self.threads))] = job
             done, _ = wait(pending, return_when=FIRST_COMPLETED)
             for future in done:
@@ -61,12 +68,21 @@ class LocalWorkers:
                 self.pool = self._started()
 
     def close(self) -> None:
-        """The processes stopped: once idle after their last answer, or at once where they never had a job (nothing
-        left to answer, or the archive could not be read): a user waits for no warming that serves nothing."""
-        if not self.used:
-            for process in list(self.pool._processes.values()):
-                process.terminate()
+        """The processes stopped once idle after their last answer (none was forked where the pool never had a job:
+        nothing left to answer, or the archive could not be read), then the fork server (``_stop_fork_server``)."""
         self.pool.shutdown(wait=True, cancel_futures=True)
+        _stop_fork_server()
+
+
+def _stop_fork_server() -> None:
+    """The fork server killed and forgotten (the next pool starts another): it holds nothing once its workers are
+    gone, and its own exit would tear torch down for half a second, which a caller reading the command's output
+    through a pipe waits for (as a user waits for no loading that serves nothing)."""
+    server: Any = multiprocessing.forkserver._forkserver  # private: the standard library offers no stop
+    if server._forkserver_pid is not None:
+        with contextlib.suppress(ProcessLookupError):
+            os.kill(server._forkserver_pid, signal.SIGTERM)
+        server._stop()
 
 
 def _warmed(threads: int) -> None:

@@ -62,19 +62,19 @@ def test_one_worker_runs_in_process_and_skips_a_bad_file(archive, tmp_path, caps
     assert "[7/7]" in captured.err and "windows/s" in captured.err  # progress: done, rate, time left
 
 
-def test_a_pool_that_never_had_a_job_stops_without_finishing_its_warming():
-    """Nothing left to answer, or an archive that cannot be read: the user waits for no warming (processes
-    stopped as they are, not after loading torch and the kernels); the one-worker path loads nothing."""
-    import signal
+def test_a_pool_that_never_had_a_job_forks_no_worker_and_stops_at_once():
+    """Nothing left to answer, or an archive that cannot be read: no worker was forked, and closing waits for no
+    loading (the fork server is stopped at once); the one-worker path loads nothing."""
+    import multiprocessing.forkserver
     import subprocess
     import sys
 
     from ema.cli.pool import LocalWorkers
 
     pool = LocalWorkers(2, 1)
-    processes = list(pool.pool._processes.values())
     pool.close()
-    assert len(processes) == 2 and all(p.exitcode == -signal.SIGTERM for p in processes)
+    assert not pool.pool._processes  # none forked: nothing to stop, nothing to wait for
+    assert multiprocessing.forkserver._forkserver._forkserver_pid is None  # type: ignore[attr-defined]
     nothing = "from ema.cli.workers import in_process; import sys; list(in_process([], None, 1, None)); "
     loaded = subprocess.run([sys.executable, "-c", nothing + "print('torch' in sys.modules)"], capture_output=True)
     assert loaded.stdout.decode().strip() == "False"
