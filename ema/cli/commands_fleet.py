@@ -30,12 +30,7 @@ ARCHIVE = click.Path(exists=True, path_type=Path)
 
 @click.command()
 @click.argument("archive", type=ARCHIVE)
-@click.option(
-    "--out",
-    required=True,
-    type=OUTPUT_FILE,
-    help="results CSV, one row per window (a rerun resumes from it)",
-)
+@click.option("--out", required=True, type=OUTPUT_FILE, help="results CSV, a row per window (a rerun resumes from it)")
 @click.option("--workers", type=click.IntRange(1, 4096), default=2, help="worker processes (windows at a time)")
 @click.option("--threads", type=click.IntRange(1, MAX_THREADS), default=1, help="threads (CPUs) each worker reserves")
 @click.option("--ray-address", default=None, help="'auto' or HOST:PORT of a cluster [default: a local Ray]")

@@ -178,12 +178,7 @@ def simulate(as_json: bool, **options: Any) -> None:
 @click.command()
 @click.argument("windows", type=EXISTING, nargs=-1, required=True)
 @click.option("--truth", type=EXISTING, help='JSON {"FDJ": ..., "eta_O": ...} of synthetic windows')
-@click.option(
-    "--figure",
-    type=OUTPUT_FILE,
-    default=None,
-    help="also write a PNG of the residual before and after",
-)
+@click.option("--figure", type=OUTPUT_FILE, help="also write a PNG of the residual before and after")
 @click.option("--copies", type=click.IntRange(8, 500), default=30, help="noise-only copies behind the noise floor")
 @click.option(
     "--out-actuator",
