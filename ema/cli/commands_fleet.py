@@ -63,12 +63,11 @@ def fleet(
 ) -> None:
     """Reprocess an archive (folder, NPZ, CSV, MATLAB or JSON logs) on worker processes; one CSV row per window.
 
-    Workers are local processes (forked from one that loads torch as the archive is read), one in this process
-    with --workers 1 or where no window trains a network (a ball screw's, a slow log's: milliseconds each), or a
-    Ray cluster's with --ray-address (``pip install 'ema[fleet]'``). Each window is read with its actuator's
-    document: the archive folder's actuators.json maps actuator_ids to ema-actuator/1 documents; the others take
-    --actuator (the thesis's where none is given). Exit status 2 when no window was answered; unreadable files
-    are skipped, listed."""
+    Workers are local processes (forked from one that loads torch as the archive is read), this one for one
+    worker, one window or where none trains a network (a ball screw's, a slow log's: milliseconds each), or a Ray
+    cluster's with --ray-address (``pip install 'ema[fleet]'``). A window is read with its actuator's document:
+    the folder's actuators.json maps actuator_ids to ema-actuator/1 documents; the others take --actuator (the
+    thesis's where none is given). Exit status 2 when no window was answered; unreadable files are skipped."""
     from ema.cli.pool import LocalWorkers
 
     started = time.perf_counter()

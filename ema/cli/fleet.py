@@ -180,20 +180,25 @@ def run_fleet(
 def _engine(
     todo: list[Window], *, workers: int, threads: int, address: str | None, pool: LocalWorkers | None
 ) -> tuple[str, LocalWorkers | None]:
-    """(the engine's name, the local pool or None): Ray with an address; this process for one worker, or where no
-    window trains a network (``ema.kinds.learns``: milliseconds a window, less than a process's start-up, the
-    pool started meanwhile stopped); else the local pool, started here if the command did not."""
+    """(the engine's name, the local pool or None): Ray with an address; this process for one worker, for one
+    window (nothing to share out), or where no window trains a network (``ema.kinds.learns``: milliseconds a window,
+    less than a process's start-up), the pool started meanwhile stopped; else the local pool, started here if the
+    command did not."""
     if address is not None:
         return "ray", pool
     if workers == 1:
         return "in-process", pool
     from ema.kinds import learns
 
-    if todo and not any(learns(window) for window in todo):
-        if pool is not None:
-            pool.close()
-        return "in-process: no window learns a network", None
-    return "local processes", LocalWorkers(workers, threads) if pool is None else pool
+    if len(todo) == 1:
+        reason = "one window"
+    elif todo and not any(learns(window) for window in todo):
+        reason = "no window learns a network"
+    else:
+        return "local processes", LocalWorkers(workers, threads) if pool is None else pool
+    if pool is not None:
+        pool.close()
+    return f"in-process: {reason}", None
 
 
 def _written(results: Iterator[Answer], out: Path, store: Any, progress: Progress) -> float:

@@ -62,6 +62,22 @@ def test_one_worker_runs_in_process_and_skips_a_bad_file(archive, tmp_path, caps
     assert "[7/7]" in captured.err and "windows/s" in captured.err  # progress: done, rate, time left
 
 
+def test_a_rerun_left_with_one_window_answers_it_in_process(archive, tmp_path, capsys):
+    """Every window but one answered already: nothing to share out, so no worker process starts for it."""
+    out = tmp_path / "results.csv"
+    arguments = ["fleet", str(archive), "--out", str(out), "--workers", "2", "--json", *SIZES]
+    assert main(arguments) == EXIT_OK
+    rows = _rows(out)
+    with out.open("w", newline="") as handle:  # the run stopped before its last window's row
+        writer = csv.DictWriter(handle, fieldnames=list(rows[0]))
+        writer.writeheader()
+        writer.writerows(rows[:-1])
+    capsys.readouterr()
+    assert main(arguments) == EXIT_OK
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["engine"] == "in-process: one window" and summary["skipped"] == 6 and len(_rows(out)) == 7
+
+
 def test_a_pool_that_never_had_a_job_forks_no_worker_and_stops_at_once():
     """Nothing left to answer, or an archive that cannot be read: no worker was forked, and closing waits for no
     loading (the fork server is stopped at once); the one-worker path loads nothing."""
