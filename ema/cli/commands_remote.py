@@ -53,6 +53,15 @@ def api_key(path: Path | None) -> str | None:
 )
 @click.option("--airspeed", type=float, default=DEFAULT_AIRSPEED_MPS, help="[m/s] for CSV/NPZ logs that carry none")
 @click.option("--altitude", type=float, default=0.0, help="[m] for CSV/NPZ logs that carry none")
+@click.option(
+    "--actuator",
+    "actuator_file",
+    type=click.Path(exists=True, dir_okay=False, path_type=Path),
+    default=None,
+    metavar="A.json",
+    help="store this ema-actuator/1 document in the service for the log's actuators before posting (a folder's "
+    "actuators.json first)  [default: the documents the service holds]",
+)
 @log_map
 @as_json
 def replay(
@@ -66,6 +75,7 @@ def replay(
     rate: float,
     airspeed: float,
     altitude: float,
+    actuator_file: Path | None,
     log_map_file: Path | None,
     as_json: bool,
 ) -> None:
@@ -73,6 +83,7 @@ def replay(
 
     Exit status 2 when no window was answered; a folder's unreadable files are skipped and listed."""
     from ema.cli.logs import Defaults, read_log
+    from ema.cli.replay import put_documents
     from ema.cli.replay import replay as post_all
 
     defaults = Defaults(actuator_id, rate, airspeed, altitude)
@@ -80,8 +91,11 @@ def replay(
         mapping = log_map_document(log_map_file)
         read = read_log(log, window_length(window_s, mapping), defaults, mapping)
     report_log(read)
+    documents, sources = replayed_documents(log, actuator_file, {window.actuator_id for window in read.windows})
     key = api_key(api_key_file)
     check_service(url, key)  # a service that is not there: said now, and no file written
+    for actuator_id, version in put_documents(url, documents, key, sources).items():
+        print(f"{actuator_id}: its document stored in the service (version {version})", file=sys.stderr)
     out = out or default_results(log, url)
     print(f"replaying {len(read.windows)} window(s) from {log} to {url}; answers in {out}", file=sys.stderr)
     rows = post_all(read.windows, url, out, key)
@@ -97,6 +111,26 @@ def replay(
     emit(result, as_json, _print_replay)
     if rows and not result["answered"]:
         raise NothingAnsweredError(f"none of the {len(rows)} window(s) posted was answered (see {out})")
+
+
+def replayed_documents(
+    log: Path, actuator_file: Path | None, actuator_ids: set[str]
+) -> tuple[dict[str, Any], dict[str, str]]:
+    """(actuator_id -> the ema-actuator/1 document to store before its windows are posted, actuator_id -> where
+    it came from): a folder's actuators.json's, else --actuator's, else none (the service reads the windows with
+    the document it holds)."""
+    from ema.cli.logs import ACTUATORS_FILE, read_actuators
+    from ema.model.actuator import read_actuator
+
+    listed = read_actuators(log)
+    given = None if actuator_file is None else read_actuator(actuator_file)
+    documents, sources = {}, {}
+    for actuator_id in sorted(actuator_ids):
+        if actuator_id in listed:
+            documents[actuator_id], sources[actuator_id] = listed[actuator_id], f"{log / ACTUATORS_FILE}: {actuator_id}"
+        elif given is not None:
+            documents[actuator_id], sources[actuator_id] = given, "--actuator"
+    return documents, sources
 
 
 def default_results(log: Path, url: str) -> Path:

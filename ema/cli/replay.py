@@ -18,8 +18,10 @@ import urllib.request
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
+from urllib.parse import quote
 
 from ema.cli.results import ResultsWriter, done_windows, row_of
+from ema.model.actuator import ActuatorDocument
 from ema.model.window import Window, window_to_dict
 
 MAX_WAIT_S = 600.0
@@ -29,11 +31,15 @@ class ServiceError(Exception):
     """The service could not be reached or failed; not the window's fault."""
 
 
-def request(url: str, api_key: str | None, data: bytes | None = None, timeout: float = 900) -> dict[str, Any]:
-    """One HTTP request to the service; the JSON answer, or HTTPError / ServiceError."""
+def request(
+    url: str, api_key: str | None, data: bytes | None = None, timeout: float = 900, method: str | None = None
+) -> dict[str, Any]:
+    """One HTTP request to the service (GET, POST with ``data``, or ``method``); the JSON answer, or HTTPError /
+    ServiceError."""
     headers = {"content-type": "application/json", **({"x-api-key": api_key} if api_key else {})}
+    asked = urllib.request.Request(url, data=data, headers=headers, method=method)
     try:
-        with urllib.request.urlopen(urllib.request.Request(url, data=data, headers=headers), timeout=timeout) as r:
+        with urllib.request.urlopen(asked, timeout=timeout) as r:
             return json.loads(r.read())
     except urllib.error.HTTPError:
         raise
@@ -64,6 +70,33 @@ def post_window(url: str, window: Window, api_key: str | None, sleep: Callable[[
             if error.code in (409, 422):
                 return {"error": refusal_text(error.code, detail)}
             raise ServiceError(f"HTTP {error.code} for {window.window_id}: {detail[:300]}") from None
+
+
+def put_documents(
+    url: str, documents: dict[str, ActuatorDocument], api_key: str | None, sources: dict[str, str]
+) -> dict[str, int]:
+    """Each actuator's document stored in the service before its windows are posted (``PUT /v1/actuators/{id}``:
+    the same document again stores nothing new, so a rerun adds no version); the versions it holds them under. A
+    document refused is an InputError naming where it came from (``sources``: a flag or a file), a key refused
+    one naming --api-key-file: said before any window is posted."""
+    from ema.model.checks import InputError
+
+    versions = {}
+    for actuator_id, document in documents.items():
+        body = document.model_dump_json(by_alias=True).encode()
+        try:
+            stored = request(f"{url}/v1/actuators/{quote(actuator_id, safe='/')}", api_key, body, 60, "PUT")
+        except urllib.error.HTTPError as error:
+            said = refusal_text(error.code, error.read().decode(errors="replace"))
+            if error.code in (401, 403):
+                raise InputError(
+                    "--api-key-file", f"the service refused the document of {actuator_id}: {said}"
+                ) from None
+            if error.code == 422:
+                raise InputError(sources[actuator_id], f"the service refused it for {actuator_id}: {said}") from None
+            raise ServiceError(f"HTTP {error.code} storing the document of {actuator_id}: {said[:300]}") from None
+        versions[actuator_id] = int(stored["version"])
+    return versions
 
 
 def refusal_text(status: int, body: str) -> str:

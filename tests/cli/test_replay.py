@@ -1,5 +1,6 @@
 """The replay client against a real uvicorn server on 127.0.0.1, and the history across a kill -9."""
 
+import csv
 import json
 import signal
 import threading
@@ -251,3 +252,34 @@ def test_an_address_that_is_no_services_root_exits_2_naming_the_flag(command, tm
     assert "--url" in said and "HTTP 404" in said and "ACTUATOR_ID" not in said and not out.exists()
     assert main([command, *target, "--url", "127.0.0.1:8000"]) == EXIT_BAD_INPUT
     assert "--url" in capsys.readouterr().err
+
+
+def test_a_servo_log_is_refused_until_its_document_is_stored_then_stored_once(tmp_path, capsys):
+    """The EMPS log (a servo's) into a service that holds no document for it: refused, saying how to store one;
+    ``--actuator`` stores it before posting (the key asked for and named), and a rerun adds no version."""
+    from pathlib import Path
+
+    examples = Path(__file__).resolve().parents[2] / "examples" / "emps"
+    log = [str(examples / "DATA_EMPS.mat"), "--log-map", str(examples / "log-map.json")]
+    port, key = free_port(), tmp_path / "key.txt"
+    key.write_text("a-key-of-sixteen-or-more\n")
+    (tmp_path / "wrong.txt").write_text("not-the-key-0123456789\n")
+    url, out = f"http://127.0.0.1:{port}", str(tmp_path / "answers.csv")
+    server = start_server(port, tmp_path / "history.sqlite3", EMA_API_KEY="a-key-of-sixteen-or-more")
+    try:
+        replay = ["replay", *log, "--url", url, "--out", out, "--json"]
+        assert main([*replay, "--api-key-file", str(key)]) == EXIT_BAD_INPUT  # nothing answered
+        assert "PUT its document to /v1/actuators/emps/axis" in capsys.readouterr().out
+        stored = [*replay, "--actuator", str(examples / "actuator.json")]
+        assert main([*stored, "--api-key-file", str(tmp_path / "wrong.txt")]) == EXIT_BAD_INPUT
+        assert "--api-key-file" in capsys.readouterr().err
+        for _ in range(2):
+            assert main([*stored, "--api-key-file", str(key)]) == EXIT_OK
+            captured = capsys.readouterr()
+            assert "emps/axis: its document stored in the service (version 1)" in captured.err
+        assert json.loads(captured.out)["posted"] == 0  # the rerun resumed: answered the first time
+        rows = list(csv.DictReader(Path(out).read_text().splitlines()))
+        assert [bool(row["error"]) for row in rows] == [True, False] and float(rows[-1]["FDJ"]) > 0
+    finally:
+        server.terminate()
+        server.wait(timeout=30)
