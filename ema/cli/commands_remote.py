@@ -218,13 +218,16 @@ def history(
             ) from None
         raise ServiceError(f"HTTP {error.code} from {url}") from None
     prognosis = Prognosis.model_validate(request(f"{base}/prognosis", key, timeout=60))
-    if plot is not None and parameter in prognosis.trends:
-        prognosis_figure(prognosis, parameter, plot)
+    drawn = plot if plot is not None and parameter in prognosis.trends else None
+    if drawn is not None:
+        prognosis_figure(prognosis, parameter, drawn)
+    elif plot is not None:
+        print(f"no figure written to {plot}: {parameter} has no trend (the notes say why)", file=sys.stderr)
     document = {
         "history": stored.model_dump(mode="json", by_alias=True),
         "prognosis": prognosis.model_dump(mode="json"),
     }
-    emit(document, as_json, lambda _: print_prognosis(stored, prognosis, plot))
+    emit(document, as_json, lambda _: print_prognosis(stored, prognosis, drawn))
 
 
 COMMANDS = (replay, history)

@@ -228,27 +228,27 @@ class ActuatorDocument(Document):
 
     def limits(self, parameter: str) -> list[tuple[float, Literal["above", "below"]]]:
         """The failure levels of ``parameter`` (FDJ, eta_O or eta_A), each with the way it is crossed: FDJ's upper
-        one (default 1.5x nominal) and its lower one where the document gives it; η's lower one (none where the
-        nominal η_O is unknown)."""
+        one (default 1.5x nominal) and its lower one where the document gives it; η's lower one. None where the
+        document gives no level and its nominal is not known (a ball screw's or a servo's before ema calibrate)."""
         if parameter == "FDJ":
             above = getattr(self.thresholds, self.facts.friction_field("fdj_above"))
             below = getattr(self.thresholds, self.facts.friction_field("fdj_below"))
-            levels: list[tuple[float, Literal["above", "below"]]] = [
-                (above if above is not None else 1.5 * self.health.fdj, "above")
-            ]
+            if above is None and self.nominal is not None:
+                above = 1.5 * self.nominal.fdj
+            levels: list[tuple[float, Literal["above", "below"]]] = [] if above is None else [(above, "above")]
             return levels + ([(below, "below")] if below is not None else [])
         eta_o = self.thresholds.eta_o_below
         if eta_o is None:  # the thesis's 0.70, or as far below a lower nominal (0.70 / 0.85 of it)
-            if self.health.eta_o is None:
+            if self.nominal is None or self.nominal.eta_o is None:
                 return []
-            eta_o = min(DEFAULT_ETA_O_BELOW, self.health.eta_o * DEFAULT_ETA_O_BELOW / THESIS_ETA_O)
+            eta_o = min(DEFAULT_ETA_O_BELOW, self.nominal.eta_o * DEFAULT_ETA_O_BELOW / THESIS_ETA_O)
         return [(eta_o if parameter == "eta_O" else float(self.eta_a(eta_o)), "below")]
 
     def threshold(self, parameter: str) -> tuple[float, Literal["above", "below"]]:
         """The first failure level of ``parameter`` (``limits``): FDJ's upper one, η's lower one."""
         found = self.limits(parameter)
         if not found:
-            raise InputError(f"thresholds.{parameter}", "has no level: the nominal η_O is not known")
+            raise InputError(f"thresholds.{parameter}", "has no level: the document gives none and no nominal")
         return found[0]
 
     @property

@@ -64,7 +64,8 @@ def prognose(
     sensors, said = sensor_trends(stored, times, unit, tolerance)
     inertias = [s.window.inertia_read for s in stored if s.window.inertia_read is not None]
     faster = [speeding_note(name) for name, seen in outlooks.items() if seen.life.speeding_up]
-    notes = [n for n in (note, *faster, *said, inertia_change_note(inertias)) if n]
+    levelless = [no_level_note(name, actuator) for name in PARAMETERS if _read(name, stored) and name not in outlooks]
+    notes = [n for n in (note, *faster, *levelless, *said, inertia_change_note(inertias)) if n]
     return Prognosis(
         actuator_id=actuator_id,
         time_unit=unit,
@@ -99,6 +100,24 @@ def _outlook(
         return seen
     tested = backtest(series, threshold=threshold, direction=direction, min_span=span)
     return replace(seen, backtest=tested)
+
+
+def _read(name: str, stored: Sequence[Stored]) -> bool:
+    return any(getattr(s.estimates, name) is not None for s in stored)
+
+
+def no_level_note(name: str, actuator: ActuatorDocument) -> Note | None:
+    """Why a parameter the windows read has no trend, where the reason is that it has no failure level to trend
+    towards (``ActuatorDocument.limits``), and how to give it one."""
+    if actuator.limits(name):
+        return None
+    field = actuator.facts.friction_field("fdj_above") if name == "FDJ" else "eta_o_below"
+    return Note(
+        code="no_threshold",
+        parameter=name,
+        text=f"{name} has no failure level to trend towards: the actuator's document gives no thresholds.{field} "
+        "and no nominal (ema calibrate on healthy windows learns it: --out-actuator, then store that document)",
+    )
 
 
 def _urgency(life: RemainingLife) -> tuple[int, float]:

@@ -28,8 +28,12 @@ URGENCY = {"due": 0, "watch": 1, "prognosis failed": 2, "pending": 3, "not enoug
 
 
 def lacking_evidence(prognosis: Prognosis, windows: int) -> str | None:
-    """Why ``windows`` windows cannot support a trend's status yet, or None where they can."""
+    """Why ``windows`` windows cannot support a trend's status yet (or no trend can: FDJ has no level to trend
+    towards), or None where they can."""
     trend = prognosis.trends.get("FDJ")
+    levelless = next((n.text for n in prognosis.notes if n.code == "no_threshold" and n.parameter == "FDJ"), None)
+    if trend is None and levelless is not None:
+        return levelless
     n = windows if trend is None else trend.n
     span = 0.0 if trend is None or not trend.points else float(np.ptp([p.time for p in trend.points]))
     unit = prognosis.time_unit.replace("_", " ")
@@ -42,9 +46,12 @@ def lacking_evidence(prognosis: Prognosis, windows: int) -> str | None:
 
 
 def off_healthy(latest: Stored | None, actuator: ActuatorDocument) -> bool:
-    """The latest estimate lies outside the healthy range, or the model did not reproduce its window."""
+    """The latest estimate lies outside the healthy range (where the document's nominal sets one), or the model
+    did not reproduce its window."""
     if latest is None:
         return False
+    if actuator.nominal is None:
+        return not latest.check.reproduced
     ranges = actuator.ranges
     fdj, eta_o = latest.estimates.FDJ.value, latest.estimates.eta_O
     outside = not ranges.fdj_nm[0] <= fdj <= ranges.fdj_nm[1]
@@ -111,7 +118,7 @@ def summary(
         estimates={name: None if e is None else e.value for name, e in entries.items()},
         stds={name: None if e is None else e.std for name, e in entries.items()},
         repeatability_stds={name: None if e is None else e.repeatability_std for name, e in entries.items()},
-        nominal={name: e.nominal for name, e in entries.items() if e is not None},
+        nominal={name: e.nominal for name, e in entries.items() if e is not None and e.nominal is not None},
         thresholds={name: Threshold(level=limits[0][0], direction=limits[0][1]) for name, limits in levels.items()},
         thresholds_below={
             name: Threshold(level=level, direction=way) for name, limits in levels.items() for level, way in limits[1:]

@@ -22,7 +22,7 @@ import time
 from dataclasses import dataclass
 
 from ema.history.open import History
-from ema.model.actuator import THESIS
+from ema.model.actuator import THESIS, ActuatorDocument
 from ema.prognosis.documents import ActuatorSummary, Prognosis, Stored
 from ema.prognosis.rul import MIN_WINDOWS as FORECAST_WINDOWS
 from ema.prognosis.status import URGENCY, failed, summary
@@ -69,15 +69,25 @@ def refreshed(store: History, stale: list[tuple[str, str, int]], cancel: threadi
             prognosis = safe_prognosis(actuator_id, history, actuator, backtested=False)
         else:
             prognosis = Prognosis(actuator_id=actuator_id, time_unit=_unit_of(last), trends={}, remaining_life={})
-        failure = next((n.text for n in prognosis.notes if n.code == "prognosis_failed"), None)
-        line = (
-            failed(actuator_id, windows, actuator, version, failure)
-            if failure is not None
-            else summary(prognosis, last, windows, actuator, version)
-        )
+        line = _line(prognosis, last, windows, actuator, version)
         store.put_summary(actuator_id, state, URGENCY[line.status], line.soonest, line.model_dump_json())
         done.add(actuator_id)
     return done
+
+
+def _line(
+    prognosis: Prognosis, last: Stored | None, windows: int, actuator: ActuatorDocument, version: int | None
+) -> ActuatorSummary:
+    """The actuator's line, or one that says its prognosis failed and why: one actuator's numbers never keep the
+    lines of the others from being brought up to date."""
+    failure = next((n.text for n in prognosis.notes if n.code == "prognosis_failed"), None)
+    if failure is None:
+        try:
+            return summary(prognosis, last, windows, actuator, version)
+        except Exception as exc:  # any failure of the numerics is this actuator's, reported on its own line
+            log.exception("the line of %s failed", prognosis.actuator_id)
+            failure = f"its line could not be computed: {type(exc).__name__}: {exc}"
+    return failed(prognosis.actuator_id, windows, actuator, version, failure)
 
 
 def kept_lines(store: History) -> tuple[dict[str, ActuatorSummary], list[tuple[str, str, int]]]:

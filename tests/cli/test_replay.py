@@ -256,7 +256,8 @@ def test_an_address_that_is_no_services_root_exits_2_naming_the_flag(command, tm
 
 def test_a_servo_log_is_refused_until_its_document_is_stored_then_stored_once(tmp_path, capsys):
     """The EMPS log (a servo's) into a service that holds no document for it: refused, saying how to store one;
-    ``--actuator`` stores it before posting (the key asked for and named), and a rerun adds no version."""
+    ``--actuator`` stores it before posting (the key asked for and named), and a rerun adds no version. Its
+    history has no trend yet (no level): said, and no figure is claimed."""
     from pathlib import Path
 
     examples = Path(__file__).resolve().parents[2] / "examples" / "emps"
@@ -280,6 +281,11 @@ def test_a_servo_log_is_refused_until_its_document_is_stored_then_stored_once(tm
         assert json.loads(captured.out)["posted"] == 0  # the rerun resumed: answered the first time
         rows = list(csv.DictReader(Path(out).read_text().splitlines()))
         assert [bool(row["error"]) for row in rows] == [True, False] and float(rows[-1]["FDJ"]) > 0
+        plot = tmp_path / "fdj.png"  # no nominal, no threshold yet: no trend, so no figure, and said
+        history = ["history", "emps/axis", "--url", url, "--api-key-file", str(key), "--plot", str(plot)]
+        assert main(history) == EXIT_OK and not plot.exists()
+        captured = capsys.readouterr()
+        assert "no figure written" in captured.err and "[no_threshold]" in captured.out
     finally:
         server.terminate()
         server.wait(timeout=30)

@@ -80,3 +80,24 @@ def test_a_friction_that_falls_past_a_lower_level_is_due_and_both_levels_are_sho
     line = summary(prognosis, stored[-1], len(stored), actuator, None)
     assert line.status == "due" and line.thresholds_below["FDJ"].level == 0.035
     assert line.thresholds["FDJ"].level == 0.075 and line.repeatability_stds["FDJ"] is not None
+
+
+def test_a_document_without_nominal_or_level_trends_nothing_says_why_and_keeps_its_line(base):
+    """A servo's document before ema calibrate (no nominal, no thresholds): no level to trend towards, said per
+    parameter; its fleet line still stands (no healthy range to judge by). Given a level, the trend comes."""
+    from pathlib import Path
+
+    from ema.model.actuator import read_actuator
+
+    servo = read_actuator(Path(__file__).resolve().parents[2] / "examples" / "emps" / "actuator.json")
+    assert servo.nominal is None and servo.limits("FDJ") == [] and servo.limits("eta_O") == []
+    stored = _history(base, [0.050, 0.053, 0.056, 0.059, 0.062, 0.065], flight_hours=[0, 20, 40, 60, 80, 100])
+    prognosis = prognose("a", stored, servo)
+    assert prognosis.trends == {}
+    assert {n.parameter for n in prognosis.notes if n.code == "no_threshold"} == {"FDJ", "eta_O", "eta_A"}
+    line = summary(prognosis, stored[-1], len(stored), servo, 1)
+    assert line.status == "not enough history" and "no failure level" in line.reason
+    assert line.thresholds == {}
+    levelled = servo.model_copy(update={"thresholds": servo.thresholds.model_copy(update={"fdj_above_n": 0.075})})
+    prognosis = prognose("a", stored, levelled)
+    assert list(prognosis.trends) == ["FDJ"] and prognosis.remaining_life["FDJ"].status == "crossing predicted"

@@ -246,3 +246,34 @@ def test_a_full_queue_says_what_holds_its_places():
     with pytest.raises(OverloadedError) as full:
         runner.admit()
     assert "all 5 places are taken: 0 job(s) running, 5 waiting for a slot or storing an answer" in str(full.value)
+
+
+def test_a_line_that_cannot_be_computed_is_its_own_and_the_others_still_come(tmp_path, base, monkeypatch):
+    """One actuator's line failing (its numbers, its document) is said on that line; the keeper's pass goes on to
+    the next actuator rather than stopping there for ever."""
+    from ema.service import view
+    from ema.service.jobs import JobRunner
+
+    store = open_history(tmp_path / "h.sqlite3")
+    for name in ("tail-1/elevator", "tail-2/elevator"):
+        store.add(_copy(base, name, "w0", 0.0))
+    original = view.summary
+
+    def summary(prognosis, *rest):
+        if prognosis.actuator_id == "tail-1/elevator":
+            raise ValueError("a number out of its range")
+        return original(prognosis, *rest)
+
+    monkeypatch.setattr(view, "summary", summary)
+    keeper = view.LineKeeper(store, JobRunner(max_queue=1, queue_timeout_s=1.0))
+    keeper.start()
+    try:
+        assert _lines_settle(store, within_s=10.0)
+        lines = {line.actuator_id: line for line in view.kept_lines(store)[0].values()}
+    finally:
+        keeper.stop()
+        store.close()
+    assert (
+        lines["tail-1/elevator"].status == "prognosis failed" and "out of its range" in lines["tail-1/elevator"].reason
+    )
+    assert lines["tail-2/elevator"].status == "not enough history"

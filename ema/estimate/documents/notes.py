@@ -70,6 +70,7 @@ NoteCode = Literal[
     "inertia_changed",
     "inertia_scatter",
     "speeding_up",
+    "no_threshold",
     # a note stored by an earlier version, as a sentence only
     "unspecified",
 ]
