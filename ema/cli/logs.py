@@ -19,9 +19,10 @@ from ema.model.actuator import ActuatorDocument, actuator_from_dict
 from ema.model.bounds import DEFAULT_SAMPLE_RATE_HZ
 from ema.model.checks import InputError, load_json
 from ema.model.envelope import DEFAULT_AIRSPEED_MPS
+from ema.model.kinds import ALL_SIGNALS, KINDS, KindFacts, nearest_kind
 from ema.model.logmap import LogMap, read_mapped
 from ema.model.tables import TABLE_SUFFIXES, read_table
-from ema.model.window import SIGNALS, Window, window_from_dict
+from ema.model.window import Window, window_from_dict
 
 SUFFIXES = (".json", *TABLE_SUFFIXES)
 ACTUATORS_FILE = "actuators.json"  # in an archive's folder: {actuator_id: its ema-actuator/1 document}
@@ -62,15 +63,33 @@ def _from_json(path: Path) -> list[Window]:
 
 
 def _from_table(path: Path, defaults: Defaults) -> list[Window]:
-    """A CSV or NPZ in ema's own columns, named as a rotary window's signals (others ignored); a CSV's
-    ``# key: value`` lines on top, an NPZ's text arrays, give metadata (``actuator_id``, ``window_id``,
-    ``sample_rate_hz``, ``airspeed_mps``, ``altitude_m``, ``recorded_at``, ``flight_hours``, ``flight_id``)."""
+    """A CSV or NPZ in ema's own columns, named as the signals of a window of its kind (the kind whose signals
+    it holds: ``tabled_kind``; others ignored); a CSV's ``# key: value`` lines on top, an NPZ's text arrays, give
+    metadata (``actuator_id``, ``window_id``, ``sample_rate_hz``, ``airspeed_mps``, ``altitude_m``,
+    ``recorded_at``, ``flight_hours``, ``flight_id``)."""
     table = read_table(path)
-    missing = [name for name in SIGNALS if name not in table.columns]
-    if missing:
-        raise InputError(str(path), f"lacks the numeric column(s) {', '.join(missing)}")
+    kind = tabled_kind(path, set(table.columns))
     meta = {**{k: str(v) for k, v in table.scalars.items()}, **table.meta}
-    return [_window({name: table.columns[name] for name in SIGNALS}, meta, defaults, path)]
+    signals = {name: table.columns[name] for name in kind.all_signals if name in table.columns}
+    return [_window(signals, meta, defaults, path)]
+
+
+def tabled_kind(path: Path, columns: set[str]) -> KindFacts:
+    """The one kind whose every signal is a column; an InputError naming the file where none is (the nearest
+    kind's missing columns said, and the log map a file in its own columns needs) or several are."""
+    found = [kind for kind in KINDS.values() if set(kind.signals) <= columns]
+    if len(found) == 1:
+        return found[0]
+    if found:
+        names = " and ".join(kind.name for kind in found)
+        raise InputError(str(path), f"holds the columns of a {names} window alike: keep one kind's")
+    own = "a log in its own columns and units is read through --log-map"
+    if not columns & set(ALL_SIGNALS):
+        kinds = "; ".join(f"a {kind.name}'s {', '.join(kind.signals)}" for kind in KINDS.values())
+        raise InputError(str(path), f"has no numeric column named as a window's signals ({kinds}): {own}")
+    nearest = nearest_kind(columns)
+    missing = ", ".join(name for name in nearest.signals if name not in columns)
+    raise InputError(str(path), f"lacks the numeric column(s) {missing} of a {nearest.name} window ({own})")
 
 
 def _window(signals: dict[str, np.ndarray], meta: dict[str, Any], defaults: Defaults, path: Path) -> Window:

@@ -46,7 +46,7 @@ from ema.model.document import Number, refused_by
 from ema.model.kinds import ALL_SIGNALS, DEFAULT_KIND, KINDS, kind_of_signals, nearest_kind
 
 SCHEMA = "ema-window/1"
-SIGNALS = KINDS[DEFAULT_KIND].signals  # a rotary window's, the layout a CSV or NPZ log without a map is read in
+SIGNALS = KINDS[DEFAULT_KIND].signals  # the default kind's (a rotary window's)
 
 Samples = Annotated[list[Number], Field(min_length=MIN_SAMPLES, max_length=MAX_SAMPLES)]
 

@@ -1,0 +1,58 @@
+"""Logs as files in ema's own columns: a window of any kind, known by the signals its columns carry."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from ema.cli.logs import read_file, read_one
+from ema.model.checks import InputError
+from ema.model.logmap import read_logmap
+
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
+MAPPED = {
+    "linear": (EXAMPLES / "ballscrew-rig" / "runs" / "normal_load20_run001.csv", "ballscrew-rig"),
+    "servo": (EXAMPLES / "emps" / "DATA_EMPS.mat", "emps"),
+}
+
+
+def _own_csv(window, path: Path, names=None) -> Path:
+    """``window`` as a CSV in ema's own columns (``names``: its signals'), in another column order."""
+    names = list(reversed(window.signals)) if names is None else names
+    head = f"# actuator_id: {window.actuator_id}\n# window_id: own\n# sample_rate_hz: {window.sample_rate_hz}\n"
+    rows = np.stack([window.signals[name] for name in names], axis=1)
+    path.write_text(head + ",".join(names) + "\n" + "\n".join(",".join(f"{v:.17g}" for v in row) for row in rows))
+    return path
+
+
+@pytest.mark.parametrize("kind", sorted(MAPPED))
+def test_a_window_of_any_kind_reads_back_from_its_own_columns_as_csv_and_npz(kind, tmp_path):
+    """A real rig's log through its map, written in ema's columns, is the same window read without one."""
+    source, folder = MAPPED[kind]
+    window = read_one(source, read_logmap(EXAMPLES / folder / "log-map.json"))
+    npz = tmp_path / "own.npz"
+    np.savez(npz, **window.signals, actuator_id=window.actuator_id, sample_rate_hz=window.sample_rate_hz)
+    for path in (_own_csv(window, tmp_path / "own.csv"), npz):
+        back = read_file(path)[0]
+        assert back.kind == window.kind == kind and back.sample_rate_hz == window.sample_rate_hz
+        assert all(np.array_equal(back.signals[name], window.signals[name]) for name in window.signals)
+
+
+def test_a_file_in_its_own_columns_is_refused_naming_the_log_map_and_each_kinds_signals():
+    with pytest.raises(InputError) as refused:
+        read_file(MAPPED["linear"][0])
+    assert "--log-map" in refused.value.message and "a linear's command_mm, position_mm" in refused.value.message
+
+
+def test_a_missing_column_is_named_with_its_kind_and_two_kinds_alike_are_refused(tmp_path):
+    window = read_one(MAPPED["linear"][0], read_logmap(EXAMPLES / "ballscrew-rig" / "log-map.json"))
+    short = _own_csv(window, tmp_path / "short.csv", ["command_mm", "position_mm", "current_a"])
+    with pytest.raises(InputError, match=r"lacks the numeric column\(s\) load_n of a linear window"):
+        read_file(short)
+    both = dict(window.signals)
+    both.update({name: window.signals["position_mm"] for name in ("command_deg", "position_deg")})
+    both.update({"motor_speed_radps": both["current_a"], "hinge_moment_nm": both["load_n"]})
+    mixed = tmp_path / "mixed.npz"
+    np.savez(mixed, **both)
+    with pytest.raises(InputError, match="rotary and linear window alike"):
+        read_file(mixed)
