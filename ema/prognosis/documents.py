@@ -230,6 +230,10 @@ class ActuatorSummary(Document):
         default_factory=dict, description="the latest window's FDJ, eta_O and eta_A (null: not read)"
     )
     stds: dict[str, float | None] = Field(default_factory=dict)
+    units: dict[str, str] = Field(
+        default_factory=dict,
+        description="each latest estimate's unit (N·m at the motor shaft, N on the load, 1 for an efficiency)",
+    )
     nominal: dict[str, float] = Field(default_factory=dict)
     thresholds: dict[str, Threshold] = Field(default_factory=dict)
     thresholds_below: dict[str, Threshold] = Field(

@@ -117,6 +117,7 @@ def summary(
         latest_when=None if latest is None else when(latest),
         estimates={name: None if e is None else e.value for name, e in entries.items()},
         stds={name: None if e is None else e.std for name, e in entries.items()},
+        units={name: e.unit for name, e in entries.items() if e is not None and e.unit is not None},
         repeatability_stds={name: None if e is None else e.repeatability_std for name, e in entries.items()},
         nominal={name: e.nominal for name, e in entries.items() if e is not None and e.nominal is not None},
         thresholds={name: Threshold(level=limits[0][0], direction=limits[0][1]) for name, limits in levels.items()},

@@ -21,7 +21,7 @@ from ema.prognosis.status import URGENCY, status_of
 from ema.service.svg import trend_plot
 
 LATEST_NOTES = 5
-PARAMETER_UNITS = {"FDJ": "FDJ [N·m]", "eta_O": "η_O", "eta_A": "η_A"}
+PARAMETER_NAMES = {"FDJ": "FDJ", "eta_O": "η_O", "eta_A": "η_A"}
 STYLE = """
 body { font-family: system-ui, sans-serif; margin: 1.5em; color: #202124; }
 table { border-collapse: collapse; } td, th { padding: 4px 10px; border-bottom: 1px solid #ddd; text-align: left; }
@@ -60,13 +60,14 @@ def _cell(line: ActuatorSummary, name: str) -> str:
     if value is None:
         return "—"
     std = line.repeatability_stds.get(name) or line.stds.get(name)  # a change between windows is judged on it
-    shown = f"{value:.4g}" + ("" if std is None else f" ± {std:.2g}")
+    unit = line.units.get(name, "1")
+    shown = f"{value:.4g}" + ("" if std is None else f" ± {std:.2g}") + ("" if unit == "1" else f" {unit}")
     nominal = line.nominal.get(name)
     limits = [] if nominal is None else [f"nominal {nominal:.3g}"]
     for threshold in (line.thresholds.get(name), line.thresholds_below.get(name)):
         if threshold is not None:
             limits.append(f"fails {'>' if threshold.direction == 'above' else '<'} {threshold.level:.3g}")
-    return f"{shown} <small>({html.escape(', '.join(limits))})</small>"
+    return html.escape(shown) + (f" <small>({html.escape(', '.join(limits))})</small>" if limits else "")
 
 
 def life_text(life: RemainingLife | None, unit: str) -> str:
@@ -121,7 +122,7 @@ def fleet_page(
             f"<p>{len(pending)} actuator(s) stored windows since their line was computed; their prognoses are being "
             "brought up to date (shown as they were, or pending): reload in a moment.</p>"
         )
-    head = "".join(f"<th>{html.escape(h)}</th>" for h in ["actuator", "status", *PARAMETER_UNITS.values()])
+    head = "".join(f"<th>{html.escape(h)}</th>" for h in ["actuator", "status", *PARAMETER_NAMES.values()])
     parts.append(f"<table><tr>{head}<th>remaining life</th><th>last window</th></tr>")
     for line in lines:
         unit = (line.time_unit or "").replace("_", " ")
@@ -129,7 +130,7 @@ def fleet_page(
         cells = [
             actuator_link(line.actuator_id),
             f'<span class="badge" title="{html.escape(line.reason, quote=True)}">{html.escape(badge)}</span>',
-            *(_cell(line, name) for name in PARAMETER_UNITS),
+            *(_cell(line, name) for name in PARAMETER_NAMES),
             html.escape(line.reason) if line.status == "prognosis failed" else life_text(line.remaining_life, unit),
             html.escape(line.latest_when or line.latest_window_id or "—"),
         ]
@@ -221,7 +222,8 @@ def actuator_page(
     ]
     for name, trend in prognosis.trends.items():
         life = prognosis.remaining_life[name]
-        parts.append(f"<h2>{PARAMETER_UNITS[name]}</h2><p>{html.escape(life_text(life, unit))}</p>")
+        heading = PARAMETER_NAMES[name] + (f" [{actuator.facts.friction_unit}]" if name == "FDJ" else "")
+        parts.append(f"<h2>{html.escape(heading)}</h2><p>{html.escape(life_text(life, unit))}</p>")
         if trend.points:
             parts.append(trend_plot(trend, life, prognosis.time_unit))
         parts.append(_backtest(prognosis, name, unit))

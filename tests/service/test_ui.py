@@ -67,3 +67,36 @@ def test_with_a_key_the_pages_ask_for_it_as_a_password(tmp_path, base):
         wrong = base64.b64encode(b"operator:wrong").decode()
         assert client.get("/ui", headers={"authorization": f"Basic {wrong}"}).status_code == 401
         assert client.post("/ui", json={}, headers={"authorization": f"Basic {basic}"}).status_code == 405  # read only
+
+
+def test_each_fleet_row_shows_its_own_friction_unit_and_no_empty_limits():
+    """A servo's friction is a force on the load, a rotary's a torque at the motor: one column, each row's unit;
+    a row with neither nominal nor threshold shows none, not an empty bracket."""
+    from ema.prognosis.documents import ActuatorSummary, Threshold
+    from ema.service.pages import fleet_page
+
+    rotary = ActuatorSummary(
+        actuator_id="tail-1/elevator",
+        status="healthy",
+        reason="",
+        windows=6,
+        document="thesis",
+        estimates={"FDJ": 0.0512, "eta_O": 0.85},
+        stds={"FDJ": 0.001, "eta_O": 0.01},
+        units={"FDJ": "N·m", "eta_O": "1"},
+        nominal={"FDJ": 0.05},
+        thresholds={"FDJ": Threshold(level=0.075, direction="above")},
+    )
+    servo = ActuatorSummary(
+        actuator_id="emps/axis",
+        status="not enough history",
+        reason="",
+        windows=1,
+        document="EMPS",
+        estimates={"FDJ": 20.79},
+        stds={"FDJ": 0.27},
+        units={"FDJ": "N"},
+    )
+    page = fleet_page([rotary, servo], page=1, pages=1, total=2, pending=[], status=None, tail=None)
+    assert "<th>FDJ</th>" in page and "0.0512 ± 0.001 N·m <small>(nominal 0.05, fails &gt; 0.075)</small>" in page
+    assert "<td>20.79 ± 0.27 N</td>" in page and "()" not in page and "0.85 ± 0.01</td>" in page
