@@ -202,7 +202,7 @@ def history(
     """An actuator's stored estimates, their trend and its remaining useful life."""
     from ema.cli.figures import prognosis_figure
     from ema.cli.printing import print_prognosis
-    from ema.cli.replay import ServiceError, refusal_text, request
+    from ema.cli.replay import ServiceError, key_refused, refusal_text, request
     from ema.model.checks import InputError
     from ema.prognosis.documents import EstimateHistory, Prognosis
 
@@ -212,6 +212,8 @@ def history(
     try:
         stored = EstimateHistory.model_validate(request(f"{base}/estimates", key, timeout=60))
     except urllib.error.HTTPError as error:
+        if error.code in (401, 403):
+            raise key_refused(url, error.code, error.read().decode(errors="replace")) from None
         if error.code in (404, 422):
             raise InputError(
                 "ACTUATOR_ID", f"{actuator_id!r}: {refusal_text(error.code, error.read().decode())}"

@@ -67,6 +67,8 @@ def post_window(url: str, window: Window, api_key: str | None, sleep: Callable[[
                 sleep(pause)
                 waited += pause
                 continue
+            if error.code in (401, 403):
+                raise key_refused(url, error.code, detail) from None
             if error.code in (409, 422):
                 return {"error": refusal_text(error.code, detail)}
             raise ServiceError(f"HTTP {error.code} for {window.window_id}: {detail[:300]}") from None
@@ -89,14 +91,20 @@ def put_documents(
         except urllib.error.HTTPError as error:
             said = refusal_text(error.code, error.read().decode(errors="replace"))
             if error.code in (401, 403):
-                raise InputError(
-                    "--api-key-file", f"the service refused the document of {actuator_id}: {said}"
-                ) from None
+                raise key_refused(url, error.code, said) from None
             if error.code == 422:
                 raise InputError(sources[actuator_id], f"the service refused it for {actuator_id}: {said}") from None
             raise ServiceError(f"HTTP {error.code} storing the document of {actuator_id}: {said[:300]}") from None
         versions[actuator_id] = int(stored["version"])
     return versions
+
+
+def key_refused(url: str, status: int, body: str) -> Exception:
+    """The InputError naming --api-key-file for a 401 or 403: the key is missing or not this service's."""
+    from ema.model.checks import InputError
+
+    said = refusal_text(status, body) if body.lstrip().startswith("{") else f"HTTP {status}"
+    return InputError("--api-key-file", f"{url} refused the key ({said}): give its key in a file, or EMA_API_KEY")
 
 
 def refusal_text(status: int, body: str) -> str:

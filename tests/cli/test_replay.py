@@ -269,6 +269,8 @@ def test_a_servo_log_is_refused_until_its_document_is_stored_then_stored_once(tm
     server = start_server(port, tmp_path / "history.sqlite3", EMA_API_KEY="a-key-of-sixteen-or-more")
     try:
         replay = ["replay", *log, "--url", url, "--out", out, "--json"]
+        assert main(replay) == EXIT_BAD_INPUT  # no key: the first post names the flag
+        assert "--api-key-file" in capsys.readouterr().err
         assert main([*replay, "--api-key-file", str(key)]) == EXIT_BAD_INPUT  # nothing answered
         assert "PUT its document to /v1/actuators/emps/axis" in capsys.readouterr().out
         stored = [*replay, "--actuator", str(examples / "actuator.json")]
@@ -286,6 +288,7 @@ def test_a_servo_log_is_refused_until_its_document_is_stored_then_stored_once(tm
         assert main(history) == EXIT_OK and not plot.exists()
         captured = capsys.readouterr()
         assert "no figure written" in captured.err and "[no_threshold]" in captured.out
+        assert main(history[:4]) == EXIT_BAD_INPUT and "--api-key-file" in capsys.readouterr().err
     finally:
         server.terminate()
         server.wait(timeout=30)
