@@ -167,6 +167,8 @@ def report_log(read: Any) -> None:
         print(f"skipped {file}: {reason}", file=sys.stderr)
     for window_id, dropped in read.dropped.items():
         print(f"{window_id}: the last {dropped} sample(s) after it do not fill a window", file=sys.stderr)
+    for window_id, reason in read.kept_whole.items():
+        print(f"{window_id}: {reason}", file=sys.stderr)
 
 
 def _number(value: float | None, width: int, digits: str) -> str:

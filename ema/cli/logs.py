@@ -9,14 +9,14 @@ names none), so a piece moving one way is read with the sensors' zero another pi
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from ema.model.actuator import ActuatorDocument, actuator_from_dict
-from ema.model.bounds import DEFAULT_SAMPLE_RATE_HZ
+from ema.model.bounds import DEFAULT_SAMPLE_RATE_HZ, MIN_SAMPLES
 from ema.model.checks import InputError, load_json
 from ema.model.envelope import DEFAULT_AIRSPEED_MPS
 from ema.model.kinds import ALL_SIGNALS, KINDS, KindFacts, nearest_kind
@@ -39,9 +39,10 @@ class Defaults:
 
 
 def cut(window: Window, window_s: float) -> tuple[list[Window], int]:
-    """Consecutive windows of ``window_s`` seconds; returns them and the number of samples dropped."""
+    """Consecutive windows of ``window_s`` seconds; returns them and the number of samples dropped. A recording
+    whose pieces would hold fewer samples than a window may (a slow log) stays whole (``too_short_to_cut``)."""
     n = round(window_s * window.sample_rate_hz)
-    if window.n_samples <= n:
+    if window.n_samples <= n or too_short_to_cut(window, window_s):
         return [window], 0
     count = window.n_samples // n
     pieces = [
@@ -54,6 +55,18 @@ def cut(window: Window, window_s: float) -> tuple[list[Window], int]:
         for i in range(count)
     ]
     return pieces, window.n_samples - count * n
+
+
+def too_short_to_cut(window: Window, window_s: float) -> str | None:
+    """Why ``window`` is not cut into pieces of ``window_s`` seconds (each would hold fewer samples than a window
+    may), or None."""
+    n = round(window_s * window.sample_rate_hz)
+    if n >= MIN_SAMPLES or window.n_samples <= n:
+        return None
+    return (
+        f"kept whole: {window_s:g} s at {window.sample_rate_hz:g} Hz is {n} sample(s), under a window's {MIN_SAMPLES} "
+        f"(--window-s {MIN_SAMPLES / window.sample_rate_hz:.3g} or more cuts it)"
+    )
 
 
 def _from_json(path: Path) -> list[Window]:
@@ -143,6 +156,7 @@ class Log:
     windows: list[Window]
     dropped: dict[str, int]  # window_id -> samples after it that did not fill a window
     bad_files: dict[str, str]  # file -> why it was skipped
+    kept_whole: dict[str, str] = field(default_factory=dict)  # window_id -> why it was not cut (too_short_to_cut)
 
 
 def read_log(path: Path, window_s: float | None, defaults: Defaults = Defaults(), log_map: LogMap | None = None) -> Log:
@@ -161,6 +175,7 @@ def read_log(path: Path, window_s: float | None, defaults: Defaults = Defaults()
     windows: list[Window] = []
     dropped: dict[str, int] = {}
     bad: dict[str, str] = {}
+    kept_whole: dict[str, str] = {}
     for file in files:
         try:
             recordings = read_file(file, defaults, log_map)
@@ -171,13 +186,16 @@ def read_log(path: Path, window_s: float | None, defaults: Defaults = Defaults()
             continue
         for recording in recordings:
             pieces, tail = cut(recording, window_s) if window_s is not None else ([recording], 0)
+            whole = None if window_s is None else too_short_to_cut(recording, window_s)
+            if whole is not None:
+                kept_whole[recording.window_id] = whole
             windows.extend(pieces)
             if tail:
                 dropped[pieces[-1].window_id] = tail
     if not windows:
         first = next(iter(bad.items()), None)
         raise InputError(str(path), "holds no readable window" + (f" ({first[0]}: {first[1]})" if first else ""))
-    return Log(windows, dropped, bad)
+    return Log(windows, dropped, bad, kept_whole)
 
 
 def read_actuators(folder: Path) -> dict[str, ActuatorDocument]:

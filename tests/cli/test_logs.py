@@ -56,3 +56,19 @@ def test_a_missing_column_is_named_with_its_kind_and_two_kinds_alike_are_refused
     np.savez(mixed, **both)
     with pytest.raises(InputError, match="rotary and linear window alike"):
         read_file(mixed)
+
+
+def test_a_slow_log_is_kept_whole_rather_than_cut_into_pieces_no_window_may_be(tmp_path):
+    """The rig's 25 Hz run in ema's columns under the default 0.5 s cut: 12-sample pieces would each be refused;
+    it stays one window, and says why and which --window-s would cut it."""
+    from ema.cli.logs import read_log
+
+    window = read_one(MAPPED["linear"][0], read_logmap(EXAMPLES / "ballscrew-rig" / "log-map.json"))
+    folder = tmp_path / "archive"
+    folder.mkdir()
+    _own_csv(window, folder / "run.csv")
+    read = read_log(folder, 0.5)
+    assert [w.n_samples for w in read.windows] == [window.n_samples] and read.dropped == {}
+    assert "kept whole: 0.5 s at 25 Hz is 12 sample(s)" in read.kept_whole["own"]
+    assert "--window-s 4 or more" in read.kept_whole["own"]
+    assert [w.n_samples for w in read_log(folder, 4.0).windows] == [100] * (window.n_samples // 100)
