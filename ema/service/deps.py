@@ -6,8 +6,9 @@ from __future__ import annotations
 import logging
 import re
 import threading
+import urllib.parse
 from collections import OrderedDict
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import Annotated
 
 from fastapi import Depends, Path, Request
@@ -19,6 +20,7 @@ from ema.history.open import History
 from ema.model.actuator import THESIS, ActuatorDocument
 from ema.model.bounds import IDENTIFIER, route_collision
 from ema.model.checks import InputError, validated
+from ema.model.window import Window
 from ema.prognosis.documents import Prognosis, Stored
 from ema.prognosis.prognose import prognose
 from ema.service.config import Settings
@@ -88,6 +90,23 @@ def document_of(store: History, actuator_id: str) -> tuple[ActuatorDocument, int
 
 async def actuator_of(store: History, actuator_id: str) -> tuple[ActuatorDocument, int | None]:
     return await run_in_threadpool(document_of, store, actuator_id)
+
+
+def stored_kind(windows: Sequence[Window], actuator: ActuatorDocument, version: int | None, *, listed: bool) -> None:
+    """InputError naming the first window of another kind than the default's where its actuator has no stored
+    document (``windows.i.signals``, or ``signals`` for a window posted alone), saying how to store one: read with
+    the default, it would be refused as a rotary window only."""
+    if version is not None:
+        return
+    for i, window in enumerate(windows):
+        if window.kind != actuator.kind:
+            path = f"/v1/actuators/{urllib.parse.quote(window.actuator_id, safe='/')}"
+            raise InputError(
+                f"windows.{i}.signals" if listed else "signals",
+                f"are a {window.kind} actuator's ({', '.join(window.signal_names)}), and no ema-actuator/1 document "
+                f"is stored for {window.actuator_id!r} (the default is a {actuator.kind} one): PUT its document to "
+                f"{path} first (ema replay --actuator A.json does)",
+            )
 
 
 def safe_prognosis(

@@ -9,7 +9,6 @@ and the answer committed before it leaves. The fleet view's line of the actuator
 from __future__ import annotations
 
 import threading
-import urllib.parse
 from collections.abc import Awaitable, Callable
 from functools import partial
 
@@ -19,12 +18,10 @@ from ema import kinds
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import Estimate
 from ema.history.open import History
-from ema.model.actuator import THESIS
-from ema.model.checks import InputError
 from ema.model.window import Window
 from ema.prognosis.documents import Stored
 from ema.service.config import Settings
-from ema.service.deps import actuator_of, request_config, stopper
+from ema.service.deps import actuator_of, request_config, stopper, stored_kind
 from ema.service.jobs import JobRunner
 from ema.service.parsing import check_budget
 from ema.service.view import LineKeeper
@@ -70,23 +67,11 @@ async def _job(
     """The pipeline run for ``window``: in this process or on Ray, with what the history lends it."""
     history = await run_in_threadpool(store.readings, window.actuator_id, window.flight_id)
     actuator, version = await actuator_of(store, window.actuator_id)
-    if version is None and window.kind != actuator.kind:
-        raise InputError("signals", _no_document(window))
+    stored_kind([window], actuator, version, listed=False)
     if settings.backend == "ray":
         from ema.kinds.remote import estimate_on_ray
 
         return partial(estimate_on_ray, window, config, 1, history, actuator, version)
     return partial(
         kinds.estimate, window, config, actuator=actuator, version=version, on_stage=stopper(cancel), history=history
-    )
-
-
-def _no_document(window: Window) -> str:
-    """Why a window of another kind than the default's is refused where its actuator has no stored document, and
-    how to store one (without it the window would be read as the default's rotary EMA)."""
-    path = f"/v1/actuators/{urllib.parse.quote(window.actuator_id, safe='/')}"
-    return (
-        f"are a {window.kind} actuator's ({', '.join(window.signal_names)}), and no ema-actuator/1 document is "
-        f"stored for {window.actuator_id!r} (the default is a {THESIS.kind} one): PUT its document to {path} "
-        "first (ema replay --actuator A.json does)"
     )

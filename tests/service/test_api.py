@@ -302,3 +302,23 @@ def test_a_bad_actuator_document_is_a_422_naming_its_field(client):
     bad["nominal"]["fsj_nm"] = 0.001
     response = client.put("/v1/actuators/x", json=bad)
     assert response.status_code == 422 and response.json()["detail"][0]["loc"] == ["body", "nominal", "fsj_nm"]
+
+
+def test_a_servo_window_without_its_stored_document_is_refused_saying_how_to_store_it(client):
+    """The EMPS log as a window, to an actuator with no document: not read as the default's rotary EMA, and the
+    refusal names the path to PUT its document to, for an estimate and for a calibration alike."""
+    from pathlib import Path
+
+    from ema.cli.logs import read_one
+    from ema.model.logmap import read_logmap
+    from ema.model.window import window_to_dict
+
+    emps = Path(__file__).resolve().parents[2] / "examples" / "emps"
+    window = window_to_dict(read_one(emps / "DATA_EMPS.mat", read_logmap(emps / "log-map.json")))
+    for route, body, field in (
+        ("/v1/estimate", window, ["body", "signals"]),
+        ("/v1/calibrate", {"windows": [window]}, ["body", "windows", "0", "signals"]),
+    ):
+        refused = client.post(route, json=body)
+        assert refused.status_code == 422 and refused.json()["detail"][0]["loc"] == field
+        assert "PUT its document to /v1/actuators/emps/axis" in refused.json()["detail"][0]["msg"]

@@ -6,7 +6,7 @@ from starlette.concurrency import run_in_threadpool
 from ema import kinds
 from ema.calibration.documents import CalibrationReport
 from ema.model.window import Window
-from ema.service.deps import RunnerDep, SettingsDep, StoreDep, actuator_of, stopper
+from ema.service.deps import RunnerDep, SettingsDep, StoreDep, actuator_of, stopper, stored_kind
 from ema.service.parsing import check_calibration_budget, read_body
 from ema.service.schemas import CalibrateIn, json_body, responses
 
@@ -32,7 +32,8 @@ async def calibrate(request: Request, settings: SettingsDep, store: StoreDep, ru
     windows, truth = await read_body(request, runner, CalibrateIn, _windows_and_truth)
     with runner.admit() as ticket:
         check_calibration_budget(windows, settings.pipeline, settings)
-        actuator, _ = await actuator_of(store, windows[0].actuator_id)
+        actuator, version = await actuator_of(store, windows[0].actuator_id)
+        stored_kind(windows, actuator, version, listed=True)
         stop = stopper(ticket.cancel)
         asked = kinds.CalibrationRequest(settings.pipeline, actuator, truth, on_stage=stop, checkpoint=lambda: stop(""))
         report = await runner.run(ticket, request.is_disconnected, lambda: kinds.calibrate(windows, asked).report)
