@@ -140,7 +140,8 @@ def pipeline_config(values: Mapping[str, Any]) -> Any:
 
 @contextlib.contextmanager
 def flags_named(flags: Mapping[str, str]) -> Iterator[None]:
-    """Re-raise an InputError about an internal field as one about the flag the user typed."""
+    """Re-raise an InputError about an internal field as one about the flag the user typed (a field below one the
+    flag sets named after it: ``effects.viscous`` -> ``--effect viscous``)."""
     from ema.model.checks import InputError
 
     try:
@@ -148,7 +149,10 @@ def flags_named(flags: Mapping[str, str]) -> Iterator[None]:
     except InputError as exc:
         flag = flags.get(exc.field) or next((f for field, f in flags.items() if exc.field.endswith(field)), None)
         if flag is None:
-            raise
+            below = next(((field, f) for field, f in flags.items() if exc.field.startswith(f"{field}.")), None)
+            if below is None:
+                raise
+            flag = f"{below[1]} {exc.field[len(below[0]) + 1 :]}"
         raise InputError(flag, exc.message) from None
 
 

@@ -14,7 +14,7 @@ from ema.cli.options import actuator_document
 from ema.model.actuator import ActuatorDocument
 from ema.model.aircraft import FlightCondition, GroundLoad
 from ema.model.checks import InputError
-from ema.model.effects import EffectSet
+from ema.model.effects import EFFECTS, EffectSet
 from ema.model.noise import NO_NOISE, SensorNoise
 from ema.model.params import HealthParams
 from ema.model.residual import residual_torque_nm
@@ -25,6 +25,9 @@ from ema.model.window import Window, write_window
 def parse_effect(text: str) -> tuple[str, dict[str, float]]:
     """``name:key=value,key=value`` (or just ``name`` for its neutral values) -> (name, parameters)."""
     name, _, assignments = text.partition(":")
+    name = name.strip()
+    if name not in EFFECTS:
+        raise InputError("--effect", f"unknown effect {name!r}; known: {', '.join(EFFECTS)}")
     parameters: dict[str, float] = {}
     for assignment in filter(None, assignments.split(",")):
         key, sep, value = assignment.partition("=")
@@ -34,7 +37,7 @@ def parse_effect(text: str) -> tuple[str, dict[str, float]]:
             parameters[key.strip()] = float(value)
         except ValueError:
             raise InputError(f"--effect {name}.{key}", f"{value!r} is not a number") from None
-    return name.strip(), parameters
+    return name, parameters
 
 
 def summary(window: Window, actuator: ActuatorDocument) -> dict[str, Any]:

@@ -97,6 +97,9 @@ def test_simulate_with_an_effect_and_a_table(tmp_path, capsys):
     [
         (["--altitude", "20000"], "--altitude"),
         (["--effect", "cogging:amplitude_nm=x"], "--effect cogging.amplitude_nm"),
+        (["--effect", "cog:amplitude_nm=x"], "--effect: unknown effect 'cog'"),  # the name before its numbers
+        (["--effect", "cogging:amp=0.01"], "--effect cogging: unknown parameter(s) ['amp']"),
+        (["--effect", "cogging:amplitude_nm=9"], "--effect cogging.amplitude_nm: 9 is outside"),
         (["--rate", "50"], "--rate"),
         (["--command", "loop"], "--command"),
     ],
