@@ -53,15 +53,18 @@ def history_of(window: Any, paths: tuple[Path, ...]) -> Any:
 
     from ema.estimate.documents import Estimate
     from ema.estimate.history import readings_of
-    from ema.model.checks import InputError
+    from ema.model.checks import InputError, from_validation, load_json
 
     results = []
     for path in paths:
         try:
-            result = Estimate.model_validate_json(path.read_bytes())
-        except (OSError, ValidationError) as exc:
-            first = str(exc).splitlines()[0]
-            raise InputError("--history", f"{path} is not an ema-estimate/1 result ({first})") from None
+            result = Estimate.model_validate(load_json(path))
+        except InputError as exc:
+            raise InputError("--history", f"{path} {exc.message}") from None
+        except ValidationError as exc:
+            first = from_validation(exc)
+            said = f"{path} is not an ema-estimate/1 result ({first.field}: {first.message})"
+            raise InputError("--history", said) from None
         if result.actuator_id != window.actuator_id:
             raise InputError(
                 "--history", f"{path} is of actuator {result.actuator_id}, the window of {window.actuator_id}"

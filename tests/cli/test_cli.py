@@ -145,7 +145,13 @@ def test_estimate_reads_other_windows_results_as_history_and_names_a_bad_one(tmp
     assert main(["estimate", str(window), *SIZES, "--history", str(result), "--history", str(result)]) == EXIT_OK
     other = tmp_path / "other.json"
     other.write_text(json.dumps({**document, "actuator_id": "another/elevator"}))
-    for bad, named in ((window, "is not an ema-estimate/1 result"), (other, "another/elevator")):
+    broken = tmp_path / "broken.json"
+    broken.write_text(json.dumps(document)[:-40])
+    for bad, named in (
+        (window, "w.json is not an ema-estimate/1 result (schema: Input should be 'ema-estimate/1')"),  # a window
+        (broken, "broken.json cannot be read as JSON"),
+        (other, "another/elevator"),
+    ):
         assert main(["estimate", str(window), "--history", str(bad)]) == EXIT_BAD_INPUT
         assert "--history" in (err := capsys.readouterr().err) and named in err
 
