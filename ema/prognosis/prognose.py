@@ -33,10 +33,13 @@ def _times(stored: Sequence[Stored]) -> tuple[np.ndarray, TimeUnit, Note | None]
         seconds = np.array([dt.datetime.fromisoformat(str(s.window.recorded_at)).timestamp() for s in stored])
         return (seconds - seconds.min()) / 86_400.0, "days", None
     timeless = sum(s.window.flight_hours is None and s.window.recorded_at is None for s in stored)
-    text = (
-        f"{timeless} of the {len(stored)} windows give neither flight_hours nor recorded_at (and not all give "
-        "one of them): trended by the order they were stored in, so a remaining life counts windows, not time"
+    said = (
+        f"none of the {len(stored)} window(s) gives flight_hours or recorded_at"
+        if timeless == len(stored)
+        else f"the windows share no time base ({timeless} of the {len(stored)} give neither flight_hours nor "
+        "recorded_at, or some give only one and others only the other)"
     )
+    text = f"{said}: trended by the order they were stored in, so a remaining life counts windows, not time"
     order = np.argsort([s.id for s in stored], kind="stable")
     return np.argsort(order).astype(float), "windows", Note(code="time_by_window_order", text=text)
 
