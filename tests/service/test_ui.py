@@ -75,28 +75,19 @@ def test_each_fleet_row_shows_its_own_friction_unit_and_no_empty_limits():
     from ema.prognosis.documents import ActuatorSummary, Threshold
     from ema.service.pages import fleet_page
 
-    rotary = ActuatorSummary(
-        actuator_id="tail-1/elevator",
-        status="healthy",
-        reason="",
-        windows=6,
-        document="thesis",
+    def line(actuator_id: str, status: str, **values) -> ActuatorSummary:
+        return ActuatorSummary(actuator_id=actuator_id, status=status, reason="", windows=6, document="d", **values)
+
+    rotary = line(
+        "tail-1/elevator",
+        "healthy",
         estimates={"FDJ": 0.0512, "eta_O": 0.85},
         stds={"FDJ": 0.001, "eta_O": 0.01},
         units={"FDJ": "N·m", "eta_O": "1"},
         nominal={"FDJ": 0.05},
         thresholds={"FDJ": Threshold(level=0.075, direction="above")},
     )
-    servo = ActuatorSummary(
-        actuator_id="emps/axis",
-        status="not enough history",
-        reason="",
-        windows=1,
-        document="EMPS",
-        estimates={"FDJ": 20.79},
-        stds={"FDJ": 0.27},
-        units={"FDJ": "N"},
-    )
+    servo = line("emps/axis", "not enough history", estimates={"FDJ": 20.79}, stds={"FDJ": 0.27}, units={"FDJ": "N"})
     page = fleet_page([rotary, servo], page=1, pages=1, total=2, pending=[], status=None, tail=None)
     assert "<th>FDJ</th>" in page and "0.0512 ± 0.001 N·m <small>(nominal 0.05, fails &gt; 0.075)</small>" in page
     assert "<td>20.79 ± 0.27 N</td>" in page and "()" not in page and "0.85 ± 0.01</td>" in page
