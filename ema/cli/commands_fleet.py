@@ -10,6 +10,7 @@ import click
 
 from ema.cli.options import (
     OUTPUT_FILE,
+    OUTPUT_FOLDER,
     NothingAnsweredError,
     actuator,
     as_json,
@@ -130,7 +131,7 @@ def _print_fleet(result: dict) -> None:
 @click.command()
 @click.option(
     "--out",
-    type=click.Path(file_okay=False, path_type=Path),
+    type=OUTPUT_FOLDER,
     default=None,
     help="also write the figures as bench.json in this folder  [default: print them, write nothing]",
 )

@@ -263,7 +263,10 @@ def schemas(out: Path | None, check: bool) -> None:
         out = REPOSITORY_SCHEMAS
         if not out.is_dir():
             raise InputError("--out", "this ema was not installed from a repository: name the folder to check")
-    stale = export(out, check=check)
+    try:
+        stale = export(out, check=check)
+    except OSError as error:
+        raise InputError("--out", f"{out}: cannot be written ({error.strerror})") from None
     if check and stale:
         raise click.ClickException(f"stale or missing in {out}: {', '.join(stale)} (run: ema schemas --out {out})")
     click.echo(json.dumps({"folder": str(out), "checked" if check else "written": "all"}))

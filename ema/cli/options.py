@@ -32,7 +32,20 @@ class _OutputFile(click.Path):
         return path
 
 
+class _OutputFolder(click.Path):
+    """A folder the command writes into: made as the flag is read, or refused naming the flag before any work."""
+
+    def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
+        path = super().convert(value, param, ctx)
+        try:
+            Path(os.fsdecode(path)).mkdir(parents=True, exist_ok=True)
+        except OSError as error:
+            self.fail(f"{value}: it cannot be made ({error.strerror})", param, ctx)
+        return path
+
+
 OUTPUT_FILE = _OutputFile(dir_okay=False, path_type=Path)
+OUTPUT_FOLDER = _OutputFolder(file_okay=False, path_type=Path)
 SIZES = {  # flag -> PipelineConfig field
     "--sims": "n_simulations",
     "--checks": "check_windows",

@@ -119,6 +119,18 @@ def test_bench_refuses_a_duration_of_no_window_naming_the_flag(durations, capsys
     assert f"--durations: {durations.split(',')[-1]} is outside" in capsys.readouterr().err
 
 
+def test_an_output_folder_that_cannot_be_made_is_refused_naming_the_flag_before_any_work(tmp_path, capsys):
+    """bench times its windows for minutes before writing bench.json: a folder it cannot make is said first (a
+    file where the folder would go); schemas names --out too, and --check writes no folder."""
+    blocker = tmp_path / "a-file"
+    blocker.write_text("")
+    assert main(["bench", "--out", str(blocker / "sub"), "--repeats", "1", "--durations", "0.05"]) == EXIT_BAD_INPUT
+    assert "--out" in capsys.readouterr().err
+    assert main(["schemas", "--out", str(blocker / "sub")]) == EXIT_BAD_INPUT
+    assert "--out" in capsys.readouterr().err
+    assert main(["schemas", "--check", "--out", str(tmp_path / "none")]) != EXIT_OK and not (tmp_path / "none").exists()
+
+
 def test_the_readmes_series_step_prints_every_window(tmp_path, capsys):
     out = tmp_path / "degrading"
     command = ["simulate", "--out", str(out), "--series", "3", "--every", "25", "--fdj-end", "0.07"]
