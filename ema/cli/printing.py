@@ -189,7 +189,6 @@ def _print_drive(drive: dict[str, Any]) -> None:
         click.echo(f"  not separable: {unread}")
 
 
-UNITS = {"FDJ": " N·m", "eta_O": "", "eta_A": "", "hinge_aircraft_ratio": ""}
 TIME_UNITS = {
     "flight_hours": ("flight hour", "flight hours"),
     "days": ("day", "days"),
@@ -197,11 +196,24 @@ TIME_UNITS = {
 }
 
 
-def _slope(trend: Any, unit: str) -> str:
-    """The trend's slope with its unit: the parameter's per the prognosis's time unit."""
+def _slope(trend: Any, unit: str, value_unit: str = "") -> str:
+    """The trend's slope with its unit: the parameter's (``value_unit``, with its leading space) per the
+    prognosis's time unit."""
     if trend.slope_std is None:
         return "no slope yet"
-    return f"slope {trend.slope_per_unit:+.3g} ± {trend.slope_std:.2g}{UNITS.get(trend.parameter, '')} per {unit}"
+    return f"slope {trend.slope_per_unit:+.3g} ± {trend.slope_std:.2g}{value_unit} per {unit}"
+
+
+def _value_units(stored: Any) -> dict[str, str]:
+    """Each parameter's unit as its latest stored estimate gives it, with a leading space (none for an efficiency,
+    or where no estimate says): N·m at the motor shaft, N on the load."""
+    units: dict[str, str] = {}
+    for entry in reversed(stored.estimates):
+        for name in ("FDJ", "eta_O", "eta_A"):
+            estimate = getattr(entry.estimates, name)
+            if name not in units and estimate is not None and estimate.unit not in (None, "1"):
+                units[name] = f" {estimate.unit}"
+    return units
 
 
 def _life(life: Any, unit: str) -> str:
@@ -219,12 +231,14 @@ def _life(life: Any, unit: str) -> str:
 def print_prognosis(stored: Any, prognosis: Any, plot: Path | None) -> None:
     """An actuator's outlook per parameter, the laws it weighs, its backtest, its sensors' trends and notes."""
     one, many = TIME_UNITS[prognosis.time_unit]
+    units = _value_units(stored)
     click.echo(f"{prognosis.actuator_id}: {len(stored.estimates)} window(s), time in {many}")
     for name, trend in prognosis.trends.items():
         level, level_std = trend.now()
         laws = ", ".join(f"{law} {w:.2f}" for law, w in sorted(trend.laws.items(), key=lambda x: -x[1]) if w >= 0.05)
         life = _life(prognosis.remaining_life[name], many)
-        click.echo(f"{name:<6} now {level:.5g} ± {level_std:.2g}{UNITS[name]}, {_slope(trend, one)}; {life}")
+        unit = units.get(name, "")
+        click.echo(f"{name:<6} now {level:.5g} ± {level_std:.2g}{unit}, {_slope(trend, one, unit)}; {life}")
         if laws:
             click.echo(f"       laws weighed by how they predicted later windows: {laws}")
         for point in prognosis.backtest.get(name, []):
