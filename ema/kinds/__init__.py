@@ -59,7 +59,8 @@ def same_kind(windows: Sequence[Window], actuator: ActuatorDocument, *, listed: 
             raise InputError(
                 f"windows.{i}.signals" if listed else "signals",
                 f"are a {window.kind} actuator's ({', '.join(window.signal_names)}), but the document "
-                f"{actuator.name!r} is of a {actuator.kind} one (its kind): window {window.window_id}",
+                f"{actuator.name!r} is a {actuator.kind} one's: read window {window.window_id} with its own "
+                "actuator's document",
             )
 
 
