@@ -117,19 +117,19 @@ def replayed_documents(
     log: Path, actuator_file: Path | None, actuator_ids: set[str]
 ) -> tuple[dict[str, Any], dict[str, str]]:
     """(actuator_id -> the ema-actuator/1 document to store before its windows are posted, actuator_id -> where
-    it came from): a folder's actuators.json's, else --actuator's, else none (the service reads the windows with
-    the document it holds)."""
+    it came from): as ``ema fleet`` reads them (``ema.cli.workers.Documents``), a folder's actuators.json's, else
+    --actuator's, else none (the service reads the windows with the document it holds)."""
     from ema.cli.logs import ACTUATORS_FILE, read_actuators
+    from ema.cli.workers import Documents
     from ema.model.actuator import read_actuator
 
-    listed = read_actuators(log)
-    given = None if actuator_file is None else read_actuator(actuator_file)
+    given = Documents(read_actuators(log), None if actuator_file is None else read_actuator(actuator_file))
     documents, sources = {}, {}
     for actuator_id in sorted(actuator_ids):
-        if actuator_id in listed:
-            documents[actuator_id], sources[actuator_id] = listed[actuator_id], f"{log / ACTUATORS_FILE}: {actuator_id}"
-        elif given is not None:
-            documents[actuator_id], sources[actuator_id] = given, "--actuator"
+        if (document := given.of(actuator_id)) is not None:
+            listed = actuator_id in given.by_actuator
+            documents[actuator_id] = document
+            sources[actuator_id] = f"{log / ACTUATORS_FILE}: {actuator_id}" if listed else "--actuator"
     return documents, sources
 
 
@@ -147,7 +147,7 @@ def check_service(url: str, key: str | None) -> None:
     """ServiceError where nothing answers at ``url`` or the service fails; an InputError naming the flag where
     what answers is no ema service's root (a path such as /v1 added) or wants a key: said before any file is
     written, and before a 404 could be read as the actuator's."""
-    from ema.cli.replay import ServiceError, request
+    from ema.cli.replay import ServiceError, key_refused, request
     from ema.model.checks import InputError
 
     try:
@@ -155,7 +155,7 @@ def check_service(url: str, key: str | None) -> None:
     except urllib.error.HTTPError as error:
         said = f"{url}/healthz answered HTTP {error.code}"
         if error.code == 401:
-            raise InputError("--api-key-file", f"{said}: the service wants its key (or EMA_API_KEY)") from None
+            raise key_refused(url, error.code, error.read().decode(errors="replace")) from None
         if error.code < 500:
             raise InputError("--url", f"{said}: no ema service's root address answers so") from None
         raise ServiceError(f"{said}: the service failed") from None

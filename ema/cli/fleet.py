@@ -256,7 +256,7 @@ def _stored_documents(store: Any, documents: Documents, actuator_ids: set[str]) 
     with the versions the history gave them."""
     versions = {}
     for actuator_id in sorted(actuator_ids):
-        document = documents.by_actuator.get(actuator_id, documents.default)
+        document = documents.of(actuator_id)
         if document is not None:
             versions[actuator_id] = store.put_actuator(actuator_id, document).version
     return replace(documents, versions=versions)

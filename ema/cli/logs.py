@@ -39,10 +39,10 @@ class Defaults:
 
 
 def cut(window: Window, window_s: float) -> tuple[list[Window], int]:
-    """Consecutive windows of ``window_s`` seconds; returns them and the number of samples dropped. A recording
-    whose pieces would hold fewer samples than a window may (a slow log) stays whole (``too_short_to_cut``)."""
+    """Consecutive windows of ``window_s`` seconds; returns them and the number of samples dropped (``read_log``
+    cuts no recording ``too_short_to_cut``)."""
     n = round(window_s * window.sample_rate_hz)
-    if window.n_samples <= n or too_short_to_cut(window, window_s):
+    if window.n_samples <= n:
         return [window], 0
     count = window.n_samples // n
     pieces = [
@@ -185,10 +185,10 @@ def read_log(path: Path, window_s: float | None, defaults: Defaults = Defaults()
             bad[str(file)] = exc.message
             continue
         for recording in recordings:
-            pieces, tail = cut(recording, window_s) if window_s is not None else ([recording], 0)
             whole = None if window_s is None else too_short_to_cut(recording, window_s)
             if whole is not None:
                 kept_whole[recording.window_id] = whole
+            pieces, tail = cut(recording, window_s) if window_s is not None and whole is None else ([recording], 0)
             windows.extend(pieces)
             if tail:
                 dropped[pieces[-1].window_id] = tail

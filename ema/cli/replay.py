@@ -89,9 +89,10 @@ def put_documents(
         try:
             stored = request(f"{url}/v1/actuators/{quote(actuator_id, safe='/')}", api_key, body, 60, "PUT")
         except urllib.error.HTTPError as error:
-            said = refusal_text(error.code, error.read().decode(errors="replace"))
+            detail = error.read().decode(errors="replace")
             if error.code in (401, 403):
-                raise key_refused(url, error.code, said) from None
+                raise key_refused(url, error.code, detail) from None
+            said = refusal_text(error.code, detail)
             if error.code == 422:
                 raise InputError(sources[actuator_id], f"the service refused it for {actuator_id}: {said}") from None
             raise ServiceError(f"HTTP {error.code} storing the document of {actuator_id}: {said[:300]}") from None

@@ -1,8 +1,8 @@
 """Where a window's task runs in ``ema fleet``: the engines, each yielding (window, answer) as answers come.
 
 - ``in_process``: one window after another in this process (one worker);
-- ``ema.cli.pool.LocalWorkers``: a pool of local processes (the standard library's executor), started first
-  thing, each warming itself while the driver reads the archive;
+- ``ema.cli.pool.LocalWorkers``: a pool of local processes (the standard library's executor), its fork server
+  started first thing and loading torch while the driver reads the archive;
 - ``on_ray``: a Ray cluster's workers (``--ray-address``).
 
 Each window is a task that pins its own thread budget (one thread by default: a worker is a core, so throughput
@@ -33,10 +33,14 @@ class Documents:
     default: Any = None  # an Actuator, or None: the thesis's (the answer then says so)
     versions: dict[str, int] = field(default_factory=dict)
 
+    def of(self, actuator_id: str) -> Any:
+        """The document ``actuator_id``'s windows are read with: its own, else ``default`` (None: the thesis's)."""
+        return self.by_actuator.get(actuator_id, self.default)
+
     def task_arguments(self, window: Window) -> tuple[dict[str, Any] | None, int | None]:
         """(the document as JSON, its version) for ``window``'s task (None: the default,
         ``ema.model.actuator.THESIS``)."""
-        document = self.by_actuator.get(window.actuator_id, self.default)
+        document = self.of(window.actuator_id)
         if document is None:
             return None, None
         return document.model_dump(mode="json", by_alias=True), self.versions.get(window.actuator_id)

@@ -17,6 +17,7 @@ from starlette.concurrency import run_in_threadpool
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import Note
 from ema.history.open import History
+from ema.kinds import same_kind
 from ema.model.actuator import THESIS, ActuatorDocument
 from ema.model.bounds import IDENTIFIER, route_collision
 from ema.model.checks import InputError, validated
@@ -93,20 +94,21 @@ async def actuator_of(store: History, actuator_id: str) -> tuple[ActuatorDocumen
 
 
 def stored_kind(windows: Sequence[Window], actuator: ActuatorDocument, version: int | None, *, listed: bool) -> None:
-    """InputError naming the first window of another kind than the default's where its actuator has no stored
-    document (``windows.i.signals``, or ``signals`` for a window posted alone), saying how to store one: read with
-    the default, it would be refused as a rotary window only."""
+    """``ema.kinds.same_kind`` where the actuator has no stored document, its refusal saying how to store one:
+    read with the default, a window of another kind is refused as that only (``listed``: ``windows.i.signals``,
+    else ``signals`` for a window posted alone)."""
     if version is not None:
-        return
-    for i, window in enumerate(windows):
-        if window.kind != actuator.kind:
-            path = f"/v1/actuators/{urllib.parse.quote(window.actuator_id, safe='/')}"
-            raise InputError(
-                f"windows.{i}.signals" if listed else "signals",
-                f"are a {window.kind} actuator's ({', '.join(window.signal_names)}), and no ema-actuator/1 document "
-                f"is stored for {window.actuator_id!r} (the default is a {actuator.kind} one): PUT its document to "
-                f"{path} first (ema replay --actuator A.json does)",
-            )
+        return  # a stored document: the kind's own run checks its windows against it
+    try:
+        same_kind(windows, actuator, listed=listed)
+    except InputError as exc:
+        actuator_id = windows[0].actuator_id
+        path = f"/v1/actuators/{urllib.parse.quote(actuator_id, safe='/')}"
+        raise InputError(
+            exc.field,
+            f"{exc.message}; no ema-actuator/1 document is stored for {actuator_id!r} (the default is used): PUT "
+            f"its document to {path} first (ema replay --actuator A.json does)",
+        ) from None
 
 
 def safe_prognosis(
