@@ -15,17 +15,21 @@ from typing import Any
 
 import numpy as np
 
+from ema.model.actuator import SCHEMA as ACTUATOR_SCHEMA
 from ema.model.actuator import ActuatorDocument, actuator_from_dict
 from ema.model.bounds import DEFAULT_SAMPLE_RATE_HZ, MIN_SAMPLES
 from ema.model.checks import InputError, load_json
 from ema.model.envelope import DEFAULT_AIRSPEED_MPS
 from ema.model.kinds import ALL_SIGNALS, KINDS, KindFacts, nearest_kind
+from ema.model.logmap import SCHEMA as LOGMAP_SCHEMA
 from ema.model.logmap import LogMap, read_mapped
 from ema.model.tables import TABLE_SUFFIXES, read_table
+from ema.model.window import SCHEMA as WINDOW_SCHEMA
 from ema.model.window import Window, window_from_dict
 
 SUFFIXES = (".json", *TABLE_SUFFIXES)
 ACTUATORS_FILE = "actuators.json"  # in an archive's folder: {actuator_id: its ema-actuator/1 document}
+GIVEN_BY_FLAG = {ACTUATOR_SCHEMA: "--actuator", LOGMAP_SCHEMA: "--log-map"}  # documents that go beside a log
 
 
 @dataclass(frozen=True)
@@ -70,7 +74,15 @@ def too_short_to_cut(window: Window, window_s: float) -> str | None:
 
 
 def _from_json(path: Path) -> list[Window]:
+    """The windows of a JSON file; another of ema's documents (one that goes beside a log, kept in its folder) is
+    refused saying what it is and the flag that takes it."""
     document = load_json(path)
+    schema = document.get("schema") if isinstance(document, dict) else None
+    if isinstance(schema, str) and schema.startswith("ema-") and schema != WINDOW_SCHEMA:
+        flag = GIVEN_BY_FLAG.get(schema)
+        raise InputError(
+            str(path), f"is an {schema} document, not a window" + (f": give it with {flag}" if flag else "")
+        )
     documents = document if isinstance(document, list) else [document]
     return [window_from_dict(d) for d in documents]
 
@@ -109,7 +121,7 @@ def _window(signals: dict[str, np.ndarray], meta: dict[str, Any], defaults: Defa
     """Arrays and metadata through the ema-window/1 contract, as a JSON window would go."""
     try:
         document: dict[str, Any] = {
-            "schema": "ema-window/1",
+            "schema": WINDOW_SCHEMA,
             "actuator_id": str(meta.get("actuator_id", defaults.actuator_id)),
             "window_id": str(meta.get("window_id", path.stem)),
             "sample_rate_hz": float(meta.get("sample_rate_hz", defaults.sample_rate_hz)),

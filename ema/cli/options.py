@@ -91,7 +91,7 @@ def log_map(function: F) -> F:
         type=EXISTING,
         default=None,
         metavar="M.json",
-        help="an ema-logmap/1 document: read CSV logs in the rig's own columns and units",
+        help="an ema-logmap/1 document: read logs (CSV, MATLAB, NPZ) in their own columns and units",
     )(function)
 
 

@@ -72,3 +72,23 @@ def test_a_slow_log_is_kept_whole_rather_than_cut_into_pieces_no_window_may_be(t
     assert "kept whole: 0.5 s at 25 Hz is 12 sample(s)" in read.kept_whole["own"]
     assert "--window-s 4 or more" in read.kept_whole["own"]
     assert [w.n_samples for w in read_log(folder, 4.0).windows] == [100] * (window.n_samples // 100)
+
+
+def test_a_document_kept_beside_a_log_is_refused_naming_the_flag_that_takes_it(tmp_path):
+    """A folder of the examples' shape (a log, its actuator's document and its map): each document is skipped
+    saying what it is and which flag takes it, not as a window that fails the window's schema."""
+    from ema.cli.logs import read_log
+
+    folder = tmp_path / "archive"
+    folder.mkdir()
+    for name in ("actuator.json", "log-map.json"):
+        (folder / name).write_bytes((EXAMPLES / "ballscrew-rig" / name).read_bytes())
+    (folder / "run.csv").write_bytes(MAPPED["linear"][0].read_bytes())
+    read = read_log(folder, None, log_map=read_logmap(folder / "log-map.json"))
+    assert [w.window_id for w in read.windows] == ["run"]
+    assert read.bad_files == {
+        str(folder / "actuator.json"): "is an ema-actuator/1 document, not a window: give it with --actuator",
+        str(folder / "log-map.json"): "is an ema-logmap/1 document, not a window: give it with --log-map",
+    }
+    with pytest.raises(InputError, match="ema-actuator/1 document, not a window: give it with --actuator"):
+        read_one(folder / "actuator.json")
