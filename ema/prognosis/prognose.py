@@ -19,6 +19,7 @@ from ema.prognosis.trend import Series, fit_trend
 
 AIRFRAME_TOLERANCE = Airframe.model_fields["tolerance"].default
 SENSOR_STDS = 3.0  # stds by which a sensor's level or drift must stand out to be said
+AWAY_STDS = 3.0  # stds by which a trend's slope away from its failure level must stand out to be said
 
 
 def _times(stored: Sequence[Stored]) -> tuple[np.ndarray, TimeUnit, Note | None]:
@@ -67,8 +68,9 @@ def prognose(
     sensors, said = sensor_trends(stored, times, unit, tolerance)
     inertias = [s.window.inertia_read for s in stored if s.window.inertia_read is not None]
     faster = [speeding_note(name) for name, seen in outlooks.items() if seen.life.speeding_up]
+    away = [away_note(name, seen, actuator, unit) for name, seen in outlooks.items()]
     levelless = [no_level_note(name, actuator) for name in PARAMETERS if _read(name, stored) and name not in outlooks]
-    notes = [n for n in (note, *faster, *levelless, *said, inertia_change_note(inertias)) if n]
+    notes = [n for n in (note, *faster, *away, *levelless, *said, inertia_change_note(inertias)) if n]
     return Prognosis(
         actuator_id=actuator_id,
         time_unit=unit,
@@ -137,6 +139,31 @@ def speeding_note(name: str) -> Note:
             "up? The remaining life weighs the laws that accelerate by how well they predicted the later windows; "
             "plan for the earliest plausible crossing"
         ),
+    )
+
+
+def away_note(name: str, seen: Outlook, actuator: ActuatorDocument, unit: TimeUnit) -> Note | None:
+    """A note where ``name``'s whole history moves away from the level its remaining life watches, its slope
+    ``AWAY_STDS`` stds from flat: a change all the same (friction that falls, an efficiency that rises), which a
+    remaining life watching one way can only call no degradation; and the level that would watch it, where the
+    document gives none that way."""
+    trend, life = seen.trend, seen.life
+    if life.status != "no degradation detected" or trend.slope_std is None:
+        return None
+    away = -trend.slope_per_unit if life.direction == "above" else trend.slope_per_unit
+    if away <= AWAY_STDS * trend.slope_std:
+        return None
+    other = "below" if life.direction == "above" else "above"
+    watched = any(way == other for _, way in actuator.limits(name))
+    field = actuator.facts.friction_field("fdj_below") if name == "FDJ" else None
+    hint = "" if watched or field is None else f"; a level {other} (thresholds.{field}) would trend towards it"
+    units = f" {actuator.facts.friction_unit}" if name == "FDJ" else ""
+    return Note(
+        code="moving_away",
+        parameter=name,
+        text=f"{name} {'falls' if other == 'below' else 'rises'} by {away:.2g} ± {trend.slope_std:.2g}{units} per "
+        f"{unit.replace('_', ' ').rstrip('s')} over {trend.n} windows: a change all the same, which the remaining "
+        f"life to its level {life.direction} ({life.threshold:.4g}{units}) cannot call a degradation{hint}",
     )
 
 

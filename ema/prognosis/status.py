@@ -1,8 +1,9 @@
 """An actuator's status: what an operator acts on, earned by evidence.
 
 - **due**: a threshold is crossed, or the earliest plausible crossing comes within ``DUE_WITHIN``;
-- **watch**: a crossing is predicted, wear is speeding up, the latest estimate lies outside the healthy
-  range, or the model did not reproduce the latest window;
+- **watch**: a crossing is predicted, wear is speeding up, a trend moves away from the failure level it is
+  watched against (friction that falls: ``moving_away``), the latest estimate lies outside the healthy range,
+  or the model did not reproduce the latest window;
 - **healthy**: none of these;
 - **not enough history**: fewer than ``MIN_WINDOWS`` windows, or windows spread over less than the
   prognosis's ``MIN_SPAN``: no trend can say "due" yet (the latest window alone may still say "watch").
@@ -77,6 +78,13 @@ def status_of(
         return "due", soonest, f"the earliest plausible crossing is within {within:g} {prognosis.time_unit}"
     if any(life.status == "crossing predicted" or life.speeding_up for life in lives):
         return "watch", soonest, "a crossing is predicted, or wear is speeding up"
+    away = [note.parameter for note in prognosis.notes if note.code == "moving_away"]
+    if away:
+        return (
+            "watch",
+            soonest,
+            f"{' and '.join(map(str, away))} moves away from its failure level: a change all the same",
+        )
     if off_healthy(latest, actuator):
         return "watch", soonest, "the latest window lies outside the healthy range or was not reproduced"
     return "healthy", soonest, "no threshold near and no degradation detected"

@@ -71,6 +71,7 @@ NoteCode = Literal[
     "inertia_scatter",
     "speeding_up",
     "no_threshold",
+    "moving_away",
     # a note stored by an earlier version, as a sentence only
     "unspecified",
 ]
