@@ -2,8 +2,9 @@
 their own.
 
 Each actuator's line (``ema.prognosis.status.summary``) is kept with the state of the history it was
-computed from (its windows' count and last row, its document's version), so a line is recomputed only
-after its actuator stored a window or a document, and a replica reads what another computed. A page
+computed from (its windows' count and last row, its document's version) and of the code that computed it
+(``rules``), so a line is recomputed only after its actuator stored a window or a document, or ema's rules
+changed, and a replica reads what another computed. A page
 only reads the kept lines (those out of date shown as they were, or as pending): it never computes, so
 people looking at the fleet take nothing from the estimates. The ``LineKeeper`` brings lines up to date
 on a thread of its own, woken when a window or a document is stored (and every ``KEEPER_PERIOD_S``, for
@@ -16,10 +17,13 @@ fewer windows than a forecast needs gets its line without one.
 
 from __future__ import annotations
 
+import functools
+import hashlib
 import logging
 import threading
 import time
 from dataclasses import dataclass
+from pathlib import Path
 
 from ema.history.open import History
 from ema.model.actuator import THESIS, ActuatorDocument
@@ -43,7 +47,21 @@ class Lines:
 
 
 def _state(version: tuple[int, int, int]) -> str:
-    return "{}:{}:{}".format(*version)
+    return "{}:{}:{}:".format(*version) + rules()
+
+
+@functools.cache
+def rules() -> str:
+    """A digest of the code a line is computed by (the prognosis, the document's levels and healthy ranges): a line
+    an earlier ema kept is out of date after an upgrade, as one kept before a window was stored is."""
+    import ema.model.actuator
+    import ema.prognosis
+
+    files = [*sorted(Path(ema.prognosis.__file__).parent.glob("*.py")), Path(ema.model.actuator.__file__)]
+    digest = hashlib.sha256()
+    for file in files:
+        digest.update(file.read_bytes())
+    return digest.hexdigest()[:16]
 
 
 def _unit_of(latest: Stored | None) -> str:

@@ -197,6 +197,28 @@ def _lines_settle(store, within_s: float) -> bool:
     return not kept_lines(store)[1]
 
 
+def test_a_line_kept_by_other_rules_is_brought_up_to_date(tmp_path, base, monkeypatch):
+    """After an upgrade that changes how a line is computed, a kept line is out of date as if a window had come: the
+    fleet view never shows a status the actuator's own page (computed now) contradicts."""
+    import ema.service.view as view
+    from ema.service.jobs import JobRunner
+
+    store = open_history(tmp_path / "h.sqlite3")
+    store.add(_copy(base, "tail-1/elevator", "w0", 0.0))
+    keeper = view.LineKeeper(store, JobRunner(max_queue=1, queue_timeout_s=1.0))
+    keeper.start()
+    try:
+        assert _lines_settle(store, within_s=10.0)
+        monkeypatch.setattr(view, "rules", lambda: "another ema")
+        assert [line[0] for line in view.kept_lines(store)[1]] == ["tail-1/elevator"]
+        keeper.poke()
+        assert _lines_settle(store, within_s=10.0)
+        assert store.summaries()["tail-1/elevator"][0].endswith(":another ema")
+    finally:
+        keeper.stop()
+        store.close()
+
+
 def test_the_keeper_yields_every_line_to_a_job_and_to_a_pause_after_it(tmp_path, base):
     """The fleet's lines are the keeper's work, done only once no job has run or waited for a moment
     (docs/service.md): a client posting one window after another has the cores between its posts."""
