@@ -30,6 +30,9 @@ from ema.kinds import estimate
 from ema.model.actuator import ActuatorDocument, read_actuator
 from ema.model.logmap import read_logmap, read_mapped
 from ema.model.window import window_from_dict
+from ema.prognosis.documents import Stored
+from ema.prognosis.prognose import prognose
+from ema.prognosis.status import status_of
 
 ROOT = Path(__file__).resolve().parent.parent
 RIG = ROOT / "examples" / "ballscrew-rig"
@@ -130,7 +133,20 @@ def main() -> None:
     for state, load in found:
         held = slice(LEARN_RUNS, None) if state == HEALTHY and load > 0 else slice(None)
         read[(state, load)] = read_set(windows(args.runs, state, load, held), learned)
-    parts = [CITATION, "", learned_text(report.drive, learned), "", *table(read), "", *checks(read), "", LIMITS]
+    lives = histories(args.runs, found, learned)
+    parts = [
+        CITATION,
+        "",
+        learned_text(report.drive, learned),
+        "",
+        *table(read),
+        "",
+        *checks(read),
+        "",
+        *lives,
+        "",
+        LIMITS,
+    ]
     body = "\n".join(parts)
     print(body)
     if args.docs:
@@ -217,6 +233,40 @@ def checks(read: dict[tuple[str, int], SetRead]) -> list[str]:
     departed = [f"{s} {load}" for (s, load), r in read.items() if r.change is not None and r.change.departed]
     lines.append(f"- `departed`: {', '.join(departed) or 'none'}.")
     return ["On these runs (the lab's checks):", "", *lines]
+
+
+def histories(folder: Path, found: list[tuple[str, int]], learned: ActuatorDocument) -> list[str]:
+    """Each load's spalling stages as one actuator's life: its held-out healthy runs, then every run of spalling 1
+    to 8 in that order, stored as the service stores them and trended in that order (the runs carry no time);
+    beside it, the healthy runs alone. What the prognosis says of FDJ, and the status it earns."""
+    rows = []
+    for load in sorted({load for _, load in found}):
+        stages = sorted((s for s, at in found if at == load and s.startswith("spalling")), key=lambda s: int(s[8:]))
+        healthy = windows(folder, HEALTHY, load, slice(LEARN_RUNS, None) if load > 0 else slice(None))
+        spalled = [w for stage in stages for w in windows(folder, stage, load, slice(None))]
+        for name, runs in (("healthy", healthy), (f"healthy, then spalling 1–{len(stages)}", healthy + spalled)):
+            stored = [
+                Stored(
+                    **estimate(w, actuator=learned).model_dump(by_alias=True), id=i, stored_at="2018-01-01T00:00:00Z"
+                )
+                for i, w in enumerate(runs)
+            ]
+            prognosis = prognose(f"rig {load}", stored, learned)
+            trend, life = prognosis.trends["FDJ"], prognosis.remaining_life["FDJ"]
+            status, _, reason = status_of(stored[-1], prognosis, learned, len(stored))
+            away = "moving_away" if any(n.code == "moving_away" for n in prognosis.notes) else "—"
+            rows.append(
+                f"| {load} | {name} | {len(runs)} | {trend.slope_per_unit:+.2g} ± {trend.slope_std or 0:.2g} | "
+                f"{life.status} (level {life.direction} {life.threshold:.3f}) | {away} | {status}: {reason} |"
+            )
+    return [
+        "The spalling stages as an actuator's life (per load: the held-out healthy runs, then each stage's runs in "
+        "order, trended in that order; FDJ slope per run):",
+        "",
+        "| load [kgf] | history | runs | FDJ slope [N·m per run] | remaining life | note | status |",
+        "|---:|---|---:|---:|---|---|---|",
+        *rows,
+    ]
 
 
 if __name__ == "__main__":

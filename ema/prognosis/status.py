@@ -76,8 +76,9 @@ def status_of(
     within = DUE_WITHIN.get(prognosis.time_unit)
     if soonest is not None and within is not None and soonest <= within:
         return "due", soonest, f"the earliest plausible crossing is within {within:g} {prognosis.time_unit}"
-    if any(life.status == "crossing predicted" or life.speeding_up for life in lives):
-        return "watch", soonest, "a crossing is predicted, or wear is speeding up"
+    watched = _watched(lives)
+    if watched:
+        return "watch", soonest, watched
     away = [note.parameter for note in prognosis.notes if note.code == "moving_away"]
     if away:
         return (
@@ -88,6 +89,17 @@ def status_of(
     if off_healthy(latest, actuator):
         return "watch", soonest, "the latest window lies outside the healthy range or was not reproduced"
     return "healthy", soonest, "no threshold near and no degradation detected"
+
+
+def _watched(lives: list[RemainingLife]) -> str | None:
+    """Which parameters a crossing is predicted for, and which speed up towards their level (or None)."""
+    predicted = [life.parameter for life in lives if life.status == "crossing predicted"]
+    faster = [life.parameter for life in lives if life.speeding_up and life.parameter not in predicted]
+    said = [f"{' and '.join(predicted)}: a crossing is predicted"] if predicted else []
+    said += (
+        [f"{' and '.join(faster)}: the latest windows move towards the level faster than the trend"] if faster else []
+    )
+    return "; ".join(said) or None
 
 
 def most_urgent_life(prognosis: Prognosis) -> RemainingLife | None:
