@@ -33,6 +33,22 @@ def test_runs_posted_in_order_show_the_friction_rising(tmp_path):
         assert page.status_code == 200 and page.text.count("<svg") == 1  # FDJ alone: η_O is not read at one load
 
 
+def test_runs_of_a_spalled_screw_show_the_friction_falling_under_its_heading(tmp_path):
+    """The fall is FDJ's: its note stands under FDJ's heading on the page, and the fleet's line watches it."""
+    _, learned, _ = calibrate_linear(runs("normal", 20, range(5)) + runs("normal", 40, range(5)), DOCUMENT)
+    assert learned is not None
+    ordered = runs("normal", 40, range(5, 10)) + runs("spalling8", 40, range(10))
+    with TestClient(create_app(settings_for(tmp_path)), base_url=LOCAL) as client:
+        actuator_id = ordered[0].actuator_id
+        client.put(f"/v1/actuators/{actuator_id}", json=learned.model_dump(mode="json", by_alias=True))
+        for window in ordered:
+            assert client.post("/v1/estimate", json=window_to_dict(window)).status_code == 200
+        page = client.get(f"/ui/actuators/{actuator_id}").text
+    fdj, rest = page.split("<h2>Notes of the latest windows</h2>")
+    assert "moving_away" in fdj.split("<h2>FDJ")[1] and "moving_away" not in rest
+    assert 'class="watch"' in page and "FDJ moves away from its failure level" in page
+
+
 def test_a_linear_actuator_is_calibrated_through_the_service_as_through_the_cli(tmp_path):
     """Healthy runs teach the stored document's drive; the answer carries the completed document; two 13 s runs
     at 25 Hz simulate nothing, so neither the window limit nor the simulation budget refuses them."""
