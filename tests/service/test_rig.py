@@ -1,6 +1,7 @@
 """The real rig through the service: its learned document stored, its runs posted in the order they were logged,
 and the friction rising in its prognosis and on the operator's page."""
 
+import pytest
 from fastapi.testclient import TestClient
 
 from ema.calibration.linear_report import calibrate_linear
@@ -14,18 +15,30 @@ from tests.estimate.test_ballscrew import DOCUMENT, runs
 from tests.service.conftest import LOCAL, settings_for
 
 
-def test_runs_posted_in_order_show_the_friction_rising(tmp_path):
-    _, learned, _ = calibrate_linear(runs("normal", 20, range(5)) + runs("normal", 40, range(5)), DOCUMENT)
-    assert learned is not None
+@pytest.fixture(scope="module")
+def learned():
+    """The drive learned on half the healthy runs at each load; the histories post the other half."""
+    _, document, _ = calibrate_linear(runs("normal", 20, range(5)) + runs("normal", 40, range(5)), DOCUMENT)
+    assert document is not None
+    return document
+
+
+def _posted(client: TestClient, learned, ordered: list) -> str:
+    """The learned document stored, then ``ordered`` posted one after another (each answered); the actuator's id."""
+    actuator_id = ordered[0].actuator_id
+    stored = client.put(f"/v1/actuators/{actuator_id}", json=learned.model_dump(mode="json", by_alias=True))
+    assert stored.status_code == 200, stored.text
+    for window in ordered:
+        answer = client.post("/v1/estimate", json=window_to_dict(window))
+        assert answer.status_code == 200, answer.text
+        assert answer.json()["stages"]["learn"].startswith("skipped")
+    return actuator_id
+
+
+def test_runs_posted_in_order_show_the_friction_rising(tmp_path, learned):
     ordered = runs("normal", 20, range(5, 10)) + runs("lackLubrication1", 20, range(10))
     with TestClient(create_app(settings_for(tmp_path)), base_url=LOCAL) as client:
-        actuator_id = ordered[0].actuator_id
-        stored = client.put(f"/v1/actuators/{actuator_id}", json=learned.model_dump(mode="json", by_alias=True))
-        assert stored.status_code == 200, stored.text
-        for window in ordered:
-            answer = client.post("/v1/estimate", json=window_to_dict(window))
-            assert answer.status_code == 200, answer.text
-            assert answer.json()["stages"]["learn"].startswith("skipped")
+        actuator_id = _posted(client, learned, ordered)
         prognosis = client.get(f"/v1/actuators/{actuator_id}/prognosis").json()
         trend = prognosis["trends"]["FDJ"]
         assert prognosis["time_unit"] == "windows" and trend["slope_per_unit"] > 2 * trend["slope_std"]
@@ -33,17 +46,11 @@ def test_runs_posted_in_order_show_the_friction_rising(tmp_path):
         assert page.status_code == 200 and page.text.count("<svg") == 1  # FDJ alone: η_O is not read at one load
 
 
-def test_runs_of_a_spalled_screw_show_the_friction_falling_under_its_heading(tmp_path):
+def test_runs_of_a_spalled_screw_show_the_friction_falling_under_its_heading(tmp_path, learned):
     """The fall is FDJ's: its note stands under FDJ's heading on the page, and the fleet's line watches it."""
-    _, learned, _ = calibrate_linear(runs("normal", 20, range(5)) + runs("normal", 40, range(5)), DOCUMENT)
-    assert learned is not None
     ordered = runs("normal", 40, range(5, 10)) + runs("spalling8", 40, range(10))
     with TestClient(create_app(settings_for(tmp_path)), base_url=LOCAL) as client:
-        actuator_id = ordered[0].actuator_id
-        client.put(f"/v1/actuators/{actuator_id}", json=learned.model_dump(mode="json", by_alias=True))
-        for window in ordered:
-            assert client.post("/v1/estimate", json=window_to_dict(window)).status_code == 200
-        page = client.get(f"/ui/actuators/{actuator_id}").text
+        page = client.get(f"/ui/actuators/{_posted(client, learned, ordered)}").text
     fdj, rest = page.split("<h2>Notes of the latest windows</h2>")
     assert "moving_away" in fdj.split("<h2>FDJ")[1] and "moving_away" not in rest
     assert 'class="watch"' in page and "FDJ moves away from its failure level" in page
