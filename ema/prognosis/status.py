@@ -81,11 +81,8 @@ def status_of(
         return "watch", soonest, watched
     away = [note.parameter for note in prognosis.notes if note.code == "moving_away"]
     if away:
-        return (
-            "watch",
-            soonest,
-            f"{' and '.join(map(str, away))} moves away from its failure level: a change all the same",
-        )
+        moves = "moves away from its failure level" if len(away) == 1 else "move away from their failure levels"
+        return "watch", soonest, f"{' and '.join(map(str, away))} {moves}: a change all the same"
     if off_healthy(latest, actuator):
         return "watch", soonest, "the latest window lies outside the healthy range or was not reproduced"
     return "healthy", soonest, "no threshold near and no degradation detected"

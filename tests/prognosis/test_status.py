@@ -101,3 +101,23 @@ def test_a_document_without_nominal_or_level_trends_nothing_says_why_and_keeps_i
     levelled = servo.model_copy(update={"thresholds": servo.thresholds.model_copy(update={"fdj_above_n": 0.075})})
     prognosis = prognose("a", stored, levelled)
     assert list(prognosis.trends) == ["FDJ"] and prognosis.remaining_life["FDJ"].status == "crossing predicted"
+
+
+def test_an_efficiency_that_rises_is_a_change_its_line_watches(base):
+    """η_O rising steadily (drawn here as a line; the rig's friction falling is ``test_rig_history``): away from
+    its lower level, so no degradation, yet a change the prognosis says and the status watches. A steady η_O
+    says nothing."""
+    hours = [0, 20, 40, 60, 80, 100, 120, 140]
+    for etas, said in (([0.80, 0.81, 0.82, 0.83, 0.84, 0.85, 0.86, 0.87], True), ([0.85] * 8, False)):
+        stored = [
+            s.model_copy(
+                update={"estimates": s.estimates.model_copy(update={"eta_O": parameter(e, 2e-3, 0.85, unit="1")})}
+            )
+            for s, e in zip(_history(base, [0.05] * 8, flight_hours=hours), etas, strict=True)
+        ]
+        prognosis = prognose("a", stored, THESIS)
+        away = [n for n in prognosis.notes if n.code == "moving_away" and n.parameter == "eta_O"]
+        assert prognosis.remaining_life["eta_O"].status == "no degradation detected"
+        assert bool(away) == said and all("eta_O rises by" in n.text and "thresholds." not in n.text for n in away)
+        status, _, reason = status_of(stored[-1], prognosis, THESIS, len(stored))
+        assert (status == "watch" and "eta_O" in reason) == said
