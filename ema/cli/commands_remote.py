@@ -203,7 +203,7 @@ def history(
 ) -> None:
     """An actuator's stored estimates, their trend and its remaining useful life."""
     from ema.cli.figures import prognosis_figure
-    from ema.cli.printing import print_prognosis
+    from ema.cli.printing import print_prognosis, value_units
     from ema.cli.replay import ServiceError, key_refused, refusal_text, request
     from ema.model.checks import InputError
     from ema.prognosis.documents import EstimateHistory, Prognosis
@@ -224,7 +224,7 @@ def history(
     prognosis = Prognosis.model_validate(request(f"{base}/prognosis", key, timeout=60))
     drawn = plot if plot is not None and parameter in prognosis.trends else None
     if drawn is not None:
-        prognosis_figure(prognosis, parameter, drawn)
+        prognosis_figure(prognosis, parameter, drawn, unit=value_units(stored).get(parameter, "").strip())
     elif plot is not None:
         print(f"no figure written to {plot}: {parameter} has no trend (the notes say why)", file=sys.stderr)
     document = {

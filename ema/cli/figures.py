@@ -32,9 +32,9 @@ def residual_figure(plot: Any, path: Path) -> Path:
     return path
 
 
-def prognosis_figure(prognosis: Any, parameter: str, path: Path) -> Path:
+def prognosis_figure(prognosis: Any, parameter: str, path: Path, unit: str = "") -> Path:
     """Estimates with ±2 std, the line through them, the weighed laws' forecast (median and 90 % band), the
-    threshold and the RUL interval."""
+    threshold and the RUL interval; ``unit``: the parameter's (none for an efficiency)."""
     plt = _pyplot()
     trend, life = prognosis.trends[parameter], prognosis.remaining_life[parameter]
     t = np.array([p.time for p in trend.points])
@@ -66,8 +66,8 @@ def prognosis_figure(prognosis: Any, parameter: str, path: Path) -> Path:
         axis.axvspan(t.max() + life.rul_low, high, color="tab:red", alpha=0.1, label="RUL 90 % interval")
     axis.set(
         xlabel=prognosis.time_unit.replace("_", " "),
-        ylabel=parameter,
-        title=f"{prognosis.actuator_id}: {parameter}: {life.status}",
+        ylabel=f"{parameter} [{unit}]" if unit else parameter,
+        title=f"{prognosis.actuator_id}: {parameter}\n{prognosis.life_status(parameter)}",
     )
     axis.legend(fontsize=8)
     figure.tight_layout()

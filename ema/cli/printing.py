@@ -204,7 +204,7 @@ def _slope(trend: Any, unit: str, value_unit: str = "") -> str:
     return f"slope {trend.slope_per_unit:+.3g} ± {trend.slope_std:.2g}{value_unit} per {unit}"
 
 
-def _value_units(stored: Any) -> dict[str, str]:
+def value_units(stored: Any) -> dict[str, str]:
     """Each parameter's unit as its latest stored estimate gives it, with a leading space (none for an efficiency,
     or where no estimate says): N·m at the motor shaft, N on the load."""
     units: dict[str, str] = {}
@@ -216,10 +216,11 @@ def _value_units(stored: Any) -> dict[str, str]:
     return units
 
 
-def _life(life: Any, unit: str) -> str:
-    """A remaining life, counted from the last window, in the prognosis's time unit."""
+def _life(life: Any, unit: str, status: str) -> str:
+    """A remaining life, counted from the last window, in the prognosis's time unit; ``status`` as the prognosis
+    words it."""
     if life.rul is None:
-        return life.status
+        return status
     high = "open" if life.rul_high is None else f"{life.rul_high:.3g}"
     faster = "; speeding up" if life.speeding_up else ""
     return (
@@ -231,12 +232,12 @@ def _life(life: Any, unit: str) -> str:
 def print_prognosis(stored: Any, prognosis: Any, plot: Path | None) -> None:
     """An actuator's outlook per parameter, the laws it weighs, its backtest, its sensors' trends and notes."""
     one, many = TIME_UNITS[prognosis.time_unit]
-    units = _value_units(stored)
+    units = value_units(stored)
     click.echo(f"{prognosis.actuator_id}: {len(stored.estimates)} window(s), time in {many}")
     for name, trend in prognosis.trends.items():
         level, level_std = trend.now()
         laws = ", ".join(f"{law} {w:.2f}" for law, w in sorted(trend.laws.items(), key=lambda x: -x[1]) if w >= 0.05)
-        life = _life(prognosis.remaining_life[name], many)
+        life = _life(prognosis.remaining_life[name], many, prognosis.life_status(name))
         unit = units.get(name, "")
         click.echo(f"{name:<6} now {level:.5g} ± {level_std:.2g}{unit}, {_slope(trend, one, unit)}; {life}")
         if laws:

@@ -193,6 +193,14 @@ class Prognosis(Document):
         description="per parameter, the prognosis as it would have stood at earlier windows, against what came after",
     )
 
+    def life_status(self, parameter: str) -> str:
+        """``parameter``'s remaining life's status in words, saying where its history moves away from the level
+        that life watches (a ``moving_away`` note): no degradation towards that level, a change all the same."""
+        life = self.remaining_life[parameter]
+        if not any(n.code == "moving_away" and n.parameter == parameter for n in self.notes):
+            return life.status
+        return f"{life.status} towards the level {life.direction}; moving away from it: a change"
+
 
 class EstimateHistory(Document):
     actuator_id: str

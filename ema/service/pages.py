@@ -70,14 +70,15 @@ def _cell(line: ActuatorSummary, name: str) -> str:
     return html.escape(shown) + (f" <small>({html.escape(', '.join(limits))})</small>" if limits else "")
 
 
-def life_text(life: RemainingLife | None, unit: str) -> str:
-    """A remaining life in words, with its unit."""
+def life_text(life: RemainingLife | None, unit: str, status: str | None = None) -> str:
+    """A remaining life in words, with its unit; ``status``: its status as the prognosis words it
+    (``Prognosis.life_status``), where one is at hand."""
     if life is None:
         return "—"
     if life.status == "already crossed":
         return f"threshold {life.threshold:g} crossed"
     if life.rul is None:
-        return life.status
+        return status or life.status
     high = "open" if life.rul_high is None else f"{life.rul_high:.3g}"
     return f"{life.rul:.3g} {unit} (90 %: {life.rul_low:.3g}–{high} {unit}; earliest {life.rul_earliest:.3g} {unit})"
 
@@ -223,7 +224,9 @@ def actuator_page(
     for name, trend in prognosis.trends.items():
         life = prognosis.remaining_life[name]
         heading = PARAMETER_NAMES[name] + (f" [{actuator.facts.friction_unit}]" if name == "FDJ" else "")
-        parts.append(f"<h2>{html.escape(heading)}</h2><p>{html.escape(life_text(life, unit))}</p>")
+        parts.append(
+            f"<h2>{html.escape(heading)}</h2><p>{html.escape(life_text(life, unit, prognosis.life_status(name)))}</p>"
+        )
         said = [("prognosis", n.code, n.text) for n in prognosis.notes if n.parameter == name]
         parts += [_notes_list(said)] if said else []
         if trend.points:

@@ -46,6 +46,9 @@ def test_a_friction_that_falls_is_a_change_the_history_says_and_the_status_watch
     away = [n for n in prognosis.notes if n.code == "moving_away"]
     assert [n.parameter for n in away] == ["FDJ"] and "FDJ falls by" in away[0].text
     assert "thresholds.fdj_below_nm" in away[0].text
+    assert (
+        prognosis.life_status("FDJ") == "no degradation detected towards the level above; moving away from it: a change"
+    )
     status, _, reason = status_of(stored[-1], prognosis, document, len(stored))
     assert status == "watch" and "FDJ moves away" in reason
 
@@ -67,4 +70,5 @@ def test_healthy_runs_at_two_loads_move_nowhere(document):
     prognosis = prognose("rig", stored, document)
     assert prognosis.remaining_life["FDJ"].status == "no degradation detected"
     assert not [n for n in prognosis.notes if n.code == "moving_away"]
+    assert prognosis.life_status("FDJ") == "no degradation detected"
     assert status_of(stored[-1], prognosis, document, len(stored))[0] == "healthy"
