@@ -180,3 +180,44 @@ def test_the_migrations_build_exactly_the_tables_the_code_declares(setting):
     finally:
         engine.dispose()
     assert differences == []
+
+
+def test_every_change_an_actuator_sees_moves_its_state_and_a_repeat_does_not(history, result):
+    """The fleet view recomputes a line when its actuator's state moves (``ema.service.view``): a window stored
+    or withdrawn, a new document. A replayed window or the same document again is no change."""
+    steps = [
+        (lambda: history.add(_as(result, "a", "w0")), True),
+        (lambda: history.add(_as(result, "a", "w0")), False),  # a replay
+        (lambda: history.add(_as(result, "a", "w1")), True),
+        (lambda: history.put_actuator("a", THESIS), True),
+        (lambda: history.put_actuator("a", THESIS), False),  # the same document: no new version
+        (lambda: history.withdraw("a", "w0", "logged on another actuator"), True),
+        (lambda: history.put_actuator("a", THESIS.model_copy(update={"name": "re-rigged"})), True),
+    ]
+    before = None
+    for step, moves in steps:
+        step()
+        now = history.versions()["a"]
+        assert (now != before) == moves, (now, before)
+        before = now
+    assert before[2] == 2  # the document's version
+
+
+def test_calibrations_come_back_whole_latest_first(history):
+    from pathlib import Path
+
+    from ema.calibration.linear_report import calibrate_linear
+    from ema.model.actuator import read_actuator
+    from ema.model.logmap import read_logmap, read_mapped
+    from ema.model.window import window_from_dict
+
+    rig = Path(__file__).resolve().parents[2] / "examples" / "ballscrew-rig"
+    paths = sorted((rig / "runs").glob("normal_load[24]0_run*.csv"))
+    windows = [window_from_dict(read_mapped(p, read_logmap(rig / "log-map.json"))) for p in paths]
+    document = read_actuator(rig / "actuator.json")
+    reports = [calibrate_linear(windows[:n] + windows[-n:], document)[0] for n in (2, 3)]
+    for report in reports:
+        history.add_calibration("rig", report)
+    stored = history.calibrations("rig")
+    assert [r for _, r in stored] == reports[::-1] and history.calibrations("other") == []
+    assert all(when for when, _ in stored)
