@@ -18,16 +18,25 @@ from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from types import MappingProxyType
 
-from ema.model.units import ANGLE_DEG, CURRENT_A, FORCE_N, LENGTH_M, LENGTH_MM, SPEED_RADPS, TORQUE_NM
+from ema.model.units import units_of
 
 
 @dataclass(frozen=True)
 class Role:
-    """A quantity a log map may name: the window signal it becomes and the units it may be written in."""
+    """A quantity a log map may name: the window signal it becomes, whose name says its unit."""
 
     signal: str
-    units: Mapping[str, float]  # unit -> factor to the signal's own unit
     required: bool = True
+
+    @property
+    def units(self) -> Mapping[str, float]:
+        """The units the log may write it in: unit -> factor to the signal's own (``ema.model.units.units_of``)."""
+        return units_of(self.signal)
+
+
+def _roles(optional: tuple[str, ...] = (), **signals: str) -> Mapping[str, Role]:
+    """Each log-map role -> the window signal it becomes; ``optional``: roles a log may go without."""
+    return MappingProxyType({role: Role(signal, role not in optional) for role, signal in signals.items()})
 
 
 @dataclass(frozen=True)
@@ -66,14 +75,12 @@ _ROTARY = KindFacts(
     summary="a current-piloted motor and a gear train to a surface",
     section="drive",
     friction_unit="N·m",
-    roles=MappingProxyType(
-        {
-            "set_point": Role("command_deg", ANGLE_DEG),
-            "position": Role("position_deg", ANGLE_DEG),
-            "motor_speed": Role("motor_speed_radps", SPEED_RADPS),
-            "current": Role("current_a", CURRENT_A),
-            "load": Role("hinge_moment_nm", TORQUE_NM),
-        }
+    roles=_roles(
+        set_point="command_deg",
+        position="position_deg",
+        motor_speed="motor_speed_radps",
+        current="current_a",
+        load="hinge_moment_nm",
     ),
     nominal_given=True,
     static_friction=True,
@@ -83,27 +90,15 @@ _LINEAR = KindFacts(
     summary="a ball screw turned by a stepper, its current read through what ema calibrate learned",
     section="screw",
     friction_unit="N·m",
-    roles=MappingProxyType(
-        {
-            "set_point": Role("command_mm", LENGTH_MM),
-            "position": Role("position_mm", LENGTH_MM),
-            "current": Role("current_a", CURRENT_A),
-            "load": Role("load_n", FORCE_N),
-        }
-    ),
+    roles=_roles(set_point="command_mm", position="position_mm", current="current_a", load="load_n"),
 )
 _SERVO = KindFacts(
     name="servo",
     summary="a linear axis driven by a force command from a known position controller, logged on the load side",
     section="servo",
     friction_unit="N",
-    roles=MappingProxyType(
-        {
-            "set_point": Role("set_point_m", LENGTH_M),
-            "position": Role("position_m", LENGTH_M),
-            "force": Role("drive_force_n", FORCE_N),
-            "load": Role("load_n", FORCE_N, required=False),
-        }
+    roles=_roles(
+        set_point="set_point_m", position="position_m", force="drive_force_n", load="load_n", optional=("load",)
     ),
     load_side=True,
 )

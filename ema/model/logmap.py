@@ -147,7 +147,7 @@ def read_mapped(path: str | Path, log_map: LogMap) -> dict[str, Any]:
         elif part is not None:
             signals[role.signal] = _read(table, part, role, name, path, n)
     time = log_map.time
-    rate = log_map.sample_rate_hz or _rate(_read(table, time, Role("time_s", TIME_S), "time", path, n), path)  # type: ignore[arg-type]
+    rate = log_map.sample_rate_hz or _rate(_read(table, time, Role("time_s"), "time", path, n), path)  # type: ignore[arg-type]
     constants = {
         field: _scalar(table, variable, path, f"constants.{field}") for field, variable in log_map.constants.items()
     }

@@ -1,8 +1,8 @@
 """The units a log may be written in, each as the factor to ema's own unit of its quantity.
 
-ema computes with the unit in each name (``position_mm``, ``load_n``): a log map names its columns' units,
-each role of a kind (``ema.model.kinds``) reads them from its quantity's table, and the reader multiplies by the
-factor.
+ema computes with the unit in each name (``position_mm``, ``load_n``), and the name is the one place it is said:
+a log map names its columns' units, each role of a kind (``ema.model.kinds``) finds the table of its signal's
+quantity by the unit its name ends in (``units_of``), and the reader multiplies by the factor.
 """
 
 from __future__ import annotations
@@ -17,3 +17,19 @@ FORCE_N = {"N": 1.0, "kN": 1e3, "kgf": 9.80665, "lbf": 4.4482216152605}
 TORQUE_NM = {"N·m": 1.0, "Nm": 1.0}
 SPEED_RADPS = {"rad/s": 1.0, "rpm": 2.0 * np.pi / 60.0}
 TIME_S = {"s": 1.0, "ms": 1e-3}
+UNITS_BY_SUFFIX = {
+    "mm": LENGTH_MM,
+    "m": LENGTH_M,
+    "deg": ANGLE_DEG,
+    "a": CURRENT_A,
+    "n": FORCE_N,
+    "nm": TORQUE_NM,
+    "radps": SPEED_RADPS,
+    "s": TIME_S,
+}
+
+
+def units_of(name: str) -> dict[str, float]:
+    """The units a quantity may be written in, by the unit its ema name ends in (``position_mm``: a length, to mm):
+    the name is the one place its unit is said."""
+    return UNITS_BY_SUFFIX[name.rsplit("_", 1)[-1]]

@@ -58,6 +58,18 @@ QUICK = (
 )
 
 
+def test_every_signal_says_its_unit_in_its_name():
+    """A log map's units come from the signal's name alone (``ema.model.units.units_of``): every role of every kind
+    resolves, and its own unit (the name's) is the factor 1."""
+    from ema.model.units import units_of
+
+    for kind in facts.KINDS.values():
+        for role in kind.roles.values():
+            assert 1.0 in role.units.values(), (kind.name, role.signal)
+    assert units_of("position_mm")["m"] == 1000.0 and units_of("set_point_m")["mm"] == 1e-3
+    assert units_of("hinge_moment_nm") is not units_of("load_n")
+
+
 def test_a_window_no_network_learns_from_never_loads_torch(tmp_path):
     """A ball screw's windows are read quasi-statically: its calibration and its estimate answer without torch's
     second of loading."""
