@@ -167,6 +167,12 @@ class CalibrationReport(Document):
         description="what the windows taught that the document lacks, each with its std and unit (a servo's mass, "
         "viscous friction, FDJ and offset, an adopted effect's constants; a stepper's drive)",
     )
+    as_simulated: list[Learned] = Field(
+        default_factory=list,
+        description="a servo's learned constants as the simulator takes them, what the completed document keeps: "
+        "each moved by what Eq. 5.1 reads of the logs simulated at it (the fit reads a simulated pre-sliding "
+        "smaller than it is); the closed loop's error after is at these",
+    )
     model_error_pct_before: dict[str, float] | None = Field(
         None,
         description="per signal: 100·‖y − ŷ‖/‖y‖, the model's reconstruction of the log (the identification "

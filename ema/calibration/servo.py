@@ -15,9 +15,10 @@ add it, and report the error before and after.
    of a log, noise does not), and cuts the held-out residual by ``MIN_HELD_OUT_DROP`` at least; then the next,
    on top of it, up to ``MAX_EFFECTS``.
 3. **Add and report.** The learned list is one consistent model: the adopted effects' constants join it, a
-   constant that differs with the direction of motion named ``_up`` and ``_down``. The error before and after
-   is the inverse model's, and the closed loop's: each window simulated at the constants, its force against
-   the log's.
+   constant that differs with the direction of motion named ``_up`` and ``_down``. The document keeps them as
+   the simulator takes them (``simulator_frame``: Eq. 5.1 reads a simulated pre-sliding smaller than it is). The
+   error before and after is the inverse model's at the fit's constants, and the closed loop's at the
+   simulator's: each window simulated, its force against the log's.
 
 Where the document already holds the load's constants (a completed document read on a new run), the report
 also gives the error of the document's model as it stands, in the inverse and in the closed loop.
@@ -27,6 +28,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Sequence
+from dataclasses import replace
 
 import numpy as np
 
@@ -40,7 +42,16 @@ from ema.calibration.documents import (
 )
 from ema.calibration.plot import ResidualPlot, Series
 from ema.calibration.servo_effects import EFFECTS, ServoEffect
-from ema.calibration.servo_fit import COPIES, FOLDS, Fitted, fitted, noise_copies, problem, undisturbed
+from ema.calibration.servo_fit import (
+    COPIES,
+    FOLDS,
+    Fitted,
+    fitted,
+    noise_copies,
+    problem,
+    simulator_frame,
+    undisturbed,
+)
 from ema.estimate.assess.weighing import misfit_limit
 from ema.estimate.physics.inverse import (
     UNITS,
@@ -130,12 +141,12 @@ def _nothing_earned(trials: list) -> str:
     )
 
 
-def learned(fit: Fitted, model: dict[str, float]) -> list[Learned]:
-    """The model's constants, each with its std and unit, in the document's words (``_up``/``_down`` by
-    direction), the adopted effects' nonlinear constants beside them."""
+def learned(fit: Fitted, model: dict[str, float], values: dict[str, float] | None = None) -> list[Learned]:
+    """The model's constants (``values``, the fit's by default), each with the fit's std and its unit, in the
+    document's words (``_up``/``_down`` by direction), the adopted effects' nonlinear constants beside them."""
     out = [
         Learned(name=LEARNED_NAMES.get(name, name), value=value, std=fit.stds[name], unit=UNITS[name])
-        for name, value in fit.values.items()
+        for name, value in (fit.values if values is None else values).items()
     ]
     for effect in EFFECTS:
         if effect.name in model and effect.constant is not None:
@@ -261,9 +272,11 @@ def calibrate_servo(
         ]
     after = fitted(problem(prepared, model))
     adopted = [name for name in model if name not in base_model]
+    simulated = {"before": simulator_frame(prepared, base.values, base_model)}
+    simulated["after"] = simulated["before"] if model == base_model else simulator_frame(prepared, after.values, model)
     closed = {
-        "before": closed_loop_error_pct(prepared, base.values, base_model),
-        "after": closed_loop_error_pct(prepared, after.values, model),
+        "before": closed_loop_error_pct(prepared, simulated["before"], base_model),
+        "after": closed_loop_error_pct(prepared, simulated["after"], model),
     }
     report = CalibrationReport(
         n_windows=len(windows),
@@ -288,9 +301,11 @@ def calibrate_servo(
         stds_before={"FDJ": base.stds["fdj_n"]},
         stds_after={"FDJ": after.stds["fdj_n"]},
         learned=learned(after, model),
+        as_simulated=learned(after, model, simulated["after"]),
         model_error_pct_before={"drive_force_n": base.error_pct, "drive_force_n_closed_loop": closed["before"]},
         model_error_pct_after={"drive_force_n": after.error_pct, "drive_force_n_closed_loop": closed["after"]},
         model_error_pct_document=_document_check(prepared, actuator),
         timings_s={"total": time.perf_counter() - started},
     )
-    return report, completed(actuator, prepared[0], after, model), _plot(prepared, base, after, model)
+    document = completed(actuator, prepared[0], replace(after, values=simulated["after"]), model)
+    return report, document, _plot(prepared, base, after, model)

@@ -1,7 +1,8 @@
 """A servo calibration's two measures of a fit over every window at once: the stacked inverse problem fitted
 (Eq. 5.1 in the load frame on each window's decimated force, Newey–West stds, each fold predicted by the others)
 and what noise alone leaves in it (each window simulated in closed loop at the fitted constants, its sensor read
-at ``COPIES`` phases of its step), from which the rows a force the log lacks disturbs are told.
+at ``COPIES`` phases of its step), from which the rows a force the log lacks disturbs are told; and the fitted
+constants as the simulator takes them (``simulator_frame``).
 """
 
 from __future__ import annotations
@@ -27,6 +28,7 @@ from ema.model.servo_sim import simulate_servo
 
 FOLDS = 5
 COPIES = 8
+FRAME_PHASES = 4  # phases of the sensor's step the twins of simulator_frame are read at
 
 
 @dataclass(frozen=True)
@@ -127,3 +129,19 @@ def undisturbed(prepared: Sequence[ServoPrepared], copies: Copies, model: dict[s
         fit = fit_inverse(p.force_n, inverse_columns(p.motion, model), p.motion)
         out.append(replace(p, disturbed=disturbed_rows(fit.residual_by_row, by_row)))
     return out
+
+
+def simulator_frame(
+    prepared: Sequence[ServoPrepared], values: dict[str, float], model: dict[str, float]
+) -> dict[str, float]:
+    """The constants at which the simulator's closed loop, read as the logs were, gives back ``values`` (what Eq.
+    5.1 read on the logs): each moved by the fit's own bias there, v + (v − v̂), v̂ the fit of the windows' twins
+    simulated at ``values`` (their sensor read at ``FRAME_PHASES`` phases, the logs' rows left out). Eq. 5.1 reads
+    a simulated effect through decimation and filters that shrink it (pre-sliding above all): the document keeps
+    the simulator's constants, so that an estimate, which reads through the simulator, finds its nominal on the
+    logs that taught it. One step: the bias barely moves over it."""
+    reads = [
+        fitted(problem([_simulated(p, values, model, phase) for p in prepared], model)).values
+        for phase in np.linspace(0.0, 1.0, FRAME_PHASES, endpoint=False)
+    ]
+    return {name: 2.0 * value - float(np.mean([read[name] for read in reads])) for name, value in values.items()}

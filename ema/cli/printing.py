@@ -152,9 +152,7 @@ def print_calibration(report: dict[str, Any]) -> None:
             line += f"   error {report['error_pct_before'][name]:.2f} % -> {report['error_pct_after'][name]:.2f} %"
         click.echo(line)
     if learned and not report.get("drive"):
-        click.echo("learned (one model):")
-        for entry in learned.values():
-            click.echo(f"  {entry['name']:<24}{entry['value']:>12.5g} ± {entry['std']:<10.2g}{entry['unit']}")
+        _print_learned(learned, {entry["name"]: entry["value"] for entry in report.get("as_simulated", [])})
     for when in ("before", "after", "document"):
         errors = report.get(f"model_error_pct_{when}")
         if errors:
@@ -165,6 +163,19 @@ def print_calibration(report: dict[str, Any]) -> None:
 
 
 ERROR_WORDS = {"drive_force_n": "force, inverse model", "drive_force_n_closed_loop": "force, closed loop"}
+
+
+def _print_learned(learned: dict[str, Any], simulated: dict[str, float]) -> None:
+    """The learned constants (the fit's, with its std), and where the report gives them, as the simulator takes
+    them: what the completed document keeps."""
+    if not simulated:
+        click.echo("learned (one model):")
+    else:
+        click.echo("learned (one model): the fit's, and as the simulator takes them (what the document keeps)")
+    for entry in learned.values():
+        kept = simulated.get(entry["name"], entry["value"])
+        beside = f"{kept:>12.5g}  " if simulated else ""
+        click.echo(f"  {entry['name']:<24}{entry['value']:>12.5g} ± {entry['std']:<10.2g}{beside}{entry['unit']}")
 
 
 def _print_drive(drive: dict[str, Any]) -> None:

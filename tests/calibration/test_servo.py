@@ -38,8 +38,10 @@ def test_a_viscous_friction_that_differs_with_direction_is_named_and_learned(see
         assert abs(learned[name].value - truth) <= max(3 * learned[name].std, 0.01 * truth), name
     assert learned["FDJ"].unit == "N" and learned["viscous_down"].unit == "N·s/m" and "viscous" not in learned
     assert report.model_error_pct_after["drive_force_n"] < 0.2 * report.model_error_pct_before["drive_force_n"]
-    servo = calibrated.completed.servo
-    assert servo.viscous_down_ns_per_m == pytest.approx(learned["viscous_down"].value)
+    servo, simulated = calibrated.completed.servo, {entry.name: entry.value for entry in report.as_simulated}
+    assert servo.viscous_down_ns_per_m == pytest.approx(simulated["viscous_down"])
+    for name, entry in learned.items():  # the foreign simulator's truth: the simulator's frame is near the fit's
+        assert abs(simulated[name] - entry.value) <= max(3 * entry.std, 0.01 * abs(entry.value)), name
 
 
 @pytest.fixture(scope="module")
@@ -69,6 +71,9 @@ def test_the_completed_document_reads_the_log_closer(emps):
     assert after.check.equation_error_ratio < before.check.equation_error_ratio
     assert after.check.output_error_pct["drive_force_n"] < before.check.output_error_pct["drive_force_n"]
     assert after.estimates.FDJ.nominal == pytest.approx(calibrated.completed.nominal.fdj_n)
+    read = {"FDJ": after.estimates.FDJ, **after.estimates.constants}
+    for name, entry in read.items():  # the log that taught the document reads its nominal, within its std
+        assert abs(entry.value - entry.nominal) <= 2 * entry.std, (name, entry.value, entry.nominal, entry.std)
     again = _calibrated([window], calibrated.completed).report
     assert again.model_error_pct_document["drive_force_n"] <= before.check.output_error_pct["drive_force_n"]
 
