@@ -45,6 +45,7 @@ from ema.calibration.servo_effects import EFFECTS, ServoEffect
 from ema.calibration.servo_fit import (
     COPIES,
     FOLDS,
+    FRAME_PHASES,
     Fitted,
     fitted,
     noise_copies,
@@ -66,6 +67,7 @@ from ema.model.servo_sim import simulate_servo
 from ema.model.window import Window
 
 MIN_HELD_OUT_DROP = 0.05  # of the held-out residual sum of squares
+CLOSED_LOOPS = COPIES + 2 * FRAME_PHASES + 2  # per window: noise copies, twins before and after, the errors
 MAX_EFFECTS = 2
 LEARNED_NAMES = {
     "fdj_n": "FDJ",

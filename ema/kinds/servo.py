@@ -12,7 +12,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from ema.calibration.servo import calibrate_servo
+from ema.calibration.servo import CLOSED_LOOPS, calibrate_servo
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import STAGES, Estimate
 from ema.kinds.base import Calibrated, CalibrationRequest, Cost, Request
@@ -49,7 +49,7 @@ class Servo:
         return Cost(simulated_s=steps * ROTARY_STEP_S, window_s=0.0)
 
     def calibration_cost(self, windows: Sequence[Window], config: PipelineConfig) -> Cost:
-        steps = sum(window.n_samples * SUBSTEPS * 2 for window in windows)  # the closed loop before and after
+        steps = sum(window.n_samples * SUBSTEPS * CLOSED_LOOPS for window in windows)
         return Cost(simulated_s=steps * ROTARY_STEP_S, window_s=0.0)
 
 

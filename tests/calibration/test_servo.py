@@ -83,3 +83,28 @@ def test_unlogged_pulses_do_not_hide_or_fake_an_effect():
         report = _calibrated([window_from_dict(foreign.draw(1, load, pushed=True))], FOREIGN).report
         assert report.selected_effects == named
         assert {e.name: e.value for e in report.learned}["FDJ"] == pytest.approx(load.fdj_n, rel=0.01)
+
+
+def test_the_budget_counts_every_closed_loop_a_calibration_runs(monkeypatch):
+    """The service refuses a calibration by its simulation work (``calibration_cost``): it counts each closed loop
+    the calibration runs, no fewer."""
+    import ema.calibration.servo as servo
+    import ema.calibration.servo_fit as servo_fit
+    from ema.kinds import calibration_cost
+    from ema.model.servo_sim import SUBSTEPS
+
+    runs = []
+
+    def counted(set_point, lanes, *args, **kwargs):
+        runs.append(len(set_point) * lanes.shape[0])
+        return simulate(set_point, lanes, *args, **kwargs)
+
+    simulate = servo.simulate_servo
+    for module in (servo, servo_fit):
+        monkeypatch.setattr(module, "simulate_servo", counted)
+    load = foreign.Load(viscous_up_ns_per_m=160.0, viscous_down_ns_per_m=240.0)
+    windows = [window_from_dict(foreign.draw(seed, load)) for seed in range(2)]
+    _calibrated(windows, FOREIGN)
+    assert runs and calibration_cost(windows, PipelineConfig()).simulated_s == pytest.approx(
+        sum(runs) * SUBSTEPS * 1e-6
+    )
