@@ -22,7 +22,7 @@ from ema.estimate.physics.inverse import (
     newey_west_std,
 )
 from ema.estimate.prepare.servo import ServoPrepared
-from ema.estimate.simulate.servo import lane_parameters
+from ema.estimate.simulate.servo import LANE_COLUMNS, lane_parameters
 from ema.estimate.stats import rms
 from ema.model.servo_sim import simulate_servo
 
@@ -139,9 +139,14 @@ def simulator_frame(
     simulated at ``values`` (their sensor read at ``FRAME_PHASES`` phases, the logs' rows left out). Eq. 5.1 reads
     a simulated effect through decimation and filters that shrink it (pre-sliding above all): the document keeps
     the simulator's constants, so that an estimate, which reads through the simulator, finds its nominal on the
-    logs that taught it. One step: the bias barely moves over it."""
+    logs that taught it. One step: the bias barely moves over it. A constant the simulator has no parameter for
+    (an effect along the stroke) is not simulated, so no bias of it is seen: it keeps the fit's value, as an
+    estimate reads it."""
     reads = [
         fitted(problem([_simulated(p, values, model, phase) for p in prepared], model)).values
         for phase in np.linspace(0.0, 1.0, FRAME_PHASES, endpoint=False)
     ]
-    return {name: 2.0 * value - float(np.mean([read[name] for read in reads])) for name, value in values.items()}
+    return {
+        name: 2.0 * value - float(np.mean([read[name] for read in reads])) if name in LANE_COLUMNS else value
+        for name, value in values.items()
+    }

@@ -76,6 +76,8 @@ def test_the_completed_document_reads_the_log_closer(emps):
         assert abs(entry.value - entry.nominal) <= 2 * entry.std, (name, entry.value, entry.nominal, entry.std)
     again = _calibrated([window], calibrated.completed).report
     assert again.model_error_pct_document["drive_force_n"] <= before.check.output_error_pct["drive_force_n"]
+    along = {e.name: e.value for e in again.learned if e.name.startswith("position_")}  # the simulator lacks it
+    assert along and along == {e.name: e.value for e in again.as_simulated if e.name in along}
 
 
 def test_unlogged_pulses_do_not_hide_or_fake_an_effect():
