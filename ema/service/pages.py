@@ -230,7 +230,7 @@ def actuator_page(
         said = [("prognosis", n.code, n.text) for n in prognosis.notes if n.parameter == name]
         parts += [_notes_list(said)] if said else []
         if trend.points:
-            parts.append(trend_plot(trend, life, prognosis.time_unit))
+            parts.append(trend_plot(trend, life, prognosis.time_unit, prognosis.life_status(name)))
         parts.append(_backtest(prognosis, name, unit))
     latest = [(s.window_id, n.code, n.text) for s in history[-LATEST_NOTES:] for n in s.notes]
     sensors = [("prognosis", n.code, n.text) for n in prognosis.notes if n.parameter not in prognosis.trends]

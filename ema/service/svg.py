@@ -76,10 +76,11 @@ def _limits(trend: Trend, life: RemainingLife) -> Axes:
     return Axes((min(times), max(times)), (min(values) - 0.05 * span, max(values) + 0.05 * span))
 
 
-def trend_plot(trend: Trend, life: RemainingLife, time_unit: str) -> str:
-    """The SVG of one parameter: estimates ±2 std, forecast band and median, threshold, RUL interval."""
+def trend_plot(trend: Trend, life: RemainingLife, time_unit: str, status: str | None = None) -> str:
+    """The SVG of one parameter: estimates ±2 std, forecast band and median, threshold, RUL interval; titled with
+    ``status`` (``Prognosis.life_status``) where given, else the remaining life's own."""
     axes = _limits(trend, life)
-    parts = _frame(axes, time_unit.replace("_", " "), f"{trend.parameter}: {life.status}")
+    parts = _frame(axes, time_unit.replace("_", " "), f"{trend.parameter}: {status or life.status}")
     last = max(p.time for p in trend.points)
     if life.rul_low is not None:
         high = axes.x1 if life.rul_high is None else last + life.rul_high

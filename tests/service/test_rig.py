@@ -54,6 +54,7 @@ def test_runs_of_a_spalled_screw_show_the_friction_falling_under_its_heading(tmp
     fdj, rest = page.split("<h2>Notes of the latest windows</h2>")
     assert "moving_away" in fdj.split("<h2>FDJ")[1] and "moving_away" not in rest
     assert 'class="watch"' in page and "FDJ moves away from its failure level" in page
+    assert 'class="title">FDJ: no degradation detected towards the level above; moving away' in page  # the plot
 
 
 def test_a_linear_actuator_is_calibrated_through_the_service_as_through_the_cli(tmp_path):
