@@ -155,7 +155,7 @@ def away_note(name: str, seen: Outlook, actuator: ActuatorDocument, unit: TimeUn
         return None
     other = "below" if life.direction == "above" else "above"
     watched = any(way == other for _, way in actuator.limits(name))
-    field = actuator.facts.friction_field("fdj_below") if name == "FDJ" else None
+    field = actuator.facts.friction_field(f"fdj_{other}") if name == "FDJ" else None
     hint = "" if watched or field is None else f"; a level {other} (thresholds.{field}) would trend towards it"
     units = f" {actuator.facts.friction_unit}" if name == "FDJ" else ""
     return Note(

@@ -121,3 +121,19 @@ def test_an_efficiency_that_rises_is_a_change_its_line_watches(base):
         assert bool(away) == said and all("eta_O rises by" in n.text and "thresholds." not in n.text for n in away)
         status, _, reason = status_of(stored[-1], prognosis, THESIS, len(stored))
         assert (status == "watch" and "eta_O" in reason) == said
+
+
+def test_a_friction_that_rises_away_from_its_only_level_below_names_the_level_above(base):
+    """A document with a lower FDJ level only (no nominal, so no default upper one): a rise is the change the
+    note says, and the level it names is the upper one, in the kind's unit."""
+    from pathlib import Path
+
+    from ema.model.actuator import read_actuator
+
+    servo = read_actuator(Path(__file__).resolve().parents[2] / "examples" / "emps" / "actuator.json")
+    below = servo.model_copy(update={"thresholds": servo.thresholds.model_copy(update={"fdj_below_n": 0.04})})
+    stored = _history(base, [0.050, 0.052, 0.054, 0.056, 0.058, 0.060], flight_hours=[0, 20, 40, 60, 80, 100])
+    prognosis = prognose("a", stored, below)
+    away = [n for n in prognosis.notes if n.code == "moving_away"]
+    assert prognosis.remaining_life["FDJ"].direction == "below" and len(away) == 1
+    assert "FDJ rises by" in away[0].text and "a level above (thresholds.fdj_above_n)" in away[0].text
