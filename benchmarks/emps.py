@@ -23,7 +23,7 @@ import numpy as np
 
 from benchmarks.as_user import run_ema
 from benchmarks.foreign_accuracy import RESULTS_MD
-from ema.calibration.servo import model_errors_pct
+from ema.calibration.servo_errors import model_errors_pct
 from ema.cli.report import typed_command, write_section
 from ema.estimate import runtime
 from ema.estimate.config import PipelineConfig

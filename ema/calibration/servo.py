@@ -42,6 +42,7 @@ from ema.calibration.documents import (
 )
 from ema.calibration.plot import ResidualPlot, Series
 from ema.calibration.servo_effects import EFFECTS, ServoEffect
+from ema.calibration.servo_errors import closed_loop_error_pct, document_check
 from ema.calibration.servo_fit import (
     COPIES,
     FOLDS,
@@ -59,11 +60,8 @@ from ema.estimate.physics.inverse import (
     decimated,
 )
 from ema.estimate.prepare.servo import ServoPrepared, document_effects, prepare_servo
-from ema.estimate.simulate.servo import lane_parameters
 from ema.estimate.stats import rms
 from ema.model.actuator import ActuatorDocument, Nominal
-from ema.model.checks import InputError
-from ema.model.servo_sim import simulate_servo
 from ema.model.window import Window
 
 MIN_HELD_OUT_DROP = 0.05  # of the held-out residual sum of squares
@@ -156,57 +154,6 @@ def learned(fit: Fitted, model: dict[str, float], values: dict[str, float] | Non
     return out
 
 
-def closed_loop_error_pct(
-    prepared: Sequence[ServoPrepared], values: dict[str, float], effects: dict[str, float] | None = None
-) -> float:
-    """100·‖F − F̂‖/‖F‖ over every window, each simulated in closed loop at ``values`` with ``effects`` (those the
-    simulator has; the others left out)."""
-    errors, norms = 0.0, 0.0
-    for p in prepared:
-        s, kept = p.window.signals, p.motion.samples
-        start = (float(s["position_m"][0]), float((s["position_m"][1] - s["position_m"][0]) * p.window.sample_rate_hz))
-        lane = lane_parameters(values, effects)[None, :]
-        run = simulate_servo(s["set_point_m"], lane, p.loop, load_n=s.get("load_n"), start=start)
-        errors += float(np.sum((s["drive_force_n"][kept] - run.drive_force_n[0, kept]) ** 2))
-        norms += float(np.sum(s["drive_force_n"][kept] ** 2))
-    return float(100.0 * np.sqrt(errors / norms))
-
-
-def model_errors_pct(
-    prepared: Sequence[ServoPrepared], values: dict[str, float], effects: dict[str, float]
-) -> dict[str, float]:
-    """The error of a model whose constants are fixed (``values`` with ``effects``), as the benchmarks state it:
-    the inverse model's reconstruction of the decimated force, and the closed loop's of the logged force."""
-    p = problem(prepared, effects)
-    names = [name for name in p.x if name in values]
-    missing = set(p.x) - set(names)
-    if missing:
-        raise InputError("values", f"the model with {', '.join(effects) or 'no effect'} needs {', '.join(missing)}")
-    residual = p.y - p.design(names) @ np.array([values[name] for name in names])
-    return {
-        "drive_force_n": float(100.0 * np.linalg.norm(residual) / np.linalg.norm(p.y)),
-        "drive_force_n_closed_loop": closed_loop_error_pct(prepared, values, effects),
-    }
-
-
-def _document_check(prepared: Sequence[ServoPrepared], actuator: ActuatorDocument) -> dict[str, float] | None:
-    """The error of the document's own model as it stands (its load's constants fixed), inverse and closed loop;
-    None where the document does not hold them, or holds an effect whose constants it does not keep."""
-    servo, nominal = prepared[0].servo, actuator.nominal
-    if servo.mass_kg is None or servo.viscous_ns_per_m is None or nominal is None or nominal.fdj_n is None:
-        return None
-    values = {"mass_kg": servo.mass_kg, "fdj_n": nominal.fdj_n, "offset_n": servo.force_offset_n or 0.0}
-    if servo.viscous_down_ns_per_m is None:
-        values["viscous_ns_per_m"] = servo.viscous_ns_per_m
-    else:
-        values |= {"viscous_up_ns_per_m": servo.viscous_ns_per_m, "viscous_down_ns_per_m": servo.viscous_down_ns_per_m}
-    values |= servo.effect_constants
-    try:
-        return model_errors_pct(prepared, values, document_effects(servo))
-    except InputError:
-        return None
-
-
 def completed(
     actuator: ActuatorDocument, prepared: ServoPrepared, fit: Fitted, model: dict[str, float]
 ) -> ActuatorDocument:
@@ -233,6 +180,22 @@ def completed(
     nominal = Nominal(fdj_n=round(v["fdj_n"], 6), eta_o=actuator.nominal.eta_o if actuator.nominal else None)
     document = actuator.model_dump(by_alias=True) | {"servo": servo.model_dump(), "nominal": nominal.model_dump()}
     return ActuatorDocument.model_validate(document)
+
+
+def _as_simulated(
+    prepared: Sequence[ServoPrepared], before: tuple[Fitted, dict[str, float]], after: tuple[Fitted, dict[str, float]]
+) -> tuple[dict[str, float], dict[str, float]]:
+    """The constants after, as the simulator takes them (``simulator_frame``), and the closed loop's error before
+    and after, each at its model's constants as the simulator takes them."""
+    frames = {"before": simulator_frame(prepared, before[0].values, before[1])}
+    frames["after"] = (
+        frames["before"] if after[1] == before[1] else simulator_frame(prepared, after[0].values, after[1])
+    )
+    closed = {
+        "before": closed_loop_error_pct(prepared, frames["before"], before[1]),
+        "after": closed_loop_error_pct(prepared, frames["after"], after[1]),
+    }
+    return frames["after"], closed
 
 
 def _plot(prepared: Sequence[ServoPrepared], base: Fitted, after: Fitted, model: dict[str, float]) -> ResidualPlot:
@@ -274,12 +237,7 @@ def calibrate_servo(
         ]
     after = fitted(problem(prepared, model))
     adopted = [name for name in model if name not in base_model]
-    simulated = {"before": simulator_frame(prepared, base.values, base_model)}
-    simulated["after"] = simulated["before"] if model == base_model else simulator_frame(prepared, after.values, model)
-    closed = {
-        "before": closed_loop_error_pct(prepared, simulated["before"], base_model),
-        "after": closed_loop_error_pct(prepared, simulated["after"], model),
-    }
+    simulated, closed = _as_simulated(prepared, (base, base_model), (after, model))
     report = CalibrationReport(
         n_windows=len(windows),
         noise_floor=NoiseFloor(copies=COPIES, equation_error_ratio=ratio),
@@ -303,11 +261,11 @@ def calibrate_servo(
         stds_before={"FDJ": base.stds["fdj_n"]},
         stds_after={"FDJ": after.stds["fdj_n"]},
         learned=learned(after, model),
-        as_simulated=learned(after, model, simulated["after"]),
+        as_simulated=learned(after, model, simulated),
         model_error_pct_before={"drive_force_n": base.error_pct, "drive_force_n_closed_loop": closed["before"]},
         model_error_pct_after={"drive_force_n": after.error_pct, "drive_force_n_closed_loop": closed["after"]},
-        model_error_pct_document=_document_check(prepared, actuator),
+        model_error_pct_document=document_check(prepared, actuator),
         timings_s={"total": time.perf_counter() - started},
     )
-    document = completed(actuator, prepared[0], replace(after, values=simulated["after"]), model)
+    document = completed(actuator, prepared[0], replace(after, values=simulated), model)
     return report, document, _plot(prepared, base, after, model)

@@ -1,0 +1,68 @@
+"""The error of a servo's model, as the identification benchmarks state it: the inverse model's reconstruction of
+the decimated force, and the closed loop's of the logged force, each window simulated at the constants (those
+the simulator has; the others left out). ``ema calibrate`` reports both before and after, and for the document
+as it stands."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from ema.calibration.servo_fit import problem
+from ema.estimate.prepare.servo import ServoPrepared, document_effects
+from ema.estimate.simulate.servo import lane_parameters
+from ema.model.actuator import ActuatorDocument
+from ema.model.checks import InputError
+from ema.model.servo_sim import simulate_servo
+
+
+def closed_loop_error_pct(
+    prepared: Sequence[ServoPrepared], values: dict[str, float], effects: dict[str, float] | None = None
+) -> float:
+    """100·‖F − F̂‖/‖F‖ over every window, each simulated in closed loop at ``values`` with ``effects`` (those the
+    simulator has; the others left out)."""
+    errors, norms = 0.0, 0.0
+    for p in prepared:
+        s, kept = p.window.signals, p.motion.samples
+        start = (float(s["position_m"][0]), float((s["position_m"][1] - s["position_m"][0]) * p.window.sample_rate_hz))
+        lane = lane_parameters(values, effects)[None, :]
+        run = simulate_servo(s["set_point_m"], lane, p.loop, load_n=s.get("load_n"), start=start)
+        errors += float(np.sum((s["drive_force_n"][kept] - run.drive_force_n[0, kept]) ** 2))
+        norms += float(np.sum(s["drive_force_n"][kept] ** 2))
+    return float(100.0 * np.sqrt(errors / norms))
+
+
+def model_errors_pct(
+    prepared: Sequence[ServoPrepared], values: dict[str, float], effects: dict[str, float]
+) -> dict[str, float]:
+    """The error of a model whose constants are fixed (``values`` with ``effects``), as the benchmarks state it:
+    the inverse model's reconstruction of the decimated force, and the closed loop's of the logged force."""
+    p = problem(prepared, effects)
+    names = [name for name in p.x if name in values]
+    missing = set(p.x) - set(names)
+    if missing:
+        raise InputError("values", f"the model with {', '.join(effects) or 'no effect'} needs {', '.join(missing)}")
+    residual = p.y - p.design(names) @ np.array([values[name] for name in names])
+    return {
+        "drive_force_n": float(100.0 * np.linalg.norm(residual) / np.linalg.norm(p.y)),
+        "drive_force_n_closed_loop": closed_loop_error_pct(prepared, values, effects),
+    }
+
+
+def document_check(prepared: Sequence[ServoPrepared], actuator: ActuatorDocument) -> dict[str, float] | None:
+    """The error of the document's own model as it stands (its load's constants fixed), inverse and closed loop;
+    None where the document does not hold them, or holds an effect whose constants it does not keep."""
+    servo, nominal = prepared[0].servo, actuator.nominal
+    if servo.mass_kg is None or servo.viscous_ns_per_m is None or nominal is None or nominal.fdj_n is None:
+        return None
+    values = {"mass_kg": servo.mass_kg, "fdj_n": nominal.fdj_n, "offset_n": servo.force_offset_n or 0.0}
+    if servo.viscous_down_ns_per_m is None:
+        values["viscous_ns_per_m"] = servo.viscous_ns_per_m
+    else:
+        values |= {"viscous_up_ns_per_m": servo.viscous_ns_per_m, "viscous_down_ns_per_m": servo.viscous_down_ns_per_m}
+    values |= servo.effect_constants
+    try:
+        return model_errors_pct(prepared, values, document_effects(servo))
+    except InputError:
+        return None
