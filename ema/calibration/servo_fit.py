@@ -141,12 +141,13 @@ def simulator_frame(
     the simulator's constants, so that an estimate, which reads through the simulator, finds its nominal on the
     logs that taught it. One step: the bias barely moves over it. A constant the simulator has no parameter for
     (an effect along the stroke) is not simulated, so no bias of it is seen: it keeps the fit's value, as an
-    estimate reads it."""
+    estimate reads it; so does one the twins give no finite read of."""
     reads = [
         fitted(problem([_simulated(p, values, model, phase) for p in prepared], model)).values
         for phase in np.linspace(0.0, 1.0, FRAME_PHASES, endpoint=False)
     ]
+    moved = {name: 2.0 * value - float(np.mean([read[name] for read in reads])) for name, value in values.items()}
     return {
-        name: 2.0 * value - float(np.mean([read[name] for read in reads])) if name in LANE_COLUMNS else value
+        name: moved[name] if name in LANE_COLUMNS and np.isfinite(moved[name]) else value
         for name, value in values.items()
     }
