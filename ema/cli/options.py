@@ -19,33 +19,25 @@ F = TypeVar("F", bound=Callable[..., Any])
 EXISTING = click.Path(exists=True, dir_okay=False, path_type=Path)  # a file that must be there
 
 
-class _OutputFile(click.Path):
-    """A file the command writes: its folder made as the flag is read (as a results CSV's always was), so that a
-    folder that cannot be made is said naming the flag before any work, never after a calibration's minutes."""
+class _Output(click.Path):
+    """A file the command writes (its folder made as the flag is read, as a results CSV's always was) or a folder it
+    writes into (made): one that cannot be made is said naming the flag before any work, never after a
+    calibration's minutes."""
 
     def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
         path = super().convert(value, param, ctx)
+        written = Path(os.fsdecode(path))
         try:
-            Path(os.fsdecode(path)).parent.mkdir(parents=True, exist_ok=True)
+            (written if self.dir_okay else written.parent).mkdir(parents=True, exist_ok=True)
         except OSError as error:
-            self.fail(f"{value}: its folder cannot be made ({error.strerror})", param, ctx)
+            self.fail(
+                f"{value}: {'it' if self.dir_okay else 'its folder'} cannot be made ({error.strerror})", param, ctx
+            )
         return path
 
 
-class _OutputFolder(click.Path):
-    """A folder the command writes into: made as the flag is read, or refused naming the flag before any work."""
-
-    def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
-        path = super().convert(value, param, ctx)
-        try:
-            Path(os.fsdecode(path)).mkdir(parents=True, exist_ok=True)
-        except OSError as error:
-            self.fail(f"{value}: it cannot be made ({error.strerror})", param, ctx)
-        return path
-
-
-OUTPUT_FILE = _OutputFile(dir_okay=False, path_type=Path)
-OUTPUT_FOLDER = _OutputFolder(file_okay=False, path_type=Path)
+OUTPUT_FILE = _Output(dir_okay=False, path_type=Path)
+OUTPUT_FOLDER = _Output(file_okay=False, path_type=Path)
 SIZES = {  # flag -> PipelineConfig field
     "--sims": "n_simulations",
     "--checks": "check_windows",

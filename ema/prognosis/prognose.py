@@ -130,6 +130,11 @@ def _urgency(life: RemainingLife) -> tuple[int, float]:
     return (0 if life.status == "already crossed" else 1, life.rul if life.rul is not None else math.inf)
 
 
+def _one(unit: str) -> str:
+    """One of the prognosis's time unit, in words: flight_hours -> flight hour."""
+    return unit.replace("_", " ").rstrip("s")
+
+
 def speeding_note(name: str) -> Note:
     return Note(
         code="speeding_up",
@@ -162,7 +167,7 @@ def away_note(name: str, seen: Outlook, actuator: ActuatorDocument, unit: TimeUn
         code="moving_away",
         parameter=name,
         text=f"{name} {'falls' if other == 'below' else 'rises'} by {away:.2g} ± {trend.slope_std:.2g}{units} per "
-        f"{unit.replace('_', ' ').rstrip('s')} over {trend.n} windows: a change all the same, which the remaining "
+        f"{_one(unit)} over {trend.n} windows: a change all the same, which the remaining "
         f"life to its level {life.direction} ({life.threshold:.4g}{units}) cannot call a degradation{hint}",
     )
 
@@ -204,7 +209,7 @@ def sensor_trends(
                 parameter="hinge_moment_nm",
                 text=f"the hinge moment's strain gauge drifts against the aircraft model by "
                 f"{trend.slope_per_unit:+.2g} "
-                f"± {trend.slope_std:.2g} per {unit.replace('_', ' ').rstrip('s')}",
+                f"± {trend.slope_std:.2g} per {_one(unit)}",
             )
         )
     return {"hinge_aircraft_ratio": trend}, notes

@@ -224,13 +224,12 @@ def actuator_page(
     for name, trend in prognosis.trends.items():
         life = prognosis.remaining_life[name]
         heading = PARAMETER_NAMES[name] + (f" [{actuator.facts.friction_unit}]" if name == "FDJ" else "")
-        parts.append(
-            f"<h2>{html.escape(heading)}</h2><p>{html.escape(life_text(life, unit, prognosis.life_status(name)))}</p>"
-        )
+        worded = prognosis.life_status(name)
+        parts.append(f"<h2>{html.escape(heading)}</h2><p>{html.escape(life_text(life, unit, worded))}</p>")
         said = [("prognosis", n.code, n.text) for n in prognosis.notes if n.parameter == name]
         parts += [_notes_list(said)] if said else []
         if trend.points:
-            parts.append(trend_plot(trend, life, prognosis.time_unit, prognosis.life_status(name)))
+            parts.append(trend_plot(trend, life, prognosis.time_unit, worded))
         parts.append(_backtest(prognosis, name, unit))
     latest = [(s.window_id, n.code, n.text) for s in history[-LATEST_NOTES:] for n in s.notes]
     sensors = [("prognosis", n.code, n.text) for n in prognosis.notes if n.parameter not in prognosis.trends]
