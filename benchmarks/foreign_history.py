@@ -6,7 +6,7 @@ come from ``tests.foreign`` as a fleet logs them (``PROSE``); every window goes 
 its windows' answers fared, the trend's level at the last window against the truth there, and the
 true remaining life against the 90 % interval.
 
-    python -m benchmarks.foreign_history [--actuators 16] [--speeding 8] [--healthy 8] [--windows 30] [--docs]
+    python -m benchmarks.foreign_history [--actuators 16] [--speeding 8] [--healthy 32] [--windows 30] [--docs]
 """
 
 from __future__ import annotations
@@ -42,8 +42,8 @@ drawn uniformly over the span, come from `tests/foreign` (the independent implem
 logs them: the five families, half 0.5 s at 10 kHz, a fifth 0.1 s gusts, a fifth 1–2 kHz logs, a
 tenth 2 s cruise; in three of ten a grease 1.2–2x as viscous as the document's (a cold flight), unlogged.
 Eight more wear as the square of the hours (wear that speeds up: a line through their windows
-crosses the threshold ~3x too late, surely), and eight do not wear at all (a monitor that claims
-degradation there raises a false alarm). Eight more wear linearly with a rotor 1.03–1.1x as heavy as
+crosses the threshold ~3x too late, surely), and thirty-two do not wear at all (a monitor that claims
+a degradation or a change there raises a false alarm). Eight more wear linearly with a rotor 1.03–1.1x as heavy as
 the document's J_M, unlogged: a window whose motor saturates as it accelerates cannot tell that from a
 weaker motor, and is read with the J_M earlier windows of the actuator read (thesis-like windows can;
 each read alone, `--actuators 0 --speeding 0 --healthy 0 --zeroed 0 --alone`, 143 of their 240 FDJ answers were
@@ -181,6 +181,14 @@ def summary(rows: list[dict[str, Any]]) -> str:
         f"Zero off by flight: of their {sum(r['n'] for r in zeroed)} windows, {carried} were read with "
         "the zero an earlier window of their flight read"
     )
+    healthy = [r for r in rows if r["kind"] == "healthy"]
+    wearing = [r for r in rows if r["kind"] != "healthy"]
+    parts.append(
+        "A trend moving away from its watched level (moving_away, 3 std): noted on "
+        f"{sum(r['away'] for r in healthy)} of the healthy actuators' {sum(r['trends'] for r in healthy)} trends "
+        f"({sum(r['away'] > 0 for r in healthy)} of {len(healthy)} actuators), and on "
+        f"{sum(r['away'] for r in wearing)} of the wearing ones' {sum(r['trends'] for r in wearing)}"
+    )
     refused = [f for r in rows for f in r["refused"]]
     head = (
         f"{windows} windows, {len(refused)} refused, {over} answered FDJ past 10 % of range ({unsaid} not said weak). "
@@ -193,7 +201,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--actuators", type=int, default=16, help="histories of actuators wearing linearly")
     parser.add_argument("--speeding", type=int, default=8, help="histories of actuators whose wear speeds up")
-    parser.add_argument("--healthy", type=int, default=8, help="histories of healthy actuators (no wear)")
+    parser.add_argument("--healthy", type=int, default=32, help="histories of healthy actuators (no wear)")
     parser.add_argument("--heavier", type=int, default=8, help="histories of linearly wearing heavier rotors")
     parser.add_argument("--zeroed", type=int, default=8, help="histories whose current sensor's zero changes by flight")
     parser.add_argument("--windows", type=int, default=30, help="windows per history")
@@ -215,6 +223,8 @@ def main() -> None:
                     "n": args.windows,
                     **fared,
                     "scores": scored(prognosis, truth, thresholds),
+                    "away": sum(n.code == "moving_away" for n in prognosis.notes),
+                    "trends": len(prognosis.trends),
                 }
             )
             print(table(rows[-1:]).splitlines()[-1], flush=True)
