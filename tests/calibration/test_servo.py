@@ -44,6 +44,19 @@ def test_a_viscous_friction_that_differs_with_direction_is_named_and_learned(see
         assert abs(simulated[name] - entry.value) <= max(3 * entry.std, 0.01 * abs(entry.value)), name
 
 
+@pytest.mark.parametrize("seed", range(4))
+def test_a_foreign_servos_completed_document_reads_its_nominal_on_the_window_that_taught_it(seed):
+    """Windows of the closed-form foreign servo (its own simulator, not ours), with and without a viscous friction
+    that differs with direction: calibrated, then estimated with the completed document, every constant reads
+    within 2 std of the nominal the document keeps (its constants as our simulator takes them)."""
+    load = foreign.Load(viscous_up_ns_per_m=160.0, viscous_down_ns_per_m=240.0) if seed % 2 else foreign.Load()
+    window = window_from_dict(foreign.draw(seed, load))
+    completed = _calibrated([window], FOREIGN).completed
+    read = estimate(window, actuator=completed).estimates
+    for name, entry in {"FDJ": read.FDJ, **read.constants}.items():
+        assert abs(entry.value - entry.nominal) <= 2 * entry.std, (name, entry.value, entry.nominal, entry.std)
+
+
 @pytest.fixture(scope="module")
 def emps():
     window = window_from_dict(read_mapped(EMPS / "DATA_EMPS.mat", read_logmap(EMPS / "log-map.json")))
