@@ -44,11 +44,15 @@ class KindFacts:
     name: str
     summary: str
     section: str  # the actuator document's field that holds this kind's constants
-    friction_unit: str  # the unit FDJ is read in: "N·m" at the motor shaft, "N" on the load
     roles: Mapping[str, Role]  # log-map role -> signal; "position" may be given as "error" (set point less it)
     nominal_given: bool = False  # the document's author gives the nominal health (else ema calibrate learns it)
     static_friction: bool = False  # a window can show a break-away (FSJ)
     load_side: bool = False  # the log is on the load side: FDJ is the load's friction force
+
+    @property
+    def friction_unit(self) -> str:
+        """The unit FDJ is read in: a force on the load for a kind logged there, else a torque at the motor shaft."""
+        return "N" if self.load_side else "N·m"
 
     @property
     def signals(self) -> tuple[str, ...]:
@@ -74,7 +78,6 @@ _ROTARY = KindFacts(
     name="rotary",
     summary="a current-piloted motor and a gear train to a surface",
     section="drive",
-    friction_unit="N·m",
     roles=_roles(
         set_point="command_deg",
         position="position_deg",
@@ -89,14 +92,12 @@ _LINEAR = KindFacts(
     name="linear",
     summary="a ball screw turned by a stepper, its current read through what ema calibrate learned",
     section="screw",
-    friction_unit="N·m",
     roles=_roles(set_point="command_mm", position="position_mm", current="current_a", load="load_n"),
 )
 _SERVO = KindFacts(
     name="servo",
     summary="a linear axis driven by a force command from a known position controller, logged on the load side",
     section="servo",
-    friction_unit="N",
     roles=_roles(
         set_point="set_point_m", position="position_m", force="drive_force_n", load="load_n", optional=("load",)
     ),
