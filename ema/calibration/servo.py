@@ -59,9 +59,10 @@ from ema.estimate.physics.inverse import (
     UNITS,
     decimated,
 )
-from ema.estimate.prepare.servo import ServoPrepared, document_effects, prepare_servo
+from ema.estimate.prepare.servo import ServoPrepared, document_effects, physical, prepare_servo
 from ema.estimate.stats import rms
 from ema.model.actuator import ActuatorDocument, Nominal
+from ema.model.checks import InputError
 from ema.model.window import Window
 
 MIN_HELD_OUT_DROP = 0.05  # of the held-out residual sum of squares
@@ -212,14 +213,25 @@ def _plot(prepared: Sequence[ServoPrepared], base: Fitted, after: Fitted, model:
     )
 
 
+def _own_controller(prepared: ServoPrepared) -> ServoPrepared:
+    """``prepared``, unless its log was run under another controller than the document's: every step of a
+    calibration simulates the document's, and would trace the controllers' difference to the load."""
+    for note in prepared.notes:
+        if note.code == "controller_mismatch":
+            raise InputError(f"window {prepared.window.window_id}", f"{note.text}; a calibration needs the log's")
+    return prepared
+
+
 def calibrate_servo(
     windows: Sequence[Window], actuator: ActuatorDocument
 ) -> tuple[CalibrationReport, ActuatorDocument, ResidualPlot]:
     """The report (module docstring), the document completed with what the windows taught, and the figure."""
     started = time.perf_counter()
-    prepared = [prepare_servo(w, actuator) for w in windows]
+    prepared = [_own_controller(prepare_servo(w, actuator)) for w in windows]
     base_model = document_effects(prepared[0].servo)
-    copies = noise_copies(prepared, fitted(problem(prepared, base_model)), base_model)
+    first = fitted(problem(prepared, base_model))
+    physical(first.values, first.stds)
+    copies = noise_copies(prepared, first, base_model)
     prepared = undisturbed(prepared, copies, base_model)
     base = fitted(problem(prepared, base_model))
     ratio = rms(base.residual) / float(np.median(copies.rms))

@@ -90,6 +90,9 @@ def array_in_range(field: str, values: np.ndarray, low: float, high: float, unit
         raise InputError(field, f"value {first:g} is outside [{low:g}, {high:g}] {unit}".rstrip())
 
 
+BOUND_ERRORS = ("greater_than", "greater_than_equal", "less_than", "less_than_equal")  # pydantic's, on a number
+
+
 def from_validation(exc: Any, prefix: str = "") -> InputError:
     """A pydantic ValidationError's first error as an InputError naming the field (list indices go
     into the message: ``signals.current_a``, "sample 17: Input should be a finite number"). A check across
@@ -98,6 +101,8 @@ def from_validation(exc: Any, prefix: str = "") -> InputError:
     names = [str(part) for part in first["loc"] if not isinstance(part, int)]
     indices = [part for part in first["loc"] if isinstance(part, int)]
     said = first["msg"].removeprefix("Value error, ")
+    if first["type"] in BOUND_ERRORS and isinstance(first.get("input"), int | float):
+        said += f", got {first['input']:g}"
     message = said if not indices else f"sample {indices[0]}: {said}"
     head, _, rest = message.partition(": ")
     if first["type"] == "value_error" and rest and head.replace("_", "").replace(".", "").isalnum():

@@ -122,7 +122,7 @@ class Servo(Document):
     def with_constants(self, constants: dict[str, float], source: str) -> Servo:
         """This section completed by the constants a log recorded (``SERVO_CONSTANTS``); a constant the
         section gives differently is refused naming it (a log read with another machine's document)."""
-        from ema.model.checks import InputError
+        from ema.model.checks import InputError, validated
 
         update: dict[str, Any] = {}
         for name, value in constants.items():
@@ -134,7 +134,7 @@ class Servo(Document):
                     f"{source}.{name}", f"the log recorded {value:g}, the actuator's document says {given:g}"
                 )
             update[name] = value
-        return self.model_validate({**self.model_dump(), **update})
+        return validated(type(self), {**self.model_dump(), **update}, source, prefix=f"{source}.")
 
     def missing(self) -> list[str]:
         """The controller's constants neither the document nor the log gave."""

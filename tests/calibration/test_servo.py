@@ -8,6 +8,7 @@ import pytest
 from ema.estimate.config import PipelineConfig
 from ema.kinds import CalibrationRequest, calibrate, estimate
 from ema.model.actuator import actuator_from_dict, read_actuator
+from ema.model.checks import InputError
 from ema.model.logmap import read_logmap, read_mapped
 from ema.model.window import window_from_dict
 from tests.foreign import servo as foreign
@@ -142,3 +143,12 @@ def test_a_constant_the_twins_give_no_finite_read_of_keeps_the_fits_value(monkey
         "mass_kg": 96.0,
         "position_friction_p1_n": 1.0,
     }
+
+
+def test_a_log_its_documents_controller_does_not_give_is_refused_naming_the_window():
+    """Every step of a servo's calibration simulates the document's controller: a log run under another (here the
+    speed read without its filter) would have the controllers' difference traced to the load."""
+    document = actuator_from_dict({**foreign.DOCUMENT, "servo": {**foreign.DOCUMENT["servo"], "speed_filter": [1.0]}})
+    with pytest.raises(InputError) as error:
+        _calibrated([window_from_dict(foreign.draw(0, seconds=3.0))], document)
+    assert error.value.field == "window servo-0" and "controller" in error.value.message

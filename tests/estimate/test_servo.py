@@ -100,6 +100,48 @@ def test_a_gain_neither_gives_is_refused_naming_the_documents_field():
     assert error.value.field == "actuator.servo.speed_gain_per_mps"
 
 
+def test_a_constant_the_log_records_out_of_bounds_is_refused_naming_it():
+    window = foreign.draw(0, seconds=3.0)
+    window["constants"]["drive_gain_n_per_unit"] *= -1.0  # a drive wired the other way round
+    with pytest.raises(InputError) as error:
+        estimate(window_from_dict(window), actuator=FOREIGN)
+    assert error.value.field == "window.constants.drive_gain_n_per_unit"
+    assert "greater than 0, got -" in error.value.message
+
+
+@pytest.mark.parametrize("noise_m", [0.0, 1e-6])
+def test_a_load_that_never_slides_is_refused_before_any_simulation(noise_m):
+    """A load held at rest (its sensor still or dithering) shows no sliding friction: refused naming the
+    position, where a no-step sensor's noise would otherwise pass for motion."""
+    window = foreign.draw(0, seconds=3.0)
+    n = len(window["signals"]["position_m"])
+    rng = np.random.default_rng(3)
+    window["signals"]["set_point_m"] = [0.0] * n
+    window["signals"]["position_m"] = (noise_m * rng.standard_normal(n)).tolist()
+    with pytest.raises(InputError) as error:
+        prepare_servo(window_from_dict(window), FOREIGN)
+    assert error.value.field == "signals.position_m" and "never slides" in error.value.message
+
+
+def test_a_window_that_moves_one_way_is_refused_not_split_between_friction_and_offset(emps):
+    """Moving one way, sgn(q̇) is a constant: FDJ and the force's offset are one column (the EMPS log's first 2 s
+    read FDJ 10.6 ± 0.85 N and an offset 10.5 N, against 20.4 and −3.2 N on the whole log)."""
+    document = read_mapped(EMPS / "DATA_EMPS.mat", read_logmap(EMPS / "log-map.json"))
+    document["signals"] = {name: values[:2000] for name, values in document["signals"].items()}
+    with pytest.raises(InputError) as error:
+        estimate(window_from_dict(document), actuator=read_actuator(EMPS / "actuator.json"))
+    assert error.value.field == "signals.position_m" and "both ways" in error.value.message
+
+
+def test_a_log_played_backwards_is_refused_naming_the_force():
+    """Backwards in time the load's friction aids its motion: the fit reads FDJ and C below zero."""
+    window = foreign.draw(0, seconds=6.0)
+    window["signals"] = {name: values[::-1] for name, values in window["signals"].items()}
+    with pytest.raises(InputError) as error:
+        estimate(window_from_dict(window), actuator=FOREIGN)
+    assert error.value.field == "signals.drive_force_n" and "fdj_n -" in error.value.message
+
+
 def test_force_pulses_the_log_does_not_carry_are_left_out_and_said():
     load = foreign.Load()
     for seed in range(3):

@@ -34,6 +34,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ema.estimate.physics.eta_search import MIN_OFFSET_BALANCE
+from ema.estimate.physics.noise import white_noise_std
 from ema.estimate.stats import rms
 from ema.model.checks import InputError
 
@@ -46,6 +48,7 @@ EDGE_CUTOFF_PERIODS = 5.0  # the filters' transients at either end, left out of 
 REST_STEPS_PER_SAMPLE = 2.0  # a filtered speed under this many sensor steps a sample: the load rests (dithers)
 REST_SHARE_OF_TOP = 0.002  # the same, for a sensor without a step: this share of the top speed
 REST_MARGIN_DECIMATIONS = 2  # a decimated row this near a rest (in decimation factors) is left out too
+MIN_TRAVEL_NOISES = 20.0  # a load whose filtered travel is under this many position-noise stds never moved
 DISTURBANCE_SIGMAS = 8.0  # a residual this far past what the model leaves there is a force the log lacks
 DISTURBANCE_MARGIN_ROWS = 3  # its neighbours, which the decimation filter smeared it into
 POLYNOMIAL_ORDER = 3  # an effect along the stroke: Legendre polynomials up to this order
@@ -116,15 +119,28 @@ def load_motion(position_m: np.ndarray, rate_hz: float, bandwidth_hz: float, res
         raise InputError("signals.position_m", f"{len(position_m)} samples are too few to read its motion from")
     kept = slice(edge, len(position_m) - edge)
     filtered = _filtfilt(*_butter_lowpass(rate_hz, cutoff), position_m)
+    _moves(filtered[kept], white_noise_std(position_m))
     speed = central_difference(filtered, rate_hz)[kept]
     acceleration = central_difference(central_difference(filtered, rate_hz), rate_hz)[kept]
     top = float(np.max(np.abs(speed)))
     rest = REST_STEPS_PER_SAMPLE * resolution_m * rate_hz if resolution_m > 0 else REST_SHARE_OF_TOP * top
-    resting = np.abs(speed) < rest
+    resting = np.abs(speed) <= rest  # a log that never moves rests throughout (rest 0)
     margin = REST_MARGIN_DECIMATIONS * decimation
     near_rest = np.convolve(resting, np.ones(2 * margin + 1), mode="same") > 0
     rows = decimated_indices(len(speed), decimation)
     return Motion(filtered[kept], speed, acceleration, edge, decimation, ~near_rest[rows])
+
+
+def _moves(filtered_m: np.ndarray, noise_m: float) -> None:
+    """Raise unless the load travels beyond its sensor's noise: a window at rest holds no sliding friction, and
+    a no-step sensor's noise would otherwise pass for motion (its rest is a share of the top speed)."""
+    travel = float(np.ptp(filtered_m))
+    if travel <= MIN_TRAVEL_NOISES * noise_m:
+        raise InputError(
+            "signals.position_m",
+            f"travels {travel:.3g} m, within {MIN_TRAVEL_NOISES:g} times its noise ({noise_m:.3g} m): the load "
+            "never slides, and friction shows only in motion",
+        )
 
 
 def decimated_indices(n: int, factor: int) -> np.ndarray:
@@ -251,6 +267,13 @@ def fit_inverse(
     x = np.column_stack([decimated_columns[name] for name in names])
     if len(y) < 4 * len(names):
         raise InputError("signals.position_m", f"the load slides in {len(y)} of the decimated samples: too few to read")
+    rarer = min(int(np.sum(decimated_columns["fdj_n"] > 0)), int(np.sum(decimated_columns["fdj_n"] < 0)))
+    if rarer < MIN_OFFSET_BALANCE * len(y):
+        raise InputError(
+            "signals.position_m",
+            f"the load slides the other way in {rarer} of {len(y)} decimated samples: moving one way, its friction "
+            "FDJ·sgn(q̇) and the force's offset are one column, and a window must move both ways to tell them apart",
+        )
     beta, *_ = np.linalg.lstsq(x, y, rcond=None)
     residual = y - x @ beta
     stds = newey_west_std(x, residual, newey_west_lags(len(y)))

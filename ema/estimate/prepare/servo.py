@@ -31,6 +31,8 @@ RATE_TOLERANCE = 0.01
 CONTROLLER_TOLERANCE = 0.02
 MIN_QUANTIZED = 0.9
 PROVISIONAL_BANDWIDTH_SHARE = 0.02  # a first fit's loop bandwidth, as a share of the rate (20 Hz at 1 kHz)
+POSITIVE = ("mass_kg", "fdj_n", "viscous_ns_per_m", "viscous_up_ns_per_m", "viscous_down_ns_per_m")
+SIGN_STDS = 3.0  # a positive constant read this many stds below zero: the log's signs, not its noise
 
 
 @dataclass(frozen=True)
@@ -110,6 +112,21 @@ def bandwidth(servo: Servo, mass_kg: float) -> float:
 def document_effects(servo: Servo) -> dict[str, float]:
     """The effects the document adopted (``ema calibrate``), as the inverse model's columns name them."""
     return {**servo.effects, **({"viscous_down": 1.0} if servo.viscous_down_ns_per_m is not None else {})}
+
+
+def physical(values: dict[str, float], stds: dict[str, float]) -> None:
+    """Raise unless the fit reads a positive mass and a friction that opposes the motion (each ``POSITIVE``
+    constant above −``SIGN_STDS`` stds): a force that pushes against the acceleration, or aids the motion it
+    should brake, is a log whose force and position disagree in sign or in time, and no constant read from it
+    means anything."""
+    wrong = [name for name in POSITIVE if name in values and values[name] < -SIGN_STDS * stds[name]]
+    if wrong:
+        read = ", ".join(f"{name} {values[name]:.4g} ± {stds[name]:.2g}" for name in wrong)
+        raise InputError(
+            "signals.drive_force_n",
+            f"the fit reads {read}: the force pushes against the motion it drives (a force or position logged "
+            "with the other sign, the log map's sign, or a log played backwards)",
+        )
 
 
 def prepare_servo(window: Window, actuator: ActuatorDocument) -> ServoPrepared:
