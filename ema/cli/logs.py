@@ -93,6 +93,9 @@ def _from_table(path: Path, defaults: Defaults) -> list[Window]:
     metadata (``actuator_id``, ``window_id``, ``sample_rate_hz``, ``airspeed_mps``, ``altitude_m``,
     ``recorded_at``, ``flight_hours``, ``flight_id``)."""
     table = read_table(path)
+    for name in ALL_SIGNALS:
+        if name in table.unread:
+            table.numeric(name, path, "a window's signal")  # names the cell that is no number
     kind = tabled_kind(path, set(table.columns))
     meta = {**{k: str(v) for k, v in table.scalars.items()}, **table.meta}
     signals = {name: table.columns[name] for name in kind.all_signals if name in table.columns}

@@ -119,9 +119,7 @@ def _read(table: Table, part: Column | Constant, role: Role, what: str, path: Pa
     factor = role.units[part.unit]
     if isinstance(part, Constant):
         return np.full(n, part.value * factor)
-    if part.column not in table.columns:
-        raise InputError(str(path), f"has no numeric variable {part.column!r} (the log map's {what}.column)")
-    values = table.columns[part.column]
+    values = table.numeric(part.column, path, f"the log map's {what}.column")
     if len(values) != n:
         raise InputError(f"{path}: {part.column}", f"has {len(values)} samples, the set point has {n}")
     scale = part.scale if not isinstance(part.scale, str) else _scalar(table, part.scale, path, f"{what}.scale")
@@ -134,9 +132,7 @@ def read_mapped(path: str | Path, log_map: LogMap) -> dict[str, Any]:
     path = Path(path)
     table = read_table(path)
     roles = KINDS[log_map.kind].roles
-    if log_map.set_point.column not in table.columns:
-        raise InputError(str(path), f"has no numeric variable {log_map.set_point.column!r} (the log map's set_point)")
-    n = len(table.columns[log_map.set_point.column])
+    n = len(table.numeric(log_map.set_point.column, path, "the log map's set_point"))
     signals: dict[str, np.ndarray] = {}
     for name, role in roles.items():
         part = getattr(log_map, name) if name != "position" else log_map.position

@@ -30,6 +30,16 @@ class Table:
     columns: dict[str, np.ndarray]
     scalars: dict[str, float] = field(default_factory=dict)
     meta: dict[str, str] = field(default_factory=dict)
+    unread: dict[str, str] = field(default_factory=dict)  # a CSV column left out as text -> its first such cell
+
+    def numeric(self, name: str, path: Path, what: str) -> np.ndarray:
+        """The column ``name``; an InputError naming the file and, where the column holds text, its first
+        non-number (an empty cell is a sample the log lacks, not a column it lacks)."""
+        if name in self.columns:
+            return self.columns[name]
+        if name in self.unread:
+            raise InputError(f"{path}: {name}", f"is not numeric throughout: {self.unread[name]} ({what})")
+        raise InputError(str(path), f"has no numeric variable {name!r} ({what})")
 
 
 def read_table(path: str | Path) -> Table:
@@ -83,11 +93,15 @@ def _csv(path: Path) -> Table:
         raise InputError(str(path), f"is not a CSV ({exc})") from None
     if count == 0:
         raise InputError(str(path), "has no data rows")
-    columns = {}
+    columns, unread = {}, {}
     for name, column in zip(header, values, strict=True):
-        if len(column) == count and all(v is not None for v in column):
+        if len(column) < count:
+            unread[name.strip()] = f"data row {len(column) + 1} lacks it"
+        elif None in column:
+            unread[name.strip()] = f"data row {column.index(None) + 1} holds no number"
+        else:
             columns[name.strip()] = np.array(column, dtype=np.float64)
-    return Table(columns, meta=meta)
+    return Table(columns, meta=meta, unread=unread)
 
 
 def _number(text: str) -> float | None:

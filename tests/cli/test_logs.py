@@ -92,3 +92,28 @@ def test_a_document_kept_beside_a_log_is_refused_naming_the_flag_that_takes_it(t
     }
     with pytest.raises(InputError, match="ema-actuator/1 document, not a window: give it with --actuator"):
         read_one(folder / "actuator.json")
+
+
+def _blanked(source: Path, path: Path, column: str, data_row: int) -> Path:
+    """``source`` copied to ``path`` with the cell of ``column`` in its ``data_row``-th data row (from 1) empty."""
+    lines = source.read_text().splitlines()
+    head = next(k for k, line in enumerate(lines) if not line.startswith("#"))
+    row = head + data_row
+    cells = lines[row].split(",")
+    cells[lines[head].split(",").index(column)] = ""
+    lines[row] = ",".join(cells)
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+@pytest.mark.parametrize("mapped", [False, True])
+def test_an_empty_cell_is_named_by_its_row_not_taken_for_a_missing_column(mapped, tmp_path):
+    """One sample a log lacks: the column and the data row are named, through a log map or in ema's columns."""
+    log_map = read_logmap(EXAMPLES / "ballscrew-rig" / "log-map.json")
+    source, column = MAPPED["linear"][0], "current"
+    if not mapped:
+        source, column = _own_csv(read_one(source, log_map), tmp_path / "own.csv"), "current_a"
+    path = _blanked(source, tmp_path / "blanked.csv", column, 51)
+    with pytest.raises(InputError) as refused:
+        read_one(path, log_map) if mapped else read_file(path)
+    assert refused.value.field == f"{path}: {column}" and "data row 51 holds no number" in refused.value.message
