@@ -31,7 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ema.estimate.quasistatic.stretches import ETA_GRID, Stretch, set_point_motion, stretches
-from ema.estimate.stats import rms, weighted_least_squares
+from ema.estimate.stats import below_zero, rms, weighted_least_squares
 from ema.model.actuator import ActuatorDocument
 from ema.model.checks import InputError
 from ema.model.params import load_factors
@@ -126,6 +126,25 @@ def _design(runs: list[Run], eta: float, actuator: ActuatorDocument) -> tuple[np
     return np.array(rows), np.array(y), np.array(w)
 
 
+def _same_signs(c: float, c_std: float, rests: np.ndarray) -> None:
+    """Raise unless the runs' current rests above zero and grows with the torque the load opposes (neither
+    ``below_zero``): a stepper's drive current is a magnitude, so a current at rest below zero is a current logged
+    with the other sign, and a current falling where the load opposes the motion is a load (or a motion) so."""
+    rest, rest_std = float(rests.mean()), float(rests.std(ddof=1)) / np.sqrt(len(rests)) if len(rests) > 1 else 0.0
+    if below_zero({"rest": rest}, {"rest": rest_std}):
+        raise InputError(
+            "signals.current_a",
+            f"the healthy runs draw {rest:.4g} A at rest: a stepper's current is a magnitude, so it is logged with "
+            "the other sign (the log map's sign)",
+        )
+    if below_zero({"c": c}, {"c": c_std}):
+        raise InputError(
+            "signals.load_n",
+            f"the healthy runs draw less current where the load opposes the motion (c = {c:.4g} ± {c_std:.2g} "
+            "A/(N·m)): the load or the motion is logged with the other sign (the log map's sign)",
+        )
+
+
 def fit_drive(runs: list[Run], actuator: ActuatorDocument) -> DriveFit:
     """c, I0, and (at two load sizes or more) the nominal FDJ and η_O, from healthy ``runs`` (module docstring)."""
     profiles = [weighted_least_squares(*_design(runs, float(eta), actuator)) for eta in ETA_GRID]
@@ -139,6 +158,7 @@ def fit_drive(runs: list[Run], actuator: ActuatorDocument) -> DriveFit:
     separable = len(sizes) > 1 and float(np.ptp(sizes)) > 0.2 * float(np.mean(sizes))
     rests = np.array([run.rest_a for run in runs])
     c_std = float(np.sqrt(covariance[0, 0])) * birge
+    _same_signs(c, c_std, rests)
     fdj = c_fdj / c
     eta_std = float(np.ptp(ETA_GRID[chi2 <= chi2_min + birge**2]) / 2) or float(ETA_GRID[1] - ETA_GRID[0])
     per_run = [_run_fdj(run, c, float(ETA_GRID[best]), actuator) for run in runs]

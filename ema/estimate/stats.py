@@ -9,6 +9,7 @@ from ema.model.residual import DEFAULT_DERIVATIVE_WINDOW_S, kernel_samples
 
 JACKKNIFE_BLOCKS = 10
 DECISIVE_Z = 4.0  # stds by which a reading must explain a window better than the document's before it is taken
+SIGN_STDS = 3.0  # a constant that must be positive read this many stds below zero: the log's signs, not its noise
 
 
 def jackknife_std(estimates: np.ndarray) -> np.ndarray:
@@ -51,3 +52,9 @@ def rms_log_likelihood_ratio(worse_rms: float, better_rms: float, n_sliding: flo
     """ln of the likelihood ratio of two fits of one window's ``n_sliding`` samples by their RMS equation
     errors, with one independent value per reconstruction kernel (the kernel smooths both sides of Eq. 5.1)."""
     return n_sliding / kernel_samples(rate, DEFAULT_DERIVATIVE_WINDOW_S) * float(np.log(worse_rms / better_rms))
+
+
+def below_zero(values: dict[str, float], stds: dict[str, float]) -> list[str]:
+    """The names whose value lies more than ``SIGN_STDS`` stds below zero: of constants that must be positive (a
+    mass, a friction that opposes the motion), what no noise explains, and a log's sign or time reversed does."""
+    return [name for name in values if values[name] < -SIGN_STDS * stds[name]]

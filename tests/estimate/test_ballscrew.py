@@ -134,6 +134,27 @@ def test_a_run_that_never_rests_is_refused_for_learning_naming_it():
         read_run(cut, DOCUMENT)
 
 
+def _signed(windows: list, signal: str) -> list:
+    """``windows`` with ``signal`` logged with the other sign (a log map's sign left out)."""
+    return [replace(w, signals={**w.signals, signal: -w.signals[signal]}) for w in windows]
+
+
+@pytest.mark.parametrize(("signal", "named"), [("current_a", "signals.current_a"), ("load_n", "signals.load_n")])
+def test_healthy_runs_logged_with_a_sign_reversed_teach_nothing(signal, named):
+    """A stepper's current is a magnitude: at rest below zero, or falling as the opposing load grows, it is a sign."""
+    healthy = runs("normal", 20, range(3)) + runs("normal", 40, range(3))
+    with pytest.raises(InputError) as refused:
+        calibrate_linear(_signed(healthy, signal), DOCUMENT)
+    assert refused.value.field == named and "the other sign" in refused.value.message
+
+
+def test_a_run_whose_current_is_logged_with_the_other_sign_is_refused_not_read_as_negative_friction(learned):
+    _, completed = learned
+    with pytest.raises(InputError) as refused:
+        estimate(_signed(runs("normal", 20, range(5, 6)), "current_a")[0], actuator=completed)
+    assert refused.value.field == "signals.current_a" and "FDJ -" in refused.value.message
+
+
 def test_a_repeatability_std_tells_what_runs_of_one_state_scatter_by(learned):
     """Held-out healthy runs: each within ±2 repeatability std of its set's median about 95 % of the time, that std
     well under the whole std (which carries the document's own η_O and c, shared by every run)."""

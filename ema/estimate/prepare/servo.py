@@ -20,7 +20,7 @@ import numpy as np
 
 from ema.estimate.documents import Note
 from ema.estimate.physics.inverse import Motion, fit_inverse, inverse_columns, load_motion
-from ema.estimate.stats import rms
+from ema.estimate.stats import below_zero, rms
 from ema.model.actuator import ActuatorDocument
 from ema.model.checks import InputError
 from ema.model.servo import Servo
@@ -32,7 +32,6 @@ CONTROLLER_TOLERANCE = 0.02
 MIN_QUANTIZED = 0.9
 PROVISIONAL_BANDWIDTH_SHARE = 0.02  # a first fit's loop bandwidth, as a share of the rate (20 Hz at 1 kHz)
 POSITIVE = ("mass_kg", "fdj_n", "viscous_ns_per_m", "viscous_up_ns_per_m", "viscous_down_ns_per_m")
-SIGN_STDS = 3.0  # a positive constant read this many stds below zero: the log's signs, not its noise
 
 
 @dataclass(frozen=True)
@@ -115,11 +114,10 @@ def document_effects(servo: Servo) -> dict[str, float]:
 
 
 def physical(values: dict[str, float], stds: dict[str, float]) -> None:
-    """Raise unless the fit reads a positive mass and a friction that opposes the motion (each ``POSITIVE``
-    constant above −``SIGN_STDS`` stds): a force that pushes against the acceleration, or aids the motion it
-    should brake, is a log whose force and position disagree in sign or in time, and no constant read from it
-    means anything."""
-    wrong = [name for name in POSITIVE if name in values and values[name] < -SIGN_STDS * stds[name]]
+    """Raise unless the fit reads a positive mass and a friction that opposes the motion (no ``POSITIVE``
+    constant ``below_zero``): a force that pushes against the acceleration, or aids the motion it should brake,
+    is a log whose force and position disagree in sign or in time, and no constant read from it means anything."""
+    wrong = below_zero({name: values[name] for name in POSITIVE if name in values}, stds)
     if wrong:
         read = ", ".join(f"{name} {values[name]:.4g} ± {stds[name]:.2g}" for name in wrong)
         raise InputError(

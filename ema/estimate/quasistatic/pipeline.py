@@ -38,6 +38,7 @@ from ema.estimate.quasistatic.stretches import (
     stretches,
 )
 from ema.estimate.report import weakly_determined
+from ema.estimate.stats import below_zero
 from ema.model.actuator import ActuatorDocument
 from ema.model.bounds import HIGH_RATE_HZ
 from ema.model.checks import InputError
@@ -89,6 +90,12 @@ def estimate_low_rate(
         eta_o_document=(nominal.efficiency, eta_std),
         repeatability=reading.spread(actuator),
     )
+    if below_zero({"FDJ": fit.fdj_nm}, {"FDJ": fit.fdj_std_nm}):
+        raise InputError(
+            "signals.current_a",
+            f"the stretches read FDJ {fit.fdj_nm:.4g} ± {fit.fdj_std_nm:.2g} N·m, a friction that drives the motion: "
+            "the current or the load is logged with the other sign (the log map's sign)",
+        )
     seconds["physics"] = time.perf_counter() - started - seconds["prepare"]
     announce("writing the report")
     document = _document(window, actuator, fit, found, torque, digest=digest, read_with=read_with, config=config)
