@@ -94,9 +94,9 @@ def outlook(series: Series, *, threshold: float, direction: str, min_span: float
     where fewer than ``MIN_WINDOWS`` windows, or windows spanning less than ``min_span``, read it."""
     parameter, times, values, stds = series.parameter, series.times, series.values, series.stds
     trend = fit_trend(series)
-    if trend.n < MIN_WINDOWS or trend.slope_std is None:
+    if trend.n < MIN_WINDOWS:
         return Outlook(trend, remaining_life(parameter, None, threshold, direction))
-    if float(np.ptp(times)) < min_span:
+    if trend.slope_std is None or float(np.ptp(times)) < min_span:  # no slope: every window at one time
         return Outlook(trend, remaining_life(parameter, None, threshold, direction, span_too_short=True))
     s, weight, t_first, span = law_inputs(times, values, stds)
     weighed = weigh(s, values, weight)
