@@ -15,7 +15,7 @@ import numpy as np
 
 from ema.prognosis.documents import BacktestPoint, ForecastPoint
 from ema.prognosis.outlook import outlook
-from ema.prognosis.rul import MIN_WINDOWS
+from ema.prognosis.rul import MIN_TREND_WINDOWS
 from ema.prognosis.trend import Series
 
 SHARES = (0.5, 0.65, 0.8)
@@ -29,7 +29,7 @@ def backtest(series: Series, *, threshold: float, direction: str, min_span: floa
     points = []
     for share in SHARES:
         k = round(share * len(times))
-        if k < MIN_WINDOWS or k >= len(times) or np.ptp(times[:k]) <= 0:
+        if k < MIN_TREND_WINDOWS or k >= len(times) or np.ptp(times[:k]) <= 0:
             continue
         then = outlook(series.first(k), threshold=threshold, direction=direction, min_span=min_span)
         life = then.life

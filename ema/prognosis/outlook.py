@@ -17,10 +17,9 @@ from ema.estimate.stats import weighted_least_squares
 from ema.prognosis.documents import BacktestPoint, ForecastPoint, RemainingLife, Trend
 from ema.prognosis.forecast import Forecast, forecast
 from ema.prognosis.laws import LAWS, fit_law
-from ema.prognosis.rul import MIN_WINDOWS, remaining_life
+from ema.prognosis.rul import MIN_TREND_WINDOWS, remaining_life
 from ema.prognosis.trend import HUBER_C, Series, excess_variance, fit_trend, robust_fit
-from ema.prognosis.weigh import MIN_WINDOWS as MIN_LAW_WINDOWS
-from ema.prognosis.weigh import weigh
+from ema.prognosis.weigh import MIN_LAW_WINDOWS, weigh
 
 BAND_POINTS = 40  # forecast points reported, from the first window to the crossing (or 3 spans past the last)
 LATE_SHARE = 1.0 / 3.0  # the latest windows whose slope is set against the whole history's
@@ -91,10 +90,10 @@ def band(fc: Forecast, life: RemainingLife, span: float) -> list[ForecastPoint]:
 
 def outlook(series: Series, *, threshold: float, direction: str, min_span: float = 0.0) -> Outlook:
     """The trend and remaining life of one parameter's history (times in the prognosis's unit); no forecast
-    where fewer than ``MIN_WINDOWS`` windows, or windows spanning less than ``min_span``, read it."""
+    where fewer than ``MIN_TREND_WINDOWS`` windows, or windows spanning less than ``min_span``, read it."""
     parameter, times, values, stds = series.parameter, series.times, series.values, series.stds
     trend = fit_trend(series)
-    if trend.n < MIN_WINDOWS:
+    if trend.n < MIN_TREND_WINDOWS:
         return Outlook(trend, remaining_life(parameter, None, threshold, direction))
     if trend.slope_std is None or float(np.ptp(times)) < min_span:  # no slope: every window at one time
         return Outlook(trend, remaining_life(parameter, None, threshold, direction, span_too_short=True))

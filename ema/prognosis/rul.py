@@ -19,7 +19,7 @@ from ema.prognosis.forecast import PLAUSIBLE_WEIGHT, Forecast
 MIN_PROBABILITY = 0.95
 MIN_LINE_PROBABILITY = 0.99  # the whole history's line towards the threshold (at 0.95 a steady one passes by chance
 # one time in twenty)
-MIN_WINDOWS = 3
+MIN_TREND_WINDOWS = 3  # fewer: no trend, and no forecast ("too few windows")
 
 
 def remaining_life(

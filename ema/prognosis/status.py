@@ -5,7 +5,7 @@
   watched against (friction that falls: ``moving_away``), the latest estimate lies outside the healthy range,
   or the model did not reproduce the latest window;
 - **healthy**: none of these;
-- **not enough history**: fewer than ``MIN_WINDOWS`` windows, or windows spread over less than the
+- **not enough history**: fewer than ``MIN_STATUS_WINDOWS`` windows, or windows spread over less than the
   prognosis's ``MIN_SPAN``: no trend can say "due" yet (the latest window alone may still say "watch").
 
 Without that evidence the status is never "due", however far the latest window lies past a threshold
@@ -24,7 +24,7 @@ from ema.prognosis.documents import MIN_SPAN, ActuatorSummary, Prognosis, Remain
 
 Status = Literal["due", "watch", "healthy", "not enough history"]
 DUE_WITHIN = {"flight_hours": 25.0, "days": 25.0}  # an earliest plausible crossing this close makes it due
-MIN_WINDOWS = 5
+MIN_STATUS_WINDOWS = 5  # fewer: "not enough history" (a status judges a trend, not a few windows)
 URGENCY = {"due": 0, "watch": 1, "prognosis failed": 2, "pending": 3, "not enough history": 4, "healthy": 5}
 
 
@@ -38,8 +38,8 @@ def lacking_evidence(prognosis: Prognosis, windows: int) -> str | None:
     n = windows if trend is None else trend.n
     span = 0.0 if trend is None or not trend.points else float(np.ptp([p.time for p in trend.points]))
     unit = prognosis.time_unit.replace("_", " ")
-    needed = f"a status needs {MIN_WINDOWS} windows over at least {MIN_SPAN[prognosis.time_unit]:g} {unit}"
-    if n < MIN_WINDOWS:
+    needed = f"a status needs {MIN_STATUS_WINDOWS} windows over at least {MIN_SPAN[prognosis.time_unit]:g} {unit}"
+    if n < MIN_STATUS_WINDOWS:
         return f"{n} window(s): {needed}"
     if span < MIN_SPAN[prognosis.time_unit]:
         return f"{n} windows over {span:.3g} {unit}: {needed}"

@@ -22,7 +22,7 @@ import numpy as np
 
 from ema.prognosis.laws import LAWS, LawFit, fit_law
 
-MIN_WINDOWS = 6  # fewer: the line alone (a law can only be told from another on more)
+MIN_LAW_WINDOWS = 6  # fewer: the line alone (a law can only be told from another on more)
 FIRST_CUT = 0.75  # the earliest cut, as a share of the history: the later windows tell where it goes now
 CUTS = 6  # cuts at most, evenly between FIRST_CUT and the last window but one
 TEMPER = 4.0  # the scores are divided by this: two laws whose scores differ by ln 2·TEMPER weigh 2 : 1
@@ -55,7 +55,7 @@ class Later:
 
 def cut_points(n: int) -> list[int]:
     """Where the history is cut: the number of windows each scoring fit sees."""
-    first = max(MIN_WINDOWS - 1, int(np.ceil(FIRST_CUT * n)))
+    first = max(MIN_LAW_WINDOWS - 1, int(np.ceil(FIRST_CUT * n)))
     return sorted({int(k) for k in np.linspace(first, n - 1, CUTS).round()} - {n})
 
 
@@ -83,7 +83,7 @@ def drift(predictions: list[list[Later]], weights: np.ndarray) -> float:
 def weigh(s: np.ndarray, y: np.ndarray, weight: np.ndarray) -> Weighed:
     """Every law fitted to the history, weighed by how well it predicts later windows from earlier ones."""
     fits = [fit_law(law, s, y, weight) for law in LAWS]
-    if len(s) < MIN_WINDOWS:
+    if len(s) < MIN_LAW_WINDOWS:
         only = np.array([1.0 if law.name == "linear" else 0.0 for law in LAWS])
         return Weighed(fits, only, np.full(len(LAWS), np.nan))
     cuts = cut_points(len(s))

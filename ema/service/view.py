@@ -28,7 +28,7 @@ from pathlib import Path
 from ema.history.open import History
 from ema.model.actuator import THESIS, ActuatorDocument
 from ema.prognosis.documents import ActuatorSummary, Prognosis, Stored
-from ema.prognosis.rul import MIN_WINDOWS as FORECAST_WINDOWS
+from ema.prognosis.rul import MIN_TREND_WINDOWS
 from ema.prognosis.status import URGENCY, failed, summary
 from ema.service.deps import safe_prognosis
 from ema.service.jobs import JobRunner
@@ -82,7 +82,7 @@ def refreshed(store: History, stale: list[tuple[str, str, int]], cancel: threadi
         stored = documents.get(actuator_id)
         actuator, version = (THESIS, None) if stored is None else (stored.document, stored.version)
         last = latest.get(actuator_id)
-        if windows >= FORECAST_WINDOWS:
+        if windows >= MIN_TREND_WINDOWS:
             history, _ = store.history(actuator_id)
             prognosis = safe_prognosis(actuator_id, history, actuator, backtested=False)
         else:

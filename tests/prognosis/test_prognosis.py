@@ -6,7 +6,7 @@ import pytest
 from ema.model.actuator import THESIS
 from ema.prognosis.backtest import backtest
 from ema.prognosis.outlook import outlook
-from ema.prognosis.rul import MIN_WINDOWS
+from ema.prognosis.rul import MIN_TREND_WINDOWS
 from ema.prognosis.trend import Series, fit_trend
 from tests.prognosis.histories import History, history
 
@@ -168,5 +168,5 @@ def test_windows_at_one_time_are_a_level_with_no_slope(times):
     assert trend.level == pytest.approx(0.06) and trend.slope_std is None
     assert trend.level_std == pytest.approx(1e-3 / np.sqrt(n))
     status = outlook(series, threshold=THRESHOLD, direction="above").life.status
-    assert status == ("too few windows" if n < MIN_WINDOWS else "span too short")  # enough windows, no time between
+    assert status == ("too few windows" if n < MIN_TREND_WINDOWS else "span too short")  # enough, at one time
     trend.model_dump_json()  # finite: JSON carries it
