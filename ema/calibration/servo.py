@@ -59,7 +59,7 @@ from ema.estimate.physics.inverse import (
     UNITS,
     decimated,
 )
-from ema.estimate.prepare.servo import ServoPrepared, document_effects, physical, prepare_servo
+from ema.estimate.prepare.servo import ServoPrepared, document_effects, prepare_servo, refuse_reversed_signs
 from ema.estimate.stats import rms
 from ema.model.actuator import ActuatorDocument, Nominal
 from ema.model.checks import InputError
@@ -230,7 +230,7 @@ def calibrate_servo(
     prepared = [_own_controller(prepare_servo(w, actuator)) for w in windows]
     base_model = document_effects(prepared[0].servo)
     first = fitted(problem(prepared, base_model))
-    physical(first.values, first.stds)
+    refuse_reversed_signs(first.values, first.stds)
     copies = noise_copies(prepared, first, base_model)
     prepared = undisturbed(prepared, copies, base_model)
     base = fitted(problem(prepared, base_model))

@@ -36,7 +36,7 @@ from ema.estimate.physics.inverse import (
     load_motion,
 )
 from ema.estimate.physics.scenario import MAX_RATIO
-from ema.estimate.prepare.servo import ServoPrepared, physical, prepare_servo
+from ema.estimate.prepare.servo import ServoPrepared, prepare_servo, refuse_reversed_signs
 from ema.estimate.report import training_info
 from ema.estimate.simulate.servo import ServoData, lane_parameters, simulate_servo_dataset
 from ema.estimate.stats import rms
@@ -264,7 +264,7 @@ def estimate_servo(
         prepared = prepare_servo(window, actuator)
     with watch("physics", "fitting Eq. 5.1 on the load side"):
         physics = physics_of(prepared)
-        physical(physics.values, physics.stds)
+        refuse_reversed_signs(physics.values, physics.stds)
     with watch("simulate", f"simulating {config.total_simulations} runs of the window's set point in closed loop"):
         data = simulate_servo_dataset(prepared, physics, config)
     with watch("learn", f"training {config.members} network(s) of {config.hidden_units} neurons"):

@@ -113,7 +113,7 @@ def document_effects(servo: Servo) -> dict[str, float]:
     return {**servo.effects, **({"viscous_down": 1.0} if servo.viscous_down_ns_per_m is not None else {})}
 
 
-def physical(values: dict[str, float], stds: dict[str, float]) -> None:
+def refuse_reversed_signs(values: dict[str, float], stds: dict[str, float]) -> None:
     """Raise unless the fit reads a positive mass and a friction that opposes the motion (no ``POSITIVE``
     constant ``below_zero``): a force that pushes against the acceleration, or aids the motion it should brake,
     is a log whose force and position disagree in sign or in time, and no constant read from it means anything."""
