@@ -221,3 +221,43 @@ def test_calibrations_come_back_whole_latest_first(history):
     stored = history.calibrations("rig")
     assert [r for _, r in stored] == reports[::-1] and history.calibrations("other") == []
     assert all(when for when, _ in stored)
+
+
+def test_a_round_three_history_upgraded_keeps_every_window_and_fills_its_lookups(setting, result):
+    """A history round 3 left (its tables, windows stored as JSON only) opened by this ema: every window comes back
+    as stored, and the lookups round 4 added (a flight's sensor zero) read from their JSON, more than the batch of
+    rows the migration fills at once."""
+    import sqlalchemy as sa
+    from alembic import command
+    from alembic.config import Config
+
+    from ema.history.migrations.versions import r4_lookups_withdrawals_summaries as r4
+    from ema.history.schema import MIGRATIONS
+
+    address = setting if "://" in setting else f"sqlite:///{setting}"
+    engine = sa.create_engine(address.replace("postgresql://", "postgresql+psycopg://", 1))
+    n = r4.BATCH + 3
+    zero = SensorZero(window_id="last", hinge_nm=0.0, current_a=1e-4, torque_std_nm=1e-4)  # in the second batch
+    rows = [_as(result, "a", f"w{i}", flight_id="f", sensor_zero=zero if i == n - 1 else None) for i in range(n)]
+    try:
+        with engine.connect() as connection:
+            config = Config()
+            config.set_main_option("script_location", str(MIGRATIONS))
+            config.attributes["connection"] = connection
+            command.upgrade(config, "r3")
+            table = sa.table("estimates", *(sa.column(c) for c in ("actuator_id", "window_id", "stored_at", "result")))
+            connection.execute(
+                table.insert(),
+                [{"actuator_id": "a", "window_id": r.window_id, "stored_at": "2026-01-01T00:00:00Z",
+                  "result": r.model_dump_json(by_alias=True)} for r in rows],
+            )  # fmt: skip
+            connection.commit()
+    finally:
+        engine.dispose()
+    store = open_history(setting)
+    try:
+        current, legacy = store.history("a")
+        assert [s.window_id for s in current] == [r.window_id for r in rows] and legacy == []
+        assert store.readings("a", "f").sensor_zero.window_id == "last"
+    finally:
+        store.close()
