@@ -126,7 +126,7 @@ def _design(runs: list[Run], eta: float, actuator: ActuatorDocument) -> tuple[np
     return np.array(rows), np.array(y), np.array(w)
 
 
-def _same_signs(c: float, c_std: float, rests: np.ndarray) -> None:
+def _refuse_reversed_signs(c: float, c_std: float, rests: np.ndarray) -> None:
     """Raise unless the runs' current rests above zero and grows with the torque the load opposes (neither
     ``below_zero``): a stepper's drive current is a magnitude, so a current at rest below zero is a current logged
     with the other sign, and a current falling where the load opposes the motion is a load (or a motion) so."""
@@ -158,7 +158,7 @@ def fit_drive(runs: list[Run], actuator: ActuatorDocument) -> DriveFit:
     separable = len(sizes) > 1 and float(np.ptp(sizes)) > 0.2 * float(np.mean(sizes))
     rests = np.array([run.rest_a for run in runs])
     c_std = float(np.sqrt(covariance[0, 0])) * birge
-    _same_signs(c, c_std, rests)
+    _refuse_reversed_signs(c, c_std, rests)
     fdj = c_fdj / c
     eta_std = float(np.ptp(ETA_GRID[chi2 <= chi2_min + birge**2]) / 2) or float(ETA_GRID[1] - ETA_GRID[0])
     per_run = [_run_fdj(run, c, float(ETA_GRID[best]), actuator) for run in runs]
