@@ -18,6 +18,7 @@ from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from types import MappingProxyType
 
+from ema.model.servo import SERVO_CONSTANTS
 from ema.model.units import units_of
 
 
@@ -48,6 +49,15 @@ class KindFacts:
     nominal_given: bool = False  # the document's author gives the nominal health (else ema calibrate learns it)
     static_friction: bool = False  # a window can show a break-away (FSJ)
     load_side: bool = False  # the log is on the load side: FDJ is the load's friction force
+    recorded: tuple[str, ...] = ()  # the section's fields a log may record beside its signals (``constants``)
+
+    def recorded_field(self, name: str) -> str | None:
+        """Why a log of this kind cannot record the constant ``name`` (None: it can)."""
+        if name in self.recorded:
+            return None
+        if not self.recorded:
+            return f"a {self.name} actuator's log records no constants"
+        return f"a {self.name} actuator's log records {', '.join(self.recorded)}, under its document's names"
 
     @property
     def friction_unit(self) -> str:
@@ -102,6 +112,7 @@ _SERVO = KindFacts(
         set_point="set_point_m", position="position_m", force="drive_force_n", load="load_n", optional=("load",)
     ),
     load_side=True,
+    recorded=SERVO_CONSTANTS,
 )
 KINDS: Mapping[str, KindFacts] = MappingProxyType({k.name: k for k in (_ROTARY, _LINEAR, _SERVO)})
 DEFAULT_KIND = _ROTARY.name

@@ -91,6 +91,9 @@ class LogMap(_Part):
                 raise ValueError(f"{name}: a {self.kind} actuator's log gives its {name}")
             if role is not None and part is not None and part.unit not in role.units:
                 raise ValueError(f"{name}.unit: {part.unit!r} is not one of {', '.join(role.units)}")
+        for name in self.constants:
+            if (why := KINDS[self.kind].recorded_field(name)) is not None:
+                raise ValueError(f"constants.{name}: {why}")
         if self.time is not None and self.time.unit not in TIME_S:
             raise ValueError(f"time.unit: {self.time.unit!r} is not one of {', '.join(TIME_S)}")
         return self

@@ -171,6 +171,10 @@ class WindowDocument(_Contract):
         for name, array in arrays.items():
             if len(array) != len(arrays[first]):
                 raise InputError(f"signals.{name}", f"has {len(array)} samples, {first} has {len(arrays[first])}")
+        kind = kind_of_signals(arrays)
+        for name in self.constants or {}:
+            if kind is not None and (why := kind.recorded_field(name)) is not None:
+                raise InputError(f"constants.{name}", why)
         flight = self.flight_condition
         condition = None if flight is None else FlightCondition(flight.airspeed_mps, flight.altitude_m)
         recorded = None if self.recorded_at is None else self.recorded_at.isoformat()

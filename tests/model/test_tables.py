@@ -14,6 +14,7 @@ from ema.model.window import window_from_dict
 
 EMPS = Path(__file__).resolve().parents[2] / "examples" / "emps"
 MAP = read_logmap(EMPS / "log-map.json")
+RIG_MAP = EMPS.parent / "ballscrew-rig" / "log-map.json"
 
 
 def _mat(path: Path, n: int = 300, **changes) -> Path:
@@ -79,3 +80,15 @@ def test_a_log_map_names_the_role_its_kind_lacks():
     with pytest.raises(InputError) as error:
         logmap_from_dict(document)
     assert error.value.field == "current"
+
+
+@pytest.mark.parametrize(
+    ("log_map", "constant", "kind"),
+    [(EMPS / "log-map.json", "gear_ratio", "servo"), (RIG_MAP, "position_gain_per_s", "linear")],
+)
+def test_a_log_map_names_a_constant_its_kinds_log_cannot_record(log_map, constant, kind):
+    """Only a servo's log records constants, and only its controller's: another is refused in the map."""
+    document = read_logmap(log_map).model_dump(by_alias=True) | {"constants": {constant: "kp"}}
+    with pytest.raises(InputError) as error:
+        logmap_from_dict(document)
+    assert error.value.field == f"constants.{constant}" and kind in error.value.message

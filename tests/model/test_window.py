@@ -66,6 +66,7 @@ def _broken(document, path, value):
         (("signals", "position_deg"), [90.0] * 500, "signals.position_deg"),
         (("signals", "extra"), [0.0] * 500, "signals.extra"),
         (("actuator_id",), 5, "actuator_id"),
+        (("constants",), {"position_gain_per_s": 100.0}, "constants.position_gain_per_s"),  # a rotary's: none
     ],
 )
 def test_bad_windows_name_the_field(document, path, value, field):
