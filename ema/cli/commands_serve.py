@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 from typing import Any
 
 import click
@@ -25,9 +26,12 @@ def serve(**flags: Any) -> None:
     from pydantic import ValidationError
 
     from ema.model.checks import InputError, from_validation
-    from ema.service.config import Settings
+    from ema.service.config import Settings, unknown_environment
     from ema.service.main import create_app
 
+    unknown = unknown_environment(os.environ)
+    if unknown is not None:
+        raise InputError(*unknown)
     try:
         settings = Settings(**{k: v for k, v in flags.items() if v is not None})
     except ValidationError as exc:

@@ -101,8 +101,9 @@ def from_validation(exc: Any, prefix: str = "") -> InputError:
     names = [str(part) for part in first["loc"] if not isinstance(part, int)]
     indices = [part for part in first["loc"] if isinstance(part, int)]
     said = first["msg"].removeprefix("Value error, ")
-    if first["type"] in BOUND_ERRORS and isinstance(first.get("input"), int | float):
-        said += f", got {first['input']:g}"
+    given = first.get("input")
+    if first["type"] in BOUND_ERRORS and isinstance(given, int | float | str):
+        said += f", got {given:g}" if isinstance(given, int | float) else f", got {given!r}"
     message = said if not indices else f"sample {indices[0]}: {said}"
     head, _, rest = message.partition(": ")
     if first["type"] == "value_error" and rest and head.replace("_", "").replace(".", "").isalnum():

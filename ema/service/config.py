@@ -6,8 +6,10 @@ their per-request ceilings and the request budget are here; nothing restates eit
 
 from __future__ import annotations
 
+import difflib
 import ipaddress
 import os
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Annotated, Literal
 
@@ -135,3 +137,17 @@ class Settings(BaseSettings):
 
     def key_bytes(self) -> bytes | None:
         return None if self.api_key is None else self.api_key.get_secret_value().encode()
+
+
+def unknown_environment(environ: Mapping[str, str]) -> tuple[str, str] | None:
+    """(the first ``EMA_*`` variable that names no setting of ``Settings`` or ``EMA_PIPELINE__<size>``, why), the
+    setting it likely misspells said: such a variable would be ignored, and the service run on a default the
+    operator meant to replace (another history, another key)."""
+    names = {f"EMA_{name.upper()}" for name in Settings.model_fields}
+    names |= {f"EMA_PIPELINE__{name.upper()}" for name in PipelineConfig.model_fields}
+    for variable in sorted(v for v in environ if v.startswith("EMA_") and v not in names):
+        near = difflib.get_close_matches(variable, sorted(names), n=1, cutoff=0.85)
+        return variable, "is no setting of the service" + (
+            f": did you mean {near[0]}?" if near else " (docs/service.md lists them)"
+        )
+    return None

@@ -237,6 +237,19 @@ def test_serve_refuses_unsafe_or_unusable_settings_naming_them(
     assert named in capsys.readouterr().err
 
 
+@pytest.mark.parametrize(
+    ("variable", "said"),
+    [("EMA_DATABSE", ": did you mean EMA_DATABASE?"), ("EMA_PIPELINE__SIMS", " (docs/service.md lists them)")],
+)
+def test_serve_refuses_an_environment_variable_that_names_no_setting(tmp_path, capsys, monkeypatch, variable, said):
+    """Ignored, it would run a default the operator meant to replace (another history, fewer simulations)."""
+    monkeypatch.setenv(variable, "64")
+    with socket.create_server(("127.0.0.1", 0)) as taken:  # a variable let through is refused here, never served
+        port = str(taken.getsockname()[1])
+        assert main(["serve", "--database", str(tmp_path / "h.sqlite3"), "--port", port]) == EXIT_BAD_INPUT
+    assert f"{variable}: is no setting of the service{said}" in capsys.readouterr().err
+
+
 def test_serve_names_a_short_key_file_and_a_port_in_use(tmp_path, capsys, monkeypatch):
     monkeypatch.delenv("EMA_API_KEY", raising=False)
     key = tmp_path / "key"
