@@ -27,6 +27,7 @@ from ema.estimate.documents.window import WindowInfo
 from ema.estimate.learn.estimator import NetworkRegressor
 from ema.estimate.learn.network import LearnConfig
 from ema.estimate.physics.inverse import (
+    EITHER_SIGN,
     UNITS,
     InverseFit,
     decimated,
@@ -192,7 +193,9 @@ def _estimates(
             continue
         servo = prepared.servo
         document = getattr(servo, NOMINAL_FIELDS.get(name, ""), None) or servo.effect_constants.get(name)
-        constants[name] = doc.parameter(values[name], stds[name], document, unit=UNITS[name])
+        constants[name] = doc.parameter(
+            values[name], stds[name], document, unit=UNITS[name], either_sign=name in EITHER_SIGN
+        )
     return doc.Estimates(
         FDJ=doc.parameter(answer.values[FDJ], answer.stds[FDJ], nominal, unit=UNITS[FDJ]),
         eta_O=None,

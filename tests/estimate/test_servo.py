@@ -56,6 +56,16 @@ def test_the_foreign_windows_are_reproduced_and_raise_no_misfit(foreign_estimate
     assert sum(any(n.code == "model_misfit" for n in r.notes) for r in results) <= 1  # a 1 % test on six
 
 
+def test_an_offset_is_compared_with_its_nominal_in_its_unit_not_in_percent():
+    """A force offset may be either sign and near zero, where a share of its nominal is noise: no drift in %; a
+    mass's drift is one."""
+    document = {**foreign.DOCUMENT, "servo": {**foreign.DOCUMENT["servo"], "mass_kg": 90.0, "force_offset_n": -0.2}}
+    result = estimate(window_from_dict(foreign.draw(0, seconds=6.0)), actuator=actuator_from_dict(document))
+    offset, mass = result.estimates.constants["offset_n"], result.estimates.constants["mass_kg"]
+    assert offset.nominal == -0.2 and offset.drift_pct is None
+    assert mass.drift_pct == pytest.approx(100 * (mass.value / 90.0 - 1))
+
+
 def test_the_physics_stage_reproduces_the_benchmarks_identification(emps):
     prepared = prepare_servo(emps, read_actuator(EMPS / "actuator.json"))
     fit = fit_inverse(prepared.force_n, inverse_columns(prepared.motion), prepared.motion)

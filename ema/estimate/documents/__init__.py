@@ -29,7 +29,10 @@ class ParameterEstimate(Document):
     value: float
     std: float | None = Field(description="one standard deviation, in the parameter's unit; null: not assessed")
     nominal: float | None = Field(description="the actuator's value new (null: its document has none yet)")
-    drift_pct: float | None = Field(description="100 · (value − nominal) / nominal (null without a nominal)")
+    drift_pct: float | None = Field(
+        description="100 · (value − nominal) / nominal (null without a nominal, and for a constant of either sign, "
+        "such as a servo's force offset, whose change no share of it measures: compare value and nominal in stds)"
+    )
     unit: str | None = Field(
         None,
         description="the value's unit: N·m for a friction at the motor shaft, N for one on the load (a servo), 1 for "
@@ -220,10 +223,14 @@ def parameter(
     *,
     unit: str | None,
     repeatability_std: float | None = None,
+    either_sign: bool = False,
 ) -> ParameterEstimate:
     """One parameter's estimate; its repeatability std is the whole std unless the document's constants share a
-    part of it (a stepper's: ``ema.estimate.quasistatic.stretches``)."""
-    drift = None if nominal is None or nominal == 0 else 100.0 * (value - nominal) / nominal
+    part of it (a stepper's: ``ema.estimate.quasistatic.stretches``). A constant of ``either_sign`` (an offset)
+    has no drift in %: near zero, a share of its nominal is noise."""
+    drift = None
+    if nominal is not None and nominal != 0 and not either_sign:
+        drift = 100.0 * (value - nominal) / nominal
     repeatable = std if repeatability_std is None else repeatability_std
     return ParameterEstimate(
         value=value,

@@ -66,6 +66,7 @@ UNITS = {
     "presliding_travel_m": "m",
     **{f"position_{kind}_p{k}_n": "N" for kind in ("force", "friction") for k in range(1, POLYNOMIAL_ORDER + 1)},
 }
+EITHER_SIGN = frozenset(name for name in UNITS if name == "offset_n" or name.startswith("position_"))  # no sign
 
 
 @dataclass(frozen=True)
