@@ -93,6 +93,16 @@ def test_a_controller_the_log_does_not_follow_is_said(emps):
     assert [n.code for n in prepared.notes if n.code == "controller_mismatch"]
 
 
+def test_a_log_cut_mid_motion_follows_its_controller():
+    """The filter and the difference read positions from before a window's first sample: the EMPS log's second half
+    (cut in motion) read 3.0 % RMS off its controller over them, 0.2 % past them, as the whole log does."""
+    document = read_mapped(EMPS / "DATA_EMPS.mat", read_logmap(EMPS / "log-map.json"))
+    half = len(document["signals"]["position_m"]) // 2
+    document["signals"] = {name: values[half:] for name, values in document["signals"].items()}
+    prepared = prepare_servo(window_from_dict(document), read_actuator(EMPS / "actuator.json"))
+    assert not [n.code for n in prepared.notes if n.code == "controller_mismatch"]
+
+
 def test_a_gain_the_log_and_the_document_give_differently_is_refused(emps):
     document = read_actuator(EMPS / "actuator.json").model_dump(by_alias=True)
     document["servo"]["position_gain_per_s"] = 150.0

@@ -83,11 +83,14 @@ def commanded(servo: Servo, set_point_m: np.ndarray, position_m: np.ndarray, rat
 
 
 def _controller_note(servo: Servo, window: Window) -> Note | None:
+    """``controller_mismatch`` where the logged command departs from the document's controller beyond
+    ``CONTROLLER_TOLERANCE``; past the filter's and the difference's start (as many samples as taps), which read
+    positions from before the window: a log cut from a longer one starts in motion."""
     s, gain = window.signals, servo.drive_gain_n_per_unit
     assert gain is not None  # completed
     logged = s["drive_force_n"] / gain
-    rate = window.sample_rate_hz
-    off = rms(logged[1:] - commanded(servo, s["set_point_m"], s["position_m"], rate)[1:])
+    rate, start = window.sample_rate_hz, len(servo.speed_filter)
+    off = rms(logged[start:] - commanded(servo, s["set_point_m"], s["position_m"], rate)[start:])
     share = float(off / max(rms(logged), 1e-300))
     if share <= CONTROLLER_TOLERANCE:
         return None
