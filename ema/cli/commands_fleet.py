@@ -21,7 +21,6 @@ from ema.cli.options import (
     pipeline_config,
     sizes,
     span,
-    window_length,
     window_s,
 )
 from ema.model.bounds import DURATION_RANGE_S, MAX_THREADS
@@ -84,7 +83,7 @@ def fleet(
         config = pipeline_config(size_values)
         documents = Documents(read_actuators(archive), None if actuator_file is None else read_actuator(actuator_file))
         mapping = log_map_document(log_map_file)
-        read = read_log(archive, window_length(window_s, mapping), log_map=mapping)
+        read = read_log(archive, window_s, log_map=mapping)
     except BaseException:
         if pool is not None:
             pool.close()

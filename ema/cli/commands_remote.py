@@ -20,7 +20,6 @@ from ema.cli.options import (
     log_map,
     log_map_document,
     service,
-    window_length,
     window_s,
 )
 from ema.model.bounds import DEFAULT_SAMPLE_RATE_HZ
@@ -89,7 +88,7 @@ def replay(
     defaults = Defaults(actuator_id, rate, airspeed, altitude)
     with flags_named({"sample_rate_hz": "--rate", "airspeed_mps": "--airspeed", "altitude_m": "--altitude"}):
         mapping = log_map_document(log_map_file)
-        read = read_log(log, window_length(window_s, mapping), defaults, mapping)
+        read = read_log(log, window_s, defaults, mapping)
     report_log(read)
     documents, sources = replayed_documents(log, actuator_file, {window.actuator_id for window in read.windows})
     key = api_key(api_key_file)

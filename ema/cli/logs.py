@@ -175,9 +175,10 @@ class Log:
 
 
 def read_log(path: Path, window_s: float | None, defaults: Defaults = Defaults(), log_map: LogMap | None = None) -> Log:
-    """The windows of a file, or of a folder's files in name order, long recordings cut to ``window_s``. A
-    bad file given alone is an InputError naming it; in a folder it is skipped and listed, and only a folder
-    with no readable window is an error. ``window_s`` None: every file's windows as they are."""
+    """The windows of a file, or of a folder's files in name order, long recordings cut to ``window_s`` (None:
+    each to its kind's ``window_s``, a servo's log or a rig's run kept whole). A bad file given alone is an
+    InputError naming it; in a folder it is skipped and listed, and only a folder with no readable window is an
+    error."""
     path = Path(path)
     if not path.exists():
         raise InputError(str(path), "does not exist")
@@ -200,10 +201,11 @@ def read_log(path: Path, window_s: float | None, defaults: Defaults = Defaults()
             bad[str(file)] = exc.message
             continue
         for recording in recordings:
-            whole = None if window_s is None else too_short_to_cut(recording, window_s)
+            length = window_s if window_s is not None else KINDS[recording.kind].window_s
+            whole = None if length is None else too_short_to_cut(recording, length)
             if whole is not None:
                 kept_whole[recording.window_id] = whole
-            pieces, tail = cut(recording, window_s) if window_s is not None and whole is None else ([recording], 0)
+            pieces, tail = cut(recording, length) if length is not None and whole is None else ([recording], 0)
             windows.extend(pieces)
             if tail:
                 dropped[pieces[-1].window_id] = tail

@@ -13,7 +13,7 @@ from typing import Any, TypeVar
 import click
 
 from ema.estimate.sizes import SIZES as PIPELINE_SIZES
-from ema.model.bounds import MAX_THREADS
+from ema.model.bounds import CUT_WINDOW_S, MAX_THREADS
 
 F = TypeVar("F", bound=Callable[..., Any])
 EXISTING = click.Path(exists=True, dir_okay=False, path_type=Path)  # a file that must be there
@@ -92,8 +92,8 @@ def span(bounds: tuple[float, float]) -> str:
     return "–".join(f"{bound:g}" for bound in bounds)
 
 
-DEFAULT_WINDOW_S = 0.5  # a recording is cut into windows this long, unless a log map makes each file one window
 WINDOW_S_RANGE = (0.1, 3600.0)
+_KINDS_CUT = "; ".join(f"a {kind} recording {seconds:g} s" for kind, seconds in CUT_WINDOW_S.items())
 
 
 def window_s(function: F) -> F:
@@ -101,17 +101,8 @@ def window_s(function: F) -> F:
         "--window-s",
         type=click.FloatRange(*WINDOW_S_RANGE),
         default=None,
-        help=f"cut recordings into windows of this length [s]  [default: {DEFAULT_WINDOW_S:g}; with --log-map, a file "
-        "is one window]",
+        help=f"cut recordings into windows of this length [s]  [default: {_KINDS_CUT}; any other kind's log whole]",
     )(function)
-
-
-def window_length(window_s: float | None, log_map: Any) -> float | None:
-    """The length a recording is cut into: the flag's, else none under a log map (a file is one window), else
-    ``DEFAULT_WINDOW_S``."""
-    if window_s is not None:
-        return window_s
-    return None if log_map is not None else DEFAULT_WINDOW_S
 
 
 def log_map_document(path: Path | None) -> Any:

@@ -18,6 +18,7 @@ from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from types import MappingProxyType
 
+from ema.model.bounds import CUT_WINDOW_S
 from ema.model.servo import SERVO_CONSTANTS
 from ema.model.units import units_of
 
@@ -58,6 +59,11 @@ class KindFacts:
         if not self.recorded:
             return f"a {self.name} actuator's log records no constants"
         return f"a {self.name} actuator's log records {', '.join(self.recorded)}, under its document's names"
+
+    @property
+    def window_s(self) -> float | None:
+        """How long the windows a recording of this kind is cut into unless told (None: read whole)."""
+        return CUT_WINDOW_S.get(self.name)
 
     @property
     def friction_unit(self) -> str:

@@ -1,5 +1,7 @@
 """Logs as files in ema's own columns: a window of any kind, known by the signals its columns carry."""
 
+import json
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -117,3 +119,22 @@ def test_an_empty_cell_is_named_by_its_row_not_taken_for_a_missing_column(mapped
     with pytest.raises(InputError) as refused:
         read_one(path, log_map) if mapped else read_file(path)
     assert refused.value.field == f"{path}: {column}" and "data row 51 holds no number" in refused.value.message
+
+
+def test_each_kind_is_cut_as_its_windows_are_read_unless_told(tmp_path):
+    """A servo's log (EMPS's first quarter, as a window document) is one window: cut to the thesis's 0.5 s, every
+    piece moved one way and was refused. A rotary recording is cut into 0.5 s windows; --window-s cuts either."""
+    from ema.cli.logs import read_log
+    from ema.model.params import HealthParams
+    from ema.model.synthetic import synthetic_window
+    from ema.model.window import window_to_dict
+
+    servo = read_one(MAPPED["servo"][0], read_logmap(EXAMPLES / "emps" / "log-map.json"))
+    quarter = {name: values[: len(values) // 4] for name, values in servo.signals.items()}
+    folder = tmp_path / "archive"
+    folder.mkdir()
+    (folder / "servo.json").write_text(json.dumps(window_to_dict(replace(servo, signals=quarter, window_id="s"))))
+    rotary = synthetic_window(HealthParams.single(), seed=0, duration_s=1.0, actuator_id="r")
+    (folder / "rotary.json").write_text(json.dumps(window_to_dict(replace(rotary, window_id="r"))))
+    assert sorted(w.window_id for w in read_log(folder, None).windows) == ["r#0", "r#1", "s"]
+    assert len(read_log(folder, 1.0).windows) == 1 + 6  # told: the servo's 6.2 s as well
