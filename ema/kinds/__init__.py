@@ -40,10 +40,17 @@ __all__ = [
     "estimate",
     "kind_of",
     "learns",
+    "warm_up",
 ]
 
 
 KINDS: dict[str, ActuatorKind] = {kind.facts.name: kind for kind in (ROTARY, LINEAR, SERVO)}
+
+
+def warm_up(names: Sequence[str] = tuple(KINDS)) -> None:
+    """Each named kind warmed (``ActuatorKind.warm_up``): a service warms every kind before it answers."""
+    for name in names:
+        KINDS[name].warm_up()
 
 
 def kind_of(actuator: ActuatorDocument) -> ActuatorKind:

@@ -40,5 +40,8 @@ class Linear:
     def calibration_cost(self, windows: Sequence[Window], config: PipelineConfig) -> Cost:
         return Cost(simulated_s=0.0, window_s=0.0)
 
+    def warm_up(self) -> None:
+        """Nothing: a stepper's window is read quasi-statically in NumPy, milliseconds from the first."""
+
 
 LINEAR = Linear()

@@ -17,11 +17,9 @@ from ema.estimate import runtime
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import Estimate
 from ema.estimate.documents.window import HistoryReadings
-from ema.kinds import estimate
+from ema.kinds import estimate, warm_up
 from ema.model.actuator import THESIS, ActuatorDocument, actuator_from_dict
 from ema.model.checks import InputError
-from ema.model.params import HealthParams
-from ema.model.synthetic import synthetic_window
 from ema.model.window import Window, window_from_dict, window_to_dict
 
 
@@ -48,23 +46,12 @@ def estimate_json(
     return result.model_dump(mode="json", by_alias=True)
 
 
-WARM_UP = PipelineConfig(n_simulations=16, check_windows=8, n_timesteps=20, hidden_units=4)
-
-
-def warm_up() -> None:
-    """A tiny pipeline run: simulation kernels, residual, network and the physics fit all exercised once (loaded
-    from the cache or compiled), so that the first window a process answers costs what any other does."""
-    from ema.estimate.pipeline import estimate_window  # torch's: a task of a kind that learns nothing never loads it
-
-    estimate_window(synthetic_window(HealthParams.single(), seed=0, duration_s=0.05), WARM_UP, actuator=THESIS)
-
-
 def warm(threads: int) -> None:
     """A worker process made ready before its first window: its thread budget pinned, its kernels loaded, and what
     it loaded (torch's modules, the kernels: it lives as long as the process) never walked by the cyclic collector
     again, at a window's collections or at the process's end."""
     runtime.configure(threads)
-    warm_up()
+    warm_up(("rotary",))  # what an archive mostly holds; a window of another kind loads its own at its first
     gc.freeze()
 
 

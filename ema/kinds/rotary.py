@@ -21,14 +21,18 @@ from ema.estimate.documents import STAGES, Estimate
 from ema.estimate.quasistatic.drive import MOTOR_READING
 from ema.estimate.quasistatic.pipeline import QUASI_STATIC
 from ema.kinds.base import Calibrated, CalibrationRequest, Cost, Request, read_quasi_statically
+from ema.model.actuator import THESIS
 from ema.model.bounds import HIGH_RATE_HZ
 from ema.model.checks import InputError
 from ema.model.kinds import KINDS, KindFacts
+from ema.model.params import HealthParams
+from ema.model.synthetic import synthetic_window
 from ema.model.window import Window
 
 if TYPE_CHECKING:
     from ema.calibration.calibrate import Calibrator
 
+WARM_UP = PipelineConfig(n_simulations=16, check_windows=8, n_timesteps=20, hidden_units=4)  # a warm-up's sizes
 VARIABLES = {
     "speed_radps": "motor speed |ω| [rad/s]",
     "current_a": "current · sgn(ω) [A]",
@@ -85,6 +89,12 @@ class Rotary:
     def calibration_cost(self, windows: Sequence[Window], config: PipelineConfig) -> Cost:
         seconds = sum(w.duration_s for w in windows)
         return Cost(simulated_s=config.total_simulations * seconds, window_s=seconds)
+
+    def warm_up(self) -> None:
+        """A tiny pipeline run: simulation kernels, residual, network and the physics fit all exercised once (loaded
+        from the cache or compiled), so that the first window a process answers costs what any other does."""
+        window = synthetic_window(HealthParams.single(), seed=0, duration_s=0.05)
+        self.estimate(window, Request(WARM_UP, THESIS))
 
 
 def residual_plot(calibrator: Calibrator) -> ResidualPlot:

@@ -12,13 +12,16 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+import numpy as np
+
 from ema.calibration.servo import CLOSED_LOOPS, calibrate_servo
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import STAGES, Estimate
 from ema.kinds.base import Calibrated, CalibrationRequest, Cost, Request
+from ema.model.actuator import actuator_from_dict
 from ema.model.kinds import KINDS, KindFacts
 from ema.model.params import DriveConstants
-from ema.model.servo_sim import SUBSTEPS
+from ema.model.servo_sim import SUBSTEPS, ServoLoop, simulate_servo
 from ema.model.window import Window
 
 ROTARY_STEP_S = DriveConstants().step_s  # what a service's simulation limit counts in
@@ -51,6 +54,38 @@ class Servo:
     def calibration_cost(self, windows: Sequence[Window], config: PipelineConfig) -> Cost:
         steps = sum(window.n_samples * SUBSTEPS * CLOSED_LOOPS for window in windows)
         return Cost(simulated_s=steps * ROTARY_STEP_S, window_s=0.0)
+
+    def warm_up(self) -> None:
+        """A tiny servo's window (``WARM_UP_SERVO``) simulated and estimated: its filters (scipy's, 0.6 s to load),
+        its simulator and its network exercised once."""
+        from ema.estimate.simulate.servo import lane_parameters
+        from ema.kinds.rotary import WARM_UP  # the rotary's tiny sizes
+
+        loop = WARM_UP_LOOP
+        rate = 1.0 / loop.period_s
+        set_point = 0.05 * np.sin(2 * np.pi * np.arange(round(2.0 * rate)) / rate)  # 2 s, a stroke each way
+        run = simulate_servo(set_point, lane_parameters(WARM_UP_LOAD)[None, :], loop)
+        window = Window(
+            {"set_point_m": set_point, "position_m": run.position_m[0], "drive_force_n": run.drive_force_n[0]},
+            rate,
+            None,
+            constants={
+                "position_gain_per_s": loop.position_gain_per_s,
+                "speed_gain_per_mps": loop.speed_gain_per_mps,
+                "drive_gain_n_per_unit": loop.drive_gain_n_per_unit,
+            },
+        )
+        self.estimate(window, Request(WARM_UP, actuator_from_dict(WARM_UP_SERVO)))
+
+
+WARM_UP_SERVO = {
+    "schema": "ema-actuator/1",
+    "name": "warm-up",
+    "kind": "servo",
+    "servo": {},  # its controller's gains the window's, its rate the window's
+}
+WARM_UP_LOOP = ServoLoop(160.0, 240.0, 35.0, np.inf, 1e-3, 0.0)  # kp, kv, gain, no limit, 1 kHz, exact position
+WARM_UP_LOAD = {"mass_kg": 90.0, "viscous_ns_per_m": 200.0, "fdj_n": 20.0, "offset_n": 0.0}
 
 
 SERVO = Servo()

@@ -16,7 +16,7 @@ from fastapi_offline import FastAPIOffline
 
 from ema.estimate import runtime
 from ema.history.open import open_history
-from ema.kinds.remote import warm_up
+from ema.kinds import warm_up
 from ema.model import runtime as sim_runtime
 from ema.model.actuator import ActuatorDocument
 from ema.model.window import WindowDocument

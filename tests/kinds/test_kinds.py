@@ -106,3 +106,32 @@ def test_an_archive_no_network_learns_from_is_read_in_process_whatever_the_worke
         engines[workers] = summary["engine"]
         assert summary["answered"] == 6
     assert engines == {"2": "in-process: no window learns a network", "1": "in-process"} and rows["2"] == rows["1"]
+
+
+def test_a_warmed_process_loads_nothing_new_for_the_first_window_of_any_kind():
+    """The service warms every kind before it answers: a servo's first window then imports no module (its filters'
+    scipy.signal took 0.6 s of EMPS's first window's 0.8) and compiles or loads no kernel of its simulator."""
+    import subprocess
+    import sys
+
+    probe = "\n".join(
+        [
+            "import sys",
+            "from ema.kinds import warm_up",
+            "warm_up()",
+            "from ema.kinds import estimate",
+            "from ema.model.actuator import read_actuator",
+            "from ema.model.logmap import read_logmap, read_mapped",
+            "from ema.model.servo_sim import run_lanes",
+            "from ema.model.window import window_from_dict",
+            "emps = sys.argv[1]",
+            "window = window_from_dict(read_mapped(emps + '/DATA_EMPS.mat', read_logmap(emps + '/log-map.json')))",
+            "actuator = read_actuator(emps + '/actuator.json')",
+            "before, signatures = set(sys.modules), list(run_lanes.signatures)",
+            "estimate(window, actuator=actuator)",
+            "print(sorted(set(sys.modules) - before), run_lanes.signatures == signatures, file=sys.stderr)",
+        ]
+    )
+    emps = str(PACKAGE.parent / "examples" / "emps")
+    done = subprocess.run([sys.executable, "-c", probe, emps], capture_output=True, text=True, check=True)
+    assert done.stderr.splitlines()[-1] == "[] True"
