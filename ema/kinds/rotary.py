@@ -20,7 +20,7 @@ from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import STAGES, Estimate
 from ema.estimate.quasistatic.drive import MOTOR_READING
 from ema.estimate.quasistatic.pipeline import QUASI_STATIC
-from ema.kinds.base import Calibrated, CalibrationRequest, Cost, Request, read_quasi_statically
+from ema.kinds.base import WARM_UP, Calibrated, CalibrationRequest, Cost, Request, read_quasi_statically
 from ema.model.actuator import THESIS
 from ema.model.bounds import HIGH_RATE_HZ
 from ema.model.checks import InputError
@@ -32,7 +32,6 @@ from ema.model.window import Window
 if TYPE_CHECKING:
     from ema.calibration.calibrate import Calibrator
 
-WARM_UP = PipelineConfig(n_simulations=16, check_windows=8, n_timesteps=20, hidden_units=4)  # a warm-up's sizes
 VARIABLES = {
     "speed_radps": "motor speed |ω| [rad/s]",
     "current_a": "current · sgn(ω) [A]",

@@ -17,7 +17,7 @@ import numpy as np
 from ema.calibration.servo import CLOSED_LOOPS, calibrate_servo
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import STAGES, Estimate
-from ema.kinds.base import Calibrated, CalibrationRequest, Cost, Request
+from ema.kinds.base import WARM_UP, Calibrated, CalibrationRequest, Cost, Request
 from ema.model.actuator import actuator_from_dict
 from ema.model.kinds import KINDS, KindFacts
 from ema.model.params import DriveConstants
@@ -59,7 +59,6 @@ class Servo:
         """A tiny servo's window (``WARM_UP_SERVO``) simulated and estimated: its filters (scipy's, 0.6 s to load),
         its simulator and its network exercised once."""
         from ema.estimate.simulate.servo import lane_parameters
-        from ema.kinds.rotary import WARM_UP  # the rotary's tiny sizes
 
         loop = WARM_UP_LOOP
         rate = 1.0 / loop.period_s
