@@ -155,6 +155,17 @@ def test_a_run_whose_current_is_logged_with_the_other_sign_is_refused_not_read_a
     assert refused.value.field == "signals.current_a" and "FDJ -" in refused.value.message
 
 
+def test_a_run_read_with_its_time_in_the_wrong_unit_says_how_long_it_then_lasts(learned):
+    """The rig's time read as ms makes a 13 s run last 0.013 s at 25 kHz: the refusal says so, not only the rate."""
+    from ema.model.logmap import logmap_from_dict
+
+    in_ms = logmap_from_dict(MAP.model_dump(by_alias=True) | {"time": {"column": "time", "unit": "ms"}})
+    path = sorted((RIG / "runs").glob("normal_load20_run*.csv"))[5]
+    with pytest.raises(InputError) as refused:
+        estimate(window_from_dict(read_mapped(path, in_ms)), actuator=learned[1])
+    assert "the window spans 0.013 s at 25000 Hz" in refused.value.message
+
+
 def test_a_repeatability_std_tells_what_runs_of_one_state_scatter_by(learned):
     """Held-out healthy runs: each within ±2 repeatability std of its set's median about 95 % of the time, that std
     well under the whole std (which carries the document's own η_O and c, shared by every run)."""

@@ -74,8 +74,8 @@ def estimate_low_rate(
     if not found:
         raise InputError(
             "signals",
-            f"no stretch at constant speed lasts {MIN_STRETCH_S:g} s: at "
-            f"{window.sample_rate_hz:g} Hz a window shows friction only at constant speed",
+            f"no stretch at constant speed lasts {MIN_STRETCH_S:g} s (the window spans {window.duration_s:.3g} s at "
+            f"{window.sample_rate_hz:g} Hz): read quasi-statically, a window shows friction only at constant speed",
         )
     torque, rest_note = reading.torque(actuator, rest)
     seconds["prepare"] = time.perf_counter() - started
