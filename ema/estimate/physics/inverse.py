@@ -120,7 +120,6 @@ def load_motion(position_m: np.ndarray, rate_hz: float, bandwidth_hz: float, res
         raise InputError("signals.position_m", f"{len(position_m)} samples are too few to read its motion from")
     kept = slice(edge, len(position_m) - edge)
     filtered = _filtfilt(*_butter_lowpass(rate_hz, cutoff), position_m)
-    _moves(filtered[kept], white_noise_std(position_m))
     speed = central_difference(filtered, rate_hz)[kept]
     acceleration = central_difference(central_difference(filtered, rate_hz), rate_hz)[kept]
     top = float(np.max(np.abs(speed)))
@@ -132,10 +131,12 @@ def load_motion(position_m: np.ndarray, rate_hz: float, bandwidth_hz: float, res
     return Motion(filtered[kept], speed, acceleration, edge, decimation, ~near_rest[rows])
 
 
-def _moves(filtered_m: np.ndarray, noise_m: float) -> None:
-    """Raise unless the load travels beyond its sensor's noise: a window at rest holds no sliding friction, and
-    a no-step sensor's noise would otherwise pass for motion (its rest is a share of the top speed)."""
-    travel = float(np.ptp(filtered_m))
+def refuse_still(motion: Motion, position_m: np.ndarray) -> None:
+    """Raise unless a logged window's load travels (``motion``'s filtered position) beyond its sensor's noise (read
+    on ``position_m``, the log's): a window at rest holds no sliding friction, and a no-step sensor's noise would
+    otherwise pass for motion (its rest is a share of the top speed). The window's own check: its simulations
+    follow its set point."""
+    travel, noise_m = float(np.ptp(motion.position_m)), white_noise_std(position_m)
     if travel <= MIN_TRAVEL_NOISES * noise_m:
         raise InputError(
             "signals.position_m",

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ema.estimate.documents import Note
-from ema.estimate.physics.inverse import Motion, fit_inverse, inverse_columns, load_motion
+from ema.estimate.physics.inverse import Motion, fit_inverse, inverse_columns, load_motion, refuse_still
 from ema.estimate.stats import below_zero, rms
 from ema.model.actuator import ActuatorDocument
 from ema.model.checks import InputError
@@ -130,6 +130,13 @@ def refuse_reversed_signs(values: dict[str, float], stds: dict[str, float]) -> N
         )
 
 
+def _window_motion(position_m: np.ndarray, rate_hz: float, bandwidth_hz: float, step_m: float) -> Motion:
+    """The logged load's motion (``load_motion``), refused where it never leaves its sensor's noise."""
+    motion = load_motion(position_m, rate_hz, bandwidth_hz, step_m)
+    refuse_still(motion, position_m)
+    return motion
+
+
 def prepare_servo(window: Window, actuator: ActuatorDocument) -> ServoPrepared:
     """The window ready for its physics (module docstring); InputError naming what cannot be read."""
     servo = completed(actuator, window)
@@ -144,11 +151,11 @@ def prepare_servo(window: Window, actuator: ActuatorDocument) -> ServoPrepared:
     step = servo.position_resolution_m if servo.position_resolution_m is not None else resolution(s["position_m"])
     mass = servo.mass_kg
     if mass is None and servo.bandwidth_hz is None:  # a first fit, for the loop's natural frequency
-        first = load_motion(s["position_m"], rate, PROVISIONAL_BANDWIDTH_SHARE * rate, step)
+        first = _window_motion(s["position_m"], rate, PROVISIONAL_BANDWIDTH_SHARE * rate, step)
         forces = (s["drive_force_n"] - load)[first.samples]
         mass = fit_inverse(forces, inverse_columns(first), first).values["mass_kg"]
     loop_hz = bandwidth(servo, max(float(mass or 1.0), 1e-6))
-    motion = load_motion(s["position_m"], rate, loop_hz, step)
+    motion = _window_motion(s["position_m"], rate, loop_hz, step)
     assert servo.position_gain_per_s and servo.speed_gain_per_mps and servo.drive_gain_n_per_unit  # completed
     loop = ServoLoop(
         position_gain_per_s=servo.position_gain_per_s,
