@@ -56,8 +56,8 @@ class Servo:
         return Cost(simulated_s=steps * ROTARY_STEP_S, window_s=0.0)
 
     def warm_up(self) -> None:
-        """A tiny servo's window (``WARM_UP_SERVO``) simulated and estimated: its filters (scipy's, 0.6 s to load),
-        its simulator and its network exercised once."""
+        """A tiny servo's window (``WARM_UP_SERVO``) simulated and estimated: its filters, its simulator and its
+        network exercised once (their kernels loaded)."""
         from ema.estimate.simulate.servo import lane_parameters
 
         loop = WARM_UP_LOOP

@@ -36,6 +36,7 @@ import numpy as np
 
 from ema.estimate.physics.eta_search import MIN_OFFSET_BALANCE
 from ema.estimate.physics.noise import white_noise_std
+from ema.estimate.physics.zero_phase import butter_lowpass, cheby1_lowpass, filtfilt
 from ema.estimate.stats import rms
 from ema.model.checks import InputError
 
@@ -88,15 +89,11 @@ class Motion:
 
 
 def _butter_lowpass(rate_hz: float, cutoff_hz: float) -> tuple[np.ndarray, np.ndarray]:
-    from scipy.signal import butter
-
-    return butter(FILTER_ORDER, min(cutoff_hz / (rate_hz / 2.0), 0.99))
+    return butter_lowpass(FILTER_ORDER, min(cutoff_hz / (rate_hz / 2.0), 0.99))
 
 
 def _filtfilt(b: np.ndarray, a: np.ndarray, x: np.ndarray) -> np.ndarray:
     """Zero-phase filtering, its start-up padded as MATLAB's filtfilt pads (3·(order) samples, odd reflection)."""
-    from scipy.signal import filtfilt
-
     return filtfilt(b, a, x, padlen=3 * (max(len(a), len(b)) - 1))
 
 
@@ -156,9 +153,7 @@ def decimated(values: np.ndarray, factor: int) -> np.ndarray:
     ``decimate``): what every column and the force go through alike."""
     if factor == 1:
         return values
-    from scipy.signal import cheby1
-
-    b, a = cheby1(DECIMATION_ORDER, DECIMATION_RIPPLE_DB, 0.8 / factor)
+    b, a = cheby1_lowpass(DECIMATION_ORDER, DECIMATION_RIPPLE_DB, 0.8 / factor)
     return _filtfilt(b, a, values)[decimated_indices(len(values), factor)]
 
 
