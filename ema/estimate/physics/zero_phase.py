@@ -19,8 +19,6 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ema.model.checks import InputError
-
 
 def butter_lowpass(order: int, cutoff: float) -> tuple[np.ndarray, np.ndarray]:
     """(b, a), each of ``order`` + 1 coefficients: the digital Butterworth low-pass of ``order`` with its −3 dB
@@ -48,7 +46,7 @@ def _digital(poles: np.ndarray, gain: float, cutoff: float) -> tuple[np.ndarray,
     """(b, a) of the all-pole analog prototype (``poles``, ``gain``; cutoff 1 rad/s) moved to the pre-warped
     ``cutoff`` and through the bilinear transform (module docstring)."""
     if not 0.0 < cutoff < 1.0:
-        raise InputError("cutoff", f"must be a share of the Nyquist rate in (0, 1), got {cutoff}")
+        raise ValueError(f"cutoff: must be a share of the Nyquist rate in (0, 1), got {cutoff}")
     warped = 4.0 * np.tan(np.pi * cutoff / 2.0)
     poles, gain = poles * warped, gain * warped ** len(poles)
     digital_gain = gain * np.real(1.0 / np.prod(4.0 - poles))
@@ -58,10 +56,13 @@ def _digital(poles: np.ndarray, gain: float, cutoff: float) -> tuple[np.ndarray,
 
 
 def filtfilt(b: np.ndarray, a: np.ndarray, x: np.ndarray, padlen: int) -> np.ndarray:
-    """``x`` (n,) filtered forwards and backwards by (b, a), its ends padded by ``padlen`` samples of odd
-    reflection and each pass started in the filter's steady state (module docstring): shape (n,)."""
+    """``x`` (n,) filtered forwards and backwards by (b, a) (of one length, as the designs here give them), its
+    ends padded by ``padlen`` samples of odd reflection and each pass started in the filter's steady state (module
+    docstring): shape (n,)."""
+    if len(b) != len(a):
+        raise ValueError(f"b, a: of one length, got {len(b)} and {len(a)}")
     if not 0 <= padlen < len(x):
-        raise InputError("padlen", f"must be below the signal's {len(x)} samples, got {padlen}")
+        raise ValueError(f"padlen: must be below the signal's {len(x)} samples, got {padlen}")
     b, a = np.asarray(b, dtype=float) / a[0], np.asarray(a, dtype=float) / a[0]
     steady = _steady_state(b, a)
     ext = np.concatenate((2.0 * x[0] - x[padlen:0:-1], x, 2.0 * x[-1] - x[-2 : -(padlen + 2) : -1]))  # odd reflection
