@@ -32,7 +32,7 @@ from ema.calibration.backlash import read_backlash
 from ema.calibration.documents import CalibrationReport, Step
 from ema.calibration.equations import Equations, equations
 from ema.calibration.families import Family, generic_families
-from ema.calibration.noise_floor import COPIES, clean_replicas, noise_copies
+from ema.calibration.noise_floor import clean_replicas, noise_copies
 from ema.calibration.readings import AMBIGUOUS_STDS, Contest, combined_stds, reading, settled
 from ema.calibration.refit import MIN_HELD_OUT_GAIN, corrected, fit_with, held_out_rss
 from ema.calibration.selection import MAX_EFFECTS, Chosen, Decision, Evidence, decide, evidence
@@ -45,7 +45,7 @@ from ema.estimate.pipeline import estimate_window
 from ema.estimate.prepare.conditioning import prepare
 from ema.estimate.report import healthy_range
 from ema.model.actuator import ActuatorDocument
-from ema.model.bounds import DEFAULT_SAMPLE_RATE_HZ
+from ema.model.bounds import DEFAULT_SAMPLE_RATE_HZ, NOISE_COPIES
 from ema.model.checks import InputError
 from ema.model.noise import SensorNoise
 from ema.model.params import HealthRanges
@@ -115,7 +115,7 @@ class Calibrator:
         self,
         pipeline: PipelineConfig = PipelineConfig(),
         max_effects: int = MAX_EFFECTS,
-        copies: int = COPIES,
+        copies: int = NOISE_COPIES,
         seed: int = 0,
         *,
         actuator: ActuatorDocument,

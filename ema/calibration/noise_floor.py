@@ -1,7 +1,7 @@
 """Stage 2, noise floor: what the equation error of *these* windows looks like when nothing is missing.
 
 Each window is simulated once, clean, with its own command, logged load and first state at the
-estimates the base model gives it; then ``COPIES`` independent draws of the window's own
+estimates the base model gives it; then ``NOISE_COPIES`` independent draws of the window's own
 estimated sensor noise are added. Every statistic the selection computes on the measured
 windows is computed on each copy too: the copies carry the same trajectory, the same 2 ms
 reconstruction and its approximation error, the same correlated noise, and none of the missing
@@ -19,11 +19,10 @@ from ema.calibration.equations import Equations, equations
 from ema.estimate.physics.scenario import inside, scenario_from_window
 from ema.model import runtime
 from ema.model.actuator import ActuatorDocument
+from ema.model.bounds import NOISE_COPIES
 from ema.model.noise import SensorNoise, add_sensor_noise
 from ema.model.params import DriveConstants
 from ema.model.window import Window
-
-COPIES = 30
 
 
 def clean_replicas(
@@ -45,7 +44,7 @@ def noise_copies(
     seed: int,
     drive: DriveConstants,
     *,
-    copies: int = COPIES,
+    copies: int = NOISE_COPIES,
     on_copy: Callable[[], None] | None = None,
 ) -> list[Equations]:
     """``copies`` noisy versions of the clean replicas, each as the selection sees a window set; ``on_copy`` is

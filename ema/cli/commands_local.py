@@ -27,7 +27,14 @@ from ema.cli.options import (
     span,
     threads,
 )
-from ema.model.bounds import DEFAULT_SAMPLE_RATE_HZ, DURATION_RANGE_S, MAX_FLIGHT_HOURS, SAMPLE_RATE_RANGE_HZ
+from ema.model.bounds import (
+    DEFAULT_SAMPLE_RATE_HZ,
+    DURATION_RANGE_S,
+    MAX_FLIGHT_HOURS,
+    NOISE_COPIES,
+    NOISE_COPIES_RANGE,
+    SAMPLE_RATE_RANGE_HZ,
+)
 from ema.model.envelope import AIRSPEED_RANGE_MPS, ALTITUDE_RANGE_M, DEFAULT_AIRSPEED_MPS
 
 FAMILIES = ("thesis", "cruise", "gust", "doublet", "steps")  # ema.model.commands.FAMILIES, without importing numpy here
@@ -182,7 +189,12 @@ def simulate(as_json: bool, **options: Any) -> None:
 @click.argument("windows", type=EXISTING, nargs=-1, required=True)
 @click.option("--truth", type=EXISTING, help='JSON {"FDJ": ..., "eta_O": ...} of synthetic windows')
 @click.option("--figure", type=OUTPUT_FILE, help="also write a PNG of the residual before and after")
-@click.option("--copies", type=click.IntRange(8, 500), default=30, help="noise-only copies behind the noise floor")
+@click.option(
+    "--copies",
+    type=click.IntRange(*NOISE_COPIES_RANGE),
+    default=NOISE_COPIES,
+    help="noise-only copies behind the noise floor",
+)
 @click.option(
     "--out-actuator",
     type=OUTPUT_FILE,

@@ -7,7 +7,6 @@ from dataclasses import dataclass
 from typing import Protocol
 
 from ema.calibration.documents import CalibrationReport
-from ema.calibration.noise_floor import COPIES
 from ema.calibration.plot import ResidualPlot
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import ActuatorRead, Estimate
@@ -15,6 +14,7 @@ from ema.estimate.documents.window import HistoryReadings
 from ema.estimate.quasistatic.drive import QuasiStaticReading
 from ema.estimate.quasistatic.pipeline import estimate_low_rate
 from ema.model.actuator import THESIS, ActuatorDocument
+from ema.model.bounds import NOISE_COPIES
 from ema.model.kinds import KindFacts
 from ema.model.window import Window
 
@@ -44,7 +44,7 @@ class CalibrationRequest:
     config: PipelineConfig
     actuator: ActuatorDocument
     truth: Mapping[str, float] | None = None
-    copies: int = COPIES
+    copies: int = NOISE_COPIES
     on_stage: Callable[[str], None] | None = None
     checkpoint: Callable[[], None] | None = None
 

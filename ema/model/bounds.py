@@ -41,6 +41,8 @@ SIGNAL_LIMITS = {
     "drive_force_n": (-1e6, 1e6),
 }
 CONSTANT_NAME = r"^[a-z][a-z0-9_]{0,63}$"
+NOISE_COPIES = 30  # noise-only copies of a rotary calibration's windows behind its noise floor
+NOISE_COPIES_RANGE = (8, 500)
 
 
 def route_collision(actuator_id: str) -> str | None:
