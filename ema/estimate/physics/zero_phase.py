@@ -66,9 +66,10 @@ def filtfilt(b: np.ndarray, a: np.ndarray, x: np.ndarray, padlen: int) -> np.nda
     b, a = np.asarray(b, dtype=float) / a[0], np.asarray(a, dtype=float) / a[0]
     steady = _steady_state(b, a)
     ext = np.concatenate((2.0 * x[0] - x[padlen:0:-1], x, 2.0 * x[-1] - x[-2 : -(padlen + 2) : -1]))  # odd reflection
-    forward = _lfilter(b, a, ext, steady * ext[0])
-    backward = _lfilter(b, a, forward[::-1].copy(), steady * forward[-1])[::-1]
-    return backward[padlen : len(backward) - padlen]
+    forward, backward = np.empty_like(ext), np.empty_like(ext)
+    _lfilter(b, a, ext, steady * ext[0], forward)
+    _lfilter(b, a, forward[::-1].copy(), steady * forward[-1], backward)
+    return backward[::-1][padlen : len(backward) - padlen]
 
 
 def _steady_state(b: np.ndarray, a: np.ndarray) -> np.ndarray:
@@ -82,18 +83,15 @@ def _steady_state(b: np.ndarray, a: np.ndarray) -> np.ndarray:
 
 
 @njit(cache=True)
-def _lfilter(b: np.ndarray, a: np.ndarray, x: np.ndarray, z0: np.ndarray) -> np.ndarray:
-    """y (n,) of the IIR filter (b, a) (each (k + 1,), ``a[0]`` = 1) on ``x`` (n,) from the delays ``z0`` (k,),
-    in the transposed direct form II:
+def _lfilter(b: np.ndarray, a: np.ndarray, x: np.ndarray, z: np.ndarray, y: np.ndarray) -> None:
+    """Writes into ``y`` (n,) the IIR filter (b, a) (each (k + 1,), ``a[0]`` = 1) run on ``x`` (n,) from the delays
+    ``z`` (k,, updated in place), in the transposed direct form II:
 
         y[t] = b[0]·x[t] + z[0];   z[i] = b[i+1]·x[t] − a[i+1]·y[t] + z[i+1]   (z[k] = 0)
     """
     order = len(a) - 1
-    z = z0.copy()
-    y = np.empty_like(x)
     for t in range(len(x)):
         y[t] = z[0] + b[0] * x[t]
         for i in range(order - 1):
             z[i] = z[i + 1] + x[t] * b[i + 1] - y[t] * a[i + 1]
         z[order - 1] = x[t] * b[order] - y[t] * a[order]
-    return y
