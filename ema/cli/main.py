@@ -16,6 +16,7 @@ import click
 
 from ema.cli import commands_fleet, commands_local, commands_remote, commands_serve
 from ema.cli.options import NothingAnsweredError, PipeClosedError
+from ema.model.collector import collect_less_often
 
 EXIT_OK, EXIT_INTERNAL, EXIT_BAD_INPUT, EXIT_INTERRUPTED = 0, 1, 2, 130
 
@@ -108,8 +109,10 @@ def _run(arguments: list[str]) -> int:
 
 
 def console() -> int:
-    """``main`` as the ``ema`` program runs it: what the command built is freed by the process's end, so the
-    cyclic collector is told not to walk it at exit (torch's objects: a third of a second)."""
+    """``main`` as the ``ema`` program runs it: the cyclic collector set for a program that loads torch
+    (``ema.model.collector``), and what the command built is freed by the process's end, so the
+    collector is told not to walk it at exit (torch's objects: a third of a second)."""
+    collect_less_often()  # before the command loads torch and the kernels
     status = main()
     gc.freeze()
     return status

@@ -39,6 +39,7 @@ from typing import TypeVar
 
 from ema.model.bounds import MAX_THREADS
 from ema.model.checks import InputError
+from ema.model.collector import collect_less_often
 
 INTERLEAVE = 3  # independent vectors per iteration of a vectorized loop (module docstring)
 T = TypeVar("T")
@@ -206,9 +207,10 @@ def prefer_wide_vectors() -> None:
 
 
 def configure_simulator(threads: int | None = None) -> int:
-    """The entry points' one call: vector width and interleaving, BLAS on one thread, then the thread budget
-    (default: the usable cores)."""
+    """The entry points' one call: vector width and interleaving, BLAS on one thread, the cyclic collector
+    (``collect_less_often``), then the thread budget (default: the usable cores)."""
     compiler_options()
+    collect_less_often()
     single_threaded_blas()
     set_threads(threads or available_cores())
     return _BUDGET.threads

@@ -84,6 +84,23 @@ def test_the_caller_is_one_of_the_budgets_threads_and_an_error_stops_the_others(
         runtime.set_threads(before)
 
 
+def test_the_collector_is_set_by_the_program_that_starts_never_at_import():
+    """Importing ema (its CLI, its simulator) leaves the collector as Python set it; the entry points' one call
+    collects the youngest generation less often, the older ones as they were."""
+    import json
+
+    from ema.model.collector import YOUNG_COLLECTION
+
+    script = (
+        "import gc, json; before = gc.get_threshold(); import ema.cli.main, ema.model.runtime as r; "
+        "imported = gc.get_threshold(); r.configure_simulator(1); "
+        "print(json.dumps([before, imported, gc.get_threshold()]))"
+    )
+    found = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, check=True).stdout
+    before, imported, configured = json.loads(found)
+    assert imported == before and configured == [YOUNG_COLLECTION, *before[1:]]
+
+
 NESTED = """
 from ema.model import runtime
 
