@@ -2,6 +2,6 @@
 
 import sys
 
-from ema.cli.main import main
+from ema.cli.main import console
 
-sys.exit(main())
+sys.exit(console())

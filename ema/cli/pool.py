@@ -1,6 +1,7 @@
 """The local worker processes of ``ema fleet --workers N``: a pool of processes forked from a fork server that has
-loaded torch and the kernels' modules once, each warmed as it starts (its thread budget pinned, its kernels
-loaded: ``ema.kinds.remote.warm``).
+loaded torch and the kernels' modules once (``ema.cli.fork_server``, its program: the collector set first, as every
+ema process sets it), each warmed as it starts (its thread budget pinned, its kernels loaded:
+``ema.kinds.remote.warm``).
 
 This module imports nothing of ema's at its top: the command starts the fork server before it imports what reads
 the archive, so that the server loads torch while the driver is still loading its own modules and reading, on the
@@ -26,7 +27,7 @@ if TYPE_CHECKING:
     from ema.cli.workers import Answer, Documents, Job
     from ema.estimate.config import PipelineConfig
 
-PRELOADED = ("ema.estimate.pipeline", "ema.kinds.remote")  # what every worker imports: torch, the kernels' modules
+PRELOADED = ("ema.cli.fork_server",)  # the server loads torch and the kernels' modules, its collector set first
 IN_FLIGHT_PER_WORKER = 2  # tasks queued per worker: enough to keep it busy, few enough to stop quickly
 NODE_LOSSES = 3  # a window whose task died with its process or node this often fails the run
 

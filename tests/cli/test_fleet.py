@@ -96,6 +96,29 @@ def test_a_pool_that_never_had_a_job_forks_no_worker_and_stops_at_once():
     assert loaded.stdout.decode().strip() == "False"
 
 
+def test_the_fork_server_loads_torch_with_its_collector_set_and_nothing_else_loads_its_module():
+    """``ema.cli.fork_server`` is the fork server's program: importing it sets the collector, then loads torch and
+    the kernels' modules (its workers hold them from their start); no module of ema imports it."""
+    import pathlib
+    import subprocess
+    import sys
+
+    from ema.cli import pool
+    from ema.model.collector import YOUNG_COLLECTION
+
+    assert pool.PRELOADED == ("ema.cli.fork_server",)
+    script = "import gc, sys; import ema.cli.fork_server; print(gc.get_threshold()[0], 'torch' in sys.modules)"
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, check=True)
+    assert done.stdout.split() == [str(YOUNG_COLLECTION), "True"]
+    package = pathlib.Path(pool.__file__).parents[1]
+    importers = [
+        path.name
+        for path in package.rglob("*.py")
+        if "import ema.cli.fork_server" in (text := path.read_text()) or "fork_server import" in text
+    ]
+    assert importers == []
+
+
 def test_a_cluster_without_ray_says_how_to_install_it_and_writes_nothing(archive, tmp_path, capsys, monkeypatch):
     from ema.cli import fleet
 
