@@ -1,9 +1,7 @@
 """Process-wide choices for the simulator, made by the program that starts, never at import.
 
-- **Threads.** Groups of simulations run on ``threads()`` threads: the caller's and a pool of the
-  others (the kernel releases the GIL), and so do the row loops that read the simulated windows
-  (``run_rows``). The caller works rather than sleeping until the pool is done: beside busy programs
-  each wake-up waits for a core. Numba's own
+- **Threads.** Groups of simulations run on a pool of ``threads()`` threads (the kernel releases the
+  GIL), and so do the row loops that read the simulated windows (``run_rows``). Numba's own
   threading layer is not used: with torch's OpenMP runtime in the same process its idle workers spun
   while the other computed (a 0.7 s training took 21 s), and a static split of the batch waits for
   its slowest thread, which on a shared computer is the one the OS has parked. A pool of our own
@@ -34,7 +32,7 @@ import itertools
 import os
 import threading
 from collections.abc import Callable, Sequence
-from concurrent.futures import Future, ThreadPoolExecutor, wait
+from concurrent.futures import Future, ThreadPoolExecutor
 from typing import TypeVar
 
 from ema.model.bounds import MAX_THREADS
@@ -100,11 +98,11 @@ def _mark_pool_thread() -> None:
 
 
 def pool() -> ThreadPoolExecutor:
-    """The shared pool of the budget's threads but the caller's (one at least), created on first use."""
+    """The shared pool, created on first use."""
     with _BUDGET.lock:
         if _BUDGET.pool is None:
             _BUDGET.pool = ThreadPoolExecutor(
-                max(_BUDGET.threads - 1, 1), thread_name_prefix="ema-sim", initializer=_mark_pool_thread
+                _BUDGET.threads, thread_name_prefix="ema-sim", initializer=_mark_pool_thread
             )
         return _BUDGET.pool
 
@@ -121,55 +119,27 @@ MIN_ROWS_PER_THREAD = 8
 
 def run_rows(work: Callable[[int, int], None], n_rows: int) -> None:
     """``work(start, stop)`` over the rows [0, n_rows) of a signal batch, in one contiguous part per thread
-    of the budget (none below ``MIN_ROWS_PER_THREAD`` rows), the first in this thread, the others on the pool;
-    inline when one part: for compiled loops over independent rows that release the GIL. Returns once every
-    part is done; inline in a pool thread."""
+    of the budget (none below ``MIN_ROWS_PER_THREAD`` rows), on the pool, inline when one part: for
+    compiled loops over independent rows that release the GIL. Waits for every part (``wait_all``); inline
+    in a pool thread."""
     compiler_options()
     parts = max(1, min(threads(), n_rows // MIN_ROWS_PER_THREAD))
     if parts == 1 or _inline():
         work(0, n_rows)
         return
     edges = [round(n_rows * k / parts) for k in range(parts + 1)]
-    spans = list(itertools.pairwise(edges))
-    helpers = [pool().submit(work, a, b) for a, b in spans[1:]]
-    _along(helpers, lambda: work(*spans[0]))
+    wait_all([pool().submit(work, a, b) for a, b in itertools.pairwise(edges)])
 
 
 def map_on_pool(work: Callable[[T], R], items: Sequence[T]) -> list[R]:
-    """``work`` of each item, in order, each item taken by the first of the budget's threads free (this one
-    among them; inline with one thread or one item): for independent pieces of work whose compiled loops
-    release the GIL; inline in a pool thread. A piece's error stops the others' next items and is raised."""
+    """``work`` of each item, in order, the items spread over the pool (inline with one thread or one item):
+    for independent pieces of work whose compiled loops release the GIL; inline in a pool thread."""
     compiler_options()
     if _inline() or len(items) <= 1:
         return [work(item) for item in items]
-    results: list = [None] * len(items)
-    taken, stop = itertools.count(), threading.Event()  # next() on a count is atomic: each item is taken once
-
-    def drain() -> None:
-        try:
-            while not stop.is_set() and (i := next(taken)) < len(items):
-                results[i] = work(items[i])
-        except BaseException:
-            stop.set()  # the other threads take no further item
-            raise
-
-    helpers = [pool().submit(drain) for _ in range(min(threads(), len(items)) - 1)]
-    _along(helpers, drain)
-    return results
-
-
-def _along(helpers: Sequence[Future], work: Callable[[], None]) -> None:
-    """``work`` run in this thread beside the pool's ``helpers``, then each helper waited for (the module
-    docstring's threads). An error or an interrupt here cancels the helpers not started (``work`` has set
-    ``stop`` for those running) and is raised once they have ended; else a helper's error is raised."""
-    try:
-        work()
-    except BaseException:
-        for helper in helpers:
-            helper.cancel()
-        wait(helpers)
-        raise
-    wait_all(helpers)
+    futures = [pool().submit(work, item) for item in items]
+    wait_all(futures)
+    return [future.result() for future in futures]
 
 
 def wait_all(futures: Sequence[Future]) -> None:

@@ -53,37 +53,6 @@ def test_map_on_pool_keeps_the_items_order_and_raises_a_pieces_error():
         runtime.set_threads(before)
 
 
-def test_the_caller_is_one_of_the_budgets_threads_and_an_error_stops_the_others():
-    """The calling thread takes items beside the pool (no more threads than the budget), and a piece's error,
-    in the caller or in a pool thread, stops the other threads taking items: the batch ends at once."""
-    import threading
-    import time
-
-    from ema.model import runtime
-
-    before = runtime.threads()
-    caller = threading.get_ident()
-    try:
-        runtime.set_threads(2)
-        ran_on: list[int] = []
-        runtime.map_on_pool(lambda x: ran_on.append(threading.get_ident()) or time.sleep(0.002), list(range(40)))
-        assert caller in ran_on and len(set(ran_on)) == 2
-        for fails_in_caller in (True, False):
-            done: list[int] = []
-
-            def fails_in_one_thread(x: int, fails_in_caller: bool = fails_in_caller, done: list = done) -> None:
-                if (threading.get_ident() == caller) == fails_in_caller:
-                    raise RuntimeError("this thread's piece")
-                time.sleep(0.005)
-                done.append(x)
-
-            with pytest.raises(RuntimeError, match="this thread's piece"):
-                runtime.map_on_pool(fails_in_one_thread, list(range(200)))
-            assert len(done) < 20  # not the 199 others
-    finally:
-        runtime.set_threads(before)
-
-
 def test_the_collector_is_set_by_the_program_that_starts_never_at_import():
     """Importing ema (its CLI, its simulator) leaves the collector as Python set it; the entry points' one call
     collects the youngest generation less often, the older ones as they were."""
