@@ -3,8 +3,8 @@
 Loading them allocates about a million objects that live as long as the process. CPython collects its youngest
 generation every 700 allocations, and each collection of an older one walks what survived: while they load, the
 collector walked them again and again, a fifth of the loading's time. Collected every ``YOUNG_COLLECTION``
-allocations instead (the older generations at their usual ratios), the loading keeps that time, and a window's
-own garbage is still collected within a fraction of one window. The program that starts sets it first thing
+allocations instead (the older generations at their usual ratios), the loading is spared that time, and a
+window's own garbage is still collected within a fraction of one window. The program that starts sets it first thing
 (``ema`` itself, then every entry point's ``ema.model.runtime.configure_simulator``); importing sets nothing.
 """
 
