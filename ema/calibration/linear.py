@@ -130,7 +130,8 @@ def _refuse_reversed_signs(c: float, c_std: float, rests: np.ndarray) -> None:
     """Raise unless the runs' current rests above zero and grows with the torque the load opposes (neither
     ``below_zero``): a stepper's drive current is a magnitude, so a current at rest below zero is a current logged
     with the other sign, and a current falling where the load opposes the motion is a load (or a motion) so."""
-    rest, rest_std = float(rests.mean()), float(rests.std(ddof=1)) / np.sqrt(len(rests)) if len(rests) > 1 else 0.0
+    rest = float(rests.mean())
+    rest_std = float(rests.std(ddof=1)) / np.sqrt(len(rests)) if len(rests) > 1 else 0.0  # the mean's std
     if below_zero({"rest": rest}, {"rest": rest_std}):
         raise InputError(
             "signals.current_a",
