@@ -17,6 +17,7 @@ each model's error on it with its constants fixed: ema's learned ones and the pu
 from __future__ import annotations
 
 import argparse
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -29,7 +30,7 @@ from ema.estimate import runtime
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import STAGES
 from ema.estimate.physics.inverse import UNITS
-from ema.estimate.prepare.servo import prepare_servo
+from ema.estimate.prepare.servo import completed, log_loop, prepare_servo
 from ema.estimate.servo import physics_of
 from ema.kinds import CalibrationRequest, calibrate, estimate
 from ema.model.actuator import ActuatorDocument, read_actuator
@@ -157,7 +158,7 @@ def main() -> None:
         f"| ema, after ({', '.join(report.selected_effects)}) | {after['drive_force_n']:.2f} % "
         f"| {after['drive_force_n_closed_loop']:.2f} % |",
     ]
-    lines += ["", reading(answer, base)]
+    lines += ["", reading(answer, base), "", recorded_gain_line(window, document, answer)]
     if args.held_out is not None:
         held_out_map = args.held_out_map or mapping
         lines += ["", *held_out_lines(args.held_out, held_out_map, document, calibrated.completed, answer)]
@@ -165,6 +166,27 @@ def main() -> None:
     print(body)
     if args.docs:
         write_section("A real EMA at 1 kHz: the EMPS benchmark", typed_command(), body, RESULTS_MD)
+
+
+WRONG_KP = (0.5, 30.0)  # the log's recorded kp times these: a log whose recorded gain is not its loop's
+
+
+def recorded_gain_line(window: Window, document: ActuatorDocument, answer: dict) -> str:
+    """The log read with its recorded kp altered: the gains its command follows (``log_loop``), and FDJ read."""
+    kp = window.constants["position_gain_per_s"]
+    read = []
+    for factor in WRONG_KP:
+        wrong = replace(window, constants={**window.constants, "position_gain_per_s": factor * kp})
+        fdj = estimate(wrong, actuator=document).estimates.FDJ
+        read.append(f"kp x{factor:g}: FDJ {fdj.value:.3f} ± {fdj.std:.3f} N")
+    gains = log_loop(completed(document, window), window)
+    return (
+        f"A log whose recorded gain is not its loop's: the same log with its kp ({kp:g} 1/s) recorded "
+        f"{' or '.join(f'{f:g}' for f in WRONG_KP)} times over is simulated with the gains its command follows, "
+        f"read by least squares (kp {gains.position_gain_per_s:.2f} 1/s, kv {gains.speed_gain_per_mps:.2f}, "
+        f"{100 * gains.off_share:.2f} % RMS off the logged command), and reads {'; '.join(read)} (as logged: "
+        f"{answer['estimates']['FDJ']['value']:.3f} N), with the note `controller_mismatch` naming both gains."
+    )
 
 
 def reading(answer: dict, base: dict[str, dict]) -> str:

@@ -218,7 +218,10 @@ def _own_controller(prepared: ServoPrepared) -> ServoPrepared:
     calibration simulates the document's, and would trace the controllers' difference to the load."""
     for note in prepared.notes:
         if note.code == "controller_mismatch":
-            raise InputError(f"window {prepared.window.window_id}", f"{note.text}; a calibration needs the log's")
+            raise InputError(
+                f"window {prepared.window.window_id}",
+                f"{note.text}; a calibration needs a document whose controller the log follows",
+            )
     return prepared
 
 

@@ -1,6 +1,7 @@
 """A servo read through every stage: on windows of the independent closed-form servo (tests/foreign/servo.py), and
 on the EMPS benchmark's real log (Janot, Gautier and Brunot 2019), bundled in examples/emps."""
 
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -8,7 +9,7 @@ import pytest
 
 from ema.estimate.documents import STAGES
 from ema.estimate.physics.inverse import fit_inverse, inverse_columns
-from ema.estimate.prepare.servo import prepare_servo
+from ema.estimate.prepare.servo import completed, log_loop, prepare_servo
 from ema.kinds import estimate
 from ema.model.actuator import actuator_from_dict, read_actuator
 from ema.model.checks import InputError
@@ -91,6 +92,38 @@ def test_a_controller_the_log_does_not_follow_is_said(emps):
     document["servo"]["speed_filter"] = [1.0]
     prepared = prepare_servo(emps, actuator_from_dict(document))
     assert [n.code for n in prepared.notes if n.code == "controller_mismatch"]
+
+
+def test_the_gains_a_log_follows_are_read_from_its_command(emps):
+    """The command is linear in the loop's two gains: least squares reads those the EMPS log's command follows
+    within 0.1 % of the ones it records (kp 160.18 1/s, kv 243.45), and the foreign servo's from its window,
+    whichever gain the log records."""
+    for window, actuator in (
+        (emps, read_actuator(EMPS / "actuator.json")),
+        (window_from_dict(foreign.draw(3, seconds=4.0)), FOREIGN),
+    ):
+        wrong = replace(window, constants={**window.constants, "position_gain_per_s": 7.0})
+        gains = log_loop(completed(actuator, wrong), wrong)
+        assert gains.position_gain_per_s == pytest.approx(window.constants["position_gain_per_s"], rel=1e-3)
+        assert gains.speed_gain_per_mps == pytest.approx(window.constants["speed_gain_per_mps"], rel=1e-3)
+        assert gains.off_share < 0.01
+
+
+@pytest.mark.parametrize("factor", [0.5, 30.0])
+def test_a_log_recording_a_gain_its_loop_did_not_run_is_simulated_with_the_one_it_did(emps, factor):
+    """The EMPS log with its kp recorded 30 times over was simulated at that kp, and the physics fit's bias read on
+    those simulations put FDJ at 10.6 ± 0.9 N: now it is simulated with the gains its command follows, reads the
+    log's own FDJ, and the note names both gains."""
+    actuator = read_actuator(EMPS / "actuator.json")
+    kp = emps.constants["position_gain_per_s"]
+    wrong = replace(emps, constants={**emps.constants, "position_gain_per_s": factor * kp})
+    prepared = prepare_servo(wrong, actuator)
+    assert prepared.loop.position_gain_per_s == pytest.approx(kp, rel=1e-3)
+    (note,) = [n for n in prepared.notes if n.code == "controller_mismatch"]
+    assert f"follows kp {kp:.5g}" in note.text and f"give kp {factor * kp:.5g}" in note.text
+    if factor > 1:
+        read, own = (estimate(w, actuator=actuator).estimates.FDJ for w in (wrong, emps))
+        assert abs(read.value - own.value) < 0.1 * own.std
 
 
 def _emps_half(which: int) -> dict:

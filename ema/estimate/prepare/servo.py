@@ -8,6 +8,12 @@
 - The command is recomputed from the set point and the position with the document's controller: a log whose
   command does not follow it (RMS beyond ``CONTROLLER_TOLERANCE`` of the command's) was run under another
   controller, and the window's own simulations would not be its (note ``controller_mismatch``).
+  The command is linear in the loop's two gains, so a least-squares fit reads the gains the log's command
+  does follow (``log_loop``); where they reproduce it, the note says them beside the document's.
+- The loop the window is simulated with, and whose gains set the loop's bandwidth, is the one the log ran: the
+  document's gains, or, where the log does not follow them but follows others, those (a log that recorded kp
+  30 times its own was simulated at that kp, and the physics fit's bias read on those simulations put FDJ at
+  half its value). The note says both.
 - The loop's bandwidth (the document's, else the natural frequency √(kp·kv·g/M) of the position loop, M from a
   first fit) sets the inverse model's filters (``ema.estimate.physics.inverse``).
 """
@@ -70,44 +76,95 @@ def resolution(position_m: np.ndarray) -> float:
     return step if np.mean(whole) >= MIN_QUANTIZED else 0.0
 
 
+@dataclass(frozen=True)
+class LoopGains:
+    """A position loop's two gains, u = kv·(kp·(q_ref − q) − dq), and how far from the logged command they leave."""
+
+    position_gain_per_s: float  # kp
+    speed_gain_per_mps: float  # kv [the command's unit per m/s]
+    off_share: float  # the RMS of the logged command less theirs, as a share of the command's RMS
+
+
+def _filtered_speed(taps: list[float], position_m: np.ndarray, rate_hz: float) -> np.ndarray:
+    """The controller's speed [m/s]: the position through its filter ``taps``, differenced (its first sample
+    held before the log)."""
+    padded = np.concatenate([np.full(len(taps) - 1, position_m[0]), position_m])
+    filtered = np.convolve(padded, np.asarray(taps), mode="valid")
+    return np.diff(filtered, prepend=filtered[0]) * rate_hz
+
+
 def commanded(servo: Servo, set_point_m: np.ndarray, position_m: np.ndarray, rate_hz: float) -> np.ndarray:
     """The command [its unit] the document's controller gives at each sample of the log."""
-    taps = np.asarray(servo.speed_filter)
-    padded = np.concatenate([np.full(len(taps) - 1, position_m[0]), position_m])
-    filtered = np.convolve(padded, taps, mode="valid")
-    speed = np.diff(filtered, prepend=filtered[0]) * rate_hz
+    speed = _filtered_speed(servo.speed_filter, position_m, rate_hz)
     assert servo.position_gain_per_s is not None and servo.speed_gain_per_mps is not None  # completed
     command = servo.speed_gain_per_mps * (servo.position_gain_per_s * (set_point_m - position_m) - speed)
     limit = servo.command_limit if servo.command_limit is not None else np.inf
     return np.clip(command, -limit, limit)
 
 
-def _controller_note(servo: Servo, window: Window) -> Note | None:
-    """``controller_mismatch`` where the logged command departs from the document's controller beyond
-    ``CONTROLLER_TOLERANCE``; past the filter's and the difference's start (as many samples as taps), which read
-    positions from before the window: a log cut from a longer one starts in motion."""
-    s, gain = window.signals, servo.drive_gain_n_per_unit
-    assert gain is not None  # completed
-    logged = s["drive_force_n"] / gain
-    rate, start = window.sample_rate_hz, len(servo.speed_filter)
-    off = rms(logged[start:] - commanded(servo, s["set_point_m"], s["position_m"], rate)[start:])
-    share = float(off / max(rms(logged), 1e-300))
-    if share <= CONTROLLER_TOLERANCE:
-        return None
-    return Note(
-        code="controller_mismatch",
-        parameter="drive_force_n",
-        text=f"the logged command differs from what the document's controller gives by {100 * share:.1f} % RMS "
-        "(its gains, filter or drive gain are not the log's): the window's own simulations are not its",
+def _logged_command(servo: Servo, window: Window) -> np.ndarray:
+    """The command [its unit] the log recorded: its drive force over the drive's gain."""
+    assert servo.drive_gain_n_per_unit is not None  # completed
+    return window.signals["drive_force_n"] / servo.drive_gain_n_per_unit
+
+
+def document_loop(servo: Servo, window: Window) -> LoopGains:
+    """The document's gains, and how far the logged command is from what they give; past the filter's and the
+    difference's start (as many samples as taps), which read positions from before the window: a log cut from a
+    longer one starts in motion."""
+    s, start = window.signals, len(servo.speed_filter)
+    logged = _logged_command(servo, window)
+    off = rms(logged[start:] - commanded(servo, s["set_point_m"], s["position_m"], window.sample_rate_hz)[start:])
+    assert servo.position_gain_per_s is not None and servo.speed_gain_per_mps is not None  # completed
+    return LoopGains(servo.position_gain_per_s, servo.speed_gain_per_mps, float(off / max(rms(logged), 1e-300)))
+
+
+def log_loop(servo: Servo, window: Window) -> LoopGains:
+    """The gains the logged command follows through the document's speed filter: the command is linear in
+    kv·kp and kv, so least squares over the samples the limit does not clip (past the filter's start) reads them."""
+    s, start = window.signals, len(servo.speed_filter)
+    speed = _filtered_speed(servo.speed_filter, s["position_m"], window.sample_rate_hz)[start:]
+    logged = _logged_command(servo, window)[start:]
+    limit = servo.command_limit if servo.command_limit is not None else np.inf
+    free = np.abs(logged) < limit
+    columns = np.column_stack([(s["set_point_m"] - s["position_m"])[start:], -speed])[free]
+    (stiffness, kv), *_ = np.linalg.lstsq(columns, logged[free], rcond=None)
+    off = rms(logged[free] - columns @ np.array([stiffness, kv]))
+    return LoopGains(float(stiffness / kv), float(kv), float(off / max(rms(logged[free]), 1e-300)))
+
+
+def followed_loop(servo: Servo, window: Window) -> tuple[LoopGains, Note | None]:
+    """The gains the log follows, the document's where it follows them within ``CONTROLLER_TOLERANCE``, else
+    those its command follows (``log_loop``) where they do; and the note ``controller_mismatch`` where the
+    document's do not, which names the log's gains where they reproduce it."""
+    document = document_loop(servo, window)
+    if document.off_share <= CONTROLLER_TOLERANCE:
+        return document, None
+    own = log_loop(servo, window)
+    if own.off_share > CONTROLLER_TOLERANCE:
+        text = (
+            f"the logged command differs from what the document's controller gives by {100 * document.off_share:.1f}"
+            " % RMS, and no gains of it reproduce it (its filter or limit is not the log's): the window's own "
+            "simulations are not its"
+        )
+        return document, Note(code="controller_mismatch", parameter="drive_force_n", text=text)
+    text = (
+        f"the logged command differs from what the document's controller gives by {100 * document.off_share:.1f} % "
+        f"RMS, and follows kp {own.position_gain_per_s:.5g} 1/s, kv {own.speed_gain_per_mps:.5g} within "
+        f"{100 * own.off_share:.1f} % where the document and the log give kp {document.position_gain_per_s:.5g}, kv "
+        f"{document.speed_gain_per_mps:.5g} (a gain, the drive gain or the filter is not the log's): the window is "
+        "simulated with the gains it followed"
     )
+    return own, Note(code="controller_mismatch", parameter="drive_force_n", text=text)
 
 
-def bandwidth(servo: Servo, mass_kg: float) -> float:
-    """The position loop's bandwidth [Hz]: the document's, else its natural frequency √(kp·kv·g/M)/2π."""
+def bandwidth(servo: Servo, mass_kg: float, gains: LoopGains) -> float:
+    """The position loop's bandwidth [Hz]: the document's, else the natural frequency √(kp·kv·g/M)/2π of the loop
+    with ``gains`` (those the log follows: ``followed_loop``)."""
     if servo.bandwidth_hz is not None:
         return servo.bandwidth_hz
-    assert servo.position_gain_per_s and servo.speed_gain_per_mps and servo.drive_gain_n_per_unit  # completed
-    stiffness = servo.position_gain_per_s * servo.speed_gain_per_mps * servo.drive_gain_n_per_unit
+    assert servo.drive_gain_n_per_unit  # completed
+    stiffness = gains.position_gain_per_s * gains.speed_gain_per_mps * servo.drive_gain_n_per_unit
     return float(np.sqrt(stiffness / mass_kg) / (2 * np.pi))
 
 
@@ -154,19 +211,20 @@ def prepare_servo(window: Window, actuator: ActuatorDocument) -> ServoPrepared:
         first = _window_motion(s["position_m"], rate, PROVISIONAL_BANDWIDTH_SHARE * rate, step)
         forces = (s["drive_force_n"] - load)[first.samples]
         mass = fit_inverse(forces, inverse_columns(first), first).values["mass_kg"]
-    loop_hz = bandwidth(servo, max(float(mass or 1.0), 1e-6))
+    gains, mismatch = followed_loop(servo, window)
+    loop_hz = bandwidth(servo, max(float(mass or 1.0), 1e-6), gains)
     motion = _window_motion(s["position_m"], rate, loop_hz, step)
     assert servo.position_gain_per_s and servo.speed_gain_per_mps and servo.drive_gain_n_per_unit  # completed
     loop = ServoLoop(
-        position_gain_per_s=servo.position_gain_per_s,
-        speed_gain_per_mps=servo.speed_gain_per_mps,
+        position_gain_per_s=gains.position_gain_per_s,
+        speed_gain_per_mps=gains.speed_gain_per_mps,
         drive_gain_n_per_unit=servo.drive_gain_n_per_unit,
         command_limit=servo.command_limit if servo.command_limit is not None else np.inf,
         period_s=1.0 / rate,
         resolution_m=step,
         taps=tuple(servo.speed_filter),
     )
-    notes = [n for n in (_controller_note(servo, window),) if n is not None]
+    notes = [mismatch] if mismatch is not None else []
     loaded = bool(np.any(load != 0.0))
     if not loaded:
         notes.append(
