@@ -180,6 +180,7 @@ def recorded_gain_line(window: Window, document: ActuatorDocument, answer: dict)
         fdj = estimate(wrong, actuator=document).estimates.FDJ
         read.append(f"kp x{factor:g}: FDJ {fdj.value:.3f} ± {fdj.std:.3f} N")
     gains = log_loop(completed(document, window), window)
+    assert gains is not None, "the EMPS log's command follows a position loop"
     return (
         f"A log whose recorded gain is not its loop's: the same log with its kp ({kp:g} 1/s) recorded "
         f"{' or '.join(f'{f:g}' for f in WRONG_KP)} times over is simulated with the gains its command follows, "

@@ -104,9 +104,25 @@ def test_the_gains_a_log_follows_are_read_from_its_command(emps):
     ):
         wrong = replace(window, constants={**window.constants, "position_gain_per_s": 7.0})
         gains = log_loop(completed(actuator, wrong), wrong)
+        assert gains is not None
         assert gains.position_gain_per_s == pytest.approx(window.constants["position_gain_per_s"], rel=1e-3)
         assert gains.speed_gain_per_mps == pytest.approx(window.constants["speed_gain_per_mps"], rel=1e-3)
         assert gains.off_share < 0.01
+
+
+def test_a_command_no_stable_loop_gives_keeps_the_documents_loop(emps):
+    """A logged command that pushes the way the error does not (its sign reversed) reads no loop of positive
+    gains, and one the limit clips everywhere reads none at all: the document's loop and the plain note."""
+    actuator = read_actuator(EMPS / "actuator.json")
+    reversed_sign = replace(emps, signals={**emps.signals, "drive_force_n": -emps.signals["drive_force_n"]})
+    clipped = actuator.model_dump(by_alias=True)
+    clipped["servo"]["command_limit"] = 1e-9
+    for window, document in ((reversed_sign, actuator), (emps, actuator_from_dict(clipped))):
+        assert log_loop(completed(document, window), window) is None
+        prepared = prepare_servo(window, document)
+        assert prepared.loop.position_gain_per_s == emps.constants["position_gain_per_s"]
+        (note,) = [n for n in prepared.notes if n.code == "controller_mismatch"]
+        assert "no gains of it reproduce it" in note.text
 
 
 @pytest.mark.parametrize("factor", [0.5, 30.0])

@@ -36,6 +36,7 @@ from ema.model.window import Window
 RATE_TOLERANCE = 0.01
 CONTROLLER_TOLERANCE = 0.02
 MIN_QUANTIZED = 0.9
+MIN_LOOP_SAMPLES = 10  # unclipped samples a log's own loop gains are read from, at least
 PROVISIONAL_BANDWIDTH_SHARE = 0.02  # a first fit's loop bandwidth, as a share of the rate (20 Hz at 1 kHz)
 POSITIVE = ("mass_kg", "fdj_n", "viscous_ns_per_m", "viscous_up_ns_per_m", "viscous_down_ns_per_m")
 
@@ -119,16 +120,21 @@ def document_loop(servo: Servo, window: Window) -> LoopGains:
     return LoopGains(servo.position_gain_per_s, servo.speed_gain_per_mps, float(off / max(rms(logged), 1e-300)))
 
 
-def log_loop(servo: Servo, window: Window) -> LoopGains:
+def log_loop(servo: Servo, window: Window) -> LoopGains | None:
     """The gains the logged command follows through the document's speed filter: the command is linear in
-    kv·kp and kv, so least squares over the samples the limit does not clip (past the filter's start) reads them."""
+    kv·kp and kv, so least squares over the samples the limit does not clip (past the filter's start) reads them.
+    None where it reads no stable loop (gains not both positive, or too few samples to read two from)."""
     s, start = window.signals, len(servo.speed_filter)
     speed = _filtered_speed(servo.speed_filter, s["position_m"], window.sample_rate_hz)[start:]
     logged = _logged_command(servo, window)[start:]
     limit = servo.command_limit if servo.command_limit is not None else np.inf
     free = np.abs(logged) < limit
+    if free.sum() < MIN_LOOP_SAMPLES:
+        return None
     columns = np.column_stack([(s["set_point_m"] - s["position_m"])[start:], -speed])[free]
     (stiffness, kv), *_ = np.linalg.lstsq(columns, logged[free], rcond=None)
+    if not (stiffness > 0 and kv > 0):
+        return None
     off = rms(logged[free] - columns @ np.array([stiffness, kv]))
     return LoopGains(float(stiffness / kv), float(kv), float(off / max(rms(logged[free]), 1e-300)))
 
@@ -141,10 +147,10 @@ def followed_loop(servo: Servo, window: Window) -> tuple[LoopGains, Note | None]
     if document.off_share <= CONTROLLER_TOLERANCE:
         return document, None
     own = log_loop(servo, window)
-    if own.off_share > CONTROLLER_TOLERANCE:
+    if own is None or own.off_share > CONTROLLER_TOLERANCE:
         text = (
             f"the logged command differs from what the document's controller gives by {100 * document.off_share:.1f}"
-            " % RMS, and no gains of it reproduce it (its filter or limit is not the log's): the window's own "
+            " % RMS, and no gains of it reproduce it (its filter, limit or sign is not the log's): the window's own "
             "simulations are not its"
         )
         return document, Note(code="controller_mismatch", parameter="drive_force_n", text=text)
