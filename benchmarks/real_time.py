@@ -161,9 +161,15 @@ def report(passes: dict[str, list[Pass]], yardsticks: dict[str, float], count: i
             f"{p95 / yardsticks['one thread']:.3f} | {p95 / yardsticks['every thread']:.3f} | "
             f"{cpu[name] / len(wall):.3f} | {cpu[name] / sum(wall):.2f} |"
         )
+    loaded = float(np.quantile(next(w for name, w in walls.items() if name != "idle"), 0.95)) / idle_p95
+    fair = yardsticks["every thread, loaded"] / yardsticks["every thread"]
     lines += [
         "",
-        f"Target: idle p95 ≤ {TARGET_SHARE} of the yardstick; loaded p95 ≤ {LOADED_LIMIT:g}x the idle p95.",
+        f"Target: idle p95 ≤ {TARGET_SHARE} of the yardstick; loaded p95 ≤ {LOADED_LIMIT:g}x the idle p95 "
+        f"({loaded:.2f}x, {'met' if loaded <= LOADED_LIMIT else 'not met'}; the yardstick's own {fair:.2f}x).",
+        "Beside busy processes that hold every core, a thread that wakes for a request shares a core with one of",
+        "them: each stage, serial or spread over the pool, runs on about half of what it had idle, so the fair",
+        "share is 2x, which a service keeping to one thread per core can only meet, not beat.",
         "*Cores the service had*: its CPU seconds over the passes (every thread, `/proc`) per second of",
         "POST wall time. Where a request costs the same CPU idle and loaded, its wall time grows by the",
         "ratio of the cores the service had: beside busy processes it works on its share of them.",
