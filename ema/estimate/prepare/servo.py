@@ -11,9 +11,9 @@
   The command is linear in the loop's two gains, so a least-squares fit reads the gains the log's command
   does follow (``log_loop``); where they reproduce it, the note says them beside the document's.
 - The loop the window is simulated with, and whose gains set the loop's bandwidth, is the one the log ran: the
-  document's gains, or, where the log does not follow them but follows others, those (a log that recorded kp
-  30 times its own was simulated at that kp, and the physics fit's bias read on those simulations put FDJ at
-  half its value). The note says both.
+  document's gains, or, where the log does not follow them but follows others, those. Simulations at gains the
+  loop did not run would move otherwise, and the physics fit's bias read on them, subtracted from the window's
+  fit (``ema.estimate.assess``), would not be the window's. The note says both pairs.
 - The loop's bandwidth (the document's, else the natural frequency √(kp·kv·g/M) of the position loop, M from a
   first fit) sets the inverse model's filters (``ema.estimate.physics.inverse``).
 """
@@ -220,7 +220,7 @@ def prepare_servo(window: Window, actuator: ActuatorDocument) -> ServoPrepared:
     gains, mismatch = followed_loop(servo, window)
     loop_hz = bandwidth(servo, max(float(mass or 1.0), 1e-6), gains)
     motion = _window_motion(s["position_m"], rate, loop_hz, step)
-    assert servo.position_gain_per_s and servo.speed_gain_per_mps and servo.drive_gain_n_per_unit  # completed
+    assert servo.drive_gain_n_per_unit  # completed
     loop = ServoLoop(
         position_gain_per_s=gains.position_gain_per_s,
         speed_gain_per_mps=gains.speed_gain_per_mps,
