@@ -136,7 +136,7 @@ def test_a_log_recording_a_gain_its_loop_did_not_run_is_simulated_with_the_one_i
     prepared = prepare_servo(wrong, actuator)
     assert prepared.loop.position_gain_per_s == pytest.approx(kp, rel=1e-3)
     (note,) = [n for n in prepared.notes if n.code == "controller_mismatch"]
-    assert f"follows kp {kp:.5g}" in note.text and f"give kp {factor * kp:.5g}" in note.text
+    assert f"follows kp {kp:.5g}" in note.text and f"has kp {factor * kp:.5g}" in note.text
     if factor > 1:
         read, own = (estimate(w, actuator=actuator).estimates.FDJ for w in (wrong, emps))
         assert abs(read.value - own.value) < 0.1 * own.std

@@ -157,9 +157,9 @@ def followed_loop(servo: Servo, window: Window) -> tuple[LoopGains, Note | None]
     text = (
         f"the logged command differs from what the document's controller gives by {100 * document.off_share:.1f} % "
         f"RMS, and follows kp {own.position_gain_per_s:.5g} 1/s, kv {own.speed_gain_per_mps:.5g} within "
-        f"{100 * own.off_share:.1f} % where the document and the log give kp {document.position_gain_per_s:.5g}, kv "
-        f"{document.speed_gain_per_mps:.5g} (a gain, the drive gain or the filter is not the log's): the window is "
-        "simulated with the gains it followed"
+        f"{100 * own.off_share:.1f} % where the document with the log's constants has kp "
+        f"{document.position_gain_per_s:.5g}, kv {document.speed_gain_per_mps:.5g} (a gain, the drive gain or the "
+        "filter is not the log's): the window is simulated with the gains it followed"
     )
     return own, Note(code="controller_mismatch", parameter="drive_force_n", text=text)
 
