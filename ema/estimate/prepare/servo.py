@@ -146,17 +146,17 @@ def followed_loop(servo: Servo, window: Window) -> tuple[LoopGains, Note | None]
     document = document_loop(servo, window)
     if document.off_share <= CONTROLLER_TOLERANCE:
         return document, None
+    off_pct = 100 * document.off_share
+    differs = f"the logged command differs from what the document's controller gives by {off_pct:.1f} % RMS"
     own = log_loop(servo, window)
     if own is None or own.off_share > CONTROLLER_TOLERANCE:
         text = (
-            f"the logged command differs from what the document's controller gives by {100 * document.off_share:.1f}"
-            " % RMS, and no gains of it reproduce it (its filter, limit or sign is not the log's): the window's own "
-            "simulations are not its"
+            f"{differs}, and no gains of it reproduce it (its filter, limit or sign is not the log's): the "
+            "window's own simulations are not its"
         )
         return document, Note(code="controller_mismatch", parameter="drive_force_n", text=text)
     text = (
-        f"the logged command differs from what the document's controller gives by {100 * document.off_share:.1f} % "
-        f"RMS, and follows kp {own.position_gain_per_s:.5g} 1/s, kv {own.speed_gain_per_mps:.5g} within "
+        f"{differs}, and follows kp {own.position_gain_per_s:.5g} 1/s, kv {own.speed_gain_per_mps:.5g} within "
         f"{100 * own.off_share:.1f} % where the document with the log's constants has kp "
         f"{document.position_gain_per_s:.5g}, kv {document.speed_gain_per_mps:.5g} (a gain, the drive gain or the "
         "filter is not the log's): the window is simulated with the gains it followed"
