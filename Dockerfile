@@ -15,12 +15,10 @@ ENV PYTHONDONTWRITEBYTECODE=1 \
 RUN useradd --create-home --uid 10001 ema && mkdir -p /data /opt/ema/numba-cache && chown ema /data /opt/ema/numba-cache
 
 # Dependencies first, from pyproject.toml alone, so code edits do not reinstall them.
-# The CPU wheel of torch: the default index would pull a multi-GB CUDA build.
 COPY pyproject.toml /tmp/ema/
-RUN pip install --index-url https://download.pytorch.org/whl/cpu "torch==2.13.0" \
-    && python -c "import tomllib; p = tomllib.load(open('/tmp/ema/pyproject.toml', 'rb'))['project']; \
+RUN python -c "import tomllib; p = tomllib.load(open('/tmp/ema/pyproject.toml', 'rb'))['project']; \
 x = p['optional-dependencies']; d = p['dependencies'] + x['history'] + x['service'][1:] + x['postgres'][1:]; \
-print('\n'.join(r for r in d if not r.startswith('torch')))" > /tmp/requirements.txt \
+print('\n'.join(d))" > /tmp/requirements.txt \
     && pip install -r /tmp/requirements.txt
 
 # The code, installed into site-packages; the sources are not kept beside it.

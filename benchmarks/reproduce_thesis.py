@@ -72,13 +72,13 @@ def cases(quick: bool) -> list[Case]:
             train=LearnConfig(components=None),
         ),
         Case(
-            "1B noisy, Adam",
+            "1B noisy, conjugate gradient",
             1000,
             500,
             100,
-            "(optimizer comparison)",
+            "(optimizer comparison: the thesis's trainscg is one)",
             noise=SensorNoise(),
-            train=LearnConfig(optimizer="adam", learning_rate=3e-3),
+            train=LearnConfig(optimizer="cg"),
         ),
         Case(
             "1A constant load",
@@ -210,7 +210,7 @@ def write_results(results: list[dict], comparison: list[str], command: str) -> N
         "  working line search, and the 16-component input projection (compare the *raw inputs* row).",
         "- **Sensor noise** is what limits accuracy in practice (thesis §6.4 expected 5-10 % on real data):",
         "  with realistic noise the test MSE is ~7e-5, i.e. an RMS error of ~0.8 % of each range",
-        "  (~1.7e-4 N·m on FDJ, ~0.0025 on η_O). Adam, tried as the optimizer, stays 15x worse.",
+        "  (~1.7e-4 N·m on FDJ, ~0.0025 on η_O). See the conjugate-gradient row for the thesis's kind of optimizer.",
         "- **Case 1A, constant load**: with n = 500, Eq. 3.4 makes 1 − η_A ≈ 1/η_O − 1, so a constant |T_ext|",
         "  adds the same k·|T_ext| whether it aids or opposes: sliding friction shows FDJ + k·|T_ext| and",
         "  not the two apart. The thesis's network kept FDJ and lost η_O; ours keeps η_O (from the",
@@ -250,7 +250,7 @@ def main() -> None:
     parser.add_argument("--docs", action="store_true", help="rewrite the section of docs/results.md")
     args = parser.parse_args()
     runtime.configure()
-    rng = np.random.default_rng(0)  # warm torch and the kernels: no start-up cost in the first row's times
+    rng = np.random.default_rng(0)  # warm the imports and the kernels: no start-up cost in the first row's times
     train(rng.normal(size=(60, 50)), rng.uniform(size=(60, 2)), LearnConfig(hidden=8, max_epochs=5))
     Scenario(THESIS.params, random_command_knots(50, RATE_HZ, rng)[0]).simulate(HealthParams.single())
     results = []

@@ -1,6 +1,6 @@
 """``ema bench``: the end-to-end latency of one window -> estimates, idle and beside other work.
 
-Warm first (kernels compiled or loaded, torch started), then for each window duration run the
+Warm first (kernels compiled or loaded, the pipeline's modules imported), then for each window duration run the
 whole pipeline on fresh synthetic windows with a known truth and realistic noise (the §5.6
 command, health drawn in Table 3.1's ranges), and record every stage's time, the real-time factor
 (pipeline seconds per second of window) and the error reached. With ``--under-load N`` the same
@@ -203,7 +203,7 @@ def run_bench(
     config: PipelineConfig, durations: list[float], *, repeats: int, under_load: int, out: Path | None, docs: bool
 ) -> dict[str, Any]:
     runtime.configure()
-    print("warming up (JIT compile or cache load, torch start)…", file=sys.stderr)
+    print("warming up (JIT compile or cache load, imports)…", file=sys.stderr)
     estimate_window(synthetic_window(HealthParams.single(), seed=0, duration_s=0.1), config, actuator=THESIS)
     gc.freeze()  # as the warm service does: what was loaded is never walked by a full collection again
     rows = [{**time_windows(config, d, repeats, seed=100), "load": "idle"} for d in durations]

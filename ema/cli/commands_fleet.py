@@ -63,7 +63,7 @@ def fleet(
 ) -> None:
     """Reprocess an archive (folder, NPZ, CSV, MATLAB or JSON logs) on worker processes; one CSV row per window.
 
-    Workers are local processes (forked from one that loads torch as the archive is read), this one for one
+    Workers are local processes (forked from one that loads the pipeline as the archive is read), this one for one
     worker, one window or where none trains a network (a ball screw's, a slow log's: milliseconds each), or a Ray
     cluster's with --ray-address (``pip install 'ema[fleet]'``). A window is read with its actuator's document:
     the folder's actuators.json maps actuator_ids to ema-actuator/1 documents; the others take --actuator (the

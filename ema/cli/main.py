@@ -109,10 +109,10 @@ def _run(arguments: list[str]) -> int:
 
 
 def console() -> int:
-    """``main`` as the ``ema`` program runs it: the cyclic collector set for a program that loads torch
-    (``ema.model.collector``), and what the command built is freed by the process's end, so the
-    collector is told not to walk it at exit (torch's objects: a third of a second)."""
-    collect_less_often()  # before the command loads torch and the kernels
+    """``main`` as the ``ema`` program runs it: the cyclic collector set for a program that loads
+    NumPy, SciPy and Numba (``ema.model.collector``), and what the command built is freed by the process's end, so the
+    collector is told not to walk it at exit (the loaded modules' objects)."""
+    collect_less_often()  # before the command loads the pipeline and the kernels
     status = main()
     gc.freeze()
     return status

@@ -1,13 +1,13 @@
 """The local worker processes of ``ema fleet --workers N``: a pool of processes forked from a fork server that has
-loaded torch and the kernels' modules once (``ema.cli.fork_server``, its program: the collector set first, as every
-ema process sets it), each warmed as it starts (its thread budget pinned, its kernels loaded:
+loaded the pipeline's and the kernels' modules once (``ema.cli.fork_server``, its program: the collector set first,
+as every ema process sets it), each warmed as it starts (its thread budget pinned, its kernels loaded:
 ``ema.kinds.remote.warm``).
 
 This module imports nothing of ema's at its top: the command starts the fork server before it imports what reads
-the archive, so that the server loads torch while the driver is still loading its own modules and reading, on the
+the archive, so that the server loads them while the driver is still loading its own modules and reading, on the
 other core. The workers fork from that clean, single-purpose process (no thread of the driver's, nothing of a
 window's run yet: the only threads there are the BLAS pool's, which stops itself at a fork), so no worker loads
-torch again; the driver, which only reads and writes, never loads it.
+them again; the driver, which only reads and writes, never loads it.
 """
 
 from __future__ import annotations
@@ -27,7 +27,7 @@ if TYPE_CHECKING:
     from ema.cli.workers import Answer, Documents, Job
     from ema.estimate.config import PipelineConfig
 
-PRELOADED = ("ema.cli.fork_server",)  # the server loads torch and the kernels' modules, its collector set first
+PRELOADED = ("ema.cli.fork_server",)  # the server loads the pipeline and the kernels' modules, its collector set first
 IN_FLIGHT_PER_WORKER = 2  # tasks queued per worker: enough to keep it busy, few enough to stop quickly
 NODE_LOSSES = 3  # a window whose task died with its process or node this often fails the run
 
@@ -77,7 +77,7 @@ class LocalWorkers:
 
 def _stop_fork_server() -> None:
     """The fork server killed and forgotten (the next pool starts another): it holds nothing once its workers are
-    gone, and its own exit would tear torch down for half a second, which a caller reading the command's output
+    gone, and its own exit would tear its modules down, which a caller reading the command's output
     through a pipe waits for (as a user waits for no loading that serves nothing)."""
     server: Any = multiprocessing.forkserver._forkserver  # private: the standard library offers no stop
     if server._forkserver_pid is not None:
@@ -88,7 +88,7 @@ def _stop_fork_server() -> None:
 
 def _warmed(threads: int) -> None:
     """A local worker's initializer, ``ema.kinds.remote.warm``, imported in the worker: the driver that only reads
-    and writes never loads torch or the kernels (a second of a core the workers need at start-up)."""
+    and writes never loads the pipeline or the kernels (a second of a core the workers need at start-up)."""
     from ema.kinds.remote import warm
 
     warm(threads)

@@ -2,7 +2,7 @@
 
 - ``in_process``: one window after another in this process (one worker);
 - ``ema.cli.pool.LocalWorkers``: a pool of local processes (the standard library's executor), its fork server
-  started first thing and loading torch while the driver reads the archive;
+  started first thing and loading the pipeline while the driver reads the archive;
 - ``on_ray``: a Ray cluster's workers (``--ray-address``).
 
 Each window is a task that pins its own thread budget (one thread by default: a worker is a core, so throughput
@@ -53,7 +53,7 @@ class Documents:
 
 
 def in_process(jobs: list[Job], config: PipelineConfig, threads: int, documents: Documents) -> Iterator[Answer]:
-    """Each job's answer from this process, one after another (torch and the kernels loaded only for a job)."""
+    """Each job's answer from this process, one after another (the pipeline and the kernels loaded only for a job)."""
     if not jobs:
         return
     from ema.kinds.remote import estimate_json

@@ -38,7 +38,7 @@ from ema.model.actuator import ActuatorDocument
 from ema.model.hinge import denoised_hinge_nm
 from ema.model.params import HealthRanges
 
-if TYPE_CHECKING:  # torch's: a window read without a network (quasi-static) never loads it
+if TYPE_CHECKING:  # SciPy's optimizers: a window read without a network (quasi-static) never loads it
     from ema.estimate.learn.estimator import NetworkEstimator
     from ema.estimate.learn.network import Trained
 

@@ -105,7 +105,7 @@ def calibrate(windows: Sequence[Window], request: CalibrationRequest) -> Calibra
 
 def learns(window: Window) -> bool:
     """Whether reading ``window`` trains a network, by its signals' kind (its ``stages``): a process that reads
-    only windows that do not never loads torch."""
+    only windows that do not never loads the network's modules (SciPy's optimizers)."""
     return "learn" in KINDS[window.kind].stages(window)
 
 

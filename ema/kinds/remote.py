@@ -48,8 +48,8 @@ def estimate_json(
 
 def warm(threads: int) -> None:
     """A worker process made ready before its first window: its thread budget pinned, its kernels loaded, and what
-    it loaded (torch's modules, the kernels: it lives as long as the process) never walked by the cyclic collector
-    again, at a window's collections or at the process's end."""
+    it loaded (the pipeline's modules, the kernels: it lives as long as the process) never walked by the cyclic
+    collector again, at a window's collections or at the process's end."""
     runtime.configure(threads)
     warm_up(("rotary",))  # what an archive mostly holds; a window of another kind loads its own at its first
     gc.freeze()

@@ -3,8 +3,8 @@
 A window at 1 kHz or more goes through the whole pipeline (``ema.estimate.pipeline``), one logged slower is
 read quasi-statically (``ema.estimate.quasistatic``); its calibration is the loop of ``ema.calibration.calibrate``,
 which reads windows at 1 kHz or more. The pipeline and the loop train networks: each is imported by the method
-that runs it, so that a process that reads only slow logs, or another kind's, never loads torch (most of a
-one-shot command's second).
+that runs it, so that a process that reads only slow logs, or another kind's, never loads SciPy's optimizers
+(half a second of a one-shot command).
 """
 
 from __future__ import annotations
@@ -53,7 +53,7 @@ class Rotary:
     def estimate(self, window: Window, request: Request) -> Estimate:
         if not window.high_rate:
             return read_quasi_statically(window, request, MOTOR_READING)
-        from ema.estimate.pipeline import estimate_window  # torch's (module docstring)
+        from ema.estimate.pipeline import estimate_window  # the network's (module docstring)
 
         return estimate_window(
             window,
@@ -73,7 +73,7 @@ class Rotary:
                     f"{window.sample_rate_hz:g} Hz: a rotary actuator's calibration simulates its windows and reads "
                     f"them at {HIGH_RATE_HZ:g} Hz or more",
                 )
-        from ema.calibration.calibrate import Calibrator  # torch's (module docstring)
+        from ema.calibration.calibrate import Calibrator  # the network's (module docstring)
 
         config = request.config
         calibrator = Calibrator(config, copies=request.copies, seed=config.seed, actuator=request.actuator)

@@ -35,7 +35,7 @@ class Servo:
         return STAGES
 
     def estimate(self, window: Window, request: Request) -> Estimate:
-        from ema.estimate.servo import estimate_servo  # torch's: loaded by the kind's first window (ema.kinds.rotary)
+        from ema.estimate.servo import estimate_servo  # the network's: loaded by its first window (ema.kinds.rotary)
 
         return estimate_servo(
             window, request.config, actuator=request.actuator, read_with=request.read_with, on_stage=request.on_stage

@@ -2,13 +2,11 @@
 
 - **Threads.** Groups of simulations run on a pool of ``threads()`` threads (the kernel releases the
   GIL), and so do the row loops that read the simulated windows (``run_rows``). Numba's own
-  threading layer is not used: with torch's OpenMP runtime in the same process its idle workers spun
-  while the other computed (a 0.7 s training took 21 s), and a static split of the batch waits for
-  its slowest thread, which on a shared computer is the one the OS has parked. A pool of our own
-  takes groups from one queue: a parked thread delays only its group. The budget is shared with
-  torch (``ema.estimate.runtime``), which trains on one thread, and with NumPy's BLAS, which gets one
-  too: its small solves gain nothing from a team, and OpenBLAS's idle worker spins after each call,
-  on a core a simulation group needs.
+  threading layer is not used: a static split of the batch waits for its slowest thread, which on a
+  shared computer is the one the OS has parked. A pool of our own takes groups from one queue: a parked
+  thread delays only its group. The budget is shared with NumPy's BLAS (which also trains the network,
+  ``ema.estimate.runtime``), which gets one thread: its small products and solves gain nothing from a
+  team, and OpenBLAS's idle worker spins after each call, on a core a simulation group needs.
 - **Vector width.** LLVM tunes AVX-512 CPUs to prefer 256-bit vectors; the lane loop is
   instruction-bound and measured ~1.5x faster with 512-bit ones (docs/benchmarks.md). Numba reads
   this when it first compiles or loads a kernel, so :func:`configure_simulator` must run before that; a

@@ -1,6 +1,6 @@
 """Admission and the job queue: one pipeline at a time, at most ``max_queue`` waiting, whatever the timing.
 
-One pipeline already uses the whole thread budget (the simulator's pool; torch on one thread),
+One pipeline already uses the whole thread budget (the simulator's pool; the network's BLAS on one thread),
 so running two side by side would only slow both (with the Ray backend, ``slots`` run at once on
 the cluster). A request is *admitted* once its body is read and parsed: a slow upload holds its
 connection, not a place in the queue. At most ``slots`` + ``max_queue`` hold a place; a request that

@@ -186,7 +186,7 @@ def test_help_is_quick_and_version_is_printed():
             "    main(['--help'])",
             "except SystemExit:",
             "    pass",
-            "print('loaded:', sorted(m for m in ('torch', 'numba', 'numpy', 'pydantic') if m in sys.modules))",
+            "print('loaded:', sorted(m for m in ('scipy.optimize', 'numba', 'numpy', 'pydantic') if m in sys.modules))",
         ]
     )
     done = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True)

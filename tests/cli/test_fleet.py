@@ -92,13 +92,15 @@ def test_a_pool_that_never_had_a_job_forks_no_worker_and_stops_at_once():
     assert not pool.pool._processes  # none forked: nothing to stop, nothing to wait for
     assert multiprocessing.forkserver._forkserver._forkserver_pid is None  # type: ignore[attr-defined]
     nothing = "from ema.cli.workers import in_process; import sys; list(in_process([], None, 1, None)); "
-    loaded = subprocess.run([sys.executable, "-c", nothing + "print('torch' in sys.modules)"], capture_output=True)
+    script = nothing + "print('scipy.optimize' in sys.modules)"
+    loaded = subprocess.run([sys.executable, "-c", script], capture_output=True)
     assert loaded.stdout.decode().strip() == "False"
 
 
-def test_the_fork_server_loads_torch_with_its_collector_set_and_nothing_else_loads_its_module():
-    """``ema.cli.fork_server`` is the fork server's program: importing it sets the collector, then loads torch and
-    the kernels' modules (its workers hold them from their start); no module of ema imports it."""
+def test_the_fork_server_loads_the_pipeline_with_its_collector_set_and_nothing_else_loads_its_module():
+    """``ema.cli.fork_server`` is the fork server's program: importing it sets the collector, then loads the
+    pipeline's (the network's among them) and the kernels' modules (its workers hold them from their start); no
+    module of ema imports it."""
     import pathlib
     import subprocess
     import sys
@@ -107,7 +109,7 @@ def test_the_fork_server_loads_torch_with_its_collector_set_and_nothing_else_loa
     from ema.model.collector import YOUNG_COLLECTION
 
     assert pool.PRELOADED == ("ema.cli.fork_server",)
-    script = "import gc, sys; import ema.cli.fork_server; print(gc.get_threshold()[0], 'torch' in sys.modules)"
+    script = "import gc, sys; import ema.cli.fork_server; print(gc.get_threshold()[0], 'scipy.optimize' in sys.modules)"
     done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, check=True)
     assert done.stdout.split() == [str(YOUNG_COLLECTION), "True"]
     package = pathlib.Path(pool.__file__).parents[1]

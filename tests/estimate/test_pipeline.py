@@ -391,7 +391,7 @@ def test_the_check_reuses_the_simulation_at_the_physics_answer_with_the_same_res
         return simulate(self, health, lanes, reuse_output)
 
     monkeypatch.setattr(Scenario, "simulate", counted)
-    drawn = draw(6, "cruise")
+    drawn = draw(8, "cruise")
     reused = _estimate(drawn)
     assert own_runs == [], "the physics estimate no longer carries this window's answer: pick one where it does"
     monkeypatch.setattr(HealthParams, "identical", lambda self, other: False)

@@ -1,6 +1,6 @@
 """Each kind is declared in one place: its facts in ema.model.kinds, its method in its module of ema.kinds; nothing
 else compares a kind with a literal or tells one by a signal's name; and a kind whose windows train no network
-never has torch loaded for them."""
+never has the network's modules (SciPy's optimizers) loaded for them."""
 
 import ast
 import csv
@@ -54,7 +54,7 @@ QUICK = (
     "given = ['--log-map', rig + '/log-map.json', '--json']; "
     "codes = [main(['calibrate', *runs, '--actuator', rig + '/actuator.json', '--out-actuator', learned, *given]), "
     "main(['estimate', rig + '/runs/lackLubrication1_load20_run001.csv', '--actuator', learned, *given])]; "
-    "print(*codes, 'torch' in sys.modules, file=sys.stderr)"
+    "print(*codes, 'scipy.optimize' in sys.modules, file=sys.stderr)"
 )
 
 
@@ -70,9 +70,9 @@ def test_every_signal_says_its_unit_in_its_name():
     assert units_of("hinge_moment_nm") is not units_of("load_n")
 
 
-def test_a_window_no_network_learns_from_never_loads_torch(tmp_path):
-    """A ball screw's windows are read quasi-statically: its calibration and its estimate answer without torch's
-    second of loading."""
+def test_a_window_no_network_learns_from_never_loads_the_network(tmp_path):
+    """A ball screw's windows are read quasi-statically: its calibration and its estimate answer without loading
+    the network's modules (SciPy's optimizers, half a second)."""
     import subprocess
     import sys
 
@@ -82,7 +82,7 @@ def test_a_window_no_network_learns_from_never_loads_torch(tmp_path):
 
 
 def test_an_archive_no_network_learns_from_is_read_in_process_whatever_the_workers(tmp_path, capsys):
-    """A ball screw's runs are read in milliseconds: no worker process is kept to load torch for them, and the
+    """A ball screw's runs are read in milliseconds: no worker process is kept to load the network for them, and the
     rows are those one worker writes."""
     rig = PACKAGE.parent / "examples" / "ballscrew-rig"
     given = ["--log-map", str(rig / "log-map.json")]

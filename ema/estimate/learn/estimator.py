@@ -11,7 +11,6 @@ from __future__ import annotations
 from dataclasses import replace
 
 import numpy as np
-import torch
 
 from ema.estimate.learn.network import LearnConfig, Trained, train
 from ema.estimate.simulate.design import Box
@@ -37,9 +36,7 @@ class NetworkRegressor:
 
     def predict_unit(self, inputs: np.ndarray) -> np.ndarray:
         """(N, T) the targets in box units, the members' mean, unclipped."""
-        x = torch.as_tensor(np.atleast_2d(inputs), dtype=torch.float64)
-        with torch.no_grad():
-            return np.mean([f.model.eval()(x).numpy() for f in self.members_], axis=0)
+        return np.mean([member.model(inputs) for member in self.members_], axis=0)
 
 
 class NetworkEstimator:

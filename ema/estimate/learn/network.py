@@ -1,13 +1,16 @@
-"""The shallow network of thesis §5.2 / Table 6.1 and its training with early stopping.
+"""The shallow network of thesis §5.2 / Table 6.1 and its training with early stopping, in NumPy.
 
 One tanh hidden layer, a saturating linear output (MATLAB's satlins) applied when predicting
 only: training on the linear output keeps a gradient where a saturated output would have none
 (a first L-BFGS step that overshoots ±1 froze training that way), MSE, a 75/15/10
 split, at most 1 000 epochs, stop after 12 validation failures and keep the best-validation
-weights. MATLAB's trainscg has no torch twin; full-batch L-BFGS is used because it measured
-both faster and more accurate than Adam on these problems (docs/results.md, optimizer table).
+weights. An epoch is one iteration of SciPy's full-batch L-BFGS (its line search included), so
+that early stopping sees every step; MATLAB's trainscg is a conjugate gradient, and SciPy's
+nonlinear conjugate gradient (``optimizer="cg"``) stands for it in the optimizer comparison
+(docs/results.md). The loss's gradient is the two layers' back-propagation written out: a network
+of ~2 000 weights on a hundred examples needs no framework.
 
-Two choices beyond the thesis, both measured there: the output layer starts at zero with its
+Two choices beyond the thesis, both measured there: the output layer starts near zero with its
 bias at the targets' mean (training starts from the best constant instead of a random offset
 that L-BFGS sometimes could not leave), and the standardized inputs are projected on their
 leading principal components (whitened) before the tanh layer. The residual-torque traces of
@@ -22,13 +25,12 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
-import torch
-from torch import nn
+from scipy.optimize import OptimizeResult, minimize
 
-from ema.estimate import runtime
 from ema.model.checks import InputError
 
-OPTIMIZERS = ("lbfgs", "adam")
+OPTIMIZERS = {"lbfgs": "L-BFGS-B", "cg": "CG"}  # ema's name -> SciPy's method
+LBFGS_MEMORY = 50  # correction pairs L-BFGS keeps (SciPy's default, 10, converged slower on these problems)
 
 
 @dataclass(frozen=True)
@@ -39,8 +41,7 @@ class LearnConfig:
     goal_mse: float = 1e-7  # stop when the training MSE reaches it (thesis: 1e-6; we aim lower)
     components: int | None = 16  # principal components fed to the tanh layer; None: the raw inputs
     split: tuple[float, float, float] = (0.75, 0.15, 0.10)  # train / validation / test
-    optimizer: str = "lbfgs"
-    learning_rate: float = 1.0  # L-BFGS step scale (line search sets the step); Adam: use ~3e-3
+    optimizer: str = "lbfgs"  # a key of OPTIMIZERS
     seed: int = 0
 
     def __post_init__(self) -> None:
@@ -56,64 +57,97 @@ class LearnConfig:
             raise InputError("split", f"must be three positive fractions summing to 1, got {self.split}")
 
 
-class ShallowNet(nn.Module):
-    """inputs (B, F) -> standardized, projected (B, P) -> tanh (B, H) -> linear (B, T).
+@dataclass(frozen=True)
+class InputTransform:
+    """Raw inputs (B, F) -> standardized, projected (B, P); fixed, from the training split."""
 
-    ``predict`` saturates the output to [0, 1]. The projection (F, P) is fixed, from the training
-    split; with ``components=None`` it is the identity and P = F.
-    """
+    mean: np.ndarray  # (F,)
+    std: np.ndarray  # (F,)
+    projection: np.ndarray  # (F, P) principal directions, scaled; the identity with components=None
 
-    mean: torch.Tensor
-    std: torch.Tensor
-    projection: torch.Tensor
-
-    def __init__(
-        self, mean: torch.Tensor, std: torch.Tensor, projection: torch.Tensor, hidden: int, targets: torch.Tensor
-    ):
-        super().__init__()
-        self.register_buffer("mean", mean)  # (F,) input standardization
-        self.register_buffer("std", std)  # (F,)
-        self.register_buffer("projection", projection)  # (F, P) principal directions, scaled
-        self.hidden = nn.Linear(projection.shape[1], hidden)
-        self.output = nn.Linear(hidden, targets.shape[1])
-        with torch.no_grad():  # start near the best constant: small weights, the targets' mean as bias
-            self.output.weight.mul_(0.1)
-            self.output.bias.copy_(targets.mean(dim=0))
-
-    def project(self, x: torch.Tensor) -> torch.Tensor:
-        """(B, F) raw inputs -> (B, P) standardized, projected: fixed, so training does it once."""
+    def __call__(self, x: np.ndarray) -> np.ndarray:
         return ((x - self.mean) / self.std) @ self.projection
 
-    def head(self, z: torch.Tensor) -> torch.Tensor:
-        """(B, P) -> tanh (B, H) -> linear (B, T): the trained part."""
-        return self.output(torch.tanh(self.hidden(z)))
 
-    def forward(self, x: torch.Tensor) -> torch.Tensor:
-        return self.head(self.project(x))
-
-
-def input_transform(x_train: torch.Tensor, components: int | None) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
-    """(mean (F,), std (F,), projection (F, P)) from the training inputs (N, F).
+def input_transform(x_train: np.ndarray, components: int | None) -> InputTransform:
+    """The standardization and projection of the training inputs (N, F).
 
     Components keep their relative spread (scaled by the leading one's std, not whitened).
     """
-    mean = x_train.mean(dim=0)
-    std = x_train.std(dim=0)
-    std = std.clamp_min(1e-6 * float(std.max()) + 1e-300)  # a column constant over the set stays finite
+    mean = x_train.mean(axis=0)
+    std = x_train.std(axis=0, ddof=1) if len(x_train) > 1 else np.zeros(x_train.shape[1])
+    std = np.maximum(std, 1e-6 * float(std.max()) + 1e-300)  # a column constant over the set stays finite
     if components is None:
-        return mean, std, torch.eye(x_train.shape[1], dtype=x_train.dtype)
+        return InputTransform(mean, std, np.eye(x_train.shape[1]))
     z = (x_train - mean) / std  # (N, F)
-    _, singular, vh = torch.linalg.svd(z, full_matrices=False)  # vh: (min(N, F), F)
+    _, singular, vh = np.linalg.svd(z, full_matrices=False)  # vh: (min(N, F), F)
     k = min(components, len(singular))
     scale = singular[0] / np.sqrt(max(len(x_train) - 1, 1))  # std of the leading component's scores
-    return mean, std, vh[:k].T / scale
+    return InputTransform(mean, std, vh[:k].T / scale)
+
+
+@dataclass(frozen=True)
+class Layers:
+    """The trained part, (B, P) -> tanh (B, H) -> linear (B, T), as views into one flat weight vector."""
+
+    weights: np.ndarray  # (P·H + H + H·T + T,) the optimizer's variable
+    inputs: int  # P
+    hidden: int  # H
+    targets: int  # T
+
+    @property
+    def parts(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """(W1 (P, H), b1 (H,), W2 (H, T), b2 (T,)), views of ``weights``."""
+        p, h, t = self.inputs, self.hidden, self.targets
+        ends = np.cumsum([p * h, h, h * t])
+        w1, b1, w2, b2 = np.split(self.weights, ends)
+        return w1.reshape(p, h), b1, w2.reshape(h, t), b2
+
+    def __call__(self, z: np.ndarray) -> np.ndarray:
+        w1, b1, w2, b2 = self.parts
+        return np.tanh(z @ w1 + b1) @ w2 + b2
+
+
+def initial_layers(inputs: int, hidden: int, y_train: np.ndarray, rng: np.random.Generator) -> Layers:
+    """Layers drawn as a linear layer's usual start, U(±1/√fan_in), the output's weights a tenth of that
+    and its bias the targets' mean: training starts near the best constant (module docstring)."""
+    targets = y_train.shape[1]
+    w1 = rng.uniform(-1, 1, (inputs, hidden)) / np.sqrt(inputs)
+    b1 = rng.uniform(-1, 1, hidden) / np.sqrt(inputs)
+    w2 = 0.1 * rng.uniform(-1, 1, (hidden, targets)) / np.sqrt(hidden)
+    weights = np.concatenate([w1.ravel(), b1, w2.ravel(), y_train.mean(axis=0)])
+    return Layers(weights, inputs, hidden, targets)
+
+
+def mse_and_gradient(weights: np.ndarray, layers: Layers, z: np.ndarray, y: np.ndarray) -> tuple[float, np.ndarray]:
+    """The mean squared error over all (N, T) outputs at ``weights`` and its gradient (back-propagation):
+    with r = (out − y)·2/(N·T), ∂W2 = aᵀr, ∂b2 = Σr, and through tanh' = 1 − a², ∂W1 = zᵀ(rW2ᵀ ⊙ (1 − a²))."""
+    w1, b1, w2, b2 = Layers(weights, layers.inputs, layers.hidden, layers.targets).parts
+    a = np.tanh(z @ w1 + b1)  # (N, H)
+    error = a @ w2 + b2 - y  # (N, T)
+    r = error * (2.0 / error.size)
+    back = (r @ w2.T) * (1.0 - a * a)  # (N, H)
+    gradient = np.concatenate([(z.T @ back).ravel(), back.sum(axis=0), (a.T @ r).ravel(), r.sum(axis=0)])
+    return float(np.mean(error * error)), gradient
+
+
+@dataclass(frozen=True)
+class ShallowNet:
+    """inputs (B, F) -> standardized, projected (B, P) -> tanh (B, H) -> linear (B, T)."""
+
+    transform: InputTransform
+    layers: Layers
+
+    def __call__(self, x: np.ndarray) -> np.ndarray:
+        """(B, T) the linear output, unsaturated."""
+        return self.layers(self.transform(np.atleast_2d(np.asarray(x, dtype=np.float64))))
 
 
 @dataclass
 class Trained:
     model: ShallowNet
     epochs: int
-    stop_reason: str  # "validation", "goal" or "max_epochs"
+    stop_reason: str  # "validation", "goal", "max_epochs" or "converged" (the optimizer can go no further)
     train_mse: float
     val_mse: float
     test_mse: float
@@ -132,88 +166,77 @@ def split_indices(n: int, fractions: tuple[float, float, float], rng: np.random.
     return {"train": order[:n_train], "val": order[n_train : n_train + n_val], "test": order[n_train + n_val :]}
 
 
-def _mse(model: ShallowNet, z: torch.Tensor, y: torch.Tensor) -> float:
-    with torch.no_grad():
-        return float(torch.mean((model.head(z) - y) ** 2))
+class EarlyStopping:
+    """The optimizer's per-iteration callback: each epoch's (train, validation) MSE, the best-validation
+    weights kept, and the stop (``StopIteration``) after ``max_validation_failures`` epochs without a better
+    validation, or at the goal."""
+
+    def __init__(self, layers: Layers, z_val: np.ndarray, y_val: np.ndarray, config: LearnConfig) -> None:
+        self.layers, self.z_val, self.y_val, self.config = layers, z_val, y_val, config
+        self.history: list[tuple[float, float]] = []
+        self.best_weights, self.best_val = layers.weights.copy(), float("inf")  # the start, until an epoch ends
+        self.failures, self.stop_reason = 0, ""
+
+    def __call__(self, intermediate_result: OptimizeResult) -> None:
+        layers = Layers(intermediate_result.x, self.layers.inputs, self.layers.hidden, self.layers.targets)
+        train_mse, val_mse = float(intermediate_result.fun), float(np.mean((layers(self.z_val) - self.y_val) ** 2))
+        self.history.append((train_mse, val_mse))
+        if val_mse < self.best_val:
+            self.best_val, self.best_weights, self.failures = val_mse, intermediate_result.x.copy(), 0
+        else:
+            self.failures += 1
+        if self.failures >= self.config.max_validation_failures:
+            self.stop_reason = "validation"
+        elif train_mse <= self.config.goal_mse:
+            self.stop_reason = "goal"
+        if self.stop_reason:
+            raise StopIteration
 
 
-def _optimizer(model: ShallowNet, config: LearnConfig) -> torch.optim.Optimizer:
-    if config.optimizer == "adam":
-        return torch.optim.Adam(model.parameters(), lr=config.learning_rate)
-    return torch.optim.LBFGS(
-        model.parameters(),
-        lr=config.learning_rate,
-        max_iter=1,  # one iteration per epoch, so early stopping sees every step
-        max_eval=25,  # the default, 1.25 x max_iter = 1, leaves the line search no evaluation
-        history_size=50,
-        line_search_fn="strong_wolfe",
-        tolerance_grad=0.0,  # its own stopping rules (on tiny gradients) would end training silently;
-        tolerance_change=0.0,  # the epoch loop's validation check decides instead
-    )
-
-
-def _snapshot(model: nn.Module) -> dict[str, torch.Tensor]:
-    """A copy of the model's parameters and buffers: a clone per tensor (deepcopy walks each object in
-    Python, and the best state is copied at every epoch that improves)."""
-    return {name: value.detach().clone() for name, value in model.state_dict().items()}
+def optimizer_options(config: LearnConfig) -> dict[str, float | int]:
+    """SciPy's options: an iteration per epoch, and no stopping rule of the optimizer's own on small steps or
+    gradients (it would end training silently; the validation check decides)."""
+    if config.optimizer == "cg":
+        return {"maxiter": config.max_epochs, "gtol": 0.0}
+    epochs = config.max_epochs
+    return {"maxiter": epochs, "maxcor": LBFGS_MEMORY, "ftol": 0.0, "gtol": 0.0, "maxfun": 25 * epochs}
 
 
 def train(inputs: np.ndarray, targets: np.ndarray, config: LearnConfig) -> Trained:
     """Train one network on (N, F) inputs and (N, T) targets in [0, 1]; seeded end to end."""
     start = time.perf_counter()
-    runtime.torch_ready()  # the process's budget, where one was set before torch was loaded
-    torch.manual_seed(config.seed)
-    parts = split_indices(len(inputs), config.split, np.random.default_rng(config.seed))
-    x = torch.as_tensor(inputs, dtype=torch.float64)  # (N, F)
-    y = torch.as_tensor(targets, dtype=torch.float64)  # (N, T)
-    x_train, y_train = x[parts["train"]], y[parts["train"]]
-    model = ShallowNet(*input_transform(x_train, config.components), config.hidden, y_train).double()
-    with torch.no_grad():
-        z = model.project(x)  # (N, P): projected once, not in every line-search evaluation
-    z_train = z[parts["train"]]
-    loss_fn = nn.MSELoss()
-    optimizer = _optimizer(model, config)
-
-    def closure() -> torch.Tensor:
-        model.zero_grad()  # what optimizer.zero_grad does, without the torch._dynamo guard it pays at each call
-        loss = loss_fn(model.head(z_train), y_train)
-        loss.backward()
-        return loss
-
-    best_val, best_state, failures, stop_reason = float("inf"), _snapshot(model), 0, "max_epochs"
-    history: list[tuple[float, float]] = []
-    for _ in range(config.max_epochs):
-        optimizer.step(closure)  # type: ignore[arg-type]  # torch types the closure as returning float
-        train_mse = _mse(model, z_train, y_train)
-        val_mse = _mse(model, z[parts["val"]], y[parts["val"]])
-        history.append((train_mse, val_mse))
-        if val_mse < best_val:
-            best_val, best_state, failures = val_mse, _snapshot(model), 0
-        else:
-            failures += 1
-        if failures >= config.max_validation_failures:
-            stop_reason = "validation"
-            break
-        if train_mse <= config.goal_mse:
-            stop_reason = "goal"
-            break
-    model.load_state_dict(best_state)
+    rng = np.random.default_rng(config.seed)
+    parts = split_indices(len(inputs), config.split, rng)
+    x, y = np.asarray(inputs, dtype=np.float64), np.asarray(targets, dtype=np.float64)  # (N, F), (N, T)
+    transform = input_transform(x[parts["train"]], config.components)
+    z = transform(x)  # (N, P): projected once, not in every line-search evaluation
+    z_train, y_train = z[parts["train"]], y[parts["train"]]
+    layers = initial_layers(z.shape[1], config.hidden, y_train, rng)
+    stopping = EarlyStopping(layers, z[parts["val"]], y[parts["val"]], config)
+    minimize(
+        mse_and_gradient,
+        layers.weights,
+        args=(layers, z_train, y_train),
+        jac=True,
+        method=OPTIMIZERS[config.optimizer],
+        callback=stopping,
+        options=optimizer_options(config),
+    )
+    best = Layers(stopping.best_weights, layers.inputs, layers.hidden, layers.targets)
+    stop_reason = stopping.stop_reason or ("max_epochs" if len(stopping.history) >= config.max_epochs else "converged")
     return Trained(
-        model=model,
-        epochs=len(history),
+        model=ShallowNet(transform, best),
+        epochs=len(stopping.history),
         stop_reason=stop_reason,
-        train_mse=_mse(model, z_train, y_train),
-        val_mse=best_val,
-        test_mse=_mse(model, z[parts["test"]], y[parts["test"]]),
+        train_mse=float(np.mean((best(z_train) - y_train) ** 2)),
+        val_mse=float(np.mean((best(z[parts["val"]]) - y[parts["val"]]) ** 2)),
+        test_mse=float(np.mean((best(z[parts["test"]]) - y[parts["test"]]) ** 2)),
         seconds=time.perf_counter() - start,
         split=parts,
-        history=history,
+        history=stopping.history,
     )
 
 
 def predict(model: ShallowNet, inputs: np.ndarray) -> np.ndarray:
     """(N, T) predictions clamped to the [0, 1] range the targets were normalized to."""
-    model.eval()
-    with torch.no_grad():
-        out = model(torch.as_tensor(np.atleast_2d(inputs), dtype=torch.float64))
-    return np.clip(out.numpy().astype(np.float64), 0.0, 1.0)
+    return np.clip(model(inputs), 0.0, 1.0)
