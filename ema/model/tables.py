@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import csv
 import io
+import zipfile
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -53,6 +54,8 @@ def read_table(path: str | Path) -> Table:
         size = path.stat().st_size
     except OSError as exc:
         raise InputError(str(path), f"cannot be read ({exc.strerror})") from None
+    if size == 0:
+        raise InputError(str(path), "is empty (0 bytes)")
     if size > MAX_LOG_BYTES:
         raise InputError(
             str(path), f"is {size / 2**20:.0f} MiB, over the {MAX_LOG_BYTES // 2**20} MiB a logged file may be: cut it"
@@ -114,12 +117,13 @@ def _number(text: str) -> float | None:
 def _mat(path: Path) -> Table:
     """A MATLAB file's vectors (any n×1 or 1×n) as columns, its 1×1 values as constants."""
     from scipy.io import loadmat  # the reader of MATLAB's files; imported only for one
+    from scipy.io.matlab import MatReadError
 
     try:
         variables = loadmat(path, squeeze_me=False)
     except NotImplementedError:
         raise InputError(str(path), "is a MATLAB 7.3 (HDF5) file: save it with -v7 (scipy reads up to 7.2)") from None
-    except (ValueError, TypeError, OSError) as exc:
+    except (MatReadError, ValueError, TypeError, OSError, EOFError) as exc:  # EOFError: a file cut short
         raise InputError(str(path), f"is not a MATLAB file ({exc})") from None
     return _arrays(path, {k: v for k, v in variables.items() if not k.startswith("__")})
 
@@ -128,7 +132,7 @@ def _npz(path: Path) -> Table:
     try:
         with np.load(path, allow_pickle=False) as archive:
             return _arrays(path, {name: archive[name] for name in archive.files})
-    except (ValueError, OSError) as exc:
+    except (ValueError, OSError, EOFError, zipfile.BadZipFile) as exc:  # EOFError: a file cut short
         raise InputError(str(path), f"is not a NumPy .npz archive ({exc})") from None
 
 
