@@ -12,6 +12,7 @@ import click
 
 from ema.cli.options import (
     EXISTING,
+    FIGURE_FILE,
     OUTPUT_FILE,
     about_file,
     actuator,
@@ -188,7 +189,7 @@ def simulate(as_json: bool, **options: Any) -> None:
 @click.command()
 @click.argument("windows", type=EXISTING, nargs=-1, required=True)
 @click.option("--truth", type=EXISTING, help='JSON {"FDJ": ..., "eta_O": ...} of synthetic windows')
-@click.option("--figure", type=OUTPUT_FILE, help="also write a PNG of the residual before and after")
+@click.option("--figure", type=FIGURE_FILE, help="also write a PNG of the residual before and after (needs [plots])")
 @click.option(
     "--copies",
     type=click.IntRange(*NOISE_COPIES_RANGE),
@@ -245,11 +246,17 @@ def calibrate(
         out_actuator.write_text(calibrated.completed.model_dump_json(by_alias=True, indent=2, exclude_none=True) + "\n")
         written["actuator_written"] = str(out_actuator)
         print(f"ema: wrote the completed document to {out_actuator}", file=sys.stderr)
-    if figure is not None:
-        if calibrated.plot is None:
-            raise InputError("--figure", f"a {document.kind} actuator's calibration has no figure")
-        written["figure"] = str(residual_figure(calibrated.plot, figure))
+    undrawn = None  # the report is printed whatever happens to the figure: nothing computed is lost
+    if figure is not None and calibrated.plot is None:
+        undrawn = InputError("--figure", f"a {document.kind} actuator's calibration has no figure")
+    elif figure is not None:
+        try:
+            written["figure"] = str(residual_figure(calibrated.plot, figure))
+        except (OSError, ValueError) as error:
+            undrawn = InputError("--figure", f"{figure}: not drawn ({error}); the report stands")
     emit({**calibrated.report.model_dump(mode="json", by_alias=True), **written}, as_json, print_calibration)
+    if undrawn is not None:
+        raise undrawn
 
 
 REPOSITORY_SCHEMAS = Path(__file__).resolve().parents[2] / "docs" / "schemas"  # an editable install's

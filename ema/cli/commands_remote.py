@@ -12,6 +12,7 @@ from typing import Any
 import click
 
 from ema.cli.options import (
+    FIGURE_FILE,
     OUTPUT_FILE,
     NothingAnsweredError,
     as_json,
@@ -194,7 +195,7 @@ def _print_replay(result: dict[str, Any]) -> None:
 @click.command()
 @click.argument("actuator_id")
 @service
-@click.option("--plot", type=OUTPUT_FILE, default=None, help="PNG of the prognosis")
+@click.option("--plot", type=FIGURE_FILE, default=None, help="PNG of the prognosis (needs [plots])")
 @click.option("--parameter", type=click.Choice(["FDJ", "eta_O", "eta_A"]), default="FDJ", help="what --plot draws")
 @as_json
 def history(

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import contextlib
+import importlib.util
 import json
 import os
 import sys
@@ -27,17 +28,29 @@ class _Output(click.Path):
     def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
         path = super().convert(value, param, ctx)
         written = Path(os.fsdecode(path))
+        folder, which = (written, "it") if self.dir_okay else (written.parent, "its folder")
         try:
-            (written if self.dir_okay else written.parent).mkdir(parents=True, exist_ok=True)
+            folder.mkdir(parents=True, exist_ok=True)
         except OSError as error:
-            self.fail(
-                f"{value}: {'it' if self.dir_okay else 'its folder'} cannot be made ({error.strerror})", param, ctx
-            )
+            self.fail(f"{value}: {which} cannot be made ({error.strerror})", param, ctx)
+        if not os.access(folder, os.W_OK | os.X_OK):
+            self.fail(f"{value}: {which} cannot be written to", param, ctx)
         return path
+
+
+class _Figure(_Output):
+    """A PNG the command draws: refused as the flag is read where the ``plots`` extra (matplotlib) is missing,
+    never after the work it would draw."""
+
+    def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
+        if importlib.util.find_spec("matplotlib") is None:
+            self.fail(f"{value}: drawing needs the optional extra 'plots': pip install 'ema[plots]'", param, ctx)
+        return super().convert(value, param, ctx)
 
 
 OUTPUT_FILE = _Output(dir_okay=False, path_type=Path)
 OUTPUT_FOLDER = _Output(file_okay=False, path_type=Path)
+FIGURE_FILE = _Figure(dir_okay=False, path_type=Path)
 SIZES = {  # flag -> PipelineConfig field
     "--sims": "n_simulations",
     "--checks": "check_windows",
