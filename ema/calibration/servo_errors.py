@@ -14,7 +14,6 @@ from ema.estimate.prepare.servo import ServoPrepared, document_effects
 from ema.estimate.simulate.servo import lane_parameters
 from ema.model.actuator import ActuatorDocument
 from ema.model.checks import InputError
-from ema.model.servo_sim import simulate_servo
 
 
 def closed_loop_error_pct(
@@ -25,9 +24,7 @@ def closed_loop_error_pct(
     errors, norms = 0.0, 0.0
     for p in prepared:
         s, kept = p.window.signals, p.motion.samples
-        start = (float(s["position_m"][0]), float((s["position_m"][1] - s["position_m"][0]) * p.window.sample_rate_hz))
-        lane = lane_parameters(values, effects)[None, :]
-        run = simulate_servo(s["set_point_m"], lane, p.loop, load_n=s.get("load_n"), start=start)
+        run = p.closed_loop(lane_parameters(values, effects)[None, :])
         errors += float(np.sum((s["drive_force_n"][kept] - run.drive_force_n[0, kept]) ** 2))
         norms += float(np.sum(s["drive_force_n"][kept] ** 2))
     return float(100.0 * np.sqrt(errors / norms))

@@ -24,7 +24,6 @@ from ema.estimate.physics.inverse import (
 from ema.estimate.prepare.servo import ServoPrepared
 from ema.estimate.simulate.servo import LANE_COLUMNS, lane_parameters
 from ema.estimate.stats import rms
-from ema.model.servo_sim import simulate_servo
 
 FOLDS = 5
 COPIES = 8
@@ -114,9 +113,7 @@ def noise_copies(prepared: Sequence[ServoPrepared], base: Fitted, model: dict[st
 def _simulated(p: ServoPrepared, values: dict[str, float], model: dict[str, float], phase: float) -> ServoPrepared:
     """``p`` with its window's position and force as the closed loop at ``values`` logs them."""
     s = p.window.signals
-    start = (float(s["position_m"][0]), float((s["position_m"][1] - s["position_m"][0]) * p.window.sample_rate_hz))
-    lane = lane_parameters(values, model)[None, :]
-    run = simulate_servo(s["set_point_m"], lane, p.loop, load_n=s.get("load_n"), start=start, phase=np.array([phase]))
+    run = p.closed_loop(lane_parameters(values, model)[None, :], np.array([phase]))
     motion = load_motion(run.position_m[0], p.window.sample_rate_hz, p.bandwidth_hz, p.loop.resolution_m)
     force = (run.drive_force_n[0] - s.get("load_n", 0.0))[motion.samples]
     return replace(p, motion=motion, force_n=force)

@@ -4,7 +4,10 @@ Each simulation (a lane) follows the window's own set point r_k. At each control
 sensor reads q_k = δ·round(x(t_k)/δ + φ) − φ·δ (a sensor of step δ, its phase φ the lane's), the controller
 filters it by its FIR taps into q̄_k, differences it into a speed, and holds the force
 
-    F_k = g·sat(kv·(kp·(r_k − q_k) − (q̄_k − q̄_{k−1})/Δt), ±u_max)
+    F_k = g·sat(kv·(kp·(r_k − q_k) − (q̄_k − q̄_{k−1})/Δt) + e_k, ±u_max)
+
+e_k being a command added to the controller's (an excitation for identification, a feed-forward: the log's
+own, ``ema.estimate.prepare.servo.added_command``; 0 for a loop left to its controller),
 
 until k + 1, over which the load moves by (``ema.model.servo``)
 
@@ -59,10 +62,12 @@ def _step_load(x, v, net, p, h, travel):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True)
-def run_lanes(reference, load, controller, taps, params, phase, start, first, count, q_out, f_out):  # pragma: no cover
-    """Simulate lanes [first, first + count) of ``params`` (L, 9) over the reference (N,) and load (N,) [N];
-    ``controller`` = (kp, kv, gain, limit, Δt, δ), ``taps`` (T,), ``phase`` (L,), ``start`` = (x0, v0).
-    Writes the recorded position (L, N) [m] and force (L, N) [N]."""
+def run_lanes(
+    reference, added, load, controller, taps, params, phase, start, first, count, q_out, f_out
+):  # pragma: no cover
+    """Simulate lanes [first, first + count) of ``params`` (L, 9) over the reference (N,) [m], the added command
+    (N,) [the command's unit] and the load (N,) [N]; ``controller`` = (kp, kv, gain, limit, Δt, δ), ``taps`` (T,),
+    ``phase`` (L,), ``start`` = (x0, v0). Writes the recorded position (L, N) [m] and force (L, N) [N]."""
     kp, kv, gain, limit, dt, step = (
         controller[0],
         controller[1],
@@ -91,7 +96,7 @@ def run_lanes(reference, load, controller, taps, params, phase, start, first, co
             filtered = 0.0
             for i in range(n_taps):
                 filtered += taps[i] * history[i]
-            u = kv * (kp * (reference[k] - q) - (filtered - filtered_prev) / dt)
+            u = kv * (kp * (reference[k] - q) - (filtered - filtered_prev) / dt) + added[k]
             u = min(max(u, -limit), limit)
             filtered_prev = filtered
             force = gain * u
@@ -129,10 +134,12 @@ def simulate_servo(
     loop: ServoLoop,
     *,
     load_n: np.ndarray | None = None,
+    added_command: np.ndarray | None = None,
     start: tuple[float, float] = (0.0, 0.0),
     phase: np.ndarray | None = None,
 ) -> ServoRuns:
-    """Each row of ``params`` (L, 9: ``LANE_PARAMETERS``) simulated over the set point (N,) in closed loop."""
+    """Each row of ``params`` (L, 9: ``LANE_PARAMETERS``) simulated over the set point (N,) in closed loop, with
+    ``added_command`` (N,) added to the controller's (none: the controller alone)."""
     reference = finite_array("set_point_m", set_point_m, ndim=1)
     params = np.ascontiguousarray(finite_array("params", params, ndim=2))
     if params.shape[1] != len(LANE_PARAMETERS):
@@ -141,6 +148,9 @@ def simulate_servo(
         raise InputError("params.mass_kg", "must be positive in every lane")
     lanes, n = params.shape[0], len(reference)
     load = np.zeros(n) if load_n is None else finite_array("load_n", load_n, ndim=1)
+    added = np.zeros(n) if added_command is None else finite_array("added_command", added_command, ndim=1)
+    if len(load) != n or len(added) != n:
+        raise InputError("load_n" if len(load) != n else "added_command", f"must have the set point's {n} samples")
     phases = np.zeros(lanes) if phase is None else finite_array("phase", phase, ndim=1)
     controller = np.array([loop.position_gain_per_s, loop.speed_gain_per_mps, loop.drive_gain_n_per_unit,
                            loop.command_limit, loop.period_s, loop.resolution_m])  # fmt: skip
@@ -149,7 +159,7 @@ def simulate_servo(
 
     def run(first: int) -> None:
         count = min(GROUP_LANES, lanes - first)
-        run_lanes(reference, load, controller, taps, params, phases, first_state, first, count, q_out, f_out)
+        run_lanes(reference, added, load, controller, taps, params, phases, first_state, first, count, q_out, f_out)
 
     runtime.map_on_pool(run, range(0, lanes, GROUP_LANES))
     return ServoRuns(q_out, f_out)

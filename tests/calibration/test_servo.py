@@ -104,8 +104,6 @@ def test_unlogged_pulses_do_not_hide_or_fake_an_effect():
 def test_the_budget_counts_every_closed_loop_a_calibration_runs(monkeypatch):
     """The service refuses a calibration by its simulation work (``calibration_cost``): it counts each closed loop
     the calibration runs, no fewer."""
-    import ema.calibration.servo_errors as servo_errors
-    import ema.calibration.servo_fit as servo_fit
     from ema.kinds import calibration_cost
     from ema.model.servo_sim import SUBSTEPS
 
@@ -115,9 +113,10 @@ def test_the_budget_counts_every_closed_loop_a_calibration_runs(monkeypatch):
         runs.append(len(set_point) * lanes.shape[0])
         return simulate(set_point, lanes, *args, **kwargs)
 
-    simulate = servo_fit.simulate_servo
-    for module in (servo_errors, servo_fit):
-        monkeypatch.setattr(module, "simulate_servo", counted)
+    from ema.estimate.prepare import servo as prepared_servo  # every closed loop of a prepared window runs there
+
+    simulate = prepared_servo.simulate_servo
+    monkeypatch.setattr(prepared_servo, "simulate_servo", counted)
     load = foreign.Load(viscous_up_ns_per_m=160.0, viscous_down_ns_per_m=240.0)
     windows = [window_from_dict(foreign.draw(seed, load)) for seed in range(2)]
     _calibrated(windows, FOREIGN)

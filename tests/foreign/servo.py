@@ -68,11 +68,25 @@ def pulses(seed: int, n: int, height_n: float = 80.0, count: int = 6) -> np.ndar
     return out
 
 
+def excitation(seed: int, n: int, height_v: float = 2.0, count: int = 8) -> np.ndarray:
+    """A command added to the controller's for identification [V]: ``count`` pulses of 10–40 ms either way, at
+    random times, and a slow sine of a tenth of their height (not the EMPS's own: its pulses are not published)."""
+    rng = np.random.default_rng(seed + 200)
+    out = 0.1 * height_v * np.sin(2 * np.pi * rng.uniform(0.2, 1.0) * np.arange(n) / RATE_HZ)
+    for start in rng.integers(n // 10, n - n // 10, size=count):
+        out[start : start + int(rng.integers(10, 40))] += height_v * rng.choice([-1.0, 1.0])
+    return out
+
+
 def simulate(
-    reference: np.ndarray, load: Load, phase: float = 0.0, push_n: np.ndarray | None = None
+    reference: np.ndarray,
+    load: Load,
+    phase: float = 0.0,
+    push_n: np.ndarray | None = None,
+    added_v: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """(position as the encoder read it [m], the drive's force [N]) at each controller sample; ``push_n`` a force
-    on the load the log does not carry."""
+    on the load the log does not carry, ``added_v`` a command added to the controller's before its limit."""
     dt = 1.0 / RATE_HZ
     x, v = float(reference[0]), 0.0
     previous = [x, x]
@@ -80,7 +94,8 @@ def simulate(
     for k, r in enumerate(reference):
         q = STEP_M * round(x / STEP_M + phase) - phase * STEP_M
         filtered, filtered_before = 0.5 * (q + previous[0]), 0.5 * (previous[0] + previous[1])
-        u = min(max(KV * (KP * (r - q) - (filtered - filtered_before) / dt), -LIMIT), LIMIT)
+        added = 0.0 if added_v is None else added_v[k]
+        u = min(max(KV * (KP * (r - q) - (filtered - filtered_before) / dt) + added, -LIMIT), LIMIT)
         previous = [q, previous[0]]
         positions[k], forces[k] = q, GAIN * u
         net, left = GAIN * u - load.offset_n + (0.0 if push_n is None else push_n[k]), dt
@@ -95,12 +110,15 @@ def simulate(
     return positions, forces
 
 
-def draw(seed: int, load: Load = Load(), seconds: float = 12.0, pushed: bool = False) -> dict:
+def draw(seed: int, load: Load = Load(), seconds: float = 12.0, pushed: bool = False, excited: bool = False) -> dict:
     """An ``ema-window/1`` document of a servo with ``load``, its controller's constants in it; ``pushed``: with
-    force pulses on the load that the log does not carry."""
+    force pulses on the load that the log does not carry; ``excited``: with a command added to the controller's
+    (``excitation``), which the logged force carries."""
     reference = set_point(seed, seconds)
     push = pulses(seed, len(reference)) if pushed else None
-    position, force = simulate(reference, load, phase=float(np.random.default_rng(seed + 1).uniform()), push_n=push)
+    added = excitation(seed, len(reference)) if excited else None
+    phase = float(np.random.default_rng(seed + 1).uniform())
+    position, force = simulate(reference, load, phase=phase, push_n=push, added_v=added)
     return {
         "schema": "ema-window/1",
         "actuator_id": "foreign/servo",

@@ -37,6 +37,7 @@ def test_the_compiled_kernel_is_its_python_twin():
         )
         kernel(
             reference,
+            0.5 * np.sin(np.arange(len(reference)) / 40.0),  # a command added to the controller's
             np.zeros(len(reference)),
             constants,
             np.array(LOOP.taps),
@@ -69,3 +70,21 @@ def test_the_closed_loop_follows_the_foreign_servo(seed):
     run = simulate_servo(reference, lane, LOOP, start=(reference[0], 0.0))
     assert np.sqrt(np.mean((run.position_m[0] - position) ** 2)) < 2e-6  # 2 µm on a 0.25 m stroke
     assert np.linalg.norm(run.drive_force_n[0] - force) / np.linalg.norm(force) < 0.02
+
+
+def test_a_command_added_to_the_controllers_is_logged_as_the_drive_applies_it():
+    """With the load at rest, the logged force is g·sat(the controller's command + the added one): the added command
+    passes the limit's saturation like the controller's own."""
+    n = 200
+    added = np.where(np.arange(n) % 50 < 10, 3.0 * foreign.LIMIT, -0.05)  # pulses past the limit, a small offset
+    heavy = _lane(fdj_n=1e6, offset_n=0.0)  # static friction holds the load: position and speed stay 0
+    run = simulate_servo(np.zeros(n), heavy, LOOP, added_command=added)
+    assert np.all(run.position_m[0] == 0.0)
+    assert np.allclose(run.drive_force_n[0], foreign.GAIN * np.clip(added, -foreign.LIMIT, foreign.LIMIT))
+
+
+def test_an_added_command_of_another_length_is_refused_naming_it():
+    from ema.model.checks import InputError
+
+    with pytest.raises(InputError, match="added_command"):
+        simulate_servo(np.zeros(100), _lane(), LOOP, added_command=np.zeros(99))

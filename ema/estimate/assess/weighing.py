@@ -192,13 +192,19 @@ def assess(c: Candidates, equation_error_ratio: float, limit: float) -> Assessed
         if note is not None:
             notes.append(note)
     if equation_error_ratio > limit:
+        widened = (
+            "stds read from that residual, its size and its correlation, so they carry it; the held-out errors "
+            "widened by that factor"
+            if c.physics_std_observed
+            else "stds widened by that factor"
+        )
         notes.append(
             Note(
                 code="model_misfit",
                 text=(
                     f"the window's Eq. 5.1 residual is {equation_error_ratio:.2f}x what noise alone leaves, beyond the "
                     f"{limit:.2f}x a window the model explains reaches {100 * MISFIT_FALSE_ALARM:g} % of the time: the "
-                    "model lacks something this window holds (stds widened by that factor; `ema calibrate` traces it)"
+                    f"model lacks something this window holds ({widened}; `ema calibrate` traces it)"
                 ),
             )
         )

@@ -39,6 +39,7 @@ NoteCode = Literal[
     "current_at_zero_torque",
     "current_per_nm",
     "controller_mismatch",
+    "added_command",
     "unlogged_force",
     "fdj_departed",
     "load_extrapolated",

@@ -14,6 +14,14 @@
   document's gains, or, where the log does not follow them but follows others, those. Simulations at gains the
   loop did not run would move otherwise, and the physics fit's bias read on them, subtracted from the window's
   fit (``ema.estimate.assess``), would not be the window's. The note says both pairs.
+- A log's command may hold more than its controller's: an excitation added for identification, a feed-forward,
+  a disturbance the drive adds. Where no gains reproduce the whole command, the command is the document's loop
+  plus an added command, the logged one less the loop's at every sample (``added_command``), unless the loop's
+  own terms explain most of that departure (then it is a gain's, the sign's or the filter's error, and the
+  note says no gains reproduce the log); where the document's gains are off as well, the gains most samples
+  follow (``trimmed_loop``: a least-squares fit without the samples an added pulse holds). Every simulation adds
+  the added command to its controller's, the training runs as well as the check: a loop left to its controller
+  would move otherwise than the log's. The note ``added_command`` says so, with its size.
 - The loop's bandwidth (the document's, else the natural frequency √(kp·kv·g/M) of the position loop, M from a
   first fit) sets the inverse model's filters (``ema.estimate.physics.inverse``).
 """
@@ -30,13 +38,20 @@ from ema.estimate.stats import below_zero, rms
 from ema.model.actuator import ActuatorDocument
 from ema.model.checks import InputError
 from ema.model.servo import Servo
-from ema.model.servo_sim import ServoLoop
+from ema.model.servo_sim import ServoLoop, ServoRuns, simulate_servo
 from ema.model.window import Window
 
 RATE_TOLERANCE = 0.01
 CONTROLLER_TOLERANCE = 0.02
 MIN_QUANTIZED = 0.9
 MIN_LOOP_SAMPLES = 10  # unclipped samples a log's own loop gains are read from, at least
+# A sample whose command departs from the loop's by more than this many robust stds of the departures holds a
+# command the loop does not give (a pulse of an excitation stands out by hundreds; a gain's rounding by none).
+ADDED_MADS = 6.0
+TRIMMED_FITS = 4  # least-squares fits of the loop's gains, each without the samples the last one left far off
+# A departure from the loop's command that the loop's own terms explain beyond this share of its energy is the
+# loop's error (a gain, the sign, the filter), not a command added to it.
+MAX_LOOP_SHARE = 0.5
 PROVISIONAL_BANDWIDTH_SHARE = 0.02  # a first fit's loop bandwidth, as a share of the rate (20 Hz at 1 kHz)
 POSITIVE = ("mass_kg", "fdj_n", "viscous_ns_per_m", "viscous_up_ns_per_m", "viscous_down_ns_per_m")
 
@@ -53,6 +68,22 @@ class ServoPrepared:
     effects: dict[str, float]  # the document's adopted effects (name -> its nonlinear constant)
     notes: list[Note]
     disturbed: np.ndarray | None = None  # (rows,) the decimated rows a force the log lacks disturbs (calibration's)
+    added_command: np.ndarray | None = None  # (N,) [the command's unit] the log's command beyond its controller's
+
+    def closed_loop(self, lanes: np.ndarray, phase: np.ndarray | None = None) -> ServoRuns:
+        """Each row of ``lanes`` (L, ``LANE_PARAMETERS``) run over the window as its log ran: its set point, its
+        load, its added command, from its first state (position and speed), its sensor at ``phase`` (L,)."""
+        s, rate = self.window.signals, self.window.sample_rate_hz
+        start = (float(s["position_m"][0]), float((s["position_m"][1] - s["position_m"][0]) * rate))
+        return simulate_servo(
+            s["set_point_m"],
+            lanes,
+            self.loop,
+            load_n=s.get("load_n"),
+            added_command=self.added_command,
+            start=start,
+            phase=phase,
+        )
 
 
 def completed(actuator: ActuatorDocument, window: Window) -> Servo:
@@ -96,11 +127,19 @@ def _filtered_speed(taps: list[float], position_m: np.ndarray, rate_hz: float) -
 
 def commanded(servo: Servo, set_point_m: np.ndarray, position_m: np.ndarray, rate_hz: float) -> np.ndarray:
     """The command [its unit] the document's controller gives at each sample of the log."""
-    speed = _filtered_speed(servo.speed_filter, position_m, rate_hz)
     assert servo.position_gain_per_s is not None and servo.speed_gain_per_mps is not None  # completed
-    command = servo.speed_gain_per_mps * (servo.position_gain_per_s * (set_point_m - position_m) - speed)
+    gains = LoopGains(servo.position_gain_per_s, servo.speed_gain_per_mps, 0.0)
+    command = _loop_law(servo, gains, set_point_m, position_m, rate_hz)
     limit = servo.command_limit if servo.command_limit is not None else np.inf
     return np.clip(command, -limit, limit)
+
+
+def _loop_law(
+    servo: Servo, gains: LoopGains, set_point_m: np.ndarray, position_m: np.ndarray, rate_hz: float
+) -> np.ndarray:
+    """kv·(kp·(q_ref − q) − dq) at each sample, before the limit, dq through the document's speed filter."""
+    speed = _filtered_speed(servo.speed_filter, position_m, rate_hz)
+    return gains.speed_gain_per_mps * (gains.position_gain_per_s * (set_point_m - position_m) - speed)
 
 
 def _logged_command(servo: Servo, window: Window) -> np.ndarray:
@@ -120,15 +159,18 @@ def document_loop(servo: Servo, window: Window) -> LoopGains:
     return LoopGains(servo.position_gain_per_s, servo.speed_gain_per_mps, float(off / max(rms(logged), 1e-300)))
 
 
-def log_loop(servo: Servo, window: Window) -> LoopGains | None:
+def log_loop(servo: Servo, window: Window, among: np.ndarray | None = None) -> LoopGains | None:
     """The gains the logged command follows through the document's speed filter: the command is linear in
-    kv·kp and kv, so least squares over the samples the limit does not clip (past the filter's start) reads them.
-    None where it reads no stable loop (gains not both positive, or too few samples to read two from)."""
+    kv·kp and kv, so least squares over the samples the limit does not clip (past the filter's start; of those
+    ``among`` (N,) marks, where given) reads them. None where it reads no stable loop (gains not both positive,
+    or too few samples to read two from)."""
     s, start = window.signals, len(servo.speed_filter)
     speed = _filtered_speed(servo.speed_filter, s["position_m"], window.sample_rate_hz)[start:]
     logged = _logged_command(servo, window)[start:]
     limit = servo.command_limit if servo.command_limit is not None else np.inf
     free = np.abs(logged) < limit
+    if among is not None:
+        free &= among[start:]
     if free.sum() < MIN_LOOP_SAMPLES:
         return None
     columns = np.column_stack([(s["set_point_m"] - s["position_m"])[start:], -speed])[free]
@@ -139,29 +181,126 @@ def log_loop(servo: Servo, window: Window) -> LoopGains | None:
     return LoopGains(float(stiffness / kv), float(kv), float(off / max(rms(logged[free]), 1e-300)))
 
 
-def followed_loop(servo: Servo, window: Window) -> tuple[LoopGains, Note | None]:
-    """The gains the log follows, the document's where it follows them within ``CONTROLLER_TOLERANCE``, else
-    those its command follows (``log_loop``) where they do; and the note ``controller_mismatch`` where the
-    document's do not, which names the log's gains where they reproduce it."""
+def departure(servo: Servo, window: Window, gains: LoopGains) -> np.ndarray:
+    """(N,) the logged command less the loop's with ``gains``: what the loop does not give. 0 where both sit at the
+    same limit (the loop gives it), and before the speed filter's start (it reads positions from before the log)."""
+    s, limit = window.signals, servo.command_limit if servo.command_limit is not None else np.inf
+    loop = _loop_law(servo, gains, s["set_point_m"], s["position_m"], window.sample_rate_hz)
+    logged = _logged_command(servo, window)
+    out = logged - loop
+    out[(np.abs(logged) >= limit) & (np.clip(loop, -limit, limit) == logged)] = 0.0
+    out[: len(servo.speed_filter)] = 0.0
+    return out
+
+
+def loops_own(departure_: np.ndarray) -> np.ndarray:
+    """(N,) the samples whose command the loop gives: departing by at most ``ADDED_MADS`` robust stds."""
+    spread = 1.4826 * float(np.median(np.abs(departure_ - np.median(departure_))))
+    return np.abs(departure_ - np.median(departure_)) <= ADDED_MADS * spread + 1e-12 * float(np.max(np.abs(departure_)))
+
+
+def trimmed_loop(servo: Servo, window: Window) -> LoopGains | None:
+    """The gains most of the logged command follows: ``log_loop`` refitted ``TRIMMED_FITS`` times, each without the
+    samples the last fit's gains leave beyond ``ADDED_MADS`` robust stds (an added command's)."""
+    gains = log_loop(servo, window)
+    for _ in range(TRIMMED_FITS - 1):
+        if gains is None:
+            return None
+        gains = log_loop(servo, window, loops_own(departure(servo, window, gains)))
+    return gains
+
+
+@dataclass(frozen=True)
+class AddedCommand:
+    """A log's command read as a loop's plus a command added to it."""
+
+    gains: LoopGains
+    values: np.ndarray  # (N,) [the command's unit]
+    loop_share: float  # of the departure's energy, the share the loop's own terms explain (a gain's error)
+
+
+def loop_share(servo: Servo, window: Window, values: np.ndarray) -> float:
+    """The share of ``values``' energy (N,) that the loop's own terms (the position error and the filtered speed,
+    at any gains) explain by least squares: near 1 where ``values`` is a gain's, the sign's or the filter's error."""
+    s, start = window.signals, len(servo.speed_filter)
+    speed = _filtered_speed(servo.speed_filter, s["position_m"], window.sample_rate_hz)[start:]
+    columns = np.column_stack([(s["set_point_m"] - s["position_m"])[start:], -speed])
+    target = values[start:]
+    fitted, *_ = np.linalg.lstsq(columns, target, rcond=None)
+    left = float(np.sum((target - columns @ fitted) ** 2))
+    return 1.0 - left / max(float(np.sum(target**2)), 1e-300)
+
+
+def added_command(servo: Servo, window: Window, gains: LoopGains | None) -> AddedCommand | None:
+    """The log's command as the loop with ``gains`` plus an added one, the departure (``departure``), where the loop's
+    own terms explain at most ``MAX_LOOP_SHARE`` of it (else it is the loop's error, not a command added to it) and
+    the logged command stays within the document's limit (no command added before the limit passes it); else
+    None."""
+    limit = servo.command_limit if servo.command_limit is not None else np.inf
+    if gains is None or np.any(np.abs(_logged_command(servo, window)) > limit * (1 + 1e-9)):
+        return None
+    values = departure(servo, window, gains)
+    share = loop_share(servo, window, values)
+    if share > MAX_LOOP_SHARE or not np.any(values):
+        return None
+    return AddedCommand(gains, values, share)
+
+
+@dataclass(frozen=True)
+class FollowedLoop:
+    """The loop a log ran, the command added to it (None: the loop's alone), and the note that says which."""
+
+    gains: LoopGains
+    added: AddedCommand | None = None
+    note: Note | None = None
+
+
+def followed_loop(servo: Servo, window: Window) -> FollowedLoop:
+    """The loop the log follows: the document's gains where the log follows them within ``CONTROLLER_TOLERANCE``,
+    else those its command follows (``log_loop``) where they do, else one of them plus a command added to it
+    (``added_command``: the document's first); and the note (``controller_mismatch``, ``added_command``) where the
+    document's gains alone do not give the command."""
     document = document_loop(servo, window)
     if document.off_share <= CONTROLLER_TOLERANCE:
-        return document, None
-    off_pct = 100 * document.off_share
-    differs = f"the logged command differs from what the document's controller gives by {off_pct:.1f} % RMS"
-    own = log_loop(servo, window)
-    if own is None or own.off_share > CONTROLLER_TOLERANCE:
-        text = (
-            f"{differs}, and no gains of it reproduce it (its filter, limit or sign is not the log's): the "
-            "window's own simulations are not its"
-        )
-        return document, Note(code="controller_mismatch", parameter="drive_force_n", text=text)
-    text = (
-        f"{differs}, and follows kp {own.position_gain_per_s:.5g} 1/s, kv {own.speed_gain_per_mps:.5g} within "
-        f"{100 * own.off_share:.1f} % where the document with the log's constants has kp "
-        f"{document.position_gain_per_s:.5g}, kv {document.speed_gain_per_mps:.5g} (a gain, the drive gain or the "
-        "filter is not the log's): the window is simulated with the gains it followed"
+        return FollowedLoop(document)
+    differs = (
+        f"the logged command differs from what the document's controller gives by {100 * document.off_share:.1f} % RMS"
     )
-    return own, Note(code="controller_mismatch", parameter="drive_force_n", text=text)
+    own = log_loop(servo, window)
+    if own is not None and own.off_share <= CONTROLLER_TOLERANCE:
+        text = (
+            f"{differs}, and follows kp {own.position_gain_per_s:.5g} 1/s, kv {own.speed_gain_per_mps:.5g} within "
+            f"{100 * own.off_share:.1f} % where the document with the log's constants has kp "
+            f"{document.position_gain_per_s:.5g}, kv {document.speed_gain_per_mps:.5g} (a gain, the drive gain or "
+            "the filter is not the log's): the window is simulated with the gains it followed"
+        )
+        return FollowedLoop(own, note=Note(code="controller_mismatch", parameter="drive_force_n", text=text))
+    added = added_command(servo, window, document) or added_command(servo, window, trimmed_loop(servo, window))
+    if added is not None:
+        return FollowedLoop(added.gains, added, _added_note(servo, window, added, document))
+    text = (
+        f"{differs}, and no gains of it reproduce it (its filter, limit or sign is not the log's): the "
+        "window's own simulations are not its"
+    )
+    return FollowedLoop(document, note=Note(code="controller_mismatch", parameter="drive_force_n", text=text))
+
+
+def _added_note(servo: Servo, window: Window, added: AddedCommand, document: LoopGains) -> Note:
+    """``added_command``: the added command's size, and whose loop it is added to."""
+    logged, values = _logged_command(servo, window), added.values
+    gains = added.gains
+    loop = (
+        "the document's controller"
+        if gains is document
+        else f"a loop of kp {gains.position_gain_per_s:.5g} 1/s, kv {gains.speed_gain_per_mps:.5g} (the document's: "
+        f"kp {document.position_gain_per_s:.5g}, kv {document.speed_gain_per_mps:.5g})"
+    )
+    text = (
+        f"the logged command is {loop} plus a command added to it (an excitation, a feed-forward, a disturbance the "
+        f"drive adds): {rms(values):.3g} RMS, {100 * rms(values) / max(rms(logged), 1e-300):.0f} % of the command's, "
+        f"peak {float(np.max(np.abs(values))):.3g} in the command's unit. Every simulation adds it to the controller's"
+    )
+    return Note(code="added_command", parameter="drive_force_n", text=text)
 
 
 def bandwidth(servo: Servo, mass_kg: float, gains: LoopGains) -> float:
@@ -217,7 +356,8 @@ def prepare_servo(window: Window, actuator: ActuatorDocument) -> ServoPrepared:
         first = _window_motion(s["position_m"], rate, PROVISIONAL_BANDWIDTH_SHARE * rate, step)
         forces = (s["drive_force_n"] - load)[first.samples]
         mass = fit_inverse(forces, inverse_columns(first), first).values["mass_kg"]
-    gains, mismatch = followed_loop(servo, window)
+    followed = followed_loop(servo, window)
+    gains = followed.gains
     loop_hz = bandwidth(servo, max(float(mass or 1.0), 1e-6), gains)
     motion = _window_motion(s["position_m"], rate, loop_hz, step)
     assert servo.drive_gain_n_per_unit  # completed
@@ -230,7 +370,7 @@ def prepare_servo(window: Window, actuator: ActuatorDocument) -> ServoPrepared:
         resolution_m=step,
         taps=tuple(servo.speed_filter),
     )
-    notes = [mismatch] if mismatch is not None else []
+    notes = [followed.note] if followed.note is not None else []
     loaded = bool(np.any(load != 0.0))
     if not loaded:
         notes.append(
@@ -238,5 +378,5 @@ def prepare_servo(window: Window, actuator: ActuatorDocument) -> ServoPrepared:
         )
     return ServoPrepared(
         window, servo, loop, motion, (s["drive_force_n"] - load)[motion.samples], loaded, loop_hz,
-        document_effects(servo), notes,
+        document_effects(servo), notes, added_command=None if followed.added is None else followed.added.values,
     )  # fmt: skip

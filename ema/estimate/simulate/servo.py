@@ -21,7 +21,7 @@ from ema.estimate.config import PipelineConfig
 from ema.estimate.physics.inverse import InverseFit
 from ema.estimate.prepare.servo import ServoPrepared
 from ema.estimate.simulate.design import halton
-from ema.model.servo_sim import LANE_PARAMETERS, ServoRuns, simulate_servo
+from ema.model.servo_sim import LANE_PARAMETERS, ServoRuns
 
 SPAN_SIGMAS = 6.0
 MIN_HALF_SHARE = 0.05
@@ -97,12 +97,9 @@ def simulate_servo_dataset(prepared: ServoPrepared, physics: InverseFit, config:
     truth = low + unit * (high - low)
     effects = prepared.effects
     lanes = np.stack([lane_parameters(dict(zip(targets, row, strict=True)), effects) for row in truth])
-    window = prepared.window
-    s = window.signals
-    start = (float(s["position_m"][0]), float((s["position_m"][1] - s["position_m"][0]) * window.sample_rate_hz))
     phases = np.random.default_rng(config.seed).uniform(size=count)
-    runs = simulate_servo(s["set_point_m"], lanes, prepared.loop, load_n=s.get("load_n"), start=start, phase=phases)
-    kept = prepared.motion.samples
+    runs = prepared.closed_loop(lanes, phases)
+    s, kept = prepared.window.signals, prepared.motion.samples
     bins = min(config.n_timesteps, (kept.stop - kept.start) // 2)
     inputs = binned(runs.drive_force_n[:, kept], bins)
     window_inputs = binned(s["drive_force_n"][kept], bins)
