@@ -210,7 +210,10 @@ def run_bench(
     if under_load:
         with load(under_load):
             rows += [
-                {**time_windows(config, d, repeats, seed=100), "load": f"{under_load} busy processes"}
+                {
+                    **time_windows(config, d, repeats, seed=100),
+                    "load": f"{under_load} busy process{'es' if under_load != 1 else ''}",
+                }
                 for d in durations
             ]
     print("timing the kernel and the yardstick…", file=sys.stderr)

@@ -20,6 +20,7 @@ from ema.cli.options import (
     as_json,
     emit,
     flags_named,
+    kind_given,
     log_map,
     log_map_document,
     pipeline_config,
@@ -117,6 +118,7 @@ def estimate(
     config = pipeline_config(size_values)
     document = actuator_document(actuator_file)
     read = read_one(window, log_map_document(log_map_file))
+    kind_given([read], actuator_file)
     known = history_of(read, history) if history else None
     runtime.configure(threads)
     with about_file(window):
@@ -125,7 +127,12 @@ def estimate(
 
 
 @click.command()
-@click.option("--out", required=True, type=OUTPUT_FILE, help="window JSON to write")
+@click.option(
+    "--out",
+    required=True,
+    type=click.Path(path_type=Path),
+    help="the window's JSON file to write; with --series, the folder to write them into",
+)
 @click.option("--fdj", type=float, default=None, help="dynamic friction FDJ [N·m]  [default: the actuator's nominal]")
 @click.option("--eta-o", "eta_o", type=float, default=None, help="opposing efficiency η_O  [default: nominal]")
 @click.option("--fsj", type=float, default=None, help="static friction FSJ [N·m]  [default: nominal]")
@@ -201,7 +208,8 @@ def simulate(as_json: bool, **options: Any) -> None:
     type=OUTPUT_FILE,
     default=None,
     metavar="A2.json",
-    help="a linear actuator: write its document completed with what healthy runs taught (c, I0, the nominal)",
+    help="write the actuator's document completed with what the windows taught (a ball screw's c, I0 and nominal; "
+    "a servo's load constants and effects)",
 )
 @actuator
 @log_map
@@ -235,6 +243,7 @@ def calibrate(
     document = actuator_document(actuator_file)
     mapping = log_map_document(log_map_file)
     loaded = [read_one(path, mapping) for path in windows]
+    kind_given(loaded, actuator_file)
     request = kinds.CalibrationRequest(config, document, read_truth(truth), copies=copies, on_stage=progress)
     calibrated = kinds.calibrate(loaded, request)
     written: dict[str, str | None] = {"figure": None, "actuator_written": None}

@@ -41,8 +41,9 @@ class Progress:
         self.refused += bool(row.get("error"))
         elapsed = time.perf_counter() - self.started
         rate = self.done / max(elapsed, 1e-9)
+        verdict = f"refused: {str(row['error'])[:160]}" if row.get("error") else "ok"
         print(
-            f"[{self.done}/{self.total}] {row['window_id']}: {'refused' if row.get('error') else 'ok'}  "
+            f"[{self.done}/{self.total}] {row['window_id']}: {verdict}  "
             f"{rate:.2f} windows/s, {(self.total - self.done) / rate:.0f} s left",
             file=sys.stderr,
         )

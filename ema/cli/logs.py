@@ -236,6 +236,10 @@ def read_actuators(folder: Path) -> dict[str, ActuatorDocument]:
 def read_one(path: Path, log_map: LogMap | None = None) -> Window:
     """The one window of a file (JSON, CSV or NPZ, any logged file through ``log_map``): what ``ema estimate`` reads; a
     file of several is refused naming it (``ema replay`` posts each)."""
+    if log_map is not None and Path(path).suffix.lower() == ".json":
+        raise InputError(
+            "--log-map", f"{path} is a JSON window, in ema's own signals: a log map reads a rig's CSV, MATLAB or NPZ"
+        )
     windows = read_file(Path(path), Defaults(), log_map)
     if len(windows) != 1:
         raise InputError(str(path), f"holds {len(windows)} windows: ema estimate reads one (ema replay posts each)")

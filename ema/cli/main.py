@@ -1,8 +1,9 @@
 """The ``ema`` command line: one click group, heavy imports inside the commands (``ema --help`` stays fast).
 
-Exit status: 0 success, 2 bad input (the message names the flag or file given), 1 internal error,
-130 interrupted. With ``--json`` standard output holds exactly one JSON document; progress and
-warnings go to standard error. A closed pipe (``ema simulate ... | head``) ends quietly.
+Exit status: 0 success, 2 bad input (the message names the flag or file given), 3 the service could not be
+reached or failed (not the input's fault, nor ema's here), 1 internal error, 130 interrupted. With ``--json``
+standard output holds exactly one JSON document; progress and warnings go to standard error. A closed pipe
+(``ema simulate ... | head``) ends quietly.
 """
 
 from __future__ import annotations
@@ -18,13 +19,14 @@ from ema.cli import commands_fleet, commands_local, commands_remote, commands_se
 from ema.cli.options import NothingAnsweredError, PipeClosedError
 from ema.model.collector import collect_less_often
 
-EXIT_OK, EXIT_INTERNAL, EXIT_BAD_INPUT, EXIT_INTERRUPTED = 0, 1, 2, 130
+EXIT_OK, EXIT_INTERNAL, EXIT_BAD_INPUT, EXIT_SERVICE, EXIT_INTERRUPTED = 0, 1, 2, 3, 130
 
 
 @click.group(context_settings={"help_option_names": ["-h", "--help"], "show_default": True})
 @click.version_option(package_name="ema", message="%(prog)s %(version)s")
 def ema() -> None:
-    """Onboard health monitor for an elevator electromechanical actuator (EMA)."""
+    """Onboard health monitor for electromechanical actuators (EMAs): a rotary EMA on a gear train (the thesis's
+    elevator actuator), a ball screw turned by a stepper, and a linear servo axis under its position controller."""
 
 
 for module in (commands_local, commands_serve, commands_remote, commands_fleet):
@@ -103,7 +105,7 @@ def _run(arguments: list[str]) -> int:
             return EXIT_BAD_INPUT
         if isinstance(exc, ServiceError):
             print(f"ema {name}: {exc}", file=sys.stderr)
-            return EXIT_INTERNAL
+            return EXIT_SERVICE
         print(f"ema {name}: internal error: {type(exc).__name__}: {exc}", file=sys.stderr)
         return EXIT_INTERNAL
 

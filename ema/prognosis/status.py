@@ -38,7 +38,9 @@ def lacking_evidence(prognosis: Prognosis, windows: int) -> str | None:
     n = windows if trend is None else trend.n
     span = 0.0 if trend is None or not trend.points else float(np.ptp([p.time for p in trend.points]))
     unit = prognosis.time_unit.replace("_", " ")
-    needed = f"a status needs {MIN_STATUS_WINDOWS} windows over at least {MIN_SPAN[prognosis.time_unit]:g} {unit}"
+    needed = (
+        f"a status needs {MIN_STATUS_WINDOWS} windows spread over at least {MIN_SPAN[prognosis.time_unit]:g} {unit}"
+    )
     if n < MIN_STATUS_WINDOWS:
         return f"{n} window(s): {needed}"
     if span < MIN_SPAN[prognosis.time_unit]:

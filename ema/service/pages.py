@@ -33,9 +33,13 @@ code { background: #f1f3f4; padding: 0 3px; } nav a { margin-right: 0.8em; }
 """
 
 
-def _page(title: str, body: str) -> str:
+PENDING_REFRESH_S = 5  # while a line is pending, the fleet's page reloads itself this often; never otherwise
+
+
+def _page(title: str, body: str, refresh_s: int | None = None) -> str:
+    refresh = "" if refresh_s is None else f'<meta http-equiv="refresh" content="{refresh_s}">'
     return (
-        f'<!doctype html><html lang="en"><head><meta charset="utf-8"><title>{html.escape(title)}</title>'
+        f'<!doctype html><html lang="en"><head><meta charset="utf-8">{refresh}<title>{html.escape(title)}</title>'
         f'<link rel="icon" href="data:,"><style>{STYLE}</style></head><body>{body}</body></html>'
     )
 
@@ -121,7 +125,8 @@ def fleet_page(
     if pending:
         parts.append(
             f"<p>{len(pending)} actuator(s) stored windows since their line was computed; their prognoses are being "
-            "brought up to date (shown as they were, or pending): reload in a moment.</p>"
+            f"brought up to date (shown as they were, or pending): this page reloads itself every {PENDING_REFRESH_S} "
+            "s until none is.</p>"
         )
     head = "".join(f"<th>{html.escape(h)}</th>" for h in ["actuator", "status", *PARAMETER_NAMES.values()])
     parts.append(f"<table><tr>{head}<th>remaining life</th><th>last window</th></tr>")
@@ -138,7 +143,7 @@ def fleet_page(
         css = line.status.split()[0]
         parts.append(f'<tr class="{css}">' + "".join(f"<td>{cell}</td>" for cell in cells) + "</tr>")
     parts.append("</table>")
-    return _page("ema: actuators", "\n".join(parts))
+    return _page("ema: actuators", "\n".join(parts), PENDING_REFRESH_S if pending else None)
 
 
 def _notes_list(notes: Sequence[tuple[str, str, str]]) -> str:

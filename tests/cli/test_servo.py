@@ -40,7 +40,7 @@ def test_a_rig_run_calibrated_without_its_actuator_exits_2_naming_the_signals(ca
     rig = Path(__file__).resolve().parents[2] / "examples" / "ballscrew-rig"
     run = rig / "runs" / "normal_load20_run001.csv"
     assert main(["calibrate", str(run), "--log-map", str(rig / "log-map.json")]) == EXIT_BAD_INPUT
-    assert "windows.0.signals" in capsys.readouterr().err
+    assert "--actuator" in capsys.readouterr().err
 
 
 def _broken_files(folder: Path) -> list[Path]:
@@ -66,7 +66,7 @@ def test_an_empty_or_cut_file_of_any_format_exits_2_naming_it(tmp_path, capsys):
         for flags in ([], READ):
             assert main(["estimate", str(path), *flags]) == EXIT_BAD_INPUT, path
             err = capsys.readouterr().err
-            assert f"bad input: {path}" in err and "internal error" not in err, err
+            assert "bad input: " in err and str(path) in err and "internal error" not in err, err
 
 
 def test_a_folder_with_empty_and_cut_files_skips_each_naming_it_and_answers_the_rest(tmp_path, capsys):

@@ -91,3 +91,23 @@ def test_each_fleet_row_shows_its_own_friction_unit_and_no_empty_limits():
     page = fleet_page([rotary, servo], page=1, pages=1, total=2, pending=[], status=None, tail=None)
     assert "<th>FDJ</th>" in page and "0.0512 ± 0.001 N·m <small>(nominal 0.05, fails &gt; 0.075)</small>" in page
     assert "<td>20.79 ± 0.27 N</td>" in page and "()" not in page and "0.85 ± 0.01</td>" in page
+
+
+def test_a_reload_of_an_unchanged_fleet_page_is_answered_not_modified(fleet_settings):
+    with TestClient(create_app(fleet_settings), base_url=LOCAL) as client:
+        settled(client)
+        first = client.get("/ui")
+        again = client.get("/ui", headers={"If-None-Match": first.headers["etag"]})
+        other = client.get("/ui", headers={"If-None-Match": '"another page"'})
+    assert first.status_code == 200 and first.headers["cache-control"] == "no-cache"
+    assert again.status_code == 304 and again.content == b"" and again.headers["etag"] == first.headers["etag"]
+    assert other.status_code == 200 and other.text == first.text
+    assert 'http-equiv="refresh"' not in first.text  # nothing pending: the page stays as it is
+
+
+def test_the_fleet_page_reloads_itself_while_a_line_is_pending_and_not_after():
+    from ema.service.pages import fleet_page
+
+    common = {"page": 1, "pages": 1, "total": 0, "status": None, "tail": None}
+    assert 'http-equiv="refresh"' in fleet_page([], pending=["tail-9/x"], **common)
+    assert 'http-equiv="refresh"' not in fleet_page([], pending=[], **common)

@@ -2,10 +2,11 @@
 
 from __future__ import annotations
 
+import hashlib
 import math
 from typing import Annotated, Literal
 
-from fastapi import APIRouter, Query, Request
+from fastapi import APIRouter, Query, Request, Response
 from fastapi.responses import HTMLResponse, RedirectResponse
 from starlette.concurrency import run_in_threadpool
 
@@ -26,12 +27,13 @@ async def root() -> RedirectResponse:
 @router.get("/ui", response_class=HTMLResponse)
 async def fleet(
     *,
+    request: Request,
     settings: SettingsDep,
     store: StoreDep,
     status: Annotated[StatusFilter | None, Query()] = None,
     tail: Annotated[str | None, Query(max_length=200, description="actuator ids starting with it")] = None,
     page: Annotated[int, Query(ge=1, le=1_000_000)] = 1,
-) -> HTMLResponse:
+) -> Response:
     """The actuators most urgent first, ``ui_page_size`` a page, filtered by status and by tail."""
     found = await run_in_threadpool(fleet_lines, store)
     lines = [
@@ -45,7 +47,17 @@ async def fleet(
     body = fleet_page(
         shown, page=min(page, pages), pages=pages, total=len(lines), pending=found.pending, status=status, tail=tail
     )
-    return HTMLResponse(body)
+    return revalidated(request, body)
+
+
+def revalidated(request: Request, body: str) -> Response:
+    """``body`` with its ETag (its content's digest), or 304 Not Modified where the browser holds that very page: a
+    reload of an unchanged view sends nothing again. ``no-cache``: the browser asks each time, the fleet moves."""
+    tag = '"' + hashlib.blake2b(body.encode(), digest_size=16).hexdigest() + '"'
+    headers = {"ETag": tag, "Cache-Control": "no-cache"}
+    if tag in [t.strip() for t in request.headers.get("if-none-match", "").split(",")]:
+        return Response(status_code=304, headers=headers)
+    return HTMLResponse(body, headers=headers)
 
 
 @router.get("/ui/actuators/{actuator_id:path}", response_class=HTMLResponse)
