@@ -25,6 +25,7 @@ from ema.cli.options import (
     log_map_document,
     pipeline_config,
     progress,
+    say_if_compiling,
     sizes,
     span,
     threads,
@@ -119,6 +120,7 @@ def estimate(
     document = actuator_document(actuator_file)
     read = read_one(window, log_map_document(log_map_file))
     kind_given([read], actuator_file)
+    say_if_compiling([read])
     known = history_of(read, history) if history else None
     runtime.configure(threads)
     with about_file(window):
@@ -130,7 +132,7 @@ def estimate(
 @click.option(
     "--out",
     required=True,
-    type=click.Path(path_type=Path),
+    type=OUTPUT_FILE,  # its folder made as the flag is read; with --series, the folder itself is made on writing
     help="the window's JSON file to write; with --series, the folder to write them into",
 )
 @click.option("--fdj", type=float, default=None, help="dynamic friction FDJ [N·m]  [default: the actuator's nominal]")

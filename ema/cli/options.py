@@ -89,6 +89,23 @@ def actuator_document(path: Path | None) -> Any:
     return THESIS if path is None else read_actuator(path)
 
 
+def say_if_compiling(windows: Any) -> None:
+    """Where a window will be simulated and Numba's cache does not hold the simulator's kernel yet (a fresh install),
+    say on standard error that this first run compiles (about 30 s, once), rather than sit silent in *prepare*."""
+    from ema.kinds import learns
+
+    if not any(learns(window) for window in windows):
+        return
+    from ema.model import kernels
+
+    try:  # Numba's cache file of the dispatcher: private, so a layout it does not have says nothing
+        index = Path(kernels.run_group._cache._cache_file._index_path)  # type: ignore[attr-defined]
+    except AttributeError:
+        return
+    if not index.exists():
+        print("ema: first run: compiling the simulation kernels into Numba's cache (about 30 s, once)", file=sys.stderr)
+
+
 def kind_given(windows: Any, path: Path | None) -> None:
     """Where no --actuator was given, an InputError naming the flag for a window of another kind than the default
     document's (a ball screw's or a servo's log read with the thesis's rotary EMA)."""

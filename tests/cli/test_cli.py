@@ -326,3 +326,19 @@ def test_simulate_stamps_a_time_and_draws_a_degrading_series(tmp_path, capsys):
     assert [w.flight_hours for w in windows] == [0.0, 25.0, 50.0, 75.0]
     assert [t["FDJ"] for t in result["truth"]] == pytest.approx([0.05, 0.055, 0.06, 0.065])
     assert len({w.window_id for w in windows}) == 4
+
+
+def test_a_first_run_says_it_compiles_and_a_warm_one_says_nothing(tmp_path, capsys, monkeypatch):
+    from ema.cli.options import say_if_compiling
+    from ema.model import kernels
+    from ema.model.params import HealthParams
+    from ema.model.synthetic import synthetic_window
+
+    window = synthetic_window(HealthParams.single(), seed=1, duration_s=0.05)
+    cache = kernels.run_group._cache._cache_file  # type: ignore[attr-defined]
+    monkeypatch.setattr(cache, "_index_path", str(tmp_path / "absent.nbi"))
+    say_if_compiling([window])
+    assert "compiling the simulation kernels" in capsys.readouterr().err
+    (tmp_path / "absent.nbi").write_bytes(b"")
+    say_if_compiling([window])
+    assert capsys.readouterr().err == ""
