@@ -193,10 +193,10 @@ def departure(servo: Servo, window: Window, gains: LoopGains) -> np.ndarray:
     return out
 
 
-def loops_own(departure_: np.ndarray) -> np.ndarray:
+def loops_own(values: np.ndarray) -> np.ndarray:
     """(N,) the samples whose command the loop gives: departing by at most ``ADDED_MADS`` robust stds."""
-    spread = 1.4826 * float(np.median(np.abs(departure_ - np.median(departure_))))
-    return np.abs(departure_ - np.median(departure_)) <= ADDED_MADS * spread + 1e-12 * float(np.max(np.abs(departure_)))
+    spread = 1.4826 * float(np.median(np.abs(values - np.median(values))))
+    return np.abs(values - np.median(values)) <= ADDED_MADS * spread + 1e-12 * float(np.max(np.abs(values)))
 
 
 def trimmed_loop(servo: Servo, window: Window) -> LoopGains | None:
