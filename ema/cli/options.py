@@ -109,16 +109,16 @@ def say_if_compiling(windows: Any) -> None:
 def kind_given(windows: Any, path: Path | None) -> None:
     """Where no --actuator was given, an InputError naming the flag for a window of another kind than the default
     document's (a ball screw's or a servo's log read with the thesis's rotary EMA)."""
+    if path is not None:
+        return
+    from ema.kinds import same_kind
     from ema.model.actuator import THESIS
     from ema.model.checks import InputError
 
-    other = next((window for window in windows if window.kind != THESIS.kind), None)
-    if path is None and other is not None:
-        raise InputError(
-            "--actuator",
-            f"window {other.window_id} is a {other.kind} actuator's log, and without --actuator it would be read with "
-            f"the default document, a {THESIS.kind} one's: give its ema-actuator/1 document with --actuator",
-        )
+    try:
+        same_kind(windows, THESIS)
+    except InputError as error:
+        raise InputError("--actuator", f"the signals {error.message}, given with --actuator") from None
 
 
 def log_map(function: F) -> F:

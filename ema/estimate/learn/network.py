@@ -22,7 +22,7 @@ trains on the raw inputs, as the thesis did).
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from scipy.optimize import OptimizeResult, minimize
@@ -122,7 +122,7 @@ def initial_layers(inputs: int, hidden: int, y_train: np.ndarray, rng: np.random
 def mse_and_gradient(weights: np.ndarray, layers: Layers, z: np.ndarray, y: np.ndarray) -> tuple[float, np.ndarray]:
     """The mean squared error over all (N, T) outputs at ``weights`` and its gradient (back-propagation):
     with r = (out − y)·2/(N·T), ∂W2 = aᵀr, ∂b2 = Σr, and through tanh' = 1 − a², ∂W1 = zᵀ(rW2ᵀ ⊙ (1 − a²))."""
-    w1, b1, w2, b2 = Layers(weights, layers.inputs, layers.hidden, layers.targets).parts
+    w1, b1, w2, b2 = replace(layers, weights=weights).parts
     a = np.tanh(z @ w1 + b1)  # (N, H)
     error = a @ w2 + b2 - y  # (N, T)
     r = error * (2.0 / error.size)
@@ -178,7 +178,7 @@ class EarlyStopping:
         self.failures, self.stop_reason = 0, ""
 
     def __call__(self, intermediate_result: OptimizeResult) -> None:
-        layers = Layers(intermediate_result.x, self.layers.inputs, self.layers.hidden, self.layers.targets)
+        layers = replace(self.layers, weights=intermediate_result.x)
         train_mse, val_mse = float(intermediate_result.fun), float(np.mean((layers(self.z_val) - self.y_val) ** 2))
         self.history.append((train_mse, val_mse))
         if val_mse < self.best_val:
@@ -222,7 +222,7 @@ def train(inputs: np.ndarray, targets: np.ndarray, config: LearnConfig) -> Train
         callback=stopping,
         options=optimizer_options(config),
     )
-    best = Layers(stopping.best_weights, layers.inputs, layers.hidden, layers.targets)
+    best = replace(layers, weights=stopping.best_weights)
     stop_reason = stopping.stop_reason or ("max_epochs" if len(stopping.history) >= config.max_epochs else "converged")
     return Trained(
         model=ShallowNet(transform, best),

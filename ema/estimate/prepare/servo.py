@@ -164,8 +164,7 @@ def log_loop(servo: Servo, window: Window, among: np.ndarray | None = None) -> L
     kv·kp and kv, so least squares over the samples the limit does not clip (past the filter's start; of those
     ``among`` (N,) marks, where given) reads them. None where it reads no stable loop (gains not both positive,
     or too few samples to read two from)."""
-    s, start = window.signals, len(servo.speed_filter)
-    speed = _filtered_speed(servo.speed_filter, s["position_m"], window.sample_rate_hz)[start:]
+    start = len(servo.speed_filter)
     logged = _logged_command(servo, window)[start:]
     limit = servo.command_limit if servo.command_limit is not None else np.inf
     free = np.abs(logged) < limit
@@ -173,12 +172,20 @@ def log_loop(servo: Servo, window: Window, among: np.ndarray | None = None) -> L
         free &= among[start:]
     if free.sum() < MIN_LOOP_SAMPLES:
         return None
-    columns = np.column_stack([(s["set_point_m"] - s["position_m"])[start:], -speed])[free]
+    columns = _loop_columns(servo, window)[free]
     (stiffness, kv), *_ = np.linalg.lstsq(columns, logged[free], rcond=None)
     if not (stiffness > 0 and kv > 0):
         return None
     off = rms(logged[free] - columns @ np.array([stiffness, kv]))
     return LoopGains(float(stiffness / kv), float(kv), float(off / max(rms(logged[free]), 1e-300)))
+
+
+def _loop_columns(servo: Servo, window: Window) -> np.ndarray:
+    """(N − taps, 2) the loop's own terms past the speed filter's start: the position error and the filtered speed
+    negated, of which the command is kv·kp times the first plus kv times the second."""
+    s, start = window.signals, len(servo.speed_filter)
+    speed = _filtered_speed(servo.speed_filter, s["position_m"], window.sample_rate_hz)[start:]
+    return np.column_stack([(s["set_point_m"] - s["position_m"])[start:], -speed])
 
 
 def departure(servo: Servo, window: Window, gains: LoopGains) -> np.ndarray:
@@ -216,16 +223,12 @@ class AddedCommand:
 
     gains: LoopGains
     values: np.ndarray  # (N,) [the command's unit]
-    loop_share: float  # of the departure's energy, the share the loop's own terms explain (a gain's error)
 
 
 def loop_share(servo: Servo, window: Window, values: np.ndarray) -> float:
     """The share of ``values``' energy (N,) that the loop's own terms (the position error and the filtered speed,
     at any gains) explain by least squares: near 1 where ``values`` is a gain's, the sign's or the filter's error."""
-    s, start = window.signals, len(servo.speed_filter)
-    speed = _filtered_speed(servo.speed_filter, s["position_m"], window.sample_rate_hz)[start:]
-    columns = np.column_stack([(s["set_point_m"] - s["position_m"])[start:], -speed])
-    target = values[start:]
+    columns, target = _loop_columns(servo, window), values[len(servo.speed_filter) :]
     fitted, *_ = np.linalg.lstsq(columns, target, rcond=None)
     left = float(np.sum((target - columns @ fitted) ** 2))
     return 1.0 - left / max(float(np.sum(target**2)), 1e-300)
@@ -240,10 +243,9 @@ def added_command(servo: Servo, window: Window, gains: LoopGains | None) -> Adde
     if gains is None or np.any(np.abs(_logged_command(servo, window)) > limit * (1 + 1e-9)):
         return None
     values = departure(servo, window, gains)
-    share = loop_share(servo, window, values)
-    if share > MAX_LOOP_SHARE or not np.any(values):
+    if not np.any(values) or loop_share(servo, window, values) > MAX_LOOP_SHARE:
         return None
-    return AddedCommand(gains, values, share)
+    return AddedCommand(gains, values)
 
 
 @dataclass(frozen=True)
