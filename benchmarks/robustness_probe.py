@@ -5,8 +5,9 @@
 3. a read-only history: refused at start, or posts refused in under a second;
 4. beside 8 trickling uploads a normal post is answered within 15 s;
 5. 4 copies of one window posted at once: the slowest answer within 2x a single one;
-6. 600 actuators of 8 windows, the service restarted: 5 viewers reloading /ui beside an estimate, the estimate
-   answered in 2 s or less and every /ui in 10 s or less (the fleet's lines are the keeper's work, not the pages');
+6. 600 actuators of 8 windows, the service restarted: 5 viewers reloading /ui as a browser does (one connection,
+   the ETag sent back) beside an estimate, the estimate answered in 2 s or less and within 1.5x its time alone,
+   and every /ui in 10 s or less (the lines are the keeper's work, the pages take turns in the view's share);
 7. a path id with a NUL, an RTL override or 10,000 characters is refused, and so is one shaped like a route.
 
 ``python -m benchmarks.robustness_probe [--docs]`` (``--docs`` writes its section of docs/benchmarks.md).
@@ -177,10 +178,24 @@ def _fleet(database: Path, actuators: int, windows: int) -> None:
 
 
 def _viewer(url: str, stop: threading.Event, times: list[float]) -> None:
-    while not stop.is_set():
+    """A browser reloading /ui as fast as it can: one kept-alive connection, the page's ETag sent back."""
+    tag = ""
+    with httpx.Client(timeout=120) as client:
+        while not stop.is_set():
+            started = time.perf_counter()
+            answer = client.get(f"{url}/ui", headers={"If-None-Match": tag} if tag else {})
+            tag = answer.headers.get("etag", tag)
+            times.append(time.perf_counter() - started)
+
+
+def _estimates(url: str, name: str, repeats: int = 3) -> tuple[float, bool]:
+    """The median time of ``repeats`` posts of fresh windows, and whether every one was answered 200."""
+    times, ok = [], True
+    for repeat in range(repeats):
         started = time.perf_counter()
-        httpx.get(f"{url}/ui", timeout=120)
+        ok &= post(url, window(f"{name}-{repeat}", actuator_id=f"probe/{name}")).status_code == 200
         times.append(time.perf_counter() - started)
+    return sorted(times)[repeats // 2], ok
 
 
 def big_fleet(folder: Path) -> str:
@@ -188,24 +203,20 @@ def big_fleet(folder: Path) -> str:
     _fleet(database, 600, 8)
     with served(database) as (url, _):
         post(url, window("warm", actuator_id="probe/warm"))  # the kernels loaded: the timing is the estimate's
-        started = time.perf_counter()
-        post(url, window("alone", actuator_id="probe/alone"))
-        alone = time.perf_counter() - started
+        alone, alone_ok = _estimates(url, "alone")
         stop, pages = threading.Event(), list[float]()
         viewers = [threading.Thread(target=_viewer, args=(url, stop, pages)) for _ in range(5)]
         for viewer in viewers:
             viewer.start()
         time.sleep(1.0)
-        started = time.perf_counter()
-        answer = post(url, window("beside", actuator_id="probe/beside"))
-        beside = time.perf_counter() - started
+        beside, beside_ok = _estimates(url, "beside")
         stop.set()
         for viewer in viewers:
             viewer.join()
-    ok = answer.status_code == 200 and beside <= 2.0 and max(pages) <= 10.0
+    ok = alone_ok and beside_ok and beside <= min(2.0, 1.5 * alone) and max(pages) <= 10.0
     return (
-        f"an estimate alone {alone:.2f} s, beside 5 viewers {beside:.2f} s; {len(pages)} /ui loads, the slowest "
-        f"{max(pages):.2f} s" + (" — pass" if ok else " — FAIL")
+        f"an estimate alone {alone:.2f} s, beside 5 viewers {beside:.2f} s ({beside / alone:.2f}x, medians of 3); "
+        f"{len(pages)} /ui loads, the slowest {max(pages):.2f} s" + (" — pass" if ok else " — FAIL")
     )
 
 

@@ -102,6 +102,9 @@ class Settings(BaseSettings):
         512_000_000, ge=1000, description="bytes of all bodies being received at once (beyond: 503)"
     )
     ui_page_size: int = Field(50, ge=1, le=1000, description="actuators per page of /ui")
+    ui_share: float = Field(
+        0.2, gt=0, le=1, description="the most of one core the operator's view takes, however many watch it"
+    )
     allowed_origins: tuple[str, ...] = Field(
         (), description="origins (scheme://host:port) of web pages allowed to write besides the service's own"
     )

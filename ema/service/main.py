@@ -27,7 +27,8 @@ from ema.service.guard import BodyLimits, Guard
 from ema.service.jobs import JobRunner
 from ema.service.routes import actuators, calibrate, estimate, health, ui
 from ema.service.schemas import CalibrateIn
-from ema.service.view import LineKeeper
+from ema.service.share import Share
+from ema.service.view import FleetView, LineKeeper
 
 log = logging.getLogger("ema.service")
 
@@ -69,7 +70,9 @@ def create_app(settings: Settings) -> FastAPI:
         app.state.store = open_history(settings.database, settings.min_free_bytes)
         slots = settings.ray_jobs if settings.backend == "ray" else 1
         app.state.runner = JobRunner(settings.max_queue, settings.queue_timeout_s, slots)
-        app.state.keeper = LineKeeper(app.state.store, app.state.runner)
+        app.state.view = FleetView(app.state.store)
+        app.state.view_share = Share(settings.ui_share)
+        app.state.keeper = LineKeeper(app.state.store, app.state.runner, app.state.view)
         if settings.backend == "ray":
             from ema.kinds.remote import connect
 

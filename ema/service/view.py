@@ -1,18 +1,17 @@
 """The fleet view's lines (``/ui``, ``GET /v1/actuators``): kept in the history, brought up to date by a worker of
 their own.
 
-Each actuator's line (``ema.prognosis.status.summary``) is kept with the state of the history it was
-computed from (its windows' count and last row, its document's version) and of the code that computed it
-(``rules``), so a line is recomputed only after its actuator stored a window or a document, or ema's rules
-changed, and a replica reads what another computed. A page
-only reads the kept lines (those out of date shown as they were, or as pending): it never computes, so
-people looking at the fleet take nothing from the estimates. The ``LineKeeper`` brings lines up to date
-on a thread of its own, woken when a window or a document is stored (and every ``KEEPER_PERIOD_S``, for
-what another replica or ``ema fleet`` stored), one actuator at a time, and only once no job has run or waited
-for ``KEEPER_QUIET_S``: a client posting windows one after another finds the cores as the last post left
-them, not shared with a line of the window just stored. Under a stream without such a pause, one line is
-brought up to date every ``KEEPER_MAX_WAIT_S``, so that the view is never further behind. An actuator with
-fewer windows than a forecast needs gets its line without one.
+Each actuator's line (``ema.prognosis.status.summary``) is kept with the state of the history it was computed from
+(its windows' count and last row, its document's version) and of the code that computed it (``rules``), so a line is
+recomputed only after its actuator stored a window or a document, or ema's rules changed, and a replica reads what
+another computed. A page only reads the kept lines (those out of date shown as they were, or as pending), through
+one shared reading (``FleetView``): it never computes, so people looking at the fleet take nothing from the
+estimates. The ``LineKeeper`` brings lines up to date on a thread of its own, woken when a window or a document is
+stored (and every ``KEEPER_PERIOD_S``, for what another replica or ``ema fleet`` stored), one actuator at a time,
+and only once no job has run or waited for ``KEEPER_QUIET_S``: a client posting windows one after another finds the
+cores as the last post left them, not shared with a line of the window just stored. Under a stream without such a
+pause, one line is brought up to date every ``KEEPER_MAX_WAIT_S``, so that the view is never further behind. An
+actuator with fewer windows than a forecast needs gets its line without one.
 """
 
 from __future__ import annotations
@@ -20,6 +19,7 @@ from __future__ import annotations
 import functools
 import hashlib
 import logging
+import math
 import threading
 import time
 from dataclasses import dataclass
@@ -38,6 +38,7 @@ KEEPER_PERIOD_S = 5.0  # the keeper looks for lines out of date at least this of
 KEEPER_QUIET_S = 0.5  # a line waits until no job has run or waited for this long
 KEEPER_MAX_WAIT_S = 30.0  # ... or until it has waited this long for such a pause
 IDLE_POLL_S = 0.05  # how often a keeper that yielded looks whether the service is quiet again
+VIEW_MAX_AGE_S = 1.0  # lines another replica or ``ema fleet`` stored show on a page within this
 
 
 @dataclass(frozen=True)
@@ -135,11 +136,34 @@ def fleet_lines(store: History) -> Lines:
     return Lines(sorted(lines.values(), key=urgency), [actuator_id for actuator_id, _, _ in stale])
 
 
+class FleetView:
+    """The fleet's lines as last read from the history, shared by every page and list: read again only once
+    ``VIEW_MAX_AGE_S`` has passed or this service stored a window, a document or a line, and by one reader at a
+    time. Five viewers reloading as fast as they can then cost one read a second, not five reads a reload."""
+
+    def __init__(self, store: History) -> None:
+        self.store = store
+        self._lock = threading.Lock()
+        self._lines: Lines | None = None
+        self._read_at = -math.inf
+
+    def out_of_date(self) -> None:
+        """Something was stored: the next page reads the history again."""
+        self._read_at = -math.inf
+
+    def lines(self) -> Lines:
+        with self._lock:
+            if self._lines is None or time.monotonic() - self._read_at >= VIEW_MAX_AGE_S:
+                self._read_at = time.monotonic()  # before the read: a store during it marks it out of date
+                self._lines = fleet_lines(self.store)
+            return self._lines
+
+
 class LineKeeper:
     """The fleet's lines brought up to date on a thread of its own, yielding to every job (module docstring)."""
 
-    def __init__(self, store: History, runner: JobRunner) -> None:
-        self.store, self.runner = store, runner
+    def __init__(self, store: History, runner: JobRunner, view: FleetView) -> None:
+        self.store, self.runner, self.view = store, runner, view
         self._wake, self._stop = threading.Event(), threading.Event()
         self._thread = threading.Thread(target=self._loop, name="ema-lines", daemon=True)
 
@@ -149,6 +173,7 @@ class LineKeeper:
 
     def poke(self) -> None:
         """A window or a document was stored: its actuator's line is out of date."""
+        self.view.out_of_date()
         self._wake.set()
 
     def stop(self) -> None:
@@ -175,6 +200,7 @@ class LineKeeper:
             if self._stop.is_set():
                 return
             refreshed(self.store, [item], self._stop)
+            self.view.out_of_date()
 
 
 def urgency(line: ActuatorSummary) -> tuple[int, float, str]:

@@ -182,6 +182,28 @@ def test_the_fleet_page_is_served_from_kept_lines_a_page_at_a_time(tmp_path, bas
     assert "4 actuator(s)" in tail.text and "tail-7/ema-3" in tail.text
 
 
+def test_pages_read_the_history_once_a_while_and_after_a_store(tmp_path, base, monkeypatch):
+    """Viewers reloading share one reading of the fleet's lines: read again once it is ``VIEW_MAX_AGE_S`` old or
+    this service stored something, never once a page."""
+    import ema.service.view as view
+
+    store = open_history(tmp_path / "h.sqlite3")
+    store.add(_copy(base, "tail-1/elevator", "w0", 0.0))
+    reads = []
+    monkeypatch.setattr(view, "fleet_lines", lambda store: reads.append(1) or view.Lines([], []))
+    fleet = view.FleetView(store)
+    for _ in range(20):
+        fleet.lines()
+    assert len(reads) == 1
+    fleet.out_of_date()
+    fleet.lines()
+    assert len(reads) == 2
+    monkeypatch.setattr(view, "VIEW_MAX_AGE_S", 0.0)
+    fleet.lines()
+    assert len(reads) == 3
+    store.close()
+
+
 def test_a_route_shaped_actuator_id_is_refused_before_it_can_be_stored(client, document):
     put = client.put("/v1/actuators/sh/estimates", json=THESIS.model_dump(by_alias=True))
     assert put.status_code == 422 and put.json()["detail"][0]["loc"] == ["path", "actuator_id"]
@@ -206,7 +228,7 @@ def test_a_line_kept_by_other_rules_is_brought_up_to_date(tmp_path, base, monkey
 
     store = open_history(tmp_path / "h.sqlite3")
     store.add(_copy(base, "tail-1/elevator", "w0", 0.0))
-    keeper = view.LineKeeper(store, JobRunner(max_queue=1, queue_timeout_s=1.0))
+    keeper = view.LineKeeper(store, JobRunner(max_queue=1, queue_timeout_s=1.0), view.FleetView(store))
     keeper.start()
     try:
         assert _lines_settle(store, within_s=10.0)
@@ -224,13 +246,13 @@ def test_the_keeper_yields_every_line_to_a_job_and_to_a_pause_after_it(tmp_path,
     """The fleet's lines are the keeper's work, done only once no job has run or waited for a moment
     (docs/service.md): a client posting one window after another has the cores between its posts."""
     from ema.service.jobs import JobRunner
-    from ema.service.view import KEEPER_QUIET_S, LineKeeper, kept_lines
+    from ema.service.view import KEEPER_QUIET_S, FleetView, LineKeeper, kept_lines
 
     store = open_history(tmp_path / "h.sqlite3")
     store.add(_copy(base, "tail-1/elevator", "w0", 0.0))
     runner = JobRunner(max_queue=1, queue_timeout_s=1.0)
     runner.admitted = 1  # a job holds its place
-    keeper = LineKeeper(store, runner)
+    keeper = LineKeeper(store, runner, FleetView(store))
     keeper.start()
     try:
         time.sleep(0.5)
@@ -252,7 +274,7 @@ def test_a_stream_without_a_pause_still_gets_its_lines(tmp_path, base, monkeypat
     store.add(_copy(base, "tail-1/elevator", "w0", 0.0))
     runner = JobRunner(max_queue=1, queue_timeout_s=1.0)
     runner.admitted = 1  # jobs, one after another, for ever
-    keeper = view.LineKeeper(store, runner)
+    keeper = view.LineKeeper(store, runner, view.FleetView(store))
     keeper.start()
     try:
         assert _lines_settle(store, within_s=5.0)
@@ -288,7 +310,7 @@ def test_a_line_that_cannot_be_computed_is_its_own_and_the_others_still_come(tmp
         return original(prognosis, *rest)
 
     monkeypatch.setattr(view, "summary", summary)
-    keeper = view.LineKeeper(store, JobRunner(max_queue=1, queue_timeout_s=1.0))
+    keeper = view.LineKeeper(store, JobRunner(max_queue=1, queue_timeout_s=1.0), view.FleetView(store))
     keeper.start()
     try:
         assert _lines_settle(store, within_s=10.0)

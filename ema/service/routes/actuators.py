@@ -14,16 +14,17 @@ from ema.service.deps import ActuatorId, RunnerDep, StoreDep, is_stored, prognos
 from ema.service.errors import NotStoredError
 from ema.service.parsing import read_body
 from ema.service.schemas import json_body, responses
-from ema.service.view import fleet_lines
+from ema.service.view import FleetView
 
 router = APIRouter(prefix="/actuators", tags=["actuators"])
 
 
 @router.get("", response_model=list[ActuatorSummary], responses=responses(401, 503))
-async def actuators(store: StoreDep) -> list[ActuatorSummary]:
+async def actuators(request: Request) -> list[ActuatorSummary]:
     """Every actuator with a stored window or document, most urgent first, with its latest status (``/ui``'s
     lines; those the service's keeper has not brought up to date yet as they were last computed, pending)."""
-    found = await run_in_threadpool(fleet_lines, store)
+    view: FleetView = request.app.state.view
+    found = await run_in_threadpool(view.lines)
     return found.lines
 
 

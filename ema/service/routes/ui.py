@@ -12,7 +12,8 @@ from starlette.concurrency import run_in_threadpool
 
 from ema.service.deps import ActuatorId, RunnerDep, SettingsDep, StoreDep, is_stored, prognosis_now
 from ema.service.pages import actuator_page, fleet_page, missing_page
-from ema.service.view import fleet_lines
+from ema.service.share import Share
+from ema.service.view import FleetView
 
 router = APIRouter(tags=["ui"], include_in_schema=False)
 StatusFilter = Literal["due", "watch", "prognosis failed", "not enough history", "healthy"]
@@ -29,19 +30,25 @@ async def fleet(
     *,
     request: Request,
     settings: SettingsDep,
-    store: StoreDep,
     status: Annotated[StatusFilter | None, Query()] = None,
     tail: Annotated[str | None, Query(max_length=200, description="actuator ids starting with it")] = None,
     page: Annotated[int, Query(ge=1, le=1_000_000)] = 1,
 ) -> Response:
-    """The actuators most urgent first, ``ui_page_size`` a page, filtered by status and by tail."""
-    found = await run_in_threadpool(fleet_lines, store)
+    """The actuators most urgent first, ``ui_page_size`` a page, filtered by status and by tail; in the view's
+    share of the machine (``ema.service.share``), from the lines as last read (``FleetView``)."""
+    share: Share = request.app.state.view_share
+    async with share.turn():
+        return await run_in_threadpool(_fleet_page, request, settings.ui_page_size, status, tail, page)
+
+
+def _fleet_page(request: Request, size: int, status: str | None, tail: str | None, page: int) -> Response:
+    view: FleetView = request.app.state.view
+    found = view.lines()
     lines = [
         line
         for line in found.lines
         if (status is None or line.status == status) and (not tail or line.actuator_id.startswith(tail))
     ]
-    size = settings.ui_page_size
     pages = max(1, math.ceil(len(lines) / size))
     shown = lines[(min(page, pages) - 1) * size : min(page, pages) * size]
     body = fleet_page(
