@@ -38,7 +38,7 @@ from ema.estimate.physics.static_friction import read_static_friction
 from ema.estimate.prepare.conditioning import Prepared, prepare, widened
 from ema.estimate.report import estimate_document
 from ema.estimate.simulate.dataset import Data, simulate_dataset
-from ema.estimate.stats import rms
+from ema.estimate.stats import RESOLUTION_SHARE, rms
 from ema.estimate.stopwatch import Stopwatch
 from ema.model.actuator import THESIS, ActuatorDocument
 from ema.model.window import Window
@@ -88,7 +88,9 @@ def checked(
     point the noise was measured at (the physics estimate, when it carries the answer), that simulation is
     the one: a lane of the dataset's batch, the same numbers as a run of its own."""
     health = inside(answer.values["FDJ"], answer.values["eta_O"], nominal_fdj_nm)
-    floor = rms((data.sims.residual_nm[n:] - data.sims.clean_residual_nm)[:, data.sliding])
+    noise = rms((data.sims.residual_nm[n:] - data.sims.clean_residual_nm)[:, data.sliding])
+    motor_nm = data.drive_as_read.torque_constant_nm_per_a * window.signals["current_a"][data.sliding]
+    floor = float(np.hypot(noise, RESOLUTION_SHARE * rms(motor_nm)))  # a log without noise: the model's resolution
     known = data.sims.reference_signals if health.identical(data.sims.reference) else None
     ratios = output_error_ratios(
         window,
@@ -128,9 +130,11 @@ def assessed(
     """The assessed answer (its stds widened by what prepare left undecided), the window's equation error over
     its held-out simulations' median, and the misfit limit that ratio is held to."""
     found, check_physics = candidates(window, physics, data, network, n)
-    floor = np.median(check_physics.residual_rms_nm) if len(check_physics.residual_rms_nm) else np.nan
-    equation_ratio = float(physics.residual_rms_nm[0] / floor) if np.isfinite(floor) else 1.0
-    limit = misfit_limit(check_physics.residual_rms_nm)
+    errors = np.hypot(check_physics.residual_rms_nm, check_physics.resolution_nm)  # never under the resolution
+    floor = np.median(errors) if len(errors) else np.nan
+    equation_ratio = float(np.hypot(physics.residual_rms_nm[0], physics.resolution_nm[0]) / floor)
+    equation_ratio = equation_ratio if np.isfinite(floor) else 1.0
+    limit = misfit_limit(errors)
     answer = assess(found, equation_ratio, limit)
     return replace(answer, stds=widened(answer.stds, prepared)), equation_ratio, limit
 

@@ -39,16 +39,13 @@ from ema.estimate.physics.scenario import MAX_RATIO
 from ema.estimate.prepare.servo import ServoPrepared, prepare_servo, refuse_reversed_signs
 from ema.estimate.report import training_info
 from ema.estimate.simulate.servo import ServoData, lane_parameters, simulate_servo_dataset
-from ema.estimate.stats import rms
+from ema.estimate.stats import RESOLUTION_SHARE, rms
 from ema.estimate.stopwatch import Stopwatch
 from ema.model.actuator import ActuatorDocument
 from ema.model.window import Window
 
 SERVO_TRAINING = LearnConfig(max_epochs=60, max_validation_failures=6)  # as the rotary pipeline's (a few dozen runs)
 CHECK_PHASES = (0.0, 0.5)  # the position sensor's phases of its step the check simulates: the answer's, its twin's
-# The closed loop's force against an exact solution of the same loop (the foreign servo, its sensor exact): ema's
-# ten load steps a sample leave 0.1 % of the force's RMS; twice that is the floor of a log's noise.
-INTEGRATION_SHARE = 0.002
 FDJ = "fdj_n"
 NOMINAL_FIELDS = {  # a constant of the inverse model -> the servo section's field of its nominal value
     "mass_kg": "mass_kg",
@@ -174,9 +171,9 @@ def closed_loop_check(prepared: ServoPrepared, answer: Assessed, ratio: float, l
 
 def noise_floor(measured: np.ndarray, twins: np.ndarray) -> float:
     """RMS [N] by which two simulations of one loop differ, ``twins`` (2, N) run with the position sensor at two
-    phases of its step (the quantization a log carries), and never under ``INTEGRATION_SHARE`` of the force: how
+    phases of its step (the quantization a log carries), and never under ``RESOLUTION_SHARE`` of the force: how
     far a log the model reproduces may lie from its simulation."""
-    return float(np.hypot(rms(twins[0] - twins[1]), INTEGRATION_SHARE * rms(measured))) or 1e-300
+    return float(np.hypot(rms(twins[0] - twins[1]), RESOLUTION_SHARE * rms(measured))) or 1e-300
 
 
 def _estimates(

@@ -10,6 +10,11 @@ from ema.model.residual import DEFAULT_DERIVATIVE_WINDOW_S, kernel_samples
 JACKKNIFE_BLOCKS = 10
 DECISIVE_Z = 4.0  # stds by which a reading must explain a window better than the document's before it is taken
 SIGN_STDS = 3.0  # a constant that must be positive read this many stds below zero: the log's signs, not its noise
+# The share of the drive's effort (the motor torque k_T·I, a servo's force) under which a model's error is no
+# evidence: the document's k_T alone moves 0.1 %/K with the magnets' temperature, and ema's integration of a closed
+# loop leaves 0.1 % of the force against an exact solution. Equation and output errors are read against a noise
+# never under it, so a log without sensor noise is judged as one with a little, never as an exact model's.
+RESOLUTION_SHARE = 0.002
 
 
 def jackknife_std(estimates: np.ndarray) -> np.ndarray:
@@ -48,10 +53,15 @@ def rms(values: np.ndarray) -> float:
     return float(np.sqrt(np.mean(values**2))) if len(values) else 0.0
 
 
-def rms_log_likelihood_ratio(worse_rms: float, better_rms: float, n_sliding: float, rate: float) -> float:
+def rms_log_likelihood_ratio(
+    worse_rms: float, better_rms: float, n_sliding: float, rate: float, *, resolution_nm: float
+) -> float:
     """ln of the likelihood ratio of two fits of one window's ``n_sliding`` samples by their RMS equation
-    errors, with one independent value per reconstruction kernel (the kernel smooths both sides of Eq. 5.1)."""
-    return n_sliding / kernel_samples(rate, DEFAULT_DERIVATIVE_WINDOW_S) * float(np.log(worse_rms / better_rms))
+    errors, with one independent value per reconstruction kernel (the kernel smooths both sides of Eq. 5.1), each
+    error never under the model's ``resolution_nm`` (``RESOLUTION_SHARE``): on a log without noise, what a fit
+    gains below it is the model's own error, not the window's evidence."""
+    worse, better = np.hypot(worse_rms, resolution_nm), np.hypot(better_rms, resolution_nm)
+    return n_sliding / kernel_samples(rate, DEFAULT_DERIVATIVE_WINDOW_S) * float(np.log(worse / better))
 
 
 def below_zero(values: dict[str, float], stds: dict[str, float]) -> list[str]:

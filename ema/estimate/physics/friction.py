@@ -27,7 +27,7 @@ import numpy as np
 from numba import njit
 
 from ema.estimate.physics.eta_search import ETA_O_SEARCH, solve
-from ema.estimate.stats import JACKKNIFE_BLOCKS, jackknife_std
+from ema.estimate.stats import JACKKNIFE_BLOCKS, RESOLUTION_SHARE, jackknife_std
 from ema.model.checks import InputError
 from ema.model.params import DriveConstants
 from ema.model.residual import (
@@ -79,6 +79,7 @@ FIT_ARRAYS = (
     "terms",
     "term_stds",
     "residual_rms_nm",
+    "resolution_nm",
     "n_sliding",
     "at_search_edge",
 )
@@ -98,6 +99,7 @@ class FrictionFit:
     terms: np.ndarray
     term_stds: np.ndarray
     residual_rms_nm: np.ndarray  # RMS equation error over the sliding samples
+    resolution_nm: np.ndarray  # the error the model does not resolve: RESOLUTION_SHARE of k_T·I's RMS there
     n_sliding: np.ndarray  # samples used
     at_search_edge: np.ndarray  # η_O at an end of ETA_O_SEARCH: a bound, not an estimate
 
@@ -233,9 +235,16 @@ def fit_friction(
         terms=terms * nan[:, None],
         term_stds=term_stds * nan[:, None],
         residual_rms_nm=np.sqrt(np.maximum(sse, 0.0) / np.maximum(total[:, -1, -1], 1.0)) * nan,
+        resolution_nm=RESOLUTION_SHARE * _sliding_rms(drive.torque_constant_nm_per_a * signals["current_a"], mask),
         n_sliding=total[:, -1, -1].astype(np.int64),
         at_search_edge=edge & enough,
     )
+
+
+def _sliding_rms(values: np.ndarray, mask: np.ndarray) -> np.ndarray:
+    """(N,) RMS of ``values`` ((n,) or (N, n)) over each row's ``mask`` (N, n)."""
+    squares = np.where(mask, np.atleast_2d(values) ** 2, 0.0).sum(axis=-1)
+    return np.sqrt(squares / np.maximum(mask.sum(axis=-1), 1))
 
 
 def fit_window(signals: Mapping[str, np.ndarray], rate: float, drive: DriveConstants) -> FrictionFit:

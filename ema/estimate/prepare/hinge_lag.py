@@ -119,7 +119,8 @@ def hinge_lag(
     rms = shifted_fits(signals, sample_rate_hz, lags, drive, "hinge_moment_nm", DEPARTURES_FREE).residual_rms_nm
     if not np.all(np.isfinite(rms)):
         return HingeLag(delay)  # too little sliding motion: the physics fit says so next
-    equation = [rms_log_likelihood_ratio(rms[0], r, float(fits.n_sliding[0]), sample_rate_hz) for r in rms]
+    used, resolution = float(fits.n_sliding[0]), float(fits.resolution_nm[0])
+    equation = [rms_log_likelihood_ratio(rms[0], r, used, sample_rate_hz, resolution_nm=resolution) for r in rms]
     band = band_log_likelihood(signals, sample_rate_hz, lags, drive.gear_ratio) if in_flight else 0.0
     log_posterior = np.log(prior) + band + np.array(equation)
     weight = np.exp(log_posterior - log_posterior.max())

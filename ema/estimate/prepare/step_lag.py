@@ -65,7 +65,10 @@ def step_lag(window: Window, drive: DriveConstants) -> StepLag:
     best = 1 + int(np.argmin(errors[1:]))
     flying = not window.on_ground  # on the ground the moment follows no deflection: the band reads no lag
     band = band_log_likelihood(dict(window.signals), rate, lags[[0, best]], drive.gear_ratio) if flying else [0, 0]
-    log_ratio = rms_log_likelihood_ratio(errors[0], errors[best], float(fits.n_sliding[0]), rate) + band[1] - band[0]
+    equation = rms_log_likelihood_ratio(
+        errors[0], errors[best], float(fits.n_sliding[0]), rate, resolution_nm=float(fits.resolution_nm[0])
+    )
+    log_ratio = equation + band[1] - band[0]
     weight = odds_weight(log_ratio + PRIOR_LOG_ODDS)
     spread = {
         name: float(np.sqrt(weight) * abs(values[best] - values[0]))

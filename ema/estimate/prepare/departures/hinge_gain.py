@@ -98,10 +98,11 @@ def _margin(window: Window, drive: DriveConstants, free_rms: float, used: int, r
     """ln LR by which the free load fit explains ``window`` better than the best of Eq. 5.1's fits with
     g = 1 and ``rivals``' terms (−inf where one cannot be compared)."""
     rate = window.sample_rate_hz
-    best = min(float(fit_as_read(window.signals, rate, drive, rival).residual_rms_nm[0]) for rival in rivals)
+    fits = [fit_as_read(window.signals, rate, drive, rival) for rival in rivals]
+    best = min(float(fit.residual_rms_nm[0]) for fit in fits)
     if not (np.isfinite(best) and free_rms > 0):
         return -np.inf
-    return rms_log_likelihood_ratio(best, free_rms, used, rate)
+    return rms_log_likelihood_ratio(best, free_rms, used, rate, resolution_nm=float(fits[0].resolution_nm[0]))
 
 
 def read_hinge_gain(window: Window, drive: DriveConstants, leading: bool = False) -> HingeGain:

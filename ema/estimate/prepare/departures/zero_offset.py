@@ -98,9 +98,8 @@ def sensor_offset(
 
 def log_likelihood_ratio(worse: FrictionFit, better: FrictionFit, rate: float) -> float:
     """ln of the likelihood ratio of two fits of one window by their equation errors (``rms_log_likelihood_ratio``)."""
-    return rms_log_likelihood_ratio(
-        float(worse.residual_rms_nm[0]), float(better.residual_rms_nm[0]), float(worse.n_sliding[0]), rate
-    )
+    errors, used = (float(worse.residual_rms_nm[0]), float(better.residual_rms_nm[0])), float(worse.n_sliding[0])
+    return rms_log_likelihood_ratio(*errors, used, rate, resolution_nm=float(worse.resolution_nm[0]))
 
 
 def equation_z(plain: FrictionFit, with_offset: FrictionFit, rate: float) -> float:
