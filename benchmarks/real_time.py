@@ -166,7 +166,8 @@ def report(passes: dict[str, list[Pass]], yardsticks: dict[str, float], count: i
     lines += [
         "",
         f"Target: idle p95 ≤ {TARGET_SHARE} of the yardstick; loaded p95 ≤ {LOADED_LIMIT:g}x the idle p95 "
-        f"({loaded:.2f}x, {'met' if loaded <= LOADED_LIMIT else 'not met'}; the yardstick's own {fair:.2f}x).",
+        f"({loaded:.2f}x, {'met' if loaded <= LOADED_LIMIT else 'not met'}; the yardstick's own {fair:.2f}x, so "
+        f"{loaded / fair:.2f}x the fair share a program keeping every core busy meets there).",
         "Beside busy processes that hold every core, a thread that wakes for a request shares a core with one of",
         "them: each stage, serial or spread over the pool, runs on about half of what it had idle, so the fair",
         "share is 2x, which a service keeping to one thread per core can only meet, not beat.",
