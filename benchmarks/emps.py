@@ -24,15 +24,15 @@ import numpy as np
 
 from benchmarks.as_user import run_ema
 from benchmarks.foreign_accuracy import RESULTS_MD
-from ema.calibration.servo_errors import model_errors_pct
 from ema.cli.report import typed_command, write_section
 from ema.estimate import runtime
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import STAGES
-from ema.estimate.physics.inverse import UNITS
-from ema.estimate.prepare.servo import completed, log_loop, prepare_servo
-from ema.estimate.servo import physics_of
 from ema.kinds import CalibrationRequest, calibrate, estimate
+from ema.kinds.servo.fold_errors import model_errors_pct
+from ema.kinds.servo.inverse import UNITS
+from ema.kinds.servo.log_reading import completed, log_loop, prepare_servo
+from ema.kinds.servo.stages import physics_of
 from ema.model.actuator import ActuatorDocument, read_actuator
 from ema.model.logmap import read_logmap, read_mapped
 from ema.model.window import Window, window_from_dict

@@ -1,5 +1,5 @@
-"""Each kind of actuator whole, in one module: how its windows are read, what a request costs, how its runs are
-calibrated (after NASA progpy's ``PrognosticsModel``: a model declares what it has, a predictor calls it).
+"""Each kind of actuator whole, in one module or one folder: how its windows are read, what a request costs, how its
+runs are calibrated (after NASA progpy's ``PrognosticsModel``: a model declares what it has, a predictor calls it).
 
 A kind's documents (its window's signals, its actuator document's section, what its log map may name) are its
 ``ema.model.kinds.KindFacts``; its module here adds the method:
@@ -7,10 +7,11 @@ A kind's documents (its window's signals, its actuator document's section, what 
 - ``ema.kinds.rotary``: the thesis's elevator EMA, the whole pipeline at 1 kHz or more, quasi-static below;
 - ``ema.kinds.linear``: a ball screw turned by a stepper, read quasi-statically at any rate;
 - ``ema.kinds.servo``: a linear axis under a known position controller, logged on the load side, the whole
-  method in the load frame.
+  method in the load frame: a folder holding everything only a servo needs (its log's reading, its inverse model,
+  its closed-loop simulator and dataset, its stages, its calibration and effects).
 
 ``estimate``, ``calibrate`` and ``cost`` are the entries the command line, the service and the fleet call; a
-fourth kind is a module here and a row of ``ema.model.kinds``, not branches in the stages.
+fourth kind is a module or a folder here and a row of ``ema.model.kinds``, not branches in the stages.
 """
 
 from __future__ import annotations

@@ -24,7 +24,7 @@ from pydantic import Field, field_validator
 from ema.model.document import Document, Number
 
 SERVO_EFFECTS = ("viscous_down", "stribeck", "presliding", "position_force", "position_friction")  # what calibration
-# may adopt into the model (``ema.calibration.servo_effects`` says what each is)
+# may adopt into the model (``ema.kinds.servo.load_effects`` says what each is)
 SERVO_CONSTANTS = (
     "drive_gain_n_per_unit",
     "command_limit",

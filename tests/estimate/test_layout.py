@@ -27,7 +27,6 @@ RANKS = {
     "ema.estimate.quasistatic.pipeline": 7,
     "ema.estimate.history": 6,
     "ema.estimate.pipeline": 7,
-    "ema.estimate.servo": 7,
 }
 
 

@@ -122,7 +122,7 @@ def test_a_warmed_process_loads_nothing_new_for_the_first_window_of_any_kind():
             "from ema.kinds import estimate",
             "from ema.model.actuator import read_actuator",
             "from ema.model.logmap import read_logmap, read_mapped",
-            "from ema.model.servo_sim import run_lanes",
+            "from ema.kinds.servo.closed_loop import run_lanes",
             "from ema.model.window import window_from_dict",
             "emps = sys.argv[1]",
             "window = window_from_dict(read_mapped(emps + '/DATA_EMPS.mat', read_logmap(emps + '/log-map.json')))",

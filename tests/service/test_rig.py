@@ -90,7 +90,7 @@ def test_windows_of_another_kind_than_the_document_are_a_422_naming_the_signals(
 
 def test_the_service_answers_a_servo_log_within_its_budget(tmp_path):
     """A 24.8 s log at 1 kHz: over the window limit in seconds, but its simulations' work is what is counted."""
-    from tests.estimate.test_servo import EMPS
+    from tests.kinds.servo.test_stages import EMPS
 
     window = window_from_dict(read_mapped(EMPS / "DATA_EMPS.mat", read_logmap(EMPS / "log-map.json")))
     with TestClient(create_app(settings_for(tmp_path, max_window_s=4.0)), base_url=LOCAL) as client:

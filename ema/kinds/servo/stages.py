@@ -1,10 +1,10 @@
 """A servo's window -> ``ema-estimate/1``, every stage of the method on a log taken on the load side.
 
-1. **prepare** (``ema.estimate.prepare.servo``): the document completed by the log's constants, the controller
+1. **prepare** (``ema.kinds.servo.log_reading``): the document completed by the log's constants, the controller
    checked against the logged command, the motion read;
-2. **physics** (``ema.estimate.physics.inverse``): Eq. 5.1 in the load frame, F = M·q̈ + FDJ·sgn(q̇) + C·q̇ +
+2. **physics** (``ema.kinds.servo.inverse``): Eq. 5.1 in the load frame, F = M·q̈ + FDJ·sgn(q̇) + C·q̇ +
    F_offset, by least squares, Newey–West stds;
-3. **simulate** (``ema.estimate.simulate.servo``): the window's own set point run in closed loop, its controller
+3. **simulate** (``ema.kinds.servo.loop_dataset``): the window's own set point run in closed loop, its controller
    at its rate, at constants drawn around the physics estimate;
 4. **learn**: the shallow network from the simulated force to the constants;
 5. **assess** (``ema.estimate.assess.weighing``): both estimators on held-out simulations, blended per
@@ -26,7 +26,11 @@ from ema.estimate.config import PipelineConfig
 from ema.estimate.documents.window import WindowInfo
 from ema.estimate.learn.estimator import NetworkRegressor
 from ema.estimate.learn.network import LearnConfig
-from ema.estimate.physics.inverse import (
+from ema.estimate.physics.scenario import MAX_RATIO
+from ema.estimate.report import training_info
+from ema.estimate.stats import RESOLUTION_SHARE, rms
+from ema.estimate.stopwatch import Stopwatch
+from ema.kinds.servo.inverse import (
     EITHER_SIGN,
     UNITS,
     InverseFit,
@@ -35,12 +39,8 @@ from ema.estimate.physics.inverse import (
     inverse_columns,
     load_motion,
 )
-from ema.estimate.physics.scenario import MAX_RATIO
-from ema.estimate.prepare.servo import ServoPrepared, prepare_servo, refuse_reversed_signs
-from ema.estimate.report import training_info
-from ema.estimate.simulate.servo import ServoData, lane_parameters, simulate_servo_dataset
-from ema.estimate.stats import RESOLUTION_SHARE, rms
-from ema.estimate.stopwatch import Stopwatch
+from ema.kinds.servo.log_reading import ServoPrepared, prepare_servo, refuse_reversed_signs
+from ema.kinds.servo.loop_dataset import ServoData, lane_parameters, simulate_servo_dataset
 from ema.model.actuator import ActuatorDocument
 from ema.model.window import Window
 

@@ -1,5 +1,5 @@
 """What a servo's inverse model may lack: each effect's physical reading, the grid of its nonlinear constant, and
-when its fitted constants are physical. Its columns of Eq. 5.1 are ``ema.estimate.physics.inverse``'s.
+when its fitted constants are physical. Its columns of Eq. 5.1 are ``ema.kinds.servo.inverse``'s.
 
 - ``viscous_down``: a viscous friction that differs with the direction of motion (a seal, a preload or the
   grease distributed unevenly): C splits into C up and C down.

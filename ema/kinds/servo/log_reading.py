@@ -23,7 +23,7 @@
   the added command to its controller's, the training runs as well as the check: a loop left to its controller
   would move otherwise than the log's. The note ``added_command`` says so, with its size.
 - The loop's bandwidth (the document's, else the natural frequency √(kp·kv·g/M) of the position loop, M from a
-  first fit) sets the inverse model's filters (``ema.estimate.physics.inverse``).
+  first fit) sets the inverse model's filters (``ema.kinds.servo.inverse``).
 """
 
 from __future__ import annotations
@@ -33,12 +33,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from ema.estimate.documents import Note
-from ema.estimate.physics.inverse import Motion, fit_inverse, inverse_columns, load_motion, refuse_still
 from ema.estimate.stats import below_zero, rms
+from ema.kinds.servo.closed_loop import ServoLoop, ServoRuns, simulate_servo
+from ema.kinds.servo.inverse import Motion, fit_inverse, inverse_columns, load_motion, refuse_still
 from ema.model.actuator import ActuatorDocument
 from ema.model.checks import InputError
 from ema.model.servo import Servo
-from ema.model.servo_sim import ServoLoop, ServoRuns, simulate_servo
 from ema.model.window import Window
 
 RATE_TOLERANCE = 0.01

@@ -1,15 +1,15 @@
 """``ema calibrate`` for a servo: learn what the document lacks, then find what the model still misses, name it,
 add it, and report the error before and after.
 
-1. **Learn.** Eq. 5.1 in the load frame (``ema.estimate.physics.inverse``) over every window at once: M, C,
+1. **Learn.** Eq. 5.1 in the load frame (``ema.kinds.servo.inverse``) over every window at once: M, C,
    FDJ and the offset, each with its Newey–West std and unit (``learned``); the model's error is the
    identification benchmarks' own, 100·‖y − ŷ‖/‖y‖ on the decimated force.
 2. **Find**, where there is something to find: rows where a force the log lacks disturbs the fit are left out
-   (``ema.estimate.physics.inverse.disturbed_rows``), and the windows' residual must stand beyond what noise
+   (``ema.kinds.servo.inverse.disturbed_rows``), and the windows' residual must stand beyond what noise
    alone leaves, the same fit on ``COPIES`` noise-only copies (each window simulated in closed loop at the learned
    constants, its sensor read at another phase of its step), at a 1 % false alarm (``misfit_limit``). Then each
    effect of
-   ``ema.calibration.servo_effects`` is fitted on four fifths of every window and
+   ``ema.kinds.servo.load_effects`` is fitted on four fifths of every window and
    predicts the fifth left out, in turn (its nonlinear constant chosen the same way). An effect is taken only
    where it is physical (its constants' signs), predicts every fold better (a real effect shows in each part
    of a log, noise does not), and cuts the held-out residual by ``MIN_HELD_OUT_DROP`` at least; then the next,
@@ -41,9 +41,10 @@ from ema.calibration.documents import (
     Step,
 )
 from ema.calibration.plot import ResidualPlot, Series
-from ema.calibration.servo_effects import EFFECTS, ServoEffect
-from ema.calibration.servo_errors import closed_loop_error_pct, document_check
-from ema.calibration.servo_fit import (
+from ema.estimate.assess.weighing import misfit_limit
+from ema.estimate.stats import rms
+from ema.kinds.servo.fold_errors import closed_loop_error_pct, document_check
+from ema.kinds.servo.fold_fit import (
     COPIES,
     FOLDS,
     FRAME_PHASES,
@@ -54,13 +55,12 @@ from ema.calibration.servo_fit import (
     simulator_frame,
     undisturbed,
 )
-from ema.estimate.assess.weighing import misfit_limit
-from ema.estimate.physics.inverse import (
+from ema.kinds.servo.inverse import (
     UNITS,
     decimated,
 )
-from ema.estimate.prepare.servo import ServoPrepared, document_effects, prepare_servo, refuse_reversed_signs
-from ema.estimate.stats import rms
+from ema.kinds.servo.load_effects import EFFECTS, ServoEffect
+from ema.kinds.servo.log_reading import ServoPrepared, document_effects, prepare_servo, refuse_reversed_signs
 from ema.model.actuator import ActuatorDocument, Nominal
 from ema.model.checks import InputError
 from ema.model.window import Window

@@ -4,8 +4,8 @@ and the loop follows the closed-form foreign servo (another integration, the sam
 import numpy as np
 import pytest
 
-from ema.model import servo_sim
-from ema.model.servo_sim import LANE_PARAMETERS, ServoLoop, simulate_servo
+from ema.kinds.servo import closed_loop as servo_sim
+from ema.kinds.servo.closed_loop import LANE_PARAMETERS, ServoLoop, simulate_servo
 from tests.foreign import servo as foreign
 
 LOOP = ServoLoop(foreign.KP, foreign.KV, foreign.GAIN, foreign.LIMIT, 1.0 / foreign.RATE_HZ, foreign.STEP_M)

@@ -176,7 +176,7 @@ def _legendre(position: np.ndarray) -> list[np.ndarray]:
 
 def inverse_columns(motion: Motion, effects: Mapping[str, float] | None = None) -> dict[str, np.ndarray]:
     """The model's columns at full rate: M, C, FDJ, the offset, and each effect in ``effects`` (name -> its
-    nonlinear constant, ``ema.calibration.servo_effects`` says what each is): ``viscous_down`` splits C by
+    nonlinear constant, ``ema.kinds.servo.load_effects`` says what each is): ``viscous_down`` splits C by
     direction; ``stribeck`` (v_S) adds sgn(q̇)·exp(−(q̇/v_S)²); ``presliding`` (σ) adds −sgn(q̇)·exp(−s/σ), s the
     travel since the last reversal; ``position_force`` adds P1..P3 of the position, ``position_friction``
     sgn(q̇)·P1..P3."""

@@ -8,16 +8,16 @@ import numpy as np
 import pytest
 
 from ema.estimate.documents import STAGES
-from ema.estimate.physics.inverse import fit_inverse, inverse_columns
-from ema.estimate.prepare.servo import completed, log_loop, prepare_servo
 from ema.kinds import estimate
+from ema.kinds.servo.inverse import fit_inverse, inverse_columns
+from ema.kinds.servo.log_reading import completed, log_loop, prepare_servo
 from ema.model.actuator import actuator_from_dict, read_actuator
 from ema.model.checks import InputError
 from ema.model.logmap import read_logmap, read_mapped
 from ema.model.window import window_from_dict
 from tests.foreign import servo as foreign
 
-EMPS = Path(__file__).resolve().parents[2] / "examples" / "emps"
+EMPS = Path(__file__).resolve().parents[3] / "examples" / "emps"
 FOREIGN = actuator_from_dict(foreign.DOCUMENT)
 
 

@@ -12,7 +12,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ema.estimate.physics.inverse import (
+from ema.estimate.stats import rms
+from ema.kinds.servo.inverse import (
     decimated_problem,
     disturbed_rows,
     fit_inverse,
@@ -21,9 +22,8 @@ from ema.estimate.physics.inverse import (
     newey_west_lags,
     newey_west_std,
 )
-from ema.estimate.prepare.servo import ServoPrepared
-from ema.estimate.simulate.servo import LANE_COLUMNS, lane_parameters
-from ema.estimate.stats import rms
+from ema.kinds.servo.log_reading import ServoPrepared
+from ema.kinds.servo.loop_dataset import LANE_COLUMNS, lane_parameters
 
 FOLDS = 5
 COPIES = 8

@@ -13,7 +13,7 @@ from ema.model.logmap import read_logmap, read_mapped
 from ema.model.window import window_from_dict
 from tests.foreign import servo as foreign
 
-EMPS = Path(__file__).resolve().parents[2] / "examples" / "emps"
+EMPS = Path(__file__).resolve().parents[3] / "examples" / "emps"
 FOREIGN = actuator_from_dict(foreign.DOCUMENT)
 
 
@@ -105,7 +105,7 @@ def test_the_budget_counts_every_closed_loop_a_calibration_runs(monkeypatch):
     """The service refuses a calibration by its simulation work (``calibration_cost``): it counts each closed loop
     the calibration runs, no fewer."""
     from ema.kinds import calibration_cost
-    from ema.model.servo_sim import SUBSTEPS
+    from ema.kinds.servo.closed_loop import SUBSTEPS
 
     runs = []
 
@@ -113,7 +113,7 @@ def test_the_budget_counts_every_closed_loop_a_calibration_runs(monkeypatch):
         runs.append(len(set_point) * lanes.shape[0])
         return simulate(set_point, lanes, *args, **kwargs)
 
-    from ema.estimate.prepare import servo as prepared_servo  # every closed loop of a prepared window runs there
+    from ema.kinds.servo import log_reading as prepared_servo  # every closed loop of a prepared window runs there
 
     simulate = prepared_servo.simulate_servo
     monkeypatch.setattr(prepared_servo, "simulate_servo", counted)
@@ -130,7 +130,7 @@ def test_a_constant_the_twins_give_no_finite_read_of_keeps_the_fits_value(monkey
     finite number (a closed loop that could not follow), the fit's value stands rather than a NaN in the document."""
     from types import SimpleNamespace
 
-    import ema.calibration.servo_fit as servo_fit
+    import ema.kinds.servo.fold_fit as servo_fit
 
     reads = {"fdj_n": float("nan"), "mass_kg": 94.0, "position_friction_p1_n": 0.0}
     monkeypatch.setattr(servo_fit, "_simulated", lambda p, *rest: p)

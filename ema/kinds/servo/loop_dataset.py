@@ -1,4 +1,4 @@
-"""A servo window's own dataset: its set point run in closed loop (``ema.model.servo_sim``) at constants drawn
+"""A servo window's own dataset: its set point run in closed loop (``ema.kinds.servo.closed_loop``) at constants drawn
 around the physics estimate.
 
 Every constant the inverse model read that the simulator has (M, C or C per direction, FDJ, the offset, a
@@ -18,10 +18,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from ema.estimate.config import PipelineConfig
-from ema.estimate.physics.inverse import InverseFit
-from ema.estimate.prepare.servo import ServoPrepared
 from ema.estimate.simulate.design import halton
-from ema.model.servo_sim import LANE_PARAMETERS, ServoRuns
+from ema.kinds.servo.closed_loop import LANE_PARAMETERS, ServoRuns
+from ema.kinds.servo.inverse import InverseFit
+from ema.kinds.servo.log_reading import ServoPrepared
 
 SPAN_SIGMAS = 6.0
 MIN_HALF_SHARE = 0.05

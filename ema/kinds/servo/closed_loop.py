@@ -7,7 +7,7 @@ filters it by its FIR taps into q̄_k, differences it into a speed, and holds th
     F_k = g·sat(kv·(kp·(r_k − q_k) − (q̄_k − q̄_{k−1})/Δt) + e_k, ±u_max)
 
 e_k being a command added to the controller's (an excitation for identification, a feed-forward: the log's
-own, ``ema.estimate.prepare.servo.added_command``; 0 for a loop left to its controller),
+own, ``ema.kinds.servo.log_reading.added_command``; 0 for a loop left to its controller),
 
 until k + 1, over which the load moves by (``ema.model.servo``)
 

@@ -1,9 +1,9 @@
 """The servo kind: a linear axis driven by a force command from a known position controller, logged on the load
 side (the EMPS benchmark's machine is one).
 
-Its windows go through every stage of the method in the load frame (``ema.estimate.servo``): its own set point
-simulated in closed loop by ``ema.model.servo_sim``, a network learned from those runs, both estimators
-assessed, the window simulated at the answer. Its calibration (``ema.calibration.servo``) learns the load's
+Its windows go through every stage of the method in the load frame (``ema.kinds.servo.stages``): its own set point
+simulated in closed loop by ``ema.kinds.servo.closed_loop``, a network learned from those runs, both estimators
+assessed, the window simulated at the answer. Its calibration (``ema.kinds.servo.calibration``) learns the load's
 constants and traces what the model still misses to a named effect.
 """
 
@@ -14,14 +14,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ema.calibration.servo import CLOSED_LOOPS, calibrate_servo
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import STAGES, Estimate
 from ema.kinds.base import WARM_UP, Calibrated, CalibrationRequest, Cost, Request
+from ema.kinds.servo.calibration import CLOSED_LOOPS, calibrate_servo
+from ema.kinds.servo.closed_loop import SUBSTEPS, ServoLoop, simulate_servo
 from ema.model.actuator import actuator_from_dict
 from ema.model.kinds import KINDS, KindFacts
 from ema.model.params import DriveConstants
-from ema.model.servo_sim import SUBSTEPS, ServoLoop, simulate_servo
 from ema.model.window import Window
 
 ROTARY_STEP_S = DriveConstants().step_s  # what a service's simulation limit counts in
@@ -35,7 +35,9 @@ class Servo:
         return STAGES
 
     def estimate(self, window: Window, request: Request) -> Estimate:
-        from ema.estimate.servo import estimate_servo  # the network's: loaded by its first window (ema.kinds.rotary)
+        from ema.kinds.servo.stages import (
+            estimate_servo,
+        )  # the network's: loaded by its first window (ema.kinds.rotary)
 
         return estimate_servo(
             window, request.config, actuator=request.actuator, read_with=request.read_with, on_stage=request.on_stage
@@ -58,7 +60,7 @@ class Servo:
     def warm_up(self) -> None:
         """A tiny servo's window (``WARM_UP_SERVO``) simulated and estimated: its filters, its simulator and its
         network exercised once (their kernels loaded)."""
-        from ema.estimate.simulate.servo import lane_parameters
+        from ema.kinds.servo.loop_dataset import lane_parameters
 
         loop = WARM_UP_LOOP
         rate = 1.0 / loop.period_s
