@@ -24,9 +24,9 @@ from pathlib import Path
 import numpy as np
 
 from ema.calibration.documents import Change, DriveLearned
-from ema.calibration.linear_report import calibrate_linear
 from ema.cli.report import write_section
 from ema.kinds import estimate
+from ema.kinds.linear.calibration_report import calibrate_linear
 from ema.model.actuator import ActuatorDocument, read_actuator
 from ema.model.logmap import read_logmap, read_mapped
 from ema.model.window import window_from_dict

@@ -5,7 +5,8 @@ A kind's documents (its window's signals, its actuator document's section, what 
 ``ema.model.kinds.KindFacts``; its module here adds the method:
 
 - ``ema.kinds.rotary``: the thesis's elevator EMA, the whole pipeline at 1 kHz or more, quasi-static below;
-- ``ema.kinds.linear``: a ball screw turned by a stepper, read quasi-statically at any rate;
+- ``ema.kinds.linear``: a ball screw turned by a stepper, read quasi-statically at any rate: a folder with its
+  drive's calibration (learned from healthy runs, faulted runs compared with it);
 - ``ema.kinds.servo``: a linear axis under a known position controller, logged on the load side, the whole
   method in the load frame: a folder holding everything only a servo needs (its log's reading, its inverse model,
   its closed-loop simulator and dataset, its stages, its calibration and effects).

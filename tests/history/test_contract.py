@@ -206,7 +206,7 @@ def test_every_change_an_actuator_sees_moves_its_state_and_a_repeat_does_not(his
 def test_calibrations_come_back_whole_latest_first(history):
     from pathlib import Path
 
-    from ema.calibration.linear_report import calibrate_linear
+    from ema.kinds.linear.calibration_report import calibrate_linear
     from ema.model.actuator import read_actuator
     from ema.model.logmap import read_logmap, read_mapped
     from ema.model.window import window_from_dict

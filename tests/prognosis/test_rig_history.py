@@ -6,8 +6,8 @@ from pathlib import Path
 
 import pytest
 
-from ema.calibration.linear_report import calibrate_linear
 from ema.kinds import estimate
+from ema.kinds.linear.calibration_report import calibrate_linear
 from ema.model.actuator import read_actuator
 from ema.model.logmap import read_logmap, read_mapped
 from ema.model.window import window_from_dict

@@ -4,14 +4,14 @@ and the friction rising in its prognosis and on the operator's page."""
 import pytest
 from fastapi.testclient import TestClient
 
-from ema.calibration.linear_report import calibrate_linear
+from ema.kinds.linear.calibration_report import calibrate_linear
 from ema.model.actuator import read_actuator
 from ema.model.logmap import read_logmap, read_mapped
 from ema.model.params import HealthParams
 from ema.model.synthetic import synthetic_window
 from ema.model.window import window_from_dict, window_to_dict
 from ema.service.main import create_app
-from tests.estimate.test_ballscrew import DOCUMENT, runs
+from tests.kinds.linear.test_ballscrew import DOCUMENT, runs
 from tests.service.conftest import LOCAL, settings_for
 
 

@@ -126,7 +126,7 @@ class TorqueReading:
 
 @dataclass(frozen=True)
 class Repeatability:
-    """What the document says of how one state's runs scatter (``ema.calibration.linear.HealthySpread``)."""
+    """What the document says of how one state's runs scatter (``ema.kinds.linear.drive_fit.HealthySpread``)."""
 
     run_to_run_nm: float | None = None  # the healthy runs' sd within a set (null: not learned)
     run_noise_nm: float = 0.0  # their typical own noise

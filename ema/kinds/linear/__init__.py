@@ -2,7 +2,7 @@
 
 Its windows are read quasi-statically at any rate (``ema.estimate.quasistatic.pipeline``: the stepper's drive is no
 current loop ema can simulate), its torque from the drive's current as ``ema calibrate`` learned it
-(``ema.calibration.linear``): healthy runs teach the drive, faulted runs are compared with it.
+(``ema.kinds.linear.drive_fit``): healthy runs teach the drive, faulted runs are compared with it.
 """
 
 from __future__ import annotations
@@ -10,12 +10,12 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from ema.calibration.linear_report import calibrate_linear
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import Estimate
 from ema.estimate.quasistatic.drive import STEPPER_READING
 from ema.estimate.quasistatic.pipeline import QUASI_STATIC
 from ema.kinds.base import Calibrated, CalibrationRequest, Cost, Request, read_quasi_statically
+from ema.kinds.linear.calibration_report import calibrate_linear
 from ema.model.kinds import KINDS, KindFacts
 from ema.model.window import Window
 

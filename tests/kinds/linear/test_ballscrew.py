@@ -7,15 +7,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from ema.calibration.linear import MIN_Z, read_run
-from ema.calibration.linear_report import calibrate_linear
 from ema.kinds import estimate
+from ema.kinds.linear.calibration_report import calibrate_linear
+from ema.kinds.linear.drive_fit import MIN_Z, read_run
 from ema.model.actuator import read_actuator
 from ema.model.checks import InputError
 from ema.model.logmap import read_logmap, read_mapped
 from ema.model.window import window_from_dict
 
-RIG = Path(__file__).resolve().parents[2] / "examples" / "ballscrew-rig"
+RIG = Path(__file__).resolve().parents[3] / "examples" / "ballscrew-rig"
 MAP = read_logmap(RIG / "log-map.json")
 DOCUMENT = read_actuator(RIG / "actuator.json")
 

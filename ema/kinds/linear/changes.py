@@ -5,7 +5,7 @@ mean FDJ is set against the nominal (``ema.estimate.quasistatic.departure``): a 
 healthy sets allow (a friction that falls is one too: a screw losing its preload), with the load outside the
 healthy runs' loads said to be extrapolated, and how large a change it could not show. Where the runs span two
 load sizes, η_O is read over all of them and set against the nominal likewise. Along the stroke, the current
-is set against the healthy runs' own profile (``ema.calibration.linear.profile_change``): a friction that
+is set against the healthy runs' own profile (``ema.kinds.linear.drive_fit.profile_change``): a friction that
 changes along the stroke is named only beyond ``MIN_Z`` of one run's scatter. Each change carries its
 machine-readable verdict (``departed``) beside its sentence.
 """
@@ -18,13 +18,13 @@ from collections.abc import Sequence
 import numpy as np
 
 from ema.calibration.documents import CalibrationReport, Candidate, Change, HeldOut, NoiseFloor, Step
-from ema.calibration.linear import MIN_Z, Run, profile_change, run_load_n
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import DIMENSIONLESS, ActuatorRead, Estimate
 from ema.estimate.quasistatic.departure import DEPARTURE_Z, Departure, departure, inside
 from ema.estimate.quasistatic.drive import STEPPER_READING
 from ema.estimate.quasistatic.pipeline import estimate_low_rate
 from ema.estimate.quasistatic.stretches import fit_stretches
+from ema.kinds.linear.drive_fit import MIN_Z, Run, profile_change, run_load_n
 from ema.model.actuator import ActuatorDocument
 from ema.model.window import Window
 

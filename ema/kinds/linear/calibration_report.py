@@ -1,6 +1,6 @@
 """``ema calibrate`` for a linear actuator: learn its drive from healthy runs, or say what faulted runs changed.
 
-Learning (the document lacks c or a nominal health; ``ema.calibration.linear.fit_drive``): the report's
+Learning (the document lacks c or a nominal health; ``ema.kinds.linear.drive_fit.fit_drive``): the report's
 ``drive`` holds what was learned, the residual of the runs' current before (the document's model) and
 after, and a leave-one-run-out check; ``completed`` is the document with it. Comparing (a calibrated
 document): each run read with it (``ema.estimate.quasistatic.pipeline``), FDJ (and η_O where the runs' loads
@@ -24,10 +24,10 @@ from ema.calibration.documents import (
     NoiseFloor,
     Step,
 )
-from ema.calibration.linear import DriveFit, Run, fit_drive, read_run
-from ema.calibration.linear_changes import baseline, compared
 from ema.calibration.plot import ResidualPlot, Series
 from ema.estimate.documents import DIMENSIONLESS
+from ema.kinds.linear.changes import baseline, compared
+from ema.kinds.linear.drive_fit import DriveFit, Run, fit_drive, read_run
 from ema.model.actuator import ActuatorDocument, Nominal
 from ema.model.params import load_factors
 from ema.model.window import Window
