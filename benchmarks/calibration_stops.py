@@ -16,8 +16,8 @@ import argparse
 from pathlib import Path
 
 from ema.calibration.calibrate import Calibrator
-from ema.cli.report import write_section
-from ema.estimate import runtime
+from ema.cli.benchmark_docs import write_section
+from ema.estimate import thread_budget
 from ema.model.actuator import THESIS
 from ema.model.window import window_from_dict
 from tests.foreign.physics import Effects, Flight
@@ -66,7 +66,7 @@ def main() -> None:
     parser.add_argument("--seeds", type=int, default=4)
     parser.add_argument("--docs", action="store_true", help="rewrite its section of docs/calibration.md")
     args = parser.parse_args()
-    runtime.configure()
+    thread_budget.configure()
     rows = []
     for case in CASES:
         for seed in range(args.seeds):

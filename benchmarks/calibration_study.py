@@ -23,9 +23,9 @@ from typing import Any
 import numpy as np
 
 from ema.calibration.calibrate import Calibrator, combined
+from ema.cli.benchmark_docs import write_section
 from ema.cli.figures import residual_figure
-from ema.cli.report import write_section
-from ema.estimate import runtime
+from ema.estimate import thread_budget
 from ema.estimate.config import PipelineConfig
 from ema.estimate.pipeline import estimate_window
 from ema.kinds.rotary import residual_plot
@@ -194,7 +194,7 @@ def main() -> None:
     parser.add_argument("--scales", default="0.2,1,5,20")
     parser.add_argument("--docs", action="store_true")
     args = parser.parse_args()
-    runtime.configure()
+    thread_budget.configure()
     if args.docs:
         (DOCS / "figures").mkdir(parents=True, exist_ok=True)
     rows = study([float(s) for s in args.scales.split(",")], args.seeds, args.docs)

@@ -15,8 +15,8 @@ from dataclasses import replace
 from benchmarks.foreign_accuracy import RESULTS_MD, run_one
 from benchmarks.foreign_groups import group_seed, groups
 from benchmarks.tails import BOUND
-from ema.cli.report import typed_command, write_section
-from ema.estimate import runtime
+from ema.cli.benchmark_docs import typed_command, write_section
+from ema.estimate import thread_budget
 from tests.foreign.careless import SLIPS, Slip, exported
 from tests.foreign.windows import Draw
 
@@ -41,7 +41,7 @@ def main() -> None:
     parser.add_argument("--per-slip", type=int, default=104, help="windows per slip (each group in turn)")
     parser.add_argument("--docs", action="store_true", help="rewrite the section of docs/results.md")
     args = parser.parse_args()
-    runtime.configure()
+    thread_budget.configure()
     started = time.perf_counter()
     names = [name for name in groups() if "held" not in name]
     counts: dict[str, Counter] = {CLEAN: Counter(), **{slip: Counter() for slip in SLIPS}}

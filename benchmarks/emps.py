@@ -24,8 +24,8 @@ import numpy as np
 
 from benchmarks.as_user import run_ema
 from benchmarks.foreign_accuracy import RESULTS_MD
-from ema.cli.report import typed_command, write_section
-from ema.estimate import runtime
+from ema.cli.benchmark_docs import typed_command, write_section
+from ema.estimate import thread_budget
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import STAGES
 from ema.kinds import CalibrationRequest, calibrate, estimate
@@ -119,7 +119,7 @@ def main() -> None:
     parser.add_argument("--held-out-map", type=Path, help="its log map")
     parser.add_argument("--docs", action="store_true", help="rewrite the section of docs/results.md")
     args = parser.parse_args()
-    runtime.configure(None)
+    thread_budget.configure(None)
     mapping, document_path = EMPS / "log-map.json", EMPS / "actuator.json"
     window, document = read(EMPS / "DATA_EMPS.mat", mapping), read_actuator(document_path)
     wall, answer = cli_seconds(EMPS / "DATA_EMPS.mat", mapping, document_path)

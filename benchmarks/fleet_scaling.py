@@ -30,7 +30,7 @@ import httpx
 from benchmarks.as_user import run_ema
 from benchmarks.real_time import cpu_seconds
 from benchmarks.service_overhead import free_port, serve
-from ema.cli.report import typed_command, write_section
+from ema.cli.benchmark_docs import typed_command, write_section
 from ema.model.params import HealthParams
 from ema.model.runtime import available_cores
 from ema.model.synthetic import synthetic_window

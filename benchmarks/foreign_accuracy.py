@@ -23,9 +23,9 @@ import numpy as np
 from benchmarks.accuracy_by_wear import wear_figure, wear_table
 from benchmarks.foreign_groups import group_seed, groups
 from benchmarks.tails import BOUND, FIRST_NOISE_SEED, expected_over
-from ema.cli.report import write_section
-from ema.estimate import runtime
-from ema.estimate.documents.window import HistoryReadings
+from ema.cli.benchmark_docs import write_section
+from ema.estimate import thread_budget
+from ema.estimate.documents.window_facts import HistoryReadings
 from ema.estimate.pipeline import estimate_window
 from ema.estimate.report import WEAK_SHARE_OF_RANGE, share_of_range
 from ema.model.actuator import THESIS
@@ -257,7 +257,7 @@ def main() -> None:
     parser.add_argument("--tail-draws", type=int, default=8, help="noise redraws per answer past 10 %% not weak")
     parser.add_argument("--docs", action="store_true", help="rewrite the section of docs/results.md")
     args = parser.parse_args()
-    runtime.configure()
+    thread_budget.configure()
     started = time.perf_counter()
     rows: dict[str, list[dict[str, Any]]] = {}
     for name, make in groups().items():

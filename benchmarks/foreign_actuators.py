@@ -20,8 +20,8 @@ from typing import Any
 
 import numpy as np
 
-from ema.cli.report import write_section
-from ema.estimate import runtime
+from ema.cli.benchmark_docs import write_section
+from ema.estimate import thread_budget
 from ema.estimate.pipeline import estimate_window
 from ema.model.actuator import THESIS, actuator_from_dict
 from ema.model.checks import InputError
@@ -119,7 +119,7 @@ def main() -> None:
     parser.add_argument("--seed", type=int, default=50_000)
     parser.add_argument("--docs", action="store_true", help="rewrite the section of docs/results.md")
     args = parser.parse_args()
-    runtime.configure()
+    thread_budget.configure()
     started, table = time.perf_counter(), {}
     for a, name in enumerate(("heavier", "smaller", "thesis")):
         for c, (condition, count) in enumerate(CONDITIONS.items()):

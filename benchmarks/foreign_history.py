@@ -21,8 +21,8 @@ import numpy as np
 
 from benchmarks.tails import BOUND
 from benchmarks.wearing_fleet import KINDS_OF_WEAR, Thresholds, Wear, flights, logged_window, wear
-from ema.cli.report import write_section
-from ema.estimate import runtime
+from ema.cli.benchmark_docs import write_section
+from ema.estimate import thread_budget
 from ema.estimate.history import readings_of
 from ema.estimate.pipeline import estimate_window
 from ema.estimate.report import share_of_range
@@ -208,7 +208,7 @@ def main() -> None:
     parser.add_argument("--alone", action="store_true", help="each window without what earlier ones read")
     parser.add_argument("--docs", action="store_true", help="rewrite the section of docs/prognosis.md")
     args = parser.parse_args()
-    runtime.configure()
+    thread_budget.configure()
     started, thresholds, rows = time.perf_counter(), Thresholds.of(THESIS), []
     sizes = (args.actuators, args.speeding, args.healthy, args.heavier, args.zeroed)
     counts = dict(zip(KINDS_OF_WEAR, sizes, strict=True))

@@ -36,8 +36,8 @@ import numpy as np
 from benchmarks.foreign_accuracy import RESULTS_MD
 from benchmarks.foreign_groups import group_seed, groups
 from benchmarks.tails import expected_over
-from ema.cli.report import write_section
-from ema.estimate import runtime
+from ema.cli.benchmark_docs import write_section
+from ema.estimate import thread_budget
 from ema.estimate.physics.features import as_read
 from ema.estimate.physics.friction import FitSettings, fit_friction, regressors
 from ema.estimate.prepare.conditioning import prepare
@@ -205,7 +205,7 @@ def main() -> None:
     parser.add_argument("--draws", type=int, default=100, help="noise draws per window for our fit's RMS")
     parser.add_argument("--docs", action="store_true", help="rewrite the section of docs/results.md")
     args = parser.parse_args()
-    runtime.configure()
+    thread_budget.configure()
     rows = {group: [one_window(group, i, args.draws) for i in range(args.per_group)] for group in GROUPS}
     body = report(rows, args.draws)
     print(body)

@@ -13,8 +13,8 @@ from typing import Any
 
 from benchmarks.foreign_accuracy import RESULTS_MD, run_one, summarize, table
 from benchmarks.foreign_groups import FAMILIES, drive_off, off_zero, viscous
-from ema.cli.report import typed_command, write_section
-from ema.estimate import runtime
+from ema.cli.benchmark_docs import typed_command, write_section
+from ema.estimate import thread_budget
 from ema.estimate.history import readings_of
 from ema.estimate.pipeline import estimate_window
 from ema.model.actuator import THESIS
@@ -127,7 +127,7 @@ def main() -> None:
     parser.add_argument("--per-group", type=int, default=20, help="windows per group")
     parser.add_argument("--docs", action="store_true", help="rewrite the section of docs/results.md")
     args = parser.parse_args()
-    runtime.configure()
+    thread_budget.configure()
     started = time.perf_counter()
     summaries: dict[str, dict[str, Any]] = {}
     for name in [*GROUPS, *AFTER_ANOTHER]:

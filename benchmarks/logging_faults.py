@@ -14,8 +14,8 @@ from typing import Any
 
 from benchmarks.foreign_accuracy import RESULTS_MD, run_one, summarize, table
 from benchmarks.foreign_groups import group_seed, groups
-from ema.cli.report import typed_command, write_section
-from ema.estimate import runtime
+from ema.cli.benchmark_docs import typed_command, write_section
+from ema.estimate import thread_budget
 from ema.estimate.prepare.stale import stale_runs
 from ema.model.actuator import THESIS
 from ema.model.window import window_from_dict
@@ -60,7 +60,7 @@ def main() -> None:
     parser.add_argument("--per-fault", type=int, default=52, help="windows per fault (each group in turn)")
     parser.add_argument("--docs", action="store_true", help="rewrite the section of docs/results.md")
     args = parser.parse_args()
-    runtime.configure()
+    thread_budget.configure()
     started = time.perf_counter()
     names = [name for name in groups() if "held" not in name]
     rows: dict[str, list[dict[str, Any]]] = {CLEAN: [], **{fault: [] for fault in FAULTS}}

@@ -15,9 +15,9 @@ from typing import Any
 
 import numpy as np
 
+from ema.cli.benchmark_docs import write_section
 from ema.cli.printing import check_line
-from ema.cli.report import write_section
-from ema.estimate import runtime
+from ema.estimate import thread_budget
 from ema.estimate.assess.weighing import MISFIT_FALSE_ALARM
 from ema.estimate.pipeline import estimate_window
 from ema.model.actuator import THESIS
@@ -56,7 +56,7 @@ def main() -> None:
     parser.add_argument("--seed", type=int, default=5000)
     parser.add_argument("--docs", action="store_true", help="rewrite its section of docs/results.md")
     args = parser.parse_args()
-    runtime.configure()
+    thread_budget.configure()
     found = measure(args.windows, args.seed)
     ratios, limits = found["ratios"], found["limits"]
     assert isinstance(ratios, np.ndarray) and isinstance(limits, np.ndarray)

@@ -19,8 +19,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ema.cli.report import typed_command, write_section
-from ema.estimate import runtime
+from ema.cli.benchmark_docs import typed_command, write_section
+from ema.estimate import thread_budget
 from ema.estimate.pipeline import estimate_window
 from ema.estimate.report import share_of_range
 from ema.model.actuator import THESIS
@@ -77,7 +77,7 @@ def legacy(paths: list[Path], checkout: Path) -> list[dict[str, float]]:
 
 
 def today(paths: list[Path]) -> list[dict[str, float]]:
-    runtime.configure()
+    thread_budget.configure()
     estimate_window(read_window(paths[0]), actuator=THESIS)  # warm
     out = []
     for path in paths:

@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ema.cli.report import write_section
+from ema.cli.benchmark_docs import write_section
 from ema.prognosis.outlook import outlook
 from ema.prognosis.trend import Series
 from tests.prognosis.histories import LAWS, THRESHOLD, history

@@ -24,7 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from ema.calibration.documents import Change, DriveLearned
-from ema.cli.report import write_section
+from ema.cli.benchmark_docs import write_section
 from ema.kinds import estimate
 from ema.kinds.linear.calibration_report import calibrate_linear
 from ema.model.actuator import ActuatorDocument, read_actuator

@@ -34,7 +34,7 @@ import numpy as np
 
 from benchmarks.service_overhead import free_port, quiet_collector, serve
 from ema.cli.bench import TARGET_SHARE, load
-from ema.cli.report import write_section
+from ema.cli.benchmark_docs import write_section
 from ema.cli.yardstick import yardstick_seconds
 from tests.foreign.windows import Ground, draw
 

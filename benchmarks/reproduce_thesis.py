@@ -20,8 +20,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
-from ema.cli.report import write_section
-from ema.estimate import runtime
+from ema.cli.benchmark_docs import write_section
+from ema.estimate import thread_budget
 from ema.estimate.learn.network import LearnConfig, predict, train
 from ema.estimate.physics.features import features
 from ema.estimate.physics.friction import fit_window
@@ -249,7 +249,7 @@ def main() -> None:
     parser.add_argument("--windows", type=int, default=20, help="windows in the network/baseline comparison")
     parser.add_argument("--docs", action="store_true", help="rewrite the section of docs/results.md")
     args = parser.parse_args()
-    runtime.configure()
+    thread_budget.configure()
     rng = np.random.default_rng(0)  # warm the imports and the kernels: no start-up cost in the first row's times
     train(rng.normal(size=(60, 50)), rng.uniform(size=(60, 2)), LearnConfig(hidden=8, max_epochs=5))
     Scenario(THESIS.params, random_command_knots(50, RATE_HZ, rng)[0]).simulate(HealthParams.single())

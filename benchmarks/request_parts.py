@@ -23,8 +23,8 @@ from typing import Any
 
 from benchmarks.real_time import documents
 from benchmarks.service_overhead import quiet_collector
-from ema.cli.report import write_section
-from ema.estimate import runtime
+from ema.cli.benchmark_docs import write_section
+from ema.estimate import thread_budget
 from ema.estimate.config import PipelineConfig
 from ema.estimate.pipeline import estimate_window
 from ema.model.actuator import THESIS
@@ -116,7 +116,7 @@ def instrumented(clock: Clock) -> Iterator[None]:
 
 def measure(count: int, seed: int) -> tuple[dict[tuple[str, str], float], dict[str, float]]:
     """Mean seconds per request of each (stage, step) and of each stage, over ``count`` warm windows."""
-    runtime.configure()
+    thread_budget.configure()
     windows = [WindowDocument.model_validate(d).to_window() for d in documents(count, seed)]
     for window in windows[:3]:
         estimate_window(window, actuator=THESIS)

@@ -33,7 +33,7 @@ from pathlib import Path
 
 import httpx
 
-from ema.cli.report import write_section
+from ema.cli.benchmark_docs import write_section
 from ema.estimate.documents import parameter
 from ema.estimate.pipeline import estimate_window
 from ema.history.open import open_history

@@ -26,7 +26,7 @@ from pathlib import Path
 import httpx
 import numpy as np
 
-from ema.cli.report import write_section
+from ema.cli.benchmark_docs import write_section
 from ema.estimate.pipeline import estimate_window
 from ema.history.open import open_history
 from ema.model.actuator import THESIS

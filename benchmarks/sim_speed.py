@@ -15,8 +15,8 @@ import time
 
 import numpy as np
 
-from ema.cli.report import typed_command, write_section
-from ema.estimate import runtime
+from ema.cli.benchmark_docs import typed_command, write_section
+from ema.estimate import thread_budget
 from ema.model.actuator import THESIS
 from ema.model.aircraft import FlightCondition, load_model
 from ema.model.batch import default_lanes, kernel_constants, simulate_batch
@@ -69,7 +69,7 @@ def main() -> None:
     parser.add_argument("--numpy-samples", type=int, default=5, help="horizon of the NumPy timing")
     parser.add_argument("--docs", action="store_true", help="rewrite the section of docs/benchmarks.md")
     args = parser.parse_args()
-    threads = runtime.configure()
+    threads = thread_budget.configure()
 
     rng = np.random.default_rng(0)
     health = HealthParams.uniform(args.sims, DEFAULT_RANGES, rng)

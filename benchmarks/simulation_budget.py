@@ -18,8 +18,8 @@ from typing import Any
 import numpy as np
 
 from benchmarks.foreign_groups import group_seed, groups
-from ema.cli.report import write_section
-from ema.estimate import runtime
+from ema.cli.benchmark_docs import write_section
+from ema.estimate import thread_budget
 from ema.estimate.config import PipelineConfig
 from ema.estimate.pipeline import estimate_window
 from ema.estimate.report import share_of_range
@@ -95,7 +95,7 @@ def main() -> None:
     parser.add_argument("--seed", type=int, default=90_000)
     parser.add_argument("--docs", action="store_true", help="rewrite the section of docs/results.md")
     args = parser.parse_args()
-    runtime.configure()
+    thread_budget.configure()
     makers = groups()
     windows = [makers[g](group_seed(g, i, args.seed)) for g in GROUPS for i in range(args.per_group)]
     started = time.perf_counter()

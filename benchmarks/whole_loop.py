@@ -37,8 +37,8 @@ from benchmarks.foreign_accuracy import RESULTS_MD
 from benchmarks.foreign_groups import group_seed, groups
 from benchmarks.information_limit import GROUPS, SENSORS, noise_levels
 from benchmarks.tails import expected_over
-from ema.cli.report import typed_command, write_section
-from ema.estimate import runtime
+from ema.cli.benchmark_docs import typed_command, write_section
+from ema.estimate import thread_budget
 from ema.estimate.physics.features import as_read
 from ema.estimate.physics.friction import fit_friction
 from ema.estimate.physics.scenario import scenario_from_window
@@ -201,7 +201,7 @@ def main() -> None:
     parser.add_argument("--per-group", type=int, default=60, help="windows per group")
     parser.add_argument("--docs", action="store_true", help="rewrite the section of docs/results.md")
     args = parser.parse_args()
-    runtime.configure()
+    thread_budget.configure()
     rows = {group: [one_window(group, i) for i in range(args.per_group)] for group in GROUPS}
     body = report(rows)
     print(body)

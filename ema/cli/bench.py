@@ -26,9 +26,9 @@ from typing import Any
 
 import numpy as np
 
-from ema.cli.report import BENCHMARKS_MD, write_section
+from ema.cli.benchmark_docs import BENCHMARKS_MD, write_section
 from ema.cli.yardstick import DURATION_S, SIMS, yardstick_seconds
-from ema.estimate import runtime
+from ema.estimate import thread_budget
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import STAGES as PIPELINE_STAGES
 from ema.estimate.pipeline import estimate_window
@@ -202,7 +202,7 @@ def markdown(rows: list[dict[str, Any]], config: PipelineConfig, refs: dict[str,
 def run_bench(
     config: PipelineConfig, durations: list[float], *, repeats: int, under_load: int, out: Path | None, docs: bool
 ) -> dict[str, Any]:
-    runtime.configure()
+    thread_budget.configure()
     print("warming up (JIT compile or cache load, imports)…", file=sys.stderr)
     estimate_window(synthetic_window(HealthParams.single(), seed=0, duration_s=0.1), config, actuator=THESIS)
     gc.freeze()  # as the warm service does: what was loaded is never walked by a full collection again

@@ -113,7 +113,7 @@ def estimate(
     NPZ in ema's columns (docs/model.md), or a rig's own CSV with --log-map."""
     from ema.cli.logs import read_one
     from ema.cli.printing import print_estimate
-    from ema.estimate import runtime
+    from ema.estimate import thread_budget
     from ema.kinds import estimate as estimate_one
 
     config = pipeline_config(size_values)
@@ -122,7 +122,7 @@ def estimate(
     kind_given([read], actuator_file)
     say_if_compiling([read])
     known = history_of(read, history) if history else None
-    runtime.configure(threads)
+    thread_budget.configure(threads)
     with about_file(window):
         result = estimate_one(read, config, actuator=document, on_stage=progress, history=known)
     emit(result, as_json, print_estimate)
@@ -237,11 +237,11 @@ def calibrate(
     from ema.cli.figures import residual_figure
     from ema.cli.logs import read_one
     from ema.cli.printing import print_calibration, read_truth
-    from ema.estimate import runtime
+    from ema.estimate import thread_budget
     from ema.model.checks import InputError
 
     config = pipeline_config(size_values)
-    runtime.configure(threads)
+    thread_budget.configure(threads)
     document = actuator_document(actuator_file)
     mapping = log_map_document(log_map_file)
     loaded = [read_one(path, mapping) for path in windows]
@@ -284,7 +284,7 @@ REPOSITORY_SCHEMAS = Path(__file__).resolve().parents[2] / "docs" / "schemas"  #
 @click.option("--check", is_flag=True, help="exit 1 if the files there differ from the code (writes nothing)")
 def schemas(out: Path | None, check: bool) -> None:
     """Export the JSON Schema of every public document (or check the exported ones)."""
-    from ema.cli.schemas import export
+    from ema.cli.schema_export import export
     from ema.model.checks import InputError
 
     if out is None and not check:

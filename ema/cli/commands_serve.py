@@ -46,8 +46,8 @@ def serve(**flags: Any) -> None:
 
 def _check_history(database: str, min_free_bytes: int) -> None:
     """InputError naming --database where the history cannot be opened or cannot take a write now."""
-    from ema.history.errors import StorageError
     from ema.history.open import open_history
+    from ema.history.refusals import StorageError
     from ema.model.checks import InputError
 
     try:

@@ -58,7 +58,7 @@ class _Readings:
     inertias: dict[str, list[Any]] = field(default_factory=dict)
 
     def add(self, window: Window, answer: dict[str, Any]) -> None:
-        from ema.estimate.documents.window import WindowInfo
+        from ema.estimate.documents.window_facts import WindowInfo
 
         info = WindowInfo.model_validate(answer["window"])
         if info.sensor_zero is not None and window.flight_id is not None:
@@ -69,7 +69,7 @@ class _Readings:
     def lacked(self, window: Window, answer: dict[str, Any]) -> dict[str, Any] | None:
         """What the run's other windows lend this one that it lacks (``ema.estimate.history.wanted``), as JSON; or
         None."""
-        from ema.estimate.documents.window import WindowInfo
+        from ema.estimate.documents.window_facts import WindowInfo
         from ema.estimate.history import lent, wanted
 
         flight = self.zeros.get((window.actuator_id, window.flight_id), [])
@@ -239,9 +239,9 @@ def ray_installed() -> bool:
 
 def _stored(store: Any, row: dict[str, Any], answer: dict[str, Any]) -> dict[str, Any]:
     """``row`` once its answer is in the history, or refused where the history holds another window's content
-    under its window_id (``ema.history.errors.ConflictError``)."""
+    under its window_id (``ema.history.refusals.ConflictError``)."""
     from ema.estimate.documents import Estimate
-    from ema.history.errors import ConflictError, WithdrawnError
+    from ema.history.refusals import ConflictError, WithdrawnError
 
     try:
         store.add(Estimate.model_validate(answer))

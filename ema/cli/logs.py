@@ -21,9 +21,9 @@ from ema.model.bounds import DEFAULT_SAMPLE_RATE_HZ, MIN_SAMPLES
 from ema.model.checks import InputError, load_json
 from ema.model.envelope import DEFAULT_AIRSPEED_MPS
 from ema.model.kinds import ALL_SIGNALS, KINDS, KindFacts, nearest_kind
+from ema.model.log_files import TABLE_SUFFIXES, read_table
 from ema.model.logmap import SCHEMA as LOGMAP_SCHEMA
 from ema.model.logmap import LogMap, read_mapped
-from ema.model.tables import TABLE_SUFFIXES, read_table
 from ema.model.window import SCHEMA as WINDOW_SCHEMA
 from ema.model.window import Window, window_from_dict
 

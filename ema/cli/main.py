@@ -52,7 +52,7 @@ def _bad_input(exc: BaseException) -> str | None:
     if isinstance(exc, ModuleNotFoundError) and (exc.name or "").split(".")[0] in EXTRAS:
         extra = EXTRAS[(exc.name or "").split(".")[0]]
         return f"this needs the optional extra '{extra}': pip install 'ema[{extra}]'"
-    from ema.history.errors import StorageError
+    from ema.history.refusals import StorageError
     from ema.model.checks import InputError
 
     if isinstance(exc, InputError):

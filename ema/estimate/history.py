@@ -15,7 +15,7 @@ from collections.abc import Iterable, Sequence
 import numpy as np
 
 from ema.estimate.documents import Note
-from ema.estimate.documents.window import HistoryReadings, InertiaReading, SensorZero, WindowInfo
+from ema.estimate.documents.window_facts import HistoryReadings, InertiaReading, SensorZero, WindowInfo
 from ema.estimate.prepare.departures.read import Known
 from ema.estimate.prepare.departures.zero_offset import ZeroOffset
 

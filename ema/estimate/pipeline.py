@@ -27,7 +27,7 @@ from ema.estimate.assess.reproduction import output_error_ratios
 from ema.estimate.assess.weighing import Assessed, Candidates, assess, misfit_limit
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import ActuatorRead, Check, Estimate, Note
-from ema.estimate.documents.window import HistoryReadings
+from ema.estimate.documents.window_facts import HistoryReadings
 from ema.estimate.history import known_from
 from ema.estimate.learn.estimator import NetworkEstimator
 from ema.estimate.learn.network import LearnConfig

@@ -27,7 +27,7 @@ from ema.estimate.documents import (
     TrainingInfo,
     parameter,
 )
-from ema.estimate.documents.window import InertiaReading, SensorZero, WindowInfo
+from ema.estimate.documents.window_facts import InertiaReading, SensorZero, WindowInfo
 from ema.estimate.physics.friction import FrictionFit, sliding_mask
 from ema.estimate.physics.static_friction import StaticFriction
 from ema.estimate.prepare.conditioning import Prepared, conditioning_done, conditioning_notes

@@ -13,7 +13,7 @@ from contextlib import contextmanager
 import sqlalchemy as sa
 from sqlalchemy.dialects import postgresql, sqlite
 
-from ema.history.errors import StorageError
+from ema.history.refusals import StorageError
 from ema.history.tables import actuators
 
 

@@ -15,8 +15,8 @@ from urllib.parse import urlsplit
 
 from ema.calibration.documents import CalibrationReport
 from ema.estimate.documents import Estimate
-from ema.estimate.documents.window import HistoryReadings
-from ema.history.errors import StorageError
+from ema.estimate.documents.window_facts import HistoryReadings
+from ema.history.refusals import StorageError
 from ema.model.actuator import ActuatorDocument
 from ema.prognosis.documents import Stored, StoredActuator, Withdrawal
 

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import sqlalchemy as sa
 
-from ema.history.errors import StorageError
+from ema.history.refusals import StorageError
 from ema.history.schema import opening, upgrade
 from ema.history.sql import SqlHistory
 

@@ -109,7 +109,7 @@ def opening(engine: sa.Engine, location: object, unusable: str) -> Iterator[None
     """The steps that open a history (its tables checked, upgraded): where one fails, the engine is let go and a
     StorageError names ``location``, another program's tables as such, a database error as ``unusable`` with
     its reason's first line."""
-    from ema.history.errors import StorageError
+    from ema.history.refusals import StorageError
 
     try:
         yield

@@ -20,10 +20,10 @@ from pydantic import ValidationError
 
 from ema.calibration.documents import CalibrationReport
 from ema.estimate.documents import Estimate
-from ema.estimate.documents.window import HistoryReadings, InertiaReading, SensorZero
+from ema.estimate.documents.window_facts import HistoryReadings, InertiaReading, SensorZero
 from ema.estimate.history import lent
 from ema.history.connection import now
-from ema.history.errors import ConflictError, WithdrawnError
+from ema.history.refusals import ConflictError, WithdrawnError
 from ema.history.tables import actuators, calibrations, estimates, summaries, withdrawals
 from ema.history.versions import VersionedDocuments
 from ema.prognosis.documents import Stored, Withdrawal

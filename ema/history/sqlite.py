@@ -21,7 +21,7 @@ from typing import Any
 
 import sqlalchemy as sa
 
-from ema.history.errors import StorageError
+from ema.history.refusals import StorageError
 from ema.history.schema import opening, upgrade
 from ema.history.sql import SqlHistory
 

@@ -11,7 +11,7 @@ from typing import Any
 import sqlalchemy as sa
 
 from ema.history.connection import SqlStore, now
-from ema.history.errors import VersionContentionError
+from ema.history.refusals import VersionContentionError
 from ema.history.tables import actuators
 from ema.model.actuator import ActuatorDocument
 from ema.prognosis.documents import StoredActuator

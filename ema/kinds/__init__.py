@@ -21,7 +21,7 @@ from collections.abc import Callable, Sequence
 
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import Estimate
-from ema.estimate.documents.window import HistoryReadings
+from ema.estimate.documents.window_facts import HistoryReadings
 from ema.kinds.base import ActuatorKind, Calibrated, CalibrationRequest, Cost, Request
 from ema.kinds.linear import LINEAR
 from ema.kinds.rotary import ROTARY

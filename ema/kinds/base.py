@@ -10,9 +10,9 @@ from ema.calibration.documents import CalibrationReport
 from ema.calibration.plot import ResidualPlot
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import ActuatorRead, Estimate
-from ema.estimate.documents.window import HistoryReadings
-from ema.estimate.quasistatic.drive import QuasiStaticReading
-from ema.estimate.quasistatic.pipeline import estimate_low_rate
+from ema.estimate.documents.window_facts import HistoryReadings
+from ema.estimate.quasistatic.drive_torque import QuasiStaticReading
+from ema.estimate.quasistatic.slow_window import estimate_low_rate
 from ema.model.actuator import THESIS, ActuatorDocument
 from ema.model.bounds import NOISE_COPIES
 from ema.model.kinds import KindFacts

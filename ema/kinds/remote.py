@@ -2,7 +2,7 @@
 process is warmed before its first.
 
 The task carries the window as its ``ema-window/1`` JSON and the config as a dict, pins its own
-thread budget (``ema.estimate.runtime``) before it computes, and returns the ``ema-estimate/1``
+thread budget (``ema.estimate.thread_budget``) before it computes, and returns the ``ema-estimate/1``
 document as JSON-able data, or the refusal as ``{"error": {"field", "message"}}`` (an ``InputError``'s
 parts, so that it crosses a process boundary typed, never as a sentence to parse back). Ray is imported only here, and
 only when asked for: it is an optional extra (``pip install -e '.[fleet]'``).
@@ -13,10 +13,10 @@ from __future__ import annotations
 import gc
 from typing import Any
 
-from ema.estimate import runtime
+from ema.estimate import thread_budget
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import Estimate
-from ema.estimate.documents.window import HistoryReadings
+from ema.estimate.documents.window_facts import HistoryReadings
 from ema.kinds import estimate, warm_up
 from ema.model.actuator import THESIS, ActuatorDocument, actuator_from_dict
 from ema.model.checks import InputError
@@ -34,7 +34,7 @@ def estimate_json(
     """The estimate of one window as a JSON-able dict, or {"error": {"field", "message"}} for a window refused;
     ``history``: what other windows of the actuator read, ``actuator``: its ema-actuator/1 document and
     ``version`` (none: the default, ``ema.model.actuator.THESIS``; ``ema.kinds.estimate``)."""
-    runtime.configure(threads)
+    thread_budget.configure(threads)
     known = None if history is None else HistoryReadings.model_validate(history)
     try:
         document = THESIS if actuator is None else actuator_from_dict(actuator)
@@ -50,7 +50,7 @@ def warm(threads: int) -> None:
     """A worker process made ready before its first window: its thread budget pinned, its kernels loaded, and what
     it loaded (the pipeline's modules, the kernels: it lives as long as the process) never walked by the cyclic
     collector again, at a window's collections or at the process's end."""
-    runtime.configure(threads)
+    thread_budget.configure(threads)
     warm_up(("rotary",))  # what an archive mostly holds; a window of another kind loads its own at its first
     gc.freeze()
 

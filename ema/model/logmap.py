@@ -1,7 +1,7 @@
 """``ema-logmap/1``: how a rig's or recorder's own variables and units become a window's signals, said once per rig.
 
 A log is read as it was written (``read_mapped``): a CSV, a MATLAB file or a NumPy archive
-(``ema.model.tables``). The map names, for each role of its kind (``ema.model.kinds``: the set point, the
+(``ema.model.log_files``). The map names, for each role of its kind (``ema.model.kinds``: the set point, the
 position or its error, the current, the force, the load, the motor speed), the file's variable and its unit,
 optionally a scale (a number, or a constant stored in the file: a drive's newtons per volt) and a sign; the
 time variable or the rate; and the constants the file records for the actuator's document (a controller's
@@ -20,7 +20,7 @@ from pydantic import BaseModel, ConfigDict, Field, model_validator
 from ema.model.checks import InputError, read_document, validated
 from ema.model.document import Number
 from ema.model.kinds import KINDS, Role
-from ema.model.tables import Table, read_table
+from ema.model.log_files import Table, read_table
 from ema.model.units import TIME_S
 
 SCHEMA = "ema-logmap/1"

@@ -5,7 +5,7 @@
   threading layer is not used: a static split of the batch waits for its slowest thread, which on a
   shared computer is the one the OS has parked. A pool of our own takes groups from one queue: a parked
   thread delays only its group. The budget is shared with NumPy's BLAS (which also trains the network,
-  ``ema.estimate.runtime``), which gets one thread: its small products and solves gain nothing from a
+  ``ema.estimate.thread_budget``), which gets one thread: its small products and solves gain nothing from a
   team, and OpenBLAS's idle worker spins after each call, on a core a simulation group needs.
 - **Vector width.** LLVM tunes AVX-512 CPUs to prefer 256-bit vectors; the lane loop is
   instruction-bound and measured ~1.5x faster with 512-bit ones (docs/benchmarks.md). Numba reads

@@ -13,7 +13,7 @@ import numpy as np
 from pydantic import Field
 
 from ema.estimate.documents import Estimate, Notes
-from ema.estimate.documents.window import InertiaReading
+from ema.estimate.documents.window_facts import InertiaReading
 from ema.model.actuator import ActuatorDocument
 from ema.model.document import Document
 

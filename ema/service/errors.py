@@ -8,7 +8,7 @@ from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse
 from starlette.requests import ClientDisconnect
 
-from ema.history.errors import ConflictError, StorageError, VersionContentionError, WithdrawnError
+from ema.history.refusals import ConflictError, StorageError, VersionContentionError, WithdrawnError
 from ema.model.checks import InputError
 from ema.service.jobs import CancelledError, OverloadedError
 

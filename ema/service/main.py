@@ -14,7 +14,7 @@ from typing import Any
 from fastapi import FastAPI
 from fastapi_offline import FastAPIOffline
 
-from ema.estimate import runtime
+from ema.estimate import thread_budget
 from ema.history.open import open_history
 from ema.kinds import warm_up
 from ema.model import runtime as sim_runtime
@@ -66,7 +66,7 @@ def _openapi(app: FastAPI) -> dict[str, Any]:
 def create_app(settings: Settings) -> FastAPI:
     @asynccontextmanager
     async def lifespan(app: FastAPI) -> AsyncIterator[None]:
-        threads = runtime.configure(settings.threads)
+        threads = thread_budget.configure(settings.threads)
         app.state.store = open_history(settings.database, settings.min_free_bytes)
         slots = settings.ray_jobs if settings.backend == "ray" else 1
         app.state.runner = JobRunner(settings.max_queue, settings.queue_timeout_s, slots)

@@ -214,7 +214,7 @@ def test_a_closed_pipe_and_an_interrupt_end_quietly(tmp_path):
 def test_schemas_in_docs_match_the_code():
     from pathlib import Path
 
-    from ema.cli.schemas import export
+    from ema.cli.schema_export import export
 
     assert export(Path(__file__).resolve().parents[2] / "docs" / "schemas", check=True) == []
 

@@ -5,7 +5,7 @@ import pytest
 
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import Estimate
-from ema.estimate.documents.window import HistoryReadings
+from ema.estimate.documents.window_facts import HistoryReadings
 from ema.estimate.pipeline import estimate_window
 from ema.estimate.report import share_of_range
 from ema.model.actuator import THESIS

@@ -4,9 +4,9 @@ import concurrent.futures
 
 import pytest
 
-from ema.estimate.documents.window import SensorZero
-from ema.history.errors import ConflictError, StorageError
+from ema.estimate.documents.window_facts import SensorZero
 from ema.history.open import open_history
+from ema.history.refusals import ConflictError, StorageError
 from ema.model.actuator import THESIS
 
 
@@ -57,7 +57,7 @@ def test_a_withdrawn_window_leaves_the_history_and_its_record_stays(history, res
 
 
 def test_a_withdrawn_window_stays_withdrawn(history, result):
-    from ema.history.errors import WithdrawnError
+    from ema.history.refusals import WithdrawnError
 
     history.add(result)
     history.withdraw(result.actuator_id, result.window_id, "bad sensor")

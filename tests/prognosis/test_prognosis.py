@@ -133,7 +133,7 @@ def test_a_strain_gauge_drifting_against_the_aircraft_is_trended_and_said(one_es
 
 
 def test_the_actuators_j_m_is_its_windows_readings_and_a_replaced_part_is_said(one_estimate):
-    from ema.estimate.documents.window import InertiaReading
+    from ema.estimate.documents.window_facts import InertiaReading
     from ema.prognosis.prognose import prognose
 
     def with_reads(factors):

@@ -10,8 +10,8 @@ from fastapi.testclient import TestClient
 
 from ema.estimate.documents import parameter
 from ema.estimate.pipeline import estimate_window
-from ema.history.errors import StorageError
 from ema.history.open import open_history
+from ema.history.refusals import StorageError
 from ema.model.actuator import THESIS
 from ema.model.params import HealthParams
 from ema.model.synthetic import synthetic_window

@@ -6,10 +6,10 @@ import stat
 
 import pytest
 
-from ema.estimate.documents.window import SensorZero
+from ema.estimate.documents.window_facts import SensorZero
 from ema.estimate.pipeline import estimate_window
-from ema.history.errors import StorageError
 from ema.history.open import open_history
+from ema.history.refusals import StorageError
 from ema.model.actuator import THESIS
 from ema.model.params import HealthParams
 from ema.model.synthetic import synthetic_window
@@ -44,7 +44,7 @@ def test_a_file_others_could_read_is_made_private_with_a_warning(tmp_path, resul
 
 
 def test_another_window_under_a_stored_key_is_a_conflict_and_an_old_row_a_replay(tmp_path, result):
-    from ema.history.errors import ConflictError
+    from ema.history.refusals import ConflictError
 
     store = open_history(tmp_path / "h.sqlite3")
     store.add(result)

@@ -14,7 +14,7 @@ from pydantic import Field, model_validator
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents.notes import AnyNote, Notes, OptionalNote
 from ema.estimate.documents.notes import Note as Note  # every stage's notes, imported from here
-from ema.estimate.documents.window import WindowInfo
+from ema.estimate.documents.window_facts import WindowInfo
 from ema.model.document import Document
 
 TARGETS = ("FDJ", "eta_O")  # what the estimators fit; η_A follows by Eq. 3.4, FSD from FSJ

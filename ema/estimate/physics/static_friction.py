@@ -30,7 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ema.estimate.documents import Note
-from ema.estimate.physics.noise import white_noise_std
+from ema.estimate.physics.noise_reading import white_noise_std
 from ema.model.noise import NO_NOISE, SensorNoise, ar1_mean_variance
 from ema.model.params import DriveConstants, load_factors
 from ema.model.residual import END_STOP_MARGIN_DEG, smoothed

@@ -36,7 +36,7 @@ from typing import Any
 import numpy as np
 
 from ema.estimate.documents import Note
-from ema.estimate.physics.noise import white_noise_std
+from ema.estimate.physics.noise_reading import white_noise_std
 from ema.estimate.prepare.alignment import Lags, aligned
 from ema.estimate.prepare.consistency import Consistency
 from ema.estimate.prepare.departures.aircraft_check import TOLERANCE, aircraft_note, check_against_aircraft

@@ -1,15 +1,14 @@
 """How late the hinge moment is logged: its filter's trace in the noise, the deflection and Eq. 5.1,
 weighed together.
 
-The hinge moment's lag barely shows in Eq. 5.1's equation error (lags of a few ms fit it about as
-well as none), yet a strain-gauge filter's delay of 1–4 ms moves FDJ beyond its std. It shows in the
-noise: the filter that delays the signal correlates the noise it passes, and ``ema.estimate.physics.noise`` reads
-that correlation as a filter's delay D (``filter_delay_samples``; 0 on white noise). But noise
-correlated after the signal (an amplifier's own noise behind its output filter) reads the same, and
-advancing an unfiltered moment by it would move FDJ as much the other way; and now and then the read
-misses a filter. So where the noise shows a filter, the lag is a model average over three stories
-(``PRIOR``): the filter delays the moment too (D within ``HINGE_LAG_UNCERTAINTY``), it filters only
-the noise (on time), or the moment is late by another amount up to ``MAX_HINGE_LAG_S``. Each lag of
+The hinge moment's lag barely shows in Eq. 5.1's equation error (lags of a few ms fit it about as well as none), yet
+a strain-gauge filter's delay of 1–4 ms moves FDJ beyond its std. It shows in the noise: the filter that delays the
+signal correlates the noise it passes, and ``ema.estimate.physics.noise_reading`` reads that correlation as a
+filter's delay D (``filter_delay_samples``; 0 on white noise). But noise correlated after the signal (an amplifier's
+own noise behind its output filter) reads the same, and advancing an unfiltered moment by it would move FDJ as much
+the other way; and now and then the read misses a filter. So where the noise shows a filter, the lag is a model
+average over three stories (``PRIOR``): the filter delays the moment too (D within ``HINGE_LAG_UNCERTAINTY``), it
+filters only the noise (on time), or the moment is late by another amount up to ``MAX_HINGE_LAG_S``. Each lag of
 the grid is weighed by
 - the deflection: in the aircraft's band the moment follows it at once, so the lag read there
   (``aircraft_band.band_lag_s``, relative to the position's own filter) is the moment's; Student's t
@@ -27,7 +26,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ema.estimate.physics.friction import FitSettings
-from ema.estimate.physics.noise import MAX_LAG, noise_of, white_noise_std
+from ema.estimate.physics.noise_reading import MAX_LAG, noise_of, white_noise_std
 from ema.estimate.physics.shifts import shifted_fits
 from ema.estimate.prepare.departures.aircraft_band import band_lag_s
 from ema.estimate.stats import JACKKNIFE_BLOCKS, rms_log_likelihood_ratio

@@ -40,7 +40,7 @@ import numpy as np
 
 from ema.estimate.documents import Note
 from ema.estimate.physics.friction import MIN_SLIDING_KERNELS, FitSettings, sliding_mask
-from ema.estimate.physics.noise import white_noise_std
+from ema.estimate.physics.noise_reading import white_noise_std
 from ema.model.checks import InputError
 from ema.model.noise import NOISY_SIGNALS
 from ema.model.params import DriveConstants

@@ -10,7 +10,7 @@ import numpy as np
 from ema.estimate.config import PipelineConfig
 from ema.estimate.physics.features import as_read, sliding_features
 from ema.estimate.physics.friction import FitSettings, FrictionFit, regressors
-from ema.estimate.physics.noise import excess_noise
+from ema.estimate.physics.noise_reading import excess_noise
 from ema.estimate.physics.scenario import Scenario, scenario_from_window
 from ema.estimate.simulate import design
 from ema.model.actuator import ActuatorDocument

@@ -1,6 +1,6 @@
 """The linear kind: a ball screw turned by a stepper, logged by a rig at its own rate.
 
-Its windows are read quasi-statically at any rate (``ema.estimate.quasistatic.pipeline``: the stepper's drive is no
+Its windows are read quasi-statically at any rate (``ema.estimate.quasistatic.slow_window``: the stepper's drive is no
 current loop ema can simulate), its torque from the drive's current as ``ema calibrate`` learned it
 (``ema.kinds.linear.drive_fit``): healthy runs teach the drive, faulted runs are compared with it.
 """
@@ -12,8 +12,8 @@ from dataclasses import dataclass
 
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import Estimate
-from ema.estimate.quasistatic.drive import STEPPER_READING
-from ema.estimate.quasistatic.pipeline import QUASI_STATIC
+from ema.estimate.quasistatic.drive_torque import STEPPER_READING
+from ema.estimate.quasistatic.slow_window import QUASI_STATIC
 from ema.kinds.base import Calibrated, CalibrationRequest, Cost, Request, read_quasi_statically
 from ema.kinds.linear.calibration_report import calibrate_linear
 from ema.model.kinds import KINDS, KindFacts

@@ -3,7 +3,7 @@
 Learning (the document lacks c or a nominal health; ``ema.kinds.linear.drive_fit.fit_drive``): the report's
 ``drive`` holds what was learned, the residual of the runs' current before (the document's model) and
 after, and a leave-one-run-out check; ``completed`` is the document with it. Comparing (a calibrated
-document): each run read with it (``ema.estimate.quasistatic.pipeline``), FDJ (and η_O where the runs' loads
+document): each run read with it (``ema.estimate.quasistatic.slow_window``), FDJ (and η_O where the runs' loads
 differ) set against the nominal in ``changes``, and the current along the stroke against the healthy
 profile, named ``position_friction`` only beyond ``MIN_Z``.
 """

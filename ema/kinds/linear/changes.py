@@ -21,8 +21,8 @@ from ema.calibration.documents import CalibrationReport, Candidate, Change, Held
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import DIMENSIONLESS, ActuatorRead, Estimate
 from ema.estimate.quasistatic.departure import DEPARTURE_Z, Departure, departure, inside
-from ema.estimate.quasistatic.drive import STEPPER_READING
-from ema.estimate.quasistatic.pipeline import estimate_low_rate
+from ema.estimate.quasistatic.drive_torque import STEPPER_READING
+from ema.estimate.quasistatic.slow_window import estimate_low_rate
 from ema.estimate.quasistatic.stretches import fit_stretches
 from ema.kinds.linear.drive_fit import MIN_Z, Run, profile_change, run_load_n
 from ema.model.actuator import ActuatorDocument

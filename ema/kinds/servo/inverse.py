@@ -35,7 +35,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ema.estimate.physics.eta_search import MIN_OFFSET_BALANCE
-from ema.estimate.physics.noise import white_noise_std
+from ema.estimate.physics.noise_reading import white_noise_std
 from ema.estimate.physics.zero_phase import butter_lowpass, cheby1_lowpass, filtfilt
 from ema.estimate.stats import rms
 from ema.model.checks import InputError

@@ -23,7 +23,7 @@ import numpy as np
 from ema.estimate import documents as doc
 from ema.estimate.assess.weighing import Assessed, Candidates, assess, misfit_limit
 from ema.estimate.config import PipelineConfig
-from ema.estimate.documents.window import WindowInfo
+from ema.estimate.documents.window_facts import WindowInfo
 from ema.estimate.learn.estimator import NetworkRegressor
 from ema.estimate.learn.network import LearnConfig
 from ema.estimate.physics.scenario import MAX_RATIO

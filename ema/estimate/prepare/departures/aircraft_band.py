@@ -11,7 +11,7 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from ema.estimate.physics.noise import MAX_LAG, noise_of
+from ema.estimate.physics.noise_reading import MAX_LAG, noise_of
 from ema.estimate.stats import JACKKNIFE_BLOCKS, jackknife_std
 from ema.model.hinge import local_line
 from ema.model.residual import kernel_samples
@@ -28,7 +28,7 @@ def band_part(values: np.ndarray, rate: float) -> np.ndarray:
 
 def band_noise_variance(position_deg: np.ndarray, rate: float) -> float:
     """The variance a sample the position sensor's noise keeps in ``band_part``: σ² of its AR(1) reading
-    (``ema.estimate.physics.noise``), over the independent values in the shorter span."""
+    (``ema.estimate.physics.noise_reading``), over the independent values in the shorter span."""
     sigma, tau_s = noise_of(position_deg, rate, MAX_LAG["position_deg"])
     rho = math.exp(-1.0 / (tau_s * rate)) if tau_s > 0 else 0.0
     span = kernel_samples(rate, BAND_S[0])

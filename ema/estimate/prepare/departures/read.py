@@ -25,7 +25,7 @@ import numpy as np
 
 from ema.estimate.documents import Note
 from ema.estimate.physics.features import fit_as_read
-from ema.estimate.physics.noise import white_noise_std
+from ema.estimate.physics.noise_reading import white_noise_std
 from ema.estimate.physics.scenario import CLEAR_MARGIN, MAX_RATIO, following_error, inside, scenario_from_window
 from ema.estimate.prepare.departures.aircraft_check import AircraftCheck, banded, divided_out
 from ema.estimate.prepare.departures.drive_constants import UNDECIDED_SHARE, DriveReading, read_drive_constants

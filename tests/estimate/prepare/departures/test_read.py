@@ -2,7 +2,7 @@
 
 import pytest
 
-from ema.estimate.documents.window import HistoryReadings, InertiaReading
+from ema.estimate.documents.window_facts import HistoryReadings, InertiaReading
 from ema.estimate.history import known_from
 from ema.estimate.physics.features import as_read
 from ema.estimate.physics.friction import fit_window

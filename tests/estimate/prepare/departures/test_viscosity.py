@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from ema.estimate.documents.window import SensorZero
+from ema.estimate.documents.window_facts import SensorZero
 from ema.estimate.physics.features import as_read
 from ema.estimate.physics.friction import fit_friction
 from ema.estimate.prepare.conditioning import prepare
@@ -68,7 +68,7 @@ def test_where_the_speed_hardly_varies_an_unseen_coefficient_is_in_the_stds(fact
     """A 0.1 s gust moving one way near slew, its current 0.2 A off and that zero known from a cruise window of
     its flight: C·|ω| is FDJ's twin. Read with the spec's C and a std without it, C 1.24x put FDJ 40 % of
     range high at 10 std (foreign history, actuator 407)."""
-    from ema.estimate.documents.window import HistoryReadings
+    from ema.estimate.documents.window_facts import HistoryReadings
     from ema.estimate.history import known_from
     from ema.estimate.physics.friction import fit_window
     from ema.estimate.prepare.conditioning import widened

@@ -6,7 +6,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from ema.estimate.documents.window import HistoryReadings, SensorZero
+from ema.estimate.documents.window_facts import HistoryReadings, SensorZero
 from ema.estimate.history import known_from
 from ema.estimate.prepare.conditioning import prepare
 from ema.estimate.prepare.departures.zero_offset import ZeroOffset

@@ -3,9 +3,9 @@
 import subprocess
 import sys
 
-from ema.cli.report import write_section
+from ema.cli.benchmark_docs import write_section
 
-SHOW = "from ema.cli.report import typed_command; print(typed_command())"
+SHOW = "from ema.cli.benchmark_docs import typed_command; print(typed_command())"
 
 
 def test_the_command_a_section_names_is_the_one_typed_with_its_arguments(tmp_path):

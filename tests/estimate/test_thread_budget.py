@@ -10,10 +10,10 @@ from pathlib import Path
 PACKAGE = Path(__file__).resolve().parents[2] / "ema"
 
 ESTIMATE = (
-    "import json, sys; from ema.estimate import runtime; from ema.estimate.config import PipelineConfig; "
+    "import json, sys; from ema.estimate import thread_budget; from ema.estimate.config import PipelineConfig; "
     "from ema.estimate.pipeline import estimate_window; from ema.model.actuator import THESIS; "
     "from ema.model.params import HealthParams; from ema.model.synthetic import synthetic_window; "
-    "runtime.configure({threads}); "
+    "thread_budget.configure({threads}); "
     "config = PipelineConfig(n_simulations=16, check_windows=8, n_timesteps=20, hidden_units=4); "
     "e = estimate_window(synthetic_window(HealthParams.single(), seed=3, duration_s=0.05), config, actuator=THESIS); "
     "from threadpoolctl import threadpool_info; "

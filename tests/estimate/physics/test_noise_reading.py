@@ -6,7 +6,7 @@ import pytest
 
 from ema.estimate.physics.features import as_read
 from ema.estimate.physics.friction import fit_window
-from ema.estimate.physics.noise import noise_of, robust_variance, second_difference_variances
+from ema.estimate.physics.noise_reading import noise_of, robust_variance, second_difference_variances
 from ema.estimate.physics.scenario import scenario_from_window
 from ema.estimate.simulate.dataset import simulate_noisy
 from ema.model.actuator import THESIS

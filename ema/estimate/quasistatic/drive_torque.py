@@ -1,7 +1,7 @@
 """What a slow window's drive current says of the motor's torque, by the kind of drive (``QuasiStaticReading``): a
 current-piloted motor's k_T·I along its logged speed, or a stepper's (I − I0)/c along its set point, with how its
 healthy runs scattered as ``ema calibrate`` learned it. A kind (``ema.kinds``) passes its reading to
-``ema.estimate.quasistatic.pipeline``.
+``ema.estimate.quasistatic.slow_window``.
 """
 
 from __future__ import annotations

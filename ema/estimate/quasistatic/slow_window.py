@@ -26,9 +26,9 @@ from ema.estimate.documents import (
     Timings,
     parameter,
 )
-from ema.estimate.documents.window import WindowInfo
+from ema.estimate.documents.window_facts import WindowInfo
 from ema.estimate.quasistatic.departure import DEPARTURE_Z, departure, inside
-from ema.estimate.quasistatic.drive import QuasiStaticReading
+from ema.estimate.quasistatic.drive_torque import QuasiStaticReading
 from ema.estimate.quasistatic.stretches import (
     MIN_STRETCH_S,
     QuasiStaticFit,

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from scipy.io import savemat
 
-from ema.model import tables
+from ema.model import log_files
 from ema.model.checks import InputError
 from ema.model.logmap import logmap_from_dict, read_logmap, read_mapped
 from ema.model.window import window_from_dict
@@ -58,20 +58,20 @@ def test_a_file_that_is_not_matlab_is_refused_naming_it(tmp_path):
 
 
 def test_a_csv_over_the_row_limit_is_refused_at_its_first_row_past_it(tmp_path, monkeypatch):
-    monkeypatch.setattr(tables, "MAX_ROWS", 1000)
+    monkeypatch.setattr(log_files, "MAX_ROWS", 1000)
     path = tmp_path / "long.csv"
     path.write_text("a,b\n" + "1,2\n" * 5000)
     with pytest.raises(InputError) as error:
-        tables.read_table(path)
+        log_files.read_table(path)
     assert "1,000 rows" in error.value.message
 
 
 def test_a_file_over_the_size_limit_is_refused_from_its_size(tmp_path, monkeypatch):
-    monkeypatch.setattr(tables, "MAX_LOG_BYTES", 100)
+    monkeypatch.setattr(log_files, "MAX_LOG_BYTES", 100)
     path = tmp_path / "big.csv"
     path.write_text("a,b\n" + "1,2\n" * 100)
     with pytest.raises(InputError) as error:
-        tables.read_table(path)
+        log_files.read_table(path)
     assert "MiB" in error.value.message and error.value.field == str(path)
 
 
