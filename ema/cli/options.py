@@ -14,7 +14,7 @@ from typing import Any, TypeVar
 import click
 
 from ema.estimate.sizes import SIZES as PIPELINE_SIZES
-from ema.model.bounds import CUT_WINDOW_S, MAX_THREADS
+from ema.model.bounds import MAX_THREADS
 
 F = TypeVar("F", bound=Callable[..., Any])
 EXISTING = click.Path(exists=True, dir_okay=False, path_type=Path)  # a file that must be there
@@ -138,16 +138,22 @@ def span(bounds: tuple[float, float]) -> str:
 
 
 WINDOW_S_RANGE = (0.1, 3600.0)
-_KINDS_CUT = "; ".join(f"a {kind} recording {seconds:g} s" for kind, seconds in CUT_WINDOW_S.items())
+
+
+class _WindowOption(click.Option):
+    """``--window-s``, its default read from the kinds' facts when help is shown (they load pydantic: a command's
+    help is read rarely, ``ema --help`` often, and must stay quick)."""
+
+    def get_help_record(self, ctx: click.Context) -> tuple[str, str] | None:
+        from ema.model.kinds import KINDS
+
+        cut = "; ".join(f"a {f.name} recording {f.window_s:g} s" for f in KINDS.values() if f.window_s is not None)
+        self.help = f"cut recordings into windows of this length [s]  [default: {cut}; any other kind's log whole]"
+        return super().get_help_record(ctx)
 
 
 def window_s(function: F) -> F:
-    return click.option(
-        "--window-s",
-        type=click.FloatRange(*WINDOW_S_RANGE),
-        default=None,
-        help=f"cut recordings into windows of this length [s]  [default: {_KINDS_CUT}; any other kind's log whole]",
-    )(function)
+    return click.option("--window-s", cls=_WindowOption, type=click.FloatRange(*WINDOW_S_RANGE), default=None)(function)
 
 
 def log_map_document(path: Path | None) -> Any:

@@ -33,12 +33,12 @@ from ema.estimate.learn.estimator import NetworkEstimator
 from ema.estimate.learn.network import LearnConfig
 from ema.estimate.physics.features import as_read
 from ema.estimate.physics.friction import FIT_ARRAYS, FrictionFit, fit_friction, fit_window
-from ema.estimate.physics.scenario import MAX_RATIO, inside
+from ema.estimate.physics.scenario import inside
 from ema.estimate.physics.static_friction import read_static_friction
 from ema.estimate.prepare.conditioning import Prepared, prepare, widened
 from ema.estimate.report import estimate_document
 from ema.estimate.simulate.dataset import Data, simulate_dataset
-from ema.estimate.stats import RESOLUTION_SHARE, rms
+from ema.estimate.stats import MAX_RATIO, RESOLUTION_SHARE, rms
 from ema.estimate.stopwatch import Stopwatch
 from ema.model.actuator import THESIS, ActuatorDocument
 from ema.model.window import Window

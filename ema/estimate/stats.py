@@ -9,6 +9,7 @@ from ema.model.residual import DEFAULT_DERIVATIVE_WINDOW_S, kernel_samples
 
 JACKKNIFE_BLOCKS = 10
 DECISIVE_Z = 4.0  # stds by which a reading must explain a window better than the document's before it is taken
+MAX_RATIO = 2.0  # every kind's check: an output error within twice its noise floor is reproduced
 SIGN_STDS = 3.0  # a constant that must be positive read this many stds below zero: the log's signs, not its noise
 # The share of the drive's effort (the motor torque k_T·I, a servo's force) under which a model's error is no
 # evidence: the document's k_T alone moves 0.1 %/K with the magnets' temperature, and ema's integration of a closed

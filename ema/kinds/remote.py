@@ -51,7 +51,7 @@ def warm(threads: int) -> None:
     it loaded (the pipeline's modules, the kernels: it lives as long as the process) never walked by the cyclic
     collector again, at a window's collections or at the process's end."""
     thread_budget.configure(threads)
-    warm_up(("rotary",))  # what an archive mostly holds; a window of another kind loads its own at its first
+    warm_up((THESIS.kind,))  # the default document's kind; a window of another kind loads its own at its first
     gc.freeze()
 
 

@@ -19,9 +19,6 @@ DURATION_RANGE_S = (0.01, 60.0)  # the lengths the simulator draws a window at (
 MAX_THREADS = 256  # a thread budget's ceiling: more than any onboard computer or server has cores
 MIN_SAMPLES = 100
 MAX_SAMPLES = 1_000_000
-# A recording of these kinds is cut into windows this long unless told (the thesis's windows: a few commands of the
-# elevator each); any other kind's log (a rig's run, a controller's log) is one window.
-CUT_WINDOW_S = {"rotary": 0.5}
 # A window may be logged at 10 Hz (a test rig's logger) to 100 kHz; below HIGH_RATE_HZ it is read quasi-statically
 # (``ema.estimate.quasistatic.stretches``), at or above it through the whole pipeline.
 WINDOW_RATE_RANGE_HZ = (10.0, 100_000.0)

@@ -18,7 +18,6 @@ from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from types import MappingProxyType
 
-from ema.model.bounds import CUT_WINDOW_S
 from ema.model.servo import SERVO_CONSTANTS
 from ema.model.units import units_of
 
@@ -51,6 +50,9 @@ class KindFacts:
     static_friction: bool = False  # a window can show a break-away (FSJ)
     load_side: bool = False  # the log is on the load side: FDJ is the load's friction force
     recorded: tuple[str, ...] = ()  # the section's fields a log may record beside its signals (``constants``)
+    # How long the windows a recording of this kind is cut into unless told (the thesis's windows: a few commands of
+    # the elevator each); None: a log is one window (a rig's run, a controller's log).
+    window_s: float | None = None
 
     def recorded_field(self, name: str) -> str | None:
         """Why a log of this kind cannot record the constant ``name`` (None: it can)."""
@@ -59,11 +61,6 @@ class KindFacts:
         if not self.recorded:
             return f"a {self.name} actuator's log records no constants"
         return f"a {self.name} actuator's log records {', '.join(self.recorded)}, under its document's names"
-
-    @property
-    def window_s(self) -> float | None:
-        """How long the windows a recording of this kind is cut into unless told (None: read whole)."""
-        return CUT_WINDOW_S.get(self.name)
 
     @property
     def friction_unit(self) -> str:
@@ -92,6 +89,7 @@ FRICTION_SUFFIX = MappingProxyType({"N·m": "nm", "N": "n"})
 
 _ROTARY = KindFacts(
     name="rotary",
+    window_s=0.5,
     summary="a current-piloted motor and a gear train to a surface",
     section="drive",
     roles=_roles(

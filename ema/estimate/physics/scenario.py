@@ -24,7 +24,6 @@ from ema.model.window import Window
 
 INITIAL_FIT_SAMPLES = 8
 SETTLE_S = 0.02  # the simulation settles from an estimated first state: compared after this
-MAX_RATIO = 2.0  # residual torque within twice its noise floor: reproduced
 CLEAR_MARGIN = 0.05  # of two models, the loser's ``following_error`` this far above the winner's: a clear call
 # What is physical, whatever the window: FDJ from a tenth of the actuator's nominal to ten times it, η_O
 # down into the irreversible range (thesis Case 1C).

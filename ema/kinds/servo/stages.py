@@ -26,9 +26,8 @@ from ema.estimate.config import PipelineConfig
 from ema.estimate.documents.window_facts import WindowInfo
 from ema.estimate.learn.estimator import NetworkRegressor
 from ema.estimate.learn.network import LearnConfig
-from ema.estimate.physics.scenario import MAX_RATIO
 from ema.estimate.report import training_info
-from ema.estimate.stats import RESOLUTION_SHARE, rms
+from ema.estimate.stats import MAX_RATIO, RESOLUTION_SHARE, rms
 from ema.estimate.stopwatch import Stopwatch
 from ema.kinds.servo.inverse import (
     EITHER_SIGN,

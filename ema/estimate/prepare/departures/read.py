@@ -26,12 +26,13 @@ import numpy as np
 from ema.estimate.documents import Note
 from ema.estimate.physics.features import fit_as_read
 from ema.estimate.physics.noise_reading import white_noise_std
-from ema.estimate.physics.scenario import CLEAR_MARGIN, MAX_RATIO, following_error, inside, scenario_from_window
+from ema.estimate.physics.scenario import CLEAR_MARGIN, following_error, inside, scenario_from_window
 from ema.estimate.prepare.departures.aircraft_check import AircraftCheck, banded, divided_out
 from ema.estimate.prepare.departures.drive_constants import UNDECIDED_SHARE, DriveReading, read_drive_constants
 from ema.estimate.prepare.departures.hinge_gain import HingeGain, read_hinge_gain
 from ema.estimate.prepare.departures.viscosity import Viscosity, read_viscosity
 from ema.estimate.prepare.departures.zero_offset import ZeroOffset, read_zero_offset, zeroed
+from ema.estimate.stats import MAX_RATIO
 from ema.model.actuator import ActuatorDocument
 from ema.model.checks import InputError
 from ema.model.noise import SensorNoise
