@@ -28,9 +28,9 @@ from ema.estimate.assess.weighing import Assessed, Candidates, assess, misfit_li
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import ActuatorRead, Check, Estimate, Note
 from ema.estimate.documents.window_facts import HistoryReadings
-from ema.estimate.history import known_from
 from ema.estimate.learn.estimator import NetworkEstimator
 from ema.estimate.learn.network import LearnConfig
+from ema.estimate.other_windows import known_from
 from ema.estimate.physics.features import as_read
 from ema.estimate.physics.friction import FIT_ARRAYS, FrictionFit, fit_friction, fit_window
 from ema.estimate.physics.scenario import inside
@@ -155,7 +155,7 @@ def estimate_window(
     default a caller chose for a user who gave none, and the answer says so), ``version`` its stored
     version; ``on_stage`` hears each stage as it starts (and may raise to stop the job there);
     ``spec_only`` reads the window with the document's model alone, no departures taken off (calibration's
-    base); ``history``: what other windows of the actuator lend this one (``ema.estimate.history``). Raises
+    base); ``history``: what other windows of the actuator lend this one (``ema.estimate.other_windows``). Raises
     InputError naming the field for a window that cannot be read.
     """
     watch = Stopwatch(on_stage)

@@ -25,7 +25,7 @@ RANKS = {
     "ema.estimate.quasistatic.drive_torque": 1,
     "ema.estimate.quasistatic.departure": 0,
     "ema.estimate.quasistatic.slow_window": 7,
-    "ema.estimate.history": 6,
+    "ema.estimate.other_windows": 6,
     "ema.estimate.pipeline": 7,
 }
 

@@ -1,5 +1,5 @@
 """What an estimate says of its window (``ema-estimate/1``'s ``window``), and what windows of one actuator lend each
-other: a flight's sensor zero, the actuator's J_M (``ema.estimate.history``). Part of the one definition of the
+other: a flight's sensor zero, the actuator's J_M (``ema.estimate.other_windows``). Part of the one definition of the
 estimate document (``ema.estimate.documents``).
 """
 

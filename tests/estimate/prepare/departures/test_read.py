@@ -3,7 +3,7 @@
 import pytest
 
 from ema.estimate.documents.window_facts import HistoryReadings, InertiaReading
-from ema.estimate.history import known_from
+from ema.estimate.other_windows import known_from
 from ema.estimate.physics.features import as_read
 from ema.estimate.physics.friction import fit_window
 from ema.estimate.prepare.conditioning import prepare, widened

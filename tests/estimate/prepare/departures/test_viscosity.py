@@ -69,7 +69,7 @@ def test_where_the_speed_hardly_varies_an_unseen_coefficient_is_in_the_stds(fact
     its flight: C·|ω| is FDJ's twin. Read with the spec's C and a std without it, C 1.24x put FDJ 40 % of
     range high at 10 std (foreign history, actuator 407)."""
     from ema.estimate.documents.window_facts import HistoryReadings
-    from ema.estimate.history import known_from
+    from ema.estimate.other_windows import known_from
     from ema.estimate.physics.friction import fit_window
     from ema.estimate.prepare.conditioning import widened
     from ema.estimate.report import weakly_determined

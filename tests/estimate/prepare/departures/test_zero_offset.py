@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from ema.estimate.documents.window_facts import HistoryReadings, SensorZero
-from ema.estimate.history import known_from
+from ema.estimate.other_windows import known_from
 from ema.estimate.prepare.conditioning import prepare
 from ema.estimate.prepare.departures.zero_offset import ZeroOffset
 from ema.model.actuator import THESIS

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from ema.estimate.documents.window_facts import HistoryReadings, InertiaReading, SensorZero
-from ema.estimate.history import NAMED_WINDOWS, best_zero, combined_inertia, known_from, readings_of, since_change
+from ema.estimate.other_windows import NAMED_WINDOWS, best_zero, combined_inertia, known_from, readings_of, since_change
 from ema.estimate.pipeline import estimate_window
 from ema.model.actuator import THESIS
 from ema.model.params import HealthParams
