@@ -29,7 +29,7 @@ USER ema
 WORKDIR /data
 # Compile the kernels at build time, from the installed package (Numba keys its cache on the source
 # path: a warm-up of another copy would leave the service to compile at every start).
-RUN python -c "from ema.estimate import runtime; thread_budget.configure(); from ema.kinds import warm_up; warm_up()"
+RUN python -c "from ema.estimate import thread_budget; thread_budget.configure(); from ema.kinds import warm_up; warm_up()"
 
 VOLUME ["/data"]
 EXPOSE 8000
