@@ -38,7 +38,7 @@ from ema.estimate.physics.static_friction import read_static_friction
 from ema.estimate.prepare.conditioning import Prepared, prepare, widened
 from ema.estimate.report import estimate_document
 from ema.estimate.simulate.dataset import Data, simulate_dataset
-from ema.estimate.stats import MAX_RATIO, RESOLUTION_SHARE, rms
+from ema.estimate.stats import MAX_RATIO, rms
 from ema.estimate.stopwatch import Stopwatch
 from ema.model.actuator import THESIS, ActuatorDocument
 from ema.model.window import Window
@@ -82,15 +82,21 @@ def candidates(
 
 
 def checked(
-    window: Window, data: Data, answer: Assessed, equation_ratio: float, n: int, nominal_fdj_nm: float
+    window: Window,
+    data: Data,
+    answer: Assessed,
+    physics: FrictionFit,
+    *,
+    equation_ratio: float,
+    n: int,
+    nominal_fdj_nm: float,
 ) -> Check:
     """Simulate the window at the answer and compare (``ema.estimate.assess.reproduction``). Where the answer is the
     point the noise was measured at (the physics estimate, when it carries the answer), that simulation is
     the one: a lane of the dataset's batch, the same numbers as a run of its own."""
     health = inside(answer.values["FDJ"], answer.values["eta_O"], nominal_fdj_nm)
     noise = rms((data.sims.residual_nm[n:] - data.sims.clean_residual_nm)[:, data.sliding])
-    motor_nm = data.drive_as_read.torque_constant_nm_per_a * window.signals["current_a"][data.sliding]
-    floor = float(np.hypot(noise, RESOLUTION_SHARE * rms(motor_nm)))  # a log without noise: the model's resolution
+    floor = float(np.hypot(noise, physics.resolution_nm[0]))  # a log without noise: the model's resolution
     known = data.sims.reference_signals if health.identical(data.sims.reference) else None
     ratios = output_error_ratios(
         window,
@@ -177,7 +183,9 @@ def estimate_window(
     with watch("assess", "weighing the estimators on held-out simulations"):
         answer, equation_ratio, limit = assessed(w, physics, data, network, prepared=prepared, n=n)
     with watch("check", "checking the answer against the window"):
-        check = checked(seen, data, answer, equation_ratio, n, actuator.health.fdj)
+        check = checked(
+            seen, data, answer, physics, equation_ratio=equation_ratio, n=n, nominal_fdj_nm=actuator.health.fdj
+        )
         check = check.model_copy(update={"equation_error_limit": limit})
     with watch("report", "reading FSJ at the answer, writing the report"):
         fsj = read_static_friction(

@@ -35,7 +35,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ema.estimate.physics.eta_search import MIN_OFFSET_BALANCE
-from ema.estimate.physics.noise_reading import white_noise_std
+from ema.estimate.physics.noise_reading import robust_variance, white_noise_std
 from ema.estimate.physics.zero_phase import butter_lowpass, cheby1_lowpass, filtfilt
 from ema.estimate.stats import rms
 from ema.model.checks import InputError
@@ -242,7 +242,7 @@ def disturbed_rows(residual_by_row: np.ndarray, simulated_by_row: np.ndarray) ->
     and the rows beside them (module docstring)."""
     fitted = np.isfinite(residual_by_row)
     r = residual_by_row[fitted]
-    noise = 1.4826 * float(np.median(np.abs(r - np.median(r)))) if len(r) else 0.0
+    noise = float(np.sqrt(robust_variance(r))) if len(r) else 0.0
     envelope = np.zeros(len(residual_by_row))
     if len(simulated_by_row):
         seen = np.isfinite(simulated_by_row).any(

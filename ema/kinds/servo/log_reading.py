@@ -33,6 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ema.estimate.documents import Note
+from ema.estimate.physics.noise_reading import robust_variance
 from ema.estimate.stats import below_zero, rms
 from ema.kinds.servo.closed_loop import ServoLoop, ServoRuns, simulate_servo
 from ema.kinds.servo.inverse import Motion, fit_inverse, inverse_columns, load_motion, refuse_still
@@ -125,12 +126,17 @@ def _filtered_speed(taps: list[float], position_m: np.ndarray, rate_hz: float) -
     return np.diff(filtered, prepend=filtered[0]) * rate_hz
 
 
+def _command_limit(servo: Servo) -> float:
+    """The command's saturation, ± in its unit (inf: none)."""
+    return servo.command_limit if servo.command_limit is not None else np.inf
+
+
 def commanded(servo: Servo, set_point_m: np.ndarray, position_m: np.ndarray, rate_hz: float) -> np.ndarray:
     """The command [its unit] the document's controller gives at each sample of the log."""
     assert servo.position_gain_per_s is not None and servo.speed_gain_per_mps is not None  # completed
     gains = LoopGains(servo.position_gain_per_s, servo.speed_gain_per_mps, 0.0)
     command = _loop_law(servo, gains, set_point_m, position_m, rate_hz)
-    limit = servo.command_limit if servo.command_limit is not None else np.inf
+    limit = _command_limit(servo)
     return np.clip(command, -limit, limit)
 
 
@@ -166,7 +172,7 @@ def log_loop(servo: Servo, window: Window, among: np.ndarray | None = None) -> L
     or too few samples to read two from)."""
     start = len(servo.speed_filter)
     logged = _logged_command(servo, window)[start:]
-    limit = servo.command_limit if servo.command_limit is not None else np.inf
+    limit = _command_limit(servo)
     free = np.abs(logged) < limit
     if among is not None:
         free &= among[start:]
@@ -191,7 +197,7 @@ def _loop_columns(servo: Servo, window: Window) -> np.ndarray:
 def departure(servo: Servo, window: Window, gains: LoopGains) -> np.ndarray:
     """(N,) the logged command less the loop's with ``gains``: what the loop does not give. 0 where both sit at the
     same limit (the loop gives it), and before the speed filter's start (it reads positions from before the log)."""
-    s, limit = window.signals, servo.command_limit if servo.command_limit is not None else np.inf
+    s, limit = window.signals, _command_limit(servo)
     loop = _loop_law(servo, gains, s["set_point_m"], s["position_m"], window.sample_rate_hz)
     logged = _logged_command(servo, window)
     out = logged - loop
@@ -202,7 +208,7 @@ def departure(servo: Servo, window: Window, gains: LoopGains) -> np.ndarray:
 
 def loops_own(values: np.ndarray) -> np.ndarray:
     """(N,) the samples whose command the loop gives: departing by at most ``ADDED_MADS`` robust stds."""
-    spread = 1.4826 * float(np.median(np.abs(values - np.median(values))))
+    spread = float(np.sqrt(robust_variance(values)))
     return np.abs(values - np.median(values)) <= ADDED_MADS * spread + 1e-12 * float(np.max(np.abs(values)))
 
 
@@ -239,7 +245,7 @@ def added_command(servo: Servo, window: Window, gains: LoopGains | None) -> Adde
     own terms explain at most ``MAX_LOOP_SHARE`` of it (else it is the loop's error, not a command added to it) and
     the logged command stays within the document's limit (no command added before the limit passes it); else
     None."""
-    limit = servo.command_limit if servo.command_limit is not None else np.inf
+    limit = _command_limit(servo)
     if gains is None or np.any(np.abs(_logged_command(servo, window)) > limit * (1 + 1e-9)):
         return None
     values = departure(servo, window, gains)
@@ -367,7 +373,7 @@ def prepare_servo(window: Window, actuator: ActuatorDocument) -> ServoPrepared:
         position_gain_per_s=gains.position_gain_per_s,
         speed_gain_per_mps=gains.speed_gain_per_mps,
         drive_gain_n_per_unit=servo.drive_gain_n_per_unit,
-        command_limit=servo.command_limit if servo.command_limit is not None else np.inf,
+        command_limit=_command_limit(servo),
         period_s=1.0 / rate,
         resolution_m=step,
         taps=tuple(servo.speed_filter),
