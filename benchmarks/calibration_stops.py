@@ -15,9 +15,9 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ema.calibration.calibrate import Calibrator
 from ema.cli.benchmark_docs import write_section
 from ema.estimate import thread_budget
+from ema.kinds.rotary.calibration import Calibrator
 from ema.model.actuator import THESIS
 from ema.model.window import window_from_dict
 from tests.foreign.physics import Effects, Flight

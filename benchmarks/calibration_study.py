@@ -22,13 +22,13 @@ from typing import Any
 
 import numpy as np
 
-from ema.calibration.calibrate import Calibrator, combined
 from ema.cli.benchmark_docs import write_section
 from ema.cli.figures import residual_figure
 from ema.estimate import thread_budget
 from ema.estimate.config import PipelineConfig
-from ema.estimate.pipeline import estimate_window
 from ema.kinds.rotary import residual_plot
+from ema.kinds.rotary.calibration import Calibrator, combined
+from ema.kinds.rotary.pipeline import estimate_window
 from ema.model.actuator import THESIS
 from ema.model.checks import InputError
 from ema.model.window import window_from_dict

@@ -31,9 +31,9 @@ from benchmarks.as_user import run_ema
 from benchmarks.real_time import cpu_seconds
 from benchmarks.service_overhead import free_port, serve
 from ema.cli.benchmark_docs import typed_command, write_section
+from ema.kinds.rotary.synthetic import synthetic_window
 from ema.model.params import HealthParams
 from ema.model.runtime import available_cores
-from ema.model.synthetic import synthetic_window
 from ema.model.window import Window, window_to_dict
 
 FLEET_DAY = 100 * 2 * (10 * 3600 // 20)  # windows a day

@@ -26,8 +26,8 @@ from benchmarks.tails import BOUND, FIRST_NOISE_SEED, expected_over
 from ema.cli.benchmark_docs import write_section
 from ema.estimate import thread_budget
 from ema.estimate.documents.window_facts import HistoryReadings
-from ema.estimate.pipeline import estimate_window
 from ema.estimate.report import WEAK_SHARE_OF_RANGE, share_of_range
+from ema.kinds.rotary.pipeline import estimate_window
 from ema.model.actuator import THESIS
 from ema.model.checks import InputError
 from ema.model.window import window_from_dict

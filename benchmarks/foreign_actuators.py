@@ -22,7 +22,7 @@ import numpy as np
 
 from ema.cli.benchmark_docs import write_section
 from ema.estimate import thread_budget
-from ema.estimate.pipeline import estimate_window
+from ema.kinds.rotary.pipeline import estimate_window
 from ema.model.actuator import THESIS, actuator_from_dict
 from ema.model.checks import InputError
 from ema.model.window import window_from_dict

@@ -24,8 +24,8 @@ from benchmarks.wearing_fleet import KINDS_OF_WEAR, Thresholds, Wear, flights, l
 from ema.cli.benchmark_docs import write_section
 from ema.estimate import thread_budget
 from ema.estimate.other_windows import readings_of
-from ema.estimate.pipeline import estimate_window
 from ema.estimate.report import share_of_range
+from ema.kinds.rotary.pipeline import estimate_window
 from ema.model.actuator import THESIS
 from ema.model.checks import InputError
 from ema.model.window import window_from_dict

@@ -16,7 +16,7 @@ from benchmarks.foreign_groups import FAMILIES, drive_off, off_zero, viscous
 from ema.cli.benchmark_docs import typed_command, write_section
 from ema.estimate import thread_budget
 from ema.estimate.other_windows import readings_of
-from ema.estimate.pipeline import estimate_window
+from ema.kinds.rotary.pipeline import estimate_window
 from ema.model.actuator import THESIS
 from ema.model.window import window_from_dict
 from tests.foreign.windows import Draw, Effects, draw, filter_widths, of_the_same_flight, through_filters

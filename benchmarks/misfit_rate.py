@@ -19,7 +19,7 @@ from ema.cli.benchmark_docs import write_section
 from ema.cli.printing import check_line
 from ema.estimate import thread_budget
 from ema.estimate.assess.weighing import MISFIT_FALSE_ALARM
-from ema.estimate.pipeline import estimate_window
+from ema.kinds.rotary.pipeline import estimate_window
 from ema.model.actuator import THESIS
 from ema.model.window import window_from_dict
 from tests.foreign.windows import draw

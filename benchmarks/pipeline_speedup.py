@@ -21,11 +21,11 @@ import numpy as np
 
 from ema.cli.benchmark_docs import typed_command, write_section
 from ema.estimate import thread_budget
-from ema.estimate.pipeline import estimate_window
 from ema.estimate.report import share_of_range
+from ema.kinds.rotary.pipeline import estimate_window
+from ema.kinds.rotary.synthetic import synthetic_window
 from ema.model.actuator import THESIS
 from ema.model.params import DEFAULT_RANGES, HealthParams
-from ema.model.synthetic import synthetic_window
 from ema.model.window import read_window, write_window
 
 LEGACY = "b8987e4"  # the last commit of round 1
@@ -33,7 +33,7 @@ ROOT = Path(__file__).resolve().parent.parent
 LEGACY_RUN = """
 import json, sys, time
 from ema.model.window import read_window
-from ema.estimate.pipeline import estimate_window
+from ema.kinds.rotary.pipeline import estimate_window
 paths = sys.argv[1:]
 estimate_window(read_window(paths[0]))  # warm
 out = []

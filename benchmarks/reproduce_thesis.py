@@ -27,11 +27,11 @@ from ema.estimate.physics.features import features
 from ema.estimate.physics.friction import fit_window
 from ema.estimate.physics.scenario import Scenario
 from ema.estimate.simulate.design import Box
+from ema.kinds.rotary.synthetic import synthetic_window
 from ema.model.aircraft import FlightCondition, GroundLoad
 from ema.model.commands import random_command_knots
 from ema.model.noise import NO_NOISE, SensorNoise, add_sensor_noise
 from ema.model.params import DEFAULT_RANGES, IRREVERSIBLE_RANGES, HealthParams, HealthRanges
-from ema.model.synthetic import synthetic_window
 
 DOCS = Path(__file__).resolve().parent.parent / "docs"
 RATE_HZ, SAMPLES = 10_000.0, 5000
@@ -157,7 +157,7 @@ def plot_parity(case: Case, index: int, prediction: np.ndarray, truth: np.ndarra
 
 def baseline_comparison(n_windows: int) -> list[str]:
     """Network pipeline vs the least-squares baseline on the same noisy windows (physical errors)."""
-    from ema.estimate.pipeline import estimate_window
+    from ema.kinds.rotary.pipeline import estimate_window
 
     rows = []
     rng = np.random.default_rng(7)
@@ -219,7 +219,7 @@ def write_results(results: list[dict], comparison: list[str], command: str) -> N
         "- **Case 2** fails for us as for the thesis: with a new command per simulation, the residual",
         "  torque trace is dominated by the command, not by FDJ or η_O; no shallow network on 1 000",
         "  simulations can invert that. Retraining per window (Case 1B on the logged command,",
-        "  `ema/estimate/pipeline.py`) is the answer the thesis proposed in §6.3, and what the product does.",
+        "  `ema/kinds/rotary/pipeline.py`) is the answer the thesis proposed in §6.3, and what the product does.",
         "",
         "### Network or physics? Both, on the same noisy windows",
         "",

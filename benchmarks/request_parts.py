@@ -26,7 +26,7 @@ from benchmarks.service_overhead import quiet_collector
 from ema.cli.benchmark_docs import write_section
 from ema.estimate import thread_budget
 from ema.estimate.config import PipelineConfig
-from ema.estimate.pipeline import estimate_window
+from ema.kinds.rotary.pipeline import estimate_window
 from ema.model.actuator import THESIS
 from ema.model.window import WindowDocument
 
@@ -41,21 +41,21 @@ PARTS = (  # (stage, "module:function" as the stage calls it, what the step does
     ("prepare", "ema.estimate.prepare.conditioning:check_against_aircraft", "the hinge moment against the airframe"),
     ("prepare", "ema.estimate.prepare.conditioning:read_departures", "departures from the actuator document"),
     ("prepare", "ema.estimate.prepare.conditioning:step_lag", "the hinge moment's step lag"),
-    ("physics", "ema.estimate.pipeline:fit_window", "Eq. 5.1 on the window"),
+    ("physics", "ema.kinds.rotary.pipeline:fit_window", "Eq. 5.1 on the window"),
     ("simulate", "ema.model.batch:run_groups", f"the kernel: {SIMULATIONS} simulations and the clean lane"),
     ("simulate", "ema.estimate.simulate.dataset:excess_noise", "the window's noise, read against the clean lane"),
     ("simulate", "ema.estimate.simulate.dataset:add_seeded_noise", "that noise added to the simulations"),
     ("simulate", "ema.estimate.simulate.dataset:as_read", "the simulations read as the window is"),
     ("simulate", "ema.estimate.simulate.dataset:residual_torque_nm", "T_R of the simulations and the window"),
     ("simulate", "ema.estimate.simulate.dataset:sliding_features", "the network's inputs"),
-    ("learn", "ema.estimate.pipeline:learned", "the network trained"),
-    ("assess", "ema.estimate.pipeline:fit_friction", "Eq. 5.1 on the held-out simulations"),
+    ("learn", "ema.kinds.rotary.pipeline:learned", "the network trained"),
+    ("assess", "ema.kinds.rotary.pipeline:fit_friction", "Eq. 5.1 on the held-out simulations"),
     ("assess", "ema.estimate.learn.estimator:NetworkEstimator.predict_unit", "the network on them and the window"),
-    ("assess", "ema.estimate.pipeline:assess", "the estimators weighed and blended"),
+    ("assess", "ema.kinds.rotary.pipeline:assess", "the estimators weighed and blended"),
     ("check", "ema.model.batch:run_groups", "the window simulated at the answer (where not reused)"),
-    ("check", "ema.estimate.assess.reproduction:as_read", "that simulation read as the window is"),
-    ("check", "ema.estimate.assess.reproduction:residual_torque_nm", "T_R of both"),
-    ("report", "ema.estimate.pipeline:read_static_friction", "FSJ read where the window shows one"),
+    ("check", "ema.kinds.rotary.reproduction:as_read", "that simulation read as the window is"),
+    ("check", "ema.kinds.rotary.reproduction:residual_torque_nm", "T_R of both"),
+    ("report", "ema.kinds.rotary.pipeline:read_static_friction", "FSJ read where the window shows one"),
 )
 
 

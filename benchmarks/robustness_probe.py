@@ -35,11 +35,11 @@ import httpx
 
 from ema.cli.benchmark_docs import write_section
 from ema.estimate.documents import parameter
-from ema.estimate.pipeline import estimate_window
 from ema.history.open import open_history
+from ema.kinds.rotary.pipeline import estimate_window
+from ema.kinds.rotary.synthetic import synthetic_window
 from ema.model.actuator import THESIS
 from ema.model.params import HealthParams
-from ema.model.synthetic import synthetic_window
 from ema.model.window import window_to_dict
 from tests.servers import SMALL_ENV, free_port
 from tests.service.conftest import SMALL

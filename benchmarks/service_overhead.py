@@ -27,8 +27,8 @@ import httpx
 import numpy as np
 
 from ema.cli.benchmark_docs import write_section
-from ema.estimate.pipeline import estimate_window
 from ema.history.open import open_history
+from ema.kinds.rotary.pipeline import estimate_window
 from ema.model.actuator import THESIS
 from ema.model.window import WindowDocument
 from tests.foreign.windows import draw

@@ -21,8 +21,8 @@ from benchmarks.foreign_groups import group_seed, groups
 from ema.cli.benchmark_docs import write_section
 from ema.estimate import thread_budget
 from ema.estimate.config import PipelineConfig
-from ema.estimate.pipeline import estimate_window
 from ema.estimate.report import share_of_range
+from ema.kinds.rotary.pipeline import estimate_window
 from ema.model.actuator import THESIS
 from ema.model.checks import InputError
 from ema.model.window import window_from_dict

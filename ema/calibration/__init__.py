@@ -1,1 +1,5 @@
-"""Close the loop: trace what the model misses in measured windows to an effect, add it, re-estimate."""
+"""What a calibration answers, whatever the kind: the ``ema-calibration/1`` report and the figure it draws.
+
+Each kind's calibration (the rotary's loop that traces a residual to a missing effect, the servo's held-out
+choice of load effects, the linear drive's learning) lives in its folder under ``ema.kinds``.
+"""

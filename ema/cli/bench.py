@@ -31,14 +31,14 @@ from ema.cli.yardstick import DURATION_S, SIMS, yardstick_seconds
 from ema.estimate import thread_budget
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import STAGES as PIPELINE_STAGES
-from ema.estimate.pipeline import estimate_window
 from ema.estimate.report import share_of_range
+from ema.kinds.rotary.pipeline import estimate_window
+from ema.kinds.rotary.synthetic import synthetic_window
 from ema.model.actuator import THESIS
 from ema.model.batch import default_lanes, simulate_batch
 from ema.model.bounds import DEFAULT_SAMPLE_RATE_HZ
 from ema.model.commands import random_command_knots
 from ema.model.params import DEFAULT_RANGES, HealthParams
-from ema.model.synthetic import synthetic_window
 
 STAGES = (*PIPELINE_STAGES, "total")
 TARGET_SHARE = 0.128  # a 0.5 s window's idle p95 as a share of the yardstick: the latency target
@@ -178,7 +178,7 @@ def stage_factors(rows: list[dict[str, Any]]) -> list[str]:
 def markdown(rows: list[dict[str, Any]], config: PipelineConfig, refs: dict[str, float] | None = None) -> str:
     lines = [
         "One synthetic window (§5.6 command, realistic sensor noise, health uniform in Table 3.1's ranges) ->",
-        f"estimates, in-process (`ema.estimate.pipeline.estimate_window`, what the service runs), "
+        f"estimates, in-process (`ema.kinds.rotary.pipeline.estimate_window`, what the service runs), "
         f"{config.n_simulations} + {config.check_windows} simulations, {config.hidden_units} neurons.",
         "p50 (p95) seconds per stage; real-time factor = pipeline seconds per second of window (≤ 1: real time);",
         "error = mean |error| in % of the thesis's range (0.02 N·m for FDJ, 0.30 for η_O).",

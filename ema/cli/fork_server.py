@@ -10,7 +10,7 @@ from ema.model.collector import collect_less_often
 
 collect_less_often()
 
-import ema.estimate.pipeline  # noqa: E402, F401  (after the collector is set: the point of this module)
+import ema.kinds.rotary.pipeline  # noqa: E402, F401  (after the collector is set: the point of this module)
 from ema.kinds.remote import warm  # noqa: E402
 
 warm(1)

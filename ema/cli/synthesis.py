@@ -11,6 +11,7 @@ from typing import Any
 import numpy as np
 
 from ema.cli.options import actuator_document
+from ema.kinds.rotary.synthetic import synthetic_window
 from ema.model.actuator import ActuatorDocument
 from ema.model.aircraft import FlightCondition, GroundLoad
 from ema.model.checks import InputError
@@ -18,7 +19,6 @@ from ema.model.effects import EFFECTS, EffectSet
 from ema.model.noise import NO_NOISE, SensorNoise
 from ema.model.params import HealthParams
 from ema.model.residual import residual_torque_nm
-from ema.model.synthetic import synthetic_window
 from ema.model.window import Window, write_window
 
 

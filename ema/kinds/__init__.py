@@ -1,18 +1,19 @@
-"""Each kind of actuator whole, in one module or one folder: how its windows are read, what a request costs, how its
-runs are calibrated (after NASA progpy's ``PrognosticsModel``: a model declares what it has, a predictor calls it).
+"""Each kind of actuator whole, in one folder (after NASA progpy's ``PrognosticsModel``: a model declares what it
+has, a predictor calls it).
 
 A kind's documents (its window's signals, its actuator document's section, what its log map may name) are its
-``ema.model.kinds.KindFacts``; its module here adds the method:
+``ema.model.kinds.KindFacts``; its folder here adds the method, everything only that kind needs:
 
-- ``ema.kinds.rotary``: the thesis's elevator EMA, the whole pipeline at 1 kHz or more, quasi-static below;
-- ``ema.kinds.linear``: a ball screw turned by a stepper, read quasi-statically at any rate: a folder with its
-  drive's calibration (learned from healthy runs, faulted runs compared with it);
+- ``ema.kinds.rotary``: the thesis's elevator EMA: its pipeline at 1 kHz or more (quasi-static below), its
+  output-error check, its calibration loop that traces a residual to a missing effect, its synthetic windows;
+- ``ema.kinds.linear``: a ball screw turned by a stepper, read quasi-statically at any rate, with its drive's
+  calibration (learned from healthy runs, faulted runs compared with it);
 - ``ema.kinds.servo``: a linear axis under a known position controller, logged on the load side, the whole
-  method in the load frame: a folder holding everything only a servo needs (its log's reading, its inverse model,
-  its closed-loop simulator and dataset, its stages, its calibration and effects).
+  method in the load frame (its log's reading, its inverse model, its closed-loop simulator and dataset, its
+  stages, its calibration and effects).
 
 ``estimate``, ``calibrate`` and ``cost`` are the entries the command line, the service and the fleet call; a
-fourth kind is a module or a folder here and a row of ``ema.model.kinds``, not branches in the stages.
+fourth kind is a folder here, a row of ``ema.model.kinds`` and a line in ``KINDS``, not branches in the stages.
 """
 
 from __future__ import annotations

@@ -1,1 +1,1 @@
-"""The HTTP service: a thin FastAPI shell over ``ema.estimate.pipeline``."""
+"""The HTTP service: a thin FastAPI shell over ``ema.kinds.rotary.pipeline``."""

@@ -42,7 +42,7 @@ def test_every_step_is_reached_on_foreign_windows():
     reached = {key for key, seconds in parts.items() if seconds > 0}
     maybe = {
         ("check", "ema.model.batch:run_groups"),
-        ("check", "ema.estimate.assess.reproduction:as_read"),
+        ("check", "ema.kinds.rotary.reproduction:as_read"),
     }  # reused lane
     assert {(stage, key) for stage, key, _ in PARTS} - maybe <= reached
     for stage in STAGES:

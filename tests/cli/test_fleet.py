@@ -6,9 +6,9 @@ import json
 import pytest
 
 from ema.cli.main import EXIT_BAD_INPUT, EXIT_OK, main
+from ema.kinds.rotary.synthetic import synthetic_window
 from ema.model.actuator import THESIS
 from ema.model.params import HealthParams
-from ema.model.synthetic import synthetic_window
 from ema.model.window import window_to_dict
 
 SIZES = ["--sims", "16", "--checks", "8", "--timesteps", "50", "--hidden", "8"]
@@ -203,8 +203,8 @@ def test_history_plots_a_prognosis_whose_interval_holds_the_truth(tmp_path, caps
 
     from ema.estimate.config import PipelineConfig
     from ema.estimate.documents import parameter
-    from ema.estimate.pipeline import estimate_window
     from ema.history.open import open_history
+    from ema.kinds.rotary.pipeline import estimate_window
     from tests.servers import free_port, start_server
 
     small = PipelineConfig(n_simulations=16, check_windows=8, n_timesteps=50, hidden_units=8)

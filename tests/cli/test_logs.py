@@ -125,8 +125,8 @@ def test_each_kind_is_cut_as_its_windows_are_read_unless_told(tmp_path):
     """A servo's log (EMPS's first quarter, as a window document) is one window: cut to the thesis's 0.5 s, every
     piece moved one way and was refused. A rotary recording is cut into 0.5 s windows; --window-s cuts either."""
     from ema.cli.logs import read_log
+    from ema.kinds.rotary.synthetic import synthetic_window
     from ema.model.params import HealthParams
-    from ema.model.synthetic import synthetic_window
     from ema.model.window import window_to_dict
 
     servo = read_one(MAPPED["servo"][0], read_logmap(EXAMPLES / "emps" / "log-map.json"))

@@ -8,8 +8,8 @@ import pytest
 from fastapi.testclient import TestClient
 
 from ema.cli.main import EXIT_BAD_INPUT, EXIT_OK, main
+from ema.kinds.rotary.synthetic import synthetic_window
 from ema.model.params import HealthParams
-from ema.model.synthetic import synthetic_window
 from ema.model.window import SIGNALS, window_to_dict
 from ema.service.main import create_app
 from tests.service.conftest import LOCAL, SMALL, settings_for

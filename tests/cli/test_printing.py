@@ -4,10 +4,10 @@ from pathlib import Path
 
 from ema.cli.printing import print_prognosis
 from ema.estimate.documents import parameter
-from ema.estimate.pipeline import estimate_window
+from ema.kinds.rotary.pipeline import estimate_window
+from ema.kinds.rotary.synthetic import synthetic_window
 from ema.model.actuator import THESIS, read_actuator
 from ema.model.params import HealthParams
-from ema.model.synthetic import synthetic_window
 from ema.prognosis.documents import EstimateHistory, Stored
 from ema.prognosis.prognose import prognose
 from tests.service.conftest import SMALL

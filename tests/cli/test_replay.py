@@ -14,9 +14,9 @@ import pytest
 from ema.cli.logs import read_log
 from ema.cli.main import EXIT_BAD_INPUT, EXIT_OK, main
 from ema.cli.replay import post_window
+from ema.kinds.rotary.synthetic import synthetic_window
 from ema.model.checks import InputError
 from ema.model.params import HealthParams
-from ema.model.synthetic import synthetic_window
 from ema.model.window import SIGNALS, window_to_dict
 from tests.servers import free_port, start_server
 

@@ -5,7 +5,7 @@ document."""
 import pytest
 
 from ema.estimate.config import PipelineConfig
-from ema.estimate.pipeline import estimate_window
+from ema.kinds.rotary.pipeline import estimate_window
 from ema.model.actuator import THESIS, actuator_from_dict
 from ema.model.checks import InputError
 from ema.model.window import window_from_dict

@@ -26,7 +26,6 @@ RANKS = {
     "ema.estimate.quasistatic.departure": 0,
     "ema.estimate.quasistatic.slow_window": 7,
     "ema.estimate.other_windows": 6,
-    "ema.estimate.pipeline": 7,
 }
 
 
@@ -65,7 +64,7 @@ def test_the_stages_are_subpackages_and_few_modules_remain_at_the_top():
 def test_the_documents_load_no_estimator():
     probe = (
         "import sys, ema.estimate.documents, ema.prognosis.documents; print(sorted(m for m in ('numpy', 'numba', "
-        "'scipy.optimize', 'ema.estimate.pipeline', 'ema.estimate.prepare') if m in sys.modules))"
+        "'scipy.optimize', 'ema.kinds.rotary.pipeline', 'ema.estimate.prepare') if m in sys.modules))"
     )
     loaded = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, check=True).stdout
     assert loaded.strip() == "['numpy']"  # prognosis's documents compute with numpy; nothing of the estimator

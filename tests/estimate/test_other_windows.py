@@ -5,10 +5,10 @@ import pytest
 
 from ema.estimate.documents.window_facts import HistoryReadings, InertiaReading, SensorZero
 from ema.estimate.other_windows import NAMED_WINDOWS, best_zero, combined_inertia, known_from, readings_of, since_change
-from ema.estimate.pipeline import estimate_window
+from ema.kinds.rotary.pipeline import estimate_window
+from ema.kinds.rotary.synthetic import synthetic_window
 from ema.model.actuator import THESIS
 from ema.model.params import HealthParams
-from ema.model.synthetic import synthetic_window
 from tests.service.conftest import SMALL
 
 

@@ -11,8 +11,8 @@ PACKAGE = Path(__file__).resolve().parents[2] / "ema"
 
 ESTIMATE = (
     "import json, sys; from ema.estimate import thread_budget; from ema.estimate.config import PipelineConfig; "
-    "from ema.estimate.pipeline import estimate_window; from ema.model.actuator import THESIS; "
-    "from ema.model.params import HealthParams; from ema.model.synthetic import synthetic_window; "
+    "from ema.kinds.rotary.pipeline import estimate_window; from ema.model.actuator import THESIS; "
+    "from ema.model.params import HealthParams; from ema.kinds.rotary.synthetic import synthetic_window; "
     "thread_budget.configure({threads}); "
     "config = PipelineConfig(n_simulations=16, check_windows=8, n_timesteps=20, hidden_units=4); "
     "e = estimate_window(synthetic_window(HealthParams.single(), seed=3, duration_s=0.05), config, actuator=THESIS); "

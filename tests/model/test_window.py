@@ -3,9 +3,9 @@ import copy
 import numpy as np
 import pytest
 
+from ema.kinds.rotary.synthetic import synthetic_window
 from ema.model.checks import InputError
 from ema.model.params import HealthParams
-from ema.model.synthetic import synthetic_window
 from ema.model.window import read_window, window_from_dict, window_to_dict, write_window
 
 

@@ -86,9 +86,9 @@ def test_the_backtest_shows_past_forecasts_against_the_windows_since():
 @pytest.fixture(scope="module")
 def one_estimate():
     from ema.estimate.config import PipelineConfig
-    from ema.estimate.pipeline import estimate_window
+    from ema.kinds.rotary.pipeline import estimate_window
+    from ema.kinds.rotary.synthetic import synthetic_window
     from ema.model.params import HealthParams
-    from ema.model.synthetic import synthetic_window
 
     small = PipelineConfig(n_simulations=16, check_windows=8, n_timesteps=50, hidden_units=8)
     return estimate_window(synthetic_window(HealthParams.single(), seed=1, duration_s=0.1), small, actuator=THESIS)

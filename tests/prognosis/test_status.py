@@ -6,10 +6,10 @@ import datetime as dt
 import pytest
 
 from ema.estimate.documents import parameter
-from ema.estimate.pipeline import estimate_window
+from ema.kinds.rotary.pipeline import estimate_window
+from ema.kinds.rotary.synthetic import synthetic_window
 from ema.model.actuator import THESIS
 from ema.model.params import HealthParams
-from ema.model.synthetic import synthetic_window
 from ema.prognosis.documents import Stored
 from ema.prognosis.prognose import prognose
 from ema.prognosis.status import status_of, summary

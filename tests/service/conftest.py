@@ -6,8 +6,8 @@ import pytest
 from fastapi.testclient import TestClient
 
 from ema.estimate.config import PipelineConfig
+from ema.kinds.rotary.synthetic import synthetic_window
 from ema.model.params import HealthParams
-from ema.model.synthetic import synthetic_window
 from ema.model.window import window_to_dict
 from ema.service.config import Settings
 from ema.service.main import create_app

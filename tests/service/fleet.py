@@ -11,11 +11,11 @@ import httpx
 import numpy as np
 
 from ema.estimate.documents import Estimate, parameter
-from ema.estimate.pipeline import estimate_window
 from ema.history.open import History, open_history
+from ema.kinds.rotary.pipeline import estimate_window
+from ema.kinds.rotary.synthetic import synthetic_window
 from ema.model.actuator import THESIS
 from ema.model.params import HealthParams
-from ema.model.synthetic import synthetic_window
 from tests.servers import free_port, start_server
 from tests.service.conftest import SMALL, settled_lines
 

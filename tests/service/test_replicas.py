@@ -8,9 +8,9 @@ import uuid
 import httpx
 import pytest
 
+from ema.kinds.rotary.synthetic import synthetic_window
 from ema.model.actuator import THESIS
 from ema.model.params import HealthParams
-from ema.model.synthetic import synthetic_window
 from ema.model.window import window_to_dict
 from tests.servers import free_port, start_server
 

@@ -5,10 +5,10 @@ import pytest
 from fastapi.testclient import TestClient
 
 from ema.kinds.linear.calibration_report import calibrate_linear
+from ema.kinds.rotary.synthetic import synthetic_window
 from ema.model.actuator import read_actuator
 from ema.model.logmap import read_logmap, read_mapped
 from ema.model.params import HealthParams
-from ema.model.synthetic import synthetic_window
 from ema.model.window import window_from_dict, window_to_dict
 from ema.service.main import create_app
 from tests.kinds.linear.test_ballscrew import DOCUMENT, runs

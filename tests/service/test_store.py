@@ -7,12 +7,12 @@ import stat
 import pytest
 
 from ema.estimate.documents.window_facts import SensorZero
-from ema.estimate.pipeline import estimate_window
 from ema.history.open import open_history
 from ema.history.refusals import StorageError
+from ema.kinds.rotary.pipeline import estimate_window
+from ema.kinds.rotary.synthetic import synthetic_window
 from ema.model.actuator import THESIS
 from ema.model.params import HealthParams
-from ema.model.synthetic import synthetic_window
 from tests.service.conftest import SMALL
 
 

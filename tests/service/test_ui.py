@@ -5,11 +5,11 @@ import base64
 import pytest
 from fastapi.testclient import TestClient
 
-from ema.estimate.pipeline import estimate_window
 from ema.history.open import open_history
+from ema.kinds.rotary.pipeline import estimate_window
+from ema.kinds.rotary.synthetic import synthetic_window
 from ema.model.actuator import THESIS
 from ema.model.params import HealthParams
-from ema.model.synthetic import synthetic_window
 from ema.service.main import create_app
 from tests.service.conftest import KEY, LOCAL, SMALL, settings_for, settled
 from tests.service.fleet import FLEET, store_fleet

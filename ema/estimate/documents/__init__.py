@@ -74,8 +74,8 @@ STAGES = ("prepare", "physics", "simulate", "learn", "assess", "check", "report"
 
 
 class Timings(Document):
-    """Seconds of each stage of ``ema.estimate.pipeline``, in order (``STAGES``); a stage that did not run for
-    this window (a low-rate window reads no simulations) is 0, and ``stages`` in the estimate says why."""
+    """Seconds of each stage of the estimate, in order (``STAGES``), whatever the kind; a stage that did not run
+    for this window (a low-rate window reads no simulations) is 0, and ``stages`` in the estimate says why."""
 
     prepare: float = Field(0.0, description="the window checked, repaired, aligned, its departures read")
     physics: float = Field(0.0, description="Eq. 5.1 fitted by least squares")

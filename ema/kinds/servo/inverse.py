@@ -36,8 +36,8 @@ import numpy as np
 
 from ema.estimate.physics.eta_search import MIN_OFFSET_BALANCE
 from ema.estimate.physics.noise_reading import robust_variance, white_noise_std
-from ema.estimate.physics.zero_phase import butter_lowpass, cheby1_lowpass, filtfilt
 from ema.estimate.stats import rms
+from ema.kinds.servo.zero_phase import butter_lowpass, cheby1_lowpass, filtfilt
 from ema.model.checks import InputError
 
 FILTER_ORDER = 4  # the position's Butterworth low-pass

@@ -20,7 +20,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from ema.estimate import documents as doc
+import ema.estimate.documents as doc
 from ema.estimate.assess.weighing import Assessed, Candidates, assess, misfit_limit
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents.window_facts import WindowInfo

@@ -3,10 +3,10 @@ import pytest
 
 from ema.estimate.physics.features import as_read, bin_means, features
 from ema.estimate.physics.friction import fit_friction
+from ema.kinds.rotary.synthetic import synthetic_window
 from ema.model.actuator import THESIS
 from ema.model.checks import InputError
 from ema.model.params import HealthParams
-from ema.model.synthetic import synthetic_window
 from tests.foreign.windows import draw, noisy
 
 

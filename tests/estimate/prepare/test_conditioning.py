@@ -15,9 +15,9 @@ from ema.estimate.prepare.conditioning import (
 from ema.estimate.prepare.departures.viscosity import Viscosity
 from ema.estimate.prepare.departures.zero_offset import ZeroOffset
 from ema.estimate.prepare.step_lag import StepLag
+from ema.kinds.rotary.synthetic import synthetic_window
 from ema.model.actuator import THESIS
 from ema.model.params import HealthParams
-from ema.model.synthetic import synthetic_window
 from ema.model.window import Window, window_from_dict
 from tests.foreign.windows import NOISE, draw, worn
 

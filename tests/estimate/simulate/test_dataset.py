@@ -3,11 +3,11 @@ import pytest
 
 from ema.estimate.physics.scenario import initial_state, scenario_from_window
 from ema.estimate.simulate.dataset import simulate_noisy
+from ema.kinds.rotary.synthetic import synthetic_window
 from ema.model.actuator import THESIS
 from ema.model.batch import InitialState
 from ema.model.noise import NO_NOISE, SensorNoise
 from ema.model.params import HealthParams
-from ema.model.synthetic import synthetic_window
 from ema.model.window import window_from_dict
 from tests.foreign.windows import draw
 

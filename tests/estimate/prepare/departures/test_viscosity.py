@@ -97,7 +97,7 @@ def test_a_current_gain_at_top_speed_is_not_read_as_a_viscous_change(seed, gain)
     as a current read a few per cent off does: read as a viscous change, FDJ came out 0.091 ± 0.0026 N·m against
     a true 0.053 (15 stds). Beside a free torque scale the change no longer stands out: the document's C, the
     stds widened by what the other reading would move FDJ, and the truth inside 2 of them."""
-    from ema.estimate.pipeline import estimate_window
+    from ema.kinds.rotary.pipeline import estimate_window
     from tests.foreign.physics import Flight
 
     drawn = draw(

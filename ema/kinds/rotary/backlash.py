@@ -21,8 +21,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ema.calibration.equations import Equations
-from ema.calibration.selection import MIN_Z, floor_rms, residual_rms
+from ema.kinds.rotary.equations import Equations
+from ema.kinds.rotary.selection import MIN_Z, floor_rms, residual_rms
 
 MIN_ENGAGED = 50  # samples pushing on each face
 # The reading's floor: the dead band read kinematically moves with dynamics the model gets wrong, and the copies

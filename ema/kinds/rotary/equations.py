@@ -12,7 +12,7 @@ read it (``ema.estimate.physics.features.as_read``), k_aid and k_opp tied by Eq.
 (``Equations.tied``). A second channel carries the backlash: the motor angle (integrated measured
 speed) minus the elevator angle, d = θ_m/n − θ_u, sits at c ± BLK/2 depending on which side of the
 dead band the motor pushes. Simulated windows go through this very function, so the noise floor
-(``ema.calibration.noise_floor``) sees what the measured window sees.
+(``ema.kinds.rotary.noise_floor``) sees what the measured window sees.
 """
 
 from __future__ import annotations

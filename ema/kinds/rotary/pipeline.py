@@ -11,7 +11,7 @@ The thesis's §6.3 proposal, made to hold on data our simulator did not draw:
 4. **learn**: the shallow network on the residual torque of the sliding samples (``learned``);
 5. **assess**: both estimators scored on held-out simulations and blended per parameter, checked against the
    window itself (``assessed``, ``ema.estimate.assess.weighing``);
-6. **check**: the window simulated at the answer (``checked``, ``ema.estimate.assess.reproduction``);
+6. **check**: the window simulated at the answer (``checked``, ``ema.kinds.rotary.reproduction``);
 7. **report**: FSJ where the window shows a quasi-static break-away (``ema.estimate.physics.static_friction``),
    and the document.
 """
@@ -23,7 +23,6 @@ from dataclasses import replace
 
 import numpy as np
 
-from ema.estimate.assess.reproduction import output_error_ratios
 from ema.estimate.assess.weighing import Assessed, Candidates, assess, misfit_limit
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import ActuatorRead, Check, Estimate, Note
@@ -40,6 +39,7 @@ from ema.estimate.report import estimate_document
 from ema.estimate.simulate.dataset import Data, simulate_dataset
 from ema.estimate.stats import MAX_RATIO, rms
 from ema.estimate.stopwatch import Stopwatch
+from ema.kinds.rotary.reproduction import output_error_ratios
 from ema.model.actuator import THESIS, ActuatorDocument
 from ema.model.window import Window
 
@@ -91,7 +91,7 @@ def checked(
     n: int,
     nominal_fdj_nm: float,
 ) -> Check:
-    """Simulate the window at the answer and compare (``ema.estimate.assess.reproduction``). Where the answer is the
+    """Simulate the window at the answer and compare (``ema.kinds.rotary.reproduction``). Where the answer is the
     point the noise was measured at (the physics estimate, when it carries the answer), that simulation is
     the one: a lane of the dataset's batch, the same numbers as a run of its own."""
     health = inside(answer.values["FDJ"], answer.values["eta_O"], nominal_fdj_nm)

@@ -1,13 +1,13 @@
-"""The vocabulary: each named effect as a flexible family of equation-error columns (``ema.calibration.families``).
+"""The vocabulary: each named effect as a flexible family of equation-error columns (``ema.kinds.rotary.families``).
 
 A named effect is not one rigid shape: friction against position is a bump of any centre and width over
 the visited deflections (a localized spall as well as a broad rise), Stribeck friction a decay of any
 speed scale and exponent, cogging a ripple of any order with the log's interval-mean attenuation
-modelled (``ema.calibration.equations.cogging_columns``).
+modelled (``ema.kinds.rotary.equations.cogging_columns``).
 
 Coefficients map back to the simulator's parameters: in t = sgn(ω)(T_R − C_M·ω) a torque
 constant g leaves (1 − g)·k_T·I, a current-sensor gain s leaves (1 − 1/s)·k_T·I_logged (the
-same trace: twins, told apart by simulation in ``ema.calibration.twins``), a hinge-moment bias b
+same trace: twins, told apart by simulation in ``ema.kinds.rotary.twins``), a hinge-moment bias b
 leaves sgn(ω)·b/n, an inertia ΔJ beyond J_M leaves sgn(ω)·ΔJ·dω/dt.
 """
 
@@ -17,8 +17,8 @@ from collections.abc import Callable
 
 import numpy as np
 
-from ema.calibration.equations import Equations
-from ema.calibration.families import Family
+from ema.kinds.rotary.equations import Equations
+from ema.kinds.rotary.families import Family
 from ema.model.effects import EffectSet, FrictionTable
 from ema.model.params import DriveConstants
 

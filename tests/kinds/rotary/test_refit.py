@@ -3,12 +3,12 @@
 import numpy as np
 import pytest
 
-from ema.calibration.equations import FOLDS, Equations, equations
-from ema.calibration.families import generic_families
-from ema.calibration.refit import fit_with
-from ema.calibration.selection import Chosen
-from ema.calibration.vocabulary import named_families
 from ema.estimate.physics.eta_search import ETA_O_SEARCH, GRID_POINTS, REFINEMENTS
+from ema.kinds.rotary.equations import FOLDS, Equations, equations
+from ema.kinds.rotary.families import generic_families
+from ema.kinds.rotary.refit import fit_with
+from ema.kinds.rotary.selection import Chosen
+from ema.kinds.rotary.vocabulary import named_families
 from ema.model.actuator import THESIS
 from ema.model.params import eta_a_from_eta_o
 from ema.model.window import window_from_dict

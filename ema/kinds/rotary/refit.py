@@ -15,9 +15,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ema.calibration.equations import FOLDS, Equations
-from ema.calibration.selection import Chosen
 from ema.estimate.physics.eta_search import coarse_to_fine
+from ema.kinds.rotary.equations import FOLDS, Equations
+from ema.kinds.rotary.selection import Chosen
 from ema.model.params import load_factors
 
 MIN_HELD_OUT_GAIN = 0.01  # a model with an effect must cut the held-out residual by at least 1 % to be adopted

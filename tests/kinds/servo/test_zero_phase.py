@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 from scipy import signal
 
-from ema.estimate.physics.zero_phase import _lfilter, butter_lowpass, cheby1_lowpass, filtfilt
+from ema.kinds.servo.zero_phase import _lfilter, butter_lowpass, cheby1_lowpass, filtfilt
 
 ORDERS = (1, 2, 3, 4, 5, 8)
 CUTOFFS = (0.01, 0.08, 0.3, 0.7, 0.99)

@@ -4,9 +4,9 @@ from types import SimpleNamespace
 
 import pytest
 
-from ema.calibration import readings
-from ema.calibration.readings import Contest, settled
-from ema.calibration.selection import Chosen
+from ema.kinds.rotary import readings
+from ema.kinds.rotary.readings import Contest, settled
+from ema.kinds.rotary.selection import Chosen
 
 BEFORE = {"FDJ": 0.050, "eta_O": 0.80}
 STDS = {"FDJ": 0.001, "eta_O": 0.01}

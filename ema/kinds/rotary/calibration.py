@@ -4,19 +4,19 @@
 checks them and runs the stages once each, in order, and leaves ``report_`` (the
 ``ema-calibration/1`` document) and the residuals a figure needs:
 
-First ``ema.estimate.pipeline`` estimates each window with the base model, the document's alone (the answer
+First ``ema.kinds.rotary.pipeline`` estimates each window with the base model, the document's alone (the answer
 before; ``ema estimate`` also takes a sensor's offset off and reads the viscous coefficient). Then the
 stages, numbered as their modules and ``docs/calibration.md`` number them:
 
-1. ``ema.calibration.equations``: the windows' equation-error problem;
-2. ``ema.calibration.noise_floor``: the same problem on noise-only copies;
-3. ``ema.calibration.families``, ``vocabulary``: each effect as a family of columns;
-4. ``ema.calibration.selection``: what explains held-out samples beyond the floor, named or described
-   (``ema.calibration.twins`` for look-alikes, ``ema.calibration.backlash`` for the dead band);
-5. ``ema.calibration.readings``: the effect against its rivals' readings, adopted only where they agree
+1. ``ema.kinds.rotary.equations``: the windows' equation-error problem;
+2. ``ema.kinds.rotary.noise_floor``: the same problem on noise-only copies;
+3. ``ema.kinds.rotary.families``, ``vocabulary``: each effect as a family of columns;
+4. ``ema.kinds.rotary.selection``: what explains held-out samples beyond the floor, named or described
+   (``ema.kinds.rotary.twins`` for look-alikes, ``ema.kinds.rotary.backlash`` for the dead band);
+5. ``ema.kinds.rotary.readings``: the effect against its rivals' readings, adopted only where they agree
    (an ambiguity keeps the base estimates, its stds widened), never where it reads worse;
-6. ``ema.calibration.refit``: the estimates with what is adopted, checked on held-out folds;
-7. ``ema.calibration.report``: the document.
+6. ``ema.kinds.rotary.refit``: the estimates with what is adopted, checked on held-out folds;
+7. ``ema.kinds.rotary.calibration_report``: the document.
 """
 
 from __future__ import annotations
@@ -27,23 +27,23 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ema.calibration import report as reporting
-from ema.calibration.backlash import read_backlash
 from ema.calibration.documents import CalibrationReport, Step
-from ema.calibration.equations import Equations, equations
-from ema.calibration.families import Family, generic_families
-from ema.calibration.noise_floor import clean_replicas, noise_copies
-from ema.calibration.readings import AMBIGUOUS_STDS, Contest, combined_stds, reading, settled
-from ema.calibration.refit import MIN_HELD_OUT_GAIN, corrected, fit_with, held_out_rss
-from ema.calibration.selection import MAX_EFFECTS, Chosen, Decision, Evidence, decide, evidence
-from ema.calibration.twins import TWINS, output_error, runners_up, tell_apart
-from ema.calibration.vocabulary import COGGING_ORDERS, named_families
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import TARGETS, Estimate
 from ema.estimate.physics.scenario import CLEAR_MARGIN
-from ema.estimate.pipeline import estimate_window
 from ema.estimate.prepare.conditioning import prepare
 from ema.estimate.report import healthy_range
+from ema.kinds.rotary import calibration_report as reporting
+from ema.kinds.rotary.backlash import read_backlash
+from ema.kinds.rotary.equations import Equations, equations
+from ema.kinds.rotary.families import Family, generic_families
+from ema.kinds.rotary.noise_floor import clean_replicas, noise_copies
+from ema.kinds.rotary.pipeline import estimate_window
+from ema.kinds.rotary.readings import AMBIGUOUS_STDS, Contest, combined_stds, reading, settled
+from ema.kinds.rotary.refit import MIN_HELD_OUT_GAIN, corrected, fit_with, held_out_rss
+from ema.kinds.rotary.selection import MAX_EFFECTS, Chosen, Decision, Evidence, decide, evidence
+from ema.kinds.rotary.twins import TWINS, output_error, runners_up, tell_apart
+from ema.kinds.rotary.vocabulary import COGGING_ORDERS, named_families
 from ema.model.actuator import ActuatorDocument
 from ema.model.bounds import DEFAULT_SAMPLE_RATE_HZ, NOISE_COPIES
 from ema.model.checks import InputError

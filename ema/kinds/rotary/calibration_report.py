@@ -7,13 +7,13 @@ from dataclasses import asdict, dataclass, replace
 
 import numpy as np
 
-from ema.calibration.backlash import BacklashReading
 from ema.calibration.documents import CalibrationReport, Candidate, HeldOut, NoiseFloor, Step, Unexplained
-from ema.calibration.equations import Equations
-from ema.calibration.refit import MIN_HELD_OUT_GAIN, corrected, fit_with, held_out_rss
-from ema.calibration.selection import Chosen, Evidence, floor_rms, residual_rms
 from ema.estimate.documents import TARGETS
 from ema.estimate.physics.eta_search import ETA_O_SEARCH
+from ema.kinds.rotary.backlash import BacklashReading
+from ema.kinds.rotary.equations import Equations
+from ema.kinds.rotary.refit import MIN_HELD_OUT_GAIN, corrected, fit_with, held_out_rss
+from ema.kinds.rotary.selection import Chosen, Evidence, floor_rms, residual_rms
 from ema.model.effects import EffectSet
 
 # How much further noise alone may move FDJ or η_O with a described term than without it before the

@@ -3,9 +3,9 @@
 import numpy as np
 import pytest
 
-from ema.calibration.calibrate import Calibrator
 from ema.calibration.documents import CalibrationReport
 from ema.estimate.config import PipelineConfig
+from ema.kinds.rotary.calibration import Calibrator
 from ema.model.actuator import THESIS
 from ema.model.checks import InputError
 from ema.model.window import window_from_dict

@@ -1,7 +1,8 @@
-"""The rotary kind: the thesis's elevator EMA, a current-piloted motor and a gear train to a surface.
+"""The rotary kind: the thesis's elevator EMA, a current-piloted motor and a gear train to a surface; this folder
+holds everything only it needs (its pipeline, its output-error check, its calibration loop, its synthetic windows).
 
-A window at 1 kHz or more goes through the whole pipeline (``ema.estimate.pipeline``), one logged slower is
-read quasi-statically (``ema.estimate.quasistatic``); its calibration is the loop of ``ema.calibration.calibrate``,
+A window at 1 kHz or more goes through the whole pipeline (``ema.kinds.rotary.pipeline``), one logged slower is
+read quasi-statically (``ema.estimate.quasistatic``); its calibration is the loop of ``ema.kinds.rotary.calibration``,
 which reads windows at 1 kHz or more. The pipeline and the loop train networks: each is imported by the method
 that runs it, so that a process that reads only slow logs, or another kind's, never loads SciPy's optimizers
 (half a second of a one-shot command).
@@ -21,16 +22,16 @@ from ema.estimate.documents import STAGES, Estimate
 from ema.estimate.quasistatic.drive_torque import MOTOR_READING
 from ema.estimate.quasistatic.slow_window import QUASI_STATIC
 from ema.kinds.base import WARM_UP, Calibrated, CalibrationRequest, Cost, Request, read_quasi_statically
+from ema.kinds.rotary.synthetic import synthetic_window
 from ema.model.actuator import THESIS
 from ema.model.bounds import HIGH_RATE_HZ
 from ema.model.checks import InputError
 from ema.model.kinds import KINDS, KindFacts
 from ema.model.params import HealthParams
-from ema.model.synthetic import synthetic_window
 from ema.model.window import Window
 
 if TYPE_CHECKING:
-    from ema.calibration.calibrate import Calibrator
+    from ema.kinds.rotary.calibration import Calibrator
 
 VARIABLES = {
     "speed_radps": "motor speed |ω| [rad/s]",
@@ -53,7 +54,7 @@ class Rotary:
     def estimate(self, window: Window, request: Request) -> Estimate:
         if not window.high_rate:
             return read_quasi_statically(window, request, MOTOR_READING)
-        from ema.estimate.pipeline import estimate_window  # the network's (module docstring)
+        from ema.kinds.rotary.pipeline import estimate_window  # the network's (module docstring)
 
         return estimate_window(
             window,
@@ -73,7 +74,7 @@ class Rotary:
                     f"{window.sample_rate_hz:g} Hz: a rotary actuator's calibration simulates its windows and reads "
                     f"them at {HIGH_RATE_HZ:g} Hz or more",
                 )
-        from ema.calibration.calibrate import Calibrator  # the network's (module docstring)
+        from ema.kinds.rotary.calibration import Calibrator  # the network's (module docstring)
 
         config = request.config
         calibrator = Calibrator(config, copies=request.copies, seed=config.seed, actuator=request.actuator)
@@ -98,8 +99,8 @@ class Rotary:
 
 def residual_plot(calibrator: Calibrator) -> ResidualPlot:
     """The equation-error residual before and after, against the variable that explains it."""
-    from ema.calibration.fitting import score
-    from ema.calibration.selection import problem
+    from ema.kinds.rotary.fitting import score
+    from ema.kinds.rotary.selection import problem
 
     e, report, chosen = calibrator.measured_, calibrator.report_, calibrator.chosen_
     variable = "time_s"

@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from ema.calibration.equations import FOLDS
-from ema.calibration.fitting import hats, score, score_grid, uniform_knots
+from ema.kinds.rotary.equations import FOLDS
+from ema.kinds.rotary.fitting import hats, score, score_grid, uniform_knots
 
 
 def _problem(seed: int, m: int = 600):
@@ -12,7 +12,7 @@ def _problem(seed: int, m: int = 600):
     base = np.column_stack([np.ones(m), rng.normal(size=(m, 2))])
     grid = rng.normal(size=(m, 7, 2))
     y = base @ [1.0, 0.5, -0.2] + grid[:, 3] @ [0.3, 0.1] + 0.1 * rng.normal(size=m)
-    folds = np.sort(np.arange(m) % FOLDS)  # grouped by fold, as ema.calibration.equations stores them
+    folds = np.sort(np.arange(m) % FOLDS)  # grouped by fold, as ema.kinds.rotary.equations stores them
     return base, grid, y, folds
 
 

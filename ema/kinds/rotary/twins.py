@@ -18,8 +18,8 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
-from ema.calibration.selection import MIN_Z, NAME_MARGIN, Evidence
 from ema.estimate.physics.scenario import CLEAR_MARGIN, following_error, inside, scenario_from_window
+from ema.kinds.rotary.selection import MIN_Z, NAME_MARGIN, Evidence
 from ema.model.actuator import ActuatorDocument
 from ema.model.effects import EffectSet
 from ema.model.noise import SensorNoise

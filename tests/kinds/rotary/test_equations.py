@@ -3,12 +3,12 @@
 import numpy as np
 import pytest
 
-from ema.calibration.backlash import width_rad
-from ema.calibration.equations import cogging_columns, equations, motor_angle_rad
+from ema.kinds.rotary.backlash import width_rad
+from ema.kinds.rotary.equations import cogging_columns, equations, motor_angle_rad
+from ema.kinds.rotary.synthetic import synthetic_window
 from ema.model.actuator import THESIS
 from ema.model.noise import NO_NOISE
 from ema.model.params import HealthParams
-from ema.model.synthetic import synthetic_window
 
 
 def test_motor_angle_integrates_the_interval_mean_speed():
@@ -33,7 +33,7 @@ def test_the_dead_band_width_is_read_from_the_windows_own_angles():
     window = synthetic_window(HealthParams.single(), seed=3, noise=NO_NOISE)
     problem = equations([window.signals], window.sample_rate_hz, [], drive=THESIS.params)
     # BLK of Table 3.1, within the few % that smoothing over the reversals takes (the noise floor's
-    # copies carry the same, so ema.calibration.backlash reads extra width against them, not against BLK)
+    # copies carry the same, so ema.kinds.rotary.backlash reads extra width against them, not against BLK)
     assert width_rad(problem) == pytest.approx(5e-3, rel=0.1)
 
 
@@ -44,7 +44,7 @@ def test_the_tied_base_holds_eq_3_4_near_the_windows_efficiency(gear_ratio, eta_
     sits, reproduces it with k_opp as its load coefficient."""
     from dataclasses import replace
 
-    from ema.calibration.fitting import score
+    from ema.kinds.rotary.fitting import score
     from ema.model.params import load_factors
 
     rng = np.random.default_rng(7)

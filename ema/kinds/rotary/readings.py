@@ -2,10 +2,10 @@
 moves the estimates elsewhere.
 
 Each effect selection would adopt is set against its **rivals**: its twins where the simulation could
-not tell them apart clearly (``ema.calibration.twins``), and the other named families that explain
+not tell them apart clearly (``ema.kinds.rotary.twins``), and the other named families that explain
 about as much of the held-out residual (within ``NAME_MARGIN``; where the effect's reading moves the
 estimates, of the measured residual too). The windows are re-estimated with each
-in its place (``ema.calibration.refit``). Where a rival's estimates differ from the effect's by more
+in its place (``ema.kinds.rotary.refit``). Where a rival's estimates differ from the effect's by more
 than ``AMBIGUOUS_STDS`` of the base estimates' stds, the windows hold two readings and the evidence does
 not choose: neither is adopted, the base estimates are kept, their stds are widened until ±2 std holds
 every reading, and the report names the readings and the data that would tell them apart. Where
@@ -21,10 +21,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ema.calibration.documents import Ambiguity
-from ema.calibration.equations import Equations
-from ema.calibration.refit import corrected, fit_with
-from ema.calibration.selection import Chosen, Evidence
 from ema.estimate.documents import TARGETS
+from ema.kinds.rotary.equations import Equations
+from ema.kinds.rotary.refit import corrected, fit_with
+from ema.kinds.rotary.selection import Chosen, Evidence
 
 AMBIGUOUS_STDS = 2.0
 # What would tell two look-alike effects apart, by the pair (either order).

@@ -6,12 +6,12 @@ import pytest
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import Estimate
 from ema.estimate.documents.window_facts import HistoryReadings
-from ema.estimate.pipeline import estimate_window
 from ema.estimate.report import share_of_range
+from ema.kinds.rotary.pipeline import estimate_window
+from ema.kinds.rotary.synthetic import synthetic_window
 from ema.model.actuator import THESIS
 from ema.model.checks import InputError
 from ema.model.params import HealthParams
-from ema.model.synthetic import synthetic_window
 from ema.model.window import window_from_dict
 from tests.foreign.windows import (
     NOISE,

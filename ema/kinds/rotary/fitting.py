@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ema.calibration.equations import FOLDS
+from ema.kinds.rotary.equations import FOLDS
 
 RIDGE = 1e-10  # relative: keeps a collinear column (two hats with no sample between) solvable
 
@@ -96,7 +96,7 @@ def _quadratic(beta: np.ndarray, gram: np.ndarray) -> np.ndarray:
 
 
 def fold_slices(folds: np.ndarray) -> list[slice | np.ndarray]:
-    """Each fold's rows: a slice where the samples are grouped by fold (``ema.calibration.equations`` does so)."""
+    """Each fold's rows: a slice where the samples are grouped by fold (``ema.kinds.rotary.equations`` does so)."""
     out: list[slice | np.ndarray] = []
     for f in range(FOLDS):
         rows = np.flatnonzero(folds == f)
