@@ -210,8 +210,8 @@ def reading(answer: dict, base: dict[str, dict]) -> str:
 
 def _base_model(window: Window, document: ActuatorDocument) -> dict[str, dict]:
     """The symmetric model's constants as ema's physics stage reads them (Newey–West stds)."""
-    fit = physics_of(prepare_servo(window, document))
-    return {NAMES[n]: {"value": fit.values[n], "std": fit.stds[n], "unit": UNITS[n]} for n in NAMES}
+    solution = physics_of(prepare_servo(window, document))
+    return {NAMES[n]: {"value": solution.values[n], "std": solution.stds[n], "unit": UNITS[n]} for n in NAMES}
 
 
 def held_out_lines(

@@ -39,7 +39,7 @@ from benchmarks.tails import expected_over
 from ema.cli.benchmark_docs import write_section
 from ema.estimate import thread_budget
 from ema.estimate.physics.features import as_read
-from ema.estimate.physics.friction import FitSettings, fit_friction, regressors
+from ema.estimate.physics.friction import SolveSettings, regressors, solve_friction
 from ema.estimate.prepare.conditioning import prepare
 from ema.estimate.report import healthy_range
 from ema.model.actuator import THESIS
@@ -77,7 +77,7 @@ def linearized(clean: Window, truth: dict[str, float]) -> tuple[np.ndarray, np.n
     """(X (m, 2): ∂y/∂(FDJ, η_O) on the sliding samples, the mask (n,), A_s (n, n) per sensor at unit std)."""
     rate, n = clean.sample_rate_hz, clean.n_samples
     signals = clean.signals
-    mask = regressors(as_read(signals, rate), rate, ACTUATOR, FitSettings())[3][0].copy()
+    mask = regressors(as_read(signals, rate), rate, ACTUATOR, SolveSettings())[3][0].copy()
     mask[[0, -1]] = False  # the central difference needs both neighbours
     direction = np.sign(signals["motor_speed_radps"])
     load = signals["hinge_moment_nm"] / ACTUATOR.gear_ratio
@@ -135,8 +135,8 @@ def our_rms(clean: Window, truth: dict[str, float], levels: dict[str, float], dr
     signals = {name: np.repeat(values[None], draws, axis=0) for name, values in clean.signals.items()}
     for name in SENSORS:
         signals[name] = signals[name] + levels[name] * rng.standard_normal(signals[name].shape)
-    fit = fit_friction(as_read(signals, clean.sample_rate_hz), clean.sample_rate_hz, drive=THESIS.params)
-    errors = np.stack([fit.fdj_nm - truth["FDJ"], fit.eta_o - truth["eta_O"]])
+    solution = solve_friction(as_read(signals, clean.sample_rate_hz), clean.sample_rate_hz, drive=THESIS.params)
+    errors = np.stack([solution.fdj_nm - truth["FDJ"], solution.eta_o - truth["eta_O"]])
     return np.sqrt(np.nanmean(errors**2, axis=1)) / np.array(
         [np.ptp(healthy_range(k, THESIS.ranges)) for k in ("FDJ", "eta_O")]
     )

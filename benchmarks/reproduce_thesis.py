@@ -22,9 +22,9 @@ import numpy as np
 
 from ema.cli.benchmark_docs import write_section
 from ema.estimate import thread_budget
-from ema.estimate.learn.network import LearnConfig, predict, train
+from ema.estimate.learn.network import LearnConfig, learn_network, predict
 from ema.estimate.physics.features import features
-from ema.estimate.physics.friction import fit_window
+from ema.estimate.physics.friction import solve_window
 from ema.estimate.physics.scenario import Scenario
 from ema.estimate.simulate.design import Box
 from ema.kinds.rotary.synthetic import synthetic_window
@@ -129,7 +129,7 @@ def run_case(case: Case, index: int) -> dict:
     inputs, targets = thesis_dataset(case, scenario, case.sims + 100, seed=index)
     simulate_s = time.perf_counter() - started
     train_x, train_y = inputs[: case.sims], targets[: case.sims]  # the last 100: reserved
-    result = train(train_x, train_y, replace(case.train, hidden=case.neurons))
+    result = learn_network(train_x, train_y, replace(case.train, hidden=case.neurons))
     reserved = predict(result.model, inputs[case.sims :])
     truth = targets[case.sims :]
     return {
@@ -169,7 +169,7 @@ def baseline_comparison(n_windows: int) -> list[str]:
         truth = np.array([health.fdj_nm[0], health.eta_o[0]])
         methods = result.methods
         errors["network"].append(np.array([methods["FDJ"].network, methods["eta_O"].network]) / truth - 1)
-        base = fit_window(window.signals, window.sample_rate_hz, drive=THESIS.params)
+        base = solve_window(window.signals, window.sample_rate_hz, drive=THESIS.params)
         errors["baseline"].append(np.array([base.fdj_nm[0], base.eta_o[0]]) / truth - 1)
         fdj, eta_o = result.estimates.FDJ, result.estimates.eta_O
         assert eta_o is not None, "a window in flight is loaded: eta_O is read"
@@ -251,7 +251,7 @@ def main() -> None:
     args = parser.parse_args()
     thread_budget.configure()
     rng = np.random.default_rng(0)  # warm the imports and the kernels: no start-up cost in the first row's times
-    train(rng.normal(size=(60, 50)), rng.uniform(size=(60, 2)), LearnConfig(hidden=8, max_epochs=5))
+    learn_network(rng.normal(size=(60, 50)), rng.uniform(size=(60, 2)), LearnConfig(hidden=8, max_epochs=5))
     Scenario(THESIS.params, random_command_knots(50, RATE_HZ, rng)[0]).simulate(HealthParams.single())
     results = []
     for index, case in enumerate(cases(args.quick)):

@@ -40,7 +40,7 @@ from benchmarks.tails import expected_over
 from ema.cli.benchmark_docs import typed_command, write_section
 from ema.estimate import thread_budget
 from ema.estimate.physics.features import as_read
-from ema.estimate.physics.friction import fit_friction
+from ema.estimate.physics.friction import solve_friction
 from ema.estimate.physics.scenario import scenario_from_window
 from ema.estimate.prepare.conditioning import prepare
 from ema.estimate.report import healthy_range
@@ -101,8 +101,10 @@ def our_fit(window: Draw, signals: dict[str, np.ndarray]) -> np.ndarray:
     """(2,) FDJ and η_O of the Eq. 5.1 fit on these signals, as shares of the range."""
     prepared = prepare(_as_window(window, signals), actuator=THESIS).window
     rate = prepared.sample_rate_hz
-    fit = fit_friction(as_read({k: v[None] for k, v in prepared.signals.items()}, rate), rate, drive=THESIS.params)
-    return np.array([fit.fdj_nm[0], fit.eta_o[0]]) / WIDTH
+    solution = solve_friction(
+        as_read({k: v[None] for k, v in prepared.signals.items()}, rate), rate, drive=THESIS.params
+    )
+    return np.array([solution.fdj_nm[0], solution.eta_o[0]]) / WIDTH
 
 
 def where_it_lies(J: np.ndarray, speed_radps: np.ndarray) -> np.ndarray:

@@ -21,14 +21,14 @@ from ema.estimate.documents import (
     DatasetInfo,
     Estimate,
     Estimates,
+    LearnedInfo,
     Note,
     RatioEstimate,
     Timings,
-    TrainingInfo,
     parameter,
 )
 from ema.estimate.documents.window_facts import InertiaReading, SensorZero, WindowInfo
-from ema.estimate.physics.friction import FrictionFit, sliding_mask
+from ema.estimate.physics.friction import FrictionSolution, sliding_mask
 from ema.estimate.physics.static_friction import StaticFriction
 from ema.estimate.prepare.conditioning import Prepared, conditioning_done, conditioning_notes
 from ema.estimate.prepare.departures.drive_constants import KERNEL_FREE_RATE_HZ
@@ -40,7 +40,7 @@ from ema.model.params import HealthRanges
 
 if TYPE_CHECKING:  # SciPy's optimizers: a window read without a network (quasi-static) never loads it
     from ema.estimate.learn.estimator import NetworkEstimator
-    from ema.estimate.learn.network import Trained
+    from ema.estimate.learn.network import LearnedNetwork
 
 # ±2 std wider than this share of the healthy range: the window is said to determine the parameter weakly.
 WEAK_SHARE_OF_RANGE = 0.10
@@ -100,7 +100,7 @@ def _estimates(
     )
 
 
-def _notes(prepared: Prepared, physics: FrictionFit, estimates: Estimates, check: Check) -> list[Note]:
+def _notes(prepared: Prepared, physics: FrictionSolution, estimates: Estimates, check: Check) -> list[Note]:
     notes = [*check.notes, *conditioning_notes(prepared)]
     ranges = prepared.document.ranges
     for name in TARGETS:
@@ -200,13 +200,13 @@ def _window_info(prepared: Prepared, data: Data, digest: str) -> WindowInfo:
     )
 
 
-def training_info(trained: Trained, config: PipelineConfig) -> TrainingInfo:
-    """The network's training as an answer reports it: ``trained``, the first member's."""
-    return TrainingInfo(
-        epochs=trained.epochs,
-        stop_reason=trained.stop_reason,
-        val_mse=trained.val_mse,
-        test_mse=trained.test_mse,
+def learned_info(network: LearnedNetwork, config: PipelineConfig) -> LearnedInfo:
+    """What the learn stage did as an answer reports it: ``network``, the first member's."""
+    return LearnedInfo(
+        epochs=network.epochs,
+        stop_reason=network.stop_reason,
+        val_mse=network.val_mse,
+        test_mse=network.test_mse,
         members=config.members,
         hidden_units=config.hidden_units,
     )
@@ -215,7 +215,7 @@ def training_info(trained: Trained, config: PipelineConfig) -> TrainingInfo:
 def estimate_document(
     *,
     prepared: Prepared,
-    physics: FrictionFit,
+    physics: FrictionSolution,
     data: Data,
     network: NetworkEstimator,
     answer: Assessed,
@@ -254,7 +254,7 @@ def estimate_document(
             noise_estimated=data.noise.as_dict(),
             box={"FDJ": data.box.fdj_nm, "eta_O": data.box.eta_o},
         ),
-        training=training_info(first, config),
+        learned=learned_info(first, config),
         methods=answer.methods,
         check=check,
         window=_window_info(prepared, data, digest),

@@ -65,9 +65,9 @@ def forecast(weighed: Weighed, t_first: float, span: float, seed: int = 0) -> Fo
     s = np.linspace(1.0, 1.0 + HORIZON, GRID)
     counts = rng.multinomial(DRAWS, weighed.weights)
     curves, laws = [], []
-    for index, (fit, count) in enumerate(zip(weighed.fits, counts, strict=True)):
+    for index, (curve, count) in enumerate(zip(weighed.curves, counts, strict=True)):
         if count:
-            curves.append(fit.curves(s, int(count), rng))
+            curves.append(curve.curves(s, int(count), rng))
             laws.append(np.full(count, index))
     drifting = np.concatenate(curves) + weighed.drift * rng.standard_normal((DRAWS, 1)) * (s - 1.0)
     return Forecast(t_first, span, s, drifting, np.concatenate(laws), weighed.weights)

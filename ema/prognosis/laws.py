@@ -2,7 +2,7 @@
 
 Time is put on s = (t − t_first) / span, 0 at the first window and 1 at the last, so that every law's
 columns are of order one. A law is its columns φ(s; θ): linear in its coefficients β for a fixed shape θ,
-its shapes a grid over which the fit keeps a posterior (``LawFit``):
+its shapes a grid over which the fit keeps a posterior (``LawCurve``):
 
 - ``linear``: 1, s;
 - ``quadratic``: 1, s, s²;
@@ -62,7 +62,7 @@ BY_NAME = {law.name: law for law in LAWS}
 
 
 @dataclass(frozen=True)
-class LawFit:
+class LawCurve:
     """One law fitted: per shape its posterior weight, coefficients and their covariance."""
 
     law: Law
@@ -95,7 +95,7 @@ class LawFit:
         return out
 
 
-def fit_law(law: Law, s: np.ndarray, y: np.ndarray, weight: np.ndarray) -> LawFit:
+def law_curve(law: Law, s: np.ndarray, y: np.ndarray, weight: np.ndarray) -> LawCurve:
     """``law`` fitted to ``y`` at ``s`` with per-window weights h / (σ² + τ²); each shape by BIC's likelihood."""
     betas, covariances, scores = [], [], []
     n_eff = max(float(np.sum(weight > 0)), 2.0)
@@ -107,4 +107,4 @@ def fit_law(law: Law, s: np.ndarray, y: np.ndarray, weight: np.ndarray) -> LawFi
         scores.append(-0.5 * chi2 - 0.5 * phi.shape[1] * np.log(n_eff))
     scores_array = np.array(scores)
     weights = np.exp(scores_array - scores_array.max())
-    return LawFit(law, weights / weights.sum(), betas, covariances, float(scores_array.max()))
+    return LawCurve(law, weights / weights.sum(), betas, covariances, float(scores_array.max()))

@@ -16,9 +16,9 @@ import numpy as np
 from ema.estimate.stats import weighted_least_squares
 from ema.prognosis.documents import BacktestPoint, ForecastPoint, RemainingLife, Trend
 from ema.prognosis.forecast import Forecast, forecast
-from ema.prognosis.laws import LAWS, fit_law
+from ema.prognosis.laws import LAWS, law_curve
 from ema.prognosis.rul import MIN_TREND_WINDOWS, remaining_life
-from ema.prognosis.trend import HUBER_C, Series, excess_variance, fit_trend, robust_fit
+from ema.prognosis.trend import HUBER_C, Series, excess_variance, robust_polynomial, trend_of
 from ema.prognosis.weigh import MIN_LAW_WINDOWS, weigh
 
 BAND_POINTS = 40  # forecast points reported, from the first window to the crossing (or 3 spans past the last)
@@ -44,14 +44,14 @@ def law_inputs(times: np.ndarray, values: np.ndarray, stds: np.ndarray) -> tuple
     variance = np.where(known, stds, np.median(stds[known]) if known.any() else 0.0) ** 2
     t_first, span = float(times.min()), float(np.ptp(times))
     s = (times - t_first) / span
-    fit = robust_fit(s - 1.0, values, variance, 1)
-    robust, tau2 = fit["robust"], float(fit["tau2"])
+    curve = robust_polynomial(s - 1.0, values, variance, 1)
+    robust, tau2 = curve["robust"], float(curve["tau2"])
     if len(times) < MIN_LAW_WINDOWS:
         return s, robust / (variance + tau2 + 1e-300), t_first, span
     robust = np.ones(len(s))
     for _ in range(ROBUST_PASSES):  # the best law's residuals set τ and the Huber weights, and again
         weight = robust / (variance + tau2 + 1e-300)
-        best = max((fit_law(law, s, values, weight) for law in LAWS), key=lambda f: f.log_likelihood)
+        best = max((law_curve(law, s, values, weight) for law in LAWS), key=lambda f: f.log_likelihood)
         shape = int(np.argmax(best.weights))
         residual = values - best.law.columns(s, best.law.shapes[shape]) @ best.betas[shape]
         tau2 = excess_variance(residual, variance, robust, max(int(robust.sum()) - len(best.betas[shape]), 1))
@@ -92,7 +92,7 @@ def outlook(series: Series, *, threshold: float, direction: str, min_span: float
     """The trend and remaining life of one parameter's history (times in the prognosis's unit); no forecast
     where fewer than ``MIN_TREND_WINDOWS`` windows, or windows spanning less than ``min_span``, read it."""
     parameter, times, values, stds = series.parameter, series.times, series.values, series.stds
-    trend = fit_trend(series)
+    trend = trend_of(series)
     if trend.n < MIN_TREND_WINDOWS:
         return Outlook(trend, remaining_life(parameter, None, threshold, direction))
     if trend.slope_std is None or float(np.ptp(times)) < min_span:  # no slope: every window at one time
@@ -103,5 +103,5 @@ def outlook(series: Series, *, threshold: float, direction: str, min_span: float
     sign = 1.0 if direction == "above" else -1.0
     line = 0.5 * (1.0 + math.erf(sign * trend.slope_per_unit / (trend.slope_std * math.sqrt(2.0))))
     life = remaining_life(parameter, fc, threshold, direction, speeding_up(times, values, weight, sign), line)
-    laws = {fit.law.name: float(w) for fit, w in zip(weighed.fits, weighed.weights, strict=True)}
+    laws = {curve.law.name: float(w) for curve, w in zip(weighed.curves, weighed.weights, strict=True)}
     return Outlook(trend.model_copy(update={"laws": laws, "forecast": band(fc, life, span)}), life)

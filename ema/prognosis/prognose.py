@@ -15,7 +15,7 @@ from ema.model.actuator import ActuatorDocument, Airframe
 from ema.prognosis.backtest import backtest
 from ema.prognosis.documents import MIN_SPAN, PARAMETERS, Prognosis, RemainingLife, Stored, TimeUnit, Trend
 from ema.prognosis.outlook import Outlook, outlook
-from ema.prognosis.trend import Series, fit_trend
+from ema.prognosis.trend import Series, trend_of
 
 AIRFRAME_TOLERANCE = Airframe.model_fields["tolerance"].default
 SENSOR_STDS = 3.0  # stds by which a sensor's level or drift must stand out to be said
@@ -186,7 +186,7 @@ def sensor_trends(
     if len(read) < 2:
         return {}, []
     t, values, stds, ids = zip(*read, strict=True)
-    trend = fit_trend(
+    trend = trend_of(
         Series("hinge_aircraft_ratio", np.array(t), np.array(values), np.array(stds, dtype=float), list(ids))
     )
     notes = []

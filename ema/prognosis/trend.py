@@ -50,7 +50,7 @@ def excess_variance(residual: np.ndarray, variance: np.ndarray, robust: np.ndarr
     return 0.5 * (low + high)
 
 
-def robust_fit(x: np.ndarray, values: np.ndarray, variance: np.ndarray, degree: int) -> dict[str, np.ndarray]:
+def robust_polynomial(x: np.ndarray, values: np.ndarray, variance: np.ndarray, degree: int) -> dict[str, np.ndarray]:
     """The polynomial of ``degree`` in x by iteratively reweighted least squares (τ and Huber weights)."""
     n_coefficients = degree + 1
     robust, tau2 = np.ones(len(x)), 0.0
@@ -75,9 +75,9 @@ def curved(x: np.ndarray, values: np.ndarray, variance: np.ndarray, line: dict[s
     """The quadratic beside ``line`` and its BIC weight, both read with the quadratic's scatter and weights."""
     if len(x) < MIN_CURVED:
         return None
-    curve = robust_fit(x, values, variance, 2)
+    curve = robust_polynomial(x, values, variance, 2)
     scale = variance + curve["tau2"]
-    chi2 = [float(np.sum(curve["robust"] * fit["residual"] ** 2 / scale)) for fit in (line, curve)]
+    chi2 = [float(np.sum(curve["robust"] * curve["residual"] ** 2 / scale)) for curve in (line, curve)]
     log_odds = 0.5 * (chi2[0] - chi2[1]) - 0.5 * np.log(max(float(curve["robust"].sum()), 2.0))
     beta, covariance = curve["beta"], curve["covariance"]
     return Curved(
@@ -110,14 +110,14 @@ class Series:
         return Series(self.parameter, self.times[:k], self.values[:k], self.stds[:k], self.window_ids[:k])
 
 
-def fit_trend(series: Series) -> Trend:
+def trend_of(series: Series) -> Trend:
     """The trend of one parameter's ``series``."""
     times, values, stds = series.times, series.values, series.stds
     x = times - times.max()
     known = np.isfinite(stds) & (stds > 0)
     variance = np.where(known, stds, np.median(stds[known]) if known.any() else 0.0) ** 2
     spans_time = len(np.unique(x)) > 1
-    line = robust_fit(x, values, variance, 1 if spans_time else 0)
+    line = robust_polynomial(x, values, variance, 1 if spans_time else 0)
     beta, covariance, z = line["beta"], line["covariance"], line["z"]
     points = [
         Point(window_id=w, time=float(t), value=float(v), std=float(s) if k else None, outlier=bool(zz > OUTLIER_Z))

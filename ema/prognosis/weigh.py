@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ema.prognosis.laws import LAWS, LawFit, fit_law
+from ema.prognosis.laws import LAWS, LawCurve, law_curve
 
 MIN_LAW_WINDOWS = 6  # fewer: the line alone (a law can only be told from another on more)
 FIRST_CUT = 0.75  # the earliest cut, as a share of the history: the later windows tell where it goes now
@@ -33,7 +33,7 @@ class Weighed:
     """Every law fitted to the whole history, its weight and extrapolation score, and the drift of the weighed
     forecast's misses per unit of s ahead (0 where it held the later windows as it said it would)."""
 
-    fits: list[LawFit]
+    curves: list[LawCurve]
     weights: np.ndarray  # (laws,), summing to 1
     scores: np.ndarray  # (laws,) mean log density of the later windows over the cuts (nan: not scored)
     drift: float = 0.0  # std of the forecast's error slope, per unit of s
@@ -61,8 +61,8 @@ def cut_points(n: int) -> list[int]:
 
 def later(law_index: int, s: np.ndarray, y: np.ndarray, weight: np.ndarray, k: int) -> Later:
     """The law fitted to the first ``k`` windows, predicting the rest."""
-    fit = fit_law(LAWS[law_index], s[:k], y[:k], weight[:k])
-    mean, variance = fit.predictive(s[k:])
+    curve = law_curve(LAWS[law_index], s[:k], y[:k], weight[:k])
+    mean, variance = curve.predictive(s[k:])
     noise = 1.0 / np.maximum(weight[k:], 1e-300)
     return Later(mean, variance + noise, y[k:], s[k:] - s[k - 1])
 
@@ -82,14 +82,14 @@ def drift(predictions: list[list[Later]], weights: np.ndarray) -> float:
 
 def weigh(s: np.ndarray, y: np.ndarray, weight: np.ndarray) -> Weighed:
     """Every law fitted to the history, weighed by how well it predicts later windows from earlier ones."""
-    fits = [fit_law(law, s, y, weight) for law in LAWS]
+    curves = [law_curve(law, s, y, weight) for law in LAWS]
     if len(s) < MIN_LAW_WINDOWS:
         only = np.array([1.0 if law.name == "linear" else 0.0 for law in LAWS])
-        return Weighed(fits, only, np.full(len(LAWS), np.nan))
+        return Weighed(curves, only, np.full(len(LAWS), np.nan))
     cuts = cut_points(len(s))
     predictions = [[later(i, s, y, weight, k) for k in cuts] for i in range(len(LAWS))]
     scores = np.array([sum(p.log_density() for p in by_cut) for by_cut in predictions])
     tempered = scores / TEMPER
     weights = np.exp(tempered - tempered.max())
     weights /= weights.sum()
-    return Weighed(fits, weights, scores / len(cuts), drift(predictions, weights))
+    return Weighed(curves, weights, scores / len(cuts), drift(predictions, weights))

@@ -117,7 +117,7 @@ def test_estimate_prints_one_json_document_and_progress_on_stderr(tmp_path, caps
     captured = capsys.readouterr()
     result = json.loads(captured.out)
     assert result["schema"] == "ema-estimate/1" and result["estimates"]["FDJ"]["value"] > 0
-    assert "training" in captured.err
+    assert "learning" in captured.err
 
 
 def test_estimate_table_and_bad_inputs(tmp_path, capsys):

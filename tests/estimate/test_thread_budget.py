@@ -17,7 +17,7 @@ ESTIMATE = (
     "config = PipelineConfig(n_simulations=16, check_windows=8, n_timesteps=20, hidden_units=4); "
     "e = estimate_window(synthetic_window(HealthParams.single(), seed=3, duration_s=0.05), config, actuator=THESIS); "
     "from threadpoolctl import threadpool_info; "
-    "print(json.dumps([e.estimates.FDJ.value, e.estimates.FDJ.std, e.training.epochs, "
+    "print(json.dumps([e.estimates.FDJ.value, e.estimates.FDJ.std, e.learned.epochs, "
     "[pool['num_threads'] for pool in threadpool_info() if pool['user_api'] == 'blas'], "
     "sorted(m for m in ('torch', 'tensorflow', 'jax') if m in sys.modules)]))"
 )

@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 from ema.prognosis.forecast import forecast
-from ema.prognosis.laws import BY_NAME, fit_law
+from ema.prognosis.laws import BY_NAME, law_curve
 from ema.prognosis.rul import remaining_life
-from ema.prognosis.trend import Series, excess_variance, robust_fit
+from ema.prognosis.trend import Series, excess_variance, robust_polynomial
 from ema.prognosis.weigh import weigh
 
 S = np.linspace(0.0, 1.0, 30)
@@ -24,10 +24,10 @@ S = np.linspace(0.0, 1.0, 30)
     ],
 )
 def test_each_law_finds_a_curve_of_its_own_family_exactly(law, shape, curve):
-    fit = fit_law(BY_NAME[law], S, curve, np.full(len(S), 1e8))
-    best = int(np.argmax(fit.weights))
+    curve = law_curve(BY_NAME[law], S, curve, np.full(len(S), 1e8))
+    best = int(np.argmax(curve.weights))
     assert BY_NAME[law].shapes[best] == pytest.approx(shape)
-    mean, _ = fit.predictive(np.array([0.5, 1.5]))
+    mean, _ = curve.predictive(np.array([0.5, 1.5]))
     truth = {"linear": lambda s: 0.05 + 0.02 * s, "quadratic": lambda s: 0.05 + 0.01 * s + 0.03 * s**2}
     truth |= {"exponential": lambda s: 0.05 + 0.01 * np.expm1(2.0 * s) / 2.0, "power": lambda s: 0.05 + 0.02 * s**3}
     assert mean == pytest.approx(truth[law](np.array([0.5, 1.5])), rel=1e-6)
@@ -48,10 +48,10 @@ def test_a_line_read_robustly_is_not_pulled_by_a_reading_thirty_stds_off():
     x = np.linspace(-1.0, 0.0, 25)
     values = 0.06 + 0.01 * x + rng.normal(0.0, 1e-4, 25)
     values[7] += 3e-3
-    fit = robust_fit(x, values, np.full(25, 1e-8), 1)
+    curve = robust_polynomial(x, values, np.full(25, 1e-8), 1)
     plain = np.polyfit(x, values, 1)[0]
-    assert abs(fit["beta"][1] - 0.01) < 0.5 * abs(plain - 0.01)  # pulled less than half as far as a plain line
-    assert int(np.argmin(fit["robust"])) == 7 and fit["robust"][7] < 0.5
+    assert abs(curve["beta"][1] - 0.01) < 0.5 * abs(plain - 0.01)  # pulled less than half as far as a plain line
+    assert int(np.argmin(curve["robust"])) == 7 and curve["robust"][7] < 0.5
 
 
 def test_the_laws_are_weighed_towards_the_one_that_drew_the_history():
@@ -59,7 +59,7 @@ def test_the_laws_are_weighed_towards_the_one_that_drew_the_history():
     s = np.linspace(0.0, 1.0, 24)
     values = 0.05 + 0.002 * np.expm1(4.0 * s) + rng.normal(0.0, 2e-4, 24)  # wear that speeds up
     weighed = weigh(s, values, np.full(24, 1.0 / 2e-4**2))
-    names = [fit.law.name for fit in weighed.fits]
+    names = [curve.law.name for curve in weighed.curves]
     assert weighed.weights[names.index("linear")] < 0.05
     assert weighed.weights[names.index("exponential")] + weighed.weights[names.index("power")] > 0.5
 

@@ -7,7 +7,7 @@ from ema.model.actuator import THESIS
 from ema.prognosis.backtest import backtest
 from ema.prognosis.outlook import outlook
 from ema.prognosis.rul import MIN_TREND_WINDOWS
-from ema.prognosis.trend import Series, fit_trend
+from ema.prognosis.trend import Series, trend_of
 from tests.prognosis.histories import History, history
 
 THRESHOLD = 0.075  # FDJ +50 % of nominal
@@ -164,7 +164,7 @@ def test_the_actuators_j_m_is_its_windows_readings_and_a_replaced_part_is_said(o
 def test_windows_at_one_time_are_a_level_with_no_slope(times):
     n = len(times)
     series = Series("FDJ", np.array(times), np.full(n, 0.06), np.full(n, 1e-3), [str(i) for i in range(n)])
-    trend = fit_trend(series)
+    trend = trend_of(series)
     assert trend.level == pytest.approx(0.06) and trend.slope_std is None
     assert trend.level_std == pytest.approx(1e-3 / np.sqrt(n))
     status = outlook(series, threshold=THRESHOLD, direction="above").life.status

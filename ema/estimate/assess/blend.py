@@ -28,7 +28,7 @@ class Blend:
         return self.weight_network * network + (1.0 - self.weight_network) * baseline
 
 
-def fit_blend(truth: np.ndarray, network: np.ndarray, baseline: np.ndarray) -> Blend:
+def best_blend(truth: np.ndarray, network: np.ndarray, baseline: np.ndarray) -> Blend:
     """The MSE-optimal convex weight from paired estimates of one parameter on check windows."""
     e_net, e_base = network - truth, baseline - truth
     difference = e_net - e_base

@@ -33,7 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ema.estimate.assess.blend import fit_blend
+from ema.estimate.assess.blend import best_blend
 from ema.estimate.documents import TARGETS, MethodReport, Note
 from ema.estimate.stats import rms
 
@@ -148,7 +148,7 @@ def _assess_parameter(c: Candidates, name: str, inflation: float) -> tuple[float
         answer_note = Note(code="physics_only", parameter=name, text=f"{name}: physics fit only; {note.text}")
     weight, rms_used, rms_net, value = 0.0, rms_physics, None, physics
     if note is None and c.network is not None and c.check_network is not None:
-        blend = fit_blend(truth, c.check_network[name], phys)
+        blend = best_blend(truth, c.check_network[name], phys)
         rms_net = blend.rms_error_network
         if blend.rms_error <= NETWORK_MARGIN * rms_physics:
             weight, rms_used, value = blend.weight_network, blend.rms_error, blend.apply(c.network[name], physics)

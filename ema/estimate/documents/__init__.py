@@ -157,7 +157,9 @@ class DatasetInfo(Document):
     box: dict[str, tuple[float, float]] = Field(description="the FDJ and η_O intervals the simulations were drawn in")
 
 
-class TrainingInfo(Document):
+class LearnedInfo(Document):
+    """What the learn stage's network did: its epochs, why it stopped, its errors, its size."""
+
     epochs: int
     stop_reason: str
     val_mse: float
@@ -195,7 +197,12 @@ class Estimate(Document):
         "is read quasi-statically: no simulation, network or check against a 1 µs simulation)",
     )
     dataset: DatasetInfo | None = Field(description="the window's own simulations (null: skipped, see stages)")
-    training: TrainingInfo | None = Field(description="the network's training (null: skipped, see stages)")
+    learned: LearnedInfo | None = Field(
+        None, description="what the learn stage's network did (null: skipped, see stages)"
+    )
+    training: LearnedInfo | None = Field(
+        None, description="deprecated alias of learned (ema-estimate/1 before the stage's name)"
+    )
     methods: dict[str, MethodReport]
     check: Check = Field(description="the window simulated at the answer, against the log (the check stage)")
     fit_check: Check | None = Field(None, description="deprecated alias of check (ema-estimate/1 as first published)")
@@ -204,14 +211,16 @@ class Estimate(Document):
 
     @model_validator(mode="before")
     @classmethod
-    def _check_under_its_stage(cls, values: Any) -> Any:
-        """The check under its stage's name; a result stored as first published (``fit_check``) read as such, and
-        the old name given beside the new one for one schema version."""
+    def _under_their_stages(cls, values: Any) -> Any:
+        """The check and the network's learning under their stages' names; a result stored under the earlier ones
+        (``fit_check``, ``training``) read as such, and the old names given beside the new ones for one schema
+        version."""
         if isinstance(values, dict):
             values = dict(values)
-            values.setdefault("check", values.get("fit_check"))
-            if values.get("fit_check") is None:
-                values["fit_check"] = values["check"]
+            for new, old in (("check", "fit_check"), ("learned", "training")):
+                values.setdefault(new, values.get(old))
+                if values.get(old) is None:
+                    values[old] = values[new]
         return values
 
 

@@ -12,7 +12,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from ema.estimate.learn.network import LearnConfig, Trained, train
+from ema.estimate.learn.network import LearnConfig, LearnedNetwork, learn_network
 from ema.estimate.simulate.design import Box
 from ema.model.checks import InputError
 
@@ -28,8 +28,8 @@ class NetworkRegressor:
     def fit(self, inputs: np.ndarray, unit_targets: np.ndarray) -> NetworkRegressor:
         if not 1 <= self.members <= 20:
             raise InputError("members", f"must be in [1, 20], got {self.members}")
-        self.members_: list[Trained] = [
-            train(inputs, unit_targets, replace(self.learn, seed=self.learn.seed + member))
+        self.members_: list[LearnedNetwork] = [
+            learn_network(inputs, unit_targets, replace(self.learn, seed=self.learn.seed + member))
             for member in range(self.members)
         ]
         return self

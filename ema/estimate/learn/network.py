@@ -144,7 +144,7 @@ class ShallowNet:
 
 
 @dataclass
-class Trained:
+class LearnedNetwork:
     model: ShallowNet
     epochs: int
     stop_reason: str  # "validation", "goal", "max_epochs" or "converged" (the optimizer can go no further)
@@ -202,7 +202,7 @@ def optimizer_options(config: LearnConfig) -> dict[str, float | int]:
     return {"maxiter": epochs, "maxcor": LBFGS_MEMORY, "ftol": 0.0, "gtol": 0.0, "maxfun": 25 * epochs}
 
 
-def train(inputs: np.ndarray, targets: np.ndarray, config: LearnConfig) -> Trained:
+def learn_network(inputs: np.ndarray, targets: np.ndarray, config: LearnConfig) -> LearnedNetwork:
     """Train one network on (N, F) inputs and (N, T) targets in [0, 1]; seeded end to end."""
     start = time.perf_counter()
     rng = np.random.default_rng(config.seed)
@@ -224,7 +224,7 @@ def train(inputs: np.ndarray, targets: np.ndarray, config: LearnConfig) -> Train
     )
     best = replace(layers, weights=stopping.best_weights)
     stop_reason = stopping.stop_reason or ("max_epochs" if len(stopping.history) >= config.max_epochs else "converged")
-    return Trained(
+    return LearnedNetwork(
         model=ShallowNet(transform, best),
         epochs=len(stopping.history),
         stop_reason=stop_reason,

@@ -50,7 +50,7 @@ def profile_grid() -> np.ndarray:
     return low + PROFILE_STEP * np.arange(int((high - low) / PROFILE_STEP + 1e-9) + 1)
 
 
-def fitted_terms(stats: np.ndarray, nuisances: tuple[str, ...]) -> np.ndarray:
+def solved_terms(stats: np.ndarray, nuisances: tuple[str, ...]) -> np.ndarray:
     """(R, F) which of (FDJ, *nuisances) each row's window can tell apart (FDJ always; the rest by their
     column's balance or variation; ``stats`` (R, P, P), z = (t, a, o, nuisances…, 1))."""
     m = stats[:, -1, -1]
@@ -67,11 +67,11 @@ def fitted_terms(stats: np.ndarray, nuisances: tuple[str, ...]) -> np.ndarray:
 def solve(stats: np.ndarray, gear: float, nuisances: tuple[str, ...] = ()) -> tuple[np.ndarray, ...]:
     """(coefficients (R, F): FDJ then the nuisances', η_O (R,), SSE (R,)) per row of ``stats`` (R, P, P).
 
-    A term a row's window cannot tell (``fitted_terms``) gets coefficient 0.
+    A term a row's window cannot tell (``solved_terms``) gets coefficient 0.
     """
     stats = np.ascontiguousarray(stats, dtype=np.float64)
     free = np.array([stats.shape[-1] - 1, *range(3, 3 + len(nuisances))], dtype=np.int64)  # the constant first
-    used = fitted_terms(stats, nuisances)
+    used = solved_terms(stats, nuisances)
     unit_grid = np.linspace(0.0, 1.0, GRID_POINTS)
     beta = np.zeros((len(stats), len(free)))
     eta_o, sse = np.empty(len(stats)), np.empty(len(stats))

@@ -13,7 +13,7 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from ema.estimate.physics.friction import FitSettings, FrictionFit, fit_friction
+from ema.estimate.physics.friction import FrictionSolution, SolveSettings, solve_friction
 from ema.model.checks import InputError
 from ema.model.hinge import denoised_hinge_nm
 from ema.model.params import DriveConstants
@@ -34,14 +34,14 @@ def as_read(signals: Mapping[str, np.ndarray], sample_rate_hz: float) -> dict[st
     return out
 
 
-def fit_as_read(
+def solve_as_read(
     signals: Mapping[str, np.ndarray],
     sample_rate_hz: float,
     drive: DriveConstants,
-    settings: FitSettings = FitSettings(),
-) -> FrictionFit:
+    settings: SolveSettings = SolveSettings(),
+) -> FrictionSolution:
     """Eq. 5.1's fit (``ema.estimate.physics.friction``) of a window's signals read as every estimator reads them."""
-    return fit_friction(as_read(signals, sample_rate_hz), sample_rate_hz, drive, settings)
+    return solve_friction(as_read(signals, sample_rate_hz), sample_rate_hz, drive, settings)
 
 
 def bin_means(values: np.ndarray, n_bins: int) -> np.ndarray:

@@ -45,7 +45,7 @@ NUISANCES = ("offset", "viscous", "torque_scale", "inertia")  # the terms a fit 
 
 
 @dataclass(frozen=True)
-class FitSettings:
+class SolveSettings:
     # sliding: |ω| above this share of the drive's top speed V_max/k_e over a whole kernel, one sign throughout
     # (30 rad/s of the thesis's 638: far past the speed sensor's noise, clear of the stick-slip near rest)
     min_speed_share: float = 0.047
@@ -71,7 +71,7 @@ class FitSettings:
         return self.min_speed_share * drive.max_motor_speed_radps
 
 
-FIT_ARRAYS = (
+SOLUTION_ARRAYS = (
     "fdj_nm",
     "eta_o",
     "fdj_std_nm",
@@ -86,7 +86,7 @@ FIT_ARRAYS = (
 
 
 @dataclass(frozen=True)
-class FrictionFit:
+class FrictionSolution:
     """Per window (arrays of one length): the estimates, their jackknife std, the fit's quality."""
 
     fdj_nm: np.ndarray
@@ -116,7 +116,7 @@ class FrictionFit:
 
 
 def sliding_mask(
-    signals: Mapping[str, np.ndarray], rate: float, drive: DriveConstants, settings: FitSettings = FitSettings()
+    signals: Mapping[str, np.ndarray], rate: float, drive: DriveConstants, settings: SolveSettings = SolveSettings()
 ) -> np.ndarray:
     """The samples Eq. 5.1 reads, shaped as the speed given ((n,) or (N, n)): the shaft past the sliding speed
     throughout a reconstruction kernel (one sign of the speed, so one sign of its friction), away from the end
@@ -132,7 +132,7 @@ def regressors(
     signals: Mapping[str, np.ndarray],
     rate: float,
     drive: DriveConstants,
-    settings: FitSettings,
+    settings: SolveSettings,
     residual_nm: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """(t, a, o, sliding mask), each (N, n): the linear model's target, aiding and opposing columns.
@@ -156,7 +156,7 @@ def regressors(
 
 
 def nuisance_columns(
-    signals: Mapping[str, np.ndarray], rate: float, drive: DriveConstants, settings: FitSettings
+    signals: Mapping[str, np.ndarray], rate: float, drive: DriveConstants, settings: SolveSettings
 ) -> list[np.ndarray]:
     """The columns of ``settings.nuisances``, each (N, n) and, like the target, signed by the direction s:
     s itself (a constant torque), |ω| smoothed (ΔC), −k_T·I smoothed where the motor is not saturated (γ:
@@ -201,15 +201,15 @@ def _block_sums(columns, mask, edges, out):
                     out[r, b, k_cols, k_cols] += 1.0
 
 
-def fit_friction(
+def solve_friction(
     signals: Mapping[str, np.ndarray],
     rate: float,
     drive: DriveConstants,
-    settings: FitSettings = FitSettings(),
+    settings: SolveSettings = SolveSettings(),
     residual_nm: np.ndarray | None = None,
-) -> FrictionFit:
+) -> FrictionSolution:
     """Fit every window of a batch (signals (N, n), or (n,) for one; or one signal (N, n) against the
-    others of one window, each (n,)); windows with too little sliding motion get NaN (``fit_window``
+    others of one window, each (n,)); windows with too little sliding motion get NaN (``solve_window``
     turns that into an error naming the signals)."""
     t, a, o, mask = regressors(signals, rate, drive, settings, residual_nm)
     columns = [t, a, o, *nuisance_columns(signals, rate, drive, settings)]
@@ -227,7 +227,7 @@ def fit_friction(
     for i, name in enumerate(settings.nuisances, start=1):
         terms[:, NUISANCES.index(name)], term_stds[:, NUISANCES.index(name)] = beta[:, i], std[:, i]
     edge = (eta_o <= ETA_O_SEARCH[0] + 1e-4) | (eta_o >= ETA_O_SEARCH[1] - 1e-4)
-    return FrictionFit(
+    return FrictionSolution(
         fdj_nm=beta[:, 0] * nan,
         eta_o=eta_o * nan,
         fdj_std_nm=std[:, 0] * nan,
@@ -247,14 +247,14 @@ def _sliding_rms(values: np.ndarray, mask: np.ndarray) -> np.ndarray:
     return np.sqrt(squares / np.maximum(mask.sum(axis=-1), 1))
 
 
-def fit_window(signals: Mapping[str, np.ndarray], rate: float, drive: DriveConstants) -> FrictionFit:
+def solve_window(signals: Mapping[str, np.ndarray], rate: float, drive: DriveConstants) -> FrictionSolution:
     """One window's fit; a window that never slides long enough is bad input naming its signals."""
-    fitted = fit_friction(signals, rate, drive)
-    if np.isnan(fitted.fdj_nm[0]):
+    solved = solve_friction(signals, rate, drive)
+    if np.isnan(solved.fdj_nm[0]):
         raise InputError(
             "signals",
-            f"too little sliding motion to estimate friction: {int(fitted.n_sliding[0])} samples with "
-            f"|motor speed| > {FitSettings().sliding_speed_radps(drive):.3g} rad/s away from the end stops "
+            f"too little sliding motion to estimate friction: {int(solved.n_sliding[0])} samples with "
+            f"|motor speed| > {SolveSettings().sliding_speed_radps(drive):.3g} rad/s away from the end stops "
             "(a held or barely moving elevator carries no friction information)",
         )
-    return fitted
+    return solved

@@ -22,7 +22,7 @@ from ema.model.params import DriveConstants, HealthParams
 from ema.model.residual import smoothed
 from ema.model.window import Window
 
-INITIAL_FIT_SAMPLES = 8
+INITIAL_SOLVE_SAMPLES = 8
 SETTLE_S = 0.02  # the simulation settles from an estimated first state: compared after this
 CLEAR_MARGIN = 0.05  # of two models, the loser's ``following_error`` this far above the winner's: a clear call
 # What is physical, whatever the window: FDJ from a tenth of the actuator's nominal to ten times it, η_O
@@ -71,7 +71,7 @@ def initial_state(window: Window, drive: DriveConstants) -> InitialState:
     Not the first sample: the fit averages the sensor noise down, and a parabola follows the motor,
     which reaches 60 rad/s within a millisecond from rest, where a line or a mean would lag it.
     """
-    n = min(INITIAL_FIT_SAMPLES, window.n_samples)
+    n = min(INITIAL_SOLVE_SAMPLES, window.n_samples)
     centres = np.arange(n) + 0.5
 
     def at_zero(values: np.ndarray) -> float:

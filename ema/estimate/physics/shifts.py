@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 from ema.estimate.physics.features import as_read
-from ema.estimate.physics.friction import FitSettings, FrictionFit, fit_friction
+from ema.estimate.physics.friction import FrictionSolution, SolveSettings, solve_friction
 from ema.model.params import DriveConstants
 
 
@@ -18,17 +18,17 @@ def advanced(values: np.ndarray, samples: float) -> np.ndarray:
     return np.interp(index + samples, index, values)
 
 
-def shifted_fits(
+def shifted_solutions(
     signals: dict[str, np.ndarray],
     sample_rate_hz: float,
     lags: np.ndarray,
     drive: DriveConstants,
     name: str = "current_a",
-    settings: FitSettings = FitSettings(),
-) -> FrictionFit:
+    settings: SolveSettings = SolveSettings(),
+) -> FrictionSolution:
     """The physics fit with signal ``name`` read ``lags`` samples later, one row per lag, one batched fit."""
     batch = dict(signals, **{name: np.stack([advanced(signals[name], lag) for lag in lags])})
     if name == "hinge_moment_nm":  # its reading leans on the deflection, row by row
         batch["position_deg"] = np.broadcast_to(signals["position_deg"], batch[name].shape)
     read = dict(as_read(batch, sample_rate_hz), position_deg=signals["position_deg"])
-    return fit_friction(read, sample_rate_hz, drive, settings)
+    return solve_friction(read, sample_rate_hz, drive, settings)

@@ -22,8 +22,8 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ema.estimate.physics.friction import FitSettings
-from ema.estimate.physics.shifts import advanced, shifted_fits
+from ema.estimate.physics.friction import SolveSettings
+from ema.estimate.physics.shifts import advanced, shifted_solutions
 from ema.estimate.prepare.hinge_lag import hinge_lag
 from ema.model.params import DriveConstants
 from ema.model.window import Window
@@ -35,11 +35,11 @@ MIN_GAIN = 0.05  # the least relative drop of the equation error a lag must brin
 # high (or a k_T off the document's) leaves γ·k_T·I, an inertia off the document's ΔJ·dω/dt, both largest where
 # the shaft accelerates, and with the current decaying after a step a shifted current took either (a 6 % gain
 # read as 0.5 ms, a rotor 20 % light as 0.9 ms). A lag leaves k_T·τ·dI/dt, which neither matches.
-LAG_FIT = FitSettings(torque_scale=True, inertia=True)
+LAG_SOLVE = SolveSettings(torque_scale=True, inertia=True)
 
 
 def _errors(signals: dict[str, np.ndarray], rate: float, lags: np.ndarray, drive: DriveConstants) -> np.ndarray:
-    return shifted_fits(signals, rate, lags, drive, settings=LAG_FIT).residual_rms_nm
+    return shifted_solutions(signals, rate, lags, drive, settings=LAG_SOLVE).residual_rms_nm
 
 
 def current_lag_samples(signals: dict[str, np.ndarray], sample_rate_hz: float, drive: DriveConstants) -> float:

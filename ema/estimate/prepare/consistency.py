@@ -42,9 +42,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ema.estimate.physics.features import as_read
-from ema.estimate.physics.friction import fit_friction
-from ema.estimate.physics.shifts import shifted_fits
-from ema.estimate.prepare.departures.zero_offset import OFFSET_FIT
+from ema.estimate.physics.friction import solve_friction
+from ema.estimate.physics.shifts import shifted_solutions
+from ema.estimate.prepare.departures.zero_offset import OFFSET_SOLVE
 from ema.model.dead_band import dead_band_paths
 from ema.model.params import DriveConstants
 from ema.model.window import Window
@@ -157,7 +157,7 @@ def better_reading(window: Window, drive: DriveConstants) -> tuple[str, float] |
             batch[name][row] = signals[name] * factor
     batch["position_deg"] = np.broadcast_to(signals["position_deg"], batch["current_a"].shape)
     read = dict(as_read(dict(signals, **batch), rate), position_deg=signals["position_deg"])
-    errors = fit_friction(read, rate, drive, OFFSET_FIT).residual_rms_nm
+    errors = solve_friction(read, rate, drive, OFFSET_SOLVE).residual_rms_nm
     gains = errors[0] / errors[1:]
     best = int(np.nanargmax(gains)) if np.any(np.isfinite(gains)) else -1
     if best < 0 or not gains[best] >= MIN_BETTER:
@@ -177,9 +177,9 @@ def out_of_step(window: Window, drive: DriveConstants) -> tuple[str, float, floa
     signals, rate, lags = window.signals, window.sample_rate_hz, step_lags(window)
     if not len(lags):
         return None
-    logged = float(fit_friction(as_read(signals, rate), rate, drive).residual_rms_nm[0])
+    logged = float(solve_friction(as_read(signals, rate), rate, drive).residual_rms_nm[0])
     for name in ("current_a", "hinge_moment_nm"):
-        errors = shifted_fits(dict(signals), rate, lags, drive, name).residual_rms_nm
+        errors = shifted_solutions(dict(signals), rate, lags, drive, name).residual_rms_nm
         best = int(np.nanargmin(errors)) if np.any(np.isfinite(errors)) else -1
         if best >= 0 and logged >= MIN_BETTER * errors[best]:
             return name, float(lags[best] / rate), logged / float(errors[best])

@@ -25,9 +25,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ema.estimate.physics.friction import FitSettings
+from ema.estimate.physics.friction import SolveSettings
 from ema.estimate.physics.noise_reading import MAX_LAG, noise_of, white_noise_std
-from ema.estimate.physics.shifts import shifted_fits
+from ema.estimate.physics.shifts import shifted_solutions
 from ema.estimate.prepare.departures.aircraft_band import band_lag_s
 from ema.estimate.stats import JACKKNIFE_BLOCKS, rms_log_likelihood_ratio
 from ema.model.hinge import denoised_hinge_nm
@@ -43,7 +43,7 @@ OTHER_LAGS = 40  # grid points over (0, MAX_HINGE_LAG_S]
 FILTER_LAGS = np.linspace(-2.0, 2.0, 9)  # D·(1 + HINGE_LAG_UNCERTAINTY·z)
 # Eq. 5.1's evidence on the lag is read with a sensor's offset and C free: the window's departures are read
 # after its lags, and a thick grease left in fits best with a clean moment read a few ms late.
-DEPARTURES_FREE = FitSettings(offset=True, viscous=True)
+DEPARTURES_FREE = SolveSettings(offset=True, viscous=True)
 
 
 @dataclass(frozen=True)
@@ -114,11 +114,11 @@ def hinge_lag(
     if delay == 0.0:
         return HingeLag()
     lags, prior = lag_grid(delay, sample_rate_hz)
-    fits = shifted_fits(signals, sample_rate_hz, lags, drive, "hinge_moment_nm")
-    rms = shifted_fits(signals, sample_rate_hz, lags, drive, "hinge_moment_nm", DEPARTURES_FREE).residual_rms_nm
+    solutions = shifted_solutions(signals, sample_rate_hz, lags, drive, "hinge_moment_nm")
+    rms = shifted_solutions(signals, sample_rate_hz, lags, drive, "hinge_moment_nm", DEPARTURES_FREE).residual_rms_nm
     if not np.all(np.isfinite(rms)):
         return HingeLag(delay)  # too little sliding motion: the physics fit says so next
-    used, resolution = float(fits.n_sliding[0]), float(fits.resolution_nm[0])
+    used, resolution = float(solutions.n_sliding[0]), float(solutions.resolution_nm[0])
     equation = [rms_log_likelihood_ratio(rms[0], r, used, sample_rate_hz, resolution_nm=resolution) for r in rms]
     band = band_log_likelihood(signals, sample_rate_hz, lags, drive.gear_ratio) if in_flight else 0.0
     log_posterior = np.log(prior) + band + np.array(equation)
@@ -126,6 +126,6 @@ def hinge_lag(
     weight /= weight.sum()
     spread = {
         name: float(np.sqrt(weight @ (values - weight @ values) ** 2))
-        for name, values in fits.values(slice(None)).items()
+        for name, values in solutions.values(slice(None)).items()
     }
     return HingeLag(delay, float(1.0 - weight[0]), float(weight @ lags), spread)

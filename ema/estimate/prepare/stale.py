@@ -39,7 +39,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ema.estimate.documents import Note
-from ema.estimate.physics.friction import MIN_SLIDING_KERNELS, FitSettings, sliding_mask
+from ema.estimate.physics.friction import MIN_SLIDING_KERNELS, SolveSettings, sliding_mask
 from ema.estimate.physics.noise_reading import white_noise_std
 from ema.model.checks import InputError
 from ema.model.noise import NOISY_SIGNALS
@@ -134,11 +134,11 @@ def stands_off(values: np.ndarray, run: StaleRun, jump: float) -> bool:
 
 def slides_during(window: Window, drive: DriveConstants, run: StaleRun) -> bool:
     """Whether the shaft slides during ``run`` of a motion sensor by the other one (module docstring, 3): the
-    speed past the sliding speed (``FitSettings.sliding_speed_radps``) for the position; for the speed, its
+    speed past the sliding speed (``SolveSettings.sliding_speed_radps``) for the position; for the speed, its
     frozen value past it, or the position
     travelling ``TRAVEL_STDS`` of its noise at that mean speed or faster. True for a torque sensor."""
     signals, rate = window.signals, window.sample_rate_hz
-    sliding_radps = FitSettings().sliding_speed_radps(drive)
+    sliding_radps = SolveSettings().sliding_speed_radps(drive)
     if run.signal in ("current_a", "hinge_moment_nm"):
         return True
     if run.signal == "position_deg":

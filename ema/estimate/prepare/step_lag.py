@@ -32,7 +32,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ema.estimate.documents import Note
-from ema.estimate.physics.shifts import shifted_fits
+from ema.estimate.physics.shifts import shifted_solutions
 from ema.estimate.prepare.consistency import step_lags
 from ema.estimate.prepare.hinge_lag import band_log_likelihood
 from ema.estimate.stats import UNDECIDED_NOTE_WEIGHT, UNDECIDED_PRIOR_LOG_ODDS, odds_weight, rms_log_likelihood_ratio
@@ -58,21 +58,21 @@ def step_lag(window: Window, drive: DriveConstants) -> StepLag:
     rate, lags = window.sample_rate_hz, np.concatenate([[0.0], step_lags(window)])
     if len(lags) == 1:
         return StepLag()
-    fits = shifted_fits(dict(window.signals), rate, lags, drive, "hinge_moment_nm")
-    errors = fits.residual_rms_nm
+    solutions = shifted_solutions(dict(window.signals), rate, lags, drive, "hinge_moment_nm")
+    errors = solutions.residual_rms_nm
     if not np.all(np.isfinite(errors)):
         return StepLag()  # too little sliding motion: the physics fit says so next
     best = 1 + int(np.argmin(errors[1:]))
     flying = not window.on_ground  # on the ground the moment follows no deflection: the band reads no lag
     band = band_log_likelihood(dict(window.signals), rate, lags[[0, best]], drive.gear_ratio) if flying else [0, 0]
     equation = rms_log_likelihood_ratio(
-        errors[0], errors[best], float(fits.n_sliding[0]), rate, resolution_nm=float(fits.resolution_nm[0])
+        errors[0], errors[best], float(solutions.n_sliding[0]), rate, resolution_nm=float(solutions.resolution_nm[0])
     )
     log_ratio = equation + band[1] - band[0]
     weight = odds_weight(log_ratio + PRIOR_LOG_ODDS)
     spread = {
         name: float(np.sqrt(weight) * abs(values[best] - values[0]))
-        for name, values in fits.values(slice(None)).items()
+        for name, values in solutions.values(slice(None)).items()
     }
     return StepLag(float(lags[best] / rate), float(errors[0] / errors[best]), weight, spread)
 

@@ -31,10 +31,10 @@ from ema.estimate.quasistatic.departure import DEPARTURE_Z, departure, inside
 from ema.estimate.quasistatic.drive_torque import QuasiStaticReading
 from ema.estimate.quasistatic.stretches import (
     MIN_STRETCH_S,
-    QuasiStaticFit,
+    QuasiStaticSolution,
     Stretch,
     TorqueReading,
-    fit_stretches,
+    solve_stretches,
     stretches,
 )
 from ema.estimate.report import weakly_determined
@@ -83,23 +83,26 @@ def estimate_low_rate(
     nominal = actuator.health
     screw = actuator.screw
     eta_std = (screw.eta_o_std if screw is not None else None) or 0.0
-    fit = fit_stretches(
+    solution = solve_stretches(
         found,
         torque,
         actuator.gear_ratio,
         eta_o_document=(nominal.efficiency, eta_std),
         repeatability=reading.spread(actuator),
     )
-    if below_zero({"FDJ": fit.fdj_nm}, {"FDJ": fit.fdj_std_nm}):
+    if below_zero({"FDJ": solution.fdj_nm}, {"FDJ": solution.fdj_std_nm}):
         raise InputError(
             "signals.current_a",
-            f"the stretches read FDJ {fit.fdj_nm:.4g} ± {fit.fdj_std_nm:.2g} N·m, a friction that drives the motion: "
+            f"the stretches read FDJ {solution.fdj_nm:.4g} ± {solution.fdj_std_nm:.2g} N·m, a friction that drives the "
+            "motion: "
             "the current or the load is logged with the other sign (the log map's sign)",
         )
     seconds["physics"] = time.perf_counter() - started - seconds["prepare"]
     announce("writing the report")
-    document = _document(window, actuator, fit, found, torque, digest=digest, read_with=read_with, config=config)
-    notes = [n for n in (rest_note, *_notes(window, actuator, fit, torque), *departure_notes(actuator, fit, load))]
+    document = _document(window, actuator, solution, found, torque, digest=digest, read_with=read_with, config=config)
+    notes = [
+        n for n in (rest_note, *_notes(window, actuator, solution, torque), *departure_notes(actuator, solution, load))
+    ]
     notes = [n for n in notes if n is not None]
     seconds["report"] = time.perf_counter() - started - seconds["prepare"] - seconds["physics"]
     return document.model_copy(
@@ -107,22 +110,27 @@ def estimate_low_rate(
     )
 
 
-def _estimates(actuator: ActuatorDocument, fit: QuasiStaticFit) -> Estimates:
+def _estimates(actuator: ActuatorDocument, solution: QuasiStaticSolution) -> Estimates:
     nominal, ranges, friction = actuator.health, actuator.ranges, actuator.facts.friction_unit
-    eta_a = float(actuator.eta_a(fit.eta_o))
-    slope = float((actuator.eta_a(fit.eta_o + 1e-5) - actuator.eta_a(fit.eta_o - 1e-5)) / 2e-5)
-    weak_eta = weakly_determined("eta_O", fit.eta_o_std, ranges)
-    eta_o = parameter(fit.eta_o, fit.eta_o_std, nominal.eta_o, weak_eta, unit=DIMENSIONLESS)
+    eta_a = float(actuator.eta_a(solution.eta_o))
+    slope = float((actuator.eta_a(solution.eta_o + 1e-5) - actuator.eta_a(solution.eta_o - 1e-5)) / 2e-5)
+    weak_eta = weakly_determined("eta_O", solution.eta_o_std, ranges)
+    eta_o = parameter(solution.eta_o, solution.eta_o_std, nominal.eta_o, weak_eta, unit=DIMENSIONLESS)
     nominal_eta_a = None if nominal.eta_o is None else float(actuator.eta_a(nominal.eta_o))
-    eta_a_entry = parameter(eta_a, abs(slope) * fit.eta_o_std, nominal_eta_a, weak_eta, unit=DIMENSIONLESS)
-    weak_fdj = weakly_determined("FDJ", fit.fdj_std_nm, ranges)
+    eta_a_entry = parameter(eta_a, abs(slope) * solution.eta_o_std, nominal_eta_a, weak_eta, unit=DIMENSIONLESS)
+    weak_fdj = weakly_determined("FDJ", solution.fdj_std_nm, ranges)
     fdj = parameter(
-        fit.fdj_nm, fit.fdj_std_nm, nominal.fdj, weak_fdj, unit=friction, repeatability_std=fit.fdj_repeatability_std_nm
+        solution.fdj_nm,
+        solution.fdj_std_nm,
+        nominal.fdj,
+        weak_fdj,
+        unit=friction,
+        repeatability_std=solution.fdj_repeatability_std_nm,
     )
     return Estimates(
         FDJ=fdj,
-        eta_O=eta_o if fit.eta_o_read else None,
-        eta_A=eta_a_entry if fit.eta_o_read else None,
+        eta_O=eta_o if solution.eta_o_read else None,
+        eta_A=eta_a_entry if solution.eta_o_read else None,
         FSJ=None,
     )
 
@@ -130,7 +138,7 @@ def _estimates(actuator: ActuatorDocument, fit: QuasiStaticFit) -> Estimates:
 def _document(
     window: Window,
     actuator: ActuatorDocument,
-    fit: QuasiStaticFit,
+    solution: QuasiStaticSolution,
     found: list[Stretch],
     reading: TorqueReading,
     *,
@@ -139,13 +147,13 @@ def _document(
     config: PipelineConfig,
 ) -> Estimate:
     used = sum(s.samples for s in found)
-    ratio = float(np.sqrt(fit.chi2_per_dof))
+    ratio = float(np.sqrt(solution.chi2_per_dof))
     rate = window.sample_rate_hz
     return Estimate(
         actuator_id=window.actuator_id,
         window_id=window.window_id,
         actuator=read_with,
-        estimates=_estimates(actuator, fit),
+        estimates=_estimates(actuator, solution),
         fsj_note=Note(
             code="fsj_no_break_away",
             text=(
@@ -153,15 +161,15 @@ def _document(
                 f"needs 1 ms samples)"
             ),
         ),
-        irreversible=fit.eta_o_read and float(actuator.eta_a(fit.eta_o)) < 0,
+        irreversible=solution.eta_o_read and float(actuator.eta_a(solution.eta_o)) < 0,
         notes=[],
         timings_s=Timings(total=0.0),
         stages={stage: f"skipped: {SKIPPED[stage]}" if stage in SKIPPED else "run" for stage in STAGES},
         dataset=None,
-        training=None,
+        learned=None,
         methods={},
         check=Check(
-            reproduced=fit.chi2_per_dof <= MAX_CHI2,
+            reproduced=solution.chi2_per_dof <= MAX_CHI2,
             equation_error_ratio=ratio,
             output_error_ratio={"current_a": ratio},
             uncertainty_inflation=1.0,
@@ -177,18 +185,18 @@ def _document(
     )
 
 
-def departure_notes(actuator: ActuatorDocument, fit: QuasiStaticFit, load_nm: np.ndarray) -> list[Note]:
+def departure_notes(actuator: ActuatorDocument, solution: QuasiStaticSolution, load_nm: np.ndarray) -> list[Note]:
     """Where the window's FDJ departs from the nominal beyond what healthy runs allow (``departure``), either way,
     and where its load (``load_nm`` at the motor) lies outside those the healthy runs were learned at: said."""
     screw = actuator.screw
     if screw is None or screw.healthy_set_nm is None:
         return []
     load = float(np.mean(load_nm)) * actuator.gear_ratio
-    shared = float(np.sqrt(max(fit.fdj_std_nm**2 - fit.fdj_repeatability_std_nm**2, 0.0)))
+    shared = float(np.sqrt(max(solution.fdj_std_nm**2 - solution.fdj_repeatability_std_nm**2, 0.0)))
     seen = departure(
-        fit.fdj_nm,
+        solution.fdj_nm,
         actuator.health.fdj,
-        repeatability_std=fit.fdj_repeatability_std_nm,
+        repeatability_std=solution.fdj_repeatability_std_nm,
         shared_std=shared,
         healthy_set=screw.healthy_set_nm,
         extrapolated=not inside(load, screw.calibrated_loads_n),
@@ -222,7 +230,9 @@ FELL = "friction lost (a ball screw losing its preload: a spalled track, smaller
 ROSE = "friction gained (grease lost, a seal tightened, a track roughened)"
 
 
-def _notes(window: Window, actuator: ActuatorDocument, fit: QuasiStaticFit, reading: TorqueReading) -> list[Note]:
+def _notes(
+    window: Window, actuator: ActuatorDocument, solution: QuasiStaticSolution, reading: TorqueReading
+) -> list[Note]:
     notes = [
         Note(
             code="low_rate",
@@ -234,7 +244,7 @@ def _notes(window: Window, actuator: ActuatorDocument, fit: QuasiStaticFit, read
             ),
         )
     ]
-    if not fit.eta_o_read:
+    if not solution.eta_o_read:
         notes.append(
             Note(
                 code="eta_o_unread",
@@ -242,22 +252,24 @@ def _notes(window: Window, actuator: ActuatorDocument, fit: QuasiStaticFit, read
                 text=(
                     "the window's load keeps one size: Eq. 5.1 shows FDJ + (1/η_O − 1)·|T_L| only, so η_O is not read "
                     "and FDJ "
-                    f"is read with the document's η_O, {fit.eta_o:.3f} ± {fit.eta_o_std:.3f} (its std in FDJ's); "
+                    f"is read with the document's η_O, {solution.eta_o:.3f} ± {solution.eta_o_std:.3f} "
+                    "(its std in FDJ's); "
                     f"windows at "
                     "two loads read both (ema calibrate)"
                 ),
             )
         )
-    if fit.per_nm_read_a is not None and fit.per_nm_read_std_a is not None:
-        z = (fit.per_nm_read_a - reading.per_nm_a) / max(fit.per_nm_read_std_a, 1e-12)
+    if solution.per_nm_read_a is not None and solution.per_nm_read_std_a is not None:
+        z = (solution.per_nm_read_a - reading.per_nm_a) / max(solution.per_nm_read_std_a, 1e-12)
         if abs(z) > 4.0:
             notes.append(
                 Note(
                     code="current_per_nm",
                     parameter="current_a",
                     text=(
-                        f"opposing and aiding stretches put the current per N·m at {fit.per_nm_read_a:.3f} ± "
-                        f"{fit.per_nm_read_std_a:.3f} A, {z:+.1f} stds from the document's {reading.per_nm_a:.3f}: the "
+                        f"opposing and aiding stretches put the current per N·m at {solution.per_nm_read_a:.3f} ± "
+                        f"{solution.per_nm_read_std_a:.3f} A, {z:+.1f} stds from the document's "
+                        f"{reading.per_nm_a:.3f}: the "
                         f"drive "
                         "or its current sensor departs from the document (recalibrate)"
                     ),

@@ -126,7 +126,7 @@ class TorqueReading:
 
 @dataclass(frozen=True)
 class Repeatability:
-    """What the document says of how one state's runs scatter (``ema.kinds.linear.drive_fit.HealthySpread``)."""
+    """What the document says of how one state's runs scatter (``ema.kinds.linear.drive_calibration.HealthySpread``)."""
 
     run_to_run_nm: float | None = None  # the healthy runs' sd within a set (null: not learned)
     run_noise_nm: float = 0.0  # their typical own noise
@@ -134,7 +134,7 @@ class Repeatability:
 
 
 @dataclass(frozen=True)
-class QuasiStaticFit:
+class QuasiStaticSolution:
     fdj_nm: float
     fdj_std_nm: float
     fdj_repeatability_std_nm: float  # what a second window read with the document would not share
@@ -146,14 +146,14 @@ class QuasiStaticFit:
     per_nm_read_std_a: float | None
 
 
-def fit_stretches(
+def solve_stretches(
     found: list[Stretch],
     reading: TorqueReading,
     gear_ratio: float,
     *,
     eta_o_document: tuple[float, float],
     repeatability: Repeatability = Repeatability(),
-) -> QuasiStaticFit:
+) -> QuasiStaticSolution:
     """FDJ (and η_O where the loads differ enough) from ``found`` stretches: y = τ + s·T_L = FDJ + k·|T_L|."""
     torques = np.array([reading.torque(s) for s in found])
     tau, tau_std = torques[:, 0], torques[:, 1]
@@ -184,7 +184,7 @@ def fit_stretches(
     repeatable, shared = _repeatable_and_shared(within, repeatability, reading)
     fdj_std = float(np.sqrt(repeatable**2 + (slope * eta_std) ** 2 + scale**2 + shared**2))
     per_nm = _per_nm_read(found, reading, eta, gear_ratio)
-    return QuasiStaticFit(fdj, fdj_std, repeatable, eta, eta_std, read, chi2_min / dof, *per_nm)
+    return QuasiStaticSolution(fdj, fdj_std, repeatable, eta, eta_std, read, chi2_min / dof, *per_nm)
 
 
 def _repeatable_and_shared(within: float, repeatability: Repeatability, reading: TorqueReading) -> tuple[float, float]:

@@ -9,7 +9,7 @@ import numpy as np
 
 from ema.estimate.config import PipelineConfig
 from ema.estimate.physics.features import as_read, sliding_features
-from ema.estimate.physics.friction import FitSettings, FrictionFit, regressors
+from ema.estimate.physics.friction import FrictionSolution, SolveSettings, regressors
 from ema.estimate.physics.noise_reading import excess_noise
 from ema.estimate.physics.scenario import Scenario, scenario_from_window
 from ema.estimate.simulate import design
@@ -83,7 +83,7 @@ class Data:
 def simulate_dataset(
     window: Window,
     seen: Window,
-    physics: FrictionFit,
+    physics: FrictionSolution,
     config: PipelineConfig,
     *,
     document: ActuatorDocument,
@@ -103,7 +103,7 @@ def simulate_dataset(
     residual = residual_torque_nm(
         seen.signals["current_a"], seen.signals["motor_speed_radps"], seen.signals["hinge_moment_nm"], rate, drive
     )
-    sliding = regressors(seen.signals, rate, drive, FitSettings(), residual_nm=residual)[3][0]
+    sliding = regressors(seen.signals, rate, drive, SolveSettings(), residual_nm=residual)[3][0]
     n_timesteps = min(config.n_timesteps, window.n_samples)
     inputs = sliding_features(sims.residual_nm, sliding, n_timesteps)
     features = sliding_features(residual, sliding, n_timesteps)

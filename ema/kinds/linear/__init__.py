@@ -2,7 +2,7 @@
 
 Its windows are read quasi-statically at any rate (``ema.estimate.quasistatic.slow_window``: the stepper's drive is no
 current loop ema can simulate), its torque from the drive's current as ``ema calibrate`` learned it
-(``ema.kinds.linear.drive_fit``): healthy runs teach the drive, faulted runs are compared with it.
+(``ema.kinds.linear.drive_calibration``): healthy runs teach the drive, faulted runs are compared with it.
 """
 
 from __future__ import annotations

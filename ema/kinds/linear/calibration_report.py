@@ -1,7 +1,7 @@
 """``ema calibrate`` for a linear actuator: learn its drive from healthy runs, or say what faulted runs changed.
 
-Learning (the document lacks c or a nominal health; ``ema.kinds.linear.drive_fit.fit_drive``): the report's
-``drive`` holds what was learned, the residual of the runs' current before (the document's model) and
+Learning (the document lacks c or a nominal health; ``ema.kinds.linear.drive_calibration.calibrate_drive``): the
+report's ``drive`` holds what was learned, the residual of the runs' current before (the document's model) and
 after, and a leave-one-run-out check; ``completed`` is the document with it. Comparing (a calibrated
 document): each run read with it (``ema.estimate.quasistatic.slow_window``), FDJ (and η_O where the runs' loads
 differ) set against the nominal in ``changes``, and the current along the stroke against the healthy
@@ -27,7 +27,7 @@ from ema.calibration.documents import (
 from ema.calibration.plot import ResidualPlot, Series
 from ema.estimate.documents import DIMENSIONLESS
 from ema.kinds.linear.changes import baseline, compared
-from ema.kinds.linear.drive_fit import DriveFit, Run, fit_drive, read_run
+from ema.kinds.linear.drive_calibration import CalibratedDrive, Run, calibrate_drive, read_run
 from ema.model.actuator import ActuatorDocument, Nominal
 from ema.model.params import load_factors
 from ema.model.window import Window
@@ -47,20 +47,20 @@ def calibrate_linear(
     screw = actuator.screw
     assert screw is not None
     if screw.current_per_nm_a is None or actuator.nominal is None:
-        fit = fit_drive(runs, actuator)
-        return _learned(runs, fit, actuator, started), completed(actuator, fit), _drive_plot(fit)
+        calibrated = calibrate_drive(runs, actuator)
+        return _learned(runs, calibrated, actuator, started), completed(actuator, calibrated), _drive_plot(calibrated)
     return compared(windows, runs, actuator), None, _stroke_plot(runs, actuator)
 
 
-def _drive_plot(fit: DriveFit) -> ResidualPlot:
+def _drive_plot(calibrated: CalibratedDrive) -> ResidualPlot:
     """Each stretch's current about the document's model and about the drive learned, against its load."""
     return ResidualPlot(
         title="calibration: the drive learned",
         x_label="load torque at the motor, + towards increasing position [N·m]",
         y_label="current about the model [A]",
         series=[
-            Series("before", fit.stretch_load_nm.tolist(), fit.stretch_residual_before_a.tolist()),
-            Series("after", fit.stretch_load_nm.tolist(), fit.stretch_residual_after_a.tolist()),
+            Series("before", calibrated.stretch_load_nm.tolist(), calibrated.stretch_residual_before_a.tolist()),
+            Series("after", calibrated.stretch_load_nm.tolist(), calibrated.stretch_residual_after_a.tolist()),
         ],
     )
 
@@ -82,33 +82,42 @@ def _stroke_plot(runs: list[Run], actuator: ActuatorDocument) -> ResidualPlot:
     )
 
 
-def _learned(runs: list[Run], fit: DriveFit, actuator: ActuatorDocument, started: float) -> CalibrationReport:
+def _learned(
+    runs: list[Run], calibrated: CalibratedDrive, actuator: ActuatorDocument, started: float
+) -> CalibrationReport:
     unread = [ANCHOR] + (
         []
-        if fit.fdj_nm is not None
+        if calibrated.fdj_nm is not None
         else [
             "FDJ and η_O: the runs hold one load size, so only FDJ + (1/η_O − 1)·|T_L| shows; give runs at a "
             "second load"
         ]
     )
-    fitted = {name: getattr(fit, name) for name in DriveLearned.model_fields if hasattr(fit, name)}  # c, I0, FDJ, …
+    values = {
+        name: getattr(calibrated, name) for name in DriveLearned.model_fields if hasattr(calibrated, name)
+    }  # c, I0, FDJ, …
     drive = DriveLearned(
-        **fitted,
+        **values,
         runs=len(runs),
-        run_to_run_nm=None if fit.spread is None else fit.spread.run_to_run_nm,
-        healthy_set_nm=None if fit.spread is None else fit.spread.set_nm,
+        run_to_run_nm=None if calibrated.spread is None else calibrated.spread.run_to_run_nm,
+        healthy_set_nm=None if calibrated.spread is None else calibrated.spread.set_nm,
         not_separable=unread,
     )
     before = {} if actuator.nominal is None else {"FDJ": actuator.nominal.fdj, "eta_O": actuator.nominal.eta_o}
-    after = {} if fit.fdj_nm is None or fit.eta_o is None else {"FDJ": fit.fdj_nm, "eta_O": fit.eta_o}
+    after = (
+        {}
+        if calibrated.fdj_nm is None or calibrated.eta_o is None
+        else {"FDJ": calibrated.fdj_nm, "eta_O": calibrated.eta_o}
+    )
     reason = (
-        f"learned from {len(runs)} healthy run(s) at {', '.join(f'{n:.0f} N' for n in fit.loads_n)}: c "
-        f"{fit.current_per_nm_a:.4f} ± {fit.current_per_nm_std_a:.4f} A/N·m, I0 {fit.current_at_zero_torque_a:.3f} A"
+        f"learned from {len(runs)} healthy run(s) at {', '.join(f'{n:.0f} N' for n in calibrated.loads_n)}: c "
+        f"{calibrated.current_per_nm_a:.4f} ± {calibrated.current_per_nm_std_a:.4f} A/N·m, "
+        f"I0 {calibrated.current_at_zero_torque_a:.3f} A"
     )
     report = _report(
         len(runs),
-        fit.residual_before_a,
-        fit.residual_after_a,
+        calibrated.residual_before_a,
+        calibrated.residual_after_a,
         before,
         after,
         steps=[Step(selected=None, reason=reason)],
@@ -116,49 +125,59 @@ def _learned(runs: list[Run], fit: DriveFit, actuator: ActuatorDocument, started
         started=started,
     )
     learned = [
-        Learned(name="current_per_nm", value=fit.current_per_nm_a, std=fit.current_per_nm_std_a, unit="A/(N·m)"),
+        Learned(
+            name="current_per_nm",
+            value=calibrated.current_per_nm_a,
+            std=calibrated.current_per_nm_std_a,
+            unit="A/(N·m)",
+        ),
         Learned(
             name="current_at_zero_torque",
-            value=fit.current_at_zero_torque_a,
-            std=fit.current_at_zero_torque_std_a,
+            value=calibrated.current_at_zero_torque_a,
+            std=calibrated.current_at_zero_torque_std_a,
             unit="A",
         ),
     ]
-    if fit.fdj_nm is not None and fit.fdj_std_nm is not None and fit.eta_o is not None and fit.eta_o_std is not None:
+    if (
+        calibrated.fdj_nm is not None
+        and calibrated.fdj_std_nm is not None
+        and calibrated.eta_o is not None
+        and calibrated.eta_o_std is not None
+    ):
         learned += [
-            Learned(name="FDJ", value=fit.fdj_nm, std=fit.fdj_std_nm, unit="N·m"),
-            Learned(name="eta_O", value=fit.eta_o, std=fit.eta_o_std, unit=DIMENSIONLESS),
+            Learned(name="FDJ", value=calibrated.fdj_nm, std=calibrated.fdj_std_nm, unit="N·m"),
+            Learned(name="eta_O", value=calibrated.eta_o, std=calibrated.eta_o_std, unit=DIMENSIONLESS),
         ]
-    if fit.spread is not None:
+    if calibrated.spread is not None:
         learned += [
-            Learned(name="run_to_run", value=fit.spread.run_to_run_nm, std=0.0, unit="N·m"),
-            Learned(name="healthy_set", value=fit.spread.set_nm, std=0.0, unit="N·m"),
+            Learned(name="run_to_run", value=calibrated.spread.run_to_run_nm, std=0.0, unit="N·m"),
+            Learned(name="healthy_set", value=calibrated.spread.set_nm, std=0.0, unit="N·m"),
         ]
     return report.model_copy(update={"drive": drive, "learned": learned})
 
 
-def completed(actuator: ActuatorDocument, fit: DriveFit) -> ActuatorDocument:
+def completed(actuator: ActuatorDocument, calibrated: CalibratedDrive) -> ActuatorDocument:
     """``actuator`` with what the runs taught (the nominal only where two load sizes read it)."""
     assert actuator.screw is not None
     screw = actuator.screw.model_copy(
         update={
-            "current_per_nm_a": fit.current_per_nm_a,
-            "current_per_nm_std_a": fit.current_per_nm_std_a,
-            "current_at_zero_torque_a": fit.current_at_zero_torque_a,
-            "current_at_zero_torque_std_a": fit.current_at_zero_torque_std_a,
-            "eta_o_std": fit.eta_o_std,
-            "repeatability_nm": fit.repeatability_nm,
-            "run_to_run_nm": None if fit.spread is None else round(fit.spread.run_to_run_nm, 6),
-            "run_noise_nm": None if fit.spread is None else round(fit.spread.run_noise_nm, 6),
-            "healthy_set_nm": None if fit.spread is None else round(fit.spread.set_nm, 6),
-            "calibrated_loads_n": fit.signed_loads_n,
-            "stroke_profile_a": np.nan_to_num(fit.profile).round(5).tolist(),
-            "stroke_profile_std_a": np.nan_to_num(fit.profile_std).round(5).tolist(),
+            "current_per_nm_a": calibrated.current_per_nm_a,
+            "current_per_nm_std_a": calibrated.current_per_nm_std_a,
+            "current_at_zero_torque_a": calibrated.current_at_zero_torque_a,
+            "current_at_zero_torque_std_a": calibrated.current_at_zero_torque_std_a,
+            "eta_o_std": calibrated.eta_o_std,
+            "repeatability_nm": calibrated.repeatability_nm,
+            "run_to_run_nm": None if calibrated.spread is None else round(calibrated.spread.run_to_run_nm, 6),
+            "run_noise_nm": None if calibrated.spread is None else round(calibrated.spread.run_noise_nm, 6),
+            "healthy_set_nm": None if calibrated.spread is None else round(calibrated.spread.set_nm, 6),
+            "calibrated_loads_n": calibrated.signed_loads_n,
+            "stroke_profile_a": np.nan_to_num(calibrated.profile).round(5).tolist(),
+            "stroke_profile_std_a": np.nan_to_num(calibrated.profile_std).round(5).tolist(),
         }
     )
     nominal = actuator.nominal
-    if fit.fdj_nm is not None and fit.eta_o is not None:
-        nominal = Nominal(fdj_nm=round(fit.fdj_nm, 5), eta_o=round(fit.eta_o, 4))
+    if calibrated.fdj_nm is not None and calibrated.eta_o is not None:
+        nominal = Nominal(fdj_nm=round(calibrated.fdj_nm, 5), eta_o=round(calibrated.eta_o, 4))
     document = actuator.model_dump(by_alias=True) | {
         "screw": screw.model_dump(),
         "nominal": nominal and nominal.model_dump(),
@@ -172,7 +191,7 @@ def _leave_one_out(runs: list[Run], actuator: ActuatorDocument) -> HeldOut:
         return HeldOut(rss_before=0.0, rss_after=0.0, adopted=True, note="too few runs to hold one out")
     before, after = 0.0, 0.0
     for i, run in enumerate(runs):
-        others = fit_drive([r for j, r in enumerate(runs) if j != i], actuator)
+        others = calibrate_drive([r for j, r in enumerate(runs) if j != i], actuator)
         if others.fdj_nm is None or others.eta_o is None:
             return HeldOut(rss_before=0.0, rss_after=0.0, adopted=True, note="one load size: no run is predicted")
         rest, eta = others.current_at_zero_torque_a, others.eta_o

@@ -5,7 +5,7 @@ mean FDJ is set against the nominal (``ema.estimate.quasistatic.departure``): a 
 healthy sets allow (a friction that falls is one too: a screw losing its preload), with the load outside the
 healthy runs' loads said to be extrapolated, and how large a change it could not show. Where the runs span two
 load sizes, η_O is read over all of them and set against the nominal likewise. Along the stroke, the current
-is set against the healthy runs' own profile (``ema.kinds.linear.drive_fit.profile_change``): a friction that
+is set against the healthy runs' own profile (``ema.kinds.linear.drive_calibration.profile_change``): a friction that
 changes along the stroke is named only beyond ``MIN_Z`` of one run's scatter. Each change carries its
 machine-readable verdict (``departed``) beside its sentence.
 """
@@ -23,8 +23,8 @@ from ema.estimate.documents import DIMENSIONLESS, ActuatorRead, Estimate
 from ema.estimate.quasistatic.departure import DEPARTURE_Z, Departure, departure, inside
 from ema.estimate.quasistatic.drive_torque import STEPPER_READING
 from ema.estimate.quasistatic.slow_window import estimate_low_rate
-from ema.estimate.quasistatic.stretches import fit_stretches
-from ema.kinds.linear.drive_fit import MIN_Z, Run, profile_change, run_load_n
+from ema.estimate.quasistatic.stretches import solve_stretches
+from ema.kinds.linear.drive_calibration import MIN_Z, Run, profile_change, run_load_n
 from ema.model.actuator import ActuatorDocument
 from ema.model.window import Window
 
@@ -91,14 +91,15 @@ def eta_change(runs: list[Run], actuator: ActuatorDocument) -> Change | None:
     assert screw is not None  # the linear kind's own section
     eta_std = screw.eta_o_std or 0.0
     found = [s for run in runs for s in run.stretches]
-    fit = fit_stretches(found, torque, actuator.gear_ratio, eta_o_document=(health.efficiency, eta_std))
-    if not fit.eta_o_read:
+    calibrated = solve_stretches(found, torque, actuator.gear_ratio, eta_o_document=(health.efficiency, eta_std))
+    if not calibrated.eta_o_read:
         return None
-    allowed = float(np.hypot(fit.eta_o_std, eta_std))
-    z = (fit.eta_o - health.efficiency) / max(allowed, 1e-12)
+    allowed = float(np.hypot(calibrated.eta_o_std, eta_std))
+    z = (calibrated.eta_o - health.efficiency) / max(allowed, 1e-12)
     departed = abs(z) > DEPARTURE_Z
     said = (
-        f"η_O reads {fit.eta_o:.3f} ± {fit.eta_o_std:.3f} over the runs' loads, {z:+.1f} times its uncertainty off "
+        f"η_O reads {calibrated.eta_o:.3f} ± {calibrated.eta_o_std:.3f} over the runs' loads, {z:+.1f} times its "
+        "uncertainty off "
         f"the nominal {health.efficiency:.3f}: "
         + (
             "the transmission's efficiency under load changed (a lubricant, a preload)"
@@ -109,7 +110,7 @@ def eta_change(runs: list[Run], actuator: ActuatorDocument) -> Change | None:
     return Change(
         parameter="eta_O",
         nominal=health.efficiency,
-        value=fit.eta_o,
+        value=calibrated.eta_o,
         std=allowed,
         z=z,
         departed=departed,

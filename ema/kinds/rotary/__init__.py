@@ -99,7 +99,7 @@ class Rotary:
 
 def residual_plot(calibrator: Calibrator) -> ResidualPlot:
     """The equation-error residual before and after, against the variable that explains it."""
-    from ema.kinds.rotary.fitting import score
+    from ema.kinds.rotary.fold_scores import score
     from ema.kinds.rotary.selection import problem
 
     e, report, chosen = calibrator.measured_, calibrator.report_, calibrator.chosen_

@@ -15,7 +15,7 @@ stages, numbered as their modules and ``docs/calibration.md`` number them:
    (``ema.kinds.rotary.twins`` for look-alikes, ``ema.kinds.rotary.backlash`` for the dead band);
 5. ``ema.kinds.rotary.readings``: the effect against its rivals' readings, adopted only where they agree
    (an ambiguity keeps the base estimates, its stds widened), never where it reads worse;
-6. ``ema.kinds.rotary.refit``: the estimates with what is adopted, checked on held-out folds;
+6. ``ema.kinds.rotary.tied_solve``: the estimates with what is adopted, checked on held-out folds;
 7. ``ema.kinds.rotary.calibration_report``: the document.
 """
 
@@ -40,8 +40,8 @@ from ema.kinds.rotary.families import Family, generic_families
 from ema.kinds.rotary.noise_floor import clean_replicas, noise_copies
 from ema.kinds.rotary.pipeline import estimate_window
 from ema.kinds.rotary.readings import AMBIGUOUS_STDS, Contest, combined_stds, reading, settled
-from ema.kinds.rotary.refit import MIN_HELD_OUT_GAIN, corrected, fit_with, held_out_rss
 from ema.kinds.rotary.selection import MAX_EFFECTS, Chosen, Decision, Evidence, decide, evidence
+from ema.kinds.rotary.tied_solve import MIN_HELD_OUT_GAIN, corrected, held_out_rss, solve_with
 from ema.kinds.rotary.twins import TWINS, output_error, runners_up, tell_apart
 from ema.kinds.rotary.vocabulary import COGGING_ORDERS, named_families
 from ema.model.actuator import ActuatorDocument
@@ -181,7 +181,7 @@ class Calibrator:
         found = reporting.Found(measured, copies, first_round, chosen, steps, unnamed, read_backlash(measured, copies))
         found, held = reporting.adopt_described(found, held)
         adopted = found.adopted
-        after = corrected(fit_with(measured, adopted).values, bias) if adopted else before
+        after = corrected(solve_with(measured, adopted).values, bias) if adopted else before
         self.measured_, self.chosen_ = measured, adopted
         report = reporting.assemble(
             found, before, after, bias, held, truth=truth, seconds=time.perf_counter() - started

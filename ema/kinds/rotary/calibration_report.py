@@ -12,8 +12,8 @@ from ema.estimate.documents import TARGETS
 from ema.estimate.physics.eta_search import ETA_O_SEARCH
 from ema.kinds.rotary.backlash import BacklashReading
 from ema.kinds.rotary.equations import Equations
-from ema.kinds.rotary.refit import MIN_HELD_OUT_GAIN, corrected, fit_with, held_out_rss
 from ema.kinds.rotary.selection import Chosen, Evidence, floor_rms, residual_rms
+from ema.kinds.rotary.tied_solve import MIN_HELD_OUT_GAIN, corrected, held_out_rss, solve_with
 from ema.model.effects import EffectSet
 
 # How much further noise alone may move FDJ or η_O with a described term than without it before the
@@ -94,8 +94,8 @@ def _errors(values: Mapping[str, float], truth: Mapping[str, float] | None) -> t
 
 def scatter(copies: Sequence[Equations], with_it: Sequence[Chosen]) -> np.ndarray:
     """Relative std of FDJ and η_O, fitted with ``with_it``, over the noise-only copies."""
-    fits = np.array([[fit_with(c, with_it).values[n] for n in TARGETS] for c in copies])
-    return fits.std(axis=0) / np.abs(fits.mean(axis=0))
+    solutions = np.array([[solve_with(c, with_it).values[n] for n in TARGETS] for c in copies])
+    return solutions.std(axis=0) / np.abs(solutions.mean(axis=0))
 
 
 def withheld(found: Found, with_it: Sequence[Chosen], estimates: Mapping[str, float], has_term: bool) -> str | None:
@@ -129,7 +129,9 @@ def adopt_described(found: Found, held: HeldOutCheck) -> tuple[Found, HeldOutChe
     term = lead.family.term(lead.beta, lead.grid)
     described = Chosen(lead.family, lead.grid)
     with_it = [*found.chosen, described]
-    if withheld(found, with_it, fit_with(found.measured, with_it).values, term is not None and term.table is not None):
+    if withheld(
+        found, with_it, solve_with(found.measured, with_it).values, term is not None and term.table is not None
+    ):
         return found, held
     current = held.rss_after if held.adopted else held.rss_before
     trial = held_out_rss(found.measured, with_it)
@@ -148,7 +150,7 @@ def unexplained(found: Found, bias: Mapping[str, float], truth: Mapping[str, flo
     term = lead.family.term(lead.beta, lead.grid)
     table = None if term is None else term.table
     with_it = [*found.chosen, Chosen(lead.family, lead.grid)]
-    raw = fit_with(found.measured, with_it).values
+    raw = solve_with(found.measured, with_it).values
     reason = withheld(found, with_it, raw, table is not None)
     estimates = None if reason else corrected(raw, bias)
     if lead.family.named:

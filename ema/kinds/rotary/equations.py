@@ -25,7 +25,7 @@ import numpy as np
 
 from ema.estimate.physics.eta_search import ETA_O_SEARCH
 from ema.estimate.physics.features import as_read
-from ema.estimate.physics.friction import FitSettings, regressors
+from ema.estimate.physics.friction import SolveSettings, regressors
 from ema.model.params import DriveConstants, load_factors
 from ema.model.residual import smooth_derivative, smoothed
 
@@ -115,7 +115,7 @@ def _one_window(
     signals: Mapping[str, np.ndarray], rate: float, drive: DriveConstants, orders: Sequence[float], index: int
 ) -> Equations:
     signals = as_read(signals, rate)  # the hinge moment as the estimators read it
-    t, a, o, mask = (x[0] for x in regressors(signals, rate, drive, FitSettings()))
+    t, a, o, mask = (x[0] for x in regressors(signals, rate, drive, SolveSettings()))
     speed = smoothed(signals["motor_speed_radps"], rate)
     sign = np.sign(speed)
     angle = motor_angle_rad(signals["motor_speed_radps"], signals["position_deg"], rate, drive.gear_ratio)

@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 
 from ema.kinds.rotary.equations import Equations
-from ema.kinds.rotary.fitting import hats, uniform_knots
+from ema.kinds.rotary.fold_scores import hats, uniform_knots
 from ema.model.effects import EffectSet, FrictionTable
 
 KNOTS = 9  # piecewise-linear curves: 8 segments over the visited range
@@ -44,7 +44,7 @@ class Family:
     # answers the friction itself, so a curve over it mimics any large effect and may not block a name.
     exogenous: bool = True
     stacked: Callable[[Equations], np.ndarray] | None = None  # (m, G, c): every grid value's columns at once
-    # For the tied refit (``ema.kinds.rotary.refit``): columns of the base replaced (a hinge-moment bias
+    # For the tied refit (``ema.kinds.rotary.tied_solve``): columns of the base replaced (a hinge-moment bias
     # moves the load a and o are built from, and their coefficients stay k_aid and k_opp), and how
     # many of ``columns`` are left as free terms (the others are that replacement's first order).
     base_shift: Callable[[Equations, Grid], np.ndarray] | None = None

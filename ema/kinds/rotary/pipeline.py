@@ -31,7 +31,7 @@ from ema.estimate.learn.estimator import NetworkEstimator
 from ema.estimate.learn.network import LearnConfig
 from ema.estimate.other_windows import known_from
 from ema.estimate.physics.features import as_read
-from ema.estimate.physics.friction import FIT_ARRAYS, FrictionFit, fit_friction, fit_window
+from ema.estimate.physics.friction import SOLUTION_ARRAYS, FrictionSolution, solve_friction, solve_window
 from ema.estimate.physics.scenario import inside
 from ema.estimate.physics.static_friction import read_static_friction
 from ema.estimate.prepare.conditioning import Prepared, prepare, widened
@@ -57,17 +57,19 @@ def learned(data: Data, config: PipelineConfig) -> NetworkEstimator:
 
 
 def candidates(
-    window: Window, physics: FrictionFit, data: Data, network: NetworkEstimator, n: int
-) -> tuple[Candidates, FrictionFit]:
+    window: Window, physics: FrictionSolution, data: Data, network: NetworkEstimator, n: int
+) -> tuple[Candidates, FrictionSolution]:
     """Physics and network on the window and on the held-out simulations (and the physics fit of those)."""
     held = {name: values[n:] for name, values in data.sims.signals.items()}
-    check_physics = fit_friction(held, window.sample_rate_hz, data.drive_as_read, residual_nm=data.sims.residual_nm[n:])
+    check_physics = solve_friction(
+        held, window.sample_rate_hz, data.drive_as_read, residual_nm=data.sims.residual_nm[n:]
+    )
     unit = network.predict_unit(np.vstack([data.inputs[n:], data.window_inputs]))
     fdj, eta_o = data.box.denormalize(unit)
     health = data.sims.health
     # A held-out simulation that never slides long enough has no physics answer: left out, not poisoning the scores.
     ok = np.isfinite(check_physics.fdj_nm) & np.isfinite(check_physics.eta_o)
-    check_physics = replace(check_physics, **{k: getattr(check_physics, k)[ok] for k in FIT_ARRAYS})
+    check_physics = replace(check_physics, **{k: getattr(check_physics, k)[ok] for k in SOLUTION_ARRAYS})
     fdj_check, eta_check = fdj[:-1][ok], eta_o[:-1][ok]
     truth_fdj, truth_eta = health.fdj_nm[n:][ok], health.eta_o[n:][ok]
     return Candidates(
@@ -85,7 +87,7 @@ def checked(
     window: Window,
     data: Data,
     answer: Assessed,
-    physics: FrictionFit,
+    physics: FrictionSolution,
     *,
     equation_ratio: float,
     n: int,
@@ -131,7 +133,7 @@ def checked(
 
 
 def assessed(
-    window: Window, physics: FrictionFit, data: Data, network: NetworkEstimator, *, prepared: Prepared, n: int
+    window: Window, physics: FrictionSolution, data: Data, network: NetworkEstimator, *, prepared: Prepared, n: int
 ) -> tuple[Assessed, float, float]:
     """The assessed answer (its stds widened by what prepare left undecided), the window's equation error over
     its held-out simulations' median, and the misfit limit that ratio is held to."""
@@ -172,13 +174,13 @@ def estimate_window(
         w, n = prepared.window, config.n_simulations
         seen = replace(w, signals=as_read(w.signals, w.sample_rate_hz))
     with watch("physics", "fitting Eq. 5.1"):
-        physics = fit_window(seen.signals, w.sample_rate_hz, prepared.drive_as_read)
+        physics = solve_window(seen.signals, w.sample_rate_hz, prepared.drive_as_read)
     with watch("simulate", f"simulating {config.total_simulations} windows around the physics estimate"):
         effects = prepared.departures.viscosity.effects()
         data = simulate_dataset(
             w, seen, physics, config, document=actuator, drive=prepared.drive_as_read, effects=effects
         )
-    with watch("learn", f"training {config.members} network(s) of {config.hidden_units} neurons"):
+    with watch("learn", f"learning {config.members} network(s) of {config.hidden_units} neurons"):
         network = learned(data, config)
     with watch("assess", "weighing the estimators on held-out simulations"):
         answer, equation_ratio, limit = assessed(w, physics, data, network, prepared=prepared, n=n)

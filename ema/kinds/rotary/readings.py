@@ -5,7 +5,7 @@ Each effect selection would adopt is set against its **rivals**: its twins where
 not tell them apart clearly (``ema.kinds.rotary.twins``), and the other named families that explain
 about as much of the held-out residual (within ``NAME_MARGIN``; where the effect's reading moves the
 estimates, of the measured residual too). The windows are re-estimated with each
-in its place (``ema.kinds.rotary.refit``). Where a rival's estimates differ from the effect's by more
+in its place (``ema.kinds.rotary.tied_solve``). Where a rival's estimates differ from the effect's by more
 than ``AMBIGUOUS_STDS`` of the base estimates' stds, the windows hold two readings and the evidence does
 not choose: neither is adopted, the base estimates are kept, their stds are widened until ±2 std holds
 every reading, and the report names the readings and the data that would tell them apart. Where
@@ -23,8 +23,8 @@ import numpy as np
 from ema.calibration.documents import Ambiguity
 from ema.estimate.documents import TARGETS
 from ema.kinds.rotary.equations import Equations
-from ema.kinds.rotary.refit import corrected, fit_with
 from ema.kinds.rotary.selection import Chosen, Evidence
+from ema.kinds.rotary.tied_solve import corrected, solve_with
 
 AMBIGUOUS_STDS = 2.0
 # What would tell two look-alike effects apart, by the pair (either order).
@@ -52,7 +52,7 @@ class Contest:
 
 def reading(measured: Equations, terms: Sequence[Chosen], bias: Mapping[str, float]) -> dict[str, float]:
     """FDJ and η_O re-estimated with ``terms``, the base pipeline's bias off."""
-    return corrected(fit_with(measured, terms).values, bias)
+    return corrected(solve_with(measured, terms).values, bias)
 
 
 def what_tells_apart(names: Sequence[str]) -> str:

@@ -44,23 +44,23 @@ from ema.calibration.plot import ResidualPlot, Series
 from ema.estimate.assess.weighing import misfit_limit
 from ema.estimate.stats import rms
 from ema.kinds.servo.fold_errors import closed_loop_error_pct, document_check
-from ema.kinds.servo.fold_fit import (
-    COPIES,
-    FOLDS,
-    FRAME_PHASES,
-    Fitted,
-    fitted,
-    noise_copies,
-    problem,
-    simulator_frame,
-    undisturbed,
-)
 from ema.kinds.servo.inverse import (
     UNITS,
     decimated,
 )
 from ema.kinds.servo.load_effects import EFFECTS, ServoEffect
 from ema.kinds.servo.log_reading import ServoPrepared, document_effects, prepare_servo, refuse_reversed_signs
+from ema.kinds.servo.stacked_solve import (
+    COPIES,
+    FOLDS,
+    FRAME_PHASES,
+    Solved,
+    noise_copies,
+    problem,
+    simulator_frame,
+    solved,
+    undisturbed,
+)
 from ema.model.actuator import ActuatorDocument, Nominal
 from ema.model.checks import InputError
 from ema.model.window import Window
@@ -78,17 +78,17 @@ LEARNED_NAMES = {
 }
 
 
-def _best_of(effect: ServoEffect, prepared: Sequence[ServoPrepared], model: dict[str, float]) -> tuple[float, Fitted]:
+def _best_of(effect: ServoEffect, prepared: Sequence[ServoPrepared], model: dict[str, float]) -> tuple[float, Solved]:
     """The effect at the grid value that predicts the held-out folds best."""
-    trials = [(value, fitted(problem(prepared, {**model, effect.name: value}))) for value in effect.grid]
+    trials = [(value, solved(problem(prepared, {**model, effect.name: value}))) for value in effect.grid]
     return min(trials, key=lambda trial: float(trial[1].held_out_rss.sum()))
 
 
-def _candidate(effect: ServoEffect, value: float, fit: Fitted, base: Fitted) -> tuple[Candidate, bool]:
-    drop = 1.0 - fit.held_out_rss.sum() / base.held_out_rss.sum()
-    every_fold = bool(np.all(fit.held_out_rss < base.held_out_rss))
-    plausible = effect.plausible(fit.values)
-    parameters = {name: fit.values[name] for name in fit.values if name not in base.values}
+def _candidate(effect: ServoEffect, value: float, solution: Solved, base: Solved) -> tuple[Candidate, bool]:
+    drop = 1.0 - solution.held_out_rss.sum() / base.held_out_rss.sum()
+    every_fold = bool(np.all(solution.held_out_rss < base.held_out_rss))
+    plausible = effect.plausible(solution.values)
+    parameters = {name: solution.values[name] for name in solution.values if name not in base.values}
     if effect.constant is not None:
         parameters[effect.constant[0]] = value
     candidate = Candidate(
@@ -96,9 +96,9 @@ def _candidate(effect: ServoEffect, value: float, fit: Fitted, base: Fitted) -> 
         follows="speed_mps" if effect.name != "position_force" else "position_m",
         named=True,
         parameters=parameters,
-        rms_reduction=float(1.0 - fit.error_pct / base.error_pct),
+        rms_reduction=float(1.0 - solution.error_pct / base.error_pct),
         held_out_drop=float(drop),
-        score=float(np.min(1.0 - fit.held_out_rss / base.held_out_rss)),
+        score=float(np.min(1.0 - solution.held_out_rss / base.held_out_rss)),
         plausible=plausible,
     )
     return candidate, plausible and every_fold and drop >= MIN_HELD_OUT_DROP
@@ -107,20 +107,20 @@ def _candidate(effect: ServoEffect, value: float, fit: Fitted, base: Fitted) -> 
 def select(prepared: Sequence[ServoPrepared], base_model: dict[str, float]) -> tuple[dict[str, float], list, list]:
     """The effects adopted on top of ``base_model``, every candidate considered, and the steps' reasons."""
     model, candidates, steps = dict(base_model), [], []
-    current = fitted(problem(prepared, model))
+    current = solved(problem(prepared, model))
     for _ in range(MAX_EFFECTS):
         trials = []
         for effect in (e for e in EFFECTS if e.name not in model):
-            value, fit = _best_of(effect, prepared, model)
-            candidate, earned = _candidate(effect, value, fit, current)
+            value, solution = _best_of(effect, prepared, model)
+            candidate, earned = _candidate(effect, value, solution, current)
             candidates.append(candidate)
-            trials.append((candidate.held_out_drop, earned, effect, value, fit))
+            trials.append((candidate.held_out_drop, earned, effect, value, solution))
         earned_trials = [t for t in trials if t[1]]
         if not earned_trials:
             steps.append(Step(selected=None, reason=_nothing_earned(trials)))
             break
-        drop, _, effect, value, fit = max(earned_trials, key=lambda t: t[0])
-        model[effect.name], current = value, fit
+        drop, _, effect, value, solution = max(earned_trials, key=lambda t: t[0])
+        model[effect.name], current = value, solution
         steps.append(
             Step(
                 selected=effect.name,
@@ -142,12 +142,12 @@ def _nothing_earned(trials: list) -> str:
     )
 
 
-def learned(fit: Fitted, model: dict[str, float], values: dict[str, float] | None = None) -> list[Learned]:
+def learned(solution: Solved, model: dict[str, float], values: dict[str, float] | None = None) -> list[Learned]:
     """The model's constants (``values``, the fit's by default), each with the fit's std and its unit, in the
     document's words (``_up``/``_down`` by direction), the adopted effects' nonlinear constants beside them."""
     out = [
-        Learned(name=LEARNED_NAMES.get(name, name), value=value, std=fit.stds[name], unit=UNITS[name])
-        for name, value in (fit.values if values is None else values).items()
+        Learned(name=LEARNED_NAMES.get(name, name), value=value, std=solution.stds[name], unit=UNITS[name])
+        for name, value in (solution.values if values is None else values).items()
     ]
     for effect in EFFECTS:
         if effect.name in model and effect.constant is not None:
@@ -156,11 +156,11 @@ def learned(fit: Fitted, model: dict[str, float], values: dict[str, float] | Non
 
 
 def completed(
-    actuator: ActuatorDocument, prepared: ServoPrepared, fit: Fitted, model: dict[str, float]
+    actuator: ActuatorDocument, prepared: ServoPrepared, solution: Solved, model: dict[str, float]
 ) -> ActuatorDocument:
     """The document with what the runs taught: the log's controller constants, the load's, the adopted effects,
     the nominal FDJ."""
-    v, sd = fit.values, fit.stds
+    v, sd = solution.values, solution.stds
     split = "viscous_down_ns_per_m" in v
     up = "viscous_up_ns_per_m" if split else "viscous_ns_per_m"
     servo = prepared.servo.model_copy(
@@ -184,7 +184,7 @@ def completed(
 
 
 def _as_simulated(
-    prepared: Sequence[ServoPrepared], before: tuple[Fitted, dict[str, float]], after: tuple[Fitted, dict[str, float]]
+    prepared: Sequence[ServoPrepared], before: tuple[Solved, dict[str, float]], after: tuple[Solved, dict[str, float]]
 ) -> tuple[dict[str, float], dict[str, float]]:
     """The constants after, as the simulator takes them (``simulator_frame``), and the closed loop's error before
     and after, each at its model's constants as the simulator takes them."""
@@ -199,7 +199,7 @@ def _as_simulated(
     return frames["after"], closed
 
 
-def _plot(prepared: Sequence[ServoPrepared], base: Fitted, after: Fitted, model: dict[str, float]) -> ResidualPlot:
+def _plot(prepared: Sequence[ServoPrepared], base: Solved, after: Solved, model: dict[str, float]) -> ResidualPlot:
     """The decimated force's residual before and after, against the speed (what the effects follow)."""
     speed = np.concatenate([decimated(p.motion.speed_mps, p.motion.decimation)[p.motion.sliding] for p in prepared])
     return ResidualPlot(
@@ -232,11 +232,11 @@ def calibrate_servo(
     started = time.perf_counter()
     prepared = [_own_controller(prepare_servo(w, actuator)) for w in windows]
     base_model = document_effects(prepared[0].servo)
-    first = fitted(problem(prepared, base_model))
+    first = solved(problem(prepared, base_model))
     refuse_reversed_signs(first.values, first.stds)
     copies = noise_copies(prepared, first, base_model)
     prepared = undisturbed(prepared, copies, base_model)
-    base = fitted(problem(prepared, base_model))
+    base = solved(problem(prepared, base_model))
     ratio = rms(base.residual) / float(np.median(copies.rms))
     limit = misfit_limit(copies.rms)
     if ratio > limit:
@@ -250,7 +250,7 @@ def calibrate_servo(
                 f"{limit:.2f}x a log the model explains reaches: nothing to trace",
             )
         ]
-    after = fitted(problem(prepared, model))
+    after = solved(problem(prepared, model))
     adopted = [name for name in model if name not in base_model]
     simulated, closed = _as_simulated(prepared, (base, base_model), (after, model))
     report = CalibrationReport(

@@ -9,9 +9,9 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ema.kinds.servo.fold_fit import problem
 from ema.kinds.servo.log_reading import ServoPrepared, document_effects
 from ema.kinds.servo.loop_dataset import lane_parameters
+from ema.kinds.servo.stacked_solve import problem
 from ema.model.actuator import ActuatorDocument
 from ema.model.checks import InputError
 

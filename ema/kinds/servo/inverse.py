@@ -199,7 +199,7 @@ def inverse_columns(motion: Motion, effects: Mapping[str, float] | None = None) 
 
 
 @dataclass(frozen=True)
-class InverseFit:
+class InverseSolution:
     """Eq. 5.1 fitted: each constant with its Newey–West std, the error as the benchmark states it."""
 
     values: dict[str, float]
@@ -237,11 +237,11 @@ def decimated_problem(
 
 
 def disturbed_rows(residual_by_row: np.ndarray, simulated_by_row: np.ndarray) -> np.ndarray:
-    """(rows,) bool: where a window's residual (``InverseFit.residual_by_row``) exceeds ``DISTURBANCE_SIGMAS`` times
-    the larger of its robust noise and its simulations' RMS residual at the row (``simulated_by_row``, (K, rows)),
+    """(rows,) bool: where a window's residual (``InverseSolution.residual_by_row``) exceeds ``DISTURBANCE_SIGMAS``
+    times the larger of its robust noise and its simulations' RMS residual at the row (``simulated_by_row``, (K, rows)),
     and the rows beside them (module docstring)."""
-    fitted = np.isfinite(residual_by_row)
-    r = residual_by_row[fitted]
+    solved = np.isfinite(residual_by_row)
+    r = residual_by_row[solved]
     noise = float(np.sqrt(robust_variance(r))) if len(r) else 0.0
     envelope = np.zeros(len(residual_by_row))
     if len(simulated_by_row):
@@ -250,13 +250,13 @@ def disturbed_rows(residual_by_row: np.ndarray, simulated_by_row: np.ndarray) ->
         )  # a row no simulation fitted has no envelope: the noise sets it
         envelope[seen] = np.sqrt(np.nanmean(simulated_by_row[:, seen] ** 2, axis=0))
     scale = np.fmax(envelope, noise)
-    far = fitted & (np.abs(np.nan_to_num(residual_by_row)) > DISTURBANCE_SIGMAS * np.maximum(scale, 1e-300))
+    far = solved & (np.abs(np.nan_to_num(residual_by_row)) > DISTURBANCE_SIGMAS * np.maximum(scale, 1e-300))
     return np.convolve(far, np.ones(2 * DISTURBANCE_MARGIN_ROWS + 1), mode="same") > 0
 
 
-def fit_inverse(
+def solve_inverse(
     force_n: np.ndarray, columns: Mapping[str, np.ndarray], motion: Motion, left_out: np.ndarray | None = None
-) -> InverseFit:
+) -> InverseSolution:
     """Least squares of the force on ``columns`` (full rate, one length), both decimated, on the rows where the
     load slides, less ``left_out`` (a disturbance's: ``disturbed_rows``)."""
     y, decimated_columns = decimated_problem(force_n, columns, motion, left_out)
@@ -276,7 +276,7 @@ def fit_inverse(
     stds = newey_west_std(x, residual, newey_west_lags(len(y)))
     by_row = np.full(len(motion.sliding), np.nan)
     by_row[motion.sliding if left_out is None else motion.sliding & ~left_out] = residual
-    return InverseFit(
+    return InverseSolution(
         values=dict(zip(names, beta.tolist(), strict=True)),
         stds=dict(zip(names, stds.tolist(), strict=True)),
         error_pct=float(100.0 * np.linalg.norm(residual) / max(float(np.linalg.norm(y)), 1e-300)),

@@ -36,7 +36,7 @@ from ema.estimate.documents import Note
 from ema.estimate.physics.noise_reading import robust_variance
 from ema.estimate.stats import below_zero, rms
 from ema.kinds.servo.closed_loop import ServoLoop, ServoRuns, simulate_servo
-from ema.kinds.servo.inverse import Motion, fit_inverse, inverse_columns, load_motion, refuse_still
+from ema.kinds.servo.inverse import Motion, inverse_columns, load_motion, refuse_still, solve_inverse
 from ema.model.actuator import ActuatorDocument
 from ema.model.checks import InputError
 from ema.model.servo import Servo
@@ -49,7 +49,7 @@ MIN_LOOP_SAMPLES = 10  # unclipped samples a log's own loop gains are read from,
 # A sample whose command departs from the loop's by more than this many robust stds of the departures holds a
 # command the loop does not give (a pulse of an excitation stands out by hundreds; a gain's rounding by none).
 ADDED_MADS = 6.0
-TRIMMED_FITS = 4  # least-squares fits of the loop's gains, each without the samples the last one left far off
+TRIMMED_SOLVES = 4  # least-squares fits of the loop's gains, each without the samples the last one left far off
 # A departure from the loop's command that the loop's own terms explain beyond this share of its energy is the
 # loop's error (a gain, the sign, the filter), not a command added to it.
 MAX_LOOP_SHARE = 0.5
@@ -213,10 +213,10 @@ def loops_own(values: np.ndarray) -> np.ndarray:
 
 
 def trimmed_loop(servo: Servo, window: Window) -> LoopGains | None:
-    """The gains most of the logged command follows: ``log_loop`` refitted ``TRIMMED_FITS`` times, each without the
+    """The gains most of the logged command follows: ``log_loop`` refitted ``TRIMMED_SOLVES`` times, each without the
     samples the last fit's gains leave beyond ``ADDED_MADS`` robust stds (an added command's)."""
     gains = log_loop(servo, window)
-    for _ in range(TRIMMED_FITS - 1):
+    for _ in range(TRIMMED_SOLVES - 1):
         if gains is None:
             return None
         gains = log_loop(servo, window, loops_own(departure(servo, window, gains)))
@@ -235,8 +235,8 @@ def loop_share(servo: Servo, window: Window, values: np.ndarray) -> float:
     """The share of ``values``' energy (N,) that the loop's own terms (the position error and the filtered speed,
     at any gains) explain by least squares: near 1 where ``values`` is a gain's, the sign's or the filter's error."""
     columns, target = _loop_columns(servo, window), values[len(servo.speed_filter) :]
-    fitted, *_ = np.linalg.lstsq(columns, target, rcond=None)
-    left = float(np.sum((target - columns @ fitted) ** 2))
+    solved, *_ = np.linalg.lstsq(columns, target, rcond=None)
+    left = float(np.sum((target - columns @ solved) ** 2))
     return 1.0 - left / max(float(np.sum(target**2)), 1e-300)
 
 
@@ -363,7 +363,7 @@ def prepare_servo(window: Window, actuator: ActuatorDocument) -> ServoPrepared:
     if mass is None and servo.bandwidth_hz is None:  # a first fit, for the loop's natural frequency
         first = _window_motion(s["position_m"], rate, PROVISIONAL_BANDWIDTH_SHARE * rate, step)
         forces = (s["drive_force_n"] - load)[first.samples]
-        mass = fit_inverse(forces, inverse_columns(first), first).values["mass_kg"]
+        mass = solve_inverse(forces, inverse_columns(first), first).values["mass_kg"]
     followed = followed_loop(servo, window)
     gains = followed.gains
     loop_hz = bandwidth(servo, max(float(mass or 1.0), 1e-6), gains)

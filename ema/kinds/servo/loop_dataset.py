@@ -20,7 +20,7 @@ import numpy as np
 from ema.estimate.config import PipelineConfig
 from ema.estimate.simulate.design import halton
 from ema.kinds.servo.closed_loop import LANE_PARAMETERS, ServoRuns
-from ema.kinds.servo.inverse import InverseFit
+from ema.kinds.servo.inverse import InverseSolution
 from ema.kinds.servo.log_reading import ServoPrepared
 
 SPAN_SIGMAS = 6.0
@@ -68,7 +68,7 @@ def lane_parameters(values: dict[str, float], effects: dict[str, float] | None =
     return lane
 
 
-def box(physics: InverseFit, targets: tuple[str, ...]) -> tuple[np.ndarray, np.ndarray]:
+def box(physics: InverseSolution, targets: tuple[str, ...]) -> tuple[np.ndarray, np.ndarray]:
     """(low, high) of each target: its estimate ±max(``SPAN_SIGMAS`` stds, ``MIN_HALF_SHARE`` of its scale)."""
     scale = {name: abs(physics.values[name]) for name in targets}
     scale["offset_n"] = abs(physics.values["fdj_n"])  # an offset near 0 is drawn on FDJ's scale
@@ -88,7 +88,7 @@ def binned(force: np.ndarray, bins: int) -> np.ndarray:
     return np.stack([force[..., a:b].mean(axis=-1) for a, b in itertools.pairwise(edges)], axis=-1)
 
 
-def simulate_servo_dataset(prepared: ServoPrepared, physics: InverseFit, config: PipelineConfig) -> ServoData:
+def simulate_servo_dataset(prepared: ServoPrepared, physics: InverseSolution, config: PipelineConfig) -> ServoData:
     """The window's ``config.total_simulations`` closed-loop runs, their constants and the network's inputs."""
     targets = tuple(name for name in physics.values if name in LANE_COLUMNS)
     low, high = box(physics, targets)

@@ -26,17 +26,17 @@ from ema.estimate.config import PipelineConfig
 from ema.estimate.documents.window_facts import WindowInfo
 from ema.estimate.learn.estimator import NetworkRegressor
 from ema.estimate.learn.network import LearnConfig
-from ema.estimate.report import training_info
+from ema.estimate.report import learned_info
 from ema.estimate.stats import MAX_RATIO, RESOLUTION_SHARE, rms
 from ema.estimate.stopwatch import Stopwatch
 from ema.kinds.servo.inverse import (
     EITHER_SIGN,
     UNITS,
-    InverseFit,
+    InverseSolution,
     disturbed_rows,
-    fit_inverse,
     inverse_columns,
     load_motion,
+    solve_inverse,
 )
 from ema.kinds.servo.log_reading import ServoPrepared, prepare_servo, refuse_reversed_signs
 from ema.kinds.servo.loop_dataset import ServoData, lane_parameters, simulate_servo_dataset
@@ -55,9 +55,11 @@ NOMINAL_FIELDS = {  # a constant of the inverse model -> the servo section's fie
 }
 
 
-def physics_of(prepared: ServoPrepared, left_out: np.ndarray | None = None) -> InverseFit:
+def physics_of(prepared: ServoPrepared, left_out: np.ndarray | None = None) -> InverseSolution:
     """Eq. 5.1 fitted to the window with the document's effects (less the ``left_out`` rows)."""
-    return fit_inverse(prepared.force_n, inverse_columns(prepared.motion, prepared.effects), prepared.motion, left_out)
+    return solve_inverse(
+        prepared.force_n, inverse_columns(prepared.motion, prepared.effects), prepared.motion, left_out
+    )
 
 
 def held_out_physics(prepared: ServoPrepared, data: ServoData, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -68,16 +70,16 @@ def held_out_physics(prepared: ServoPrepared, data: ServoData, n: int) -> tuple[
     for position, force in zip(data.runs.position_m[n:], data.runs.drive_force_n[n:], strict=True):
         motion = load_motion(position, rate, prepared.bandwidth_hz, prepared.loop.resolution_m)
         pushed = force if load is None else force - load
-        fit = fit_inverse(pushed[motion.samples], inverse_columns(motion, prepared.effects), motion)
-        values.append([fit.values[name] for name in data.targets])
-        rms.append(fit.residual_rms_n)
-        by_row.append(fit.residual_by_row)
+        solution = solve_inverse(pushed[motion.samples], inverse_columns(motion, prepared.effects), motion)
+        values.append([solution.values[name] for name in data.targets])
+        rms.append(solution.residual_rms_n)
+        by_row.append(solution.residual_by_row)
     return np.array(values), np.array(rms), np.array(by_row)
 
 
 def undisturbed(
-    prepared: ServoPrepared, physics: InverseFit, simulated_by_row: np.ndarray
-) -> tuple[InverseFit, doc.Note | None]:
+    prepared: ServoPrepared, physics: InverseSolution, simulated_by_row: np.ndarray
+) -> tuple[InverseSolution, doc.Note | None]:
     """The physics fit again without the rows a force the log does not carry disturbs (``disturbed_rows``: the
     window's residual beyond what its simulations leave there), and a note saying how long they last."""
     disturbed = disturbed_rows(physics.residual_by_row, simulated_by_row)
@@ -100,8 +102,8 @@ def learned(data: ServoData, config: PipelineConfig) -> NetworkRegressor:
 
 
 def assessed(
-    prepared: ServoPrepared, physics: InverseFit, data: ServoData, network: NetworkRegressor, n: int
-) -> tuple[Assessed, float, float, InverseFit]:
+    prepared: ServoPrepared, physics: InverseSolution, data: ServoData, network: NetworkRegressor, n: int
+) -> tuple[Assessed, float, float, InverseSolution]:
     """The assessed answer, the window's equation error over the held-out simulations' median, its limit, and the
     physics fit the answer read (without the rows a force the log lacks disturbs; a note says so)."""
     check_physics, check_rms, check_by_row = held_out_physics(prepared, data, n)
@@ -176,7 +178,7 @@ def noise_floor(measured: np.ndarray, twins: np.ndarray) -> float:
 
 
 def _estimates(
-    actuator: ActuatorDocument, prepared: ServoPrepared, physics: InverseFit, answer: Assessed
+    actuator: ActuatorDocument, prepared: ServoPrepared, physics: InverseSolution, answer: Assessed
 ) -> doc.Estimates:
     """FDJ in N against the document's nominal (none before ema calibrate), the other constants beside it (an
     effect's that the simulator lacks as the physics fit read it)."""
@@ -202,7 +204,7 @@ def _estimates(
 
 def _report(
     prepared: ServoPrepared,
-    physics: InverseFit,
+    physics: InverseSolution,
     data: ServoData,
     network: NetworkRegressor,
     answer: Assessed,
@@ -234,7 +236,7 @@ def _report(
             noise_estimated={"position_resolution_m": prepared.loop.resolution_m},
             box={name: (float(lo), float(hi)) for name, lo, hi in zip(data.targets, data.low, data.high, strict=True)},
         ),
-        training=training_info(first, config),
+        learned=learned_info(first, config),
         methods={"FDJ" if name == FDJ else name: report for name, report in answer.methods.items()},
         check=check,
         window=WindowInfo.logged(
@@ -265,7 +267,7 @@ def estimate_servo(
         refuse_reversed_signs(physics.values, physics.stds)
     with watch("simulate", f"simulating {config.total_simulations} runs of the window's set point in closed loop"):
         data = simulate_servo_dataset(prepared, physics, config)
-    with watch("learn", f"training {config.members} network(s) of {config.hidden_units} neurons"):
+    with watch("learn", f"learning {config.members} network(s) of {config.hidden_units} neurons"):
         network = learned(data, config)
     with watch("assess", "weighing the estimators on held-out simulations"):
         answer, ratio, limit, physics = assessed(prepared, physics, data, network, n)

@@ -1,7 +1,14 @@
 import numpy as np
 import pytest
 
-from ema.estimate.learn.network import LearnConfig, initial_layers, mse_and_gradient, predict, split_indices, train
+from ema.estimate.learn.network import (
+    LearnConfig,
+    initial_layers,
+    learn_network,
+    mse_and_gradient,
+    predict,
+    split_indices,
+)
 from ema.model.checks import InputError
 
 
@@ -16,7 +23,7 @@ def test_learns_a_smooth_map_round_trip():
     targets = rng.uniform(0, 1, (400, 2))
     basis = rng.normal(size=(2, 60))
     inputs = targets @ basis + 0.3 * np.sin(targets @ basis) + 1e-4 * rng.normal(size=(400, 60))
-    result = train(inputs, targets, LearnConfig(hidden=30, components=8))
+    result = learn_network(inputs, targets, LearnConfig(hidden=30, components=8))
     assert result.test_mse < 1e-4
     assert result.stop_reason in ("validation", "goal", "max_epochs", "converged")
     np.testing.assert_allclose(predict(result.model, inputs[:5]), np.clip(targets[:5], 0, 1), atol=0.03)
@@ -25,7 +32,7 @@ def test_learns_a_smooth_map_round_trip():
 def test_early_stopping_after_12_validation_failures_keeps_the_best_weights():
     rng = np.random.default_rng(2)
     inputs, targets = rng.normal(size=(200, 20)), rng.uniform(0, 1, (200, 2))  # nothing to learn: overfits
-    result = train(inputs, targets, LearnConfig(hidden=50, components=None, max_epochs=500))
+    result = learn_network(inputs, targets, LearnConfig(hidden=50, components=None, max_epochs=500))
     assert result.stop_reason == "validation"
     validation = [v for _, v in result.history]
     best_epoch = int(np.argmin(validation))
@@ -36,15 +43,15 @@ def test_early_stopping_after_12_validation_failures_keeps_the_best_weights():
 def test_training_is_seeded():
     rng = np.random.default_rng(3)
     inputs, targets = rng.normal(size=(100, 10)), rng.uniform(0, 1, (100, 2))
-    a = train(inputs, targets, LearnConfig(hidden=8, max_epochs=20, seed=5))
-    b = train(inputs, targets, LearnConfig(hidden=8, max_epochs=20, seed=5))
+    a = learn_network(inputs, targets, LearnConfig(hidden=8, max_epochs=20, seed=5))
+    b = learn_network(inputs, targets, LearnConfig(hidden=8, max_epochs=20, seed=5))
     np.testing.assert_array_equal(predict(a.model, inputs), predict(b.model, inputs))
 
 
 def test_predictions_saturate_to_the_target_range():
     rng = np.random.default_rng(4)
     inputs = rng.normal(size=(100, 5))
-    result = train(inputs, rng.uniform(0, 1, (100, 2)), LearnConfig(hidden=4, max_epochs=5))
+    result = learn_network(inputs, rng.uniform(0, 1, (100, 2)), LearnConfig(hidden=4, max_epochs=5))
     out = predict(result.model, 1e3 * inputs)
     assert out.min() >= 0.0 and out.max() <= 1.0
 
@@ -78,5 +85,5 @@ def test_the_conjugate_gradient_learns_the_same_map():
     rng = np.random.default_rng(6)
     targets = rng.uniform(0, 1, (300, 2))
     inputs = targets @ rng.normal(size=(2, 40)) + 1e-4 * rng.normal(size=(300, 40))
-    result = train(inputs, targets, LearnConfig(hidden=20, components=6, optimizer="cg"))
+    result = learn_network(inputs, targets, LearnConfig(hidden=20, components=6, optimizer="cg"))
     assert result.test_mse < 1e-3

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from ema.estimate.physics.eta_search import ETA_O_SEARCH, GRID_POINTS, REFINEMENTS, fitted_terms, solve
+from ema.estimate.physics.eta_search import ETA_O_SEARCH, GRID_POINTS, REFINEMENTS, solve, solved_terms
 from ema.model.params import eta_a_from_eta_o
 
 GEAR = 500.0
@@ -27,7 +27,7 @@ def plain_profile(stats, eta_o, nuisances):
     if not nuisances:
         fdj = cross[..., 0] / np.maximum(s[..., -1, -1], 1.0)
         return fdj[..., None], uu - fdj * cross[..., 0]
-    used = fitted_terms(stats, nuisances)[:, None, :]
+    used = solved_terms(stats, nuisances)[:, None, :]
     both = used[..., :, None] & used[..., None, :]
     gram = np.where(both, stats[:, free][:, :, free][:, None], 0.0)
     diagonal = np.where(used, np.diagonal(gram, axis1=-2, axis2=-1) * (1.0 + 1e-12), 1.0)
@@ -85,5 +85,5 @@ def test_it_finds_the_truth_and_the_offset():
 
 def test_an_offset_a_one_way_window_cannot_tell_gets_zero():
     stats = sums(np.random.default_rng(4), 0.05, 0.8, ("offset",), one_way=True)[None]
-    assert not fitted_terms(stats, ("offset",))[0, 1]
+    assert not solved_terms(stats, ("offset",))[0, 1]
     assert solve(stats, GEAR, ("offset",))[0][0, 1] == 0.0

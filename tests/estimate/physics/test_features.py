@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 
 from ema.estimate.physics.features import as_read, bin_means, features
-from ema.estimate.physics.friction import fit_friction
+from ema.estimate.physics.friction import solve_friction
 from ema.kinds.rotary.synthetic import synthetic_window
 from ema.model.actuator import THESIS
 from ema.model.checks import InputError
@@ -47,9 +47,9 @@ def test_reading_the_hinge_along_the_deflection_lowers_the_fit_error_on_foreign_
         batch = [noisy(dict(signals), np.random.default_rng(k), 1.0) for k in range(40)]
         stacked = {name: np.stack([b[name] for b in batch]) for name in signals}
         for label, read in (("logged", stacked), ("read", as_read(stacked, 10_000.0))):
-            fit = fit_friction(read, 10_000.0, drive=THESIS.params)
+            solution = solve_friction(read, 10_000.0, drive=THESIS.params)
             # η_O in FDJ units of range (0.30 against 0.02 N·m)
-            error = np.hypot(fit.fdj_nm - clean.truth["FDJ"], (fit.eta_o - clean.truth["eta_O"]) / 15)
+            error = np.hypot(solution.fdj_nm - clean.truth["FDJ"], (solution.eta_o - clean.truth["eta_O"]) / 15)
             squares[label].append(np.mean(error**2))
     ratios = np.sqrt(np.array(squares["read"]) / np.array(squares["logged"]))
     assert np.all(ratios < 1.0), ratios

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from ema.estimate.physics.features import as_read
-from ema.estimate.physics.friction import fit_window
+from ema.estimate.physics.friction import solve_window
 from ema.estimate.physics.noise_reading import noise_of, robust_variance, second_difference_variances
 from ema.estimate.physics.scenario import scenario_from_window
 from ema.estimate.simulate.dataset import simulate_noisy
@@ -21,7 +21,7 @@ SENSORS = ("position_deg", "motor_speed_radps", "current_a", "hinge_moment_nm")
 def _measured_and_realized(seed: int, family: str, widths: dict[str, int]):
     d = draw(seed, family, filter_samples=widths)
     window = window_from_dict(d.document)
-    physics = fit_window(as_read(window.signals, RATE), RATE, drive=THESIS.params)
+    physics = solve_window(as_read(window.signals, RATE), RATE, drive=THESIS.params)
     at = HealthParams.single(fdj_nm=float(physics.fdj_nm[0]), eta_o=float(physics.eta_o[0]))
     scenario = scenario_from_window(window, drive=THESIS.params, hinge=THESIS.hinge)
     measured = simulate_noisy(scenario, at, window, at, seed=0, clean_last=1).noise  # read against the clean lane

@@ -8,7 +8,7 @@ import pytest
 
 from benchmarks.foreign_groups import group_seed, groups
 from ema.estimate.physics.features import as_read
-from ema.estimate.physics.friction import fit_window
+from ema.estimate.physics.friction import solve_window
 from ema.estimate.prepare.conditioning import Prepared, conditioning_done, conditioning_notes, prepare, widened
 from ema.estimate.prepare.stale import MIN_STALE_SAMPLES, equal_runs, stale_runs
 from ema.estimate.report import share_of_range
@@ -25,9 +25,9 @@ def _physics(document: dict) -> tuple[dict[str, float], dict[str, float], Prepar
     """Eq. 5.1's answer to the window as prepared, its stds widened by what conditioning left open."""
     prepared = prepare(window_from_dict(document), actuator=THESIS)
     w = prepared.window
-    fitted = fit_window(as_read(w.signals, w.sample_rate_hz), w.sample_rate_hz, prepared.drive_as_read)
-    stds = widened({"FDJ": float(fitted.fdj_std_nm[0]), "eta_O": float(fitted.eta_o_std[0])}, prepared)
-    return {"FDJ": float(fitted.fdj_nm[0]), "eta_O": float(fitted.eta_o[0])}, stds, prepared
+    solved = solve_window(as_read(w.signals, w.sample_rate_hz), w.sample_rate_hz, prepared.drive_as_read)
+    stds = widened({"FDJ": float(solved.fdj_std_nm[0]), "eta_O": float(solved.eta_o_std[0])}, prepared)
+    return {"FDJ": float(solved.fdj_nm[0]), "eta_O": float(solved.eta_o[0])}, stds, prepared
 
 
 def _fault(seed: int) -> Fault:

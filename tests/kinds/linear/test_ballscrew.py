@@ -9,7 +9,7 @@ import pytest
 
 from ema.kinds import estimate
 from ema.kinds.linear.calibration_report import calibrate_linear
-from ema.kinds.linear.drive_fit import MIN_Z, read_run
+from ema.kinds.linear.drive_calibration import MIN_Z, read_run
 from ema.model.actuator import read_actuator
 from ema.model.checks import InputError
 from ema.model.logmap import read_logmap, read_mapped

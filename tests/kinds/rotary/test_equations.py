@@ -44,7 +44,7 @@ def test_the_tied_base_holds_eq_3_4_near_the_windows_efficiency(gear_ratio, eta_
     sits, reproduces it with k_opp as its load coefficient."""
     from dataclasses import replace
 
-    from ema.kinds.rotary.fitting import score
+    from ema.kinds.rotary.fold_scores import score
     from ema.model.params import load_factors
 
     rng = np.random.default_rng(7)
@@ -54,6 +54,6 @@ def test_the_tied_base_holds_eq_3_4_near_the_windows_efficiency(gear_ratio, eta_
     base = np.column_stack([np.ones(e.m), a, o])
     tied = replace(e, y=0.05 + k_aid * a + k_opp * o, base=base, gear_ratio=gear_ratio)
     design, fixed = tied.tied
-    fit = score(design, tied.y - fixed, e.folds)
-    assert np.sqrt(fit.rss / e.m) < 1e-4 * 0.05
-    assert fit.beta[1] == pytest.approx(k_opp, rel=1e-3)
+    solution = score(design, tied.y - fixed, e.folds)
+    assert np.sqrt(solution.rss / e.m) < 1e-4 * 0.05
+    assert solution.beta[1] == pytest.approx(k_opp, rel=1e-3)

@@ -125,19 +125,20 @@ def test_the_budget_counts_every_closed_loop_a_calibration_runs(monkeypatch):
     )
 
 
-def test_a_constant_the_twins_give_no_finite_read_of_keeps_the_fits_value(monkeypatch):
-    """The simulator's constants are the fit's moved by the fit's bias on the twins; where a twin's fit reads no
-    finite number (a closed loop that could not follow), the fit's value stands rather than a NaN in the document."""
+def test_a_constant_the_twins_give_no_finite_read_of_keeps_the_solved_value(monkeypatch):
+    """The simulator's constants are the stacked solution's moved by its bias on the twins; where a twin's solution
+    reads no finite number (a closed loop that could not follow), the solved value stands rather than a NaN in the
+    document."""
     from types import SimpleNamespace
 
-    import ema.kinds.servo.fold_fit as servo_fit
+    import ema.kinds.servo.stacked_solve as stacked_solve
 
     reads = {"fdj_n": float("nan"), "mass_kg": 94.0, "position_friction_p1_n": 0.0}
-    monkeypatch.setattr(servo_fit, "_simulated", lambda p, *rest: p)
-    monkeypatch.setattr(servo_fit, "problem", lambda prepared, model: None)
-    monkeypatch.setattr(servo_fit, "fitted", lambda p: SimpleNamespace(values=reads))
+    monkeypatch.setattr(stacked_solve, "_simulated", lambda p, *rest: p)
+    monkeypatch.setattr(stacked_solve, "problem", lambda prepared, model: None)
+    monkeypatch.setattr(stacked_solve, "solved", lambda p: SimpleNamespace(values=reads))
     values = {"fdj_n": 20.0, "mass_kg": 95.0, "position_friction_p1_n": 1.0}
-    assert servo_fit.simulator_frame([None], values, {}) == {
+    assert stacked_solve.simulator_frame([None], values, {}) == {
         "fdj_n": 20.0,
         "mass_kg": 96.0,
         "position_friction_p1_n": 1.0,

@@ -9,7 +9,7 @@ import pytest
 
 from ema.estimate.documents import STAGES
 from ema.kinds import estimate
-from ema.kinds.servo.inverse import fit_inverse, inverse_columns
+from ema.kinds.servo.inverse import inverse_columns, solve_inverse
 from ema.kinds.servo.log_reading import completed, log_loop, prepare_servo
 from ema.model.actuator import actuator_from_dict, read_actuator
 from ema.model.checks import InputError
@@ -69,12 +69,12 @@ def test_an_offset_is_compared_with_its_nominal_in_its_unit_not_in_percent():
 
 def test_the_physics_stage_reproduces_the_benchmarks_identification(emps):
     prepared = prepare_servo(emps, read_actuator(EMPS / "actuator.json"))
-    fit = fit_inverse(prepared.force_n, inverse_columns(prepared.motion), prepared.motion)
+    solution = solve_inverse(prepared.force_n, inverse_columns(prepared.motion), prepared.motion)
     published = {"mass_kg": 95.1089, "viscous_ns_per_m": 203.5034, "fdj_n": 20.3935, "offset_n": -3.1648}
     tolerance = {"mass_kg": 0.01, "viscous_ns_per_m": 0.02, "fdj_n": 0.02, "offset_n": 0.05}
     for name, value in published.items():  # its IDIM-LS, less the filters' end transients and the rests
-        assert fit.values[name] == pytest.approx(value, rel=tolerance[name])
-    assert fit.error_pct == pytest.approx(4.08, abs=0.1)
+        assert solution.values[name] == pytest.approx(value, rel=tolerance[name])
+    assert solution.error_pct == pytest.approx(4.08, abs=0.1)
     assert prepared.loop.resolution_m == pytest.approx(5e-8, rel=1e-3)  # the encoder's step, read from the log
 
 

@@ -40,11 +40,11 @@ from typing import Literal
 import numpy as np
 
 from ema.estimate.documents import Note
-from ema.estimate.physics.features import fit_as_read
+from ema.estimate.physics.features import solve_as_read
 from ema.estimate.prepare.consistency import STEP_LAGS_S
 from ema.estimate.prepare.departures.aircraft_band import BAND_S, band_noise_variance, band_part
 from ema.estimate.prepare.departures.drive_constants import BESIDE
-from ema.estimate.prepare.departures.hinge_gain import divided_hinge, free_load_fit
+from ema.estimate.prepare.departures.hinge_gain import divided_hinge, free_load_solution
 from ema.estimate.stats import JACKKNIFE_BLOCKS, jackknife_std
 from ema.model.actuator import Airframe
 from ema.model.aircraft import HingeGeometry
@@ -56,7 +56,7 @@ from ema.model.window import Window
 TOLERANCE = Airframe.model_fields["tolerance"].default  # how far the airframe's C_hδ may be off: the document's default
 DEPART_STDS = 2.0  # stds beyond the tolerance by which a ratio departs: the gauge is off by it
 SUSPECT_STDS = 1.0  # stds beyond the tolerance by which a ratio puts the gauge in doubt
-FIT_STDS = 2.0  # a ratio read at another lag fits within the tolerance and this many stds ...
+SOLUTION_STDS = 2.0  # a ratio read at another lag fits within the tolerance and this many stds ...
 STEP_UNEXPLAINED = 0.75  # ... and leaves under this share of what lag 0 leaves unexplained
 GROSS = (0.5, 2.0)  # no gauge's calibration nor hinge coefficient is off beyond these
 GROSS_STDS = 4.0
@@ -180,7 +180,7 @@ def lag_against_aircraft(
     tolerance: float = TOLERANCE,
 ) -> tuple[float, AircraftCheck, float] | None:
     """The lag of ``STEP_LAGS_S`` [s] the moment read that much later fits the aircraft's at (within the
-    tolerance and ``FIT_STDS``) leaving the least of what lag 0 leaves unexplained (1 − correlation²),
+    tolerance and ``SOLUTION_STDS``) leaving the least of what lag 0 leaves unexplained (1 − correlation²),
     under ``STEP_UNEXPLAINED`` of it; its reading and that share. None where no lag does."""
     found = None
     for lag_s in STEP_LAGS_S:
@@ -191,7 +191,7 @@ def lag_against_aircraft(
         at_lag = AircraftCheck(value / per_deg, std / abs(per_deg), tolerance=tolerance)
         unexplained = (1.0 - at_correlation**2) / max(1.0 - correlation**2, 1e-12)
         best = STEP_UNEXPLAINED if found is None else found[2]
-        if at_lag.readable and not at_lag.beyond(FIT_STDS) and unexplained < best:
+        if at_lag.readable and not at_lag.beyond(SOLUTION_STDS) and unexplained < best:
             found = lag / rate, at_lag, unexplained
     return found
 
@@ -212,9 +212,9 @@ def banded(read: AircraftCheck, window: Window, gain: float, drive: DriveConstan
     if gain != 1.0 or read.factor == 1.0 or not read.beyond(SUSPECT_STDS):
         return read
     band = math.hypot(read.tolerance, read.ratio_std / read.ratio)
-    fitted = free_load_fit(window, drive, BESIDE)
-    if fitted is not None:
-        own, own_std = float(fitted[0][0]), float(jackknife_std(fitted[0][None, 1:])[0])
+    solved = free_load_solution(window, drive, BESIDE)
+    if solved is not None:
+        own, own_std = float(solved[0][0]), float(jackknife_std(solved[0][None, 1:])[0])
         if np.isfinite(own) and own_std > 0.0 and abs(own - 1.0) <= 2.0 * own_std:
             band = 1.0 / math.hypot(1.0 / band, 1.0 / own_std)
     return replace(read, spread=_moved(window, drive, 1.0 - band, 1.0 + band, 0.5))
@@ -223,7 +223,7 @@ def banded(read: AircraftCheck, window: Window, gain: float, drive: DriveConstan
 def _moved(window: Window, drive: DriveConstants, first: float, second: float, share: float) -> dict[str, float]:
     """``share`` of how far FDJ and η_O of Eq. 5.1's fit move between the hinge moment divided by
     ``first`` and by ``second``."""
-    ends = [fit_as_read(divided_hinge(window, g).signals, window.sample_rate_hz, drive) for g in (first, second)]
+    ends = [solve_as_read(divided_hinge(window, g).signals, window.sample_rate_hz, drive) for g in (first, second)]
     return {
         "FDJ": share * abs(float(ends[1].fdj_nm[0] - ends[0].fdj_nm[0])),
         "eta_O": share * abs(float(ends[1].eta_o[0] - ends[0].eta_o[0])),

@@ -32,8 +32,8 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ema.estimate.documents import Note
-from ema.estimate.physics.features import fit_as_read
-from ema.estimate.physics.friction import FitSettings, FrictionFit
+from ema.estimate.physics.features import solve_as_read
+from ema.estimate.physics.friction import FrictionSolution, SolveSettings
 from ema.estimate.prepare.departures.zero_offset import equation_z, log_likelihood_ratio
 from ema.estimate.stats import DECISIVE_Z
 from ema.model.checks import InputError
@@ -42,7 +42,7 @@ from ema.model.window import Window
 
 ITERATIONS = 3  # refits of the corrected window at most: each settles what the peak torque's cut left
 SETTLED = 0.01  # of the constant's std: what a refit may leave
-BESIDE = FitSettings(offset=True, viscous=True)  # what each constant is fitted beside
+BESIDE = SolveSettings(offset=True, viscous=True)  # what each constant is fitted beside
 FIELDS = {"torque_scale": "torque_scale", "inertia": "inertia_kgm2"}  # the fit's nuisance -> the field it reads
 # Beyond these no drive runs (γ: k_T from −55 to 125 °C and a sensor's gain; ΔJ: of J_M): a read past them
 # is something else the model lacks, which the fit check reports.
@@ -92,7 +92,7 @@ class DriveReading:
         """The actuator the window's T_R is reconstructed with: the document's, its J_M as read."""
         return replace(self.spec, inertia_kgm2=self.spec.inertia_kgm2 + self.inertia_kgm2)
 
-    def added(self, left: FrictionFit) -> DriveReading:
+    def added(self, left: FrictionSolution) -> DriveReading:
         """These constants with what a fit of the corrected window left of them."""
         scale = self.torque_factor * (1.0 + float(left.term("torque_scale")[0])) - 1.0
         return replace(self, torque_scale=scale, inertia_kgm2=self.inertia_kgm2 + float(left.term("inertia")[0]))
@@ -104,8 +104,8 @@ class DriveReading:
         return replace(window, signals=dict(window.signals, current_a=self.torque_factor * window.signals["current_a"]))
 
 
-def _fit(window: Window, drive: DriveConstants, settings: FitSettings) -> FrictionFit:
-    return fit_as_read(window.signals, window.sample_rate_hz, drive, settings)
+def _solve(window: Window, drive: DriveConstants, settings: SolveSettings) -> FrictionSolution:
+    return solve_as_read(window.signals, window.sample_rate_hz, drive, settings)
 
 
 def read_drive_constants(window: Window, drive: DriveConstants) -> DriveReading:
@@ -113,8 +113,8 @@ def read_drive_constants(window: Window, drive: DriveConstants) -> DriveReading:
     both do, the likelier if the window decides (``DECISIVE``); else γ, with ΔJ beside it as the
     ``alternative`` (``ema.estimate.prepare.departures.read`` replays both, or widens the stds by their gap)."""
     rate = window.sample_rate_hz
-    plain = _fit(window, drive, BESIDE)
-    alone = {name: _fit(window, drive, replace(BESIDE, **{name: True})) for name in FIELDS}
+    plain = _solve(window, drive, BESIDE)
+    alone = {name: _solve(window, drive, replace(BESIDE, **{name: True})) for name in FIELDS}
     gamma = beyond_any_motor(plain, alone["torque_scale"], rate)
     refusal = no_drive_error(gamma, alone["inertia"], drive)
     if refusal is not None:
@@ -126,7 +126,7 @@ def read_drive_constants(window: Window, drive: DriveConstants) -> DriveReading:
 
 
 def _read_constants(
-    window: Window, drive: DriveConstants, plain: FrictionFit, alone: dict[str, FrictionFit]
+    window: Window, drive: DriveConstants, plain: FrictionSolution, alone: dict[str, FrictionSolution]
 ) -> DriveReading:
     rate = window.sample_rate_hz
     found = [name for name in FIELDS if _stands_out(plain, alone[name], name, rate, drive)]
@@ -135,14 +135,14 @@ def _read_constants(
         return DriveReading(spec=drive)
     if len(readings) == 1:
         return _with_spread(window, next(iter(readings.values()))[0])
-    (scale, scale_fit), (inertia, inertia_fit) = readings["torque_scale"], readings["inertia"]
-    ratio = log_likelihood_ratio(scale_fit, inertia_fit, rate)  # for the inertia
+    (scale, scale_solution), (inertia, inertia_solution) = readings["torque_scale"], readings["inertia"]
+    ratio = log_likelihood_ratio(scale_solution, inertia_solution, rate)  # for the inertia
     if ratio >= DECISIVE["inertia"] or ratio <= DECISIVE["torque_scale"]:
         return _with_spread(window, inertia if ratio > 0 else scale)
     return replace(_with_spread(window, scale), alternative=_with_spread(window, inertia))
 
 
-def beyond_any_motor(plain: FrictionFit, scale: FrictionFit, rate: float) -> float:
+def beyond_any_motor(plain: FrictionSolution, scale: FrictionSolution, rate: float) -> float:
     """γ fitted alone (``scale``) where it lies beyond any motor, ``PLAUSIBLE`` by ``SCALE_STDS`` of its std,
     and stands ``DECISIVE_Z`` out; else 0."""
     gamma, std = float(scale.term("torque_scale")[0]), float(scale.term_std("torque_scale")[0])
@@ -150,7 +150,7 @@ def beyond_any_motor(plain: FrictionFit, scale: FrictionFit, rate: float) -> flo
     return gamma if beyond else 0.0
 
 
-def no_drive_error(gamma: float, inertia_alone: FrictionFit, spec: DriveConstants) -> InputError | None:
+def no_drive_error(gamma: float, inertia_alone: FrictionSolution, spec: DriveConstants) -> InputError | None:
     """The error naming the current where Eq. 5.1 balances the window only with a motor torque per k_T·I
     and an inertia no drive has, each fitted alone (``gamma`` from ``beyond_any_motor``; ΔJ, its rival
     where the motor saturates, beyond ``PLAUSIBLE`` too): a current in other units (a tenth: γ = 9). None
@@ -168,7 +168,9 @@ def no_drive_error(gamma: float, inertia_alone: FrictionFit, spec: DriveConstant
     )
 
 
-def unit_story(read: DriveReading, gamma: float, plain: FrictionFit, alone: dict[str, FrictionFit]) -> DriveReading:
+def unit_story(
+    read: DriveReading, gamma: float, plain: FrictionSolution, alone: dict[str, FrictionSolution]
+) -> DriveReading:
     """``read`` with the story of a current in other units weighed in, where γ fitted alone lies beyond any
     motor (``gamma`` from ``beyond_any_motor``) and yet ΔJ reads a drive: a current logged 0.71x (RMS for
     amplitude) reads as a rotor ~0.7x as heavy with other friction, and a rotor 1.3–1.45x as heavy as a
@@ -182,18 +184,20 @@ def unit_story(read: DriveReading, gamma: float, plain: FrictionFit, alone: dict
     return replace(read, unit_scale=gamma, spread=spread)
 
 
-def _stands_out(plain: FrictionFit, alone: FrictionFit, name: str, rate: float, spec: DriveConstants) -> bool:
+def _stands_out(plain: FrictionSolution, alone: FrictionSolution, name: str, rate: float, spec: DriveConstants) -> bool:
     """The fit with constant ``name`` explains the window ``DECISIVE_Z`` stds better, read within ``PLAUSIBLE``."""
     relative = float(alone.term(name)[0]) / (spec.inertia_kgm2 if name == "inertia" else 1.0)
     return bool(
         np.isfinite(relative)
-        and alone.term_std(name)[0] > 0  # else the window cannot tell it from FDJ (``eta_search.fitted_terms``)
+        and alone.term_std(name)[0] > 0  # else the window cannot tell it from FDJ (``eta_search.solved_terms``)
         and abs(relative) < PLAUSIBLE[name]
         and equation_z(plain, alone, rate) > DECISIVE_Z
     )
 
 
-def _reading(window: Window, drive: DriveConstants, name: str, first: FrictionFit) -> tuple[DriveReading, FrictionFit]:
+def _reading(
+    window: Window, drive: DriveConstants, name: str, first: FrictionSolution
+) -> tuple[DriveReading, FrictionSolution]:
     """Constant ``name``, refitted on the corrected window until nothing is left, its std ΔJ's with the
     kernel's (``kernel_inertia_std``); and the last fit (its likelihood)."""
     settings, std = replace(BESIDE, **{name: True}), float(first.term_std(name)[0])
@@ -201,7 +205,7 @@ def _reading(window: Window, drive: DriveConstants, name: str, first: FrictionFi
     read, left = DriveReading(spec=drive, stds={FIELDS[name]: float(np.hypot(std, kernel))}), first
     for _ in range(ITERATIONS + 1):
         read = read.added(left)
-        left = _fit(read.corrected(window), read.drive_as_read, settings)
+        left = _solve(read.corrected(window), read.drive_as_read, settings)
         if abs(float(left.term(name)[0])) < SETTLED * std:  # ΔJ is linear: settled at once; γ within a few
             break
     return read, left
@@ -213,8 +217,8 @@ def kernel_inertia_std(rate_hz: float, spec: DriveConstants) -> float:
 
 
 def _plain(window: Window, read: DriveReading) -> dict[str, float]:
-    fitted = _fit(read.corrected(window), read.drive_as_read, FitSettings())
-    return {name: float(value) for name, value in fitted.values().items()}
+    solved = _solve(read.corrected(window), read.drive_as_read, SolveSettings())
+    return {name: float(value) for name, value in solved.values().items()}
 
 
 def _with_spread(window: Window, read: DriveReading) -> DriveReading:

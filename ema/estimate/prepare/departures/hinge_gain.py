@@ -4,7 +4,7 @@ calibrated off, or a log in lbf·ft taken for N·m.
 Eq. 5.1 reads the load as t = FDJ + k_aid·a + k_opp·o, with k_aid = 1 − η_A and k_opp = 1/η_O − 1
 over the aiding and opposing |T_ext| (``ema.estimate.physics.friction``), η_A tied to η_O by Eq. 3.4. A
 hinge moment logged g times the true one puts (g − 1)·H/n into T_R and g into a and o, so the window
-holds c_aid = 1 − η_A/g and c_opp = 1/(g·η_O) − 1 instead. Fitted freely (both are linear), they
+holds c_aid = 1 − η_A/g and c_opp = 1/(g·η_O) − 1 instead. Solved freely (both are linear), they
 give η_A·η_O = (1 − c_aid)/(1 + c_opp), whence η_O by Eq. 3.4 (a quadratic), and
 g = 1/((1 + c_opp)·η_O). Read with g = 1, a gain is η_O's twin in the constrained fit.
 
@@ -28,8 +28,8 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ema.estimate.documents import Note
-from ema.estimate.physics.features import as_read, fit_as_read
-from ema.estimate.physics.friction import MIN_SLIDING_KERNELS, FitSettings, nuisance_columns, regressors
+from ema.estimate.physics.features import as_read, solve_as_read
+from ema.estimate.physics.friction import MIN_SLIDING_KERNELS, SolveSettings, nuisance_columns, regressors
 from ema.estimate.prepare.departures.drive_constants import BESIDE, FIELDS
 from ema.estimate.stats import DECISIVE_Z, JACKKNIFE_BLOCKS, jackknife_std, rms, rms_log_likelihood_ratio
 from ema.model.params import DriveConstants
@@ -71,8 +71,8 @@ def eta_o_from_product(product: np.ndarray, gear: float) -> np.ndarray:
         return (-b + np.sqrt(discriminant)) / (4 * n**2)
 
 
-def free_load_fit(
-    window: Window, drive: DriveConstants, beside: FitSettings = FitSettings()
+def free_load_solution(
+    window: Window, drive: DriveConstants, beside: SolveSettings = SolveSettings()
 ) -> tuple[np.ndarray, float, int] | None:
     """The least squares of t on (1, a, o) and ``beside``'s nuisance columns over the sliding samples: g
     from the whole window and from each jackknife block left out ((B + 1,), the whole first), the RMS
@@ -94,25 +94,25 @@ def free_load_fit(
     return 1.0 / ((1 + betas[:, 2]) * eta_o), misfit, used
 
 
-def _margin(window: Window, drive: DriveConstants, free_rms: float, used: int, rivals: list[FitSettings]) -> float:
+def _margin(window: Window, drive: DriveConstants, free_rms: float, used: int, rivals: list[SolveSettings]) -> float:
     """ln LR by which the free load fit explains ``window`` better than the best of Eq. 5.1's fits with
     g = 1 and ``rivals``' terms (−inf where one cannot be compared)."""
     rate = window.sample_rate_hz
-    fits = [fit_as_read(window.signals, rate, drive, rival) for rival in rivals]
-    best = min(float(fit.residual_rms_nm[0]) for fit in fits)
+    solutions = [solve_as_read(window.signals, rate, drive, rival) for rival in rivals]
+    best = min(float(solution.residual_rms_nm[0]) for solution in solutions)
     if not (np.isfinite(best) and free_rms > 0):
         return -np.inf
-    return rms_log_likelihood_ratio(best, free_rms, used, rate, resolution_nm=float(fits[0].resolution_nm[0]))
+    return rms_log_likelihood_ratio(best, free_rms, used, rate, resolution_nm=float(solutions[0].resolution_nm[0]))
 
 
 def read_hinge_gain(window: Window, drive: DriveConstants, leading: bool = False) -> HingeGain:
     """g where it stands out and is plausible (module docstring), with FDJ's and η_O's change across g ± its
     std; ``leading``: only where it also explains the window ``DECISIVE`` (ln LR) better than γ or ΔJ alone,
     each beside an offset and ΔC, to be read before them (which would each take a part of it)."""
-    fitted = free_load_fit(window, drive, BESIDE)
-    if fitted is None:
+    solved = free_load_solution(window, drive, BESIDE)
+    if solved is None:
         return HingeGain()
-    gain, free_rms, used = fitted
+    gain, free_rms, used = solved
     plausible = np.all(np.isfinite(gain)) and PLAUSIBLE[0] <= gain[0] <= PLAUSIBLE[1]
     if not (plausible and abs(gain[0] - 1.0) >= MIN_CHANGE):
         return HingeGain()
@@ -123,7 +123,9 @@ def read_hinge_gain(window: Window, drive: DriveConstants, leading: bool = False
         return HingeGain()
     std = float(jackknife_std(gain[None, 1:])[0])
     rate = window.sample_rate_hz
-    low, high = (fit_as_read(HingeGain(float(gain[0]) + d).corrected(window).signals, rate, drive) for d in (-std, std))
+    low, high = (
+        solve_as_read(HingeGain(float(gain[0]) + d).corrected(window).signals, rate, drive) for d in (-std, std)
+    )
     spread = {
         "FDJ": abs(float(high.fdj_nm[0] - low.fdj_nm[0])) / 2,
         "eta_O": abs(float(high.eta_o[0] - low.eta_o[0])) / 2,

@@ -24,7 +24,7 @@ from functools import cached_property
 import numpy as np
 
 from ema.estimate.documents import Note
-from ema.estimate.physics.features import fit_as_read
+from ema.estimate.physics.features import solve_as_read
 from ema.estimate.physics.noise_reading import white_noise_std
 from ema.estimate.physics.scenario import CLEAR_MARGIN, following_error, inside, scenario_from_window
 from ema.estimate.prepare.departures.aircraft_check import AircraftCheck, banded, divided_out
@@ -71,8 +71,8 @@ class Departures:
     @cached_property
     def answer(self) -> dict[str, float]:
         """FDJ and η_O of Eq. 5.1's fit of the window as read (fitted once: the tie-break and the stds ask)."""
-        fitted = fit_as_read(self.window.signals, self.window.sample_rate_hz, self.drive_as_read)
-        return {name: float(value) for name, value in fitted.values().items()}
+        solved = solve_as_read(self.window.signals, self.window.sample_rate_hz, self.drive_as_read)
+        return {name: float(value) for name, value in solved.values().items()}
 
 
 def read_departures(

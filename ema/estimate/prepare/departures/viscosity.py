@@ -3,7 +3,7 @@
 The document fixes C_M; a grease's viscosity is not fixed (it grows several-fold in the cold), and
 an excess ΔC·|ω| left in the residual is read as friction. Where a window slides at one speed the
 two are twins, but most windows slide across 100–600 rad/s (the accelerations to and from slew),
-and there ΔC is fitted beside FDJ (``FitSettings(viscous=True)``).
+and there ΔC is fitted beside FDJ (``SolveSettings(viscous=True)``).
 
 Freeing C costs FDJ precision where C is right, so a change is read only where it stands
 ``DECISIVE_Z`` stds out and is ``MIN_CHANGE`` of the document's C or more. Then every estimator of
@@ -29,7 +29,7 @@ import numpy as np
 
 from ema.estimate.documents import Note
 from ema.estimate.physics.features import as_read
-from ema.estimate.physics.friction import FitSettings, fit_friction
+from ema.estimate.physics.friction import SolveSettings, solve_friction
 from ema.estimate.prepare.departures.drive_constants import UNDECIDED_SHARE
 from ema.estimate.stats import DECISIVE_Z, UNDECIDED_NOTE_WEIGHT, UNDECIDED_PRIOR_LOG_ODDS, odds_weight
 from ema.model.effects import EffectSet
@@ -44,13 +44,13 @@ READ_ERROR_OF_C = 0.025
 # carry a C this share of the document's off, either way (the spread of C over a fleet a third of it cold).
 UNSEEN_SHARE = 0.3
 CHANGE_BOUNDS_NMS = (-5e-5, 5e-3)  # what the simulator's viscous effect accepts (``ema.model.effects``)
-VISCOUS_FIT = FitSettings(offset=True, viscous=True)
+VISCOUS_SOLVE = SolveSettings(offset=True, viscous=True)
 # A change that stands out is fitted again beside a scale of the motor torque: at the drive's top speed the
 # speed falls as the load grows, so C·|ω| follows the load, and a current read a few per cent high (which scales
 # the aiding and the opposing load's share alike, against Eq. 3.4) reads as a viscous change. Where it no longer
 # stands out there, the window cannot tell the two: C stays the document's, and the stds carry
 # ``UNDECIDED_SHARE`` of what reading the change would move.
-BESIDE_A_GAIN = FitSettings(offset=True, viscous=True, torque_scale=True)
+BESIDE_A_GAIN = SolveSettings(offset=True, viscous=True, torque_scale=True)
 # the prior odds of "C is off" where the change does not stand out, and the note's weight (as step_lag's)
 PRIOR_LOG_ODDS, NOTE_WEIGHT = UNDECIDED_PRIOR_LOG_ODDS, UNDECIDED_NOTE_WEIGHT
 
@@ -92,8 +92,8 @@ def read_viscosity(window: Window, spec: DriveConstants) -> Viscosity:
     with what the change the window leans to would move them, by its weight (module docstring)."""
     rate = window.sample_rate_hz
     seen = as_read(window.signals, rate)
-    fitted = fit_friction(seen, rate, spec, VISCOUS_FIT)
-    change, std = float(fitted.term("viscous")[0]), float(fitted.term_std("viscous")[0])
+    solved = solve_friction(seen, rate, spec, VISCOUS_SOLVE)
+    change, std = float(solved.term("viscous")[0]), float(solved.term_std("viscous")[0])
     if not (np.isfinite(change) and std > 0):  # the speed hardly varies: C·|ω| is FDJ's twin
         return _unseen(seen, rate, spec)
     stands_out = abs(change) > max(DECISIVE_Z * std, MIN_CHANGE * spec.viscous_nms)
@@ -101,7 +101,7 @@ def read_viscosity(window: Window, spec: DriveConstants) -> Viscosity:
     if not stands_out:
         return _leaning(seen, rate, spec, change, std)
     change = float(np.clip(change, *CHANGE_BOUNDS_NMS))
-    beside = fit_friction(seen, rate, spec, BESIDE_A_GAIN)
+    beside = solve_friction(seen, rate, spec, BESIDE_A_GAIN)
     if not abs(float(beside.term("viscous")[0])) > DECISIVE_Z * float(beside.term_std("viscous")[0]):
         return _gain_alike(seen, rate, spec, change)
     return Viscosity(change, std, _half_change(seen, rate, spec, change, std), spec.viscous_nms)
@@ -119,8 +119,8 @@ def _targets_at(
     seen: dict[str, np.ndarray], rate: float, spec: DriveConstants, changes: tuple[float, ...]
 ) -> list[dict[str, float]]:
     """FDJ and η_O read with the document's C plus each change."""
-    fits = (fit_friction(seen, rate, replace(spec, viscous_nms=spec.viscous_nms + d)) for d in changes)
-    return [{name: float(value) for name, value in fit.values().items()} for fit in fits]
+    solutions = (solve_friction(seen, rate, replace(spec, viscous_nms=spec.viscous_nms + d)) for d in changes)
+    return [{name: float(value) for name, value in solution.values().items()} for solution in solutions]
 
 
 def _half_change(

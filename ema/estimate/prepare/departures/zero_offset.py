@@ -4,7 +4,7 @@ A strain gauge drifts with temperature, a Hall current sensor has an offset; eit
 constant c beyond friction (k_T·i₀ from the current, b/n from the hinge moment), which Eq. 5.1's
 t = sgn(ω)(T_R − C·ω) reads as c·sgn(ω): friction, unless it is taken off.
 
-With motion both ways c·sgn(ω) is told from FDJ, so it is fitted beside it (``FitSettings(offset=
+With motion both ways c·sgn(ω) is told from FDJ, so it is fitted beside it (``SolveSettings(offset=
 True)``) and read where the fit with it explains the window ``DECISIVE_Z`` stds better than the fit
 without (the likelihood ratio of their equation errors, ``equation_z``). The offset's own jackknife
 std is no test: where one direction's samples gather in a few time blocks, leaving those out leaves
@@ -33,8 +33,8 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ema.estimate.documents import Note
-from ema.estimate.physics.features import fit_as_read
-from ema.estimate.physics.friction import FitSettings, FrictionFit
+from ema.estimate.physics.features import solve_as_read
+from ema.estimate.physics.friction import FrictionSolution, SolveSettings
 from ema.estimate.stats import DECISIVE_Z, odds_weight, rms_log_likelihood_ratio
 from ema.model.params import DriveConstants
 from ema.model.window import Window
@@ -49,7 +49,7 @@ UNSEEN_CURRENT_OFFSET_A = 0.05
 # Refits of a sensor's offset: the hinge moment's moves |H − b| (each refit cuts what is left by ~k), the
 # current's is lost where k_T·I meets the motor's peak torque (worn windows saturate more, and need more refits).
 ITERATIONS = 4
-OFFSET_FIT = FitSettings(offset=True)
+OFFSET_SOLVE = SolveSettings(offset=True)
 
 
 @dataclass(frozen=True)
@@ -89,25 +89,25 @@ def sensor_offset(
     per_nm = drive.gear_ratio if sensor == "hinge_nm" else 1.0 / drive.torque_constant_nm_per_a
     offset = per_nm * torque_nm
     for _ in range(ITERATIONS):
-        left = fit_as_read(_shifted(signals, **{sensor: offset}), rate, drive, OFFSET_FIT).term("offset")[0]
+        left = solve_as_read(_shifted(signals, **{sensor: offset}), rate, drive, OFFSET_SOLVE).term("offset")[0]
         if not np.isfinite(left):
             break
         offset += per_nm * float(left)
     return offset
 
 
-def log_likelihood_ratio(worse: FrictionFit, better: FrictionFit, rate: float) -> float:
+def log_likelihood_ratio(worse: FrictionSolution, better: FrictionSolution, rate: float) -> float:
     """ln of the likelihood ratio of two fits of one window by their equation errors (``rms_log_likelihood_ratio``)."""
     errors, used = (float(worse.residual_rms_nm[0]), float(better.residual_rms_nm[0])), float(worse.n_sliding[0])
     return rms_log_likelihood_ratio(*errors, used, rate, resolution_nm=float(worse.resolution_nm[0]))
 
 
-def equation_z(plain: FrictionFit, with_offset: FrictionFit, rate: float) -> float:
+def equation_z(plain: FrictionSolution, with_offset: FrictionSolution, rate: float) -> float:
     """How many stds the offset's fit explains the window better by: √(2·ln LR), as for one parameter."""
     return float(np.sqrt(max(0.0, 2.0 * log_likelihood_ratio(plain, with_offset, rate))))
 
 
-def second_weight(first: FrictionFit, second: FrictionFit, rate: float) -> float:
+def second_weight(first: FrictionSolution, second: FrictionSolution, rate: float) -> float:
     """The weight of the second of two readings of a window against the first: their likelihoods, equal
     odds before."""
     return odds_weight(log_likelihood_ratio(first, second, rate))
@@ -119,7 +119,7 @@ def read_zero_offset(window: Window, drive: DriveConstants, carried: ZeroOffset 
     of the same flight where it is the more precise and holds here (``flight_zero``); where the motion goes
     one way, the carried zero, or the note that none is known."""
     rate, signals = window.sample_rate_hz, dict(window.signals)
-    found = fit_as_read(signals, rate, drive, OFFSET_FIT)
+    found = solve_as_read(signals, rate, drive, OFFSET_SOLVE)
     if float(found.term_std("offset")[0]) == 0.0:  # too little motion the other way (``eta_search.MIN_OFFSET_BALANCE``)
         unseen = UNSEEN_CURRENT_OFFSET_A * drive.torque_constant_nm_per_a
         known = carried or ZeroOffset(zero_std_nm=unseen)
@@ -130,15 +130,17 @@ def read_zero_offset(window: Window, drive: DriveConstants, carried: ZeroOffset 
     return flight_zero(signals, rate, drive, carried, own)
 
 
-def own_reading(signals: dict[str, np.ndarray], rate: float, drive: DriveConstants, found: FrictionFit) -> ZeroOffset:
+def own_reading(
+    signals: dict[str, np.ndarray], rate: float, drive: DriveConstants, found: FrictionSolution
+) -> ZeroOffset:
     """The offset the window reads itself from ``found``, Eq. 5.1's fit with one (module docstring)."""
     torque, std = float(found.term("offset")[0]), float(found.term_std("offset")[0])
-    if not (np.isfinite(torque) and equation_z(fit_as_read(signals, rate, drive), found, rate) > DECISIVE_Z):
+    if not (np.isfinite(torque) and equation_z(solve_as_read(signals, rate, drive), found, rate) > DECISIVE_Z):
         return ZeroOffset(zero_std_nm=float(np.hypot(std, torque)) if np.isfinite(torque) else 0.0)
     current_a = sensor_offset(signals, rate, torque, "current_a", drive)
     hinge_nm = sensor_offset(signals, rate, torque, "hinge_nm", drive)
-    as_current = fit_as_read(_shifted(signals, current_a=current_a), rate, drive)
-    as_hinge = fit_as_read(_shifted(signals, hinge_nm=hinge_nm), rate, drive)
+    as_current = solve_as_read(_shifted(signals, current_a=current_a), rate, drive)
+    as_hinge = solve_as_read(_shifted(signals, hinge_nm=hinge_nm), rate, drive)
     share = second_weight(as_current, as_hinge, rate)
     apart = {
         "FDJ": float(as_hinge.fdj_nm[0] - as_current.fdj_nm[0]),
@@ -161,7 +163,7 @@ def flight_zero(
 ) -> ZeroOffset:
     """The flight's zero ``carried``, where it holds on this window (taken off, the constant left lies within
     ``HOLDS_Z`` stds of none); else the window's ``own`` reading, with how far the flight's is off."""
-    left = fit_as_read(_shifted(signals, carried.hinge_nm, carried.current_a), rate, drive, OFFSET_FIT)
+    left = solve_as_read(_shifted(signals, carried.hinge_nm, carried.current_a), rate, drive, OFFSET_SOLVE)
     z = abs(float(left.term("offset")[0])) / float(np.hypot(left.term_std("offset")[0], carried.zero_std_nm))
     if not z <= HOLDS_Z:
         return replace(own, unheld_from=carried.carried_from, unheld_z=z)

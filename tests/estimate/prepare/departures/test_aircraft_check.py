@@ -6,7 +6,7 @@ import math
 import numpy as np
 import pytest
 
-from ema.estimate.physics.features import fit_as_read
+from ema.estimate.physics.features import solve_as_read
 from ema.estimate.prepare.conditioning import conditioning_done, prepare, widened
 from ema.estimate.prepare.departures.aircraft_check import (
     DEPART_STDS,
@@ -113,10 +113,10 @@ def test_the_aircrafts_gain_is_divided_out_and_its_band_covers_the_true_moments_
     )
     corrected = read.corrected(slipped)
     read = banded(read, corrected, gain=1.0, drive=THESIS.params)
-    fitted = fit_as_read(corrected.signals, slipped.sample_rate_hz, drive=THESIS.params)
-    answer = fit_as_read(true.signals, true.sample_rate_hz, drive=THESIS.params)
-    assert abs(fitted.eta_o[0] - answer.eta_o[0]) <= 2 * np.hypot(read.spread["eta_O"], fitted.eta_o_std[0])
-    assert abs(fitted.fdj_nm[0] - answer.fdj_nm[0]) <= 2 * np.hypot(read.spread["FDJ"], fitted.fdj_std_nm[0])
+    solved = solve_as_read(corrected.signals, slipped.sample_rate_hz, drive=THESIS.params)
+    answer = solve_as_read(true.signals, true.sample_rate_hz, drive=THESIS.params)
+    assert abs(solved.eta_o[0] - answer.eta_o[0]) <= 2 * np.hypot(read.spread["eta_O"], solved.eta_o_std[0])
+    assert abs(solved.fdj_nm[0] - answer.fdj_nm[0]) <= 2 * np.hypot(read.spread["FDJ"], solved.fdj_std_nm[0])
     assert (
         banded(
             divided_out(check_against_aircraft(slipped, hinge=THESIS.hinge)),
@@ -160,8 +160,8 @@ def test_where_a_short_window_puts_the_gauge_in_doubt_the_stds_reach_the_moment_
             continue
         prepared = prepare(slipped, actuator=THESIS)
         departures = prepared.departures
-        fitted = fit_as_read(departures.window.signals, slipped.sample_rate_hz, departures.drive_as_read)
-        stds = widened({"FDJ": float(fitted.fdj_std_nm[0]), "eta_O": float(fitted.eta_o_std[0])}, prepared)
+        solved = solve_as_read(departures.window.signals, slipped.sample_rate_hz, departures.drive_as_read)
+        stds = widened({"FDJ": float(solved.fdj_std_nm[0]), "eta_O": float(solved.eta_o_std[0])}, prepared)
         answer = prepared.departures.answer
         doubted += 1
         covered += all(abs(answer[name] - drawn.truth[name]) <= 2 * stds[name] for name in stds)

@@ -37,7 +37,7 @@ def test_a_current_sensors_gain_is_read_as_the_inverse_scale(gain):
 
 
 def test_a_lighter_inertia_than_the_specs_is_read_on_its_own_not_as_a_scale():
-    """Fitted alone, γ took up most of a ΔJ (J_M 0.92x read as k_T 1.086x, FDJ then 27 % of range off)."""
+    """Solved alone, γ took up most of a ΔJ (J_M 0.92x read as k_T 1.086x, FDJ then 27 % of range off)."""
     for seed in range(83, 88):
         read = _read(seed, Effects(inertia_factor=0.93))
         assert read.inertia_factor == pytest.approx(0.93, abs=max(3 * read.stds["inertia_kgm2"] / 2.5e-5, 0.002))

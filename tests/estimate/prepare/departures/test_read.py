@@ -5,7 +5,7 @@ import pytest
 from ema.estimate.documents.window_facts import HistoryReadings, InertiaReading
 from ema.estimate.other_windows import known_from
 from ema.estimate.physics.features import as_read
-from ema.estimate.physics.friction import fit_window
+from ema.estimate.physics.friction import solve_window
 from ema.estimate.prepare.conditioning import prepare, widened
 from ema.model.actuator import THESIS
 from ema.model.window import window_from_dict
@@ -19,9 +19,9 @@ def test_where_a_scale_and_an_inertia_cannot_be_told_apart_the_stds_reach_both_e
     prepared = prepare(window_from_dict(drawn.document), actuator=THESIS)
     assert prepared.departures.drive.alternative is not None
     w = prepared.window
-    fitted = fit_window(as_read(w.signals, w.sample_rate_hz), w.sample_rate_hz, prepared.drive_as_read)
-    std = widened({"FDJ": float(fitted.fdj_std_nm[0])}, prepared)["FDJ"]
-    error = abs(float(fitted.fdj_nm[0]) - drawn.truth["FDJ"])
+    solved = solve_window(as_read(w.signals, w.sample_rate_hz), w.sample_rate_hz, prepared.drive_as_read)
+    std = widened({"FDJ": float(solved.fdj_std_nm[0])}, prepared)["FDJ"]
+    error = abs(float(solved.fdj_nm[0]) - drawn.truth["FDJ"])
     assert error > 0.3 * 0.02  # the γ end is far off ...
     assert error < 2 * std  # ... and the std says so,
     assert prepared.departures.drive.spread["FDJ"] > 0.5 * error  # by the gap between the two ends
@@ -87,9 +87,9 @@ def test_a_gauge_gain_in_doubt_that_only_a_drive_no_one_has_explains_does_not_re
     aircraft = prepared.departures.aircraft
     assert aircraft.in_doubt and aircraft.spread == {}
     w = prepared.window
-    fitted = fit_window(as_read(w.signals, w.sample_rate_hz), w.sample_rate_hz, prepared.drive_as_read)
-    std = widened({"FDJ": float(fitted.fdj_std_nm[0])}, prepared)["FDJ"]
-    assert abs(float(fitted.fdj_nm[0]) - drawn.truth["FDJ"]) < 2 * std
+    solved = solve_window(as_read(w.signals, w.sample_rate_hz), w.sample_rate_hz, prepared.drive_as_read)
+    std = widened({"FDJ": float(solved.fdj_std_nm[0])}, prepared)["FDJ"]
+    assert abs(float(solved.fdj_nm[0]) - drawn.truth["FDJ"]) < 2 * std
 
 
 # Windows of four families logged without sensor noise (the real-time benchmark's is a thesis window of other seeds).

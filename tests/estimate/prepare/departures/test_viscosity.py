@@ -5,7 +5,7 @@ import pytest
 
 from ema.estimate.documents.window_facts import SensorZero
 from ema.estimate.physics.features import as_read
-from ema.estimate.physics.friction import fit_friction
+from ema.estimate.physics.friction import solve_friction
 from ema.estimate.prepare.conditioning import prepare
 from ema.estimate.prepare.departures.viscosity import NOTE_WEIGHT, Viscosity, viscosity_note
 from ema.model.actuator import THESIS
@@ -52,13 +52,13 @@ def test_a_change_too_unclear_to_read_is_weighed_into_fdjs_std():
         if read.change_nms:
             continue
         unread += 1
-        fit = fit_friction(
+        solution = solve_friction(
             as_read(window.signals, window.sample_rate_hz), window.sample_rate_hz, prepared.departures.drive_as_read
         )
-        error = abs(float(fit.fdj_nm[0]) - drawn.truth["FDJ"])
+        error = abs(float(solution.fdj_nm[0]) - drawn.truth["FDJ"])
         assert read.leaning_nms > 0.1 * SPEC_C, seed  # it leans the true way
-        assert error > 2 * float(fit.fdj_std_nm[0]), seed  # the spec's reading alone is confidently wrong
-        covered += error <= 2 * float(np.hypot(read.spread["FDJ"], fit.fdj_std_nm[0]))
+        assert error > 2 * float(solution.fdj_std_nm[0]), seed  # the spec's reading alone is confidently wrong
+        covered += error <= 2 * float(np.hypot(read.spread["FDJ"], solution.fdj_std_nm[0]))
     assert unread >= 8
     assert covered >= 0.6 * unread, (covered, unread)
 
@@ -70,7 +70,7 @@ def test_where_the_speed_hardly_varies_an_unseen_coefficient_is_in_the_stds(fact
     range high at 10 std (foreign history, actuator 407)."""
     from ema.estimate.documents.window_facts import HistoryReadings
     from ema.estimate.other_windows import known_from
-    from ema.estimate.physics.friction import fit_window
+    from ema.estimate.physics.friction import solve_window
     from ema.estimate.prepare.conditioning import widened
     from ema.estimate.report import weakly_determined
 
@@ -84,9 +84,9 @@ def test_where_the_speed_hardly_varies_an_unseen_coefficient_is_in_the_stds(fact
     assert prepared.departures.viscosity.unseen and prepared.departures.offset.carried_from == "c"
     assert viscosity_note(prepared.departures.viscosity)[0].code == "viscosity_unseen"
     w = prepared.window
-    fitted = fit_window(as_read(w.signals, w.sample_rate_hz), w.sample_rate_hz, prepared.drive_as_read)
-    std = widened({"FDJ": float(fitted.fdj_std_nm[0])}, prepared)["FDJ"]
-    assert abs(float(fitted.fdj_nm[0]) - gust.truth["FDJ"]) < 2 * std and weakly_determined(
+    solved = solve_window(as_read(w.signals, w.sample_rate_hz), w.sample_rate_hz, prepared.drive_as_read)
+    std = widened({"FDJ": float(solved.fdj_std_nm[0])}, prepared)["FDJ"]
+    assert abs(float(solved.fdj_nm[0]) - gust.truth["FDJ"]) < 2 * std and weakly_determined(
         "FDJ", std, ranges=THESIS.ranges
     )
 

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from ema.kinds.rotary.equations import FOLDS
-from ema.kinds.rotary.fitting import hats, score, score_grid, uniform_knots
+from ema.kinds.rotary.fold_scores import hats, score, score_grid, uniform_knots
 
 
 def _problem(seed: int, m: int = 600):
@@ -29,9 +29,9 @@ def test_the_grid_fast_path_equals_one_design_at_a_time():
 
 def test_held_out_error_exceeds_in_sample_and_recovers_the_coefficients():
     base, grid, y, folds = _problem(1)
-    fitted = score(np.concatenate([base, grid[:, 3]], axis=1), y, folds)
-    assert fitted.cv_rss > fitted.rss
-    np.testing.assert_allclose(fitted.beta, [1.0, 0.5, -0.2, 0.3, 0.1], atol=0.02)
+    solved = score(np.concatenate([base, grid[:, 3]], axis=1), y, folds)
+    assert solved.cv_rss > solved.rss
+    np.testing.assert_allclose(solved.beta, [1.0, 0.5, -0.2, 0.3, 0.1], atol=0.02)
 
 
 def test_hats_are_a_partition_of_unity_without_the_first():

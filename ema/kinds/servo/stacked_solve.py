@@ -16,11 +16,11 @@ from ema.estimate.stats import rms
 from ema.kinds.servo.inverse import (
     decimated_problem,
     disturbed_rows,
-    fit_inverse,
     inverse_columns,
     load_motion,
     newey_west_lags,
     newey_west_std,
+    solve_inverse,
 )
 from ema.kinds.servo.log_reading import ServoPrepared
 from ema.kinds.servo.loop_dataset import LANE_COLUMNS, lane_parameters
@@ -62,7 +62,7 @@ def problem(prepared: Sequence[ServoPrepared], model: dict[str, float]) -> Probl
 
 
 @dataclass(frozen=True)
-class Fitted:
+class Solved:
     values: dict[str, float]
     stds: dict[str, float]
     error_pct: float
@@ -70,7 +70,7 @@ class Fitted:
     residual: np.ndarray
 
 
-def fitted(p: Problem) -> Fitted:
+def solved(p: Problem) -> Solved:
     names = list(p.x)
     x = p.design(names)
     beta, *_ = np.linalg.lstsq(x, p.y, rcond=None)
@@ -81,7 +81,7 @@ def fitted(p: Problem) -> Fitted:
         out = p.fold == k
         b, *_ = np.linalg.lstsq(x[~out], p.y[~out], rcond=None)
         held[k] = float(np.sum((p.y[out] - x[out] @ b) ** 2))
-    return Fitted(
+    return Solved(
         dict(zip(names, beta.tolist(), strict=True)),
         dict(zip(names, stds.tolist(), strict=True)),
         float(100.0 * np.linalg.norm(residual) / np.linalg.norm(p.y)),
@@ -98,15 +98,15 @@ class Copies:
     by_row: list[np.ndarray]  # per window, (COPIES, rows): its copies' residual by decimated row
 
 
-def noise_copies(prepared: Sequence[ServoPrepared], base: Fitted, model: dict[str, float]) -> Copies:
+def noise_copies(prepared: Sequence[ServoPrepared], base: Solved, model: dict[str, float]) -> Copies:
     misfits: list[float] = []
     by_row: list[list[np.ndarray]] = [[] for _ in prepared]
     for phase in np.linspace(0.0, 1.0, COPIES, endpoint=False):
         twins = [_simulated(p, base.values, model, phase) for p in prepared]
-        misfits.append(rms(fitted(problem(twins, model)).residual))
+        misfits.append(rms(solved(problem(twins, model)).residual))
         for i, twin in enumerate(twins):
-            fit = fit_inverse(twin.force_n, inverse_columns(twin.motion, model), twin.motion)
-            by_row[i].append(fit.residual_by_row)
+            solution = solve_inverse(twin.force_n, inverse_columns(twin.motion, model), twin.motion)
+            by_row[i].append(solution.residual_by_row)
     return Copies(np.array(misfits), [np.array(rows) for rows in by_row])
 
 
@@ -123,8 +123,8 @@ def undisturbed(prepared: Sequence[ServoPrepared], copies: Copies, model: dict[s
     """Each window with the rows a force its log lacks disturbs (``disturbed_rows``) left out of every fit."""
     out = []
     for p, by_row in zip(prepared, copies.by_row, strict=True):
-        fit = fit_inverse(p.force_n, inverse_columns(p.motion, model), p.motion)
-        out.append(replace(p, disturbed=disturbed_rows(fit.residual_by_row, by_row)))
+        solution = solve_inverse(p.force_n, inverse_columns(p.motion, model), p.motion)
+        out.append(replace(p, disturbed=disturbed_rows(solution.residual_by_row, by_row)))
     return out
 
 
@@ -140,7 +140,7 @@ def simulator_frame(
     (an effect along the stroke) is not simulated, so no bias of it is seen: it keeps the fit's value, as an
     estimate reads it; so does one the twins give no finite read of."""
     reads = [
-        fitted(problem([_simulated(p, values, model, phase) for p in prepared], model)).values
+        solved(problem([_simulated(p, values, model, phase) for p in prepared], model)).values
         for phase in np.linspace(0.0, 1.0, FRAME_PHASES, endpoint=False)
     ]
     moved = {name: 2.0 * value - float(np.mean([read[name] for read in reads])) for name, value in values.items()}

@@ -14,7 +14,7 @@ number (FDJ + k·|T_L|), said so, and no nominal is written. Each run's FDJ scat
 by more than its own noise: that excess is the runs' repeatability, written into the document and into
 every later estimate's std.
 
-**Learn** (the document lacks c or a nominal health): ``fit_drive`` writes the completed document.
+**Learn** (the document lacks c or a nominal health): ``calibrate_drive`` writes the completed document.
 **Compare** (a calibrated document): the runs are read with it, their FDJ (and η_O where their loads
 differ) set against the nominal, and the current along the stroke against the healthy runs' own
 profile (``screw.stroke_profile_a``): a friction that changes along the stroke (a local defect) is named
@@ -87,7 +87,7 @@ class HealthySpread:
 
 
 @dataclass(frozen=True)
-class DriveFit:
+class CalibratedDrive:
     """What healthy runs say of the drive and of the actuator new."""
 
     current_per_nm_a: float
@@ -146,7 +146,7 @@ def _refuse_reversed_signs(c: float, c_std: float, rests: np.ndarray) -> None:
         )
 
 
-def fit_drive(runs: list[Run], actuator: ActuatorDocument) -> DriveFit:
+def calibrate_drive(runs: list[Run], actuator: ActuatorDocument) -> CalibratedDrive:
     """c, I0, and (at two load sizes or more) the nominal FDJ and η_O, from healthy ``runs`` (module docstring)."""
     profiles = [weighted_least_squares(*_design(runs, float(eta), actuator)) for eta in ETA_GRID]
     chi2 = np.array([p[2] for p in profiles])
@@ -165,7 +165,7 @@ def fit_drive(runs: list[Run], actuator: ActuatorDocument) -> DriveFit:
     per_run = [_run_fdj(run, c, float(ETA_GRID[best]), actuator) for run in runs]
     repeat = _excess_std(np.array([f for f, _ in per_run]), np.array([s for _, s in per_run]))
     anchored = [_run_fdj(run, c, float(ETA_GRID[best]), actuator, float(rests.mean())) for run in runs]
-    return DriveFit(
+    return CalibratedDrive(
         current_per_nm_a=float(c),
         current_per_nm_std_a=c_std,
         current_at_zero_torque_a=float(rests.mean()),

@@ -24,7 +24,7 @@ MIN_HELD_OUT_GAIN = 0.01  # a model with an effect must cut the held-out residua
 
 
 @dataclass(frozen=True)
-class TiedFit:
+class TiedSolution:
     fdj_nm: float
     eta_o: float
     beta: np.ndarray  # FDJ, then the effect columns' coefficients
@@ -63,7 +63,7 @@ def _target(y: np.ndarray, eta_o: float, loads: np.ndarray, gear_ratio: float) -
     return y - k_aid * loads[:, 0] - k_opp * loads[:, 1]
 
 
-def fit_with(e: Equations, chosen: Sequence[Chosen], rows: np.ndarray | None = None) -> TiedFit:
+def solve_with(e: Equations, chosen: Sequence[Chosen], rows: np.ndarray | None = None) -> TiedSolution:
     """The base model plus ``chosen``'s columns, η_O searched coarse to fine, on ``rows`` (all by default).
 
     The target at η_O is y − k_aid·a − k_opp·o, and least squares is linear in its target: one solve for
@@ -81,7 +81,7 @@ def fit_with(e: Equations, chosen: Sequence[Chosen], rows: np.ndarray | None = N
 
     eta_o, grid, best = coarse_to_fine(lambda grid: np.sum((residuals @ mixes(grid)) ** 2, axis=0))
     beta = coefficients @ mixes(grid)[:, best]
-    return TiedFit(float(beta[0]), eta_o, beta)
+    return TiedSolution(float(beta[0]), eta_o, beta)
 
 
 def held_out_rss(e: Equations, chosen: Sequence[Chosen]) -> float:
@@ -89,9 +89,9 @@ def held_out_rss(e: Equations, chosen: Sequence[Chosen]) -> float:
     design, loads, y = _extra(e, chosen), _loads(e, chosen), e.y - _offset(e, chosen)
     total = 0.0
     for f in range(FOLDS):
-        fitted = fit_with(e, chosen, np.flatnonzero(e.folds != f))
+        solved = solve_with(e, chosen, np.flatnonzero(e.folds != f))
         held = e.folds == f
-        error = _target(y, fitted.eta_o, loads, e.gear_ratio)[held] - design[held] @ fitted.beta
+        error = _target(y, solved.eta_o, loads, e.gear_ratio)[held] - design[held] @ solved.beta
         total += float(error @ error)
     return total
 

@@ -6,8 +6,8 @@ import pytest
 from ema.estimate.physics.eta_search import ETA_O_SEARCH, GRID_POINTS, REFINEMENTS
 from ema.kinds.rotary.equations import FOLDS, Equations, equations
 from ema.kinds.rotary.families import generic_families
-from ema.kinds.rotary.refit import fit_with
 from ema.kinds.rotary.selection import Chosen
+from ema.kinds.rotary.tied_solve import solve_with
 from ema.kinds.rotary.vocabulary import named_families
 from ema.model.actuator import THESIS
 from ema.model.params import eta_a_from_eta_o
@@ -23,15 +23,15 @@ def _plain_fit(e: Equations, design: np.ndarray, loads: np.ndarray, y: np.ndarra
     low, high = ETA_O_SEARCH
     for _ in range(REFINEMENTS):
         grid = np.linspace(low, high, GRID_POINTS)
-        fits = []
+        solutions = []
         for eta in grid:
             target = y - (1 - eta_a_from_eta_o(eta, GEAR)) * loads[:, 0] - (1 / eta - 1) * loads[:, 1]
             beta = np.linalg.lstsq(design, target, rcond=None)[0]
-            fits.append((float(np.sum((target - design @ beta) ** 2)), beta))
-        best = int(np.argmin([sse for sse, _ in fits]))
+            solutions.append((float(np.sum((target - design @ beta) ** 2)), beta))
+        best = int(np.argmin([sse for sse, _ in solutions]))
         step = grid[1] - grid[0]
         low, high = max(grid[best] - step, ETA_O_SEARCH[0]), min(grid[best] + step, ETA_O_SEARCH[1])
-    return float(grid[best]), fits[best][1]
+    return float(grid[best]), solutions[best][1]
 
 
 def _measured(case: str, seed: int) -> Equations:
@@ -50,10 +50,10 @@ def test_one_solve_for_the_grid_equals_a_solve_per_point(case, family):
     chosen = [Chosen(found, found.grid[len(found.grid) // 2])]
     extra = found.columns(e, chosen[0].grid)[:, : found.free_columns]
     for with_it, design in (([], e.base[:, :1]), (chosen, np.column_stack([e.base[:, :1], extra]))):
-        fitted = fit_with(e, with_it)
+        solved = solve_with(e, with_it)
         eta_o, beta = _plain_fit(e, design, e.base[:, 1:], e.y)
-        assert fitted.eta_o == eta_o
-        np.testing.assert_allclose(fitted.beta, beta, rtol=1e-9, atol=1e-12)
+        assert solved.eta_o == eta_o
+        np.testing.assert_allclose(solved.beta, beta, rtol=1e-9, atol=1e-12)
 
 
 def test_a_known_fdj_and_eta_o_come_back():
@@ -72,6 +72,6 @@ def test_a_known_fdj_and_eta_o_come_back():
         window=np.zeros(m, dtype=int),
         gear_ratio=GEAR,
     )
-    fitted = fit_with(e, [])
-    assert fitted.fdj_nm == pytest.approx(fdj, rel=0.02)
-    assert fitted.eta_o == pytest.approx(eta_o, abs=0.01)
+    solved = solve_with(e, [])
+    assert solved.fdj_nm == pytest.approx(fdj, rel=0.02)
+    assert solved.eta_o == pytest.approx(eta_o, abs=0.01)
