@@ -103,7 +103,7 @@ def main() -> None:
     results = {}
     for budget in args.budgets.split(","):
         train, held = (int(part) for part in budget.split("+"))
-        config = PipelineConfig(n_simulations=train, check_windows=held)
+        config = PipelineConfig(n_simulations=train, check_simulations=held)
         results[budget] = scored(config, windows)
         print(budget, results[budget], flush=True)
     body = "\n".join(

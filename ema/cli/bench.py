@@ -179,7 +179,7 @@ def markdown(rows: list[dict[str, Any]], config: PipelineConfig, refs: dict[str,
     lines = [
         "One synthetic window (§5.6 command, realistic sensor noise, health uniform in Table 3.1's ranges) ->",
         f"estimates, in-process (`ema.kinds.rotary.pipeline.estimate_window`, what the service runs), "
-        f"{config.n_simulations} + {config.check_windows} simulations, {config.hidden_units} neurons.",
+        f"{config.n_simulations} + {config.check_simulations} simulations, {config.hidden_units} neurons.",
         "p50 (p95) seconds per stage; real-time factor = pipeline seconds per second of window (≤ 1: real time);",
         "error = mean |error| in % of the thesis's range (0.02 N·m for FDJ, 0.30 for η_O).",
         "Windows run back to back, so beside busy processes this loop keeps a core of its own; a service",

@@ -201,7 +201,7 @@ def read_log(path: Path, window_s: float | None, defaults: Defaults = Defaults()
             bad[str(file)] = exc.message
             continue
         for recording in recordings:
-            length = window_s if window_s is not None else KINDS[recording.kind].window_s
+            length = window_s if window_s is not None else KINDS[recording.kind].cut_s
             whole = None if length is None else too_short_to_cut(recording, length)
             if whole is not None:
                 kept_whole[recording.window_id] = whole

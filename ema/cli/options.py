@@ -53,7 +53,7 @@ OUTPUT_FOLDER = _Output(file_okay=False, path_type=Path)
 FIGURE_FILE = _Figure(dir_okay=False, path_type=Path)
 SIZES = {  # flag -> PipelineConfig field
     "--sims": "n_simulations",
-    "--checks": "check_windows",
+    "--checks": "check_simulations",
     "--timesteps": "n_timesteps",
     "--hidden": "hidden_units",
     "--members": "members",
@@ -147,7 +147,7 @@ class _WindowOption(click.Option):
     def get_help_record(self, ctx: click.Context) -> tuple[str, str] | None:
         from ema.model.kinds import KINDS
 
-        cut = "; ".join(f"a {f.name} recording {f.window_s:g} s" for f in KINDS.values() if f.window_s is not None)
+        cut = "; ".join(f"a {f.name} recording {f.cut_s:g} s" for f in KINDS.values() if f.cut_s is not None)
         self.help = f"cut recordings into windows of this length [s]  [default: {cut}; any other kind's log whole]"
         return super().get_help_record(ctx)
 

@@ -8,9 +8,10 @@ from __future__ import annotations
 
 from typing import Any
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import BaseModel, ConfigDict, Field, computed_field, model_validator
 
 from ema.estimate.sizes import SIZES
+from ema.model.document import renamed
 
 
 def _field(name: str) -> Any:
@@ -24,15 +25,24 @@ class PipelineConfig(BaseModel):
     model_config = ConfigDict(frozen=True, extra="forbid")
 
     n_simulations: int = _field("n_simulations")
-    check_windows: int = _field("check_windows")
+    check_simulations: int = _field("check_simulations")
     n_timesteps: int = _field("n_timesteps")
     hidden_units: int = _field("hidden_units")
     members: int = _field("members")
     seed: int = _field("seed")
 
+    @model_validator(mode="before")
+    @classmethod
+    def _earlier_names(cls, values: Any) -> Any:
+        return renamed(values, {"check_simulations": "check_windows"})
+
+    @computed_field(description="deprecated alias of check_simulations (ema-estimate/1 as first published)")
+    def check_windows(self) -> int:
+        return self.check_simulations
+
     @property
     def total_simulations(self) -> int:
-        return self.n_simulations + self.check_windows
+        return self.n_simulations + self.check_simulations
 
 
 def bounds(name: str) -> tuple[int, int]:

@@ -250,7 +250,7 @@ def estimate_document(
             n_simulations=config.n_simulations,
             n_timesteps=data.inputs.shape[1],
             inputs=["residual_torque, sliding samples"],
-            check_windows=config.check_windows,
+            check_simulations=config.check_simulations,
             noise_estimated=data.noise.as_dict(),
             box={"FDJ": data.box.fdj_nm, "eta_O": data.box.eta_o},
         ),

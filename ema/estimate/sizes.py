@@ -19,7 +19,7 @@ class Size(NamedTuple):
 
 SIZES = {
     "n_simulations": Size(64, 16, 4000, "simulations the network trains on"),
-    "check_windows": Size(24, 8, 1000, "held-out simulations that score the estimators"),
+    "check_simulations": Size(24, 8, 1000, "held-out simulations that score the estimators"),
     "n_timesteps": Size(500, 10, 10_000, "network input timesteps (bins of the window)"),
     "hidden_units": Size(100, 1, 2000, "hidden neurons"),
     "members": Size(1, 1, 20, "networks in the ensemble"),

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ema.model.residual import DEFAULT_DERIVATIVE_WINDOW_S, kernel_samples
+from ema.model.residual import DERIVATIVE_SPAN_S, kernel_samples
 
 JACKKNIFE_BLOCKS = 10
 DECISIVE_Z = 4.0  # stds by which a reading must explain a window better than the document's before it is taken
@@ -62,7 +62,7 @@ def rms_log_likelihood_ratio(
     error never under the model's ``resolution_nm`` (``RESOLUTION_SHARE``): on a log without noise, what a fit
     gains below it is the model's own error, not the window's evidence."""
     worse, better = np.hypot(worse_rms, resolution_nm), np.hypot(better_rms, resolution_nm)
-    return n_sliding / kernel_samples(rate, DEFAULT_DERIVATIVE_WINDOW_S) * float(np.log(worse / better))
+    return n_sliding / kernel_samples(rate, DERIVATIVE_SPAN_S) * float(np.log(worse / better))
 
 
 def below_zero(values: dict[str, float], stds: dict[str, float]) -> list[str]:

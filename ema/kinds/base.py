@@ -18,7 +18,7 @@ from ema.model.bounds import NOISE_COPIES
 from ema.model.kinds import KindFacts
 from ema.model.window import Window
 
-WARM_UP = PipelineConfig(n_simulations=16, check_windows=8, n_timesteps=20, hidden_units=4)  # a warm-up's sizes
+WARM_UP = PipelineConfig(n_simulations=16, check_simulations=8, n_timesteps=20, hidden_units=4)  # a warm-up's sizes
 
 
 @dataclass(frozen=True)

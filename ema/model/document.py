@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable
-from typing import Annotated, TypeVar
+from collections.abc import Callable, Mapping
+from typing import Annotated, Any, TypeVar
 
 from pydantic import AfterValidator, AllowInfNan, BaseModel, ConfigDict, Strict
 
@@ -22,6 +22,21 @@ def refused_by(rule: Callable[[T], str | None]) -> AfterValidator:
         return value
 
     return AfterValidator(check)
+
+
+def renamed(values: Any, names: Mapping[str, str]) -> Any:
+    """A document's input with each field's earlier name (``names``: new -> earlier) read as the new one, so that a
+    client of the document as first published keeps working; both names given with two values is refused, naming
+    the earlier one. For a ``model_validator(mode="before")``."""
+    if not isinstance(values, dict):
+        return values
+    values = dict(values)
+    for new, earlier in names.items():
+        if earlier in values:
+            given = values.pop(earlier)
+            if values.setdefault(new, given) != given:
+                raise ValueError(f"{earlier}: is the earlier name of {new}; give one of them")
+    return values
 
 
 class Document(BaseModel):

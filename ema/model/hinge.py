@@ -64,7 +64,7 @@ def denoised_hinge_nm(
     hinge_moment_nm: np.ndarray,
     position_deg: np.ndarray,
     sample_rate_hz: float,
-    window_s: float = HINGE_SMOOTHING_S,
+    span_s: float = HINGE_SMOOTHING_S,
 ) -> np.ndarray:
     """H_read (module docstring) for one window (n,) or a batch (N, n), time along the last axis."""
     hinge = np.asarray(hinge_moment_nm, dtype=np.float64)
@@ -72,7 +72,7 @@ def denoised_hinge_nm(
     if hinge.shape != position.shape:
         raise InputError("signals", f"shapes differ: hinge {hinge.shape}, position {position.shape}")
     n = hinge.shape[-1]
-    width = _line_width(kernel_samples(sample_rate_hz, window_s), n)
+    width = _line_width(kernel_samples(sample_rate_hz, span_s), n)
     hinge_rows, position_rows = (np.ascontiguousarray(x.reshape(-1, n)) for x in (hinge, position))
     out = np.empty(hinge_rows.shape)
     runtime.run_rows(lambda a, b: _denoise_rows(hinge_rows[a:b], position_rows[a:b], width, out[a:b]), len(out))

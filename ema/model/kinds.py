@@ -52,7 +52,7 @@ class KindFacts:
     recorded: tuple[str, ...] = ()  # the section's fields a log may record beside its signals (``constants``)
     # How long the windows a recording of this kind is cut into unless told (the thesis's windows: a few commands of
     # the elevator each); None: a log is one window (a rig's run, a controller's log).
-    window_s: float | None = None
+    cut_s: float | None = None
 
     def recorded_field(self, name: str) -> str | None:
         """Why a log of this kind cannot record the constant ``name`` (None: it can)."""
@@ -89,7 +89,7 @@ FRICTION_SUFFIX = MappingProxyType({"N·m": "nm", "N": "n"})
 
 _ROTARY = KindFacts(
     name="rotary",
-    window_s=0.5,
+    cut_s=0.5,
     summary="a current-piloted motor and a gear train to a surface",
     section="drive",
     roles=_roles(

@@ -23,7 +23,7 @@ from ema.model import runtime
 from ema.model.checks import InputError, finite_array, in_range
 from ema.model.params import DriveConstants
 
-DEFAULT_DERIVATIVE_WINDOW_S = 2e-3
+DERIVATIVE_SPAN_S = 2e-3
 # Within this of the end stops the shaft may rest against them: T_R there is not friction.
 END_STOP_MARGIN_DEG = 1.0
 
@@ -52,15 +52,15 @@ def _smoothing_weights(half_width: int) -> np.ndarray:
     return np.convolve(acceleration_weights(half_width), [0.5, 0.5])
 
 
-def kernel_samples(sample_rate_hz: float, window_s: float = DEFAULT_DERIVATIVE_WINDOW_S) -> int:
+def kernel_samples(sample_rate_hz: float, span_s: float = DERIVATIVE_SPAN_S) -> int:
     """Samples the reconstruction kernel spans at this rate (2·half + 1)."""
-    return 2 * max(1, round(window_s * sample_rate_hz / 2)) + 1
+    return 2 * max(1, round(span_s * sample_rate_hz / 2)) + 1
 
 
-def _half_width(values: np.ndarray, sample_rate_hz: float, window_s: float) -> int:
-    half = max(1, round(window_s * sample_rate_hz / 2))
+def _half_width(values: np.ndarray, sample_rate_hz: float, span_s: float) -> int:
+    half = max(1, round(span_s * sample_rate_hz / 2))
     if values.shape[-1] <= 2 * half:
-        raise InputError("signals", f"need more than {2 * half} samples to differentiate over {window_s:g} s")
+        raise InputError("signals", f"need more than {2 * half} samples to differentiate over {span_s:g} s")
     return half
 
 
@@ -133,20 +133,18 @@ def _residual_rows(signals, weights, constants, out):
             out[r, i] = smooth[i] - inertia * slope[i]
 
 
-def smoothed(values: np.ndarray, sample_rate_hz: float, window_s: float = DEFAULT_DERIVATIVE_WINDOW_S) -> np.ndarray:
+def smoothed(values: np.ndarray, sample_rate_hz: float, span_s: float = DERIVATIVE_SPAN_S) -> np.ndarray:
     """``values`` averaged with the kernel that matches :func:`smooth_derivative`."""
-    return _correlate(values, smoothing_weights(_half_width(values, sample_rate_hz, window_s)), odd_extension=False)
+    return _correlate(values, smoothing_weights(_half_width(values, sample_rate_hz, span_s)), odd_extension=False)
 
 
-def smooth_derivative(
-    values: np.ndarray, sample_rate_hz: float, window_s: float = DEFAULT_DERIVATIVE_WINDOW_S
-) -> np.ndarray:
-    """d(values)/dt along the last axis by a centred least-squares line of ``window_s``.
+def smooth_derivative(values: np.ndarray, sample_rate_hz: float, span_s: float = DERIVATIVE_SPAN_S) -> np.ndarray:
+    """d(values)/dt along the last axis by a centred least-squares line of ``span_s``.
 
     The ends are padded by point reflection (2·x₀ − x), which keeps the end slope, so the
     output has the input's length and no transient at the edges.
     """
-    half = _half_width(values, sample_rate_hz, window_s)
+    half = _half_width(values, sample_rate_hz, span_s)
     return _correlate(values, derivative_weights(half, sample_rate_hz), odd_extension=True)
 
 
@@ -183,7 +181,7 @@ def residual_torque_nm(
     hinge_moment_nm: np.ndarray,
     sample_rate_hz: float,
     drive: DriveConstants,
-    derivative_window_s: float = DEFAULT_DERIVATIVE_WINDOW_S,
+    derivative_span_s: float = DERIVATIVE_SPAN_S,
 ) -> np.ndarray:
     """T_R [N·m] at the motor shaft, one value per sample; works on one window or a batch (last axis = time)."""
     current = finite_array("current_a", current_a)
@@ -196,7 +194,7 @@ def residual_torque_nm(
             "signals", f"shapes differ: current {current.shape}, speed {speed.shape}, hinge {hinge.shape}"
         ) from None
     rate = in_range("sample_rate_hz", sample_rate_hz, 100.0, 1e6, "Hz")
-    half = _half_width(speed, rate, derivative_window_s)
+    half = _half_width(speed, rate, derivative_span_s)
     i, w, h = (np.ascontiguousarray(np.broadcast_to(x, shape).reshape(-1, shape[-1])) for x in (current, speed, hinge))
     a = drive
     constants = (a.torque_constant_nm_per_a, a.max_motor_torque_nm, a.gear_ratio, a.inertia_kgm2)

@@ -147,7 +147,8 @@ def unknown_environment(environ: Mapping[str, str]) -> tuple[str, str] | None:
     setting it likely misspells said: such a variable would be ignored, and the service run on a default the
     operator meant to replace (another history, another key)."""
     names = {f"EMA_{name.upper()}" for name in Settings.model_fields}
-    names |= {f"EMA_PIPELINE__{name.upper()}" for name in PipelineConfig.model_fields}
+    sizes = [*PipelineConfig.model_fields, *PipelineConfig.model_computed_fields]  # the latter: earlier names
+    names |= {f"EMA_PIPELINE__{name.upper()}" for name in sizes}
     for variable in sorted(v for v in environ if v.startswith("EMA_") and v not in names):
         near = difflib.get_close_matches(variable, sorted(names), n=1, cutoff=0.85)
         return variable, "is no setting of the service" + (

@@ -158,7 +158,7 @@ def test_a_local_worker_killed_mid_run_loses_no_window_and_duplicates_none(tmp_p
 
     killer = threading.Thread(target=kill_when_two_answered, daemon=True)
     killer.start()
-    small = PipelineConfig(n_simulations=16, check_windows=8, n_timesteps=50, hidden_units=8)
+    small = PipelineConfig(n_simulations=16, check_simulations=8, n_timesteps=50, hidden_units=8)
     summary = run_fleet(windows, out, config=small, workers=2, address=None, pool=pool)
     killer.join(timeout=5)
     assert killed_at and killed_at[0] < len(windows)  # the worker died with windows still to answer
@@ -207,7 +207,7 @@ def test_history_plots_a_prognosis_whose_interval_holds_the_truth(tmp_path, caps
     from ema.kinds.rotary.pipeline import estimate_window
     from tests.servers import free_port, start_server
 
-    small = PipelineConfig(n_simulations=16, check_windows=8, n_timesteps=50, hidden_units=8)
+    small = PipelineConfig(n_simulations=16, check_simulations=8, n_timesteps=50, hidden_units=8)
     base = estimate_window(synthetic_window(HealthParams.single(), seed=1, duration_s=0.1), small, actuator=THESIS)
     rng, store = np.random.default_rng(0), open_history(tmp_path / "history.sqlite3")
     hours = np.sort(rng.uniform(0, 200, 200))
@@ -320,7 +320,7 @@ def test_a_node_that_dies_mid_run_loses_no_window_and_duplicates_none(tmp_path):
     killer = threading.Thread(target=kill_when_two_answered, daemon=True)
     killer.start()
     try:
-        small = PipelineConfig(n_simulations=16, check_windows=8, n_timesteps=50, hidden_units=8)
+        small = PipelineConfig(n_simulations=16, check_simulations=8, n_timesteps=50, hidden_units=8)
         run_fleet(windows, out, config=small, workers=2, address=cluster.address, database=database)
     finally:
         ray.shutdown()

@@ -18,7 +18,7 @@ SIZES = [
     "--sims",
     str(SMALL.n_simulations),
     "--checks",
-    str(SMALL.check_windows),
+    str(SMALL.check_simulations),
     "--timesteps",
     str(SMALL.n_timesteps),
     "--hidden",

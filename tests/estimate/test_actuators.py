@@ -12,7 +12,7 @@ from ema.model.window import window_from_dict
 from tests.foreign.actuators import DRIVES, NOMINAL, document
 from tests.foreign.windows import Ground, draw
 
-SMALL = PipelineConfig(n_simulations=32, check_windows=12)
+SMALL = PipelineConfig(n_simulations=32, check_simulations=12)
 CONDITIONS = {  # what the window shows: a family, where it was logged
     "flight": ("thesis", None),
     "cruise": ("cruise", None),

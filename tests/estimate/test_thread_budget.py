@@ -14,7 +14,7 @@ ESTIMATE = (
     "from ema.kinds.rotary.pipeline import estimate_window; from ema.model.actuator import THESIS; "
     "from ema.model.params import HealthParams; from ema.kinds.rotary.synthetic import synthetic_window; "
     "thread_budget.configure({threads}); "
-    "config = PipelineConfig(n_simulations=16, check_windows=8, n_timesteps=20, hidden_units=4); "
+    "config = PipelineConfig(n_simulations=16, check_simulations=8, n_timesteps=20, hidden_units=4); "
     "e = estimate_window(synthetic_window(HealthParams.single(), seed=3, duration_s=0.05), config, actuator=THESIS); "
     "from threadpoolctl import threadpool_info; "
     "print(json.dumps([e.estimates.FDJ.value, e.estimates.FDJ.std, e.learned.epochs, "

@@ -34,7 +34,7 @@ def test_the_compiled_reading_equals_its_formula_written_plainly():
     slow = _plain_local_line(hinge, width)
     fast = position - _plain_local_line(position, width)
     want = slow + np.sum((hinge - slow) * fast) / np.sum(fast**2) * fast
-    np.testing.assert_allclose(denoised_hinge_nm(hinge, position, RATE_HZ, window_s=0.004), want, atol=1e-9)
+    np.testing.assert_allclose(denoised_hinge_nm(hinge, position, RATE_HZ, span_s=0.004), want, atol=1e-9)
 
 
 def test_a_fast_deflection_term_is_kept_and_its_slope_is_measured():

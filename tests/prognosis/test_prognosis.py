@@ -90,7 +90,7 @@ def one_estimate():
     from ema.kinds.rotary.synthetic import synthetic_window
     from ema.model.params import HealthParams
 
-    small = PipelineConfig(n_simulations=16, check_windows=8, n_timesteps=50, hidden_units=8)
+    small = PipelineConfig(n_simulations=16, check_simulations=8, n_timesteps=50, hidden_units=8)
     return estimate_window(synthetic_window(HealthParams.single(), seed=1, duration_s=0.1), small, actuator=THESIS)
 
 

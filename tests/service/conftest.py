@@ -12,7 +12,7 @@ from ema.model.window import window_to_dict
 from ema.service.config import Settings
 from ema.service.main import create_app
 
-SMALL = PipelineConfig(n_simulations=16, check_windows=8, n_timesteps=50, hidden_units=8)
+SMALL = PipelineConfig(n_simulations=16, check_simulations=8, n_timesteps=50, hidden_units=8)
 KEY = "a-key-of-sixteen-characters"
 LOCAL = "http://127.0.0.1"  # without a key the service answers loopback hosts only
 

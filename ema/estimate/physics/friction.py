@@ -31,7 +31,7 @@ from ema.estimate.stats import JACKKNIFE_BLOCKS, RESOLUTION_SHARE, jackknife_std
 from ema.model.checks import InputError
 from ema.model.params import DriveConstants
 from ema.model.residual import (
-    DEFAULT_DERIVATIVE_WINDOW_S,
+    DERIVATIVE_SPAN_S,
     END_STOP_MARGIN_DEG,
     above_throughout,
     kernel_samples,
@@ -49,7 +49,7 @@ class SolveSettings:
     # sliding: |ω| above this share of the drive's top speed V_max/k_e over a whole kernel, one sign throughout
     # (30 rad/s of the thesis's 638: far past the speed sensor's noise, clear of the stick-slip near rest)
     min_speed_share: float = 0.047
-    derivative_window_s: float = DEFAULT_DERIVATIVE_WINDOW_S
+    derivative_span_s: float = DERIVATIVE_SPAN_S
     blocks: int = JACKKNIFE_BLOCKS
     offset: bool = False  # also fit a constant torque at the shaft (a current or hinge sensor off zero)
     viscous: bool = False  # also fit a change ΔC of the viscous coefficient (C·|ω| beyond the document's)
@@ -122,7 +122,7 @@ def sliding_mask(
     throughout a reconstruction kernel (one sign of the speed, so one sign of its friction), away from the end
     stops. Every rule that counts or weighs sliding samples reads this one."""
     speed = np.asarray(signals["motor_speed_radps"])
-    width = kernel_samples(rate, settings.derivative_window_s)
+    width = kernel_samples(rate, settings.derivative_span_s)
     mask = above_throughout(np.abs(np.atleast_2d(speed)), settings.sliding_speed_radps(drive), width)
     mask &= np.abs(np.atleast_2d(signals["position_deg"])) < drive.end_stop_deg - END_STOP_MARGIN_DEG
     return mask if speed.ndim > 1 else mask[0]
@@ -139,19 +139,19 @@ def regressors(
 
     ``residual_nm`` is T_R of these signals when the caller has reconstructed it already.
     """
-    window_s = settings.derivative_window_s
+    span_s = settings.derivative_span_s
     speed = np.atleast_2d(signals["motor_speed_radps"])
     if residual_nm is None:
         current, hinge = np.atleast_2d(signals["current_a"]), np.atleast_2d(signals["hinge_moment_nm"])
-        residual_nm = residual_torque_nm(current, speed, hinge, rate, drive, window_s)
+        residual_nm = residual_torque_nm(current, speed, hinge, rate, drive, span_s)
     residual = np.atleast_2d(residual_nm)
-    load = smoothed(np.atleast_2d(signals["hinge_moment_nm"]) / drive.gear_ratio, rate, window_s)
+    load = smoothed(np.atleast_2d(signals["hinge_moment_nm"]) / drive.gear_ratio, rate, span_s)
     sliding = np.atleast_2d(sliding_mask(signals, rate, drive, settings))
     direction = np.sign(speed)
     aiding = load * direction > 0
-    aid = smoothed(np.abs(load) * aiding, rate, window_s)
-    opp = smoothed(np.abs(load) * ~aiding, rate, window_s)
-    target = direction * (residual - drive.viscous_nms * smoothed(speed, rate, window_s))
+    aid = smoothed(np.abs(load) * aiding, rate, span_s)
+    opp = smoothed(np.abs(load) * ~aiding, rate, span_s)
+    target = direction * (residual - drive.viscous_nms * smoothed(speed, rate, span_s))
     return target, aid, opp, sliding
 
 
@@ -162,15 +162,15 @@ def nuisance_columns(
     s itself (a constant torque), |ω| smoothed (ΔC), −k_T·I smoothed where the motor is not saturated (γ:
     T_R misses γ·k_T·I there; where k_T·I is cut at the peak torque, it misses nothing), and the
     reconstruction's dω/dt (ΔJ: T_R holds ΔJ·dω/dt too much)."""
-    window_s, peak = settings.derivative_window_s, drive.max_motor_torque_nm
+    span_s, peak = settings.derivative_span_s, drive.max_motor_torque_nm
     speed = np.atleast_2d(signals["motor_speed_radps"])
     direction = np.sign(speed)
     motor = drive.torque_constant_nm_per_a * np.atleast_2d(signals["current_a"])
     columns = {
         "offset": lambda: direction,
-        "viscous": lambda: direction * smoothed(speed, rate, window_s),
-        "torque_scale": lambda: -direction * smoothed(motor * (np.abs(motor) < peak), rate, window_s),
-        "inertia": lambda: direction * smooth_derivative(speed, rate, window_s),
+        "viscous": lambda: direction * smoothed(speed, rate, span_s),
+        "torque_scale": lambda: -direction * smoothed(motor * (np.abs(motor) < peak), rate, span_s),
+        "inertia": lambda: direction * smooth_derivative(speed, rate, span_s),
     }
     return [columns[name]() for name in settings.nuisances]
 
@@ -221,7 +221,7 @@ def solve_friction(
     beta_b, eta_b = (x.reshape(len(total), blocks.shape[1], -1) for x in solve(left_out, *model)[:2])
     std = jackknife_std(beta_b)
     eta_o_std = jackknife_std(eta_b[..., 0])
-    enough = total[:, -1, -1] >= MIN_SLIDING_KERNELS * kernel_samples(rate, settings.derivative_window_s)
+    enough = total[:, -1, -1] >= MIN_SLIDING_KERNELS * kernel_samples(rate, settings.derivative_span_s)
     nan = np.where(enough, 1.0, np.nan)
     terms, term_stds = np.zeros((2, len(total), len(NUISANCES)))
     for i, name in enumerate(settings.nuisances, start=1):

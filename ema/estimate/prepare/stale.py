@@ -44,7 +44,7 @@ from ema.estimate.physics.noise_reading import white_noise_std
 from ema.model.checks import InputError
 from ema.model.noise import NOISY_SIGNALS
 from ema.model.params import DriveConstants
-from ema.model.residual import DEFAULT_DERIVATIVE_WINDOW_S, kernel_samples
+from ema.model.residual import DERIVATIVE_SPAN_S, kernel_samples
 from ema.model.window import Window
 
 MIN_STALE_SAMPLES = 4  # equal samples: fewer is the glitch repair's (3 at most)
@@ -223,7 +223,7 @@ def stale_note(stale: Stale) -> list[Note]:
         return []
     listed = "; ".join(f"{run.signal} {run.describe(stale.rate_hz)}" for run in runs[:3])
     more = f" (and {len(runs) - 3} more runs)" if len(runs) > 3 else ""
-    bridge_ms = 1e3 * DEFAULT_DERIVATIVE_WINDOW_S
+    bridge_ms = 1e3 * DERIVATIVE_SPAN_S
     done = f"the runs of up to {bridge_ms:g} ms bridged by the line between their flanks" if stale.bridged else ""
     if stale.span is not None:
         start, stop = stale.span

@@ -73,7 +73,7 @@ class Data:
     scenario: Scenario
     box: design.Box
     noise: SensorNoise
-    sims: Simulated  # n_simulations for training, then check_windows held out
+    sims: Simulated  # n_simulations for training, then check_simulations held out
     sliding: np.ndarray  # (n_samples,) the window's Eq. 5.1 samples
     inputs: np.ndarray  # (n_total, n_timesteps) network inputs of every simulation
     window_inputs: np.ndarray  # (1, n_timesteps)
@@ -98,7 +98,7 @@ def simulate_dataset(
     box = design.box_around(fdj, physics.fdj_std_nm[0], eta_o, physics.eta_o_std[0], document.health.fdj)
     scenario = scenario_from_window(seen, document.params, document.hinge, effects)
     health = design.draw(box, config.total_simulations, config.seed)
-    sims = simulate_noisy(scenario, health, window, design.centre(box), config.seed + 1, config.check_windows)
+    sims = simulate_noisy(scenario, health, window, design.centre(box), config.seed + 1, config.check_simulations)
     rate = window.sample_rate_hz
     residual = residual_torque_nm(
         seen.signals["current_a"], seen.signals["motor_speed_radps"], seen.signals["hinge_moment_nm"], rate, drive

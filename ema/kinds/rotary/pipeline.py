@@ -51,9 +51,11 @@ PIPELINE_LEARNING = LearnConfig(max_epochs=60, max_validation_failures=6)
 
 def learned(data: Data, config: PipelineConfig) -> NetworkEstimator:
     n = config.n_simulations
-    train = replace(PIPELINE_LEARNING, hidden=config.hidden_units, seed=config.seed)
+    settings = replace(PIPELINE_LEARNING, hidden=config.hidden_units, seed=config.seed)
     health = data.sims.health
-    return NetworkEstimator(train, config.members).fit(data.inputs[:n], health.fdj_nm[:n], health.eta_o[:n], data.box)
+    return NetworkEstimator(settings, config.members).fit(
+        data.inputs[:n], health.fdj_nm[:n], health.eta_o[:n], data.box
+    )
 
 
 def candidates(

@@ -43,7 +43,7 @@ from ema.kinds.servo.loop_dataset import ServoData, lane_parameters, simulate_se
 from ema.model.actuator import ActuatorDocument
 from ema.model.window import Window
 
-SERVO_TRAINING = LearnConfig(max_epochs=60, max_validation_failures=6)  # as the rotary pipeline's (a few dozen runs)
+SERVO_LEARNING = LearnConfig(max_epochs=60, max_validation_failures=6)  # as the rotary pipeline's (a few dozen runs)
 CHECK_PHASES = (0.0, 0.5)  # the position sensor's phases of its step the check simulates: the answer's, its twin's
 FDJ = "fdj_n"
 NOMINAL_FIELDS = {  # a constant of the inverse model -> the servo section's field of its nominal value
@@ -96,7 +96,7 @@ def undisturbed(
 
 
 def learned(data: ServoData, config: PipelineConfig) -> NetworkRegressor:
-    settings = replace(SERVO_TRAINING, hidden=config.hidden_units, seed=config.seed)
+    settings = replace(SERVO_LEARNING, hidden=config.hidden_units, seed=config.seed)
     n = config.n_simulations
     return NetworkRegressor(settings, config.members).fit(data.inputs[:n], data.normalize(data.truth[:n]))
 
@@ -232,7 +232,7 @@ def _report(
             n_simulations=config.n_simulations,
             n_timesteps=data.inputs.shape[1],
             inputs=["drive_force_n"],
-            check_windows=config.check_windows,
+            check_simulations=config.check_simulations,
             noise_estimated={"position_resolution_m": prepared.loop.resolution_m},
             box={name: (float(lo), float(hi)) for name, lo, hi in zip(data.targets, data.low, data.high, strict=True)},
         ),

@@ -13,7 +13,7 @@ from tests.foreign.effects import CASES
 from tests.foreign.physics import Flight
 from tests.foreign.windows import Effects, draw, filter_widths
 
-SMALL = PipelineConfig(n_simulations=32, check_windows=16, n_timesteps=100, hidden_units=20)
+SMALL = PipelineConfig(n_simulations=32, check_simulations=16, n_timesteps=100, hidden_units=20)
 STOPS_FLIGHT = Flight(airspeed_mps=100.0, altitude_m=5000.0)  # a low q̄: the motor holds the stop against it
 
 

@@ -25,7 +25,7 @@ from tests.foreign.windows import (
     worn,
 )
 
-SMALL = PipelineConfig(n_simulations=48, check_windows=16, n_timesteps=100, hidden_units=20)
+SMALL = PipelineConfig(n_simulations=48, check_simulations=16, n_timesteps=100, hidden_units=20)
 
 
 def _codes(result) -> set[str]:
@@ -350,9 +350,15 @@ def test_the_result_is_the_typed_contract_and_carries_its_config():
     assert document["schema"] == "ema-estimate/1"
     assert set(document["timings_s"]) >= {"simulate", "train", "predict", "total"}
     assert document["check"] == document["fit_check"]  # the check under its stage's name, and as first published
+    assert document["learned"] == document["training"] and document["learned"]["epochs"] >= 1
+    assert document["dataset"]["check_windows"] == document["dataset"]["check_simulations"] == SMALL.check_simulations
+    assert document["config"]["check_windows"] == SMALL.check_simulations
     assert Estimate.model_validate(document) == result
-    first_published = {key: value for key, value in document.items() if key != "check"}
-    assert Estimate.model_validate(first_published).check == result.check
+    renamed = ("check", "learned", "check_simulations")
+    first_published = {key: value for key, value in document.items() if key not in renamed}
+    first_published["dataset"] = {k: v for k, v in document["dataset"].items() if k not in renamed}
+    first_published["config"] = {k: v for k, v in document["config"].items() if k not in renamed}
+    assert Estimate.model_validate(first_published) == result
     assert result.config == SMALL
     assert result.estimates.FDJ.drift_pct == pytest.approx(100 * (result.estimates.FDJ.value / 0.05 - 1))
 

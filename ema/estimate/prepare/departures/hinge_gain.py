@@ -33,7 +33,7 @@ from ema.estimate.physics.friction import MIN_SLIDING_KERNELS, SolveSettings, nu
 from ema.estimate.prepare.departures.drive_constants import BESIDE, FIELDS
 from ema.estimate.stats import DECISIVE_Z, JACKKNIFE_BLOCKS, jackknife_std, rms, rms_log_likelihood_ratio
 from ema.model.params import DriveConstants
-from ema.model.residual import DEFAULT_DERIVATIVE_WINDOW_S, kernel_samples
+from ema.model.residual import DERIVATIVE_SPAN_S, kernel_samples
 from ema.model.window import Window
 
 PLAUSIBLE = (0.7, 1.35)  # lbf·ft for N·m is 0.74; outside, no sensor's: not taken
@@ -82,7 +82,7 @@ def free_load_solution(
     seen = as_read(window.signals, rate)
     t, a, o, sliding = (x[0] for x in regressors(seen, rate, drive, beside))
     used = int(sliding.sum())
-    if used < MIN_SLIDING_KERNELS * kernel_samples(rate, DEFAULT_DERIVATIVE_WINDOW_S):
+    if used < MIN_SLIDING_KERNELS * kernel_samples(rate, DERIVATIVE_SPAN_S):
         return None
     blocks = np.minimum(np.arange(len(t)) * JACKKNIFE_BLOCKS // len(t), JACKKNIFE_BLOCKS - 1)
     nuisances = [column[0] for column in nuisance_columns(seen, rate, drive, beside)]
