@@ -48,8 +48,8 @@ class Documents:
     def task(self, job: Job, config: PipelineConfig, threads: int) -> tuple[Any, ...]:
         """``ema.kinds.remote.estimate_json``'s arguments for ``job``: all of it JSON-able, for any process."""
         window, history = job
-        actuator, version = self.task_arguments(window)
-        return window_to_dict(window), config.model_dump(), threads, history, actuator, version
+        document, version = self.task_arguments(window)
+        return window_to_dict(window), config.model_dump(), threads, history, document, version
 
 
 def in_process(jobs: list[Job], config: PipelineConfig, threads: int, documents: Documents) -> Iterator[Answer]:

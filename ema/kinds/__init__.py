@@ -23,7 +23,7 @@ from collections.abc import Callable, Sequence
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import Estimate
 from ema.estimate.documents.window_facts import HistoryReadings
-from ema.kinds.base import ActuatorKind, Calibrated, CalibrationRequest, Cost, Request
+from ema.kinds.base import Calibrated, CalibrationRequest, Cost, Kind, Request
 from ema.kinds.linear import LINEAR
 from ema.kinds.rotary import ROTARY
 from ema.kinds.servo import SERVO
@@ -47,16 +47,16 @@ __all__ = [
 ]
 
 
-KINDS: dict[str, ActuatorKind] = {kind.facts.name: kind for kind in (ROTARY, LINEAR, SERVO)}
+KINDS: dict[str, Kind] = {kind.facts.name: kind for kind in (ROTARY, LINEAR, SERVO)}
 
 
 def warm_up(names: Sequence[str] = tuple(KINDS)) -> None:
-    """Each named kind warmed (``ActuatorKind.warm_up``): a service warms every kind before it answers."""
+    """Each named kind warmed (``Kind.warm_up``): a service warms every kind before it answers."""
     for name in names:
         KINDS[name].warm_up()
 
 
-def kind_of(actuator: ActuatorDocument) -> ActuatorKind:
+def kind_of(actuator: ActuatorDocument) -> Kind:
     """The method of ``actuator``'s kind."""
     return KINDS[actuator.kind]
 

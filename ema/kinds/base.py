@@ -1,4 +1,4 @@
-"""What every kind of actuator declares (``ActuatorKind``) and the requests and answers its methods share."""
+"""What every kind of actuator declares (``Kind``) and the requests and answers its methods share."""
 
 from __future__ import annotations
 
@@ -80,7 +80,7 @@ def read_quasi_statically(window: Window, request: Request, reading: QuasiStatic
     )
 
 
-class ActuatorKind(Protocol):
+class Kind(Protocol):
     @property
     def facts(self) -> KindFacts: ...
     def stages(self, window: Window) -> tuple[str, ...]: ...

@@ -28,18 +28,18 @@ def estimate_json(
     config: dict[str, Any],
     threads: int,
     history: dict[str, Any] | None = None,
-    actuator: dict[str, Any] | None = None,
+    document: dict[str, Any] | None = None,
     version: int | None = None,
 ) -> dict[str, Any]:
     """The estimate of one window as a JSON-able dict, or {"error": {"field", "message"}} for a window refused;
-    ``history``: what other windows of the actuator read, ``actuator``: its ema-actuator/1 document and
+    ``history``: what other windows of the actuator read, ``document``: its ema-actuator/1 document and
     ``version`` (none: the default, ``ema.model.actuator.THESIS``; ``ema.kinds.estimate``)."""
     thread_budget.configure(threads)
     known = None if history is None else HistoryReadings.model_validate(history)
     try:
-        document = THESIS if actuator is None else actuator_from_dict(actuator)
+        actuator = THESIS if document is None else actuator_from_dict(document)
         result = estimate(
-            window_from_dict(window), PipelineConfig(**config), actuator=document, version=version, history=known
+            window_from_dict(window), PipelineConfig(**config), actuator=actuator, version=version, history=known
         )
     except InputError as exc:
         return {"error": {"field": exc.field, "message": exc.message}}
