@@ -33,7 +33,7 @@ from ema.kinds.servo.fold_errors import model_errors_pct
 from ema.kinds.servo.inverse import UNITS
 from ema.kinds.servo.log_reading import completed, log_loop, prepare_servo
 from ema.kinds.servo.stages import physics_of
-from ema.model.actuator import ActuatorDocument, read_actuator
+from ema.model.actuator import ServoActuator, as_kind, read_actuator
 from ema.model.logmap import read_logmap, read_mapped
 from ema.model.window import Window, window_from_dict
 
@@ -92,7 +92,7 @@ def identification_table(learned: dict, base: dict, simulated: dict[str, float])
     return "\n".join(rows)
 
 
-def errors_on(window: Window, document: ActuatorDocument, completed: ActuatorDocument) -> dict[str, dict[str, float]]:
+def errors_on(window: Window, document: ServoActuator, completed: ServoActuator) -> dict[str, dict[str, float]]:
     """Each model's error on ``window``, its constants fixed: ema's learned, the published symmetric and asymmetric."""
     prepared = [prepare_servo(window, document)]
     servo = completed.servo
@@ -121,7 +121,7 @@ def main() -> None:
     args = parser.parse_args()
     thread_budget.configure(None)
     mapping, document_path = EMPS / "log-map.json", EMPS / "actuator.json"
-    window, document = read(EMPS / "DATA_EMPS.mat", mapping), read_actuator(document_path)
+    window, document = read(EMPS / "DATA_EMPS.mat", mapping), as_kind(read_actuator(document_path), ServoActuator)
     wall, answer = cli_seconds(EMPS / "DATA_EMPS.mat", mapping, document_path)
     stages = answer["timings_s"]
     calibrated = calibrate([window], CalibrationRequest(PipelineConfig(), document))
@@ -161,7 +161,8 @@ def main() -> None:
     lines += ["", reading(answer, base), "", recorded_gain_line(window, document, answer)]
     if args.held_out is not None:
         held_out_map = args.held_out_map or mapping
-        lines += ["", *held_out_lines(args.held_out, held_out_map, document, calibrated.completed, answer)]
+        completed = None if calibrated.completed is None else as_kind(calibrated.completed, ServoActuator)
+        lines += ["", *held_out_lines(args.held_out, held_out_map, document, completed, answer)]
     body = "\n".join(lines)
     print(body)
     if args.docs:
@@ -171,7 +172,7 @@ def main() -> None:
 WRONG_KP = (0.5, 30.0)  # the log's recorded kp times these: a log whose recorded gain is not its loop's
 
 
-def recorded_gain_line(window: Window, document: ActuatorDocument, answer: dict) -> str:
+def recorded_gain_line(window: Window, document: ServoActuator, answer: dict) -> str:
     """The log read with its recorded kp altered: the gains its command follows (``log_loop``), and FDJ read."""
     kp = window.constants["position_gain_per_s"]
     read = []
@@ -208,14 +209,14 @@ def reading(answer: dict, base: dict[str, dict]) -> str:
     )
 
 
-def _base_model(window: Window, document: ActuatorDocument) -> dict[str, dict]:
+def _base_model(window: Window, document: ServoActuator) -> dict[str, dict]:
     """The symmetric model's constants as ema's physics stage reads them (Newey–West stds)."""
     solution = physics_of(prepare_servo(window, document))
     return {NAMES[n]: {"value": solution.values[n], "std": solution.stds[n], "unit": UNITS[n]} for n in NAMES}
 
 
 def held_out_lines(
-    path: Path, mapping: Path, document: ActuatorDocument, completed: ActuatorDocument | None, shared: dict
+    path: Path, mapping: Path, document: ServoActuator, completed: ServoActuator | None, shared: dict
 ) -> list[str]:
     assert completed is not None
     window = read(path, mapping)

@@ -27,7 +27,7 @@ from ema.calibration.documents import Change, DriveLearned
 from ema.cli.benchmark_docs import write_section
 from ema.kinds import estimate
 from ema.kinds.linear.calibration_report import calibrate_linear
-from ema.model.actuator import ActuatorDocument, read_actuator
+from ema.model.actuator import LinearActuator, as_kind, read_actuator
 from ema.model.logmap import read_logmap, read_mapped
 from ema.model.window import window_from_dict
 from ema.prognosis.documents import Stored
@@ -107,7 +107,7 @@ class SetRead:
     stroke: str
 
 
-def read_set(runs: list, learned: ActuatorDocument) -> SetRead:
+def read_set(runs: list, learned: LinearActuator) -> SetRead:
     results = [estimate(w, actuator=learned) for w in runs]
     fdj = np.array([(r.estimates.FDJ.value, r.estimates.FDJ.std, r.estimates.FDJ.repeatability_std) for r in results])
     detected = sum(any(n.code == "fdj_departed" for n in r.notes) for r in results)
@@ -127,7 +127,7 @@ def main() -> None:
     teach = [
         w for state, load in found if state == HEALTHY and load > 0 for w in windows(args.runs, state, load, first)
     ]
-    report, learned, _ = calibrate_linear(teach, read_actuator(RIG / "actuator.json"))
+    report, learned, _ = calibrate_linear(teach, as_kind(read_actuator(RIG / "actuator.json"), LinearActuator))
     assert learned is not None and report.drive is not None
     read = {}
     for state, load in found:
@@ -159,7 +159,7 @@ def main() -> None:
         write_section("A real actuator: the Cranfield ball-screw rig", command, body, ROOT / "docs" / "results.md")
 
 
-def learned_text(drive: DriveLearned, learned: ActuatorDocument) -> str:
+def learned_text(drive: DriveLearned, learned: LinearActuator) -> str:
     screw = learned.screw
     assert screw is not None and drive.fdj_nm is not None and drive.fdj_std_nm is not None
     return (
@@ -235,7 +235,7 @@ def checks(read: dict[tuple[str, int], SetRead]) -> list[str]:
     return ["On these runs (the lab's checks):", "", *lines]
 
 
-def histories(folder: Path, found: list[tuple[str, int]], learned: ActuatorDocument) -> list[str]:
+def histories(folder: Path, found: list[tuple[str, int]], learned: LinearActuator) -> list[str]:
     """Each load's spalling stages as one actuator's life: its held-out healthy runs, then every run of spalling 1
     to 8 in that order, stored as the service stores them and trended in that order (the runs carry no time);
     beside it, the healthy runs alone. What the prognosis says of FDJ, and the status it earns."""

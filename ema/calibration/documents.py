@@ -10,7 +10,7 @@ from typing import Literal
 
 from pydantic import Field
 
-from ema.model.actuator import ActuatorDocument
+from ema.model.actuator import AnyActuator
 from ema.model.document import Document
 
 
@@ -188,7 +188,7 @@ class CalibrationReport(Document):
     error_after: dict[str, float] | None = None
     error_pct_before: dict[str, float] | None = None
     error_pct_after: dict[str, float] | None = None
-    completed_actuator: ActuatorDocument | None = Field(
+    completed_actuator: AnyActuator | None = Field(
         None,
         description="the actuator's ema-actuator/1 document completed with what the windows taught (a linear "
         "actuator's drive, a servo's load): store it with PUT /v1/actuators/{id} (null: nothing to complete)",

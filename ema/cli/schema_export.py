@@ -4,21 +4,22 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
+from typing import Any
 
 from pydantic import BaseModel
 
 
-def documents() -> dict[str, type[BaseModel]]:
-    """File stem -> the model (imported here: the CLI's help must not pay for them)."""
+def schemas() -> dict[str, dict[str, Any]]:
+    """File stem -> the JSON Schema of that document (its model imported here: the CLI's help must not pay for
+    them). ``ema-actuator/1`` is one kind's document, chosen by its ``kind`` (``ema.model.actuator.AnyActuator``)."""
     from ema.calibration.documents import CalibrationReport
     from ema.estimate.documents import Estimate
-    from ema.model.actuator import ActuatorDocument
+    from ema.model.actuator import actuator_schema
     from ema.model.logmap import LogMap
     from ema.model.window import WindowDocument
     from ema.prognosis.documents import ActuatorSummary, EstimateHistory, Prognosis, StoredActuator, Withdrawal
 
-    return {
-        "ema-actuator-1": ActuatorDocument,
+    models: dict[str, type[BaseModel]] = {
         "stored-actuator": StoredActuator,
         "ema-window-1": WindowDocument,
         "ema-logmap-1": LogMap,
@@ -29,6 +30,10 @@ def documents() -> dict[str, type[BaseModel]]:
         "actuator-summary": ActuatorSummary,
         "withdrawal": Withdrawal,
     }
+    return {
+        "ema-actuator-1": actuator_schema(),
+        **{stem: m.model_json_schema(by_alias=True) for stem, m in models.items()},
+    }
 
 
 def export(folder: Path, check: bool = False) -> list[str]:
@@ -36,8 +41,8 @@ def export(folder: Path, check: bool = False) -> list[str]:
     if not check:
         folder.mkdir(parents=True, exist_ok=True)
     stale = []
-    for stem, model in documents().items():
-        text = json.dumps(model.model_json_schema(by_alias=True), indent=2, sort_keys=True) + "\n"
+    for stem, schema in schemas().items():
+        text = json.dumps(schema, indent=2, sort_keys=True) + "\n"
         path = folder / f"{stem}.json"
         if check:
             if not path.exists() or path.read_text() != text:

@@ -12,7 +12,7 @@ import numpy as np
 
 from ema.cli.options import actuator_document
 from ema.kinds.rotary.synthetic import synthetic_window
-from ema.model.actuator import ActuatorDocument
+from ema.model.actuator import ActuatorDocument, RotaryActuator
 from ema.model.aircraft import FlightCondition, GroundLoad
 from ema.model.checks import InputError
 from ema.model.effects import EFFECTS, EffectSet
@@ -71,7 +71,7 @@ def _healths(
     ``end`` (FDJ, η_O; no change where None) over ``series`` windows, FSJ never below FDJ (static friction
     never below dynamic)."""
     nominal_health = actuator.nominal
-    if actuator.drive is None or nominal_health is None or nominal_health.fsj_nm is None:
+    if not isinstance(actuator, RotaryActuator) or nominal_health is None or nominal_health.fsj_nm is None:
         raise InputError("--actuator", f"a {actuator.kind} actuator's drive is not simulated: give a rotary one")
     nominal = (nominal_health.fdj, nominal_health.efficiency, nominal_health.fsj_nm)
     first = {

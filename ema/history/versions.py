@@ -13,7 +13,7 @@ import sqlalchemy as sa
 from ema.history.connection import SqlStore, now
 from ema.history.refusals import VersionContentionError
 from ema.history.tables import actuators
-from ema.model.actuator import ActuatorDocument
+from ema.model.actuator import ActuatorDocument, actuator_from_json
 from ema.prognosis.documents import StoredActuator
 
 VERSION_ATTEMPTS = 20  # replicas racing for an actuator's next document version
@@ -76,7 +76,7 @@ class VersionedDocuments(SqlStore):
         row = self._latest_document(actuator_id)
         if row is None:
             return None
-        document = ActuatorDocument.model_validate_json(row.document)
+        document = actuator_from_json(row.document)
         return StoredActuator(actuator_id=actuator_id, version=row.version, stored_at=row.stored_at, document=document)
 
     def latest_documents(self, actuator_ids: Sequence[str]) -> dict[str, StoredActuator]:
@@ -97,7 +97,7 @@ class VersionedDocuments(SqlStore):
                 actuator_id=row.actuator_id,
                 version=row.version,
                 stored_at=row.stored_at,
-                document=ActuatorDocument.model_validate_json(row.document),
+                document=actuator_from_json(row.document),
             )
             for row in rows
         }

@@ -1,26 +1,29 @@
-"""``ema-actuator/1``: one actuator of the architecture (position, speed and current loops, gearbox, Borello
-friction, backlash, end stops) with its own constants, as its user writes it down.
+"""``ema-actuator/1``: one actuator with its own constants, as its user writes it down.
 
-:class:`Actuator` is the document and what every stage reads its constants from: the drive's constants
-(``params``: the simulator's :class:`~ema.model.params.DriveConstants`, same field names), the nominal health and
-the healthy range around it (``ranges``), the prognosis's failure levels (``thresholds``), and optionally
-the sensors' noise and the airframe the hinge moment is checked against. ``THESIS`` is the thesis's
-elevator EMA (Table 3.1), the default wherever a user names none; ``examples/actuator.json`` holds it.
+What every kind's document holds is :class:`ActuatorDocument`, what every stage reads: the nominal health and the
+healthy range around it (``ranges``), the prognosis's failure levels (``thresholds``), and optionally the sensors'
+noise and the airframe the hinge moment is checked against. Each kind's class adds its own section (the sections'
+models: ``ema.model.drive``, ``ema.model.screw``, ``ema.model.servo``): ``RotaryActuator`` its drive (``params``:
+the simulator's :class:`~ema.model.params.DriveConstants`, same field names), ``LinearActuator`` its screw,
+``ServoActuator`` its servo. ``AnyActuator`` joins them, tagged by ``kind``: a document is read as its kind's
+class, and a rotary document may omit ``kind`` (as first published). ``THESIS`` is the thesis's elevator EMA
+(Table 3.1), the default wherever a user names none; ``examples/actuator.json`` holds it.
 """
 
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Literal
+from typing import TYPE_CHECKING, Annotated, Any, Literal, TypeVar
 
 import numpy as np
-from pydantic import Field, model_validator
+from pydantic import Discriminator, Field, Tag, TypeAdapter, ValidationError, model_validator
+from pydantic.json_schema import DEFAULT_REF_TEMPLATE
 
 from ema.model.aircraft import HingeGeometry
-from ema.model.checks import InputError, read_document, validated
+from ema.model.checks import UNKNOWN_TAG, InputError, from_validation, read_document
 from ema.model.document import Document, Number
 from ema.model.drive import Drive
-from ema.model.kinds import KINDS, KindFacts
+from ema.model.kinds import DEFAULT_KIND, KIND_NAMES, KINDS, KindFacts
 from ema.model.params import MAX_CORRELATION_S, DriveConstants, HealthRanges, eta_a_from_eta_o
 from ema.model.screw import Screw
 from ema.model.servo import Servo
@@ -32,6 +35,11 @@ SCHEMA = "ema-actuator/1"
 DEFAULT_ETA_O_BELOW, THESIS_ETA_O = 0.70, 0.85  # the prognosis's default η_O threshold, at the thesis's nominal
 HEALTHY_SPAN = 0.2  # the healthy range: nominal ±20 % (η_O capped below 1), the thesis's §5.4 ranges
 MAX_HEALTHY_ETA_O = 0.98
+SECTIONS = tuple(kind.section for kind in KINDS.values())  # each kind's own field
+_KIND_DESCRIPTION = (
+    "rotary: a gear train to a surface (drive); linear: a ball screw turned by a stepper (screw); servo: a linear "
+    "axis under a known position controller, logged on the load side (servo)"
+)
 
 
 class Nominal(Document):
@@ -121,18 +129,12 @@ class Airframe(Document):
 
 
 class ActuatorDocument(Document):
-    """``ema-actuator/1``."""
+    """``ema-actuator/1``: what every kind's document holds. A document is one kind's class (``RotaryActuator``,
+    ``LinearActuator``, ``ServoActuator``), which adds its own section; ``AnyActuator`` joins them on ``kind``."""
 
     schema_: Literal["ema-actuator/1"] = Field("ema-actuator/1", alias="schema")
     name: str = Field(min_length=1, max_length=200, description="for a person")
-    kind: Literal["rotary", "linear", "servo"] = Field(
-        "rotary",
-        description="rotary: a gear train to a surface (drive); linear: a ball screw turned by a stepper (screw); "
-        "servo: a linear axis under a known position controller, logged on the load side (servo)",
-    )
-    drive: Drive | None = Field(None, description="a rotary actuator's drive and gear train")
-    screw: Screw | None = Field(None, description="a linear actuator's screw and drive")
-    servo: Servo | None = Field(None, description="a servo's drive, controller and load")
+    kind: str  # each kind's class narrows it to its name
     nominal: Nominal | None = Field(
         None, description="the health new; a linear actuator's or a servo's is learned by ema calibrate"
     )
@@ -140,14 +142,25 @@ class ActuatorDocument(Document):
     sensor_noise: SensorNoiseDocument | None = Field(None, description="null: the thesis's levels")
     airframe: Airframe | None = Field(None, description="null: the hinge moment is not checked against an aircraft")
 
+    @model_validator(mode="before")
+    @classmethod
+    def _its_own_section(cls, values: Any) -> Any:
+        """The document's input with its kind's section named where missing, and another kind's refused where given
+        (a null one, as documents were first written, dropped)."""
+        if not isinstance(values, dict) or values.get("kind", DEFAULT_KIND) not in KINDS:
+            return values
+        kind = values.get("kind", DEFAULT_KIND)
+        own = KINDS[kind].section
+        values = {k: v for k, v in values.items() if v is not None or k == own or k not in SECTIONS}
+        for other in SECTIONS:
+            if other != own and other in values:
+                raise ValueError(f"{other}: a {kind} actuator has no {other} (kind: {kind})")
+        if values.get(own) is None:
+            raise ValueError(f"{own}: a {kind} actuator's document gives its {own}")
+        return values
+
     @model_validator(mode="after")
-    def _one_kind(self) -> ActuatorDocument:
-        own = self.facts.section
-        if getattr(self, own) is None:
-            raise ValueError(f"{own}: a {self.kind} actuator's document gives its {own}")
-        for other in (k.section for k in KINDS.values() if k.section != own):
-            if getattr(self, other) is not None:
-                raise ValueError(f"{other}: a {self.kind} actuator has no {other} (kind: {self.kind})")
+    def _nominal_in_its_unit(self) -> ActuatorDocument:
         if self.facts.nominal_given and (
             self.nominal is None or self.nominal.fsj_nm is None or self.nominal.eta_o is None
         ):
@@ -177,16 +190,12 @@ class ActuatorDocument(Document):
     @property
     def section(self) -> Drive | Screw | Servo:
         """The kind's own section of the document (its drive, its screw, its servo)."""
-        section = getattr(self, self.facts.section)
-        assert section is not None  # _one_kind
-        return section
+        raise NotImplementedError  # each kind's class
 
     @property
     def params(self) -> DriveConstants:
         """The drive's constants as the simulator takes them (a rotary actuator's)."""
-        if self.drive is None:
-            raise InputError("actuator.kind", f"a {self.kind} actuator has no rotary drive to simulate")
-        return DriveConstants(**self.drive.model_dump())
+        raise InputError("actuator.kind", f"a {self.kind} actuator has no rotary drive to simulate")
 
     @property
     def gear_ratio(self) -> float:
@@ -266,10 +275,79 @@ class ActuatorDocument(Document):
         return SensorNoise() if self.sensor_noise is None else SensorNoise(**self.sensor_noise.model_dump())
 
 
-def _thesis() -> ActuatorDocument:
+KindDocument = TypeVar("KindDocument", bound=ActuatorDocument)
+
+
+class RotaryActuator(ActuatorDocument):
+    """A rotary actuator's document: a gear train to a surface, its drive simulated at 1 µs."""
+
+    kind: Literal["rotary"] = Field("rotary", description=_KIND_DESCRIPTION)
+    drive: Drive = Field(description="the drive and its gear train")
+
+    @property
+    def section(self) -> Drive:
+        return self.drive
+
+    @property
+    def params(self) -> DriveConstants:
+        return DriveConstants(**self.drive.model_dump())
+
+
+class LinearActuator(ActuatorDocument):
+    """A linear actuator's document: a ball screw turned by a stepper."""
+
+    kind: Literal["linear"] = Field(description=_KIND_DESCRIPTION)
+    screw: Screw = Field(description="the screw and its drive")
+
+    @property
+    def section(self) -> Screw:
+        return self.screw
+
+
+class ServoActuator(ActuatorDocument):
+    """A servo's document: a linear axis under a known position controller, logged on the load side."""
+
+    kind: Literal["servo"] = Field(description=_KIND_DESCRIPTION)
+    servo: Servo = Field(description="the drive, its controller and the load")
+
+    @property
+    def section(self) -> Servo:
+        return self.servo
+
+
+def as_kind(actuator: ActuatorDocument, kind: type[KindDocument]) -> KindDocument:
+    """``actuator`` as ``kind``'s class (a kind's method reading its own section); InputError naming ``kind`` where
+    the document is another kind's."""
+    if not isinstance(actuator, kind):
+        raise InputError("actuator.kind", f"is {actuator.kind}: this needs a {kind.__name__} document")
+    return actuator
+
+
+def _kind_of(document: Any) -> Any:
+    """The tag ``AnyActuator`` dispatches on: the document's ``kind`` (a document without one is a rotary
+    actuator's, as first published)."""
+    if isinstance(document, dict):
+        return document.get("kind", DEFAULT_KIND)
+    return getattr(document, "kind", None)
+
+
+AnyActuator = Annotated[
+    Annotated[RotaryActuator, Tag("rotary")]
+    | Annotated[LinearActuator, Tag("linear")]
+    | Annotated[ServoActuator, Tag("servo")],
+    Discriminator(
+        _kind_of,
+        custom_error_type=UNKNOWN_TAG,
+        custom_error_message=f"kind: is one of {', '.join(KIND_NAMES)}",
+    ),
+]  # ``ema-actuator/1`` as read: one kind's document, by its ``kind``
+ACTUATOR_DOCUMENT: TypeAdapter[ActuatorDocument] = TypeAdapter(AnyActuator)  # what parses and exports it
+
+
+def _thesis() -> RotaryActuator:
     params, hinge = DriveConstants(), HingeGeometry()
     drive = {name: getattr(params, name) for name in Drive.model_fields}
-    return ActuatorDocument(
+    return RotaryActuator(
         name="thesis elevator EMA (Table 3.1)",
         drive=Drive(**drive),
         nominal=Nominal(fdj_nm=0.05, fsj_nm=0.10, eta_o=0.85),
@@ -282,8 +360,23 @@ THESIS = _thesis()
 
 
 def actuator_from_dict(document: Any) -> ActuatorDocument:
-    """Parse and validate an ``ema-actuator/1`` document (a dict); errors name the field."""
-    return validated(ActuatorDocument, document, "actuator")
+    """Parse and validate an ``ema-actuator/1`` document (a dict) as its kind's class; errors name the field."""
+    if not isinstance(document, dict):
+        raise InputError("actuator", f"must be a JSON object, got {type(document).__name__}")
+    try:
+        return ACTUATOR_DOCUMENT.validate_python(document)
+    except ValidationError as exc:
+        raise from_validation(exc, tags=KIND_NAMES) from None
+
+
+def actuator_from_json(text: str | bytes) -> ActuatorDocument:
+    """An ``ema-actuator/1`` document from its JSON text (a stored one), as its kind's class."""
+    return ACTUATOR_DOCUMENT.validate_json(text)
+
+
+def actuator_schema(ref_template: str = DEFAULT_REF_TEMPLATE) -> dict[str, Any]:
+    """The JSON Schema of ``ema-actuator/1``: one kind's document, chosen by ``kind``."""
+    return {"title": "ActuatorDocument", **ACTUATOR_DOCUMENT.json_schema(by_alias=True, ref_template=ref_template)}
 
 
 def read_actuator(path: str | Path) -> ActuatorDocument:

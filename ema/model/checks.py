@@ -97,21 +97,24 @@ def array_in_range(field: str, values: np.ndarray, low: float, high: float, unit
 
 
 BOUND_ERRORS = ("greater_than", "greater_than_equal", "less_than", "less_than_equal")  # pydantic's, on a number
+UNKNOWN_TAG = "unknown_tag"  # a tagged union's error where the tag names no member ("kind: is one of ...")
 
 
-def from_validation(exc: Any, prefix: str = "") -> InputError:
+def from_validation(exc: Any, prefix: str = "", tags: tuple[str, ...] = ()) -> InputError:
     """A pydantic ValidationError's first error as an InputError naming the field (list indices go
     into the message: ``signals.current_a``, "sample 17: Input should be a finite number"). A check across
-    fields names the one it reports on first in its message ("fsj_nm: ..."): that field is named."""
+    fields names the one it reports on first in its message ("fsj_nm: ..."): that field is named. ``tags``: a
+    tagged union's member names, which pydantic puts first in the field's path and the document does not hold."""
     first = exc.errors()[0]
-    names = [str(part) for part in first["loc"] if not isinstance(part, int)]
-    indices = [part for part in first["loc"] if isinstance(part, int)]
+    loc = first["loc"][1:] if first["loc"] and first["loc"][0] in tags else first["loc"]
+    names = [str(part) for part in loc if not isinstance(part, int)]
+    indices = [part for part in loc if isinstance(part, int)]
     said = first["msg"].removeprefix("Value error, ")
     given = first.get("input")
     if first["type"] in BOUND_ERRORS and isinstance(given, int | float | str):
         said += f", got {given:g}" if isinstance(given, int | float) else f", got {given!r}"
     message = said if not indices else f"sample {indices[0]}: {said}"
     head, _, rest = message.partition(": ")
-    if first["type"] == "value_error" and rest and head.replace("_", "").replace(".", "").isalnum():
+    if first["type"] in ("value_error", UNKNOWN_TAG) and rest and head.replace("_", "").replace(".", "").isalnum():
         names, message = [*names, head], rest
     return InputError(prefix + (".".join(names) or "document"), message)

@@ -14,7 +14,7 @@ from pydantic import Field
 
 from ema.estimate.documents import Estimate, Notes
 from ema.estimate.documents.window_facts import InertiaReading
-from ema.model.actuator import ActuatorDocument
+from ema.model.actuator import AnyActuator
 from ema.model.document import Document
 
 PARAMETERS = ("FDJ", "eta_O", "eta_A")
@@ -38,7 +38,7 @@ class StoredActuator(Document):
     actuator_id: str
     version: int = Field(ge=1, description="1 for the first document PUT, then one more for each that differs")
     stored_at: str = Field(description="when this version was stored (UTC, ISO 8601)")
-    document: ActuatorDocument
+    document: AnyActuator
 
 
 class Withdrawal(Document):

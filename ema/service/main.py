@@ -18,7 +18,7 @@ from ema.estimate import thread_budget
 from ema.history.open import open_history
 from ema.kinds import warm_up
 from ema.model import runtime as sim_runtime
-from ema.model.actuator import ActuatorDocument
+from ema.model.actuator import ActuatorDocument, actuator_schema
 from ema.model.window import WindowDocument
 from ema.service import errors
 from ema.service.config import Settings
@@ -55,10 +55,14 @@ def _openapi(app: FastAPI) -> dict[str, Any]:
 
         schema = get_openapi(title=app.title, version=app.version, description=app.description, routes=app.routes)
         components = schema.setdefault("components", {}).setdefault("schemas", {})
-        for model in (WindowDocument, CalibrateIn, ActuatorDocument):
-            document = model.model_json_schema(ref_template="#/components/schemas/{model}", by_alias=True)
+        template = "#/components/schemas/{model}"
+        for model in (WindowDocument, CalibrateIn):
+            document = model.model_json_schema(ref_template=template, by_alias=True)
             components.update(document.pop("$defs", {}))
             components[model.__name__] = document
+        document = actuator_schema(ref_template=template)  # one kind's document, by its kind
+        components.update(document.pop("$defs", {}))
+        components[ActuatorDocument.__name__] = document
         app.openapi_schema = schema
     return app.openapi_schema
 

@@ -14,11 +14,12 @@ from collections.abc import Callable, Sequence
 from typing import TypeVar
 
 from fastapi import Request
-from pydantic import BaseModel, ValidationError
+from pydantic import BaseModel, TypeAdapter, ValidationError
 
 from ema import kinds
 from ema.estimate.config import PipelineConfig
 from ema.model.checks import InputError, from_validation
+from ema.model.kinds import KIND_NAMES
 from ema.model.window import Window
 from ema.service.config import Settings
 from ema.service.jobs import JobRunner
@@ -27,19 +28,21 @@ Model = TypeVar("Model", bound=BaseModel)
 T = TypeVar("T")
 
 
-def _parse(model: type[Model], body: bytes) -> Model:
+def _parse(model: type[Model] | TypeAdapter[Model], body: bytes) -> Model:
     if not body:
         raise InputError("body", "is empty: expected a JSON document")
     try:
-        return model.model_validate_json(body)
+        return model.validate_json(body) if isinstance(model, TypeAdapter) else model.model_validate_json(body)
     except ValidationError as exc:
         first = exc.errors()[0]
         if first["type"] == "json_invalid":
             raise InputError("body", f"is not valid JSON ({first['msg']})") from None
-        raise from_validation(exc) from None
+        raise from_validation(exc, tags=KIND_NAMES) from None  # an actuator's kind tags its document, no field
 
 
-async def read_body(request: Request, runner: JobRunner, model: type[Model], then: Callable[[Model], T]) -> T:
+async def read_body(
+    request: Request, runner: JobRunner, model: type[Model] | TypeAdapter[Model], then: Callable[[Model], T]
+) -> T:
     """``then`` of the request's body validated as ``model`` (``JobRunner.receiving``: 503 at once when there is
     no room), both on the runner's parsing thread; InputError naming the field otherwise."""
     runner.receiving()

@@ -40,12 +40,18 @@ def test_every_kind_of_the_documents_has_its_method():
 
 
 def test_the_documents_kind_field_lists_every_kind():
-    from ema.model.actuator import ActuatorDocument
+    from ema.model.actuator import actuator_schema
     from ema.model.logmap import LogMap
 
-    for model in (ActuatorDocument, LogMap):
-        schema = model.model_json_schema()["properties"]["kind"]
-        assert set(schema["enum"]) == set(facts.KINDS)
+    assert set(LogMap.model_json_schema()["properties"]["kind"]["enum"]) == set(facts.KINDS)
+    schema = actuator_schema()
+    members = [schema["$defs"][ref["$ref"].rpartition("/")[2]] for ref in schema["oneOf"]]
+    by_kind = {member["properties"]["kind"]["const"]: member for member in members}
+    assert set(by_kind) == set(facts.KINDS)  # one document class per kind, joined on kind
+    for name, member in by_kind.items():
+        section = facts.KINDS[name].section
+        assert section in member["required"]  # its own section, and no other kind's
+        assert not ({other.section for other in facts.KINDS.values()} - {section}) & set(member["properties"])
 
 
 QUICK = (

@@ -72,3 +72,34 @@ def test_a_document_without_its_airframe_is_valid_and_checks_no_aircraft():
     with pytest.raises(InputError) as refused:
         actuator_from_dict({**document, "schema": "ema-actuator/2"})
     assert refused.value.field == "schema"
+
+
+@pytest.mark.parametrize(
+    "path", [EXAMPLE, EXAMPLE.parent / "emps" / "actuator.json", EXAMPLE.parent / "ballscrew-rig" / "actuator.json"]
+)
+def test_each_kinds_document_is_its_own_class_and_round_trips(path):
+    """A document is read as its kind's class (its section typed), and written back reads the same."""
+    from ema.model.actuator import LinearActuator, RotaryActuator, ServoActuator, actuator_from_json
+
+    document = read_actuator(path)
+    classes = {"rotary": RotaryActuator, "linear": LinearActuator, "servo": ServoActuator}
+    assert type(document) is classes[document.kind] and document.section is getattr(document, document.facts.section)
+    assert actuator_from_json(document.model_dump_json(by_alias=True)) == document
+    assert {"drive", "screw", "servo"} & set(document.model_dump()) == {document.facts.section}
+
+
+def test_a_document_as_first_written_still_reads_and_another_kinds_section_is_refused():
+    """Documents stored before the kinds' classes carry every section, null but their own, and a rotary one may
+    omit its kind: both still read. A section of another kind is refused naming it, and so is an unknown kind."""
+    document = json.loads(EXAMPLE.read_text())
+    document.pop("kind", None)
+    assert actuator_from_dict({**document, "screw": None, "servo": None}) == THESIS
+    with pytest.raises(InputError, match="a rotary actuator has no screw") as refused:
+        actuator_from_dict({**document, "screw": {"lead_mm": 5.0}})
+    assert refused.value.field == "screw"
+    with pytest.raises(InputError, match="is one of rotary, linear, servo") as refused:
+        actuator_from_dict({**document, "kind": "hydraulic"})
+    assert refused.value.field == "kind"
+    with pytest.raises(InputError, match="gives its drive") as refused:
+        actuator_from_dict({key: value for key, value in document.items() if key != "drive"})
+    assert refused.value.field == "drive"

@@ -16,6 +16,7 @@ from ema.estimate.quasistatic.drive_torque import STEPPER_READING
 from ema.estimate.quasistatic.slow_window import QUASI_STATIC
 from ema.kinds.base import Calibrated, CalibrationRequest, Cost, Request, read_quasi_statically
 from ema.kinds.linear.calibration_report import calibrate_linear
+from ema.model.actuator import LinearActuator, as_kind
 from ema.model.kinds import KINDS, KindFacts
 from ema.model.window import Window
 
@@ -31,7 +32,7 @@ class Linear:
         return read_quasi_statically(window, request, STEPPER_READING)
 
     def calibrate(self, windows: Sequence[Window], request: CalibrationRequest) -> Calibrated:
-        report, completed, plot = calibrate_linear(windows, request.actuator, request.truth)
+        report, completed, plot = calibrate_linear(windows, as_kind(request.actuator, LinearActuator), request.truth)
         return Calibrated(report.model_copy(update={"completed_actuator": completed}), completed, plot)
 
     def cost(self, window: Window, config: PipelineConfig) -> Cost:

@@ -28,7 +28,7 @@ from ema.calibration.plot import ResidualPlot, Series
 from ema.estimate.documents import DIMENSIONLESS
 from ema.kinds.linear.changes import baseline, compared
 from ema.kinds.linear.drive_calibration import CalibratedDrive, Run, calibrate_drive, read_run
-from ema.model.actuator import ActuatorDocument, Nominal
+from ema.model.actuator import LinearActuator, Nominal
 from ema.model.params import load_factors
 from ema.model.window import Window
 
@@ -39,8 +39,8 @@ ANCHOR = (
 
 
 def calibrate_linear(
-    windows: Sequence[Window], actuator: ActuatorDocument, truth: Mapping[str, float] | None = None
-) -> tuple[CalibrationReport, ActuatorDocument | None, ResidualPlot]:
+    windows: Sequence[Window], actuator: LinearActuator, truth: Mapping[str, float] | None = None
+) -> tuple[CalibrationReport, LinearActuator | None, ResidualPlot]:
     """The report, the completed document where the runs taught the drive (None when comparing), and its figure."""
     started = time.perf_counter()
     runs = [read_run(w, actuator) for w in windows]
@@ -65,7 +65,7 @@ def _drive_plot(calibrated: CalibratedDrive) -> ResidualPlot:
     )
 
 
-def _stroke_plot(runs: list[Run], actuator: ActuatorDocument) -> ResidualPlot:
+def _stroke_plot(runs: list[Run], actuator: LinearActuator) -> ResidualPlot:
     """The current along each stroke, less its mean: the healthy runs' (the document's) and these runs'."""
     healthy, _ = baseline(actuator)
     mean = np.nanmean([run.profile for run in runs], axis=0)
@@ -83,7 +83,7 @@ def _stroke_plot(runs: list[Run], actuator: ActuatorDocument) -> ResidualPlot:
 
 
 def _learned(
-    runs: list[Run], calibrated: CalibratedDrive, actuator: ActuatorDocument, started: float
+    runs: list[Run], calibrated: CalibratedDrive, actuator: LinearActuator, started: float
 ) -> CalibrationReport:
     unread = [ANCHOR] + (
         []
@@ -156,7 +156,7 @@ def _learned(
     return report.model_copy(update={"drive": drive, "learned": learned})
 
 
-def completed(actuator: ActuatorDocument, calibrated: CalibratedDrive) -> ActuatorDocument:
+def completed(actuator: LinearActuator, calibrated: CalibratedDrive) -> LinearActuator:
     """``actuator`` with what the runs taught (the nominal only where two load sizes read it)."""
     assert actuator.screw is not None
     screw = actuator.screw.model_copy(
@@ -182,10 +182,10 @@ def completed(actuator: ActuatorDocument, calibrated: CalibratedDrive) -> Actuat
         "screw": screw.model_dump(),
         "nominal": nominal and nominal.model_dump(),
     }
-    return ActuatorDocument.model_validate(document)
+    return LinearActuator.model_validate(document)
 
 
-def _leave_one_out(runs: list[Run], actuator: ActuatorDocument) -> HeldOut:
+def _leave_one_out(runs: list[Run], actuator: LinearActuator) -> HeldOut:
     """Each run's stretches predicted by the drive learned on the others (at two runs or more)."""
     if len(runs) < 3:
         return HeldOut(rss_before=0.0, rss_after=0.0, adopted=True, note="too few runs to hold one out")

@@ -25,14 +25,14 @@ from ema.estimate.quasistatic.drive_torque import STEPPER_READING
 from ema.estimate.quasistatic.slow_window import estimate_low_rate
 from ema.estimate.quasistatic.stretches import solve_stretches
 from ema.kinds.linear.drive_calibration import MIN_Z, Run, profile_change, run_load_n
-from ema.model.actuator import ActuatorDocument
+from ema.model.actuator import LinearActuator
 from ema.model.window import Window
 
 FELL = "friction lost (a ball screw losing its preload: a spalled track, smaller balls)"
 ROSE = "friction gained (grease lost, a seal tightened, a track roughened)"
 
 
-def fdj_changes(runs: list[Run], results: list[Estimate], actuator: ActuatorDocument) -> list[Change]:
+def fdj_changes(runs: list[Run], results: list[Estimate], actuator: LinearActuator) -> list[Change]:
     """Per load the runs were logged at: their mean FDJ against the nominal, departed either way or not."""
     screw, nominal = actuator.screw, actuator.health.fdj
     assert screw is not None  # the linear kind's own section
@@ -84,7 +84,7 @@ def _fdj_change(seen: Departure, load: float, nominal: float, runs: int) -> Chan
     )
 
 
-def eta_change(runs: list[Run], actuator: ActuatorDocument) -> Change | None:
+def eta_change(runs: list[Run], actuator: LinearActuator) -> Change | None:
     """η_O over every run where their loads differ enough to read it, against the nominal; None where not."""
     torque, _ = STEPPER_READING.torque(actuator, None)
     screw, health = actuator.screw, actuator.health
@@ -119,7 +119,7 @@ def eta_change(runs: list[Run], actuator: ActuatorDocument) -> Change | None:
     )
 
 
-def stroke_step(runs: list[Run], actuator: ActuatorDocument) -> tuple[Step, Candidate]:
+def stroke_step(runs: list[Run], actuator: LinearActuator) -> tuple[Step, Candidate]:
     """The current along the stroke against the healthy runs' profile: a step naming a local change or not (not
     compared at a load outside those the profile was learned at: its shape is the load's too)."""
     healthy = baseline(actuator)
@@ -156,7 +156,7 @@ def stroke_step(runs: list[Run], actuator: ActuatorDocument) -> tuple[Step, Cand
     return Step(selected="position_friction" if named else None, reason=reason), candidate
 
 
-def baseline(actuator: ActuatorDocument) -> tuple[np.ndarray, np.ndarray]:
+def baseline(actuator: LinearActuator) -> tuple[np.ndarray, np.ndarray]:
     """The healthy runs' profile along the stroke and its run-to-run std; NaN where the document lacks either (one
     learned before the std was kept: the runs' own scatter alone would take a load's profile for a defect)."""
     screw = actuator.screw
@@ -165,7 +165,7 @@ def baseline(actuator: ActuatorDocument) -> tuple[np.ndarray, np.ndarray]:
     return np.array(screw.stroke_profile_a, dtype=float), np.array(screw.stroke_profile_std_a, dtype=float)
 
 
-def compared(windows: Sequence[Window], runs: list[Run], actuator: ActuatorDocument) -> CalibrationReport:
+def compared(windows: Sequence[Window], runs: list[Run], actuator: LinearActuator) -> CalibrationReport:
     """The runs against the calibrated document (module docstring)."""
     started = time.perf_counter()
     read_with = ActuatorRead(name=actuator.name)

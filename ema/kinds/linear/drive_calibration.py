@@ -32,7 +32,7 @@ import numpy as np
 
 from ema.estimate.quasistatic.stretches import ETA_GRID, Stretch, set_point_motion, stretches
 from ema.estimate.stats import below_zero, rms, weighted_least_squares
-from ema.model.actuator import ActuatorDocument
+from ema.model.actuator import LinearActuator
 from ema.model.checks import InputError
 from ema.model.params import load_factors
 from ema.model.window import Window
@@ -52,7 +52,7 @@ class Run:
     profile: np.ndarray  # (2, PROFILE_BINS): current along each direction's stroke, less its stroke's mean
 
 
-def read_run(window: Window, actuator: ActuatorDocument) -> Run:
+def read_run(window: Window, actuator: LinearActuator) -> Run:
     """A run's stretches and rest; InputError naming the window where it has no stretch or never rests."""
     speed, load = set_point_motion(window, actuator.gear_ratio)
     found, rest = stretches(speed, window.signals["current_a"], load, window.sample_rate_hz)
@@ -111,7 +111,7 @@ class CalibratedDrive:
     stretch_residual_after_a: np.ndarray  # (S,) about the drive learned
 
 
-def _design(runs: list[Run], eta: float, actuator: ActuatorDocument) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _design(runs: list[Run], eta: float, actuator: LinearActuator) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(X, y, w): y = I − I0 per stretch (I0 the runs' mean current at rest: the anchor of FDJ), X = [g, 1] with
     g = k·|T_L| − s·T_L at ``eta``, weights 1/σ²."""
     rest = float(np.mean([run.rest_a for run in runs]))
@@ -146,7 +146,7 @@ def _refuse_reversed_signs(c: float, c_std: float, rests: np.ndarray) -> None:
         )
 
 
-def calibrate_drive(runs: list[Run], actuator: ActuatorDocument) -> CalibratedDrive:
+def calibrate_drive(runs: list[Run], actuator: LinearActuator) -> CalibratedDrive:
     """c, I0, and (at two load sizes or more) the nominal FDJ and η_O, from healthy ``runs`` (module docstring)."""
     profiles = [weighted_least_squares(*_design(runs, float(eta), actuator)) for eta in ETA_GRID]
     chi2 = np.array([p[2] for p in profiles])
@@ -191,7 +191,7 @@ def calibrate_drive(runs: list[Run], actuator: ActuatorDocument) -> CalibratedDr
 
 
 def _run_fdj(
-    run: Run, c: float, eta: float, actuator: ActuatorDocument, rest_a: float | None = None
+    run: Run, c: float, eta: float, actuator: LinearActuator, rest_a: float | None = None
 ) -> tuple[float, float]:
     """One run's FDJ (and its std) at ``c`` and ``eta``: the stretches' mean of (I − I0)/c − g, I0 the run's own
     current at rest, or ``rest_a`` (the document's: as an estimate reads the run)."""
@@ -256,7 +256,7 @@ def _excess_std(values: np.ndarray, stds: np.ndarray) -> float:
     return float(np.sqrt(0.5 * (low + high)))
 
 
-def _predicted_before(runs: list[Run], actuator: ActuatorDocument) -> np.ndarray:
+def _predicted_before(runs: list[Run], actuator: LinearActuator) -> np.ndarray:
     """What the document as given predicts of I − I0: its own c and nominal where it has them, else nothing."""
     screw, nominal = actuator.screw, actuator.nominal
     if screw is None or screw.current_per_nm_a is None or nominal is None:

@@ -19,7 +19,7 @@ from ema.estimate.documents import STAGES, Estimate
 from ema.kinds.base import WARM_UP, Calibrated, CalibrationRequest, Cost, Request
 from ema.kinds.servo.calibration import CLOSED_LOOPS, calibrate_servo
 from ema.kinds.servo.closed_loop import SUBSTEPS, ServoLoop, simulate_servo
-from ema.model.actuator import actuator_from_dict
+from ema.model.actuator import ServoActuator, actuator_from_dict, as_kind
 from ema.model.kinds import KINDS, KindFacts
 from ema.model.params import DriveConstants
 from ema.model.window import Window
@@ -39,12 +39,13 @@ class Servo:
             estimate_servo,
         )  # the network's: loaded by its first window (ema.kinds.rotary)
 
+        actuator = as_kind(request.actuator, ServoActuator)
         return estimate_servo(
-            window, request.config, actuator=request.actuator, read_with=request.read_with, on_stage=request.on_stage
+            window, request.config, actuator=actuator, read_with=request.read_with, on_stage=request.on_stage
         )
 
     def calibrate(self, windows: Sequence[Window], request: CalibrationRequest) -> Calibrated:
-        report, completed, plot = calibrate_servo(windows, request.actuator)
+        report, completed, plot = calibrate_servo(windows, as_kind(request.actuator, ServoActuator))
         return Calibrated(report.model_copy(update={"completed_actuator": completed}), completed, plot)
 
     def cost(self, window: Window, config: PipelineConfig) -> Cost:

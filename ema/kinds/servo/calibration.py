@@ -61,7 +61,7 @@ from ema.kinds.servo.stacked_solve import (
     solved,
     undisturbed,
 )
-from ema.model.actuator import ActuatorDocument, Nominal
+from ema.model.actuator import Nominal, ServoActuator
 from ema.model.checks import InputError
 from ema.model.window import Window
 
@@ -156,8 +156,8 @@ def learned(solution: Solved, model: dict[str, float], values: dict[str, float] 
 
 
 def completed(
-    actuator: ActuatorDocument, prepared: ServoPrepared, solution: Solved, model: dict[str, float]
-) -> ActuatorDocument:
+    actuator: ServoActuator, prepared: ServoPrepared, solution: Solved, model: dict[str, float]
+) -> ServoActuator:
     """The document with what the runs taught: the log's controller constants, the load's, the adopted effects,
     the nominal FDJ."""
     v, sd = solution.values, solution.stds
@@ -180,7 +180,7 @@ def completed(
     )
     nominal = Nominal(fdj_n=round(v["fdj_n"], 6), eta_o=actuator.nominal.eta_o if actuator.nominal else None)
     document = actuator.model_dump(by_alias=True) | {"servo": servo.model_dump(), "nominal": nominal.model_dump()}
-    return ActuatorDocument.model_validate(document)
+    return ServoActuator.model_validate(document)
 
 
 def _as_simulated(
@@ -226,8 +226,8 @@ def _own_controller(prepared: ServoPrepared) -> ServoPrepared:
 
 
 def calibrate_servo(
-    windows: Sequence[Window], actuator: ActuatorDocument
-) -> tuple[CalibrationReport, ActuatorDocument, ResidualPlot]:
+    windows: Sequence[Window], actuator: ServoActuator
+) -> tuple[CalibrationReport, ServoActuator, ResidualPlot]:
     """The report (module docstring), the document completed with what the windows taught, and the figure."""
     started = time.perf_counter()
     prepared = [_own_controller(prepare_servo(w, actuator)) for w in windows]

@@ -12,7 +12,7 @@ import numpy as np
 from ema.kinds.servo.log_reading import ServoPrepared, document_effects
 from ema.kinds.servo.loop_dataset import lane_parameters
 from ema.kinds.servo.stacked_solve import problem
-from ema.model.actuator import ActuatorDocument
+from ema.model.actuator import ServoActuator
 from ema.model.checks import InputError
 
 
@@ -47,7 +47,7 @@ def model_errors_pct(
     }
 
 
-def document_check(prepared: Sequence[ServoPrepared], actuator: ActuatorDocument) -> dict[str, float] | None:
+def document_check(prepared: Sequence[ServoPrepared], actuator: ServoActuator) -> dict[str, float] | None:
     """The error of the document's own model as it stands (its load's constants fixed), inverse and closed loop;
     None where the document does not hold them, or holds an effect whose constants it does not keep."""
     servo, nominal = prepared[0].servo, actuator.nominal

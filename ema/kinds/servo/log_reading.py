@@ -37,7 +37,7 @@ from ema.estimate.physics.noise_reading import robust_variance
 from ema.estimate.stats import below_zero, rms
 from ema.kinds.servo.closed_loop import ServoLoop, ServoRuns, simulate_servo
 from ema.kinds.servo.inverse import Motion, inverse_columns, load_motion, refuse_still, solve_inverse
-from ema.model.actuator import ActuatorDocument
+from ema.model.actuator import ServoActuator
 from ema.model.checks import InputError
 from ema.model.servo import Servo
 from ema.model.window import Window
@@ -87,7 +87,7 @@ class ServoPrepared:
         )
 
 
-def completed(actuator: ActuatorDocument, window: Window) -> Servo:
+def completed(actuator: ServoActuator, window: Window) -> Servo:
     """The document's servo section with the log's constants; InputError naming what neither gives."""
     assert actuator.servo is not None  # the kind's own section (ema.kinds)
     servo = actuator.servo.with_constants(window.constants, "window.constants")
@@ -347,7 +347,7 @@ def _window_motion(position_m: np.ndarray, rate_hz: float, bandwidth_hz: float, 
     return motion
 
 
-def prepare_servo(window: Window, actuator: ActuatorDocument) -> ServoPrepared:
+def prepare_servo(window: Window, actuator: ServoActuator) -> ServoPrepared:
     """The window ready for its physics (module docstring); InputError naming what cannot be read."""
     servo = completed(actuator, window)
     rate = servo.controller_rate_hz or window.sample_rate_hz

@@ -40,7 +40,7 @@ from ema.kinds.servo.inverse import (
 )
 from ema.kinds.servo.log_reading import ServoPrepared, prepare_servo, refuse_reversed_signs
 from ema.kinds.servo.loop_dataset import ServoData, lane_parameters, simulate_servo_dataset
-from ema.model.actuator import ActuatorDocument
+from ema.model.actuator import ServoActuator
 from ema.model.window import Window
 
 SERVO_LEARNING = LearnConfig(max_epochs=60, max_validation_failures=6)  # as the rotary pipeline's (a few dozen runs)
@@ -178,7 +178,7 @@ def noise_floor(measured: np.ndarray, twins: np.ndarray) -> float:
 
 
 def _estimates(
-    actuator: ActuatorDocument, prepared: ServoPrepared, physics: InverseSolution, answer: Assessed
+    actuator: ServoActuator, prepared: ServoPrepared, physics: InverseSolution, answer: Assessed
 ) -> doc.Estimates:
     """FDJ in N against the document's nominal (none before ema calibrate), the other constants beside it (an
     effect's that the simulator lacks as the physics fit read it)."""
@@ -210,7 +210,7 @@ def _report(
     answer: Assessed,
     check: doc.Check,
     *,
-    actuator: ActuatorDocument,
+    actuator: ServoActuator,
     read_with: doc.ActuatorRead,
     config: PipelineConfig,
 ) -> doc.Estimate:
@@ -254,7 +254,7 @@ def estimate_servo(
     window: Window,
     config: PipelineConfig,
     *,
-    actuator: ActuatorDocument,
+    actuator: ServoActuator,
     read_with: doc.ActuatorRead,
     on_stage: Callable[[str], None] | None = None,
 ) -> doc.Estimate:

@@ -8,7 +8,7 @@ from typing import Annotated
 from fastapi import APIRouter, Query, Request
 from starlette.concurrency import run_in_threadpool
 
-from ema.model.actuator import ActuatorDocument
+from ema.model.actuator import ACTUATOR_DOCUMENT, ActuatorDocument
 from ema.prognosis.documents import ActuatorSummary, EstimateHistory, Prognosis, StoredActuator, Withdrawal
 from ema.service.deps import ActuatorId, RunnerDep, StoreDep, is_stored, prognosis_now
 from ema.service.errors import NotStoredError
@@ -85,7 +85,7 @@ async def prognosis(actuator_id: ActuatorId, request: Request, store: StoreDep, 
 async def put_actuator(actuator_id: ActuatorId, request: Request, store: StoreDep, runner: RunnerDep) -> StoredActuator:
     """Store the actuator's document as its next version: its windows are read with it from now on (those
     stored keep the version they were read with). The same document again stores nothing new."""
-    document = await read_body(request, runner, ActuatorDocument, lambda d: d)
+    document = await read_body(request, runner, ACTUATOR_DOCUMENT, lambda d: d)
     await run_in_threadpool(store.probe)
     stored = await run_in_threadpool(store.put_actuator, actuator_id, document)
     request.app.state.keeper.poke()
