@@ -40,7 +40,7 @@ from ema.model.bounds import DEFAULT_SAMPLE_RATE_HZ
 from ema.model.commands import random_command_knots
 from ema.model.params import DEFAULT_RANGES, HealthParams
 
-STAGES = (*PIPELINE_STAGES, "total")
+TIMED_STAGES = (*PIPELINE_STAGES, "total")
 TARGET_SHARE = 0.128  # a 0.5 s window's idle p95 as a share of the yardstick: the latency target
 CONFIDENCE = 0.9  # a verdict on the p95 is given when it holds at this confidence, else more windows are asked for
 BUSY = "import itertools\nfor _ in itertools.count(): pass"
@@ -61,13 +61,13 @@ def load(processes: int) -> Iterator[None]:
 def time_windows(config: PipelineConfig, duration_s: float, repeats: int, seed: int) -> dict[str, Any]:
     """p50/p95 per stage, the real-time factor and the mean error over ``repeats`` windows."""
     rng = np.random.default_rng(seed)
-    timings: dict[str, list[float]] = {stage: [] for stage in STAGES}
+    timings: dict[str, list[float]] = {stage: [] for stage in TIMED_STAGES}
     errors: dict[str, list[float]] = {"FDJ": [], "eta_O": []}
     for repeat in range(repeats):
         truth = HealthParams.uniform(1, DEFAULT_RANGES, rng)
         window = synthetic_window(truth, seed=seed + repeat, duration_s=duration_s)
         result = estimate_window(window, config, actuator=THESIS)
-        for stage in STAGES:
+        for stage in TIMED_STAGES:
             timings[stage].append(getattr(result.timings_s, stage))
         estimates, ranges = result.estimates, THESIS.ranges
         errors["FDJ"].append(share_of_range("FDJ", abs(estimates.FDJ.value - truth.fdj_nm[0]), ranges))
@@ -165,12 +165,12 @@ def reference_lines(rows: list[dict[str, Any]], refs: dict[str, float]) -> list[
 def stage_factors(rows: list[dict[str, Any]]) -> list[str]:
     """Each stage's real-time factor (its seconds per second of window), p50 (p95)."""
     lines = [
-        "| load | window | " + " | ".join(STAGES) + " |",
-        "|---|---:|" + "---:|" * len(STAGES),
+        "| load | window | " + " | ".join(TIMED_STAGES) + " |",
+        "|---|---:|" + "---:|" * len(TIMED_STAGES),
     ]
     for r in rows:
         d = r["duration_s"]
-        cells = " | ".join(f"{r['p50_s'][s] / d:.3f} ({r['p95_s'][s] / d:.3f})" for s in STAGES)
+        cells = " | ".join(f"{r['p50_s'][s] / d:.3f} ({r['p95_s'][s] / d:.3f})" for s in TIMED_STAGES)
         lines.append(f"| {r['load']} | {d:g} s | {cells} |")
     return lines
 
@@ -185,11 +185,11 @@ def markdown(rows: list[dict[str, Any]], config: PipelineConfig, refs: dict[str,
         "Windows run back to back, so beside busy processes this loop keeps a core of its own; a service",
         "waiting between requests does not (*Real time on a warm service* measures one).",
         "",
-        "| load | window | " + " | ".join(STAGES) + " | real-time factor p50 (p95) | error FDJ / η_O |",
-        "|---|---:|" + "---:|" * (len(STAGES) + 2),
+        "| load | window | " + " | ".join(TIMED_STAGES) + " | real-time factor p50 (p95) | error FDJ / η_O |",
+        "|---|---:|" + "---:|" * (len(TIMED_STAGES) + 2),
     ]
     for r in rows:
-        cells = " | ".join(f"{r['p50_s'][s]:.2f} ({r['p95_s'][s]:.2f})" for s in STAGES)
+        cells = " | ".join(f"{r['p50_s'][s]:.2f} ({r['p95_s'][s]:.2f})" for s in TIMED_STAGES)
         error = f"{r['error_pct_of_range']['FDJ']:.2f} % / {r['error_pct_of_range']['eta_O']:.2f} %"
         rtf = f"{r['real_time_factor_p50']:.2f} ({r['real_time_factor_p95']:.2f})"
         lines.append(f"| {r['load']} | {r['duration_s']:g} s | {cells} | {rtf} | {error} |")

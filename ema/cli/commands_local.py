@@ -31,6 +31,7 @@ from ema.cli.options import (
     threads,
 )
 from ema.model.bounds import (
+    COMMAND_FAMILIES,
     DEFAULT_SAMPLE_RATE_HZ,
     DURATION_RANGE_S,
     MAX_FLIGHT_HOURS,
@@ -40,7 +41,6 @@ from ema.model.bounds import (
 )
 from ema.model.envelope import AIRSPEED_RANGE_MPS, ALTITUDE_RANGE_M, DEFAULT_AIRSPEED_MPS
 
-FAMILIES = ("thesis", "cruise", "gust", "doublet", "steps")  # ema.model.commands.FAMILIES, without importing numpy here
 SIMULATE_FLAGS = {
     "flight_condition.airspeed_mps": "--airspeed",
     "flight_condition.altitude_m": "--altitude",
@@ -145,7 +145,7 @@ def estimate(
 @click.option("--ground", is_flag=True, help="on the ground: a load cell's load (--load, --load-ramp), no aircraft")
 @click.option("--load", "load_nm", type=float, default=0.0, help="with --ground: the hinge moment at t = 0 [N·m]")
 @click.option("--load-ramp", "load_ramp_nmps", type=float, default=0.0, help="with --ground: its rate [N·m/s]")
-@click.option("--command", type=click.Choice(FAMILIES), default="thesis", help="the command's family")
+@click.option("--command", type=click.Choice(COMMAND_FAMILIES), default="thesis", help="the command's family")
 @click.option("--seed", type=int, default=0, help="seed of the command and the noise")
 @click.option("--duration", type=click.FloatRange(*DURATION_RANGE_S), default=0.5, help="window length [s]")
 @click.option("--rate", type=float, default=DEFAULT_SAMPLE_RATE_HZ, help=f"log rate [Hz], {span(SAMPLE_RATE_RANGE_HZ)}")

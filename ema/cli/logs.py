@@ -15,17 +15,14 @@ from typing import Any
 
 import numpy as np
 
-from ema.model.actuator import SCHEMA as ACTUATOR_SCHEMA
-from ema.model.actuator import ActuatorDocument, actuator_from_dict
+from ema.model.actuator import ACTUATOR_SCHEMA, ActuatorDocument, actuator_from_dict
 from ema.model.bounds import DEFAULT_SAMPLE_RATE_HZ, MIN_SAMPLES
 from ema.model.checks import InputError, load_json
 from ema.model.envelope import DEFAULT_AIRSPEED_MPS
 from ema.model.kinds import ALL_SIGNALS, KINDS, KindFacts, nearest_kind
 from ema.model.log_files import TABLE_SUFFIXES, read_table
-from ema.model.logmap import SCHEMA as LOGMAP_SCHEMA
-from ema.model.logmap import LogMap, read_mapped
-from ema.model.window import SCHEMA as WINDOW_SCHEMA
-from ema.model.window import Window, window_from_dict
+from ema.model.logmap import LOGMAP_SCHEMA, LogMap, read_mapped
+from ema.model.window import WINDOW_SCHEMA, Window, window_from_dict
 
 SUFFIXES = (".json", *TABLE_SUFFIXES)
 ACTUATORS_FILE = "actuators.json"  # in an archive's folder: {actuator_id: its ema-actuator/1 document}

@@ -51,7 +51,7 @@ class _Figure(_Output):
 OUTPUT_FILE = _Output(dir_okay=False, path_type=Path)
 OUTPUT_FOLDER = _Output(file_okay=False, path_type=Path)
 FIGURE_FILE = _Figure(dir_okay=False, path_type=Path)
-SIZES = {  # flag -> PipelineConfig field
+FLAG_SIZES = {  # flag -> PipelineConfig field
     "--sims": "n_simulations",
     "--checks": "check_simulations",
     "--timesteps": "n_timesteps",
@@ -59,12 +59,12 @@ SIZES = {  # flag -> PipelineConfig field
     "--members": "members",
     "--seed": "seed",
 }
-SIZE_FLAGS = {f"{field}": flag for flag, field in SIZES.items()}  # an InputError's field -> the flag typed
+SIZE_FLAGS = {f"{field}": flag for flag, field in FLAG_SIZES.items()}  # an InputError's field -> the flag typed
 
 
 def sizes(function: F) -> F:
     """--sims, --checks, --timesteps, --hidden, --members, --seed with PipelineConfig's defaults."""
-    for flag, field in reversed(SIZES.items()):
+    for flag, field in reversed(FLAG_SIZES.items()):
         size = PIPELINE_SIZES[field]
         kind = click.IntRange(size.low, size.high)
         function = click.option(flag, field, type=kind, default=size.default, help=size.description)(function)
@@ -182,7 +182,7 @@ def pipeline_config(values: Mapping[str, Any]) -> Any:
     from ema.model.checks import validated
 
     with flags_named(SIZE_FLAGS):
-        return validated(PipelineConfig, {field: values[field] for field in SIZES.values()}, "sizes")
+        return validated(PipelineConfig, {field: values[field] for field in FLAG_SIZES.values()}, "sizes")
 
 
 @contextlib.contextmanager

@@ -26,7 +26,7 @@ from ema.model.bounds import DEFAULT_SAMPLE_RATE_HZ
 SIMS = 500
 LANES = 16
 DURATION_S = 0.5
-STEP_S = 1e-6
+YARDSTICK_STEP_S = 1e-6
 RATE_HZ = DEFAULT_SAMPLE_RATE_HZ
 # Table 3.1's drive (the yardstick needs numbers, not our document types)
 G_P, GAP, R, L, K_T, T_MAX, V_MAX, I_MAX, N, J, C = (
@@ -55,7 +55,7 @@ def _group(command_rad: np.ndarray, fdj: np.ndarray, load_nm: np.ndarray, steps:
     speed = np.zeros(LANES)
     angle = np.zeros(LANES)
     omega_max = V_MAX / K_T
-    h_over_l, h_over_j, gap_over_kt, weight = STEP_S / L, STEP_S / J, GAP / K_T, 1.0 / per_sample
+    h_over_l, h_over_j, gap_over_kt, weight = YARDSTICK_STEP_S / L, YARDSTICK_STEP_S / J, GAP / K_T, 1.0 / per_sample
     for k in range(steps):
         target = command_rad[k // per_sample]
         sample = k // per_sample
@@ -73,7 +73,7 @@ def _group(command_rad: np.ndarray, fdj: np.ndarray, load_nm: np.ndarray, steps:
             new_speed = w + h_over_j * (drive - friction)
             new_speed = 0.0 if new_speed * w < 0.0 else new_speed
             speed[lane] = new_speed
-            angle[lane] += STEP_S * new_speed
+            angle[lane] += YARDSTICK_STEP_S * new_speed
             out[lane, sample] += theta_u * weight
     return out
 
@@ -93,7 +93,7 @@ def yardstick_seconds(repeats: int = 2, threads: int | None = None) -> float:
     """Best wall time of ``SIMS`` × 0.5 s on the yardstick kernel, compiled (or loaded) outside the timing,
     its groups over ``threads`` (None: every thread Numba has; 1: one group after another)."""
     rng = np.random.default_rng(0)
-    per_sample = round(1.0 / (RATE_HZ * STEP_S))
+    per_sample = round(1.0 / (RATE_HZ * YARDSTICK_STEP_S))
     samples = round(DURATION_S * RATE_HZ)
     sims = -(-SIMS // LANES) * LANES
     command = np.radians(20.0) * np.sin(2 * np.pi * 2.0 * np.arange(samples) / RATE_HZ)

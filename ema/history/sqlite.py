@@ -26,7 +26,7 @@ from ema.history.schema import opening, upgrade
 from ema.history.sql import SqlHistory
 
 log = logging.getLogger("ema.history")
-HEADER = b"SQLite format 3\x00"
+SQLITE_HEADER = b"SQLite format 3\x00"
 OURS = frozenset(
     {
         "estimates",
@@ -48,8 +48,8 @@ def _check_file(path: Path) -> None:
         if not path.is_file():
             raise StorageError(path, "is not a file")
         with path.open("rb") as handle:
-            head = handle.read(len(HEADER))
-        if head and head != HEADER:
+            head = handle.read(len(SQLITE_HEADER))
+        if head and head != SQLITE_HEADER:
             raise StorageError(path, "is not an SQLite database (refused, left as it is)")
         if not os.access(path, os.R_OK | os.W_OK) or not path.stat().st_mode & stat.S_IWUSR:
             raise StorageError(path, "is read-only: the service stores every answer it gives")

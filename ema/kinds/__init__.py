@@ -13,7 +13,7 @@ A kind's documents (its window's signals, its actuator document's section, what 
   stages, its calibration and effects).
 
 ``estimate``, ``calibrate`` and ``cost`` are the entries the command line, the service and the fleet call; a
-fourth kind is a folder here, a row of ``ema.model.kinds`` and a line in ``KINDS``, not branches in the stages.
+fourth kind is a folder here, a row of ``ema.model.kinds`` and a line in ``REGISTRY``, not branches in the stages.
 """
 
 from __future__ import annotations
@@ -32,7 +32,7 @@ from ema.model.checks import InputError
 from ema.model.window import Window
 
 __all__ = [
-    "KINDS",
+    "REGISTRY",
     "Calibrated",
     "CalibrationRequest",
     "Cost",
@@ -47,18 +47,18 @@ __all__ = [
 ]
 
 
-KINDS: dict[str, Kind] = {kind.facts.name: kind for kind in (ROTARY, LINEAR, SERVO)}
+REGISTRY: dict[str, Kind] = {kind.facts.name: kind for kind in (ROTARY, LINEAR, SERVO)}
 
 
-def warm_up(names: Sequence[str] = tuple(KINDS)) -> None:
+def warm_up(names: Sequence[str] = tuple(REGISTRY)) -> None:
     """Each named kind warmed (``Kind.warm_up``): a service warms every kind before it answers."""
     for name in names:
-        KINDS[name].warm_up()
+        REGISTRY[name].warm_up()
 
 
 def kind_of(actuator: ActuatorDocument) -> Kind:
     """The method of ``actuator``'s kind."""
-    return KINDS[actuator.kind]
+    return REGISTRY[actuator.kind]
 
 
 def same_kind(windows: Sequence[Window], actuator: ActuatorDocument, *, listed: bool = True) -> None:
@@ -109,14 +109,14 @@ def calibrate(windows: Sequence[Window], request: CalibrationRequest) -> Calibra
 def learns(window: Window) -> bool:
     """Whether reading ``window`` trains a network, by its signals' kind (its ``stages``): a process that reads
     only windows that do not never loads the network's modules (SciPy's optimizers)."""
-    return "learn" in KINDS[window.kind].stages(window)
+    return "learn" in REGISTRY[window.kind].stages(window)
 
 
 def cost(window: Window, config: PipelineConfig) -> Cost:
     """What reading ``window`` asks of a service (``Cost``), by its signals' kind."""
-    return KINDS[window.kind].cost(window, config)
+    return REGISTRY[window.kind].cost(window, config)
 
 
 def calibration_cost(windows: Sequence[Window], config: PipelineConfig) -> Cost:
     """What calibrating ``windows`` asks of a service beside reading each (``Cost``), by their kind."""
-    return KINDS[windows[0].kind].calibration_cost(windows, config) if windows else Cost(0.0, 0.0)
+    return REGISTRY[windows[0].kind].calibration_cost(windows, config) if windows else Cost(0.0, 0.0)

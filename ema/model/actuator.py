@@ -31,7 +31,7 @@ from ema.model.servo import Servo
 if TYPE_CHECKING:
     from ema.model.noise import SensorNoise
 
-SCHEMA = "ema-actuator/1"
+ACTUATOR_SCHEMA = "ema-actuator/1"
 DEFAULT_ETA_O_BELOW, THESIS_ETA_O = 0.70, 0.85  # the prognosis's default η_O threshold, at the thesis's nominal
 HEALTHY_SPAN = 0.2  # the healthy range: nominal ±20 % (η_O capped below 1), the thesis's §5.4 ranges
 MAX_HEALTHY_ETA_O = 0.98

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ema.model.bounds import COMMAND_FAMILIES
 from ema.model.checks import InputError, finite_array
 
 COMMAND_AMPLITUDE_DEG = 25.0
@@ -91,9 +92,6 @@ def _steps(times: np.ndarray, rng: np.random.Generator) -> np.ndarray:
     return levels[np.searchsorted(edges, times)]
 
 
-FAMILIES = ("thesis", "cruise", "gust", "doublet", "steps")
-
-
 def family_knots(family: str, n_samples: int, sample_rate_hz: float, rng: np.random.Generator) -> np.ndarray:
     """(n_samples + 1,) knots [deg] of one command of a family: the §5.6 polynomial, or what real
     flights mostly hold (cruise corrections, gust rejection, a pilot's doublet, steps and holds)."""
@@ -101,7 +99,7 @@ def family_knots(family: str, n_samples: int, sample_rate_hz: float, rng: np.ran
         return random_command_knots(n_samples, sample_rate_hz, rng)[0]
     makers = {"cruise": _sines, "gust": _gust, "doublet": _doublet, "steps": _steps}
     if family not in makers:
-        raise InputError("command", f"unknown command family {family!r}; known: {', '.join(FAMILIES)}")
+        raise InputError("command", f"unknown command family {family!r}; known: {', '.join(COMMAND_FAMILIES)}")
     return makers[family](np.arange(n_samples + 1) / sample_rate_hz, rng)
 
 

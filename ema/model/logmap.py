@@ -23,7 +23,7 @@ from ema.model.kinds import KINDS, Role
 from ema.model.log_files import Table, read_table
 from ema.model.units import TIME_S
 
-SCHEMA = "ema-logmap/1"
+LOGMAP_SCHEMA = "ema-logmap/1"
 UNIFORM = 0.01  # time steps within this share of the median step: uniformly sampled
 ROLES = ("set_point", "position", "error", "current", "force", "load", "motor_speed")
 

@@ -45,7 +45,7 @@ from ema.model.checks import InputError, read_document, validated
 from ema.model.document import Number, refused_by
 from ema.model.kinds import ALL_SIGNALS, DEFAULT_KIND, KINDS, kind_of_signals, nearest_kind
 
-SCHEMA = "ema-window/1"
+WINDOW_SCHEMA = "ema-window/1"
 SIGNALS = KINDS[DEFAULT_KIND].signals  # the default kind's (a rotary window's)
 
 Samples = Annotated[list[Number], Field(min_length=MIN_SAMPLES, max_length=MAX_SAMPLES)]
@@ -262,7 +262,7 @@ def window_from_dict(document: Any) -> Window:
 def window_to_dict(window: Window) -> dict[str, Any]:
     """The ``ema-window/1`` document of ``window``."""
     return {
-        "schema": SCHEMA,
+        "schema": WINDOW_SCHEMA,
         "actuator_id": window.actuator_id,
         "window_id": window.window_id,
         "sample_rate_hz": float(window.sample_rate_hz),

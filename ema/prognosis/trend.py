@@ -25,7 +25,7 @@ from ema.prognosis.documents import Curved, Point, Trend
 
 HUBER_C = 2.5
 OUTLIER_Z = 3.5
-ITERATIONS = 20
+HUBER_ITERATIONS = 20
 MIN_CURVED = 6  # windows from which a quadratic is fitted beside the line
 
 
@@ -54,7 +54,7 @@ def robust_polynomial(x: np.ndarray, values: np.ndarray, variance: np.ndarray, d
     """The polynomial of ``degree`` in x by iteratively reweighted least squares (τ and Huber weights)."""
     n_coefficients = degree + 1
     robust, tau2 = np.ones(len(x)), 0.0
-    for _ in range(ITERATIONS):
+    for _ in range(HUBER_ITERATIONS):
         beta, covariance = _wls(x, values, robust / (variance + tau2 + 1e-300), degree)
         residual = values - np.vander(x, n_coefficients, increasing=True) @ beta
         dof = max(int(robust.sum()) - n_coefficients, 1)

@@ -8,7 +8,7 @@ import json
 from pathlib import Path
 
 from ema.cli.main import EXIT_OK, main
-from ema.kinds import KINDS
+from ema.kinds import REGISTRY
 from ema.model import kinds as facts
 
 PACKAGE = Path(__file__).resolve().parents[2] / "ema"
@@ -35,8 +35,8 @@ def test_no_kind_is_compared_with_a_literal_outside_its_own_module():
 
 
 def test_every_kind_of_the_documents_has_its_method():
-    assert set(KINDS) == set(facts.KINDS)
-    assert all(kind.facts is facts.KINDS[name] for name, kind in KINDS.items())
+    assert set(REGISTRY) == set(facts.KINDS)
+    assert all(kind.facts is facts.KINDS[name] for name, kind in REGISTRY.items())
 
 
 def test_the_documents_kind_field_lists_every_kind():

@@ -3,10 +3,10 @@ import signal
 import numpy as np
 import pytest
 
+from ema.model.bounds import COMMAND_FAMILIES
 from ema.model.checks import InputError
 from ema.model.commands import (
     COMMAND_LIMIT_DEG,
-    FAMILIES,
     family_knots,
     knots_from_samples,
     random_command_coefficients,
@@ -69,7 +69,7 @@ def test_knots_from_samples_do_not_ring_at_a_step():
     np.testing.assert_array_equal(knots[12:], 10.0)
 
 
-@pytest.mark.parametrize("family", FAMILIES)
+@pytest.mark.parametrize("family", COMMAND_FAMILIES)
 def test_every_family_is_seeded_finite_and_within_a_flights_deflections(family):
     a = family_knots(family, 5000, 10_000.0, np.random.default_rng(1))
     b = family_knots(family, 5000, 10_000.0, np.random.default_rng(1))

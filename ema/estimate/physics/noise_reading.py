@@ -47,7 +47,7 @@ DIP = 0.1
 # S rises by at most ``RISE`` of its plateau across the span's upper half (a least-squares line: a
 # correlation longer than the span rises ~0.67 there). The fewest flat lags keep the mismatch's rise out.
 RISE = 0.25
-MIN_SPAN = 8
+MIN_LAGS = 8
 MAD_TO_STD = 1.4826  # σ of Gaussian data over its median absolute deviation
 
 
@@ -117,7 +117,7 @@ def levels_off(structure: np.ndarray) -> bool:
 
 
 def noise_structure(values: np.ndarray, max_lag: int, rising_is_noise: bool) -> np.ndarray:
-    """S(L) for L = 1 … the fewest lags (at least ``MIN_SPAN``: the mismatch grows into the longer
+    """S(L) for L = 1 … the fewest lags (at least ``MIN_LAGS``: the mismatch grows into the longer
     ones) over which it ``levels_off``, computed lag by lag (white noise's settles at 8). When it never
     does within ``max_lag`` (or the window's half, less 4): all of them if ``rising_is_noise`` (a
     reading against the signal's own smoothing, where the rise is a correlation too long for the
@@ -126,10 +126,10 @@ def noise_structure(values: np.ndarray, max_lag: int, rising_is_noise: bool) -> 
     hinge moment 500 N·m off zero made a worn dead band of white speed noise)."""
     available = min(max_lag, (len(values) - 8) // 2)
     values = np.ascontiguousarray(values, dtype=np.float64)
-    structure = second_difference_variances(values, 1, min(MIN_SPAN, available))
+    structure = second_difference_variances(values, 1, min(MIN_LAGS, available))
     while len(structure) < available and not levels_off(np.array(structure)):
         structure.append(second_difference_variance(values, len(structure) + 1))
-    if len(structure) >= MIN_SPAN and not rising_is_noise and not levels_off(np.array(structure)):
+    if len(structure) >= MIN_LAGS and not rising_is_noise and not levels_off(np.array(structure)):
         return np.array(structure[:1])
     return np.array(structure)
 

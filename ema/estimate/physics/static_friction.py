@@ -37,7 +37,7 @@ from ema.model.residual import END_STOP_MARGIN_DEG, smoothed
 
 REST_SPEED_RADPS = 0.5  # at rest: the smoothed speed below this (the sensor noise alone exceeds a creep of 1 rad/s)
 MIN_RUN_S = 1e-3  # a rest and the motion after it must each last this long
-QUASI_STATIC = 0.05  # the drive moves less than this share of its level in the 3 samples into a break-away, or 1 ms out
+STILL_SHARE = 0.05  # the drive moves less than this share of its level in the 3 samples into a break-away, or 1 ms out
 MIN_RISE_NOISE = 4.0  # noise stds: how far the drive must rise over a rest; the allowance of the jump and creep tests
 MIN_EVENTS_FOR_STD = 3
 LOOKBACK_RUNS = 3  # the break-away is sought over the last 3 MIN_RUN_S of a rest
@@ -100,9 +100,9 @@ def _break_away(t: _Traces, rest: tuple[int, int], run: int, end_stop_deg: float
     peak = first + int(np.argmax(drive[first : end + 2]))
     level = drive[peak]
     tolerance = 3 * noise * np.sqrt(2 / 3)  # 3 std of the difference of two 3-sample means
-    if peak < 3 or level - drive[peak - 3] > QUASI_STATIC * level + tolerance:
+    if peak < 3 or level - drive[peak - 3] > STILL_SHARE * level + tolerance:
         return None  # the drive jumped into the break-away: a step
-    if drive[end + 1 : end + 1 + run].max() > (1 + QUASI_STATIC) * level + MIN_RISE_NOISE * noise:
+    if drive[end + 1 : end + 1 + run].max() > (1 + STILL_SHARE) * level + MIN_RISE_NOISE * noise:
         return None  # it jumped as the shaft let go: the rest's drive only bounds the static level
     inside = t.speed_radps[begin + run // 2 : end + 1 - run]  # the rest but its ends, where the motion leaks in
     if len(inside) < 2 or abs(inside.mean()) > MIN_RISE_NOISE * t.speed_noise_radps / np.sqrt(len(inside)):

@@ -21,7 +21,7 @@ every later stage costs per logged sample, and a batch of simulations records ev
 simulation. So the window is averaged over f adjacent samples first: interval means of interval
 means are the interval means of the longer intervals, exactly, which is also what the simulations
 record at the lower rate. ``f`` keeps the rate at or below ``MAX_RATE_HZ`` (the 2 ms reconstruction
-needs no more) and the samples at or below ``MAX_SAMPLES``: memory and time grow at most linearly
+needs no more) and the samples at or below ``RESAMPLED_MAX_SAMPLES``: memory and time grow at most linearly
 with the duration, and are bounded. A window of up to 10 s is kept at ``KERNEL_FREE_RATE_HZ`` or more
 where it was logged so: below it the 2 ms kernel spans few samples and reads J_M low
 (``ema.estimate.prepare.departures.drive_constants``), and a long window's stds are small enough to show it.
@@ -56,7 +56,7 @@ from ema.model.params import DriveConstants
 from ema.model.window import Window
 
 MAX_RATE_HZ = DEFAULT_SAMPLE_RATE_HZ
-MAX_SAMPLES = int(10.0 * KERNEL_FREE_RATE_HZ)  # a 10 s window (0.1–10 s are answered) at the unbiased rate
+RESAMPLED_MAX_SAMPLES = int(10.0 * KERNEL_FREE_RATE_HZ)  # a 10 s window (0.1–10 s are answered) at the unbiased rate
 GLITCH_STDS = 30.0
 GLITCH_ACTIVITY = 5.0
 ACTIVITY_HALF_WIDTH = 10  # samples each side whose median step sets the signal's local activity
@@ -90,8 +90,8 @@ class Prepared:
 
 
 def averaging_factor(n_samples: int, rate_hz: float) -> int:
-    """The smallest f with rate / f ≤ MAX_RATE_HZ and n / f ≤ MAX_SAMPLES."""
-    return max(1, math.ceil(rate_hz / MAX_RATE_HZ - 1e-9), math.ceil(n_samples / MAX_SAMPLES - 1e-9))
+    """The smallest f with rate / f ≤ MAX_RATE_HZ and n / f ≤ RESAMPLED_MAX_SAMPLES."""
+    return max(1, math.ceil(rate_hz / MAX_RATE_HZ - 1e-9), math.ceil(n_samples / RESAMPLED_MAX_SAMPLES - 1e-9))
 
 
 def glitch_floor(values: np.ndarray) -> float:

@@ -52,7 +52,7 @@ SKIPPED = {
     "assess": "no held-out simulations: the std is the stretches' own noise and the document's repeatability",
     "check": "no simulation of the window at the answer: the stretches' fit to Eq. 5.1 is the check",
 }
-QUASI_STATIC = tuple(stage for stage in STAGES if stage not in SKIPPED)  # the stages a low-rate window runs
+QUASI_STATIC_STAGES = tuple(stage for stage in STAGES if stage not in SKIPPED)  # the stages a low-rate window runs
 
 
 def estimate_low_rate(

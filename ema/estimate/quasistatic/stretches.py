@@ -39,7 +39,7 @@ from ema.model.params import eta_a_of, load_factors
 from ema.model.window import Window
 
 BLOCKS = 5  # a stretch's mean and its std from this many blocks (the current is correlated over samples)
-SETTLE_S = 0.4  # after a change of speed, the drive settles this long before a stretch is read
+STRETCH_SETTLE_S = 0.4  # after a change of speed, the drive settles this long before a stretch is read
 REST_SETTLE_S = 1.5  # after the motion stops, the drive's current settles this long before it reads I0
 MIN_STRETCH_S = 1.0  # a stretch at constant speed, or at rest, this long at least (after settling)
 SPEED_TOLERANCE = 0.02  # constant speed: within this share of the stretch's own speed
@@ -83,9 +83,9 @@ def stretches(
     speed: np.ndarray, current: np.ndarray, load_nm: np.ndarray, rate: float
 ) -> tuple[list[Stretch], Rest | None]:
     """The stretches at constant speed (by the commanded or logged ``speed``) and at rest, each after its
-    settling (``SETTLE_S``; at rest ``REST_SETTLE_S``: a stepper's current decays for a second after it stops),
+    settling (``STRETCH_SETTLE_S``; at rest ``REST_SETTLE_S``: a stepper's current decays for a second after it stops),
     at least ``MIN_STRETCH_S`` long."""
-    settle, least = round(SETTLE_S * rate), max(round(MIN_STRETCH_S * rate), BLOCKS)
+    settle, least = round(STRETCH_SETTLE_S * rate), max(round(MIN_STRETCH_S * rate), BLOCKS)
     rest_settle = round(REST_SETTLE_S * rate)
     top = float(np.max(np.abs(speed))) if len(speed) else 0.0
     moving = np.abs(speed) > 0.05 * top

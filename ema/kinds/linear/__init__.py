@@ -13,7 +13,7 @@ from dataclasses import dataclass
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import Estimate
 from ema.estimate.quasistatic.drive_torque import STEPPER_READING
-from ema.estimate.quasistatic.slow_window import QUASI_STATIC
+from ema.estimate.quasistatic.slow_window import QUASI_STATIC_STAGES
 from ema.kinds.base import Calibrated, CalibrationRequest, Cost, Request, read_quasi_statically
 from ema.kinds.linear.calibration_report import calibrate_linear
 from ema.model.actuator import LinearActuator, as_kind
@@ -26,7 +26,7 @@ class Linear:
     facts: KindFacts = KINDS["linear"]
 
     def stages(self, window: Window) -> tuple[str, ...]:
-        return QUASI_STATIC
+        return QUASI_STATIC_STAGES
 
     def estimate(self, window: Window, request: Request) -> Estimate:
         return read_quasi_statically(window, request, STEPPER_READING)

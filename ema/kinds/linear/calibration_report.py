@@ -5,7 +5,7 @@ report's ``drive`` holds what was learned, the residual of the runs' current bef
 after, and a leave-one-run-out check; ``completed`` is the document with it. Comparing (a calibrated
 document): each run read with it (``ema.estimate.quasistatic.slow_window``), FDJ (and η_O where the runs' loads
 differ) set against the nominal in ``changes``, and the current along the stroke against the healthy
-profile, named ``position_friction`` only beyond ``MIN_Z``.
+profile, named ``position_friction`` only beyond ``NAME_Z``.
 """
 
 from __future__ import annotations

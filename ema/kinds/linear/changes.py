@@ -6,7 +6,7 @@ healthy sets allow (a friction that falls is one too: a screw losing its preload
 healthy runs' loads said to be extrapolated, and how large a change it could not show. Where the runs span two
 load sizes, η_O is read over all of them and set against the nominal likewise. Along the stroke, the current
 is set against the healthy runs' own profile (``ema.kinds.linear.drive_calibration.profile_change``): a friction that
-changes along the stroke is named only beyond ``MIN_Z`` of one run's scatter. Each change carries its
+changes along the stroke is named only beyond ``NAME_Z`` of one run's scatter. Each change carries its
 machine-readable verdict (``departed``) beside its sentence.
 """
 
@@ -18,18 +18,16 @@ from collections.abc import Sequence
 import numpy as np
 
 from ema.calibration.documents import CalibrationReport, Candidate, Change, HeldOut, NoiseFloor, Step
+from ema.calibration.limits import NAME_Z
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import DIMENSIONLESS, ActuatorRead, Estimate
 from ema.estimate.quasistatic.departure import DEPARTURE_Z, Departure, departure, inside
 from ema.estimate.quasistatic.drive_torque import STEPPER_READING
-from ema.estimate.quasistatic.slow_window import estimate_low_rate
+from ema.estimate.quasistatic.slow_window import FELL, ROSE, estimate_low_rate
 from ema.estimate.quasistatic.stretches import solve_stretches
-from ema.kinds.linear.drive_calibration import MIN_Z, Run, profile_change, run_load_n
+from ema.kinds.linear.drive_calibration import Run, profile_change, run_load_n
 from ema.model.actuator import LinearActuator
 from ema.model.window import Window
-
-FELL = "friction lost (a ball screw losing its preload: a spalled track, smaller balls)"
-ROSE = "friction gained (grease lost, a seal tightened, a track roughened)"
 
 
 def fdj_changes(runs: list[Run], results: list[Estimate], actuator: LinearActuator) -> list[Change]:
@@ -129,7 +127,7 @@ def stroke_step(runs: list[Run], actuator: LinearActuator) -> tuple[Step, Candid
     if outside:
         healthy = (np.full_like(healthy[0], np.nan), np.full_like(healthy[1], np.nan))
     profile_z, departure_a = profile_change(runs, *healthy)
-    named = profile_z >= MIN_Z
+    named = profile_z >= NAME_Z
     candidate = Candidate(
         effect="position_friction",
         follows="position_mm",
@@ -144,7 +142,7 @@ def stroke_step(runs: list[Run], actuator: LinearActuator) -> tuple[Step, Candid
         f"the current along the stroke departs from the healthy runs' by {profile_z:.1f} run-to-run stds: a "
         "friction that changes along the stroke (a local defect)"
         if named
-        else f"nothing beyond FDJ stands above the runs' noise along the stroke (z = {profile_z:.1f} < {MIN_Z:g}): a "
+        else f"nothing beyond FDJ stands above the runs' noise along the stroke (z = {profile_z:.1f} < {NAME_Z:g}): a "
         "local defect such as a spall may well be invisible in a current logged at 25 Hz"
         if np.isfinite(healthy[1]).any()
         else f"the stroke is not compared at {', '.join(f'{n} N' for n in outside)}: the healthy profile was learned "

@@ -18,7 +18,7 @@ every later estimate's std.
 **Compare** (a calibrated document): the runs are read with it, their FDJ (and η_O where their loads
 differ) set against the nominal, and the current along the stroke against the healthy runs' own
 profile (``screw.stroke_profile_a``): a friction that changes along the stroke (a local defect) is named
-only where the runs' mean stands ``MIN_Z`` of one run's scatter (the larger of theirs and the healthy
+only where the runs' mean stands ``NAME_Z`` of one run's scatter (the larger of theirs and the healthy
 runs', ``screw.stroke_profile_std_a``) above that profile; where nothing does, the report says what 25 Hz
 cannot show. One run's scatter, not the standard error of the runs' mean: runs of one set share their
 day and their load, and healthy sets logged apart differ by several standard errors of their means.
@@ -37,7 +37,6 @@ from ema.model.checks import InputError
 from ema.model.params import load_factors
 from ema.model.window import Window
 
-MIN_Z = 6.0
 PROFILE_BINS = 8  # the current along each stroke, in this many bins, against the healthy runs'
 
 

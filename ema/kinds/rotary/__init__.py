@@ -20,7 +20,7 @@ from ema.calibration.plot import ResidualPlot, Series
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import STAGES, Estimate
 from ema.estimate.quasistatic.drive_torque import MOTOR_READING
-from ema.estimate.quasistatic.slow_window import QUASI_STATIC
+from ema.estimate.quasistatic.slow_window import QUASI_STATIC_STAGES
 from ema.kinds.base import WARM_UP, Calibrated, CalibrationRequest, Cost, Request, read_quasi_statically
 from ema.kinds.rotary.synthetic import synthetic_window
 from ema.model.actuator import THESIS
@@ -33,7 +33,7 @@ from ema.model.window import Window
 if TYPE_CHECKING:
     from ema.kinds.rotary.calibration import Calibrator
 
-VARIABLES = {
+VARIABLE_LABELS = {
     "speed_radps": "motor speed |ω| [rad/s]",
     "current_a": "current · sgn(ω) [A]",
     "time_s": "time in the window [s]",
@@ -49,7 +49,7 @@ class Rotary:
     facts: KindFacts = KINDS["rotary"]
 
     def stages(self, window: Window) -> tuple[str, ...]:
-        return STAGES if window.high_rate else QUASI_STATIC
+        return STAGES if window.high_rate else QUASI_STATIC_STAGES
 
     def estimate(self, window: Window, request: Request) -> Estimate:
         if not window.high_rate:
@@ -118,7 +118,7 @@ def residual_plot(calibrator: Calibrator) -> ResidualPlot:
         series.append(Series(label, x[::4].tolist(), residual[::4].tolist()))
     return ResidualPlot(
         title=f"calibration: {report.selected_effect or 'no effect named'}",
-        x_label=VARIABLES.get(variable, variable),
+        x_label=VARIABLE_LABELS.get(variable, variable),
         y_label="equation error of Eq. 5.1 [N·m]",
         series=series,
     )

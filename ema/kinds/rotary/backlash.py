@@ -6,7 +6,7 @@ on one face of the dead band, then on the other. Fitting that step (a level per 
 samples where the elevator moves with the motor (after a reversal the motor first crosses the
 band, d between the faces, and a wide band read over those samples comes out narrow). The noise
 copies, simulated with the nominal band, give the reading's own spread and bias: a band of any
-size is named when it stands ``MIN_Z`` of those stds from them, and its extra width is the
+size is named when it stands ``NAME_Z`` of those stds from them, and its extra width is the
 difference. The copies are replicas of the base model as estimated, without what the torque channel
 adopts; where it does not reproduce the window (an equation error R times the copies'), they
 understate every spread about R-fold, and the spread is widened by R: a torque constant at half its
@@ -21,13 +21,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ema.calibration.limits import NAME_Z
 from ema.kinds.rotary.equations import Equations
-from ema.kinds.rotary.selection import MIN_Z, floor_rms, residual_rms
+from ema.kinds.rotary.selection import floor_rms, residual_rms
 
 MIN_ENGAGED = 50  # samples pushing on each face
 # The reading's floor: the dead band read kinematically moves with dynamics the model gets wrong, and the copies
 # share the model's dynamics, so their spread alone understates it (docs/calibration.md): a band is named wider
-# only beyond MIN_Z of this share of its nominal width.
+# only beyond NAME_Z of this share of its nominal width.
 RESOLUTION = 0.05
 
 
@@ -51,7 +52,7 @@ class BacklashReading:
     def significant(self) -> bool:
         # One-sided: wear widens a dead band. A reading well below the nominal one means the step
         # model does not hold (a band so wide the motor seldom pushes on both faces), not a tight gear.
-        return self.z >= MIN_Z
+        return self.z >= NAME_Z
 
 
 def width_rad(e: Equations) -> float:

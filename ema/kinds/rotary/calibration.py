@@ -28,6 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ema.calibration.documents import CalibrationReport, Step
+from ema.calibration.limits import MAX_EFFECTS
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import TARGETS, Estimate
 from ema.estimate.physics.scenario import CLEAR_MARGIN
@@ -40,7 +41,7 @@ from ema.kinds.rotary.families import Family, generic_families
 from ema.kinds.rotary.noise_floor import clean_replicas, noise_copies
 from ema.kinds.rotary.pipeline import estimate_window
 from ema.kinds.rotary.readings import AMBIGUOUS_STDS, Contest, combined_stds, reading, settled
-from ema.kinds.rotary.selection import MAX_EFFECTS, Chosen, Decision, Evidence, decide, evidence
+from ema.kinds.rotary.selection import Chosen, Decision, Evidence, decide, evidence
 from ema.kinds.rotary.tied_solve import MIN_HELD_OUT_GAIN, corrected, held_out_rss, solve_with
 from ema.kinds.rotary.twins import TWINS, output_error, runners_up, tell_apart
 from ema.kinds.rotary.vocabulary import COGGING_ORDERS, named_families

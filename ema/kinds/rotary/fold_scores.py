@@ -14,9 +14,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ema.kinds.rotary.equations import FOLDS
+from ema.calibration.limits import FOLDS
 
-RIDGE = 1e-10  # relative: keeps a collinear column (two hats with no sample between) solvable
+FOLD_RIDGE = 1e-10  # relative: keeps a collinear column (two hats with no sample between) solvable
 
 
 @dataclass(frozen=True)
@@ -28,7 +28,7 @@ class Scored:
 
 def _solve(gram: np.ndarray, rhs: np.ndarray) -> np.ndarray:
     scale = np.maximum(np.diag(gram), 1e-300)
-    regularized = gram + RIDGE * np.diag(scale)
+    regularized = gram + FOLD_RIDGE * np.diag(scale)
     return np.linalg.solve(regularized, rhs)
 
 
@@ -129,7 +129,7 @@ def score_offsets(
 
 def _solve_many(gram: np.ndarray, rhs: np.ndarray) -> np.ndarray:
     scale = np.maximum(np.einsum("gkk->gk", gram), 1e-300)
-    regularized = gram + RIDGE * scale[:, :, None] * np.eye(gram.shape[1])[None]
+    regularized = gram + FOLD_RIDGE * scale[:, :, None] * np.eye(gram.shape[1])[None]
     return np.linalg.solve(regularized, rhs[..., None])[..., 0]
 
 

@@ -6,7 +6,7 @@ every noise copy (``ema.kinds.rotary.noise_floor``), where a family with a grid 
 value on each copy as it does on the data (the look-elsewhere freedom is in the floor). Its
 evidence is z = (measured − mean of copies) / std of copies.
 
-A family enters when z ≥ ``MIN_Z``. The one that explains held-out samples best is named only if
+A family enters when z ≥ ``NAME_Z``. The one that explains held-out samples best is named only if
 no curve over *another* variable explains nearly as much (``NAME_MARGIN``): a friction drifting
 in time is not a position effect because the elevator happened to move while it drifted. When a
 generic curve wins and a named family over the same variable comes within the margin, the name
@@ -24,17 +24,16 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ema.calibration.limits import NAME_Z
 from ema.kinds.rotary.equations import Equations
 from ema.kinds.rotary.families import Family, Grid
 from ema.kinds.rotary.fold_scores import Scored, score, score_grid, score_offsets
 from ema.model import runtime
 
-MIN_Z = 6.0  # the measured drop stands this many noise-floor stds above the copies' mean
 # A floor under the copies' std: a family whose grid holds "no effect" (a gain of 1) drops exactly
 # nothing on every copy, and a zero std would make any drop infinitely significant.
 MIN_NULL_STD = 1e-3
 NAME_MARGIN = 0.15  # a rival curve explaining ≥ 85 % as much leaves the name undecided
-MAX_EFFECTS = 2
 
 
 @dataclass(frozen=True)
@@ -128,8 +127,8 @@ def settle(
 ) -> str:
     """Between a named family and a curve over another variable that explains about as much: does
     either still explain held-out samples once the other is in? Returns "named", "rival" or "tie"."""
-    rival_beyond = evidence(measured, copies, [*chosen, Chosen(named.family, named.grid)], rival.family).z >= MIN_Z
-    named_beyond = evidence(measured, copies, [*chosen, Chosen(rival.family, rival.grid)], named.family).z >= MIN_Z
+    rival_beyond = evidence(measured, copies, [*chosen, Chosen(named.family, named.grid)], rival.family).z >= NAME_Z
+    named_beyond = evidence(measured, copies, [*chosen, Chosen(rival.family, rival.grid)], named.family).z >= NAME_Z
     if rival_beyond and not named_beyond:
         return "rival"
     if named_beyond or not rival_beyond:
@@ -157,7 +156,7 @@ def simplest(
         if e.family.named and e.family.follows == named.family.follows and len(e.family.grid) < len(named.family.grid)
     ]
     for rival in sorted(simpler, key=lambda e: len(e.family.grid)):
-        if evidence(measured, copies, [*chosen, Chosen(rival.family, rival.grid)], named.family).z < MIN_Z:
+        if evidence(measured, copies, [*chosen, Chosen(rival.family, rival.grid)], named.family).z < NAME_Z:
             return rival, [named.family.name]
     return named, []
 
@@ -166,12 +165,12 @@ def decide(
     found: Sequence[Evidence], measured: Equations, copies: Sequence[Equations], chosen: Sequence[Chosen]
 ) -> Decision:
     """One forward step: adopt the best significant family if a name is earned; else describe."""
-    significant = sorted((e for e in found if e.z >= MIN_Z and not e.at_bound), key=lambda e: -e.improvement)
+    significant = sorted((e for e in found if e.z >= NAME_Z and not e.at_bound), key=lambda e: -e.improvement)
     if not significant:
-        bounded = [e.family.name for e in found if e.z >= MIN_Z and e.at_bound]
+        bounded = [e.family.name for e in found if e.z >= NAME_Z and e.at_bound]
         if bounded:
             return Decision(None, [], f"{', '.join(bounded)} reads at the end of its search: larger than any it names")
-        return Decision(None, [], f"no candidate lowers the held-out residual beyond {MIN_Z:g} noise-floor stds")
+        return Decision(None, [], f"no candidate lowers the held-out residual beyond {NAME_Z:g} noise-floor stds")
     best = significant[0]
     close = [e for e in significant[1:] if e.improvement >= (1 - NAME_MARGIN) * best.improvement]
     named = (
@@ -183,7 +182,7 @@ def decide(
         return Decision(None, [best], f"the residual follows {best.family.follows} in a way no named effect describes")
     named, alike = simplest(named, [best, *close], measured, copies, chosen)
     if _falls_with_speed(named):
-        decays = [e for e in found if e.family.name == "stribeck" and e.z >= MIN_Z]
+        decays = [e for e in found if e.family.name == "stribeck" and e.z >= NAME_Z]
         return Decision(
             None,
             [named, *decays],
@@ -235,7 +234,7 @@ def _step_in_time(named: Evidence, found: Sequence[Evidence]) -> Evidence | None
     tell a step from a drift are the very samples both fit."""
     if named.family.follows != "direction":
         return None
-    timed = [e for e in found if not e.family.named and e.family.follows == "time_s" and e.z >= MIN_Z]
+    timed = [e for e in found if not e.family.named and e.family.follows == "time_s" and e.z >= NAME_Z]
     close = [e for e in timed if e.improvement >= (1 - NAME_MARGIN) * named.improvement]
     return close[0] if close else None
 

@@ -39,7 +39,7 @@ def synthetic_window(
     actuator: ActuatorDocument = THESIS,
 ) -> Window:
     """One window logged from the model of ``actuator``: a command of ``command``'s family
-    (``ema.model.commands.FAMILIES``), the actuator at rest where the command starts, sensor noise; in flight at
+    (``ema.model.commands.COMMAND_FAMILIES``), the actuator at rest where the command starts, sensor noise; in flight at
     ``condition``, or on the ground under a load cell's ``GroundLoad`` (the window then names no flight
     condition).
 

@@ -15,8 +15,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ema.calibration.limits import FOLDS
 from ema.estimate.physics.eta_search import coarse_to_fine
-from ema.kinds.rotary.equations import FOLDS, Equations
+from ema.kinds.rotary.equations import Equations
 from ema.kinds.rotary.selection import Chosen
 from ema.model.params import load_factors
 

@@ -18,8 +18,9 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
+from ema.calibration.limits import NAME_Z
 from ema.estimate.physics.scenario import CLEAR_MARGIN, following_error, inside, scenario_from_window
-from ema.kinds.rotary.selection import MIN_Z, NAME_MARGIN, Evidence
+from ema.kinds.rotary.selection import NAME_MARGIN, Evidence
 from ema.model.actuator import ActuatorDocument
 from ema.model.effects import EffectSet
 from ema.model.noise import SensorNoise
@@ -95,7 +96,7 @@ def runners_up(pick: Evidence, found: Sequence[Evidence], alike: Sequence[str], 
             e.family.follows == pick.family.follows and len(e.family.grid) > len(pick.family.grid)
         ):
             return False
-        held_out = e.z >= MIN_Z and e.improvement >= (1 - NAME_MARGIN) * pick.improvement
+        held_out = e.z >= NAME_Z and e.improvement >= (1 - NAME_MARGIN) * pick.improvement
         in_sample = wide and e.rms_reduction >= (1 - NAME_MARGIN) * pick.rms_reduction
         return held_out or in_sample
 

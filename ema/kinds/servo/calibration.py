@@ -40,6 +40,7 @@ from ema.calibration.documents import (
     NoiseFloor,
     Step,
 )
+from ema.calibration.limits import MAX_EFFECTS
 from ema.calibration.plot import ResidualPlot, Series
 from ema.estimate.assess.weighing import misfit_limit
 from ema.estimate.stats import rms
@@ -48,7 +49,7 @@ from ema.kinds.servo.inverse import (
     UNITS,
     decimated,
 )
-from ema.kinds.servo.load_effects import EFFECTS, ServoEffect
+from ema.kinds.servo.load_effects import LOAD_EFFECTS, ServoEffect
 from ema.kinds.servo.log_reading import ServoPrepared, document_effects, prepare_servo, refuse_reversed_signs
 from ema.kinds.servo.stacked_solve import (
     COPIES,
@@ -67,7 +68,6 @@ from ema.model.window import Window
 
 MIN_HELD_OUT_DROP = 0.05  # of the held-out residual sum of squares
 CLOSED_LOOPS = COPIES + 2 * FRAME_PHASES + 2  # per window: noise copies, twins before and after, the errors
-MAX_EFFECTS = 2
 LEARNED_NAMES = {
     "fdj_n": "FDJ",
     "mass_kg": "mass",
@@ -110,7 +110,7 @@ def select(prepared: Sequence[ServoPrepared], base_model: dict[str, float]) -> t
     current = solved(problem(prepared, model))
     for _ in range(MAX_EFFECTS):
         trials = []
-        for effect in (e for e in EFFECTS if e.name not in model):
+        for effect in (e for e in LOAD_EFFECTS if e.name not in model):
             value, solution = _best_of(effect, prepared, model)
             candidate, earned = _candidate(effect, value, solution, current)
             candidates.append(candidate)
@@ -149,7 +149,7 @@ def learned(solution: Solved, model: dict[str, float], values: dict[str, float] 
         Learned(name=LEARNED_NAMES.get(name, name), value=value, std=solution.stds[name], unit=UNITS[name])
         for name, value in (solution.values if values is None else values).items()
     ]
-    for effect in EFFECTS:
+    for effect in LOAD_EFFECTS:
         if effect.name in model and effect.constant is not None:
             out.append(Learned(name=effect.constant[0], value=model[effect.name], std=0.0, unit=effect.constant[1]))
     return out

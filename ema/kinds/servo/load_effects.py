@@ -30,7 +30,7 @@ class ServoEffect:
     constant: tuple[str, str] | None = None  # its nonlinear constant's name and unit
 
 
-EFFECTS = (
+LOAD_EFFECTS = (
     ServoEffect(
         "viscous_down",
         "a viscous friction that differs with the direction of motion",

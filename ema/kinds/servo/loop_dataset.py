@@ -18,12 +18,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from ema.estimate.config import PipelineConfig
-from ema.estimate.simulate.design import halton
+from ema.estimate.simulate.design import SPAN_SIGMAS, halton
 from ema.kinds.servo.closed_loop import LANE_PARAMETERS, ServoRuns
 from ema.kinds.servo.inverse import InverseSolution
 from ema.kinds.servo.log_reading import ServoPrepared
 
-SPAN_SIGMAS = 6.0
 MIN_HALF_SHARE = 0.05
 LANE_COLUMNS = {
     "mass_kg": (0,),

@@ -12,6 +12,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from ema.calibration.limits import FOLDS
 from ema.estimate.stats import rms
 from ema.kinds.servo.inverse import (
     decimated_problem,
@@ -25,7 +26,6 @@ from ema.kinds.servo.inverse import (
 from ema.kinds.servo.log_reading import ServoPrepared
 from ema.kinds.servo.loop_dataset import LANE_COLUMNS, lane_parameters
 
-FOLDS = 5
 COPIES = 8
 FRAME_PHASES = 4  # phases of the sensor's step the twins of simulator_frame are read at
 

@@ -7,7 +7,7 @@ from ema.estimate.prepare.alignment import Lags
 from ema.estimate.prepare.conditioning import (
     GLITCH_ACTIVITY,
     MAX_RATE_HZ,
-    MAX_SAMPLES,
+    RESAMPLED_MAX_SAMPLES,
     averaging_factor,
     prepare,
     widened,
@@ -29,7 +29,7 @@ def test_averaging_keeps_rate_and_samples_bounded():
     assert averaging_factor(1_000_000, 100_000.0) == 20  # ... however fast it was logged
     for n, rate in ((1_000_000, 100_000.0), (30_000, 12_800.0), (100, 1_000.0)):
         f = averaging_factor(n, rate)
-        assert rate / f <= MAX_RATE_HZ and n / f <= MAX_SAMPLES
+        assert rate / f <= MAX_RATE_HZ and n / f <= RESAMPLED_MAX_SAMPLES
 
 
 def test_averaged_samples_are_the_means_of_the_longer_intervals():

@@ -7,18 +7,18 @@ import pytest
 from ema.estimate.prepare.conditioning import conditioning_notes, prepare
 from ema.estimate.prepare.verdict import check_consistency
 from ema.model.actuator import THESIS
+from ema.model.bounds import COMMAND_FAMILIES
 from ema.model.checks import InputError
 from ema.model.window import window_from_dict
 from tests.foreign.careless import SLIPS, Slip, exported
 from tests.foreign.windows import Effects, draw, filter_widths, through_filters, worn
 
-FAMILIES = ("thesis", "cruise", "gust", "doublet", "steps")
 SEEDS = range(4400, 4405)
 
 
 def _windows(seed: int) -> list[dict]:
     """Windows of a working drive the checks must pass: each family, 1 and 100 kHz, 0.1 s, worn, filtered."""
-    family = FAMILIES[seed % 5]
+    family = COMMAND_FAMILIES[seed % 5]
     return [
         draw(seed, family).document,
         draw(seed, family, sample_rate_hz=1_000.0).document,
@@ -75,7 +75,8 @@ def test_a_careless_export_is_refused_naming_its_field(slip):
     for seed in SEEDS:
         try:
             check_consistency(
-                window_from_dict(exported(draw(seed, FAMILIES[seed % 5]).document, SLIPS[slip])), drive=THESIS.params
+                window_from_dict(exported(draw(seed, COMMAND_FAMILIES[seed % 5]).document, SLIPS[slip])),
+                drive=THESIS.params,
             )
         except InputError as refused:
             named.append(refused.field)

@@ -7,9 +7,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from ema.calibration.limits import NAME_Z
 from ema.kinds import estimate
 from ema.kinds.linear.calibration_report import calibrate_linear
-from ema.kinds.linear.drive_calibration import MIN_Z, read_run
+from ema.kinds.linear.drive_calibration import read_run
 from ema.model.actuator import read_actuator
 from ema.model.checks import InputError
 from ema.model.logmap import read_logmap, read_mapped
@@ -98,7 +99,7 @@ def test_healthy_runs_logged_apart_name_nothing_along_the_stroke(learned):
     _, document = learned
     for load in (20, 40):
         report, _, _ = calibrate_linear(runs("normal", load, range(5, 10)), document)
-        assert report.selected_effects == [] and report.candidates[0].score < MIN_Z
+        assert report.selected_effects == [] and report.candidates[0].score < NAME_Z
         assert abs(report.changes[0].z) < 2 and not report.changes[0].departed
 
 
@@ -121,7 +122,7 @@ def test_a_local_rise_of_the_current_along_the_stroke_is_named(learned):
         signals["current_a"] = signals["current_a"] + 0.3 * over * (np.abs(np.gradient(signals["position_mm"])) > 0.5)
         spalled.append(replace(window, signals=signals))
     report, _, _ = calibrate_linear(spalled, document)
-    assert report.selected_effects == ["position_friction"] and report.candidates[0].score >= MIN_Z
+    assert report.selected_effects == ["position_friction"] and report.candidates[0].score >= NAME_Z
 
 
 def test_a_run_that_never_rests_is_refused_for_learning_naming_it():

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from ema.kinds.rotary.equations import FOLDS
+from ema.calibration.limits import FOLDS
 from ema.kinds.rotary.fold_scores import hats, score, score_grid, uniform_knots
 
 

@@ -9,7 +9,7 @@ give η_A·η_O = (1 − c_aid)/(1 + c_opp), whence η_O by Eq. 3.4 (a quadratic
 g = 1/((1 + c_opp)·η_O). Read with g = 1, a gain is η_O's twin in the constrained fit.
 
 So g is read where the free fit explains the window ``DECISIVE_Z`` stds better (the likelihood ratio
-of the two equation errors, as for the offset) and lies in ``PLAUSIBLE``; the hinge moment is then
+of the two equation errors, as for the offset) and lies in ``GAIN_PLAUSIBLE``; the hinge moment is then
 divided by it before every estimator, and FDJ's and η_O's stds grow by what g's jackknife std moves
 them (``spread``).
 
@@ -36,9 +36,9 @@ from ema.model.params import DriveConstants
 from ema.model.residual import DERIVATIVE_SPAN_S, kernel_samples
 from ema.model.window import Window
 
-PLAUSIBLE = (0.7, 1.35)  # lbf·ft for N·m is 0.74; outside, no sensor's: not taken
-MIN_CHANGE = 0.01  # a gain nearer 1 than this changes nothing worth a note
-DECISIVE = 12.0  # ln LR by which g must beat γ and ΔJ to be read before them (as ΔJ must beat γ)
+GAIN_PLAUSIBLE = (0.7, 1.35)  # lbf·ft for N·m is 0.74; outside, no sensor's: not taken
+GAIN_MIN_CHANGE = 0.01  # a gain nearer 1 than this changes nothing worth a note
+GAIN_DECISIVE = 12.0  # ln LR by which g must beat γ and ΔJ to be read before them (as ΔJ must beat γ)
 
 
 @dataclass(frozen=True)
@@ -107,19 +107,19 @@ def _margin(window: Window, drive: DriveConstants, free_rms: float, used: int, r
 
 def read_hinge_gain(window: Window, drive: DriveConstants, leading: bool = False) -> HingeGain:
     """g where it stands out and is plausible (module docstring), with FDJ's and η_O's change across g ± its
-    std; ``leading``: only where it also explains the window ``DECISIVE`` (ln LR) better than γ or ΔJ alone,
+    std; ``leading``: only where it also explains the window ``GAIN_DECISIVE`` (ln LR) better than γ or ΔJ alone,
     each beside an offset and ΔC, to be read before them (which would each take a part of it)."""
     solved = free_load_solution(window, drive, BESIDE)
     if solved is None:
         return HingeGain()
     gain, free_rms, used = solved
-    plausible = np.all(np.isfinite(gain)) and PLAUSIBLE[0] <= gain[0] <= PLAUSIBLE[1]
-    if not (plausible and abs(gain[0] - 1.0) >= MIN_CHANGE):
+    plausible = np.all(np.isfinite(gain)) and GAIN_PLAUSIBLE[0] <= gain[0] <= GAIN_PLAUSIBLE[1]
+    if not (plausible and abs(gain[0] - 1.0) >= GAIN_MIN_CHANGE):
         return HingeGain()
     if not 2.0 * _margin(window, drive, free_rms, used, [BESIDE]) > DECISIVE_Z**2:
         return HingeGain()
     rivals = [replace(BESIDE, **{name: True}) for name in FIELDS]  # γ alone, ΔJ alone
-    if leading and not _margin(window, drive, free_rms, used, rivals) > DECISIVE:
+    if leading and not _margin(window, drive, free_rms, used, rivals) > GAIN_DECISIVE:
         return HingeGain()
     std = float(jackknife_std(gain[None, 1:])[0])
     rate = window.sample_rate_hz

@@ -48,7 +48,7 @@ HOLDS_Z = 3.0
 UNSEEN_CURRENT_OFFSET_A = 0.05
 # Refits of a sensor's offset: the hinge moment's moves |H − b| (each refit cuts what is left by ~k), the
 # current's is lost where k_T·I meets the motor's peak torque (worn windows saturate more, and need more refits).
-ITERATIONS = 4
+OFFSET_ITERATIONS = 4
 OFFSET_SOLVE = SolveSettings(offset=True)
 
 
@@ -85,10 +85,10 @@ def sensor_offset(
     signals: dict[str, np.ndarray], rate: float, torque_nm: float, sensor: str, drive: DriveConstants
 ) -> float:
     """The offset of ``sensor`` (``hinge_nm`` or ``current_a``) that leaves no constant in T_R: from the
-    shaft's c in the sensor's unit, refitted as the reading moves (``ITERATIONS``)."""
+    shaft's c in the sensor's unit, refitted as the reading moves (``OFFSET_ITERATIONS``)."""
     per_nm = drive.gear_ratio if sensor == "hinge_nm" else 1.0 / drive.torque_constant_nm_per_a
     offset = per_nm * torque_nm
-    for _ in range(ITERATIONS):
+    for _ in range(OFFSET_ITERATIONS):
         left = solve_as_read(_shifted(signals, **{sensor: offset}), rate, drive, OFFSET_SOLVE).term("offset")[0]
         if not np.isfinite(left):
             break

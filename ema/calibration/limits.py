@@ -1,0 +1,6 @@
+"""What every kind's calibration holds to: how many folds it holds out, the evidence from which it names an effect,
+and how many effects it adopts. A kind's calibration reads these; none restates them."""
+
+FOLDS = 5  # each window's samples in five folds, each predicted from the other four (a held-out score)
+NAME_Z = 6.0  # an effect is named where what it explains stands this many stds of what noise alone explains
+MAX_EFFECTS = 2  # effects adopted into the model at most, one at a time, each judged given the ones before
