@@ -18,7 +18,7 @@ class Candidate(Document):
     effect: str = Field(description="a named effect, or 'friction vs <variable>' for a generic curve")
     follows: str = Field(description="the variable its trace follows")
     named: bool
-    parameters: dict[str, float] = Field(description="at its best fit; a curve as value per grid point")
+    parameters: dict[str, float] = Field(description="at its best; a curve as value per grid point")
     rms_reduction: float = Field(description="1 − √(residual with it / without), in sample")
     held_out_drop: float = Field(description="fractional drop of the held-out residual")
     score: float = Field(description="z: held-out drop in noise-floor stds above what noise alone gives")
@@ -33,7 +33,7 @@ class Step(Document):
 
 
 class Unexplained(Document):
-    """Structure no named effect fits, described rather than named."""
+    """Structure no named effect matches, described rather than named."""
 
     adopted: bool = Field(
         False,
@@ -170,7 +170,7 @@ class CalibrationReport(Document):
     as_simulated: list[Learned] = Field(
         default_factory=list,
         description="a servo's learned constants as the simulator takes them, what the completed document keeps: "
-        "each moved by what Eq. 5.1 reads of the logs simulated at it (the fit reads a simulated pre-sliding "
+        "each moved by what Eq. 5.1 reads of the logs simulated at it (the solution reads a simulated pre-sliding "
         "smaller than it is); the closed loop's error after is at these",
     )
     model_error_pct_before: dict[str, float] | None = Field(

@@ -166,12 +166,12 @@ ERROR_WORDS = {"drive_force_n": "force, inverse model", "drive_force_n_closed_lo
 
 
 def _print_learned(learned: dict[str, Any], simulated: dict[str, float]) -> None:
-    """The learned constants (the fit's, with its std), and where the report gives them, as the simulator takes
+    """The learned constants (the solution's, with its std), and where the report gives them, as the simulator takes
     them: what the completed document keeps."""
     if not simulated:
         click.echo("learned (one model):")
     else:
-        click.echo("learned (one model): the fit's, and as the simulator takes them (what the document keeps)")
+        click.echo("learned (one model): the solution's, and as the simulator takes them (what the document keeps)")
     for entry in learned.values():
         kept = simulated.get(entry["name"], entry["value"])
         beside = f"{kept:>12.5g}  " if simulated else ""

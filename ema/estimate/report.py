@@ -77,7 +77,7 @@ def _estimates(
     if fsj.value_nm is not None and fsj.std_nm is not None:
         relative = np.hypot(fsj.std_nm / fsj.value_nm, answer.stds["FDJ"] / fdj)
         ratio = RatioEstimate(value=fsj.value_nm / fdj, std=fsj.value_nm / fdj * relative)
-    # η_A is η_O's through Eq. 3.4, and as weak; a bound of the search is no value, whatever its std: the fit
+    # η_A is η_O's through Eq. 3.4, and as weak; a bound of the search is no value, whatever its std: the solution
     # stops there for a reason it does not know (a unit, a departure), and FDJ with it where the window is loaded
     weak_eta = weakly_determined("eta_O", eta_o_std, ranges) or eta_o_bound
     weak_fdj = weakly_determined("FDJ", answer.stds["FDJ"], ranges) or (eta_o_bound and loaded)
@@ -166,7 +166,7 @@ def carries_load(prepared: Prepared) -> bool:
     load_nm = denoised_hinge_nm(w.signals["hinge_moment_nm"], w.signals["position_deg"], w.sample_rate_hz)
     sliding = sliding_mask(w.signals, w.sample_rate_hz, document.params)
     if not np.any(sliding):
-        return True  # nothing slides: the physics fit refuses the window, not this rule
+        return True  # nothing slides: the physics solution refuses the window, not this rule
     term = (1.0 / document.health.efficiency - 1.0) * rms(load_nm[sliding] / document.gear_ratio)
     return bool(term >= NO_LOAD_SHARE * document.health.fdj)
 

@@ -1,4 +1,4 @@
-"""Statistics every stage shares: block-jackknife stds, likelihood ratios of two fits, posterior weights of two
+"""Statistics every stage shares: block-jackknife stds, likelihood ratios of two solutions, posterior weights of two
 stories, and how decisive a difference must be."""
 
 from __future__ import annotations
@@ -57,9 +57,9 @@ def rms(values: np.ndarray) -> float:
 def rms_log_likelihood_ratio(
     worse_rms: float, better_rms: float, n_sliding: float, rate: float, *, resolution_nm: float
 ) -> float:
-    """ln of the likelihood ratio of two fits of one window's ``n_sliding`` samples by their RMS equation
+    """ln of the likelihood ratio of two solutions of one window's ``n_sliding`` samples by their RMS equation
     errors, with one independent value per reconstruction kernel (the kernel smooths both sides of Eq. 5.1), each
-    error never under the model's ``resolution_nm`` (``RESOLUTION_SHARE``): on a log without noise, what a fit
+    error never under the model's ``resolution_nm`` (``RESOLUTION_SHARE``): on a log without noise, what a solution
     gains below it is the model's own error, not the window's evidence."""
     worse, better = np.hypot(worse_rms, resolution_nm), np.hypot(better_rms, resolution_nm)
     return n_sliding / kernel_samples(rate, DERIVATIVE_SPAN_S) * float(np.log(worse / better))

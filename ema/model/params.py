@@ -50,7 +50,7 @@ def eta_a_of(eta_o: Any, n: float) -> Any:
 
 def load_factors(eta_o: Any, gear_ratio: float) -> tuple[Any, Any]:
     """(k_aid, k_opp) of Eq. 5.1 at η_O: what a load adds to the friction per N·m, aiding (1 − η_A, Eq. 3.4) and
-    opposing (1/η_O − 1); on scalars or arrays, and the one definition the simulator, the fits and the calibration
+    opposing (1/η_O − 1); on scalars or arrays, and the one definition the simulator, the solutions and the calibration
     use."""
     return 1.0 - eta_a_of(eta_o, gear_ratio), 1.0 / eta_o - 1.0
 

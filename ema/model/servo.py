@@ -90,7 +90,7 @@ class Servo(Document):
     )
     effect_constants: dict[str, Number] = Field(
         default_factory=dict,
-        description="the adopted effects' fitted constants, in the inverse model's names (presliding_n: the friction "
+        description="the adopted effects' solved constants, in the inverse model's names (presliding_n: the friction "
         "short of FDJ right after a reversal [N])",
     )
     repeatability_n: Number | None = Field(

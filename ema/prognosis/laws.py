@@ -1,8 +1,8 @@
-"""Degradation laws a parameter's history may follow, each fitted by weighted least squares.
+"""Degradation laws a parameter's history may follow, each solved by weighted least squares.
 
 Time is put on s = (t − t_first) / span, 0 at the first window and 1 at the last, so that every law's
 columns are of order one. A law is its columns φ(s; θ): linear in its coefficients β for a fixed shape θ,
-its shapes a grid over which the fit keeps a posterior (``LawCurve``):
+its shapes a grid over which the curve keeps a posterior (``LawCurve``):
 
 - ``linear``: 1, s;
 - ``quadratic``: 1, s, s²;
@@ -63,13 +63,13 @@ BY_NAME = {law.name: law for law in LAWS}
 
 @dataclass(frozen=True)
 class LawCurve:
-    """One law fitted: per shape its posterior weight, coefficients and their covariance."""
+    """One law's curve: per shape its posterior weight, coefficients and their covariance."""
 
     law: Law
     weights: np.ndarray  # (shapes,) posterior over the law's shapes
     betas: list[np.ndarray]  # per shape, (p,)
     covariances: list[np.ndarray]  # per shape, (p, p)
-    log_likelihood: float  # the best shape's, with BIC's penalty: how well the law fits what it saw
+    log_likelihood: float  # the best shape's, with BIC's penalty: how well the law follows what it saw
 
     def predictive(self, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(mean, variance) of the curve at ``s``: the shapes' mixture (the windows' own noise not included)."""
@@ -83,8 +83,8 @@ class LawCurve:
         return mean, spread
 
     def curves(self, s: np.ndarray, n: int, rng: np.random.Generator, scale: float = 1.0) -> np.ndarray:
-        """(n, len(s)) curves drawn from the fit: a shape by its weight, then coefficients about it, their
-        spread ``scale`` times the fit's."""
+        """(n, len(s)) curves drawn from this posterior: a shape by its weight, then coefficients about it, their
+        spread ``scale`` times the curve's."""
         shape = rng.choice(len(self.weights), size=n, p=self.weights)
         out = np.empty((n, len(s)))
         for k in np.unique(shape):
@@ -96,7 +96,7 @@ class LawCurve:
 
 
 def law_curve(law: Law, s: np.ndarray, y: np.ndarray, weight: np.ndarray) -> LawCurve:
-    """``law`` fitted to ``y`` at ``s`` with per-window weights h / (σ² + τ²); each shape by BIC's likelihood."""
+    """``law`` drawn through ``y`` at ``s`` with per-window weights h / (σ² + τ²); each shape by BIC's likelihood."""
     betas, covariances, scores = [], [], []
     n_eff = max(float(np.sum(weight > 0)), 2.0)
     for theta in law.shapes:

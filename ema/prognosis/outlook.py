@@ -1,6 +1,6 @@
 """One parameter's outlook: its trend, the laws weighed on its history, the forecast and the remaining life.
 
-The windows enter the laws with the weights the trend's robust fit gives them (``ema.prognosis.trend``:
+The windows enter the laws with the weights the trend's robust curve gives them (``ema.prognosis.trend``:
 each window's std, the scatter beyond the stds, a Huber weight for a window the model could not
 explain), read off the quadratic, which bends with wear that speeds up and so does not take the bend
 for scatter as a line would.

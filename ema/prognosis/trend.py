@@ -8,7 +8,7 @@ The level is quoted at the last window, where it is best known and where the rem
 
 Wear need not be linear: friction that grows faster as the transmission wears bends the windows
 upwards, and a line through them would cross its threshold far too late, and surely. So the
-quadratic is fitted beside the line (the same weights, its own τ) and weighed against it by BIC with
+quadratic is drawn beside the line (the same weights, its own τ) and weighed against it by BIC with
 the quadratic's scatter: ln odds = ½(χ²_line − χ²_curve) − ½ ln n, which says whether the history
 bends. Which law to extrapolate is ``ema.prognosis.weigh``'s question.
 """
@@ -26,7 +26,7 @@ from ema.prognosis.documents import Curved, Point, Trend
 HUBER_C = 2.5
 OUTLIER_Z = 3.5
 HUBER_ITERATIONS = 20
-MIN_CURVED = 6  # windows from which a quadratic is fitted beside the line
+MIN_CURVED = 6  # windows from which a quadratic is drawn beside the line
 
 
 def _wls(x: np.ndarray, y: np.ndarray, w: np.ndarray, degree: int) -> tuple[np.ndarray, np.ndarray]:

@@ -1,8 +1,8 @@
 """Which degradation law to believe: the one that predicts the later windows from the earlier ones.
 
 A prognosis extrapolates, so a law is scored on extrapolation: the history is cut at several of its
-later windows, each law is fitted to the windows before the cut (``ema.prognosis.laws``) and scored by the
-log density it gives the windows after it (each with its own noise, σ² + τ²). A law that fits the
+later windows, each law is drawn through the windows before the cut (``ema.prognosis.laws``) and scored by the
+log density it gives the windows after it (each with its own noise, σ² + τ²). A law that follows the
 past by bending towards its noise predicts the next windows badly, and one too stiff for wear that
 speeds up predicts them too low: the scores weigh both. The weights are the scores' softmax over the
 laws, tempered (``TEMPER``) so that laws that predict about as well share the weight: the remaining
@@ -30,7 +30,7 @@ TEMPER = 4.0  # the scores are divided by this: two laws whose scores differ by 
 
 @dataclass(frozen=True)
 class Weighed:
-    """Every law fitted to the whole history, its weight and extrapolation score, and the drift of the weighed
+    """Every law drawn through the whole history, its weight and extrapolation score, and the drift of the weighed
     forecast's misses per unit of s ahead (0 where it held the later windows as it said it would)."""
 
     curves: list[LawCurve]
@@ -44,7 +44,7 @@ class Later:
     """One law's prediction, from the windows before a cut, of the windows after it."""
 
     mean: np.ndarray
-    variance: np.ndarray  # the fit's, plus each window's noise
+    variance: np.ndarray  # the curve's, plus each window's noise
     observed: np.ndarray
     ahead: np.ndarray  # s past the cut's last window
 
@@ -54,13 +54,13 @@ class Later:
 
 
 def cut_points(n: int) -> list[int]:
-    """Where the history is cut: the number of windows each scoring fit sees."""
+    """Where the history is cut: the number of windows each scoring curve sees."""
     first = max(MIN_LAW_WINDOWS - 1, int(np.ceil(FIRST_CUT * n)))
     return sorted({int(k) for k in np.linspace(first, n - 1, CUTS).round()} - {n})
 
 
 def later(law_index: int, s: np.ndarray, y: np.ndarray, weight: np.ndarray, k: int) -> Later:
-    """The law fitted to the first ``k`` windows, predicting the rest."""
+    """The law drawn through the first ``k`` windows, predicting the rest."""
     curve = law_curve(LAWS[law_index], s[:k], y[:k], weight[:k])
     mean, variance = curve.predictive(s[k:])
     noise = 1.0 / np.maximum(weight[k:], 1e-300)
@@ -81,7 +81,7 @@ def drift(predictions: list[list[Later]], weights: np.ndarray) -> float:
 
 
 def weigh(s: np.ndarray, y: np.ndarray, weight: np.ndarray) -> Weighed:
-    """Every law fitted to the history, weighed by how well it predicts later windows from earlier ones."""
+    """Every law drawn through the history, weighed by how well it predicts later windows from earlier ones."""
     curves = [law_curve(law, s, y, weight) for law in LAWS]
     if len(s) < MIN_LAW_WINDOWS:
         only = np.array([1.0 if law.name == "linear" else 0.0 for law in LAWS])

@@ -109,7 +109,7 @@ class Body:
         self.done = done
 
     def reserve(self, declared: int) -> bool:
-        """Count a declared length against the bytes in flight; False where it does not fit."""
+        """Count a declared length against the bytes in flight; False where it finds no room."""
         if self.guard.in_flight + declared > self.limits.max_upload_bytes:
             return False
         self.guard.in_flight += declared

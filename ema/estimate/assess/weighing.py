@@ -1,20 +1,20 @@
 """Which estimator to believe, and how much: held-out simulations first, then the window itself.
 
 Both estimators run on held-out simulations of the window's own scenario (its command, load,
-first state and noise; health drawn in the same box). The physics fit's mean error there is its
+first state and noise; health drawn in the same box). The physics solution's mean error there is its
 bias on this scenario (the 2 ms reconstruction blurs the reversals, the motor saturates); it is
 subtracted as far as those K simulations resolve it (James–Stein shrinkage). The errors then give
 each parameter's MSE-optimal blend (``ema.estimate.assess.blend``) and an in-distribution std. The network
-joins the answer only where the blend cuts the physics fit's error there by ``1 − NETWORK_MARGIN``
-or more: a weight fitted on a few dozen simulations overstates what the network adds on data the
+joins the answer only where the blend cuts the physics solution's error there by ``1 − NETWORK_MARGIN``
+or more: a weight chosen on a few dozen simulations overstates what the network adds on data the
 simulator did not draw, and so does the full bias. Those simulations cannot
 see a mismatch between the model and the measured window, so two checks on the window follow:
 
-- **Consistency.** The network reads the window's residual torque, the physics fit reads it
+- **Consistency.** The network reads the window's residual torque, the physics solution reads it
   too, through Eq. 5.1. On held-out simulations their difference has a known spread; on the
   window it must fall inside it (|z| ≤ ``MAX_DISAGREEMENT_Z``), and the network's answer must
   lie in the box it was trained on. Otherwise the network is extrapolating from a trace the
-  simulator does not produce, and only the physics fit is kept.
+  simulator does not produce, and only the physics solution is kept.
 - **Equation error.** The window's Eq. 5.1 residual RMS over the simulations' (the same noise,
   no missing physics): ≈ 1 when the model explains the window. Above, the stds are scaled by it
   (the Birge ratio): structure the model lacks widens the uncertainty instead of hiding in it.
@@ -23,13 +23,15 @@ see a mismatch between the model and the measured window, so two checks on the w
   note ``model_misfit`` is said only beyond exp(t₀.₉₉,ₖ₋₁ · s · √(1 + 1/K)) (``misfit_limit``): a
   clean window draws it ``MISFIT_FALSE_ALARM`` of the time.
 
-The std is never below the physics fit's block-jackknife std on the window itself (or, where that std was read
-from the window's own residual, as a servo's Newey–West std is, never below it unscaled).
+The std is never below the physics estimator's own std on the window, widened as it is read: a block-jackknife
+std sees only noise and is widened by the ratio; a std read from the window's own residual (Newey–West) carries the
+misfit already and stands unscaled (``Candidates.physics_std_source``).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Literal
 
 import numpy as np
 
@@ -40,7 +42,7 @@ from ema.estimate.stats import rms
 MAX_DISAGREEMENT_Z = 3.0
 MIN_CHECKS = 4  # held-out simulations the scoring needs (those that could not slide are left out)
 BOX_TOLERANCE = 0.1  # the network may answer this far outside its box (in box units) before it extrapolates
-NETWORK_MARGIN = 0.8  # the network joins only if the blend's RMS error on the checks is below this share of the fit's
+NETWORK_MARGIN = 0.8  # the network joins only if the blend's RMS error on the checks is below this share of physics'
 STUDENT_95 = {8: 2.31, 16: 2.12, 32: 2.04}  # t quantiles: a std read from K simulations is itself uncertain
 MISFIT_FALSE_ALARM = 0.01  # the share of clean windows the model_misfit note may be said of
 Z_99 = 2.3263  # the normal's 0.99 quantile, for MISFIT_FALSE_ALARM
@@ -58,9 +60,11 @@ class Candidates:
     check_physics: dict[str, np.ndarray]
     check_network: dict[str, np.ndarray] | None
     targets: tuple[str, ...] = TARGETS  # what both estimate, in the network's output order
-    # True where the physics std was read from the window's own residual (its size and its correlation): then the
-    # misfit has widened it already, and only the held-out errors are scaled by the equation-error ratio
-    physics_std_observed: bool = False
+    # Where the physics estimator's std comes from: "jackknife", the spread of the window's segments, which sees
+    # only noise (the equation-error ratio widens it as it widens the held-out errors); "residual", the window's
+    # own residual, its size and its correlation (Newey–West), which carries a misfit already (only the held-out
+    # errors are widened)
+    physics_std_source: Literal["jackknife", "residual"] = "jackknife"
 
 
 @dataclass(frozen=True)
@@ -98,7 +102,7 @@ def misfit_limit(check_rms: np.ndarray) -> float:
 
 
 def bias_corrected(physics: np.ndarray, truth: np.ndarray) -> tuple[float, np.ndarray]:
-    """The physics fit's bias on this scenario as far as the held-out simulations resolve it, and each
+    """The physics solution's bias on this scenario as far as the held-out simulations resolve it, and each
     simulation's estimate corrected alike by the mean of the *others'* errors (leave-one-out: honest errors).
 
     K errors of mean b and standard error s give b·max(0, 1 − s²/b²) (positive-part James–Stein): a
@@ -145,7 +149,7 @@ def _assess_parameter(c: Candidates, name: str, inflation: float) -> tuple[float
     note = network_note(c, name)
     answer_note = None
     if note is not None and c.network is not None:
-        answer_note = Note(code="physics_only", parameter=name, text=f"{name}: physics fit only; {note.text}")
+        answer_note = Note(code="physics_only", parameter=name, text=f"{name}: physics solution only; {note.text}")
     weight, rms_used, rms_net, value = 0.0, rms_physics, None, physics
     if note is None and c.network is not None and c.check_network is not None:
         blend = best_blend(truth, c.check_network[name], phys)
@@ -157,13 +161,13 @@ def _assess_parameter(c: Candidates, name: str, inflation: float) -> tuple[float
                 code="network_not_better",
                 parameter=name,
                 text=(
-                    f"the network would cut the physics fit's error on held-out simulations by "
+                    f"the network would cut the physics solution's error on held-out simulations by "
                     f"{100 * (1 - blend.rms_error / max(rms_physics, 1e-300)):.0f} %, under the "
                     f"{100 * (1 - NETWORK_MARGIN):.0f} % it must"
                 ),
             )
     held_out = _t_factor(len(truth)) * rms_used
-    if c.physics_std_observed:
+    if c.physics_std_source == "residual":
         std = max(inflation * held_out, c.physics_std[name])
     else:
         std = inflation * max(held_out, c.physics_std[name])
@@ -182,7 +186,7 @@ def _assess_parameter(c: Candidates, name: str, inflation: float) -> tuple[float
 
 
 def assess(c: Candidates, equation_error_ratio: float, limit: float) -> Assessed:
-    """Per target, the bias-corrected physics fit, blended with the network where it earns it; the stds
+    """Per target, the bias-corrected physics solution, blended with the network where it earns it; the stds
     widened by the equation-error ratio and never below the window's jackknife std; a misfit said only past
     ``limit`` (``misfit_limit``)."""
     inflation = max(1.0, equation_error_ratio)
@@ -195,7 +199,7 @@ def assess(c: Candidates, equation_error_ratio: float, limit: float) -> Assessed
         widened = (
             "stds read from that residual, its size and its correlation, so they carry it; the held-out errors "
             "widened by that factor"
-            if c.physics_std_observed
+            if c.physics_std_source == "residual"
             else "stds widened by that factor"
         )
         notes.append(

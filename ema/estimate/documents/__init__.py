@@ -17,7 +17,7 @@ from ema.estimate.documents.notes import Note as Note  # every stage's notes, im
 from ema.estimate.documents.window_facts import WindowInfo
 from ema.model.document import Document, renamed
 
-TARGETS = ("FDJ", "eta_O")  # what the estimators fit; η_A follows by Eq. 3.4, FSD from FSJ
+TARGETS = ("FDJ", "eta_O")  # what the estimators read; η_A follows by Eq. 3.4, FSD from FSJ
 
 DIMENSIONLESS = "1"  # η's unit
 
@@ -78,7 +78,7 @@ class Timings(Document):
     for this window (a low-rate window reads no simulations) is 0, and ``stages`` in the estimate says why."""
 
     prepare: float = Field(0.0, description="the window checked, repaired, aligned, its departures read")
-    physics: float = Field(0.0, description="Eq. 5.1 fitted by least squares")
+    physics: float = Field(0.0, description="Eq. 5.1 solved by least squares")
     simulate: float = Field(0.0, description="the window's own dataset simulated")
     learn: float = Field(0.0, description="the network trained")
     assess: float = Field(0.0, description="both estimators on held-out simulations, weighed and blended")

@@ -102,7 +102,7 @@ class WindowInfo(Document):
         description="the position's travel over the speed's integral / gear ratio through the dead band (1 in a "
         "consistent log; 0.9-1.1 accepted; null: too little motion to tell)",
     )
-    sliding_fraction: float = Field(description="share of samples the friction fit could use")
+    sliding_fraction: float = Field(description="share of samples the friction solution could use")
     recorded_at: str | None = None
     flight_hours: float | None = None
     flight_id: str | None = None

@@ -3,7 +3,7 @@
 With η_A tied to η_O by Eq. 3.4, the model t = FDJ + k_aid·a + k_opp·o (+ nuisances) is linear in
 everything but η_O. At each η_O of a grid, u = t − k_aid·a − k_opp·o is regressed on (1, nuisances…)
 in closed form from the sums alone, and the grid is refined around its best point (the SSE is smooth
-and unimodal in η_O). A fit and its block jackknife solve thousands of such rows per window, so the
+and unimodal in η_O). A solution and its block jackknife solve thousands of such rows per window, so the
 search runs in one compiled pass (``_search``); ``tests/estimate/physics`` holds the plain vectorized
 form it must equal.
 """
@@ -23,7 +23,7 @@ GRID_POINTS = 41
 REFINEMENTS = 3  # coarse-to-fine passes: η_O to ~1e-5
 PROFILE_STEP = 0.005  # a likelihood profile over η_O (its width gives the std) is drawn at this step
 # An offset needs motion both ways: with fewer than this share of the samples in the rarer direction,
-# it cannot be told from FDJ and is not fitted. ΔC, γ and ΔJ need columns that vary: a coefficient of
+# it cannot be told from FDJ and is not solved. ΔC, γ and ΔJ need columns that vary: a coefficient of
 # variation below this, and they cannot be told from FDJ either.
 MIN_OFFSET_BALANCE = 0.05
 MIN_VARIATION = 0.05
@@ -45,7 +45,7 @@ def coarse_to_fine(score: Callable[[np.ndarray], np.ndarray]) -> tuple[float, np
 
 def profile_grid() -> np.ndarray:
     """η_O every ``PROFILE_STEP`` over ``ETA_O_SEARCH``: where a likelihood profile is drawn whole (the
-    quasi-static reading's, the drive fit's), its width being the std."""
+    quasi-static reading's, the drive solution's), its width being the std."""
     low, high = ETA_O_SEARCH
     return low + PROFILE_STEP * np.arange(int((high - low) / PROFILE_STEP + 1e-9) + 1)
 

@@ -40,7 +40,7 @@ def solve_as_read(
     drive: DriveConstants,
     settings: SolveSettings = SolveSettings(),
 ) -> FrictionSolution:
-    """Eq. 5.1's fit (``ema.estimate.physics.friction``) of a window's signals read as every estimator reads them."""
+    """Eq. 5.1 solved (``ema.estimate.physics.friction``) on a window's signals read as every estimator reads them."""
     return solve_friction(as_read(signals, sample_rate_hz), sample_rate_hz, drive, settings)
 
 

@@ -1,10 +1,10 @@
-"""A physics estimator with no simulation and no network: Eq. 5.1 fitted by least squares.
+"""A physics estimator with no simulation and no network: Eq. 5.1 solved by least squares.
 
 While sliding, the residual torque is T_R = sgn(ω)·(FDJ + k·|T_ext|) + C·ω with k = 1 − η_A when
 the load aids the motion and 1/η_O − 1 when it opposes it (T_ext = H_e / n). Both sides go
 through the same smoothing kernel as the reconstruction (``ema.model.residual``), which keeps the
 model linear in FDJ and k: with t = sgn(ω)·(T_R − C·ω), a and o the smoothed aiding and opposing
-|T_ext|, t = FDJ + k_aid·a + k_opp·o. η_A is tied to η_O by Eq. 3.4, so the fit is a search over
+|T_ext|, t = FDJ + k_aid·a + k_opp·o. η_A is tied to η_O by Eq. 3.4, so the solution is a search over
 η_O with FDJ in closed form at each point (``ema.estimate.physics.eta_search``). Where asked, nuisances
 join FDJ in that closed form (``nuisance_columns``): a constant torque c (a sensor off zero,
 ``ema.estimate.prepare.departures.zero_offset``), a change ΔC of the viscous coefficient
@@ -12,7 +12,7 @@ join FDJ in that closed form (``nuisance_columns``): a constant torque c (a sens
 inertia (k_T, a current sensor's gain or J_M off, ``ema.estimate.prepare.departures.drive_constants``).
 
 Everything the search needs is the matrix of sums Σ z·zᵀ per window, z = (t, a, o, nuisances…, 1)
-(ten numbers without nuisances), so a batch of simulated windows is fitted at the cost of one pass
+(ten numbers without nuisances), so a batch of simulated windows is solved at the cost of one pass
 over its samples, and a block jackknife (the sums of B contiguous time blocks, each left out in
 turn) gives a standard error from the window itself, one that grows when the residual holds
 structure the model lacks.
@@ -40,8 +40,8 @@ from ema.model.residual import (
     smoothed,
 )
 
-MIN_SLIDING_KERNELS = 10  # fewer sliding samples than 10 kernel widths: too little motion to fit
-NUISANCES = ("offset", "viscous", "torque_scale", "inertia")  # the terms a fit may carry beside FDJ, in this order
+MIN_SLIDING_KERNELS = 10  # fewer sliding samples than 10 kernel widths: too little motion to solve
+NUISANCES = ("offset", "viscous", "torque_scale", "inertia")  # the terms a solution may carry beside FDJ, in this order
 
 
 @dataclass(frozen=True)
@@ -51,10 +51,10 @@ class SolveSettings:
     min_speed_share: float = 0.047
     derivative_span_s: float = DERIVATIVE_SPAN_S
     blocks: int = JACKKNIFE_BLOCKS
-    offset: bool = False  # also fit a constant torque at the shaft (a current or hinge sensor off zero)
-    viscous: bool = False  # also fit a change ΔC of the viscous coefficient (C·|ω| beyond the document's)
-    torque_scale: bool = False  # also fit γ, the motor torque per logged k_T·I beyond 1 (k_T or a current gain off)
-    inertia: bool = False  # also fit ΔJ, the inertia at the motor shaft beyond the actuator's J_M
+    offset: bool = False  # also solve for a constant torque at the shaft (a current or hinge sensor off zero)
+    viscous: bool = False  # also solve for a change ΔC of the viscous coefficient (C·|ω| beyond the document's)
+    torque_scale: bool = False  # also solve for γ, the motor torque per logged k_T·I beyond 1 (k_T or a gain off)
+    inertia: bool = False  # also solve for ΔJ, the inertia at the motor shaft beyond the actuator's J_M
 
     def __post_init__(self) -> None:
         if not 0 < self.min_speed_share < 1:
@@ -87,13 +87,13 @@ SOLUTION_ARRAYS = (
 
 @dataclass(frozen=True)
 class FrictionSolution:
-    """Per window (arrays of one length): the estimates, their jackknife std, the fit's quality."""
+    """Per window (arrays of one length): the estimates, their jackknife std, the solution's quality."""
 
     fdj_nm: np.ndarray
     eta_o: np.ndarray
     fdj_std_nm: np.ndarray
     eta_o_std: np.ndarray
-    # (N, len(NUISANCES)), 0 where not fitted: the constant torque c [N·m] at the shaft T_R holds beyond
+    # (N, len(NUISANCES)), 0 where not solved: the constant torque c [N·m] at the shaft T_R holds beyond
     # friction, ΔC [N·m·s/rad] beyond the actuator's C, γ (the motor's torque is (1 + γ)·k_T·I where
     # unsaturated), ΔJ [kg·m²] beyond the actuator's J_M
     terms: np.ndarray
@@ -104,7 +104,7 @@ class FrictionSolution:
     at_search_edge: np.ndarray  # η_O at an end of ETA_O_SEARCH: a bound, not an estimate
 
     def term(self, name: str) -> np.ndarray:
-        """The nuisance ``name``'s fitted value per window (its unit: ``terms``)."""
+        """The nuisance ``name``'s solved value per window (its unit: ``terms``)."""
         return self.terms[:, NUISANCES.index(name)]
 
     def term_std(self, name: str) -> np.ndarray:
@@ -208,7 +208,7 @@ def solve_friction(
     settings: SolveSettings = SolveSettings(),
     residual_nm: np.ndarray | None = None,
 ) -> FrictionSolution:
-    """Fit every window of a batch (signals (N, n), or (n,) for one; or one signal (N, n) against the
+    """Solve every window of a batch (signals (N, n), or (n,) for one; or one signal (N, n) against the
     others of one window, each (n,)); windows with too little sliding motion get NaN (``solve_window``
     turns that into an error naming the signals)."""
     t, a, o, mask = regressors(signals, rate, drive, settings, residual_nm)
@@ -248,7 +248,7 @@ def _sliding_rms(values: np.ndarray, mask: np.ndarray) -> np.ndarray:
 
 
 def solve_window(signals: Mapping[str, np.ndarray], rate: float, drive: DriveConstants) -> FrictionSolution:
-    """One window's fit; a window that never slides long enough is bad input naming its signals."""
+    """One window's solution; a window that never slides long enough is bad input naming its signals."""
     solved = solve_friction(signals, rate, drive)
     if np.isnan(solved.fdj_nm[0]):
         raise InputError(

@@ -18,7 +18,7 @@ between 7 and 8 times ΣR(k) for any correlation shape, so T is read from it wit
 (summed over the lags before S first reaches ``1 − DIP`` of its plateau), on the fewest lags over
 which S levels off (``noise_structure``).
 The simulations then draw AR(1) noise of the same per-sample std and the same T:
-ρ = (T − 1) / (T + 1) (a W-sample moving average's noise has T = W; a test pins the read). Fitting
+ρ = (T − 1) / (T + 1) (a W-sample moving average's noise has T = W; a test pins the read). Solving
 an AR(1)'s shape to S instead would assume the shape the area rule does not need, and a moving
 average is far from that shape.
 """

@@ -68,7 +68,7 @@ class Scenario:
 def initial_state(window: Window, drive: DriveConstants) -> InitialState:
     """The state at t = 0: a parabola through the first samples (at their interval centres), taken at 0.
 
-    Not the first sample: the fit averages the sensor noise down, and a parabola follows the motor,
+    Not the first sample: the solution averages the sensor noise down, and a parabola follows the motor,
     which reaches 60 rad/s within a millisecond from rest, where a line or a mean would lag it.
     """
     n = min(INITIAL_SOLVE_SAMPLES, window.n_samples)
@@ -114,7 +114,7 @@ def scenario_from_window(
 
 def inside(fdj_nm: float, eta_o: float, nominal_fdj_nm: float, fsd: float = 2.0) -> HealthParams:
     """One health point at (FDJ, η_O), held inside the physical limits of an actuator of ``nominal_fdj_nm`` (a
-    window the model cannot explain may be fitted with a negative FDJ: it is still simulated, at the limit)."""
+    window the model cannot explain may be solved with a negative FDJ: it is still simulated, at the limit)."""
     fdj = float(np.clip(fdj_nm, *physical_fdj_nm(nominal_fdj_nm)))
     return HealthParams.single(fsd * fdj, fdj, float(np.clip(eta_o, *PHYSICAL_ETA_O)))
 

@@ -1,4 +1,4 @@
-"""A signal read later than logged, and Eq. 5.1's fit of the window so: what every reading of a
+"""A signal read later than logged, and Eq. 5.1's solution of the window so: what every reading of a
 sensor's lag compares (``ema.estimate.prepare.alignment``, ``ema.estimate.prepare.hinge_lag``,
 ``ema.estimate.prepare.consistency``,
 ``ema.estimate.prepare.step_lag``)."""
@@ -26,7 +26,7 @@ def shifted_solutions(
     name: str = "current_a",
     settings: SolveSettings = SolveSettings(),
 ) -> FrictionSolution:
-    """The physics fit with signal ``name`` read ``lags`` samples later, one row per lag, one batched fit."""
+    """The physics solution with signal ``name`` read ``lags`` samples later, one row per lag, one batched solution."""
     batch = dict(signals, **{name: np.stack([advanced(signals[name], lag) for lag in lags])})
     if name == "hinge_moment_nm":  # its reading leans on the deflection, row by row
         batch["position_deg"] = np.broadcast_to(signals["position_deg"], batch[name].shape)

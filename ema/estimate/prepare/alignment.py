@@ -6,7 +6,7 @@ logged a fraction of a millisecond after the speed (an anti-aliasing filter, an 
 speed read through a filtered resolver) leaves a residual that no friction explains.
 
 The lag is read as the shift of the current, to half a sample within ``MAX_LAG_S``, that minimizes
-the equation error of the physics fit: batched fits of the window with the current shifted each way
+the equation error of the physics solution: batched solutions of the window with the current shifted each way
 (the sliding samples, set by the speed, stay the same). The minimum is sharp, because the
 accelerations are large. A lag is applied only where it lowers the equation error by ``MIN_GAIN``;
 then the later of the two signals is advanced (a filter only delays), by linear interpolation, the
@@ -31,7 +31,7 @@ from ema.model.window import Window
 MAX_LAG_S = 1e-3
 HALF_STEP = 0.5  # samples: the finest grid searched
 MIN_GAIN = 0.05  # the least relative drop of the equation error a lag must bring
-# Each shift is fitted with a free scale of the motor torque and a free inertia: a current read a few per cent
+# Each shift is solved with a free scale of the motor torque and a free inertia: a current read a few per cent
 # high (or a k_T off the document's) leaves γ·k_T·I, an inertia off the document's ΔJ·dω/dt, both largest where
 # the shaft accelerates, and with the current decaying after a step a shifted current took either (a 6 % gain
 # read as 0.5 ms, a rotor 20 % light as 0.9 ms). A lag leaves k_T·τ·dI/dt, which neither matches.
@@ -51,7 +51,7 @@ def current_lag_samples(signals: dict[str, np.ndarray], sample_rate_hz: float, d
     grid = np.arange(-reach, reach + 0.5)
     coarse = _errors(signals, sample_rate_hz, grid, drive)
     if not np.all(np.isfinite(coarse)):
-        return 0.0  # too little sliding motion: the physics fit says so next
+        return 0.0  # too little sliding motion: the physics solution says so next
     near = grid[int(np.argmin(coarse))] + np.array([-HALF_STEP, HALF_STEP])
     errors = dict(zip(grid, coarse, strict=True)) | dict(
         zip(near, _errors(signals, sample_rate_hz, near, drive), strict=True)

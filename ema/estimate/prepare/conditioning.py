@@ -85,7 +85,7 @@ class Prepared:
 
     @property
     def drive_as_read(self) -> DriveConstants:
-        """What every reconstruction and fit of the window reads it with: the document's, J_M and C as read."""
+        """What every reconstruction and solution of the window reads it with: the document's, J_M and C as read."""
         return self.departures.drive_as_read
 
 
@@ -172,7 +172,7 @@ def prepare(
         else read_departures(window, actuator, aircraft, known or Known())
     )
     rate = read.window.sample_rate_hz * factor
-    # with the departures left in, a lag fits what they leave (an offset above all): the story is no test there
+    # with the departures left in, a lag absorbs what they leave (an offset above all): the story is no test there
     step = StepLag() if spec_only else step_lag(read.window, read.drive_as_read)
     return Prepared(actuator, factor, logged, rate, clipped, glitches, consistent, lags, read, step, stale)
 

@@ -7,7 +7,7 @@ in every window of a working drive, whatever its health:
 
 1. Kinematics: the surface turns as the motor does, θ_u = θ_m / n behind the backlash's dead band.
    The position is ``g`` times the speed's integral over n carried through a dead band
-   (``ema.model.dead_band``, its width fitted: a worn band as well); a working drive reads g within a
+   (``ema.model.dead_band``, its width solved: a worn band as well); a working drive reads g within a
    percent of 1. A speed of the other sign gives g = −1, a sample rate stated twice the log's g = 2,
    a position in radians 1/57.3.
    Refused outside ``verdict.TRAVEL_GAIN``: a position sensor's gain a few % off is no unit error.
@@ -18,12 +18,12 @@ in every window of a working drive, whatever its health:
    over ``MIN_FOLLOW_S`` of such steps.
 3. Eq. 5.1: the current drives the motion against friction and load. Read with the current's sign
    flipped, the hinge moment's, both (which is the motion's sign flipped), or the hinge moment read
-   from kN·m, lbf·in or lbf·ft, the window's fit (a sensor offset free) is ``MIN_BETTER`` times
+   from kN·m, lbf·in or lbf·ft, the window's solution (a sensor offset free) is ``MIN_BETTER`` times
    better only if that field is wrong. A load 0.74x (lbf·ft) is much what η_O 0.74x as high reads
-   (Eq. 5.1's load term), and seldom told; what is missed, the fit check still flags.
+   (Eq. 5.1's load term), and seldom told; what is missed, the check still flags.
 
 4. One clock: a sensor's filter logs it up to ~1 ms late (``ema.estimate.prepare.alignment`` reads
-   that), but a channel exported out of step by 5–20 ms puts FDJ ranges off. Where Eq. 5.1 fits
+   that), but a channel exported out of step by 5–20 ms puts FDJ ranges off. Where Eq. 5.1 explains
    ``MIN_BETTER`` times better with the current or the hinge moment read ``STEP_LAGS_S`` away, the
    window is refused naming it and the lag.
 
@@ -57,7 +57,7 @@ FOLLOW_MIN_STEP_DEG = 0.05  # a step that moves: 5 position-noise stds
 REACTION_MARGIN = 1.3  # a drive turns from full speed one way to the other in J_M·2ω_max / T_M,max: this once more
 MIN_FOLLOW_S = 0.01  # of steps over the gap, to judge the loop by
 STEP_LAGS_S = np.array([-50, -20, -10, -5, -3, 3, 5, 10, 20, 50]) * 1e-3  # channel lags tried, beyond any filter
-MIN_BETTER = 3.0  # how many times better a reading of a field must fit Eq. 5.1 to call the field wrong
+MIN_BETTER = 3.0  # how many times better a reading of a field must follow Eq. 5.1 to call the field wrong
 READINGS = {  # fields read otherwise: ({signal: factor}, the field named, what it would mean)
     "current sign": (
         {"current_a": -1.0},
@@ -148,8 +148,8 @@ def following(window: Window, drive: DriveConstants) -> float | None:
 
 
 def better_reading(window: Window, drive: DriveConstants) -> tuple[str, float] | None:
-    """The reading of ``READINGS`` that fits Eq. 5.1 best, with how many times its equation error is below
-    the window's as logged, if by ``MIN_BETTER``; one batched fit of the window and its readings."""
+    """The reading of ``READINGS`` that follows Eq. 5.1 best, with how many times its equation error is below
+    the window's as logged, if by ``MIN_BETTER``; one batched solution of the window and its readings."""
     signals, rate = window.signals, window.sample_rate_hz
     batch = {name: np.stack([signals[name]] * (1 + len(READINGS))) for name in ("current_a", "hinge_moment_nm")}
     for row, (factors, _, _) in enumerate(READINGS.values(), start=1):
@@ -172,8 +172,8 @@ def step_lags(window: Window) -> np.ndarray:
 
 
 def out_of_step(window: Window, drive: DriveConstants) -> tuple[str, float, float] | None:
-    """The channel (current or hinge moment), its lag [s] and how many times better Eq. 5.1 fits with it,
-    where a lag of ``STEP_LAGS_S`` fits ``MIN_BETTER`` times better than none; else None."""
+    """The channel (current or hinge moment), its lag [s] and how many times better Eq. 5.1 explains with it,
+    where a lag of ``STEP_LAGS_S`` explains it ``MIN_BETTER`` times better than none; else None."""
     signals, rate, lags = window.signals, window.sample_rate_hz, step_lags(window)
     if not len(lags):
         return None

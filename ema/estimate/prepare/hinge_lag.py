@@ -1,7 +1,7 @@
 """How late the hinge moment is logged: its filter's trace in the noise, the deflection and Eq. 5.1,
 weighed together.
 
-The hinge moment's lag barely shows in Eq. 5.1's equation error (lags of a few ms fit it about as well as none), yet
+The hinge moment's lag barely shows in Eq. 5.1's equation error (lags of a few ms explain it about as well as none), yet
 a strain-gauge filter's delay of 1–4 ms moves FDJ beyond its std. It shows in the noise: the filter that delays the
 signal correlates the noise it passes, and ``ema.estimate.physics.noise_reading`` reads that correlation as a
 filter's delay D (``filter_delay_samples``; 0 on white noise). But noise correlated after the signal (an amplifier's
@@ -42,7 +42,7 @@ PRIOR = {"filter": 0.45, "on_time": 0.45, "other": 0.1}  # where the noise shows
 OTHER_LAGS = 40  # grid points over (0, MAX_HINGE_LAG_S]
 FILTER_LAGS = np.linspace(-2.0, 2.0, 9)  # D·(1 + HINGE_LAG_UNCERTAINTY·z)
 # Eq. 5.1's evidence on the lag is read with a sensor's offset and C free: the window's departures are read
-# after its lags, and a thick grease left in fits best with a clean moment read a few ms late.
+# after its lags, and a thick grease left in explains it best with a clean moment read a few ms late.
 DEPARTURES_FREE = SolveSettings(offset=True, viscous=True)
 
 
@@ -117,7 +117,7 @@ def hinge_lag(
     solutions = shifted_solutions(signals, sample_rate_hz, lags, drive, "hinge_moment_nm")
     rms = shifted_solutions(signals, sample_rate_hz, lags, drive, "hinge_moment_nm", DEPARTURES_FREE).residual_rms_nm
     if not np.all(np.isfinite(rms)):
-        return HingeLag(delay)  # too little sliding motion: the physics fit says so next
+        return HingeLag(delay)  # too little sliding motion: the physics solution says so next
     used, resolution = float(solutions.n_sliding[0]), float(solutions.resolution_nm[0])
     equation = [rms_log_likelihood_ratio(rms[0], r, used, sample_rate_hz, resolution_nm=resolution) for r in rms]
     band = band_log_likelihood(signals, sample_rate_hz, lags, drive.gear_ratio) if in_flight else 0.0

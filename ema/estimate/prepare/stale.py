@@ -210,7 +210,7 @@ def without_stale(window: Window, drive: DriveConstants) -> tuple[Window, Stale]
             f"signals.{worst.signal}",
             f"{worst.describe(rate)}: a sensor that stopped updating, or a logging "
             f"gap filled in; the stretch without such a run holds {sliding} sliding samples, fewer than the {needed} "
-            "a friction fit needs",
+            "a friction solution needs",
         )
     signals = {name: values[start:stop] for name, values in signals.items()}
     return replace(window, signals=signals), Stale(short, cut, (start, stop), rate)

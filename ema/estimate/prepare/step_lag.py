@@ -2,11 +2,11 @@
 without deciding.
 
 ``ema.estimate.prepare.consistency`` refuses a window whose hinge moment, read 3–50 ms away
-(``STEP_LAGS_S``), fits Eq. 5.1 ``MIN_BETTER`` times better: exported on another clock. Below that
+(``STEP_LAGS_S``), follows Eq. 5.1 ``MIN_BETTER`` times better: exported on another clock. Below that
 the window is answered as logged, yet where the deflection moves slowly Eq. 5.1 hardly feels 20 ms,
 and an answer read at the wrong lag is off by what reading the moment at the right one changes.
 Once the window's departures are taken off (an offset, a gain, C), the moment read at any of those
-lags fits a window in step worse than as logged, or barely better; out of step, it fits better at
+lags explains a window in step worse than as logged, or barely better; out of step, it explains it better at
 about the lag the export shifted it by.
 
 So the window is still read as logged, and the story "out of step by the best of those lags" is
@@ -45,9 +45,9 @@ PRIOR_LOG_ODDS, NOTE_WEIGHT = UNDECIDED_PRIOR_LOG_ODDS, UNDECIDED_NOTE_WEIGHT
 
 @dataclass(frozen=True)
 class StepLag:
-    """The best lag of ``STEP_LAGS_S`` the hinge moment fits Eq. 5.1 at, and the weight of its story."""
+    """The best lag of ``STEP_LAGS_S`` the hinge moment follows Eq. 5.1 at, and the weight of its story."""
 
-    lag_s: float = 0.0  # the moment read this much later fits best (0: none tried)
+    lag_s: float = 0.0  # the moment read this much later explains it best (0: none tried)
     better: float = 1.0  # the equation error as logged over that at the lag
     weight: float = 0.0  # the posterior weight of "out of step by lag_s"
     spread: dict[str, float] = field(default_factory=dict)  # per target, the std the story adds
@@ -61,7 +61,7 @@ def step_lag(window: Window, drive: DriveConstants) -> StepLag:
     solutions = shifted_solutions(dict(window.signals), rate, lags, drive, "hinge_moment_nm")
     errors = solutions.residual_rms_nm
     if not np.all(np.isfinite(errors)):
-        return StepLag()  # too little sliding motion: the physics fit says so next
+        return StepLag()  # too little sliding motion: the physics solution says so next
     best = 1 + int(np.argmin(errors[1:]))
     flying = not window.on_ground  # on the ground the moment follows no deflection: the band reads no lag
     band = band_log_likelihood(dict(window.signals), rate, lags[[0, best]], drive.gear_ratio) if flying else [0, 0]
@@ -85,8 +85,8 @@ def step_lag_note(found: StepLag) -> list[Note]:
         Note(
             code="hinge_out_of_step",
             parameter="hinge_moment_nm",
-            text=f"the hinge moment fits Eq. 5.1 {100 * (found.better - 1):.1f} % better read {1e3 * found.lag_s:+g} "
-            f"ms later: "
+            text=f"the hinge moment follows Eq. 5.1 {100 * (found.better - 1):.1f} % better read "
+            f"{1e3 * found.lag_s:+g} ms later: "
             f"out of step with the other channels (exported on another clock?) with weight {found.weight:.2f}, too "
             f"little "
             "to refuse the window; read as logged, the stds include what reading it so would change",

@@ -85,7 +85,7 @@ def _travel_error(
     )
     rate = window.sample_rate_hz
     rate_slip = any(abs(gain / factor - 1.0) < RATE_SLIP_TOLERANCE for factor in RATE_SLIPS)
-    if unit is not None and rate_slip:  # a logger's rate setting fits more closely than a unit (2 % against 10 %)
+    if unit is not None and rate_slip:  # a logger's rate setting matches more closely than a unit (2 % against 10 %)
         return InputError(
             "sample_rate_hz",
             f"is {rate:.6g} Hz, but {travel}: at {rate / gain:.6g} Hz it would be 1 "
@@ -137,12 +137,12 @@ def check_consistency(window: Window, drive: DriveConstants) -> Consistency:
         name, lag_s, better = shifted
         raise InputError(
             f"signals.{name}",
-            f"is out of step with the other channels: Eq. 5.1 fits the window {better:.3g}x better with it read "
+            f"is out of step with the other channels: Eq. 5.1 explains the window {better:.3g}x better with it read "
             f"{1e3 * lag_s:+g} ms later (a sensor's filter delays ~1 ms at most): exported on another clock?",
         )
     if reading is not None:
         _, name, meaning = READINGS[reading[0]]
         unseen = " (or position_deg and motor_speed_radps have: the command moves too little to tell which)"
         meaning += unseen if follows is None and reading[0] == "torque signs" else ""
-        raise InputError(f"signals.{name}", f"{meaning}: Eq. 5.1 fits the window {reading[1]:.3g}x better so")
+        raise InputError(f"signals.{name}", f"{meaning}: Eq. 5.1 explains the window {reading[1]:.3g}x better so")
     return found

@@ -2,7 +2,7 @@
 a document, the stages a high rate needs said to be skipped and why.
 
 Stages here: **prepare** finds the stretches at constant speed and at rest and what the current says of the
-torque (``TorqueReading``: the kind's), **physics** fits Eq. 5.1 to the stretches, **report** writes the
+torque (``TorqueReading``: the kind's), **physics** follows Eq. 5.1 to the stretches, **report** writes the
 document. A window with no stretch long enough at constant speed carries no friction information at this
 rate and is refused with that reason.
 """
@@ -50,7 +50,7 @@ SKIPPED = {
     "with samples that average over its motor's dynamics",
     "learn": "no simulations to train the network on",
     "assess": "no held-out simulations: the std is the stretches' own noise and the document's repeatability",
-    "check": "no simulation of the window at the answer: the stretches' fit to Eq. 5.1 is the check",
+    "check": "no simulation of the window at the answer: the stretches' solution to Eq. 5.1 is the check",
 }
 QUASI_STATIC_STAGES = tuple(stage for stage in STAGES if stage not in SKIPPED)  # the stages a low-rate window runs
 
@@ -79,7 +79,7 @@ def estimate_low_rate(
         )
     torque, rest_note = reading.torque(actuator, rest)
     seconds["prepare"] = time.perf_counter() - started
-    announce("fitting Eq. 5.1 to the stretches")
+    announce("solving Eq. 5.1 on the stretches")
     nominal = actuator.health
     screw = actuator.screw if isinstance(actuator, LinearActuator) else None
     eta_std = (screw.eta_o_std if screw is not None else None) or 0.0

@@ -119,7 +119,7 @@ class TorqueReading:
 
     def torque(self, stretch: Stretch) -> tuple[float, float]:
         """τ along the motion and its std from the stretch's own noise (I0's and c's, common to every stretch,
-        enter FDJ's std in the fit)."""
+        enter FDJ's std in the solution)."""
         along = stretch.current_a * stretch.direction if self.signed else stretch.current_a
         return (along - self.offset_a) / self.per_nm_a, stretch.current_std_a / self.per_nm_a
 

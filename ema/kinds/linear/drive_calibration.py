@@ -8,7 +8,7 @@ Over runs at two loads or more:
 
     I − I0 = c·FDJ + c·(k·|T_L| − s·T_L),   k = 1/η_O − 1 opposing, 1 − η_A aiding,
 
-is linear in c and c·FDJ at each η_O, so a profile over η_O fits all three. Opposing against aiding
+is linear in c and c·FDJ at each η_O, so a profile over η_O reads all three. Opposing against aiding
 stretches give c whatever FDJ; the loads' sizes separate FDJ from η_O; one load size leaves them one
 number (FDJ + k·|T_L|), said so, and no nominal is written. Each run's FDJ scatters about the nominal
 by more than its own noise: that excess is the runs' repeatability, written into the document and into

@@ -91,8 +91,8 @@ class Rotary:
         return Cost(simulated_s=config.total_simulations * seconds, window_s=seconds)
 
     def warm_up(self) -> None:
-        """A tiny pipeline run: simulation kernels, residual, network and the physics fit all exercised once (loaded
-        from the cache or compiled), so that the first window a process answers costs what any other does."""
+        """A tiny pipeline run: simulation kernels, residual, network and the physics solution all exercised once
+        (loaded from the cache or compiled), so that the first window a process answers costs what any other does."""
         window = synthetic_window(HealthParams.single(), seed=0, duration_s=0.05)
         self.estimate(window, Request(WARM_UP, THESIS))
 

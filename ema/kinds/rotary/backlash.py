@@ -1,7 +1,7 @@
 """The backlash channel: the dead band read from the motor angle against the elevator angle.
 
 While the motor drives the elevator, d = θ_m/n − θ_u sits at c + (B/2)·sgn(ω): the motor pushes
-on one face of the dead band, then on the other. Fitting that step (a level per window, since
+on one face of the dead band, then on the other. Solving that step (a level per window, since
 θ_m is only known up to where the shaft started in the band) reads the total width B, over the
 samples where the elevator moves with the motor (after a reversal the motor first crosses the
 band, d between the faces, and a wide band read over those samples comes out narrow). The noise

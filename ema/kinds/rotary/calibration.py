@@ -197,7 +197,7 @@ class Calibrator:
         self, context: Context, families: Sequence[Family], check: Callable[[], None]
     ) -> tuple[list[Chosen], list[Step], list[Evidence], list[Evidence]]:
         """Forward selection; returns the chosen families, each step, the first round's evidence, and the
-        curves that describe what no name fits (``check`` before each family is scored)."""
+        curves that describe what no name matches (``check`` before each family is scored)."""
         measured, copies = context.measured, context.copies
         chosen: list[Chosen] = []
         steps: list[Step] = []

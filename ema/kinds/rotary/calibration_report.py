@@ -30,11 +30,11 @@ class Found:
     steps: Sequence[Step]
     unnamed: Sequence[Evidence]
     backlash: BacklashReading
-    described: Chosen | None = None  # the generic term adopted where no name fits (``adopt_described``)
+    described: Chosen | None = None  # the generic term adopted where no name matches (``adopt_described``)
 
     @property
     def adopted(self) -> list[Chosen]:
-        """Every term the estimates after are fitted with: the named effects, then the described one."""
+        """Every term the estimates after are solved with: the named effects, then the described one."""
         return [*self.chosen, *([self.described] if self.described else [])]
 
 
@@ -93,7 +93,7 @@ def _errors(values: Mapping[str, float], truth: Mapping[str, float] | None) -> t
 
 
 def scatter(copies: Sequence[Equations], with_it: Sequence[Chosen]) -> np.ndarray:
-    """Relative std of FDJ and η_O, fitted with ``with_it``, over the noise-only copies."""
+    """Relative std of FDJ and η_O, solved with ``with_it``, over the noise-only copies."""
     solutions = np.array([[solve_with(c, with_it).values[n] for n in TARGETS] for c in copies])
     return solutions.std(axis=0) / np.abs(solutions.mean(axis=0))
 

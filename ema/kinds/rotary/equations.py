@@ -2,7 +2,7 @@
 
 Comparing a measured window with a re-simulated one mixes trajectory mismatch into the
 residual as soon as an effect is large (the simulation no longer follows the same path). Here,
-as in the Eq. 5.1 fit, the measured residual torque is regressed on functions of the *measured*
+as in the Eq. 5.1 solution, the measured residual torque is regressed on functions of the *measured*
 states, sample by sample, over the sliding samples:
 
     t = sgn(ω)·(T_R − C_M·ω) = FDJ + k_aid·a + k_opp·o + Σ effect columns + noise,
@@ -57,7 +57,7 @@ class Equations:
     def tied(self) -> tuple[np.ndarray, np.ndarray]:
         """(design (m, 2), fixed (m,)): the base with η_A tied to η_O by Eq. 3.4, as the estimators tie it:
         t ≈ FDJ + k_opp·(o + r·a) + q·a, the aiding factor k_aid = q + r·k_opp linearized where this window's
-        free fit sits (over η_O 0.5–0.95 and n ≥ 150, r stays within 2 % of 1). The tie is what a gain of the
+        free solution sits (over η_O 0.5–0.95 and n ≥ 150, r stays within 2 % of 1). The tie is what a gain of the
         current's reading breaks: it scales the aiding and the opposing load's share alike, where Eq. 3.4 makes
         them differ by the transmission's loss; free columns a and o would absorb it into FDJ and η_O."""
         free = np.linalg.lstsq(self.base, self.y, rcond=None)[0]
@@ -86,7 +86,7 @@ def cogging_columns(
 
     A ripple of p periods per revolution is averaged over each log interval, where θ_m advances
     by ω·Δt: its interval mean is the centre value times sinc(p·ω·Δt/2). The 2 ms reconstruction
-    kernel then attenuates it again; applying both here keeps the fitted amplitude the true one.
+    kernel then attenuates it again; applying both here keeps the solved amplitude the true one.
     """
     out = {}
     for p in orders:

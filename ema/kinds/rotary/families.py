@@ -3,7 +3,7 @@
 A ``Family`` is one candidate: its columns in Eq. 5.1's equation error given its one nonlinear parameter
 (a grid value), what its coefficients mean, and the term the simulator adds for it. The named effects
 are the vocabulary (``ema.kinds.rotary.vocabulary``); beside them, generic families (piecewise-linear
-curves over time, speed, load and current) say what the residual follows when no name fits; over
+curves over time, speed, load and current) say what the residual follows when no name matches; over
 time, speed or position they are also a term the simulator can add (``ema.model.effects.FrictionTable``).
 """
 
@@ -50,7 +50,7 @@ class Family:
     base_shift: Callable[[Equations, Grid], np.ndarray] | None = None
     free_columns: int | None = None
     # The physics fixes the size (a gain's trace, given the gain): its one column enters with
-    # coefficient 1, subtracted from t, and only the grid value is fitted.
+    # coefficient 1, subtracted from t, and only the grid value is solved.
     offset: bool = False
     # Its grid is the effect's size (a gain, an offset, a bias): a best value at either end is a bound, not a
     # reading, and the effect is larger than any the loop names.

@@ -2,8 +2,8 @@
 
 Every candidate is a few columns added to the base design (FDJ's and the tied load's, ``Equations.tied``,
 and what is already chosen).
-Its score is the held-out residual: fit on four folds, predict the fifth, in turn. The Gram
-matrices of each fold are summed once, so a fit without fold f is (G − G_f)⁻¹(b − b_f) and its
+Its score is the held-out residual: solved on four folds, predict the fifth, in turn. The Gram
+matrices of each fold are summed once, so a solution without fold f is (G − G_f)⁻¹(b − b_f) and its
 held-out error y_fᵀy_f − 2βᵀb_f + βᵀG_fβ: a candidate costs one pass over the samples, and a
 noise floor of thirty simulated copies stays cheap.
 """
@@ -43,7 +43,7 @@ def fold_sums(design: np.ndarray, y: np.ndarray, folds: np.ndarray) -> tuple[np.
 
 
 def score(design: np.ndarray, y: np.ndarray, folds: np.ndarray) -> Scored:
-    """Held-out and in-sample fit of ``y`` on ``design`` (m, k)."""
+    """Held-out and in-sample solution of ``y`` on ``design`` (m, k)."""
     gram, rhs, yy = fold_sums(design, y, folds)
     total_g, total_b, total_y = gram.sum(0), rhs.sum(0), yy.sum()
     cv = 0.0

@@ -4,7 +4,7 @@ The thesis's §6.3 proposal, made to hold on data our simulator did not draw:
 
 1. **prepare**: repair, average, align and zero the window's sensors, read its viscous coefficient
    (``ema.estimate.prepare.conditioning``);
-2. **physics**: fit Eq. 5.1 by least squares (``ema.estimate.physics.friction``), a block-jackknife std beside;
+2. **physics**: solve Eq. 5.1 by least squares (``ema.estimate.physics.friction``), a block-jackknife std beside;
 3. **simulate**: a Case-1B dataset of the window's own command, logged load and first state, its
    health drawn in a box around the physics estimate (``ema.estimate.simulate.design``: no fixed range, so no
    cap on a worn actuator), with the window's own sensor noise;
@@ -43,7 +43,7 @@ from ema.kinds.rotary.reproduction import output_error_ratios
 from ema.model.actuator import THESIS, ActuatorDocument
 from ema.model.window import Window
 
-# On a few dozen noisy simulations the network stops improving within a few epochs, and the physics fit
+# On a few dozen noisy simulations the network stops improving within a few epochs, and the physics solution
 # carries most of the answer (ema.estimate.assess.weighing): the thesis's 12 failures and 1000 epochs made its time
 # the pipeline's least predictable.
 PIPELINE_LEARNING = LearnConfig(max_epochs=60, max_validation_failures=6)
@@ -61,7 +61,7 @@ def learned(data: Data, config: PipelineConfig) -> NetworkEstimator:
 def candidates(
     window: Window, physics: FrictionSolution, data: Data, network: NetworkEstimator, n: int
 ) -> tuple[Candidates, FrictionSolution]:
-    """Physics and network on the window and on the held-out simulations (and the physics fit of those)."""
+    """Physics and network on the window and on the held-out simulations (and the physics solution of those)."""
     held = {name: values[n:] for name, values in data.sims.signals.items()}
     check_physics = solve_friction(
         held, window.sample_rate_hz, data.drive_as_read, residual_nm=data.sims.residual_nm[n:]
@@ -175,7 +175,7 @@ def estimate_window(
         prepared = prepare(window, actuator, spec_only=spec_only, known=known_from(history))
         w, n = prepared.window, config.n_simulations
         seen = replace(w, signals=as_read(w.signals, w.sample_rate_hz))
-    with watch("physics", "fitting Eq. 5.1"):
+    with watch("physics", "solving Eq. 5.1"):
         physics = solve_window(seen.signals, w.sample_rate_hz, prepared.drive_as_read)
     with watch("simulate", f"simulating {config.total_simulations} windows around the physics estimate"):
         effects = prepared.departures.viscosity.effects()

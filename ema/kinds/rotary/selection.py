@@ -231,7 +231,7 @@ def _step_in_time(named: Evidence, found: Sequence[Evidence]) -> Evidence | None
     """The curve over time that explains within ``NAME_MARGIN`` as much as a family following the direction
     (a sensor off zero leaves sgn(ω)·c), or None. A curve over another variable is set aside when the named
     family explains held-out samples beyond it (``settle``); a step in time is not, as the few reversals that
-    tell a step from a drift are the very samples both fit."""
+    tell a step from a drift are the very samples both explain."""
     if named.family.follows != "direction":
         return None
     timed = [e for e in found if not e.family.named and e.family.follows == "time_s" and e.z >= NAME_Z]

@@ -1,10 +1,10 @@
 """Stage 6, the estimates once the effect is in: Eq. 5.1 with its columns, η_A tied by Eq. 3.4.
 
 The same profile search over η_O as ``ema.estimate.physics.friction``, with FDJ and the effect's
-coefficients solved in closed form at each point. The physics fit's bias on this window's
+coefficients solved in closed form at each point. The physics solution's bias on this window's
 scenario, measured by the base pipeline on its held-out simulations, is subtracted as it is
 there, so that before and after differ only by the effect. "Never worse" is judged the same
-way: the model with the effect, fitted on four folds, must predict the fifth better than the
+way: the model with the effect, solved on four folds, must predict the fifth better than the
 base model does, over every fold (``held_out_rss``).
 """
 
@@ -86,7 +86,7 @@ def solve_with(e: Equations, chosen: Sequence[Chosen], rows: np.ndarray | None =
 
 
 def held_out_rss(e: Equations, chosen: Sequence[Chosen]) -> float:
-    """Σ over folds of the squared error on the fold of the model fitted on the other four."""
+    """Σ over folds of the squared error on the fold of the model solved on the other four."""
     design, loads, y = _extra(e, chosen), _loads(e, chosen), e.y - _offset(e, chosen)
     total = 0.0
     for f in range(FOLDS):

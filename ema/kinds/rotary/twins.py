@@ -6,7 +6,7 @@ near top speed, hence how the motor speed and current evolve. An inertia off the
 term in dω/dt, which k_T·I mostly is, and moves how fast the speed follows the current. A current
 sensor and a hinge-moment sensor off zero both leave a constant in T_R; only the first is felt by the
 loop, which regulates the logged current. Each twin is added to the simulator in turn, the window
-simulated at the estimates re-fitted with it (each reading at its own FDJ and η_O), and the one whose
+simulated at the estimates solved again with it (each reading at its own FDJ and η_O), and the one whose
 speed and current stay closer to the measured ones (in units of their noise) is named; the other is
 reported as indistinguishable when the difference is small. ``runners_up`` is what the simulation sets
 against an effect: its twins, always, and the named families that read the windows about as well.

@@ -4,12 +4,12 @@ add it, and report the error before and after.
 1. **Learn.** Eq. 5.1 in the load frame (``ema.kinds.servo.inverse``) over every window at once: M, C,
    FDJ and the offset, each with its Newey–West std and unit (``learned``); the model's error is the
    identification benchmarks' own, 100·‖y − ŷ‖/‖y‖ on the decimated force.
-2. **Find**, where there is something to find: rows where a force the log lacks disturbs the fit are left out
+2. **Find**, where there is something to find: rows where a force the log lacks disturbs the solution are left out
    (``ema.kinds.servo.inverse.disturbed_rows``), and the windows' residual must stand beyond what noise
-   alone leaves, the same fit on ``COPIES`` noise-only copies (each window simulated in closed loop at the learned
+   alone leaves, the same solution on ``COPIES`` noise-only copies (each window simulated in closed loop at the learned
    constants, its sensor read at another phase of its step), at a 1 % false alarm (``misfit_limit``). Then each
    effect of
-   ``ema.kinds.servo.load_effects`` is fitted on four fifths of every window and
+   ``ema.kinds.servo.load_effects`` is solved on four fifths of every window and
    predicts the fifth left out, in turn (its nonlinear constant chosen the same way). An effect is taken only
    where it is physical (its constants' signs), predicts every fold better (a real effect shows in each part
    of a log, noise does not), and cuts the held-out residual by ``MIN_HELD_OUT_DROP`` at least; then the next,
@@ -17,7 +17,7 @@ add it, and report the error before and after.
 3. **Add and report.** The learned list is one consistent model: the adopted effects' constants join it, a
    constant that differs with the direction of motion named ``_up`` and ``_down``. The document keeps them as
    the simulator takes them (``simulator_frame``: Eq. 5.1 reads a simulated pre-sliding smaller than it is). The
-   error before and after is the inverse model's at the fit's constants, and the closed loop's at the
+   error before and after is the inverse model's at the solution's constants, and the closed loop's at the
    simulator's: each window simulated, its force against the log's.
 
 Where the document already holds the load's constants (a completed document read on a new run), the report
@@ -143,7 +143,7 @@ def _nothing_earned(trials: list) -> str:
 
 
 def learned(solution: Solved, model: dict[str, float], values: dict[str, float] | None = None) -> list[Learned]:
-    """The model's constants (``values``, the fit's by default), each with the fit's std and its unit, in the
+    """The model's constants (``values``, the solution's by default), each with the solution's std and its unit, in the
     document's words (``_up``/``_down`` by direction), the adopted effects' nonlinear constants beside them."""
     out = [
         Learned(name=LEARNED_NAMES.get(name, name), value=value, std=solution.stds[name], unit=UNITS[name])

@@ -1,4 +1,4 @@
-"""Eq. 5.1 on the load side: a servo's inverse dynamic model, fitted by least squares (IDIM-LS).
+"""Eq. 5.1 on the load side: a servo's inverse dynamic model, solved by least squares (IDIM-LS).
 
 A servo's log holds the force its drive applied and the motion it caused, both on the load. The force is
 what moved the load:
@@ -45,7 +45,7 @@ CUTOFF_BANDWIDTHS = 5.0  # its cutoff, in loop bandwidths
 DECIMATED_BANDWIDTHS = 2.0  # the decimation's anti-alias edge, in loop bandwidths
 DECIMATION_RIPPLE_DB = 0.05  # the Chebyshev's pass-band ripple (MATLAB's decimate)
 DECIMATION_ORDER = 8
-EDGE_CUTOFF_PERIODS = 5.0  # the filters' transients at either end, left out of the fit
+EDGE_CUTOFF_PERIODS = 5.0  # the filters' transients at either end, left out of the solution
 REST_STEPS_PER_SAMPLE = 2.0  # a filtered speed under this many sensor steps a sample: the load rests (dithers)
 REST_SHARE_OF_TOP = 0.002  # the same, for a sensor without a step: this share of the top speed
 REST_MARGIN_DECIMATIONS = 2  # a decimated row this near a rest (in decimation factors) is left out too
@@ -72,7 +72,7 @@ EITHER_SIGN = frozenset(name for name in UNITS if name == "offset_n" or name.sta
 
 @dataclass(frozen=True)
 class Motion:
-    """The load's motion as the fit reads it, full rate, the filters' transients at both ends left out (samples
+    """The load's motion as the solution reads it, full rate, the filters' transients at both ends left out (samples
     ``first`` to ``first + len``)."""
 
     position_m: np.ndarray
@@ -200,14 +200,14 @@ def inverse_columns(motion: Motion, effects: Mapping[str, float] | None = None) 
 
 @dataclass(frozen=True)
 class InverseSolution:
-    """Eq. 5.1 fitted: each constant with its Newey–West std, the error as the benchmark states it."""
+    """Eq. 5.1 solved: each constant with its Newey–West std, the error as the benchmark states it."""
 
     values: dict[str, float]
     stds: dict[str, float]
     error_pct: float  # 100·‖y − ŷ‖/‖y‖ on the decimated force
     residual_rms_n: float  # RMS of that residual
-    samples: int  # decimated samples fitted
-    residual_by_row: np.ndarray  # (rows,) over every decimated row: the residual where fitted, NaN elsewhere
+    samples: int  # decimated samples solved
+    residual_by_row: np.ndarray  # (rows,) over every decimated row: the residual where solved, NaN elsewhere
 
 
 def newey_west_lags(n: int) -> int:
@@ -247,7 +247,7 @@ def disturbed_rows(residual_by_row: np.ndarray, simulated_by_row: np.ndarray) ->
     if len(simulated_by_row):
         seen = np.isfinite(simulated_by_row).any(
             axis=0
-        )  # a row no simulation fitted has no envelope: the noise sets it
+        )  # a row no simulation solved has no envelope: the noise sets it
         envelope[seen] = np.sqrt(np.nanmean(simulated_by_row[:, seen] ** 2, axis=0))
     scale = np.fmax(envelope, noise)
     far = solved & (np.abs(np.nan_to_num(residual_by_row)) > DISTURBANCE_SIGMAS * np.maximum(scale, 1e-300))

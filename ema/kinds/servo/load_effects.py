@@ -1,5 +1,5 @@
 """What a servo's inverse model may lack: each effect's physical reading, the grid of its nonlinear constant, and
-when its fitted constants are physical. Its columns of Eq. 5.1 are ``ema.kinds.servo.inverse``'s.
+when its solved constants are physical. Its columns of Eq. 5.1 are ``ema.kinds.servo.inverse``'s.
 
 - ``viscous_down``: a viscous friction that differs with the direction of motion (a seal, a preload or the
   grease distributed unevenly): C splits into C up and C down.
@@ -26,7 +26,7 @@ class ServoEffect:
     name: str
     description: str
     grid: tuple[float, ...]  # its nonlinear constant's candidates (one value: it has none)
-    plausible: Callable[[dict[str, float]], bool] = lambda _: True  # of the fitted constants
+    plausible: Callable[[dict[str, float]], bool] = lambda _: True  # of the solved constants
     constant: tuple[str, str] | None = None  # its nonlinear constant's name and unit
 
 

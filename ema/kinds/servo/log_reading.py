@@ -8,22 +8,22 @@
 - The command is recomputed from the set point and the position with the document's controller: a log whose
   command does not follow it (RMS beyond ``CONTROLLER_TOLERANCE`` of the command's) was run under another
   controller, and the window's own simulations would not be its (note ``controller_mismatch``).
-  The command is linear in the loop's two gains, so a least-squares fit reads the gains the log's command
+  The command is linear in the loop's two gains, so a least-squares solution reads the gains the log's command
   does follow (``log_loop``); where they reproduce it, the note says them beside the document's.
 - The loop the window is simulated with, and whose gains set the loop's bandwidth, is the one the log ran: the
   document's gains, or, where the log does not follow them but follows others, those. Simulations at gains the
-  loop did not run would move otherwise, and the physics fit's bias read on them, subtracted from the window's
-  fit (``ema.estimate.assess``), would not be the window's. The note says both pairs.
+  loop did not run would move otherwise, and the physics solution's bias read on them, subtracted from the window's
+  solution (``ema.estimate.assess``), would not be the window's. The note says both pairs.
 - A log's command may hold more than its controller's: an excitation added for identification, a feed-forward,
   a disturbance the drive adds. Where no gains reproduce the whole command, the command is the document's loop
   plus an added command, the logged one less the loop's at every sample (``added_command``), unless the loop's
   own terms explain most of that departure (then it is a gain's, the sign's or the filter's error, and the
   note says no gains reproduce the log); where the document's gains are off as well, the gains most samples
-  follow (``trimmed_loop``: a least-squares fit without the samples an added pulse holds). Every simulation adds
+  follow (``trimmed_loop``: a least-squares solution without the samples an added pulse holds). Every simulation adds
   the added command to its controller's, the training runs as well as the check: a loop left to its controller
   would move otherwise than the log's. The note ``added_command`` says so, with its size.
 - The loop's bandwidth (the document's, else the natural frequency √(kp·kv·g/M) of the position loop, M from a
-  first fit) sets the inverse model's filters (``ema.kinds.servo.inverse``).
+  first solution) sets the inverse model's filters (``ema.kinds.servo.inverse``).
 """
 
 from __future__ import annotations
@@ -49,11 +49,11 @@ MIN_LOOP_SAMPLES = 10  # unclipped samples a log's own loop gains are read from,
 # A sample whose command departs from the loop's by more than this many robust stds of the departures holds a
 # command the loop does not give (a pulse of an excitation stands out by hundreds; a gain's rounding by none).
 ADDED_MADS = 6.0
-TRIMMED_SOLVES = 4  # least-squares fits of the loop's gains, each without the samples the last one left far off
+TRIMMED_SOLVES = 4  # least-squares solutions of the loop's gains, each without the samples the last one left far off
 # A departure from the loop's command that the loop's own terms explain beyond this share of its energy is the
 # loop's error (a gain, the sign, the filter), not a command added to it.
 MAX_LOOP_SHARE = 0.5
-PROVISIONAL_BANDWIDTH_SHARE = 0.02  # a first fit's loop bandwidth, as a share of the rate (20 Hz at 1 kHz)
+PROVISIONAL_BANDWIDTH_SHARE = 0.02  # a first solution's loop bandwidth, as a share of the rate (20 Hz at 1 kHz)
 POSITIVE = ("mass_kg", "fdj_n", "viscous_ns_per_m", "viscous_up_ns_per_m", "viscous_down_ns_per_m")
 
 
@@ -214,7 +214,7 @@ def loops_own(values: np.ndarray) -> np.ndarray:
 
 def trimmed_loop(servo: Servo, window: Window) -> LoopGains | None:
     """The gains most of the logged command follows: ``log_loop`` refitted ``TRIMMED_SOLVES`` times, each without the
-    samples the last fit's gains leave beyond ``ADDED_MADS`` robust stds (an added command's)."""
+    samples the last solution's gains leave beyond ``ADDED_MADS`` robust stds (an added command's)."""
     gains = log_loop(servo, window)
     for _ in range(TRIMMED_SOLVES - 1):
         if gains is None:
@@ -327,7 +327,7 @@ def document_effects(servo: Servo) -> dict[str, float]:
 
 
 def refuse_reversed_signs(values: dict[str, float], stds: dict[str, float]) -> None:
-    """Raise unless the fit reads a positive mass and a friction that opposes the motion (no ``POSITIVE``
+    """Raise unless the solution reads a positive mass and a friction that opposes the motion (no ``POSITIVE``
     constant ``below_zero``): a force that pushes against the acceleration, or aids the motion it should brake,
     is a log whose force and position disagree in sign or in time, and no constant read from it means anything."""
     wrong = below_zero({name: values[name] for name in POSITIVE if name in values}, stds)
@@ -335,7 +335,7 @@ def refuse_reversed_signs(values: dict[str, float], stds: dict[str, float]) -> N
         read = ", ".join(f"{name} {values[name]:.4g} ± {stds[name]:.2g}" for name in wrong)
         raise InputError(
             "signals.drive_force_n",
-            f"the fit reads {read}: the force pushes against the motion it drives (a force or position logged "
+            f"the solution reads {read}: the force pushes against the motion it drives (a force or position logged "
             "with the other sign, the log map's sign, or a log played backwards)",
         )
 
@@ -360,7 +360,7 @@ def prepare_servo(window: Window, actuator: ServoActuator) -> ServoPrepared:
     load = s.get("load_n", np.zeros(window.n_samples))
     step = servo.position_resolution_m if servo.position_resolution_m is not None else resolution(s["position_m"])
     mass = servo.mass_kg
-    if mass is None and servo.bandwidth_hz is None:  # a first fit, for the loop's natural frequency
+    if mass is None and servo.bandwidth_hz is None:  # a first solution, for the loop's natural frequency
         first = _window_motion(s["position_m"], rate, PROVISIONAL_BANDWIDTH_SHARE * rate, step)
         forces = (s["drive_force_n"] - load)[first.samples]
         mass = solve_inverse(forces, inverse_columns(first), first).values["mass_kg"]

@@ -1,7 +1,7 @@
-"""A servo calibration's two measures of a fit over every window at once: the stacked inverse problem fitted
+"""A servo calibration's two measures of a solution over every window at once: the stacked inverse problem solved
 (Eq. 5.1 in the load frame on each window's decimated force, Newey–West stds, each fold predicted by the others)
-and what noise alone leaves in it (each window simulated in closed loop at the fitted constants, its sensor read
-at ``COPIES`` phases of its step), from which the rows a force the log lacks disturbs are told; and the fitted
+and what noise alone leaves in it (each window simulated in closed loop at the solved constants, its sensor read
+at ``COPIES`` phases of its step), from which the rows a force the log lacks disturbs are told; and the solved
 constants as the simulator takes them (``simulator_frame``).
 """
 
@@ -120,7 +120,7 @@ def _simulated(p: ServoPrepared, values: dict[str, float], model: dict[str, floa
 
 
 def undisturbed(prepared: Sequence[ServoPrepared], copies: Copies, model: dict[str, float]) -> list[ServoPrepared]:
-    """Each window with the rows a force its log lacks disturbs (``disturbed_rows``) left out of every fit."""
+    """Each window with the rows a force its log lacks disturbs (``disturbed_rows``) left out of every solution."""
     out = []
     for p, by_row in zip(prepared, copies.by_row, strict=True):
         solution = solve_inverse(p.force_n, inverse_columns(p.motion, model), p.motion)
@@ -132,12 +132,12 @@ def simulator_frame(
     prepared: Sequence[ServoPrepared], values: dict[str, float], model: dict[str, float]
 ) -> dict[str, float]:
     """The constants at which the simulator's closed loop, read as the logs were, gives back ``values`` (what Eq.
-    5.1 read on the logs): each moved by the fit's own bias there, v + (v − v̂), v̂ the fit of the windows' twins
-    simulated at ``values`` (their sensor read at ``FRAME_PHASES`` phases, the logs' rows left out). Eq. 5.1 reads
+    5.1 read on the logs): each moved by the solution's own bias there, v + (v − v̂), v̂ the solution of the windows'
+    twins simulated at ``values`` (their sensor read at ``FRAME_PHASES`` phases, the logs' rows left out). Eq. 5.1 reads
     a simulated effect through decimation and filters that shrink it (pre-sliding above all): the document keeps
     the simulator's constants, so that an estimate, which reads through the simulator, finds its nominal on the
     logs that taught it. One step: the bias barely moves over it. A constant the simulator has no parameter for
-    (an effect along the stroke) is not simulated, so no bias of it is seen: it keeps the fit's value, as an
+    (an effect along the stroke) is not simulated, so no bias of it is seen: it keeps the solution's value, as an
     estimate reads it; so does one the twins give no finite read of."""
     reads = [
         solved(problem([_simulated(p, values, model, phase) for p in prepared], model)).values

@@ -56,14 +56,14 @@ NOMINAL_FIELDS = {  # a constant of the inverse model -> the servo section's fie
 
 
 def physics_of(prepared: ServoPrepared, left_out: np.ndarray | None = None) -> InverseSolution:
-    """Eq. 5.1 fitted to the window with the document's effects (less the ``left_out`` rows)."""
+    """Eq. 5.1 solved to the window with the document's effects (less the ``left_out`` rows)."""
     return solve_inverse(
         prepared.force_n, inverse_columns(prepared.motion, prepared.effects), prepared.motion, left_out
     )
 
 
 def held_out_physics(prepared: ServoPrepared, data: ServoData, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(K, T) the physics fit of each held-out simulation, (K,) its residual RMS and (K, rows) its residual by
+    """(K, T) the physics solution of each held-out simulation, (K,) its residual RMS and (K, rows) its residual by
     decimated row."""
     rate, values, rms, by_row = prepared.window.sample_rate_hz, [], [], []
     load = prepared.window.signals.get("load_n")
@@ -80,7 +80,7 @@ def held_out_physics(prepared: ServoPrepared, data: ServoData, n: int) -> tuple[
 def undisturbed(
     prepared: ServoPrepared, physics: InverseSolution, simulated_by_row: np.ndarray
 ) -> tuple[InverseSolution, doc.Note | None]:
-    """The physics fit again without the rows a force the log does not carry disturbs (``disturbed_rows``: the
+    """The physics solution again without the rows a force the log does not carry disturbs (``disturbed_rows``: the
     window's residual beyond what its simulations leave there), and a note saying how long they last."""
     disturbed = disturbed_rows(physics.residual_by_row, simulated_by_row)
     if not disturbed.any():
@@ -105,7 +105,7 @@ def assessed(
     prepared: ServoPrepared, physics: InverseSolution, data: ServoData, network: NetworkRegressor, n: int
 ) -> tuple[Assessed, float, float, InverseSolution]:
     """The assessed answer, the window's equation error over the held-out simulations' median, its limit, and the
-    physics fit the answer read (without the rows a force the log lacks disturbs; a note says so)."""
+    physics solution the answer read (without the rows a force the log lacks disturbs; a note says so)."""
     check_physics, check_rms, check_by_row = held_out_physics(prepared, data, n)
     physics, disturbed = undisturbed(prepared, physics, check_by_row)
     unit = network.predict_unit(np.vstack([data.inputs[n:], data.window_inputs]))
@@ -120,7 +120,7 @@ def assessed(
         check_physics={name: check_physics[:, i] for i, name in enumerate(names)},
         check_network={name: values[:-1, i] for i, name in enumerate(names)},
         targets=names,
-        physics_std_observed=True,
+        physics_std_source="residual",
     )
     ratio = physics.residual_rms_n / float(np.median(check_rms))
     limit = misfit_limit(check_rms)
@@ -181,7 +181,7 @@ def _estimates(
     actuator: ServoActuator, prepared: ServoPrepared, physics: InverseSolution, answer: Assessed
 ) -> doc.Estimates:
     """FDJ in N against the document's nominal (none before ema calibrate), the other constants beside it (an
-    effect's that the simulator lacks as the physics fit read it)."""
+    effect's that the simulator lacks as the physics solution read it)."""
     nominal = None if actuator.nominal is None else actuator.nominal.fdj
     values, stds = {**physics.values, **answer.values}, {**physics.stds, **answer.stds}
     constants = {}
@@ -262,7 +262,7 @@ def estimate_servo(
     watch, n = Stopwatch(on_stage), config.n_simulations
     with watch("prepare", "completing the document from the log, checking its controller"):
         prepared = prepare_servo(window, actuator)
-    with watch("physics", "fitting Eq. 5.1 on the load side"):
+    with watch("physics", "solving Eq. 5.1 on the load side"):
         physics = physics_of(prepared)
         refuse_reversed_signs(physics.values, physics.stds)
     with watch("simulate", f"simulating {config.total_simulations} runs of the window's set point in closed loop"):

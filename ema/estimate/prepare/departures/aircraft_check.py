@@ -13,7 +13,7 @@ attenuate the slope); the std is the larger of the white-noise one and a jackkni
 ``JACKKNIFE_BLOCKS`` (which sees a filter's correlated noise).
 
 In turn:
-1. Where the moment read ``STEP_LAGS_S`` away fits the aircraft's (within the tolerance) and the
+1. Where the moment read ``STEP_LAGS_S`` away matches the aircraft's (within the tolerance) and the
    band clearly better (``STEP_UNEXPLAINED``): it was exported out of step, refused naming it and
    the lag.
 2. Outside ``GROSS`` by ``GROSS_STDS``: no strain gauge's calibration nor hinge coefficient is that
@@ -56,7 +56,7 @@ from ema.model.window import Window
 TOLERANCE = Airframe.model_fields["tolerance"].default  # how far the airframe's C_hδ may be off: the document's default
 DEPART_STDS = 2.0  # stds beyond the tolerance by which a ratio departs: the gauge is off by it
 SUSPECT_STDS = 1.0  # stds beyond the tolerance by which a ratio puts the gauge in doubt
-SOLUTION_STDS = 2.0  # a ratio read at another lag fits within the tolerance and this many stds ...
+SOLUTION_STDS = 2.0  # a ratio read at another lag matches within the tolerance and this many stds ...
 STEP_UNEXPLAINED = 0.75  # ... and leaves under this share of what lag 0 leaves unexplained
 GROSS = (0.5, 2.0)  # no gauge's calibration nor hinge coefficient is off beyond these
 GROSS_STDS = 4.0
@@ -179,7 +179,7 @@ def lag_against_aircraft(
     span: int,
     tolerance: float = TOLERANCE,
 ) -> tuple[float, AircraftCheck, float] | None:
-    """The lag of ``STEP_LAGS_S`` [s] the moment read that much later fits the aircraft's at (within the
+    """The lag of ``STEP_LAGS_S`` [s] the moment read that much later matches the aircraft's at (within the
     tolerance and ``SOLUTION_STDS``) leaving the least of what lag 0 leaves unexplained (1 − correlation²),
     under ``STEP_UNEXPLAINED`` of it; its reading and that share. None where no lag does."""
     found = None
@@ -207,7 +207,7 @@ def banded(read: AircraftCheck, window: Window, gain: float, drive: DriveConstan
     """``read`` with the stds it adds to FDJ and η_O of ``window`` (its ratio divided out already, where
     it departs) where the window's own loads read no ``gain`` (``ema.estimate.prepare.departures.hinge_gain``); as it is
     otherwise. Divided out: half of what the ends of the ratio's band move them (the tolerance and the
-    ratio's std, narrowed by what the loads' free fit knows of the gain where it agrees within 2 stds).
+    ratio's std, narrowed by what the loads' free solution knows of the gain where it agrees within 2 stds).
     In doubt, the whole reading moves (``ema.estimate.prepare.departures.read``)."""
     if gain != 1.0 or read.factor == 1.0 or not read.beyond(SUSPECT_STDS):
         return read
@@ -221,7 +221,7 @@ def banded(read: AircraftCheck, window: Window, gain: float, drive: DriveConstan
 
 
 def _moved(window: Window, drive: DriveConstants, first: float, second: float, share: float) -> dict[str, float]:
-    """``share`` of how far FDJ and η_O of Eq. 5.1's fit move between the hinge moment divided by
+    """``share`` of how far FDJ and η_O of Eq. 5.1's solution move between the hinge moment divided by
     ``first`` and by ``second``."""
     ends = [solve_as_read(divided_hinge(window, g).signals, window.sample_rate_hz, drive) for g in (first, second)]
     return {

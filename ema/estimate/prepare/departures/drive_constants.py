@@ -7,8 +7,8 @@ reflect an inertia the document rounds (T_R then holds ΔJ·dω/dt too much). Bo
 beside friction, so a small error in either moves FDJ by much of its range.
 
 Friction follows the direction and |T_ext|; k_T·I follows the signed load and the acceleration,
-dω/dt the acceleration alone. So each constant is fitted beside FDJ, with the offset and ΔC free,
-and read where the fit with it explains the window ``DECISIVE_Z`` stds better than the fit without
+dω/dt the acceleration alone. So each constant is solved beside FDJ, with the offset and ΔC free,
+and read where the solution with it explains the window ``DECISIVE_Z`` stds better than the solution without
 (``zero_offset.equation_z``). Never both together: γ and ΔJ/J_M equal make a gain of the hinge
 moment's term, and the noise the two columns share with the target would read one. Where both
 stand out alone, the likelihood ratio of the two readings decides if it can (``DECISIVE``); where it
@@ -42,12 +42,12 @@ from ema.model.window import Window
 
 ITERATIONS = 3  # refits of the corrected window at most: each settles what the peak torque's cut left
 SETTLED = 0.01  # of the constant's std: what a refit may leave
-BESIDE = SolveSettings(offset=True, viscous=True)  # what each constant is fitted beside
-FIELDS = {"torque_scale": "torque_scale", "inertia": "inertia_kgm2"}  # the fit's nuisance -> the field it reads
+BESIDE = SolveSettings(offset=True, viscous=True)  # what each constant is solved beside
+FIELDS = {"torque_scale": "torque_scale", "inertia": "inertia_kgm2"}  # the solution's nuisance -> the field it reads
 # Beyond these no drive runs (γ: k_T from −55 to 125 °C and a sensor's gain; ΔJ: of J_M): a read past them
-# is something else the model lacks, which the fit check reports.
+# is something else the model lacks, which the check reports.
 PLAUSIBLE = {"torque_scale": 0.2, "inertia": 0.5}
-# Stds of its own by which a γ fitted alone must pass PLAUSIBLE for the current to be refused (``no_drive_error``):
+# Stds of its own by which a γ solved alone must pass PLAUSIBLE for the current to be refused (``no_drive_error``):
 # a window whose blocks split the accelerations unevenly reads γ loosely, and must not be refused on that.
 SCALE_STDS = 2.0
 # Where both stand out, the log-likelihood ratio of the two readings that decides for each. The bounds are
@@ -75,7 +75,7 @@ class DriveReading:
     stds: dict[str, float] = field(default_factory=dict)  # per field read, its std
     spread: dict[str, float] = field(default_factory=dict)  # per target, the std the constants' uncertainty adds
     alternative: DriveReading | None = None  # where the window did not tell ΔJ from this γ: the ΔJ reading
-    unit_scale: float = 0.0  # γ fitted alone beyond any motor, its answer's gap in ``spread`` (``unit_story``)
+    unit_scale: float = 0.0  # γ solved alone beyond any motor, its answer's gap in ``spread`` (``unit_story``)
 
     @property
     def torque_factor(self) -> float:
@@ -93,7 +93,7 @@ class DriveReading:
         return replace(self.spec, inertia_kgm2=self.spec.inertia_kgm2 + self.inertia_kgm2)
 
     def added(self, left: FrictionSolution) -> DriveReading:
-        """These constants with what a fit of the corrected window left of them."""
+        """These constants with what a solution of the corrected window left of them."""
         scale = self.torque_factor * (1.0 + float(left.term("torque_scale")[0])) - 1.0
         return replace(self, torque_scale=scale, inertia_kgm2=self.inertia_kgm2 + float(left.term("inertia")[0]))
 
@@ -143,7 +143,7 @@ def _read_constants(
 
 
 def beyond_any_motor(plain: FrictionSolution, scale: FrictionSolution, rate: float) -> float:
-    """γ fitted alone (``scale``) where it lies beyond any motor, ``PLAUSIBLE`` by ``SCALE_STDS`` of its std,
+    """γ solved alone (``scale``) where it lies beyond any motor, ``PLAUSIBLE`` by ``SCALE_STDS`` of its std,
     and stands ``DECISIVE_Z`` out; else 0."""
     gamma, std = float(scale.term("torque_scale")[0]), float(scale.term_std("torque_scale")[0])
     beyond = abs(gamma) > PLAUSIBLE["torque_scale"] + SCALE_STDS * std and equation_z(plain, scale, rate) > DECISIVE_Z
@@ -152,7 +152,7 @@ def beyond_any_motor(plain: FrictionSolution, scale: FrictionSolution, rate: flo
 
 def no_drive_error(gamma: float, inertia_alone: FrictionSolution, spec: DriveConstants) -> InputError | None:
     """The error naming the current where Eq. 5.1 balances the window only with a motor torque per k_T·I
-    and an inertia no drive has, each fitted alone (``gamma`` from ``beyond_any_motor``; ΔJ, its rival
+    and an inertia no drive has, each solved alone (``gamma`` from ``beyond_any_motor``; ΔJ, its rival
     where the motor saturates, beyond ``PLAUSIBLE`` too): a current in other units (a tenth: γ = 9). None
     otherwise."""
     inertia = float(inertia_alone.term("inertia")[0]) / spec.inertia_kgm2
@@ -171,7 +171,7 @@ def no_drive_error(gamma: float, inertia_alone: FrictionSolution, spec: DriveCon
 def unit_story(
     read: DriveReading, gamma: float, plain: FrictionSolution, alone: dict[str, FrictionSolution]
 ) -> DriveReading:
-    """``read`` with the story of a current in other units weighed in, where γ fitted alone lies beyond any
+    """``read`` with the story of a current in other units weighed in, where γ solved alone lies beyond any
     motor (``gamma`` from ``beyond_any_motor``) and yet ΔJ reads a drive: a current logged 0.71x (RMS for
     amplitude) reads as a rotor ~0.7x as heavy with other friction, and a rotor 1.3–1.45x as heavy as a
     current logged 1.41x, alike. Each target's std grows by the full gap between the γ reading's answer
@@ -185,7 +185,7 @@ def unit_story(
 
 
 def _stands_out(plain: FrictionSolution, alone: FrictionSolution, name: str, rate: float, spec: DriveConstants) -> bool:
-    """The fit with constant ``name`` explains the window ``DECISIVE_Z`` stds better, read within ``PLAUSIBLE``."""
+    """The solution with constant ``name`` explains the window ``DECISIVE_Z`` stds better, read within ``PLAUSIBLE``."""
     relative = float(alone.term(name)[0]) / (spec.inertia_kgm2 if name == "inertia" else 1.0)
     return bool(
         np.isfinite(relative)
@@ -199,7 +199,7 @@ def _reading(
     window: Window, drive: DriveConstants, name: str, first: FrictionSolution
 ) -> tuple[DriveReading, FrictionSolution]:
     """Constant ``name``, refitted on the corrected window until nothing is left, its std ΔJ's with the
-    kernel's (``kernel_inertia_std``); and the last fit (its likelihood)."""
+    kernel's (``kernel_inertia_std``); and the last solution (its likelihood)."""
     settings, std = replace(BESIDE, **{name: True}), float(first.term_std(name)[0])
     kernel = kernel_inertia_std(window.sample_rate_hz, drive) if name == "inertia" else 0.0
     read, left = DriveReading(spec=drive, stds={FIELDS[name]: float(np.hypot(std, kernel))}), first
@@ -222,7 +222,7 @@ def _plain(window: Window, read: DriveReading) -> dict[str, float]:
 
 
 def _with_spread(window: Window, read: DriveReading) -> DriveReading:
-    """``read`` with, per target, half the change of the plain fit across each read constant ± its std, in
+    """``read`` with, per target, half the change of the plain solution across each read constant ± its std, in
     quadrature."""
     spread = {"FDJ": 0.0, "eta_O": 0.0}
     for key, std in read.stds.items():

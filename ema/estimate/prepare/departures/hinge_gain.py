@@ -6,9 +6,9 @@ over the aiding and opposing |T_ext| (``ema.estimate.physics.friction``), η_A t
 hinge moment logged g times the true one puts (g − 1)·H/n into T_R and g into a and o, so the window
 holds c_aid = 1 − η_A/g and c_opp = 1/(g·η_O) − 1 instead. Solved freely (both are linear), they
 give η_A·η_O = (1 − c_aid)/(1 + c_opp), whence η_O by Eq. 3.4 (a quadratic), and
-g = 1/((1 + c_opp)·η_O). Read with g = 1, a gain is η_O's twin in the constrained fit.
+g = 1/((1 + c_opp)·η_O). Read with g = 1, a gain is η_O's twin in the constrained solution.
 
-So g is read where the free fit explains the window ``DECISIVE_Z`` stds better (the likelihood ratio
+So g is read where the free solution explains the window ``DECISIVE_Z`` stds better (the likelihood ratio
 of the two equation errors, as for the offset) and lies in ``GAIN_PLAUSIBLE``; the hinge moment is then
 divided by it before every estimator, and FDJ's and η_O's stds grow by what g's jackknife std moves
 them (``spread``).
@@ -16,7 +16,7 @@ them (``spread``).
 A k_T or J_M off (``ema.estimate.prepare.departures.drive_constants``) and g each take a part of the
 other, whichever is read first. So g is read before them only where it explains the window
 decisively better than γ or ΔJ alone (``leading``, as ΔJ must beat γ), and after them otherwise.
-Every fit of g sits beside a sensor offset and a change of C, and leads on the window the offset
+Every solution of g sits beside a sensor offset and a change of C, and leads on the window the offset
 stage zeroed: a hinge moment off zero bends |H − b| as a gain would, and C·|ω| grows with the load's
 speeds.
 """
@@ -76,7 +76,7 @@ def free_load_solution(
 ) -> tuple[np.ndarray, float, int] | None:
     """The least squares of t on (1, a, o) and ``beside``'s nuisance columns over the sliding samples: g
     from the whole window and from each jackknife block left out ((B + 1,), the whole first), the RMS
-    equation error and the samples used; None where too few samples slide for Eq. 5.1's own fit
+    equation error and the samples used; None where too few samples slide for Eq. 5.1's own solution
     (``MIN_SLIDING_KERNELS``)."""
     rate = window.sample_rate_hz
     seen = as_read(window.signals, rate)
@@ -95,7 +95,7 @@ def free_load_solution(
 
 
 def _margin(window: Window, drive: DriveConstants, free_rms: float, used: int, rivals: list[SolveSettings]) -> float:
-    """ln LR by which the free load fit explains ``window`` better than the best of Eq. 5.1's fits with
+    """ln LR by which the free load solution explains ``window`` better than the best of Eq. 5.1's solutions with
     g = 1 and ``rivals``' terms (−inf where one cannot be compared)."""
     rate = window.sample_rate_hz
     solutions = [solve_as_read(window.signals, rate, drive, rival) for rival in rivals]

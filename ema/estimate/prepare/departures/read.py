@@ -65,12 +65,12 @@ class Departures:
 
     @property
     def drive_as_read(self) -> DriveConstants:
-        """What every reconstruction and fit of the window reads it with: the document's, J_M and C as read."""
+        """What every reconstruction and solution of the window reads it with: the document's, J_M and C as read."""
         return self.viscosity.drive_as_read(self.drive.drive_as_read)
 
     @cached_property
     def answer(self) -> dict[str, float]:
-        """FDJ and η_O of Eq. 5.1's fit of the window as read (fitted once: the tie-break and the stds ask)."""
+        """FDJ and η_O of Eq. 5.1's solution of the window as read (solved once: the tie-break and the stds ask)."""
         solved = solve_as_read(self.window.signals, self.window.sample_rate_hz, self.drive_as_read)
         return {name: float(value) for name, value in solved.values().items()}
 

@@ -3,20 +3,20 @@
 The document fixes C_M; a grease's viscosity is not fixed (it grows several-fold in the cold), and
 an excess ΔC·|ω| left in the residual is read as friction. Where a window slides at one speed the
 two are twins, but most windows slide across 100–600 rad/s (the accelerations to and from slew),
-and there ΔC is fitted beside FDJ (``SolveSettings(viscous=True)``).
+and there ΔC is solved beside FDJ (``SolveSettings(viscous=True)``).
 
 Freeing C costs FDJ precision where C is right, so a change is read only where it stands
 ``DECISIVE_Z`` stds out and is ``MIN_CHANGE`` of the document's C or more. Then every estimator of
-the window uses the read C, the fits and the simulations alike, and the stds of FDJ and η_O grow by
+the window uses the read C, the solutions and the simulations alike, and the stds of FDJ and η_O grow by
 what C's own std moves them (``spread``; its floor, ``READ_ERROR_OF_C``, as the reconstruction's
 bias follows the speed a little).
 
-Where the speed hardly varies (one way, at slew), ΔC cannot be fitted at all, and the stds carry a C
+Where the speed hardly varies (one way, at slew), ΔC cannot be solved at all, and the stds carry a C
 ``UNSEEN_SHARE`` off the document's either way, as the offset stage carries an unseen sensor offset.
 Where the change does not stand out, the window is read with the document's C, but not as if it had
 shown C to be right: as for a hinge moment out of step (``ema.estimate.prepare.step_lag``), the story
 "C is off by the change the window leans to" is weighed against the document's by the likelihood
-ratio of the nested fit (z²/2, z over the std with its floor) and a prior of e⁻⁴: its weight w.
+ratio of the nested solution (z²/2, z over the std with its floor) and a prior of e⁻⁴: its weight w.
 Each target's std grows by √w·|gap|, the gap what reading C so would change, and a note says so
 from ``NOTE_WEIGHT``.
 """
@@ -40,12 +40,12 @@ MIN_CHANGE = 0.1  # of the document's C
 # A floor of C's std, of the document's C: the reconstruction's bias follows the speed a little, beyond what the
 # jackknife sees.
 READ_ERROR_OF_C = 0.025
-# Where the speed hardly varies (one way at slew) C·|ω| is FDJ's twin and ΔC cannot be fitted: the stds then
+# Where the speed hardly varies (one way at slew) C·|ω| is FDJ's twin and ΔC cannot be solved: the stds then
 # carry a C this share of the document's off, either way (the spread of C over a fleet a third of it cold).
 UNSEEN_SHARE = 0.3
 CHANGE_BOUNDS_NMS = (-5e-5, 5e-3)  # what the simulator's viscous effect accepts (``ema.model.effects``)
 VISCOUS_SOLVE = SolveSettings(offset=True, viscous=True)
-# A change that stands out is fitted again beside a scale of the motor torque: at the drive's top speed the
+# A change that stands out is solved again beside a scale of the motor torque: at the drive's top speed the
 # speed falls as the load grows, so C·|ω| follows the load, and a current read a few per cent high (which scales
 # the aiding and the opposing load's share alike, against Eq. 3.4) reads as a viscous change. Where it no longer
 # stands out there, the window cannot tell the two: C stays the document's, and the stds carry
@@ -79,7 +79,7 @@ class Viscosity:
         return 1.0 + self.leaning_nms / self.spec_nms if self.spec_nms > 0 else 1.0
 
     def drive_as_read(self, spec: DriveConstants) -> DriveConstants:
-        """The actuator every fit of the window reads it with."""
+        """The actuator every solution of the window reads it with."""
         return replace(spec, viscous_nms=spec.viscous_nms + self.change_nms) if self.change_nms else spec
 
     def effects(self) -> EffectSet:
@@ -136,7 +136,7 @@ def _unseen(seen: dict[str, np.ndarray], rate: float, spec: DriveConstants) -> V
     ``UNSEEN_SHARE`` of it either way (module docstring)."""
     spread = _half_change(seen, rate, spec, 0.0, UNSEEN_SHARE * spec.viscous_nms)
     if not all(np.isfinite(v) for v in spread.values()):
-        return Viscosity()  # too little sliding motion to fit at all: the physics fit says so next
+        return Viscosity()  # too little sliding motion to solve at all: the physics solution says so next
     return Viscosity(spread=spread, spec_nms=spec.viscous_nms, unseen=True)
 
 

@@ -4,8 +4,8 @@ A strain gauge drifts with temperature, a Hall current sensor has an offset; eit
 constant c beyond friction (k_T·i₀ from the current, b/n from the hinge moment), which Eq. 5.1's
 t = sgn(ω)(T_R − C·ω) reads as c·sgn(ω): friction, unless it is taken off.
 
-With motion both ways c·sgn(ω) is told from FDJ, so it is fitted beside it (``SolveSettings(offset=
-True)``) and read where the fit with it explains the window ``DECISIVE_Z`` stds better than the fit
+With motion both ways c·sgn(ω) is told from FDJ, so it is solved beside it (``SolveSettings(offset=
+True)``) and read where the solution with it explains the window ``DECISIVE_Z`` stds better than the solution
 without (the likelihood ratio of their equation errors, ``equation_z``). The offset's own jackknife
 std is no test: where one direction's samples gather in a few time blocks, leaving those out leaves
 c unread. Which sensor is off matters: a hinge moment off by b also shifts |T_ext|, whose k·|T_ext|
@@ -97,13 +97,14 @@ def sensor_offset(
 
 
 def log_likelihood_ratio(worse: FrictionSolution, better: FrictionSolution, rate: float) -> float:
-    """ln of the likelihood ratio of two fits of one window by their equation errors (``rms_log_likelihood_ratio``)."""
+    """ln of the likelihood ratio of two solutions of one window, by their equation errors
+    (``rms_log_likelihood_ratio``)."""
     errors, used = (float(worse.residual_rms_nm[0]), float(better.residual_rms_nm[0])), float(worse.n_sliding[0])
     return rms_log_likelihood_ratio(*errors, used, rate, resolution_nm=float(worse.resolution_nm[0]))
 
 
 def equation_z(plain: FrictionSolution, with_offset: FrictionSolution, rate: float) -> float:
-    """How many stds the offset's fit explains the window better by: √(2·ln LR), as for one parameter."""
+    """How many stds the offset's solution explains the window better by: √(2·ln LR), as for one parameter."""
     return float(np.sqrt(max(0.0, 2.0 * log_likelihood_ratio(plain, with_offset, rate))))
 
 
@@ -114,7 +115,7 @@ def second_weight(first: FrictionSolution, second: FrictionSolution, rate: float
 
 
 def read_zero_offset(window: Window, drive: DriveConstants, carried: ZeroOffset | None = None) -> ZeroOffset:
-    """The window's constant torque beyond friction, where the fit with it explains the window ``DECISIVE_Z``
+    """The window's constant torque beyond friction, where the solution with it explains the window ``DECISIVE_Z``
     stds better, and the two readings of it (module docstring) weighed; the zero ``carried`` from a window
     of the same flight where it is the more precise and holds here (``flight_zero``); where the motion goes
     one way, the carried zero, or the note that none is known."""
@@ -133,7 +134,7 @@ def read_zero_offset(window: Window, drive: DriveConstants, carried: ZeroOffset 
 def own_reading(
     signals: dict[str, np.ndarray], rate: float, drive: DriveConstants, found: FrictionSolution
 ) -> ZeroOffset:
-    """The offset the window reads itself from ``found``, Eq. 5.1's fit with one (module docstring)."""
+    """The offset the window reads itself from ``found``, Eq. 5.1's solution with one (module docstring)."""
     torque, std = float(found.term("offset")[0]), float(found.term_std("offset")[0])
     if not (np.isfinite(torque) and equation_z(solve_as_read(signals, rate, drive), found, rate) > DECISIVE_Z):
         return ZeroOffset(zero_std_nm=float(np.hypot(std, torque)) if np.isfinite(torque) else 0.0)
