@@ -37,18 +37,6 @@ def odds_weight(log_odds: float) -> float:
     return float(1.0 / (1.0 + np.exp(-np.clip(log_odds, -50.0, 50.0))))
 
 
-def weighted_least_squares(
-    design: np.ndarray, y: np.ndarray, weight: np.ndarray
-) -> tuple[np.ndarray, np.ndarray, float]:
-    """(coefficients (K,), their covariance (K, K), χ²) of y (N,) on ``design`` (N, K), each row weighed by
-    ``weight`` (N,) = 1/variance: the normal equations solved through their pseudo-inverse, so that a column the
-    rows cannot tell from another gets no share rather than an infinite one."""
-    gram = design.T @ (weight[:, None] * design)
-    covariance = np.linalg.pinv(gram)
-    beta = covariance @ design.T @ (weight * y)
-    return beta, covariance, float(np.sum(weight * (y - design @ beta) ** 2))
-
-
 def rms(values: np.ndarray) -> float:
     """The root mean square of ``values`` (0 for none)."""
     return float(np.sqrt(np.mean(values**2))) if len(values) else 0.0

@@ -25,7 +25,7 @@ from typing import Any
 
 import numpy as np
 
-from ema.estimate.stats import weighted_least_squares
+from ema.estimate.least_squares import weighted
 
 # Shapes on grids fine enough that a precise history's posterior does not sit on a neighbour of the truth (on
 # a grid of 4 and 6, histories doubling every 4.6 spans read 4, and crossed 6-20 % late).
@@ -101,7 +101,7 @@ def law_curve(law: Law, s: np.ndarray, y: np.ndarray, weight: np.ndarray) -> Law
     n_eff = max(float(np.sum(weight > 0)), 2.0)
     for theta in law.shapes:
         phi = law.columns(s, theta)
-        beta, covariance, chi2 = weighted_least_squares(phi, y, weight)
+        beta, covariance, chi2 = weighted(phi, y, weight)
         betas.append(beta)
         covariances.append(covariance)
         scores.append(-0.5 * chi2 - 0.5 * phi.shape[1] * np.log(n_eff))

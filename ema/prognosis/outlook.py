@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ema.estimate.stats import weighted_least_squares
+from ema.estimate.least_squares import weighted
 from ema.prognosis.documents import BacktestPoint, ForecastPoint, RemainingLife, Trend
 from ema.prognosis.forecast import Forecast, forecast
 from ema.prognosis.laws import LAWS, law_curve
@@ -70,7 +70,7 @@ def speeding_up(times: np.ndarray, values: np.ndarray, weight: np.ndarray, sign:
 
 
 def _slope(t: np.ndarray, y: np.ndarray, w: np.ndarray) -> tuple[float, float]:
-    beta, covariance, _ = weighted_least_squares(np.column_stack([np.ones_like(t), t - t.mean()]), y, w)
+    beta, covariance, _ = weighted(np.column_stack([np.ones_like(t), t - t.mean()]), y, w)
     return float(beta[1]), float(covariance[1, 1])
 
 

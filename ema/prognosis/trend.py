@@ -20,7 +20,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ema.estimate.stats import odds_weight, weighted_least_squares
+from ema.estimate.least_squares import weighted
+from ema.estimate.stats import odds_weight
 from ema.prognosis.documents import Curved, Point, Trend
 
 HUBER_C = 2.5
@@ -31,7 +32,7 @@ MIN_CURVED = 6  # windows from which a quadratic is drawn beside the line
 
 def _wls(x: np.ndarray, y: np.ndarray, w: np.ndarray, degree: int) -> tuple[np.ndarray, np.ndarray]:
     """(coefficients (level, slope[, curvature]), covariance) of weighted least squares, w = 1/variance."""
-    beta, covariance, _ = weighted_least_squares(np.vander(x, degree + 1, increasing=True), y, w)
+    beta, covariance, _ = weighted(np.vander(x, degree + 1, increasing=True), y, w)
     return beta, covariance
 
 

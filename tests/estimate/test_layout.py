@@ -14,6 +14,7 @@ RANKS = {
     "ema.estimate.documents": 0,
     "ema.estimate.thread_budget": 0,
     "ema.estimate.stats": 0,
+    "ema.estimate.least_squares": 0,
     "ema.estimate.stopwatch": 0,
     "ema.estimate.physics": 1,
     "ema.estimate.prepare": 2,

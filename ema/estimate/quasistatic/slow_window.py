@@ -50,7 +50,7 @@ SKIPPED = {
     "with samples that average over its motor's dynamics",
     "learn": "no simulations to train the network on",
     "assess": "no held-out simulations: the std is the stretches' own noise and the document's repeatability",
-    "check": "no simulation of the window at the answer: the stretches' solution to Eq. 5.1 is the check",
+    "check": "no simulation of the window at the answer: Eq. 5.1 solved on the stretches is the check",
 }
 QUASI_STATIC_STAGES = tuple(stage for stage in STAGES if stage not in SKIPPED)  # the stages a low-rate window runs
 

@@ -30,8 +30,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ema.estimate.least_squares import weighted
 from ema.estimate.quasistatic.stretches import ETA_GRID, Stretch, set_point_motion, stretches
-from ema.estimate.stats import below_zero, rms, weighted_least_squares
+from ema.estimate.stats import below_zero, rms
 from ema.model.actuator import LinearActuator
 from ema.model.checks import InputError
 from ema.model.params import load_factors
@@ -147,7 +148,7 @@ def _refuse_reversed_signs(c: float, c_std: float, rests: np.ndarray) -> None:
 
 def calibrate_drive(runs: list[Run], actuator: LinearActuator) -> CalibratedDrive:
     """c, I0, and (at two load sizes or more) the nominal FDJ and η_O, from healthy ``runs`` (module docstring)."""
-    profiles = [weighted_least_squares(*_design(runs, float(eta), actuator)) for eta in ETA_GRID]
+    profiles = [weighted(*_design(runs, float(eta), actuator)) for eta in ETA_GRID]
     chi2 = np.array([p[2] for p in profiles])
     best = int(np.argmin(chi2))
     (c, c_fdj), covariance, chi2_min = profiles[best]

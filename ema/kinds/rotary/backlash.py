@@ -22,6 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ema.calibration.limits import NAME_Z
+from ema.estimate.least_squares import coefficients
 from ema.kinds.rotary.equations import Equations
 from ema.kinds.rotary.selection import floor_rms, residual_rms
 
@@ -64,7 +65,7 @@ def width_rad(e: Equations) -> float:
         rows = np.ones(e.m, dtype=bool)  # too few pushes on one face to read it: all sliding samples
     levels = (e.window[rows, None] == np.unique(e.window)[None, :]).astype(float)
     design = np.concatenate([levels, 0.5 * e.variables["direction"][rows, None]], axis=1)
-    return float(np.linalg.lstsq(design, e.kinematic[rows], rcond=None)[0][-1])
+    return float(coefficients(design, e.kinematic[rows])[-1])
 
 
 def read_backlash(measured: Equations, copies: Sequence[Equations]) -> BacklashReading:

@@ -24,6 +24,7 @@ from functools import cached_property
 import numpy as np
 
 from ema.calibration.limits import FOLDS
+from ema.estimate.least_squares import coefficients
 from ema.estimate.physics.eta_search import ETA_O_SEARCH
 from ema.estimate.physics.features import as_read
 from ema.estimate.physics.friction import SolveSettings, regressors
@@ -60,7 +61,7 @@ class Equations:
         free solution sits (over η_O 0.5–0.95 and n ≥ 150, r stays within 2 % of 1). The tie is what a gain of the
         current's reading breaks: it scales the aiding and the opposing load's share alike, where Eq. 3.4 makes
         them differ by the transmission's loss; free columns a and o would absorb it into FDJ and η_O."""
-        free = np.linalg.lstsq(self.base, self.y, rcond=None)[0]
+        free = coefficients(self.base, self.y)
         eta_o = float(np.clip(1.0 / (1.0 + max(0.5 * (free[1] + free[2]), 0.0)), *ETA_O_SEARCH))
         step = 1e-4
         (aid_low, opp_low), (aid_high, opp_high) = (

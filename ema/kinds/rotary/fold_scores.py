@@ -15,6 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ema.calibration.limits import FOLDS
+from ema.estimate.least_squares import ridge_solved
 
 FOLD_RIDGE = 1e-10  # relative: keeps a collinear column (two hats with no sample between) solvable
 
@@ -24,12 +25,6 @@ class Scored:
     cv_rss: float  # held-out residual sum of squares, all folds
     rss: float  # in-sample
     beta: np.ndarray  # coefficients from all samples, in design order
-
-
-def _solve(gram: np.ndarray, rhs: np.ndarray) -> np.ndarray:
-    scale = np.maximum(np.diag(gram), 1e-300)
-    regularized = gram + FOLD_RIDGE * np.diag(scale)
-    return np.linalg.solve(regularized, rhs)
 
 
 def fold_sums(design: np.ndarray, y: np.ndarray, folds: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -48,9 +43,9 @@ def score(design: np.ndarray, y: np.ndarray, folds: np.ndarray) -> Scored:
     total_g, total_b, total_y = gram.sum(0), rhs.sum(0), yy.sum()
     cv = 0.0
     for f in range(FOLDS):
-        beta = _solve(total_g - gram[f], total_b - rhs[f])
+        beta = ridge_solved(total_g - gram[f], total_b - rhs[f], FOLD_RIDGE)
         cv += yy[f] - 2 * beta @ rhs[f] + beta @ gram[f] @ beta
-    beta = _solve(total_g, total_b)
+    beta = ridge_solved(total_g, total_b, FOLD_RIDGE)
     rss = total_y - 2 * beta @ total_b + beta @ total_g @ beta
     return Scored(float(cv), float(max(rss, 0.0)), beta)
 
@@ -83,9 +78,9 @@ def score_grid(
     total_b, total_r, total_y = blocks.sum(0), rhs.sum(0), yy.sum()
     cv = np.zeros(g)
     for f in range(FOLDS):
-        beta = _solve_many(total_b - blocks[f], total_r - rhs[f])
+        beta = ridge_solved(total_b - blocks[f], total_r - rhs[f], FOLD_RIDGE)
         cv += yy[f] - 2 * np.sum(beta * rhs[f], axis=1) + _quadratic(beta, blocks[f])
-    beta = _solve_many(total_b, total_r)
+    beta = ridge_solved(total_b, total_r, FOLD_RIDGE)
     rss = total_y - 2 * np.sum(beta * total_r, axis=1) + _quadratic(beta, total_b)
     return cv, np.maximum(rss, 0.0), beta
 
@@ -120,17 +115,11 @@ def score_offsets(
     total_g, total_r, total_y = gram.sum(0), rhs.sum(0), yy.sum(0)
     cv = np.zeros(offsets.shape[1])
     for f in range(FOLDS):
-        beta = _solve(total_g - gram[f], total_r - rhs[f])  # (k, G)
+        beta = ridge_solved(total_g - gram[f], total_r - rhs[f], FOLD_RIDGE)  # (k, G)
         cv += yy[f] - 2 * np.sum(beta * rhs[f], axis=0) + np.sum(beta * (gram[f] @ beta), axis=0)
-    beta = _solve(total_g, total_r)
+    beta = ridge_solved(total_g, total_r, FOLD_RIDGE)
     rss = total_y - 2 * np.sum(beta * total_r, axis=0) + np.sum(beta * (total_g @ beta), axis=0)
     return cv, np.maximum(rss, 0.0), beta.T
-
-
-def _solve_many(gram: np.ndarray, rhs: np.ndarray) -> np.ndarray:
-    scale = np.maximum(np.einsum("gkk->gk", gram), 1e-300)
-    regularized = gram + FOLD_RIDGE * scale[:, :, None] * np.eye(gram.shape[1])[None]
-    return np.linalg.solve(regularized, rhs[..., None])[..., 0]
 
 
 def hats(x: np.ndarray, knots: np.ndarray) -> np.ndarray:

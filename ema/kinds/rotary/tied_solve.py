@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ema.calibration.limits import FOLDS
+from ema.estimate.least_squares import coefficients
 from ema.estimate.physics.eta_search import coarse_to_fine
 from ema.kinds.rotary.equations import Equations
 from ema.kinds.rotary.selection import Chosen
@@ -74,14 +75,14 @@ def solve_with(e: Equations, chosen: Sequence[Chosen], rows: np.ndarray | None =
     rows = np.arange(e.m) if rows is None else rows
     design, loads, y = _extra(e, chosen)[rows], _loads(e, chosen)[rows], (e.y - _offset(e, chosen))[rows]
     parts = np.column_stack([y, loads])  # (m, 3): y, a, o
-    coefficients = np.linalg.lstsq(design, parts, rcond=None)[0]  # (k, 3)
-    residuals = parts - design @ coefficients
+    solved = coefficients(design, parts)  # (k, 3)
+    residuals = parts - design @ solved
 
     def mixes(grid: np.ndarray) -> np.ndarray:  # (3, G): y − k_aid·a − k_opp·o at each η_O
         return np.vstack([np.ones(len(grid)), *(-k for k in load_factors(grid, e.gear_ratio))])
 
     eta_o, grid, best = coarse_to_fine(lambda grid: np.sum((residuals @ mixes(grid)) ** 2, axis=0))
-    beta = coefficients @ mixes(grid)[:, best]
+    beta = solved @ mixes(grid)[:, best]
     return TiedSolution(float(beta[0]), eta_o, beta)
 
 

@@ -34,6 +34,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ema.estimate.least_squares import coefficients, newey_west_lags, newey_west_std
 from ema.estimate.physics.eta_search import MIN_OFFSET_BALANCE
 from ema.estimate.physics.noise_reading import robust_variance, white_noise_std
 from ema.estimate.stats import rms
@@ -210,23 +211,6 @@ class InverseSolution:
     residual_by_row: np.ndarray  # (rows,) over every decimated row: the residual where solved, NaN elsewhere
 
 
-def newey_west_lags(n: int) -> int:
-    """The residual's correlation lags the std weighs: Newey and West's (1994) plug-in, 4·(n/100)^(2/9)."""
-    return int(4.0 * (n / 100.0) ** (2.0 / 9.0))
-
-
-def newey_west_std(x: np.ndarray, residual: np.ndarray, lags: int) -> np.ndarray:
-    """Each coefficient's std from the sandwich (XᵀX)⁻¹·S·(XᵀX)⁻¹, S the residual's long-run covariance with
-    Bartlett weights 1 − k/(lags + 1)."""
-    inverse = np.linalg.pinv(x.T @ x)
-    scores = x * residual[:, None]
-    s = scores.T @ scores
-    for k in range(1, lags + 1):
-        shifted = scores[k:].T @ scores[:-k]
-        s += (1.0 - k / (lags + 1.0)) * (shifted + shifted.T)
-    return np.sqrt(np.clip(np.diag(inverse @ s @ inverse), 0.0, None))
-
-
 def decimated_problem(
     force_n: np.ndarray, columns: Mapping[str, np.ndarray], motion: Motion, left_out: np.ndarray | None = None
 ) -> tuple[np.ndarray, dict[str, np.ndarray]]:
@@ -271,7 +255,7 @@ def solve_inverse(
             f"the load slides the other way in {rarer} of {len(y)} decimated samples: moving one way, its friction "
             "FDJ·sgn(q̇) and the force's offset are one column, and a window must move both ways to tell them apart",
         )
-    beta, *_ = np.linalg.lstsq(x, y, rcond=None)
+    beta = coefficients(x, y)
     residual = y - x @ beta
     stds = newey_west_std(x, residual, newey_west_lags(len(y)))
     by_row = np.full(len(motion.sliding), np.nan)

@@ -33,6 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ema.estimate.documents import Note
+from ema.estimate.least_squares import coefficients
 from ema.estimate.physics.noise_reading import robust_variance
 from ema.estimate.stats import below_zero, rms
 from ema.kinds.servo.closed_loop import ServoLoop, ServoRuns, simulate_servo
@@ -179,7 +180,7 @@ def log_loop(servo: Servo, window: Window, among: np.ndarray | None = None) -> L
     if free.sum() < MIN_LOOP_SAMPLES:
         return None
     columns = _loop_columns(servo, window)[free]
-    (stiffness, kv), *_ = np.linalg.lstsq(columns, logged[free], rcond=None)
+    stiffness, kv = coefficients(columns, logged[free])
     if not (stiffness > 0 and kv > 0):
         return None
     off = rms(logged[free] - columns @ np.array([stiffness, kv]))
@@ -235,7 +236,7 @@ def loop_share(servo: Servo, window: Window, values: np.ndarray) -> float:
     """The share of ``values``' energy (N,) that the loop's own terms (the position error and the filtered speed,
     at any gains) explain by least squares: near 1 where ``values`` is a gain's, the sign's or the filter's error."""
     columns, target = _loop_columns(servo, window), values[len(servo.speed_filter) :]
-    solved, *_ = np.linalg.lstsq(columns, target, rcond=None)
+    solved = coefficients(columns, target)
     left = float(np.sum((target - columns @ solved) ** 2))
     return 1.0 - left / max(float(np.sum(target**2)), 1e-300)
 

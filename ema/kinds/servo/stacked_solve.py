@@ -13,14 +13,13 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ema.calibration.limits import FOLDS
+from ema.estimate.least_squares import coefficients, newey_west_lags, newey_west_std
 from ema.estimate.stats import rms
 from ema.kinds.servo.inverse import (
     decimated_problem,
     disturbed_rows,
     inverse_columns,
     load_motion,
-    newey_west_lags,
-    newey_west_std,
     solve_inverse,
 )
 from ema.kinds.servo.log_reading import ServoPrepared
@@ -73,13 +72,13 @@ class Solved:
 def solved(p: Problem) -> Solved:
     names = list(p.x)
     x = p.design(names)
-    beta, *_ = np.linalg.lstsq(x, p.y, rcond=None)
+    beta = coefficients(x, p.y)
     residual = p.y - x @ beta
     stds = newey_west_std(x, residual, newey_west_lags(len(p.y)))
     held = np.zeros(FOLDS)
     for k in range(FOLDS):
         out = p.fold == k
-        b, *_ = np.linalg.lstsq(x[~out], p.y[~out], rcond=None)
+        b = coefficients(x[~out], p.y[~out])
         held[k] = float(np.sum((p.y[out] - x[out] @ b) ** 2))
     return Solved(
         dict(zip(names, beta.tolist(), strict=True)),

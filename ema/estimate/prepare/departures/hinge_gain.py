@@ -28,6 +28,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ema.estimate.documents import Note
+from ema.estimate.least_squares import coefficients
 from ema.estimate.physics.features import as_read, solve_as_read
 from ema.estimate.physics.friction import MIN_SLIDING_KERNELS, SolveSettings, nuisance_columns, regressors
 from ema.estimate.prepare.departures.drive_constants import BESIDE, FIELDS
@@ -88,7 +89,7 @@ def free_load_solution(
     nuisances = [column[0] for column in nuisance_columns(seen, rate, drive, beside)]
     columns = np.column_stack([np.ones_like(t), a, o, *nuisances])
     keep = [sliding] + [sliding & (blocks != b) for b in range(JACKKNIFE_BLOCKS)]
-    betas = np.array([np.linalg.lstsq(columns[k], t[k], rcond=None)[0] for k in keep])
+    betas = np.array([coefficients(columns[k], t[k]) for k in keep])
     eta_o = eta_o_from_product((1 - betas[:, 1]) / (1 + betas[:, 2]), drive.gear_ratio)
     misfit = rms(t[sliding] - columns[sliding] @ betas[0])
     return 1.0 / ((1 + betas[:, 2]) * eta_o), misfit, used
