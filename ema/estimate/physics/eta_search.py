@@ -50,6 +50,14 @@ def profile_grid() -> np.ndarray:
     return low + PROFILE_STEP * np.arange(int((high - low) / PROFILE_STEP + 1e-9) + 1)
 
 
+def profile_std(grid: np.ndarray, chi2: np.ndarray, rise: float = 1.0) -> float:
+    """η_O's std from its χ² profile over ``grid``: half the width where χ² lies within ``rise`` of its minimum
+    (1: one std; a Birge ratio's square where the scatter exceeds the stated noise), never under one grid step
+    (a profile no wider than its step is resolved only to it)."""
+    inside = grid[chi2 <= np.min(chi2) + rise]
+    return float(max((inside.max() - inside.min()) / 2.0, grid[1] - grid[0]))
+
+
 def solved_terms(stats: np.ndarray, nuisances: tuple[str, ...]) -> np.ndarray:
     """(R, F) which of (FDJ, *nuisances) each row's window can tell apart (FDJ always; the rest by their
     column's balance or variation; ``stats`` (R, P, P), z = (t, a, o, nuisances…, 1))."""

@@ -33,7 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ema.estimate.physics.eta_search import profile_grid
+from ema.estimate.physics.eta_search import profile_grid, profile_std
 from ema.estimate.stats import rms
 from ema.model.params import eta_a_of, load_factors
 from ema.model.window import Window
@@ -173,7 +173,7 @@ def solve_stretches(
     if read:
         chi2 = np.array([fdj_at(eta)[1] for eta in ETA_GRID])
         best = int(np.argmin(chi2))
-        eta, eta_std = float(ETA_GRID[best]), _profile_std(ETA_GRID, chi2, best)
+        eta, eta_std = float(ETA_GRID[best]), profile_std(ETA_GRID, chi2)
     else:
         eta, eta_std = eta_o_document
     fdj, chi2_min = fdj_at(eta)
@@ -204,12 +204,6 @@ def _rel(reading: TorqueReading) -> float:
 def _eta_a_slope(eta: float, gear_ratio: float) -> float:
     h = 1e-5
     return float((eta_a_of(eta + h, gear_ratio) - eta_a_of(eta - h, gear_ratio)) / (2 * h))
-
-
-def _profile_std(grid: np.ndarray, chi2: np.ndarray, best: int) -> float:
-    """η_O's std from where χ² rises by 1 about its minimum (the grid step at least)."""
-    inside = grid[chi2 <= chi2[best] + 1.0]
-    return float(max((inside.max() - inside.min()) / 2.0, grid[1] - grid[0]))
 
 
 def _per_nm_read(

@@ -31,6 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ema.estimate.least_squares import weighted
+from ema.estimate.physics.eta_search import profile_std
 from ema.estimate.quasistatic.stretches import ETA_GRID, Stretch, set_point_motion, stretches
 from ema.estimate.stats import below_zero, rms
 from ema.model.actuator import LinearActuator
@@ -161,7 +162,7 @@ def calibrate_drive(runs: list[Run], actuator: LinearActuator) -> CalibratedDriv
     c_std = float(np.sqrt(covariance[0, 0])) * birge
     _refuse_reversed_signs(c, c_std, rests)
     fdj = c_fdj / c
-    eta_std = float(np.ptp(ETA_GRID[chi2 <= chi2_min + birge**2]) / 2) or float(ETA_GRID[1] - ETA_GRID[0])
+    eta_std = profile_std(ETA_GRID, chi2, rise=birge**2)
     per_run = [_run_fdj(run, c, float(ETA_GRID[best]), actuator) for run in runs]
     repeat = _excess_std(np.array([f for f, _ in per_run]), np.array([s for _, s in per_run]))
     anchored = [_run_fdj(run, c, float(ETA_GRID[best]), actuator, float(rests.mean())) for run in runs]
