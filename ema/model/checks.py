@@ -50,7 +50,7 @@ def read_document(path: str | Path, parse: Callable[[Any], Parsed]) -> Parsed:
         raise InputError(f"{path}: {exc.field}", exc.message) from None
 
 
-def validated(model: type[Model], document: Any, what: str, prefix: str = "") -> Model:
+def validated(model: type[Model], document: Any, what: str, prefix: str = "", tags: tuple[str, ...] = ()) -> Model:
     """``document`` (a dict) validated as ``model``; anything else, or a field it refuses, is an InputError naming
     it (``what``: the document's name where the whole is wrong; ``prefix`` before a field's name: where it came
     from, ``query.``)."""
@@ -59,7 +59,7 @@ def validated(model: type[Model], document: Any, what: str, prefix: str = "") ->
     try:
         return model.model_validate(document)
     except ValidationError as exc:
-        raise from_validation(exc, prefix) from None
+        raise from_validation(exc, prefix, tags) from None
 
 
 def finite_array(field: str, values: object, ndim: int | None = None) -> np.ndarray:
@@ -104,9 +104,9 @@ def from_validation(exc: Any, prefix: str = "", tags: tuple[str, ...] = ()) -> I
     """A pydantic ValidationError's first error as an InputError naming the field (list indices go
     into the message: ``signals.current_a``, "sample 17: Input should be a finite number"). A check across
     fields names the one it reports on first in its message ("fsj_nm: ..."): that field is named. ``tags``: a
-    tagged union's member names, which pydantic puts first in the field's path and the document does not hold."""
+    tagged union's member names, which pydantic puts in the field's path and the document does not hold."""
     first = exc.errors()[0]
-    loc = first["loc"][1:] if first["loc"] and first["loc"][0] in tags else first["loc"]
+    loc = [part for part in first["loc"] if part not in tags]
     names = [str(part) for part in loc if not isinstance(part, int)]
     indices = [part for part in loc if isinstance(part, int)]
     said = first["msg"].removeprefix("Value error, ")

@@ -14,14 +14,16 @@ import hashlib
 import json
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Annotated, Any, Literal
+from typing import Annotated, Any, ClassVar, Literal
 
 import numpy as np
 from pydantic import (
     AwareDatetime,
     BaseModel,
     ConfigDict,
+    Discriminator,
     Field,
+    Tag,
     field_validator,
     model_validator,
 )
@@ -43,7 +45,7 @@ from ema.model.bounds import (
 )
 from ema.model.checks import InputError, read_document, validated
 from ema.model.document import Number, refused_by
-from ema.model.kinds import ALL_SIGNALS, DEFAULT_KIND, KINDS, kind_of_signals, nearest_kind
+from ema.model.kinds import DEFAULT_KIND, KIND_NAMES, KINDS, kind_of_signals, nearest_kind
 
 WINDOW_SCHEMA = "ema-window/1"
 SIGNALS = KINDS[DEFAULT_KIND].signals  # the default kind's (a rotary window's)
@@ -60,46 +62,31 @@ class FlightConditionDocument(_Contract):
     altitude_m: Number = Field(ge=ALTITUDE_RANGE_M[0], le=ALTITUDE_RANGE_M[1], description="pressure altitude, ISA")
 
 
-class SignalsDocument(_Contract):
+class _Signals(_Contract):
     """Signals of one length, uniformly sampled from t = 0, each sample the mean over its interval: one kind's
-    (``ema.model.kinds``: a rotary actuator's five, a linear one's four, a servo's three and its load where it
-    has one), never a mix."""
+    (``ema.model.kinds``), never a mix. Each kind's class lists its own."""
 
-    command_deg: Samples | None = Field(None, description=f"elevator command, within {SIGNAL_LIMITS['command_deg']}")
-    position_deg: Samples | None = Field(None, description=f"deflection θ_u, within {SIGNAL_LIMITS['position_deg']}")
-    motor_speed_radps: Samples | None = Field(
-        None, description=f"motor speed ω_m, within {SIGNAL_LIMITS['motor_speed_radps']}"
-    )
-    current_a: Samples | None = Field(None, description=f"the drive's current I, within {SIGNAL_LIMITS['current_a']}")
-    hinge_moment_nm: Samples | None = Field(
-        None, description=f"hinge moment H_e, within {SIGNAL_LIMITS['hinge_moment_nm']}"
-    )
-    command_mm: Samples | None = Field(None, description="a linear actuator's position set point [mm]")
-    position_mm: Samples | None = Field(None, description="a linear actuator's measured position [mm]")
-    load_n: Samples | None = Field(
-        None,
-        description="the external force on a linear actuator or a servo [N], positive pushing towards increasing "
-        "position (a servo logged without one carries no load)",
-    )
-    set_point_m: Samples | None = Field(None, description="a servo's position set point, on the load side [m]")
-    position_m: Samples | None = Field(None, description="a servo's measured position, on the load side [m]")
-    drive_force_n: Samples | None = Field(
-        None, description="the force a servo's drive applies to the load [N]: its command times the drive's gain"
-    )
+    kind: ClassVar[str]
 
-    @model_validator(mode="after")
-    def _one_kind(self) -> SignalsDocument:
-        given = [name for name in ALL_SIGNALS if getattr(self, name) is not None]
-        if kind_of_signals(given) is not None:
-            return self
-        kind = nearest_kind(given)
-        missing = [name for name in kind.signals if name not in given]
-        extra = [name for name in given if name not in kind.all_signals]
-        field = missing[0] if missing else extra[0]
+    @model_validator(mode="before")
+    @classmethod
+    def _its_own_signals(cls, values: Any) -> Any:
+        """A missing signal or another kind's named with what this kind's window carries (a null signal is
+        absent, as the earlier document, which held every kind's signals, read it)."""
+        if not isinstance(values, dict):
+            return values
+        values = {name: v for name, v in values.items() if v is not None}
+        kind = KINDS[cls.kind]
         carries = f"a {kind.name} window carries {', '.join(kind.signals)}"
-        raise ValueError(f"{field}: is missing ({carries})" if missing else f"{field}: is no signal of it ({carries})")
+        missing = [name for name in kind.signals if name not in values]
+        if missing:
+            raise ValueError(f"{missing[0]}: is missing ({carries})")
+        extra = [name for name in values if name not in kind.all_signals]
+        if extra:
+            raise ValueError(f"{extra[0]}: is no signal of it ({carries})")
+        return values
 
-    @field_validator(*ALL_SIGNALS)
+    @field_validator("*")
     @classmethod
     def _plausible(cls, values: list[float] | None, info: Any) -> list[float] | None:
         if values is None:
@@ -114,6 +101,64 @@ class SignalsDocument(_Contract):
                 hint = ": in rpm? (rad/s = rpm × π/30)"
             raise ValueError(f"sample {index} = {array[index]:g} is outside [{low:g}, {high:g}]{hint}")
         return values
+
+    def arrays(self) -> dict[str, list[float]]:
+        """Each signal the window carries, by name."""
+        return {name: values for name in type(self).model_fields if (values := getattr(self, name)) is not None}
+
+
+class RotarySignals(_Signals):
+    """A rotary actuator's five signals."""
+
+    kind: ClassVar[str] = "rotary"
+    command_deg: Samples = Field(description=f"elevator command, within {SIGNAL_LIMITS['command_deg']}")
+    position_deg: Samples = Field(description=f"deflection θ_u, within {SIGNAL_LIMITS['position_deg']}")
+    motor_speed_radps: Samples = Field(description=f"motor speed ω_m, within {SIGNAL_LIMITS['motor_speed_radps']}")
+    current_a: Samples = Field(description=f"the drive's current I, within {SIGNAL_LIMITS['current_a']}")
+    hinge_moment_nm: Samples = Field(description=f"hinge moment H_e, within {SIGNAL_LIMITS['hinge_moment_nm']}")
+
+
+class LinearSignals(_Signals):
+    """A linear actuator's four signals."""
+
+    kind: ClassVar[str] = "linear"
+    command_mm: Samples = Field(description="the position set point [mm]")
+    position_mm: Samples = Field(description="the measured position [mm]")
+    current_a: Samples = Field(description=f"the drive's current I, within {SIGNAL_LIMITS['current_a']}")
+    load_n: Samples = Field(description="the external force [N], positive pushing towards increasing position")
+
+
+class ServoSignals(_Signals):
+    """A servo's three signals on the load side, and its load where it has one."""
+
+    kind: ClassVar[str] = "servo"
+    set_point_m: Samples = Field(description="the position set point, on the load side [m]")
+    position_m: Samples = Field(description="the measured position, on the load side [m]")
+    drive_force_n: Samples = Field(
+        description="the force the drive applies to the load [N]: its command times the drive's gain"
+    )
+    load_n: Samples | None = Field(
+        None,
+        description="the external force [N], positive pushing towards increasing position (a servo logged without "
+        "one carries no load)",
+    )
+
+
+def _signals_kind(signals: Any) -> str | None:
+    """The tag ``SignalsDocument`` dispatches on: the kind whose signals these are, else the one they come closest
+    to (whose class then names what is missing or foreign)."""
+    if isinstance(signals, dict):
+        names = [name for name, values in signals.items() if values is not None]
+        return (kind_of_signals(names) or nearest_kind(names)).name
+    return getattr(signals, "kind", None)
+
+
+SignalsDocument = Annotated[
+    Annotated[RotarySignals, Tag("rotary")]
+    | Annotated[LinearSignals, Tag("linear")]
+    | Annotated[ServoSignals, Tag("servo")],
+    Discriminator(_signals_kind),
+]  # one kind's signals, told by which it carries
 
 
 class WindowDocument(_Contract):
@@ -165,8 +210,7 @@ class WindowDocument(_Contract):
 
     def to_window(self) -> Window:
         """The arrays; signals of unequal lengths are refused naming the first one that differs."""
-        names = [name for name in ALL_SIGNALS if getattr(self.signals, name) is not None]
-        arrays = {name: np.asarray(getattr(self.signals, name), dtype=np.float64) for name in names}
+        arrays = {name: np.asarray(values, dtype=np.float64) for name, values in self.signals.arrays().items()}
         first = next(iter(arrays))
         for name, array in arrays.items():
             if len(array) != len(arrays[first]):
@@ -256,7 +300,7 @@ class Window:
 
 def window_from_dict(document: Any) -> Window:
     """Parse and validate an ``ema-window/1`` document (a dict); errors name the field."""
-    return validated(WindowDocument, document, "window").to_window()
+    return validated(WindowDocument, document, "window", tags=KIND_NAMES).to_window()
 
 
 def window_to_dict(window: Window) -> dict[str, Any]:

@@ -54,6 +54,19 @@ def test_the_documents_kind_field_lists_every_kind():
         assert not ({other.section for other in facts.KINDS.values()} - {section}) & set(member["properties"])
 
 
+def test_each_kinds_window_signals_are_its_facts_signals():
+    """ema-window/1's signals are one class per kind, joined by which signals a window carries: each class's
+    required and optional signals are its facts' own, so a kind's row is the one place they are declared."""
+    from ema.model.window import LinearSignals, RotarySignals, ServoSignals
+
+    classes = {cls.kind: cls for cls in (RotarySignals, LinearSignals, ServoSignals)}
+    assert set(classes) == set(facts.KINDS)
+    for name, cls in classes.items():
+        fields = cls.model_fields
+        assert tuple(fields) == facts.KINDS[name].all_signals
+        assert {f for f, info in fields.items() if info.is_required()} == set(facts.KINDS[name].signals)
+
+
 QUICK = (
     "import glob, sys; from ema.cli.main import main; rig, learned = sys.argv[1:]; "
     "runs = sorted(glob.glob(rig + '/runs/normal_load[24]0_*.csv')); "

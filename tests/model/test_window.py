@@ -65,6 +65,8 @@ def _broken(document, path, value):
         (("signals", "position_deg"), [float("nan")] * 500, "signals.position_deg"),
         (("signals", "position_deg"), [90.0] * 500, "signals.position_deg"),
         (("signals", "extra"), [0.0] * 500, "signals.extra"),
+        (("signals", "position_mm"), [0.0] * 500, "signals.position_mm"),  # a linear actuator's, in a rotary window
+        (("signals", "hinge_moment_nm"), [0.0] * 499 + [1e9], "signals.hinge_moment_nm"),
         (("actuator_id",), 5, "actuator_id"),
         (("constants",), {"position_gain_per_s": 100.0}, "constants.position_gain_per_s"),  # a rotary's: none
     ],
@@ -83,3 +85,11 @@ def test_too_short_and_unreadable(tmp_path, document):
     (tmp_path / "bad.json").write_text("{not json")
     with pytest.raises(InputError, match=r"bad\.json"):
         read_window(tmp_path / "bad.json")
+
+
+def test_a_null_signal_of_another_kind_is_absent_as_in_the_earlier_document(document):
+    """The earlier signals document held every kind's signals, null but its own (what a dump of it wrote): such a
+    window still reads as its kind's."""
+    padded = copy.deepcopy(document)
+    padded["signals"].update(command_mm=None, position_mm=None, load_n=None, set_point_m=None)
+    assert window_from_dict(padded).signals.keys() == window_from_dict(document).signals.keys()
