@@ -23,8 +23,8 @@ from benchmarks.tails import BOUND
 from benchmarks.wearing_fleet import KINDS_OF_WEAR, Thresholds, Wear, flights, logged_window, wear
 from ema.cli.benchmark_docs import write_section
 from ema.estimate import thread_budget
-from ema.estimate.other_windows import readings_of
 from ema.estimate.report import share_of_range
+from ema.kinds.rotary.other_windows import readings_of
 from ema.kinds.rotary.pipeline import estimate_window
 from ema.model.actuator import THESIS
 from ema.model.checks import InputError
@@ -53,7 +53,7 @@ three windows a flight, 0.3 h apart, their current sensor 0.04–0.2 A off zero,
 (`flight_id`): a window moving one way cannot read that, and is read with the zero an earlier window
 of its flight read.
 Every window goes through `estimate_window` with what the actuator's earlier windows read
-(`ema.estimate.other_windows`), and the history through `prognose`, as the service does
+(`ema.kinds.rotary.other_windows`), and the history through `prognose`, as the service does
 (`benchmarks/foreign_history.py`). Per actuator: its windows' FDJ
 answers said weak, past 10 % of the range, and past it without saying so; the trend's level at the
 last window against the truth there (error in % of the range and in the trend's stds); the true

@@ -15,7 +15,7 @@ from benchmarks.foreign_accuracy import RESULTS_MD, run_one, summarize, table
 from benchmarks.foreign_groups import FAMILIES, drive_off, off_zero, viscous
 from ema.cli.benchmark_docs import typed_command, write_section
 from ema.estimate import thread_budget
-from ema.estimate.other_windows import readings_of
+from ema.kinds.rotary.other_windows import readings_of
 from ema.kinds.rotary.pipeline import estimate_window
 from ema.model.actuator import THESIS
 from ema.model.window import window_from_dict
@@ -56,7 +56,7 @@ def _short_drive_off(seed: int) -> Draw:
 
 def _after_another(make: Callable[[int], Draw], seed: int, family: str, duration_s: float) -> dict[str, Any]:
     """The answer for the window ``make`` draws, after a window of ``family`` of its flight (the same actuator,
-    sensors and flight condition) was read: with what that read (``ema.estimate.other_windows``), as the service
+    sensors and flight condition) was read: with what that read (``ema.kinds.rotary.other_windows``), as the service
     answers a window after others of its actuator and flight_id."""
     drawn = make(seed)
     other = of_the_same_flight(drawn, seed + 500_000, family, duration_s)
@@ -119,7 +119,7 @@ does not decide; a replay of the window with each tells them apart only where it
 within the noise (thesis windows), and elsewhere γ is read with FDJ's std widened by 0.6 of what
 reading ΔJ would change (`ema.estimate.prepare.departures.read`): honest, but often weak. J_M stays with the build: the
 last row answers the same windows after a 0.5 s thesis window of the actuator (a pre-flight check) read
-it, which decides between the two readings where one agrees with it (`ema.estimate.other_windows`)."""
+it, which decides between the two readings where one agrees with it (`ema.kinds.rotary.other_windows`)."""
 
 
 def main() -> None:

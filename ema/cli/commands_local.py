@@ -58,11 +58,11 @@ SIMULATE_FLAGS = {
 
 def history_of(window: Any, paths: tuple[Path, ...]) -> Any:
     """What the ema-estimate/1 results in ``paths``, of other windows of ``window``'s actuator, read that it may
-    not (``ema.estimate.other_windows``); InputError naming --history."""
+    not (``ema.kinds.rotary.other_windows``); InputError naming --history."""
     from pydantic import ValidationError
 
     from ema.estimate.documents import Estimate
-    from ema.estimate.other_windows import readings_of
+    from ema.kinds.rotary.other_windows import readings_of
     from ema.model.checks import InputError, from_validation, load_json
 
     results = []

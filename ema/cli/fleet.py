@@ -5,7 +5,7 @@ Results are written as they complete, the CSV is the checkpoint (a rerun skips w
 duplicates a window), and the same rows can go into a service's history (idempotent as well). A window that
 lacks what other windows of its actuator read (its flight's sensor zero, where it moved one way or read its
 own less precisely; J_M, where it could not tell a heavier rotor from a weaker motor) is answered again
-at the end with what they read (``ema.estimate.other_windows``), as the service answers it from its history. A
+at the end with what they read (``ema.kinds.rotary.other_windows``), as the service answers it from its history. A
 window of a named flight is written once its flight's windows are answered (a recording's pieces come
 together), one that could not tell J_M at the end of the run. The answer says how the wall time split:
 start-up (from the command's start to the first answer), windows, and of those, writing rows.
@@ -51,7 +51,7 @@ class Progress:
 
 @dataclass
 class _Readings:
-    """What the run's windows read that others may lack (``ema.estimate.other_windows``): sensor zeros by (actuator,
+    """What the run's windows read that others may lack (``ema.kinds.rotary.other_windows``): sensor zeros by (actuator,
     flight), J_M readings by actuator, in the order answered; indexed so that each lookup reads one flight."""
 
     zeros: dict[tuple[str, str | None], list[Any]] = field(default_factory=dict)
@@ -67,10 +67,10 @@ class _Readings:
             self.inertias.setdefault(window.actuator_id, []).append(info.inertia_read)
 
     def lacked(self, window: Window, answer: dict[str, Any]) -> dict[str, Any] | None:
-        """What the run's other windows lend this one that it lacks (``ema.estimate.other_windows.wanted``), as JSON; or
-        None."""
+        """What the run's other windows lend this one that it lacks (``ema.kinds.rotary.other_windows.wanted``), as
+        JSON; or None."""
         from ema.estimate.documents.window_facts import WindowInfo
-        from ema.estimate.other_windows import lent, wanted
+        from ema.kinds.rotary.other_windows import lent, wanted
 
         flight = self.zeros.get((window.actuator_id, window.flight_id), [])
         others = lent((z for z in flight if z.window_id != window.window_id), self.inertias.get(window.actuator_id, []))

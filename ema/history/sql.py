@@ -21,11 +21,11 @@ from pydantic import ValidationError
 from ema.calibration.documents import CalibrationReport
 from ema.estimate.documents import Estimate
 from ema.estimate.documents.window_facts import HistoryReadings, InertiaReading, SensorZero
-from ema.estimate.other_windows import lent
 from ema.history.connection import now
 from ema.history.refusals import ConflictError, WithdrawnError
 from ema.history.tables import actuators, calibrations, estimates, summaries, withdrawals
 from ema.history.versions import VersionedDocuments
+from ema.kinds.rotary.other_windows import lent
 from ema.prognosis.documents import Stored, Withdrawal
 
 
@@ -179,7 +179,7 @@ class SqlHistory(VersionedDocuments):
 
     def readings(self, actuator_id: str, flight_id: str | None) -> HistoryReadings:
         """What the stored windows of this actuator lend a window of ``flight_id``
-        (``ema.estimate.other_windows.lent``)."""
+        (``ema.kinds.rotary.other_windows.lent``)."""
         mine = estimates.c.actuator_id == actuator_id
         with self._reading() as connection:
             zeros: list[SensorZero] = []

@@ -26,7 +26,6 @@ RANKS = {
     "ema.estimate.quasistatic.drive_torque": 1,
     "ema.estimate.quasistatic.departure": 0,
     "ema.estimate.quasistatic.slow_window": 7,
-    "ema.estimate.other_windows": 6,
 }
 
 

@@ -1,6 +1,6 @@
 """What an estimate says of its window (``ema-estimate/1``'s ``window``), and what windows of one actuator lend each
-other: a flight's sensor zero, the actuator's J_M (``ema.estimate.other_windows``). Part of the one definition of the
-estimate document (``ema.estimate.documents``).
+other: a flight's sensor zero, the actuator's J_M (``ema.kinds.rotary.other_windows``). Part of the one definition of
+the estimate document (``ema.estimate.documents``).
 """
 
 from __future__ import annotations

@@ -29,7 +29,6 @@ from ema.estimate.documents import ActuatorRead, Check, Estimate, Note
 from ema.estimate.documents.window_facts import HistoryReadings
 from ema.estimate.learn.estimator import NetworkEstimator
 from ema.estimate.learn.network import LearnConfig
-from ema.estimate.other_windows import known_from
 from ema.estimate.physics.features import as_read
 from ema.estimate.physics.friction import SOLUTION_ARRAYS, FrictionSolution, solve_friction, solve_window
 from ema.estimate.physics.scenario import inside
@@ -39,6 +38,7 @@ from ema.estimate.report import estimate_document
 from ema.estimate.simulate.dataset import Data, simulate_dataset
 from ema.estimate.stats import MAX_RATIO, rms
 from ema.estimate.stopwatch import Stopwatch
+from ema.kinds.rotary.other_windows import known_from
 from ema.kinds.rotary.reproduction import output_error_ratios
 from ema.model.actuator import THESIS, ActuatorDocument
 from ema.model.window import Window
@@ -165,7 +165,7 @@ def estimate_window(
     default a caller chose for a user who gave none, and the answer says so), ``version`` its stored
     version; ``on_stage`` hears each stage as it starts (and may raise to stop the job there);
     ``spec_only`` reads the window with the document's model alone, no departures taken off (calibration's
-    base); ``history``: what other windows of the actuator lend this one (``ema.estimate.other_windows``). Raises
+    base); ``history``: what other windows of the actuator lend this one (``ema.kinds.rotary.other_windows``). Raises
     InputError naming the field for a window that cannot be read.
     """
     watch = Stopwatch(on_stage)

@@ -49,7 +49,7 @@ async def estimate(
     (``replay: true``) without recomputing; other content under a stored key is another window: 409; a window an
     operator withdrew stays withdrawn: 410, naming the withdrawal.
     What the stored windows of the actuator read that this one may not (its ``flight_id``'s sensor
-    zero, the actuator's J_M: ``ema.estimate.other_windows``) is read with it, and so is the actuator's latest
+    zero, the actuator's J_M: ``ema.kinds.rotary.other_windows``) is read with it, and so is the actuator's latest
     ``ema-actuator/1`` document (the default where it has none; the answer records which).
     Budget: the window's duration and its simulation work (simulations × seconds) are limited by the
     service's settings; over it, 422 naming the limit.

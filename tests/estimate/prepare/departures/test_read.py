@@ -3,10 +3,10 @@
 import pytest
 
 from ema.estimate.documents.window_facts import HistoryReadings, InertiaReading
-from ema.estimate.other_windows import known_from
 from ema.estimate.physics.features import as_read
 from ema.estimate.physics.friction import solve_window
 from ema.estimate.prepare.conditioning import prepare, widened
+from ema.kinds.rotary.other_windows import known_from
 from ema.model.actuator import THESIS
 from ema.model.window import window_from_dict
 from tests.foreign.windows import Effects, draw, of_the_same_flight, worn

@@ -69,10 +69,10 @@ def test_where_the_speed_hardly_varies_an_unseen_coefficient_is_in_the_stds(fact
     its flight: C·|ω| is FDJ's twin. Read with the spec's C and a std without it, C 1.24x put FDJ 40 % of
     range high at 10 std (foreign history, actuator 407)."""
     from ema.estimate.documents.window_facts import HistoryReadings
-    from ema.estimate.other_windows import known_from
     from ema.estimate.physics.friction import solve_window
     from ema.estimate.prepare.conditioning import widened
     from ema.estimate.report import weakly_determined
+    from ema.kinds.rotary.other_windows import known_from
 
     effects = Effects(viscous_factor=factor, current_bias_a=0.2)
     gust = draw(318, "gust", duration_s=0.1, effects=effects)

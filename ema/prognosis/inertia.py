@@ -1,31 +1,22 @@
-"""What other windows of an actuator read that one window may not, gathered from their results.
+"""An actuator's J_M over its windows: one reading from many, and a replaced part said.
 
-Two facts outlive a window: the sensors' zero, which a drive keeps for a power-on (a window of the
-same ``flight_id``, moving both ways, reads it: ``ema.estimate.prepare.departures.zero_offset``), and J_M,
-which stays with the build (a window that tells a heavier rotor from a weaker motor reads it:
-``ema.estimate.prepare.departures.read``).
-The service gathers them from its history before it estimates a window, the fleet from the windows of
-its run; ``known_from`` hands them to conditioning.
+J_M stays with the build, so the readings of an actuator's windows (those that told a heavier rotor from a weaker
+motor) are one quantity read many times: combined by inverse variance since it last changed, a change or a
+scatter beyond their stds said. The prognosis reports it beside the trends; the rotary kind lends it to a window
+that cannot read it (``ema.kinds.rotary.other_windows``).
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Sequence
+from collections.abc import Sequence
 
 import numpy as np
 
 from ema.estimate.documents import Note
-from ema.estimate.documents.window_facts import HistoryReadings, InertiaReading, SensorZero, WindowInfo
-from ema.estimate.prepare.departures.read import Known
-from ema.estimate.prepare.departures.zero_offset import ZeroOffset
+from ema.estimate.documents.window_facts import InertiaReading
 
 NAMED_WINDOWS = 10  # the latest windows an actuator's J_M names as read by (all weigh in)
 SCATTER_NOTED = 3.0  # stds (a reading's from the others', or the Birge ratio) from which J_M readings disagree
-
-
-def best_zero(zeros: Iterable[SensorZero]) -> SensorZero | None:
-    """The most precise of a flight's sensor zeros (a drive keeps one zero for a power-on), or None."""
-    return min(zeros, key=lambda zero: zero.torque_std_nm, default=None)
 
 
 def _arrays(readings: Sequence[InertiaReading]) -> tuple[np.ndarray, np.ndarray]:
@@ -109,52 +100,3 @@ def inertia_change_note(readings: Sequence[InertiaReading]) -> Note | None:
             "said with its std widened as much"
         ),
     )
-
-
-def lent(zeros: Iterable[SensorZero], inertias: Sequence[InertiaReading]) -> HistoryReadings:
-    """What an actuator's stored windows lend another: the most precise of its flight's sensor ``zeros``, and
-    J_M from its ``inertias`` (oldest first) since it last changed. The one policy of the service's history,
-    the fleet's run and ``ema estimate --history``."""
-    return HistoryReadings(sensor_zero=best_zero(zeros), inertia=combined_inertia(inertias))
-
-
-def readings_of(windows: Iterable[WindowInfo], flight_id: str | None) -> HistoryReadings:
-    """What the results of other windows of an actuator (their ``window`` parts, oldest first) lend a window
-    of ``flight_id`` (``lent``)."""
-    zeros, inertias = [], []
-    for info in windows:
-        if info.sensor_zero is not None and flight_id is not None and info.flight_id == flight_id:
-            zeros.append(info.sensor_zero)
-        if info.inertia_read is not None:
-            inertias.append(info.inertia_read)
-    return lent(zeros, inertias)
-
-
-def wanted(read: WindowInfo, others: HistoryReadings) -> HistoryReadings | None:
-    """What a window answered alone (``read``) would be answered again with: its flight's sensor zero where it
-    read none or a less precise one (conditioning takes it where it holds), J_M where it could not tell a
-    heavier rotor from a weaker motor; None where the others lend it nothing it lacks."""
-    zero = others.sensor_zero
-    own = read.sensor_zero
-    takes_zero = zero is not None and (own is None or zero.torque_std_nm < own.torque_std_nm)
-    inertia = others.inertia if read.inertia_undecided else None
-    if not takes_zero and inertia is None:
-        return None
-    return HistoryReadings(sensor_zero=zero if takes_zero else None, inertia=inertia)
-
-
-def known_from(history: HistoryReadings | None) -> Known:
-    """A flight's sensor zero and an actuator's J_M as conditioning takes them."""
-    if history is None:
-        return Known()
-    zero, inertia, carried = history.sensor_zero, history.inertia, None
-    if zero is not None:
-        carried = ZeroOffset(
-            hinge_nm=zero.hinge_nm,
-            current_a=zero.current_a,
-            zero_std_nm=zero.torque_std_nm,
-            carried_from=zero.window_id,
-        )
-    if inertia is None:
-        return Known(zero=carried)
-    return Known(carried, inertia.factor, inertia.std, tuple(inertia.window_ids))
