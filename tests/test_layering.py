@@ -1,4 +1,4 @@
-"""The package's layers import one way (the README's table): model ← estimate ← calibration, prognosis ← kinds ←
+"""The package's layers import one way (the README's table): model ← estimate ← calibration ← kinds ← prognosis ←
 history ← service ← cli. A module may import its own layer or a lower one, never a higher one, at module level or
 inside a function; and no module imports another in a circle at import time."""
 
@@ -6,7 +6,7 @@ import ast
 from pathlib import Path
 
 PACKAGE = Path(__file__).resolve().parents[1] / "ema"
-RANKS = {"model": 0, "estimate": 1, "calibration": 2, "prognosis": 2, "kinds": 3, "history": 4, "service": 5, "cli": 6}
+RANKS = {"model": 0, "estimate": 1, "calibration": 2, "kinds": 3, "prognosis": 4, "history": 5, "service": 6, "cli": 7}
 
 
 def _layer(module: str) -> str | None:

@@ -6,7 +6,7 @@ which stays with the build (a window that tells a heavier rotor from a weaker mo
 ``ema.estimate.prepare.departures.read``).
 The service gathers them from its history before it estimates a window, the fleet from the windows of
 its run; ``known_from`` hands them to conditioning. J_M's readings are combined as the prognosis reads them
-(``ema.prognosis.inertia``).
+(``ema.kinds.rotary.inertia``).
 """
 
 from __future__ import annotations
@@ -16,7 +16,7 @@ from collections.abc import Iterable, Sequence
 from ema.estimate.documents.window_facts import HistoryReadings, InertiaReading, SensorZero, WindowInfo
 from ema.estimate.prepare.departures.read import Known
 from ema.estimate.prepare.departures.zero_offset import ZeroOffset
-from ema.prognosis.inertia import combined_inertia
+from ema.kinds.rotary.inertia import combined_inertia
 
 
 def best_zero(zeros: Iterable[SensorZero]) -> SensorZero | None:

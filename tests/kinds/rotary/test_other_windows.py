@@ -4,12 +4,12 @@ import numpy as np
 import pytest
 
 from ema.estimate.documents.window_facts import HistoryReadings, InertiaReading, SensorZero
+from ema.kinds.rotary.inertia import NAMED_WINDOWS, combined_inertia, since_change
 from ema.kinds.rotary.other_windows import best_zero, known_from, readings_of
 from ema.kinds.rotary.pipeline import estimate_window
 from ema.kinds.rotary.synthetic import synthetic_window
 from ema.model.actuator import THESIS
 from ema.model.params import HealthParams
-from ema.prognosis.inertia import NAMED_WINDOWS, combined_inertia, since_change
 from tests.service.conftest import SMALL
 
 
