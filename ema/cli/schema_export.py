@@ -15,14 +15,13 @@ def schemas() -> dict[str, dict[str, Any]]:
     from ema.calibration.documents import CalibrationReport
     from ema.estimate.documents import Estimate
     from ema.model.actuator import actuator_schema
-    from ema.model.logmap import LogMap
+    from ema.model.logmap import logmap_schema
     from ema.model.window import WindowDocument
     from ema.prognosis.documents import ActuatorSummary, EstimateHistory, Prognosis, StoredActuator, Withdrawal
 
     models: dict[str, type[BaseModel]] = {
         "stored-actuator": StoredActuator,
         "ema-window-1": WindowDocument,
-        "ema-logmap-1": LogMap,
         "ema-estimate-1": Estimate,
         "ema-calibration-1": CalibrationReport,
         "history": EstimateHistory,
@@ -30,10 +29,8 @@ def schemas() -> dict[str, dict[str, Any]]:
         "actuator-summary": ActuatorSummary,
         "withdrawal": Withdrawal,
     }
-    return {
-        "ema-actuator-1": actuator_schema(),
-        **{stem: m.model_json_schema(by_alias=True) for stem, m in models.items()},
-    }
+    exported = {stem: model.model_json_schema(by_alias=True) for stem, model in models.items()}
+    return {"ema-actuator-1": actuator_schema(), "ema-logmap-1": logmap_schema(), **exported}
 
 
 def export(folder: Path, check: bool = False) -> list[str]:

@@ -11,21 +11,24 @@ one without a load, not a stuck sensor. A file that does not match its map is re
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from pathlib import Path
-from typing import Any, Literal
+from typing import Annotated, Any, Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import BaseModel, ConfigDict, Discriminator, Field, Tag, TypeAdapter, ValidationError, model_validator
 
-from ema.model.checks import InputError, read_document, validated
+from ema.model.checks import UNKNOWN_TAG, InputError, from_validation, read_document
 from ema.model.document import Number
-from ema.model.kinds import KINDS, Role
+from ema.model.kinds import KIND_NAMES, KINDS, Role
 from ema.model.log_files import Table, read_table
 from ema.model.units import TIME_S
 
 LOGMAP_SCHEMA = "ema-logmap/1"
 UNIFORM = 0.01  # time steps within this share of the median step: uniformly sampled
 ROLES = ("set_point", "position", "error", "current", "force", "load", "motor_speed")
+DEFAULT_LOG_KIND = "linear"  # a map that names no kind: a rig's, as the first log maps were
+_KIND_DESCRIPTION = "the actuator's kind (its signals)"
 
 
 class _Part(BaseModel):
@@ -50,30 +53,41 @@ class Constant(_Part):
 
 
 class LogMap(_Part):
-    """``ema-logmap/1``."""
+    """``ema-logmap/1``: what every kind's log map holds. A map is one kind's class (``RotaryLogMap``,
+    ``LinearLogMap``, ``ServoLogMap``), which adds the roles only its kind logs; ``AnyLogMap`` joins them on
+    ``kind`` (a map without one is a linear rig's, as first published)."""
 
     schema_: Literal["ema-logmap/1"] = Field("ema-logmap/1", alias="schema")
     name: str = Field(min_length=1, max_length=200, description="the rig or recorder, for a person")
-    kind: Literal["rotary", "linear", "servo"] = Field("linear", description="the actuator's kind (its signals)")
+    kind: str  # each kind's class narrows it to its name
     actuator_id: str = Field(min_length=1, max_length=200, description="the actuator every file of this rig logs")
     time: Column | None = Field(None, description="seconds (s or ms) from the start; or give sample_rate_hz")
     sample_rate_hz: Number | None = Field(None, gt=0, description="where the log has no time variable")
     set_point: Column = Field(description="the position set point (linear: mm, m, in; rotary: deg, rad; servo: m)")
     position: Column | None = Field(None, description="the measured position; or give error")
     error: Column | None = Field(None, description="set point minus measured position (sign -1: the other way)")
-    current: Column | None = Field(None, description="rotary, linear: the drive's current (A, mA)")
-    force: Column | None = Field(None, description="servo: the drive's force on the load (N; a command with a scale)")
-    load: Column | Constant | None = Field(
-        None,
-        description="the external load: linear, servo: a force (N, kgf, lbf), positive pushing towards increasing "
-        "position; rotary: the hinge moment (N·m); a servo's may be left out (no load)",
-    )
-    motor_speed: Column | None = Field(None, description="rotary: the motor's speed (rad/s, rpm)")
     constants: dict[str, str] = Field(
         default_factory=dict,
         description="the actuator document's section field -> the file's constant that holds it (a servo's "
         "position_gain_per_s: kp)",
     )
+
+    @model_validator(mode="before")
+    @classmethod
+    def _its_own_roles(cls, values: Any) -> Any:
+        """Another kind's role refused naming it, one of its own missing named (a null role is absent)."""
+        if not isinstance(values, dict) or values.get("kind", DEFAULT_LOG_KIND) not in KINDS:
+            return values
+        kind = values.get("kind", DEFAULT_LOG_KIND)
+        roles = KINDS[kind].roles
+        values = {name: v for name, v in values.items() if v is not None or name not in ROLES}
+        for name in ROLES:
+            role = roles.get("position" if name == "error" else name)
+            if role is None and name in values:
+                raise ValueError(f"{name}: a {kind} actuator's log has no {name} ({', '.join(roles)})")
+            if role is not None and role.required and name not in ("position", "error") and name not in values:
+                raise ValueError(f"{name}: a {kind} actuator's log gives its {name}")
+        return values
 
     @model_validator(mode="after")
     def _complete(self) -> LogMap:
@@ -81,14 +95,8 @@ class LogMap(_Part):
             raise ValueError("time: give the time variable or sample_rate_hz, one of them")
         if (self.position is None) == (self.error is None):
             raise ValueError("position: give the position variable or the error variable, one of them")
-        roles = KINDS[self.kind].roles
         for name in ROLES:
-            role = roles.get("position" if name == "error" else name)
-            part = getattr(self, name)
-            if role is None and part is not None:
-                raise ValueError(f"{name}: a {self.kind} actuator's log has no {name} ({', '.join(roles)})")
-            if role is not None and part is None and role.required and name not in ("position", "error"):
-                raise ValueError(f"{name}: a {self.kind} actuator's log gives its {name}")
+            role, part = self.roles.get("position" if name == "error" else name), self.part(name)
             if role is not None and part is not None and part.unit not in role.units:
                 raise ValueError(f"{name}.unit: {part.unit!r} is not one of {', '.join(role.units)}")
         for name in self.constants:
@@ -98,9 +106,79 @@ class LogMap(_Part):
             raise ValueError(f"time.unit: {self.time.unit!r} is not one of {', '.join(TIME_S)}")
         return self
 
+    @property
+    def roles(self) -> Mapping[str, Role]:
+        """The roles its kind's log holds (``ema.model.kinds``)."""
+        return KINDS[self.kind].roles
+
+    def part(self, name: str) -> Column | Constant | None:
+        """Where the log holds role ``name`` (None: a role this map leaves out)."""
+        return getattr(self, name, None)
+
+
+class RotaryLogMap(LogMap):
+    """A rotary actuator's log: its current, its motor's speed and the hinge moment besides."""
+
+    kind: Literal["rotary"] = Field(description=_KIND_DESCRIPTION)
+    current: Column = Field(description="the drive's current (A, mA)")
+    motor_speed: Column = Field(description="the motor's speed (rad/s, rpm)")
+    load: Column | Constant = Field(description="the hinge moment (N·m)")
+
+
+class LinearLogMap(LogMap):
+    """A linear actuator's log: its drive's current and the load besides."""
+
+    kind: Literal["linear"] = Field("linear", description=_KIND_DESCRIPTION)
+    current: Column = Field(description="the drive's current (A, mA)")
+    load: Column | Constant = Field(
+        description="the external force (N, kgf, lbf), positive pushing towards increasing position"
+    )
+
+
+class ServoLogMap(LogMap):
+    """A servo's log: its drive's force on the load, and the load where it has one."""
+
+    kind: Literal["servo"] = Field(description=_KIND_DESCRIPTION)
+    force: Column = Field(description="the drive's force on the load (N; a command with a scale)")
+    load: Column | Constant | None = Field(
+        None,
+        description="the external force (N, kgf, lbf), positive pushing towards increasing position; left out: no load",
+    )
+
+
+def _kind_of(document: Any) -> Any:
+    """The tag ``AnyLogMap`` dispatches on: the map's ``kind`` (a linear rig's where it gives none)."""
+    if isinstance(document, dict):
+        return document.get("kind", DEFAULT_LOG_KIND)
+    return getattr(document, "kind", None)
+
+
+AnyLogMap = Annotated[
+    Annotated[RotaryLogMap, Tag("rotary")]
+    | Annotated[LinearLogMap, Tag("linear")]
+    | Annotated[ServoLogMap, Tag("servo")],
+    Discriminator(
+        _kind_of,
+        custom_error_type=UNKNOWN_TAG,
+        custom_error_message=f"kind: is one of {', '.join(KIND_NAMES)}",
+    ),
+]
+LOG_MAP: TypeAdapter[LogMap] = TypeAdapter(AnyLogMap)  # what parses and exports it
+
+
+def logmap_schema() -> dict[str, Any]:
+    """The JSON Schema of ``ema-logmap/1``: one kind's map, chosen by ``kind``."""
+    return {"title": "LogMap", **LOG_MAP.json_schema(by_alias=True)}
+
 
 def logmap_from_dict(document: Any) -> LogMap:
-    return validated(LogMap, document, "log map")
+    """Parse and validate an ``ema-logmap/1`` document (a dict) as its kind's class; errors name the field."""
+    if not isinstance(document, dict):
+        raise InputError("log map", f"must be a JSON object, got {type(document).__name__}")
+    try:
+        return LOG_MAP.validate_python(document)
+    except ValidationError as exc:
+        raise from_validation(exc, tags=KIND_NAMES) from None
 
 
 def read_logmap(path: str | Path) -> LogMap:
@@ -138,7 +216,7 @@ def read_mapped(path: str | Path, log_map: LogMap) -> dict[str, Any]:
     n = len(table.numeric(log_map.set_point.column, path, "the log map's set_point"))
     signals: dict[str, np.ndarray] = {}
     for name, role in roles.items():
-        part = getattr(log_map, name) if name != "position" else log_map.position
+        part = log_map.part(name)
         if name == "position" and part is None:
             assert log_map.error is not None  # LogMap._complete
             error = _read(table, log_map.error, role, "error", path, n)

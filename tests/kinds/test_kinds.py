@@ -41,17 +41,24 @@ def test_every_kind_of_the_documents_has_its_method():
 
 def test_the_documents_kind_field_lists_every_kind():
     from ema.model.actuator import actuator_schema
-    from ema.model.logmap import LogMap
+    from ema.model.logmap import ROLES, logmap_schema
 
-    assert set(LogMap.model_json_schema()["properties"]["kind"]["enum"]) == set(facts.KINDS)
-    schema = actuator_schema()
-    members = [schema["$defs"][ref["$ref"].rpartition("/")[2]] for ref in schema["oneOf"]]
-    by_kind = {member["properties"]["kind"]["const"]: member for member in members}
-    assert set(by_kind) == set(facts.KINDS)  # one document class per kind, joined on kind
-    for name, member in by_kind.items():
+    def by_kind(schema: dict) -> dict[str, dict]:
+        members = [schema["$defs"][ref["$ref"].rpartition("/")[2]] for ref in schema["oneOf"]]
+        return {member["properties"]["kind"]["const"]: member for member in members}
+
+    actuators, log_maps = by_kind(actuator_schema()), by_kind(logmap_schema())
+    assert set(actuators) == set(log_maps) == set(facts.KINDS)  # one class per kind, joined on kind
+    for name, member in actuators.items():
         section = facts.KINDS[name].section
         assert section in member["required"]  # its own section, and no other kind's
         assert not ({other.section for other in facts.KINDS.values()} - {section}) & set(member["properties"])
+    for name, member in log_maps.items():  # its kind's roles, and no other kind's
+        roles = facts.KINDS[name].roles
+        assert {r for r in ROLES if r in member["properties"]} == {*roles, "error"}
+        assert {r for r in member["required"] if r in ROLES} == {
+            r for r, role in roles.items() if role.required and r != "position"
+        }
 
 
 def test_each_kinds_window_signals_are_its_facts_signals():
