@@ -16,11 +16,11 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any, Literal, TypeVar
 
 import numpy as np
-from pydantic import Discriminator, Field, Tag, TypeAdapter, ValidationError, model_validator
+from pydantic import Field, Tag, TypeAdapter, model_validator
 from pydantic.json_schema import DEFAULT_REF_TEMPLATE
 
 from ema.model.aircraft import HingeGeometry
-from ema.model.checks import UNKNOWN_TAG, InputError, from_validation, read_document
+from ema.model.checks import InputError, read_document, tagged_by, validated
 from ema.model.document import Document, Number
 from ema.model.drive import Drive
 from ema.model.kinds import DEFAULT_KIND, KIND_NAMES, KINDS, KindFacts
@@ -323,23 +323,11 @@ def as_kind(actuator: ActuatorDocument, kind: type[KindDocument]) -> KindDocumen
     return actuator
 
 
-def _kind_of(document: Any) -> Any:
-    """The tag ``AnyActuator`` dispatches on: the document's ``kind`` (a document without one is a rotary
-    actuator's, as first published)."""
-    if isinstance(document, dict):
-        return document.get("kind", DEFAULT_KIND)
-    return getattr(document, "kind", None)
-
-
 AnyActuator = Annotated[
     Annotated[RotaryActuator, Tag("rotary")]
     | Annotated[LinearActuator, Tag("linear")]
     | Annotated[ServoActuator, Tag("servo")],
-    Discriminator(
-        _kind_of,
-        custom_error_type=UNKNOWN_TAG,
-        custom_error_message=f"kind: is one of {', '.join(KIND_NAMES)}",
-    ),
+    tagged_by("kind", KIND_NAMES, DEFAULT_KIND),
 ]  # ``ema-actuator/1`` as read: one kind's document, by its ``kind``
 ACTUATOR_DOCUMENT: TypeAdapter[ActuatorDocument] = TypeAdapter(AnyActuator)  # what parses and exports it
 
@@ -361,12 +349,7 @@ THESIS = _thesis()
 
 def actuator_from_dict(document: Any) -> ActuatorDocument:
     """Parse and validate an ``ema-actuator/1`` document (a dict) as its kind's class; errors name the field."""
-    if not isinstance(document, dict):
-        raise InputError("actuator", f"must be a JSON object, got {type(document).__name__}")
-    try:
-        return ACTUATOR_DOCUMENT.validate_python(document)
-    except ValidationError as exc:
-        raise from_validation(exc, tags=KIND_NAMES) from None
+    return validated(ACTUATOR_DOCUMENT, document, "actuator", tags=KIND_NAMES)
 
 
 def actuator_from_json(text: str | bytes) -> ActuatorDocument:

@@ -9,7 +9,7 @@ from typing import Any, TypeVar
 
 import numpy as np
 import pydantic_core
-from pydantic import BaseModel, ValidationError
+from pydantic import BaseModel, Discriminator, TypeAdapter, ValidationError
 
 
 class InputError(ValueError):
@@ -50,14 +50,16 @@ def read_document(path: str | Path, parse: Callable[[Any], Parsed]) -> Parsed:
         raise InputError(f"{path}: {exc.field}", exc.message) from None
 
 
-def validated(model: type[Model], document: Any, what: str, prefix: str = "", tags: tuple[str, ...] = ()) -> Model:
-    """``document`` (a dict) validated as ``model``; anything else, or a field it refuses, is an InputError naming
-    it (``what``: the document's name where the whole is wrong; ``prefix`` before a field's name: where it came
-    from, ``query.``)."""
+def validated(
+    model: type[Model] | TypeAdapter[Model], document: Any, what: str, prefix: str = "", tags: tuple[str, ...] = ()
+) -> Model:
+    """``document`` (a dict) validated as ``model`` (a class, or a union of documents through its adapter);
+    anything else, or a field it refuses, is an InputError naming it (``what``: the document's name where the whole
+    is wrong; ``prefix`` before a field's name: where it came from, ``query.``; ``tags``: ``from_validation``'s)."""
     if not isinstance(document, dict):
         raise InputError(what, f"must be a JSON object, got {type(document).__name__}")
     try:
-        return model.model_validate(document)
+        return model.validate_python(document) if isinstance(model, TypeAdapter) else model.model_validate(document)
     except ValidationError as exc:
         raise from_validation(exc, prefix, tags) from None
 
@@ -98,6 +100,20 @@ def array_in_range(field: str, values: np.ndarray, low: float, high: float, unit
 
 BOUND_ERRORS = ("greater_than", "greater_than_equal", "less_than", "less_than_equal")  # pydantic's, on a number
 UNKNOWN_TAG = "unknown_tag"  # a tagged union's error where the tag names no member ("kind: is one of ...")
+
+
+def tagged_by(field: str, names: tuple[str, ...], default: str) -> Discriminator:
+    """The discriminator of a union of documents told apart by ``field`` (one of ``names``; ``default`` where a
+    document gives none, as documents first written without it): an unknown value refused naming the field."""
+
+    def tag(document: Any) -> Any:
+        if isinstance(document, dict):
+            return document.get(field, default)
+        return getattr(document, field, None)
+
+    return Discriminator(
+        tag, custom_error_type=UNKNOWN_TAG, custom_error_message=f"{field}: is one of {', '.join(names)}"
+    )
 
 
 def from_validation(exc: Any, prefix: str = "", tags: tuple[str, ...] = ()) -> InputError:

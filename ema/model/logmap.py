@@ -16,9 +16,9 @@ from pathlib import Path
 from typing import Annotated, Any, Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Discriminator, Field, Tag, TypeAdapter, ValidationError, model_validator
+from pydantic import BaseModel, ConfigDict, Field, Tag, TypeAdapter, model_validator
 
-from ema.model.checks import UNKNOWN_TAG, InputError, from_validation, read_document
+from ema.model.checks import InputError, read_document, tagged_by, validated
 from ema.model.document import Number
 from ema.model.kinds import KIND_NAMES, KINDS, Role
 from ema.model.log_files import Table, read_table
@@ -146,22 +146,11 @@ class ServoLogMap(LogMap):
     )
 
 
-def _kind_of(document: Any) -> Any:
-    """The tag ``AnyLogMap`` dispatches on: the map's ``kind`` (a linear rig's where it gives none)."""
-    if isinstance(document, dict):
-        return document.get("kind", DEFAULT_LOG_KIND)
-    return getattr(document, "kind", None)
-
-
 AnyLogMap = Annotated[
     Annotated[RotaryLogMap, Tag("rotary")]
     | Annotated[LinearLogMap, Tag("linear")]
     | Annotated[ServoLogMap, Tag("servo")],
-    Discriminator(
-        _kind_of,
-        custom_error_type=UNKNOWN_TAG,
-        custom_error_message=f"kind: is one of {', '.join(KIND_NAMES)}",
-    ),
+    tagged_by("kind", KIND_NAMES, DEFAULT_LOG_KIND),
 ]
 LOG_MAP: TypeAdapter[LogMap] = TypeAdapter(AnyLogMap)  # what parses and exports it
 
@@ -173,12 +162,7 @@ def logmap_schema() -> dict[str, Any]:
 
 def logmap_from_dict(document: Any) -> LogMap:
     """Parse and validate an ``ema-logmap/1`` document (a dict) as its kind's class; errors name the field."""
-    if not isinstance(document, dict):
-        raise InputError("log map", f"must be a JSON object, got {type(document).__name__}")
-    try:
-        return LOG_MAP.validate_python(document)
-    except ValidationError as exc:
-        raise from_validation(exc, tags=KIND_NAMES) from None
+    return validated(LOG_MAP, document, "log map", tags=KIND_NAMES)
 
 
 def read_logmap(path: str | Path) -> LogMap:

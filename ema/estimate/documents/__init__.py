@@ -9,13 +9,13 @@ from __future__ import annotations
 
 from typing import Any, Literal
 
-from pydantic import Field, computed_field, model_validator
+from pydantic import Field, model_validator
 
-from ema.estimate.config import PipelineConfig
+from ema.estimate.config import EarlierCheckWindows, PipelineConfig
 from ema.estimate.documents.notes import AnyNote, Notes, OptionalNote
 from ema.estimate.documents.notes import Note as Note  # every stage's notes, imported from here
 from ema.estimate.documents.window_facts import WindowInfo
-from ema.model.document import Document, renamed
+from ema.model.document import Document
 
 TARGETS = ("FDJ", "eta_O")  # what the estimators read; η_A follows by Eq. 3.4, FSD from FSJ
 
@@ -148,22 +148,13 @@ class Check(Document):
     notes: Notes = Field(default_factory=list)
 
 
-class DatasetInfo(Document):
+class DatasetInfo(Document, EarlierCheckWindows):
     n_simulations: int
     n_timesteps: int
     inputs: list[str]
     check_simulations: int = Field(description="the held-out simulations that score the estimators")
     noise_estimated: dict[str, float]
     box: dict[str, tuple[float, float]] = Field(description="the FDJ and η_O intervals the simulations were drawn in")
-
-    @model_validator(mode="before")
-    @classmethod
-    def _earlier_names(cls, values: Any) -> Any:
-        return renamed(values, {"check_simulations": "check_windows"})
-
-    @computed_field(description="deprecated alias of check_simulations (ema-estimate/1 as first published)")
-    def check_windows(self) -> int:
-        return self.check_simulations
 
 
 class LearnedInfo(Document):
