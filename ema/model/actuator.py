@@ -146,7 +146,9 @@ class ActuatorDocument(Document):
     @classmethod
     def _its_own_section(cls, values: Any) -> Any:
         """The document's input with its kind's section named where missing, and another kind's refused where given
-        (a null one, as documents were first written, dropped)."""
+        (a null one, as documents were first written, dropped). The shared class alone holds no document."""
+        if cls is ActuatorDocument:
+            raise TypeError("an actuator document is one kind's class: read it with actuator_from_dict")
         if not isinstance(values, dict) or values.get("kind", DEFAULT_KIND) not in KINDS:
             return values
         kind = values.get("kind", DEFAULT_KIND)

@@ -75,7 +75,10 @@ class LogMap(_Part):
     @model_validator(mode="before")
     @classmethod
     def _its_own_roles(cls, values: Any) -> Any:
-        """Another kind's role refused naming it, one of its own missing named (a null role is absent)."""
+        """Another kind's role refused naming it, one of its own missing named (a null role is absent). The shared
+        class alone holds no map."""
+        if cls is LogMap:
+            raise TypeError("a log map is one kind's class: read it with logmap_from_dict")
         if not isinstance(values, dict) or values.get("kind", DEFAULT_LOG_KIND) not in KINDS:
             return values
         kind = values.get("kind", DEFAULT_LOG_KIND)
