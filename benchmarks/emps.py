@@ -142,9 +142,9 @@ def main() -> None:
         "",
         identification_table(learned, base, {e.name: e.value for e in report.as_simulated}),
         "",
-        "*As simulated*: each constant moved by what Eq. 5.1 reads of the log simulated in closed loop at it (the fit "
-        "reads a simulated pre-sliding smaller than it is, through the decimation and filters): the constants the "
-        "completed document keeps, at which an estimate of this log reads its nominal.",
+        "*As simulated*: each constant moved by what Eq. 5.1 reads of the log simulated in closed loop at it (the "
+        "solution reads a simulated pre-sliding smaller than it is, through the decimation and filters): the "
+        "constants the completed document keeps, at which an estimate of this log reads its nominal.",
         "",
         f"`ema calibrate` named {', then '.join(report.selected_effects) or 'nothing'}: "
         + "; ".join(s.reason for s in report.selection_steps if s.selected)
@@ -158,7 +158,17 @@ def main() -> None:
         f"| ema, after ({', '.join(report.selected_effects)}) | {after['drive_force_n']:.2f} % "
         f"| {after['drive_force_n_closed_loop']:.2f} % |",
     ]
-    lines += ["", reading(answer, base), "", recorded_gain_line(window, document, answer)]
+    lines += ["", reading(answer, base), ""]
+    if calibrated.completed is not None:
+        again = estimate(window, actuator=calibrated.completed).model_dump(mode="json")
+        lines += [
+            "What the network reads, beside physics:",
+            "",
+            network_line("with the bundled document", answer),
+            network_line("with the calibrated document", again),
+            "",
+        ]
+    lines += [recorded_gain_line(window, document, answer)]
     if args.held_out is not None:
         held_out_map = args.held_out_map or mapping
         completed = None if calibrated.completed is None else as_kind(calibrated.completed, ServoActuator)
@@ -201,12 +211,22 @@ def reading(answer: dict, base: dict[str, dict]) -> str:
         f"friction holds it and sgn(q̇) reads the encoder's dither); that moves FDJ to {base['FDJ']['value']:.2f} N "
         f"and C to {base['viscous']['value']:.1f} N·s/m. Its std of FDJ, {base['FDJ']['std']:.3f} N, is Newey–West's: "
         f"{base['FDJ']['std'] / PUBLISHED_STD['fdj_n']:.1f}x the least-squares std, which takes the residual for "
-        "white where a reversal's misfit spans many samples. The network learned from the window's own "
-        f"closed-loop runs carries a weight of {max(used.values()):.2f} at most in the answer ({', '.join(notes)}): "
-        "trained on the model's simulations, it reads a trace the symmetric model does not produce, and only "
-        "the physics fit, corrected by its bias on those simulations, answers. The calibrated document's model "
-        "(its effects in the simulations) brings the two closer (`ema estimate` with it)."
+        "white where a reversal's misfit spans many samples. The log holds more than the model (its Eq. 5.1 "
+        f"residual {answer['check']['equation_error_ratio']:.2f}x what the model's noise leaves), so the network "
+        "learns from the window's own closed-loop runs each carrying the window's misfit at a random shift and "
+        f"sign; it carries a weight of {max(used.values()):.2f} at most in the answer ({', '.join(notes)}): its "
+        "held-out errors, misfit included, are no smaller than the physics solution's, which answers, corrected "
+        "by its bias on those simulations."
     )
+
+
+def network_line(name: str, answer: dict) -> str:
+    """What the network reads beside physics on one run, per constant, from this run's figures."""
+    methods = answer["methods"]
+    read = [f"{key} {m['physics']:.4g} / {m['network']:.4g}" for key, m in methods.items() if m["network"] is not None]
+    disagree = [k for k, m in methods.items() if (m.get("network_note") or {}).get("code") == "network_disagrees"]
+    said = f"disagrees on {', '.join(disagree)}" if disagree else "no constant beyond the network's own spread"
+    return f"- {name}: physics / network {'; '.join(read)}: {said}."
 
 
 def _base_model(window: Window, document: ServoActuator) -> dict[str, dict]:

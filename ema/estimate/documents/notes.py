@@ -52,6 +52,7 @@ NoteCode = Literal[
     "network_not_better",
     "physics_only",
     "model_misfit",
+    "misfit_learned",
     "not_reproduced",
     "weakly_determined",
     "eta_o_at_bound",

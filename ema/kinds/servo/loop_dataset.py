@@ -8,12 +8,19 @@ may be near 0) or of itself, filled by a scrambled Halton sequence. Each simulat
 at its own phase of the sensor's step (the quantization a real log carries, drawn anew). The network's inputs
 are the drive's force, averaged into ``n_timesteps`` bins: what a window of this command shows of its
 constants.
+
+Where the window holds more than the model explains (its Eq. 5.1 residual beyond what the model's own noise
+leaves, ``misfit_limit``), the simulations are not the log: a network trained on them alone reads the log's
+unexplained part as a change of its constants. So each simulation then carries the window's own misfit in its
+inputs (``carrying``: the window's bins less those of its simulation at the physics answer), shifted in time and
+signed at random: the network learns the constants beside a disturbance of that size and shape, and its errors
+on the held-out simulations, which carry it too, say what it costs.
 """
 
 from __future__ import annotations
 
 import itertools
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -103,3 +110,21 @@ def simulate_servo_dataset(prepared: ServoPrepared, physics: InverseSolution, co
     inputs = binned(runs.drive_force_n[:, kept], bins)
     window_inputs = binned(s["drive_force_n"][kept], bins)
     return ServoData(targets, low, high, truth, runs, inputs, window_inputs)
+
+
+def window_misfit(prepared: ServoPrepared, physics: InverseSolution, bins: int) -> np.ndarray:
+    """(bins,) what the window's binned force holds beyond its simulation at the physics answer (the sensor read
+    mid-step): the model's miss, with one draw of noise."""
+    kept = prepared.motion.samples
+    centre = prepared.closed_loop(lane_parameters(physics.values, prepared.effects)[None, :], np.array([0.5]))
+    return binned(prepared.window.signals["drive_force_n"][kept], bins) - binned(centre.drive_force_n[:, kept], bins)[0]
+
+
+def carrying(data: ServoData, misfit: np.ndarray, seed: int) -> ServoData:
+    """``data`` with ``misfit`` (bins,) added to every simulation's inputs, each at its own circular shift and sign
+    (drawn from ``seed``): a disturbance of the window's own size and spectrum, at no fixed place."""
+    rng = np.random.default_rng(seed)
+    shifts = rng.integers(0, len(misfit), size=len(data.inputs))
+    signs = rng.choice([-1.0, 1.0], size=len(data.inputs))
+    added = signs[:, None] * np.stack([np.roll(misfit, shift) for shift in shifts])
+    return replace(data, inputs=data.inputs + added)

@@ -16,7 +16,7 @@
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -39,11 +39,12 @@ from ema.kinds.servo.inverse import (
     solve_inverse,
 )
 from ema.kinds.servo.log_reading import ServoPrepared, prepare_servo, refuse_reversed_signs
-from ema.kinds.servo.loop_dataset import ServoData, lane_parameters, simulate_servo_dataset
+from ema.kinds.servo.loop_dataset import ServoData, carrying, lane_parameters, simulate_servo_dataset, window_misfit
 from ema.model.actuator import ServoActuator
 from ema.model.window import Window
 
 SERVO_LEARNING = LearnConfig(max_epochs=60, max_validation_failures=6)  # as the rotary pipeline's (a few dozen runs)
+MISFIT_SEED_OFFSET = 7919  # the misfit's shifts and signs draw from the window's seed plus this: a stream of their own
 CHECK_PHASES = (0.0, 0.5)  # the position sensor's phases of its step the check simulates: the answer's, its twin's
 FDJ = "fdj_n"
 NOMINAL_FIELDS = {  # a constant of the inverse model -> the servo section's field of its nominal value
@@ -95,19 +96,55 @@ def undisturbed(
     return physics_of(prepared, disturbed), note
 
 
+@dataclass(frozen=True)
+class Screened:
+    """What the held-out simulations say of the window before the network learns: their physics solutions
+    (K, T) and residual RMS (K,), the window's physics without the rows a force the log lacks disturbs (a note
+    where it left some out), and its equation error over theirs with the limit past which the model misses it."""
+
+    check_physics: np.ndarray
+    check_rms: np.ndarray
+    physics: InverseSolution
+    disturbed: doc.Note | None
+    ratio: float
+    limit: float
+
+
+def screened(prepared: ServoPrepared, physics: InverseSolution, data: ServoData, n: int) -> Screened:
+    check_physics, check_rms, check_by_row = held_out_physics(prepared, data, n)
+    physics, disturbed = undisturbed(prepared, physics, check_by_row)
+    ratio = physics.residual_rms_n / float(np.median(check_rms))
+    return Screened(check_physics, check_rms, physics, disturbed, ratio, misfit_limit(check_rms))
+
+
+def misfit_carried(
+    prepared: ServoPrepared, data: ServoData, held: Screened, seed: int
+) -> tuple[ServoData, doc.Note | None]:
+    """``data`` as the network learns from it: carrying the window's own misfit where the model misses part of the
+    window (``ema.kinds.servo.loop_dataset``), with a note of its size; else as simulated."""
+    if held.ratio <= held.limit:
+        return data, None
+    misfit = window_misfit(prepared, held.physics, data.inputs.shape[1])
+    share = 100.0 * rms(misfit) / max(rms(data.window_inputs), 1e-300)
+    note = doc.Note(
+        code="misfit_learned",
+        text=f"the network learned its constants beside the window's own misfit ({rms(misfit):.3g} N RMS over "
+        f"{len(misfit)} bins, {share:.1f} % of the force), added to every simulation at a random shift and sign: "
+        "what the model misses of this window costs the network in its held-out errors, not in its answer",
+    )
+    return carrying(data, misfit, seed), note
+
+
 def learned(data: ServoData, config: PipelineConfig) -> NetworkRegressor:
     settings = replace(SERVO_LEARNING, hidden=config.hidden_units, seed=config.seed)
     n = config.n_simulations
     return NetworkRegressor(settings, config.members).fit(data.inputs[:n], data.normalize(data.truth[:n]))
 
 
-def assessed(
-    prepared: ServoPrepared, physics: InverseSolution, data: ServoData, network: NetworkRegressor, n: int
-) -> tuple[Assessed, float, float, InverseSolution]:
-    """The assessed answer, the window's equation error over the held-out simulations' median, its limit, and the
-    physics solution the answer read (without the rows a force the log lacks disturbs; a note says so)."""
-    check_physics, check_rms, check_by_row = held_out_physics(prepared, data, n)
-    physics, disturbed = undisturbed(prepared, physics, check_by_row)
+def assessed(held: Screened, data: ServoData, network: NetworkRegressor, n: int) -> Assessed:
+    """The assessed answer from the physics solution the held-out simulations screened (``held``: without the rows
+    a force the log lacks disturbs; a note says so) and the network."""
+    physics, check_physics = held.physics, held.check_physics
     unit = network.predict_unit(np.vstack([data.inputs[n:], data.window_inputs]))
     values = data.denormalize(unit)
     names = data.targets
@@ -122,12 +159,9 @@ def assessed(
         targets=names,
         physics_std_source="residual",
     )
-    ratio = physics.residual_rms_n / float(np.median(check_rms))
-    limit = misfit_limit(check_rms)
-    answer = assess(candidates, ratio, limit)
-    if disturbed is not None:
-        answer = replace(answer, notes=[disturbed, *answer.notes])
-    return answer, ratio, limit, physics
+    answer = assess(candidates, held.ratio, held.limit)
+    said = [note for note in (held.disturbed, *answer.notes) if note is not None]
+    return replace(answer, notes=said)
 
 
 def _relative_error_pct(measured: np.ndarray, simulated: np.ndarray) -> float:
@@ -268,11 +302,15 @@ def estimate_servo(
     with watch("simulate", f"simulating {config.total_simulations} runs of the window's set point in closed loop"):
         data = simulate_servo_dataset(prepared, physics, config)
     with watch("learn", f"learning {config.members} network(s) of {config.hidden_units} neurons"):
+        held = screened(prepared, physics, data, n)
+        data, carried = misfit_carried(prepared, data, held, config.seed + MISFIT_SEED_OFFSET)
         network = learned(data, config)
     with watch("assess", "weighing the estimators on held-out simulations"):
-        answer, ratio, limit, physics = assessed(prepared, physics, data, network, n)
+        answer, physics = assessed(held, data, network, n), held.physics
+        if carried is not None:
+            answer = replace(answer, notes=[*answer.notes, carried])
     with watch("check", "simulating the window at the answer"):
-        check = closed_loop_check(prepared, answer, ratio, limit)
+        check = closed_loop_check(prepared, answer, held.ratio, held.limit)
     with watch("report", "writing the report"):
         document = _report(
             prepared, physics, data, network, answer, check, actuator=actuator, read_with=read_with, config=config
