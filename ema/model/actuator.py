@@ -20,7 +20,7 @@ from pydantic import Field, Tag, TypeAdapter, model_validator
 from pydantic.json_schema import DEFAULT_REF_TEMPLATE
 
 from ema.model.aircraft import HingeGeometry
-from ema.model.checks import InputError, read_document, tagged_by, validated
+from ema.model.checks import InputError, kind_named, read_document, tagged_by, validated
 from ema.model.document import Document, Number
 from ema.model.drive import Drive
 from ema.model.kinds import DEFAULT_KIND, KIND_NAMES, KINDS, KindFacts
@@ -147,11 +147,9 @@ class ActuatorDocument(Document):
     def _its_own_section(cls, values: Any) -> Any:
         """The document's input with its kind's section named where missing, and another kind's refused where given
         (a null one, as documents were first written, dropped). The shared class alone holds no document."""
-        if cls is ActuatorDocument:
-            raise TypeError("an actuator document is one kind's class: read it with actuator_from_dict")
-        if not isinstance(values, dict) or values.get("kind", DEFAULT_KIND) not in KINDS:
+        kind = kind_named(values, DEFAULT_KIND, KINDS, shared=cls if cls is ActuatorDocument else None)
+        if kind is None:
             return values
-        kind = values.get("kind", DEFAULT_KIND)
         own = KINDS[kind].section
         values = {k: v for k, v in values.items() if v is not None or k == own or k not in SECTIONS}
         for other in SECTIONS:

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Container
 from pathlib import Path
 from typing import Any, TypeVar
 
@@ -100,6 +100,18 @@ def array_in_range(field: str, values: np.ndarray, low: float, high: float, unit
 
 BOUND_ERRORS = ("greater_than", "greater_than_equal", "less_than", "less_than_equal")  # pydantic's, on a number
 UNKNOWN_TAG = "unknown_tag"  # a tagged union's error where the tag names no member ("kind: is one of ...")
+
+
+def kind_named(values: Any, default: str, kinds: Container[str], *, shared: type | None = None) -> str | None:
+    """The kind a document's input names (``default`` where it names none), or None where the input is no object
+    or names no kind of ``kinds`` (the union's discriminator refuses it, naming the field). ``shared``: the class
+    every kind's extends, validated itself: a TypeError, as it holds no document alone."""
+    if shared is not None:
+        raise TypeError(f"{shared.__name__} holds what every kind shares, no document alone: parse through the union")
+    if not isinstance(values, dict):
+        return None
+    kind = values.get("kind", default)
+    return kind if isinstance(kind, str) and kind in kinds else None
 
 
 def tagged_by(field: str, names: tuple[str, ...], default: str) -> Discriminator:

@@ -18,7 +18,7 @@ from typing import Annotated, Any, Literal
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, Tag, TypeAdapter, model_validator
 
-from ema.model.checks import InputError, read_document, tagged_by, validated
+from ema.model.checks import InputError, kind_named, read_document, tagged_by, validated
 from ema.model.document import Number
 from ema.model.kinds import KIND_NAMES, KINDS, Role
 from ema.model.log_files import Table, read_table
@@ -77,11 +77,9 @@ class LogMap(_Part):
     def _its_own_roles(cls, values: Any) -> Any:
         """Another kind's role refused naming it, one of its own missing named (a null role is absent). The shared
         class alone holds no map."""
-        if cls is LogMap:
-            raise TypeError("a log map is one kind's class: read it with logmap_from_dict")
-        if not isinstance(values, dict) or values.get("kind", DEFAULT_LOG_KIND) not in KINDS:
+        kind = kind_named(values, DEFAULT_LOG_KIND, KINDS, shared=cls if cls is LogMap else None)
+        if kind is None:
             return values
-        kind = values.get("kind", DEFAULT_LOG_KIND)
         roles = KINDS[kind].roles
         values = {name: v for name, v in values.items() if v is not None or name not in ROLES}
         for name in ROLES:
