@@ -99,11 +99,10 @@ def undisturbed(
 @dataclass(frozen=True)
 class Screened:
     """What the held-out simulations say of the window before the network learns: their physics solutions
-    (K, T) and residual RMS (K,), the window's physics without the rows a force the log lacks disturbs (a note
-    where it left some out), and its equation error over theirs with the limit past which the model misses it."""
+    (K, T), the window's physics without the rows a force the log lacks disturbs (a note where it left some out),
+    and its equation error over theirs with the limit past which the model misses part of it."""
 
     check_physics: np.ndarray
-    check_rms: np.ndarray
     physics: InverseSolution
     disturbed: doc.Note | None
     ratio: float
@@ -111,10 +110,11 @@ class Screened:
 
 
 def screened(prepared: ServoPrepared, physics: InverseSolution, data: ServoData, n: int) -> Screened:
+    """The window screened by its ``n``-th and later (held-out) simulations (``Screened``)."""
     check_physics, check_rms, check_by_row = held_out_physics(prepared, data, n)
     physics, disturbed = undisturbed(prepared, physics, check_by_row)
     ratio = physics.residual_rms_n / float(np.median(check_rms))
-    return Screened(check_physics, check_rms, physics, disturbed, ratio, misfit_limit(check_rms))
+    return Screened(check_physics, physics, disturbed, ratio, misfit_limit(check_rms))
 
 
 def misfit_carried(
