@@ -82,6 +82,41 @@ def _stroke_plot(runs: list[Run], actuator: LinearActuator) -> ResidualPlot:
     )
 
 
+def _learned_constants(calibrated: CalibratedDrive) -> list[Learned]:
+    """What the healthy runs taught, each with its std and unit: c and I0 always, the nominal FDJ and η_O where
+    two load sizes read them, the run-to-run and healthy-set spreads where the runs showed them."""
+    learned = [
+        Learned(
+            name="current_per_nm",
+            value=calibrated.current_per_nm_a,
+            std=calibrated.current_per_nm_std_a,
+            unit="A/(N·m)",
+        ),
+        Learned(
+            name="current_at_zero_torque",
+            value=calibrated.current_at_zero_torque_a,
+            std=calibrated.current_at_zero_torque_std_a,
+            unit="A",
+        ),
+    ]
+    if (
+        calibrated.fdj_nm is not None
+        and calibrated.fdj_std_nm is not None
+        and calibrated.eta_o is not None
+        and calibrated.eta_o_std is not None
+    ):
+        learned += [
+            Learned(name="FDJ", value=calibrated.fdj_nm, std=calibrated.fdj_std_nm, unit="N·m"),
+            Learned(name="eta_O", value=calibrated.eta_o, std=calibrated.eta_o_std, unit=DIMENSIONLESS),
+        ]
+    if calibrated.spread is not None:
+        learned += [
+            Learned(name="run_to_run", value=calibrated.spread.run_to_run_nm, std=0.0, unit="N·m"),
+            Learned(name="healthy_set", value=calibrated.spread.set_nm, std=0.0, unit="N·m"),
+        ]
+    return learned
+
+
 def _learned(
     runs: list[Run], calibrated: CalibratedDrive, actuator: LinearActuator, started: float
 ) -> CalibrationReport:
@@ -124,36 +159,7 @@ def _learned(
         held=_leave_one_out(runs, actuator),
         started=started,
     )
-    learned = [
-        Learned(
-            name="current_per_nm",
-            value=calibrated.current_per_nm_a,
-            std=calibrated.current_per_nm_std_a,
-            unit="A/(N·m)",
-        ),
-        Learned(
-            name="current_at_zero_torque",
-            value=calibrated.current_at_zero_torque_a,
-            std=calibrated.current_at_zero_torque_std_a,
-            unit="A",
-        ),
-    ]
-    if (
-        calibrated.fdj_nm is not None
-        and calibrated.fdj_std_nm is not None
-        and calibrated.eta_o is not None
-        and calibrated.eta_o_std is not None
-    ):
-        learned += [
-            Learned(name="FDJ", value=calibrated.fdj_nm, std=calibrated.fdj_std_nm, unit="N·m"),
-            Learned(name="eta_O", value=calibrated.eta_o, std=calibrated.eta_o_std, unit=DIMENSIONLESS),
-        ]
-    if calibrated.spread is not None:
-        learned += [
-            Learned(name="run_to_run", value=calibrated.spread.run_to_run_nm, std=0.0, unit="N·m"),
-            Learned(name="healthy_set", value=calibrated.spread.set_nm, std=0.0, unit="N·m"),
-        ]
-    return report.model_copy(update={"drive": drive, "learned": learned})
+    return report.model_copy(update={"drive": drive, "learned": _learned_constants(calibrated)})
 
 
 def completed(actuator: LinearActuator, calibrated: CalibratedDrive) -> LinearActuator:
