@@ -15,9 +15,16 @@ from ema.estimate.documents import Note
 from ema.estimate.quasistatic.stretches import Repeatability, Rest, TorqueReading, logged_motion, set_point_motion
 from ema.model.actuator import ActuatorDocument, LinearActuator
 from ema.model.checks import InputError
+from ema.model.screw import Screw
 from ema.model.window import Window
 
 REST_DEPARTURE = 4.0  # a window's current at rest this many day-to-day spreads off the document's: said
+
+
+def screw_of(actuator: ActuatorDocument) -> Screw | None:
+    """The document's screw, what a stepper's current is read through; None for a kind without one (a rotary
+    actuator's window read quasi-statically)."""
+    return actuator.screw if isinstance(actuator, LinearActuator) else None
 
 
 def motor_torque(actuator: ActuatorDocument, rest: Rest | None) -> tuple[TorqueReading, Note | None]:
@@ -33,7 +40,7 @@ def stepper_torque(actuator: ActuatorDocument, rest: Rest | None) -> tuple[Torqu
     reading at rest scatters by more than its noise from one stop to the next (where the motor comes to rest
     within a step) and tells nothing of its current while it moves, so it only checks the document (a drive
     whose zero-torque current moved: recalibrate)."""
-    screw = actuator.screw if isinstance(actuator, LinearActuator) else None
+    screw = screw_of(actuator)
     if screw is None or screw.current_per_nm_a is None or screw.current_at_zero_torque_a is None:
         raise InputError(
             "actuator.screw.current_per_nm_a",
@@ -72,7 +79,7 @@ class QuasiStaticReading:
 
 def screw_spread(actuator: ActuatorDocument) -> Repeatability:
     """How a screw's healthy runs scattered, as its document learned it."""
-    screw = actuator.screw if isinstance(actuator, LinearActuator) else None
+    screw = screw_of(actuator)
     if screw is None:
         return Repeatability()
     return Repeatability(screw.run_to_run_nm, screw.run_noise_nm or 0.0, screw.repeatability_nm or 0.0)

@@ -28,7 +28,7 @@ from ema.estimate.documents import (
 )
 from ema.estimate.documents.window_facts import WindowInfo
 from ema.estimate.quasistatic.departure import DEPARTURE_Z, departure, inside
-from ema.estimate.quasistatic.drive_torque import QuasiStaticReading
+from ema.estimate.quasistatic.drive_torque import QuasiStaticReading, screw_of
 from ema.estimate.quasistatic.stretches import (
     MIN_STRETCH_S,
     QuasiStaticSolution,
@@ -39,7 +39,7 @@ from ema.estimate.quasistatic.stretches import (
 )
 from ema.estimate.report import weakly_determined
 from ema.estimate.stats import below_zero
-from ema.model.actuator import ActuatorDocument, LinearActuator
+from ema.model.actuator import ActuatorDocument
 from ema.model.bounds import HIGH_RATE_HZ
 from ema.model.checks import InputError
 from ema.model.window import Window
@@ -81,7 +81,7 @@ def estimate_low_rate(
     seconds["prepare"] = time.perf_counter() - started
     announce("solving Eq. 5.1 on the stretches")
     nominal = actuator.health
-    screw = actuator.screw if isinstance(actuator, LinearActuator) else None
+    screw = screw_of(actuator)
     eta_std = (screw.eta_o_std if screw is not None else None) or 0.0
     solution = solve_stretches(
         found,
@@ -188,7 +188,7 @@ def _document(
 def departure_notes(actuator: ActuatorDocument, solution: QuasiStaticSolution, load_nm: np.ndarray) -> list[Note]:
     """Where the window's FDJ departs from the nominal beyond what healthy runs allow (``departure``), either way,
     and where its load (``load_nm`` at the motor) lies outside those the healthy runs were learned at: said."""
-    screw = actuator.screw if isinstance(actuator, LinearActuator) else None
+    screw = screw_of(actuator)
     if screw is None or screw.healthy_set_nm is None:
         return []
     load = float(np.mean(load_nm)) * actuator.gear_ratio
