@@ -24,6 +24,7 @@ import numpy as np
 
 from benchmarks.as_user import run_ema
 from benchmarks.foreign_accuracy import RESULTS_MD
+from ema.calibration.documents import ServoCalibration
 from ema.cli.benchmark_docs import typed_command, write_section
 from ema.estimate import thread_budget
 from ema.estimate.config import PipelineConfig
@@ -126,6 +127,7 @@ def main() -> None:
     stages = answer["timings_s"]
     calibrated = calibrate([window], CalibrationRequest(PipelineConfig(), document))
     report = calibrated.report
+    assert isinstance(report, ServoCalibration), "a servo's calibration answers a servo's report"
     learned = {e.name: e.model_dump() for e in report.learned}
     base = _base_model(window, document)
     before, after = report.model_error_pct_before, report.model_error_pct_after

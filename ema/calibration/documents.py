@@ -1,17 +1,22 @@
 """``ema-calibration/1``: the one definition of a calibration report (``docs/calibration.md``).
 
-The loop returns it, ``POST /v1/calibrate`` declares it, ``ema calibrate`` prints it, the study
-in benchmarks/ reads it; docs/schemas/ema-calibration-1.json is exported from it.
+What every kind's report holds is ``CalibrationReport``; each kind's class adds what only its loop answers
+(``LinearCalibration`` its drive and faulted runs' changes, ``ServoCalibration`` its constants as simulated), and
+``AnyCalibration`` joins them on ``kind``. The loop returns one, ``POST /v1/calibrate`` declares the union,
+``ema calibrate`` prints it, the history stores it, the study in benchmarks/ reads it;
+docs/schemas/ema-calibration-1.json is exported from it.
 """
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import Annotated, Any, Literal
 
-from pydantic import Field
+from pydantic import Field, Tag, TypeAdapter, model_validator
 
 from ema.model.actuator import AnyActuator
+from ema.model.checks import kind_named, tagged_by
 from ema.model.document import Document
+from ema.model.kinds import DEFAULT_KIND, KIND_NAMES
 
 
 class Candidate(Document):
@@ -130,9 +135,11 @@ class HeldOut(Document):
 
 
 class CalibrationReport(Document):
-    """``ema-calibration/1``."""
+    """``ema-calibration/1``: what every kind's report holds. A report is one kind's class (``RotaryCalibration``,
+    ``LinearCalibration``, ``ServoCalibration``), which adds what only that kind's loop answers."""
 
     schema_: Literal["ema-calibration/1"] = Field("ema-calibration/1", alias="schema")
+    kind: str  # each kind's class narrows it to its name
     n_windows: int
     noise_floor: NoiseFloor
     residual_rms_before: dict[str, float]
@@ -156,22 +163,10 @@ class CalibrationReport(Document):
     ambiguity: Ambiguity | None = Field(
         None, description="effects the windows cannot choose between whose estimates differ (null: none)"
     )
-    drive: DriveLearned | None = Field(
-        None, description="a linear actuator's drive as its healthy runs taught it (null: not a learning run)"
-    )
-    changes: list[Change] = Field(
-        default_factory=list, description="a linear actuator's faulted runs against its calibrated nominal"
-    )
     learned: list[Learned] = Field(
         default_factory=list,
         description="what the windows taught that the document lacks, each with its std and unit (a servo's mass, "
         "viscous friction, FDJ and offset, an adopted effect's constants; a stepper's drive)",
-    )
-    as_simulated: list[Learned] = Field(
-        default_factory=list,
-        description="a servo's learned constants as the simulator takes them, what the completed document keeps: "
-        "each moved by what Eq. 5.1 reads of the logs simulated at it (the solution reads a simulated pre-sliding "
-        "smaller than it is); the closed loop's error after is at these",
     )
     model_error_pct_before: dict[str, float] | None = Field(
         None,
@@ -194,3 +189,82 @@ class CalibrationReport(Document):
         "actuator's drive, a servo's load): store it with PUT /v1/actuators/{id} (null: nothing to complete)",
     )
     timings_s: dict[str, float]
+
+    @model_validator(mode="before")
+    @classmethod
+    def _its_own_parts(cls, values: Any) -> Any:
+        """The report's input without another kind's parts where they are empty (as reports were first written,
+        every part in each), refused where they hold anything. The shared class alone holds no report."""
+        kind = kind_named(values, kind_written, KIND_NAMES, shared=cls if cls is CalibrationReport else None)
+        if kind is None:
+            return values
+        own = _PARTS.get(kind, ())
+        others = [part for parts in _PARTS.values() for part in parts if part not in own]
+        for part in others:
+            if values.get(part):
+                raise ValueError(f"{part}: a {kind} actuator's report has no {part} (kind: {kind})")
+        return {k: v for k, v in values.items() if k not in others}
+
+
+_KIND_DESCRIPTION = "the kind of actuator the windows are of (reports first written without it read by their parts)"
+
+
+class RotaryCalibration(CalibrationReport):
+    """A rotary actuator's report: the shared parts only."""
+
+    kind: Literal["rotary"] = Field("rotary", description=_KIND_DESCRIPTION)
+
+
+class LinearCalibration(CalibrationReport):
+    """A linear actuator's report: what its healthy runs taught of its drive, or what its faulted runs changed."""
+
+    kind: Literal["linear"] = Field("linear", description=_KIND_DESCRIPTION)
+    drive: DriveLearned | None = Field(
+        None, description="its drive as its healthy runs taught it (null: not a learning run)"
+    )
+    changes: list[Change] = Field(default_factory=list, description="its faulted runs against its calibrated nominal")
+
+
+class ServoCalibration(CalibrationReport):
+    """A servo's report: its learned constants also as the simulator takes them."""
+
+    kind: Literal["servo"] = Field("servo", description=_KIND_DESCRIPTION)
+    as_simulated: list[Learned] = Field(
+        default_factory=list,
+        description="its learned constants as the simulator takes them, what the completed document keeps: "
+        "each moved by what Eq. 5.1 reads of the logs simulated at it (the solution reads a simulated pre-sliding "
+        "smaller than it is); the closed loop's error after is at these",
+    )
+
+
+_PARTS = {  # each kind's own parts of a report, beside the shared ones
+    report.model_fields["kind"].default: tuple(
+        name for name in report.model_fields if name not in CalibrationReport.model_fields
+    )
+    for report in (RotaryCalibration, LinearCalibration, ServoCalibration)
+}
+
+
+def kind_written(report: dict) -> str:
+    """The kind of a report written before reports named it: the one whose parts it fills, else its completed
+    document's, else the default (a rotary report held none of the parts)."""
+    for kind, parts in _PARTS.items():
+        if any(report.get(part) for part in parts):
+            return kind
+    completed = report.get("completed_actuator")
+    named = completed.get("kind") if isinstance(completed, dict) else None
+    return named if isinstance(named, str) else DEFAULT_KIND
+
+
+AnyCalibration = Annotated[
+    Annotated[RotaryCalibration, Tag("rotary")]
+    | Annotated[LinearCalibration, Tag("linear")]
+    | Annotated[ServoCalibration, Tag("servo")],
+    tagged_by("kind", KIND_NAMES, kind_written),
+]  # ``ema-calibration/1`` as read: one kind's report, by its ``kind``
+CALIBRATION_REPORT: TypeAdapter[CalibrationReport] = TypeAdapter(AnyCalibration)  # what parses and exports it
+
+
+def calibration_schema() -> dict[str, Any]:
+    """The JSON Schema of ``ema-calibration/1``: one kind's report, chosen by ``kind``."""
+    return {"title": "CalibrationReport", **CALIBRATION_REPORT.json_schema(by_alias=True)}

@@ -12,7 +12,7 @@ from pydantic import BaseModel
 def schemas() -> dict[str, dict[str, Any]]:
     """File stem -> the JSON Schema of that document (its model imported here: the CLI's help must not pay for
     them). ``ema-actuator/1`` is one kind's document, chosen by its ``kind`` (``ema.model.actuator.AnyActuator``)."""
-    from ema.calibration.documents import CalibrationReport
+    from ema.calibration.documents import calibration_schema
     from ema.estimate.documents import Estimate
     from ema.model.actuator import actuator_schema
     from ema.model.logmap import logmap_schema
@@ -23,14 +23,18 @@ def schemas() -> dict[str, dict[str, Any]]:
         "stored-actuator": StoredActuator,
         "ema-window-1": WindowDocument,
         "ema-estimate-1": Estimate,
-        "ema-calibration-1": CalibrationReport,
         "history": EstimateHistory,
         "prognosis": Prognosis,
         "actuator-summary": ActuatorSummary,
         "withdrawal": Withdrawal,
     }
     exported = {stem: model.model_json_schema(by_alias=True) for stem, model in models.items()}
-    return {"ema-actuator-1": actuator_schema(), "ema-logmap-1": logmap_schema(), **exported}
+    return {
+        "ema-actuator-1": actuator_schema(),
+        "ema-logmap-1": logmap_schema(),
+        "ema-calibration-1": calibration_schema(),
+        **exported,
+    }
 
 
 def export(folder: Path, check: bool = False) -> list[str]:

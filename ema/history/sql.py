@@ -18,7 +18,7 @@ from typing import Any
 import sqlalchemy as sa
 from pydantic import ValidationError
 
-from ema.calibration.documents import CalibrationReport
+from ema.calibration.documents import CALIBRATION_REPORT, CalibrationReport
 from ema.estimate.documents import Estimate
 from ema.estimate.documents.window_facts import HistoryReadings, InertiaReading, SensorZero
 from ema.history.connection import now
@@ -132,7 +132,7 @@ class SqlHistory(VersionedDocuments):
                 .where(calibrations.c.actuator_id == actuator_id)
                 .order_by(calibrations.c.id.desc())
             ).all()
-        return [(row.stored_at, CalibrationReport.model_validate_json(row.report)) for row in rows]
+        return [(row.stored_at, CALIBRATION_REPORT.validate_json(row.report)) for row in rows]
 
     def actuator_ids(self) -> list[str]:
         """Every actuator with a stored estimate, document or withdrawn window, in name order."""

@@ -102,7 +102,14 @@ BOUND_ERRORS = ("greater_than", "greater_than_equal", "less_than", "less_than_eq
 UNKNOWN_TAG = "unknown_tag"  # a tagged union's error where the tag names no member ("kind: is one of ...")
 
 
-def kind_named(values: Any, default: str, kinds: Container[str], *, shared: type | None = None) -> str | None:
+Unnamed = str | Callable[[dict], str]  # the kind of a document that names none: one, or read from its content
+
+
+def _unnamed(document: dict, default: Unnamed) -> str:
+    return default if isinstance(default, str) else default(document)
+
+
+def kind_named(values: Any, default: Unnamed, kinds: Container[str], *, shared: type | None = None) -> str | None:
     """The kind a document's input names (``default`` where it names none), or None where the input is no object
     or names no kind of ``kinds`` (the union's discriminator refuses it, naming the field). ``shared``: the class
     every kind's extends, validated itself: a TypeError, as it holds no document alone."""
@@ -110,17 +117,17 @@ def kind_named(values: Any, default: str, kinds: Container[str], *, shared: type
         raise TypeError(f"{shared.__name__} holds what every kind shares, no document alone: parse through the union")
     if not isinstance(values, dict):
         return None
-    kind = values.get("kind", default)
+    kind = values["kind"] if "kind" in values else _unnamed(values, default)
     return kind if isinstance(kind, str) and kind in kinds else None
 
 
-def tagged_by(field: str, names: tuple[str, ...], default: str) -> Discriminator:
+def tagged_by(field: str, names: tuple[str, ...], default: Unnamed) -> Discriminator:
     """The discriminator of a union of documents told apart by ``field`` (one of ``names``; ``default`` where a
     document gives none, as documents first written without it): an unknown value refused naming the field."""
 
     def tag(document: Any) -> Any:
         if isinstance(document, dict):
-            return document.get(field, default)
+            return document[field] if field in document else _unnamed(document, default)
         return getattr(document, field, None)
 
     return Discriminator(

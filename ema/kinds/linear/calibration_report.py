@@ -16,11 +16,11 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 
 from ema.calibration.documents import (
-    CalibrationReport,
     Candidate,
     DriveLearned,
     HeldOut,
     Learned,
+    LinearCalibration,
     NoiseFloor,
     Step,
 )
@@ -40,7 +40,7 @@ ANCHOR = (
 
 def calibrate_linear(
     windows: Sequence[Window], actuator: LinearActuator, truth: Mapping[str, float] | None = None
-) -> tuple[CalibrationReport, LinearActuator | None, ResidualPlot]:
+) -> tuple[LinearCalibration, LinearActuator | None, ResidualPlot]:
     """The report, the completed document where the runs taught the drive (None when comparing), and its figure."""
     started = time.perf_counter()
     runs = [read_run(w, actuator) for w in windows]
@@ -119,7 +119,7 @@ def _learned_constants(calibrated: CalibratedDrive) -> list[Learned]:
 
 def _learned(
     runs: list[Run], calibrated: CalibratedDrive, actuator: LinearActuator, started: float
-) -> CalibrationReport:
+) -> LinearCalibration:
     unread = [ANCHOR] + (
         []
         if calibrated.fdj_nm is not None
@@ -228,8 +228,8 @@ def _report(
     held: HeldOut,
     started: float,
     candidates: list[Candidate] | None = None,
-) -> CalibrationReport:
-    return CalibrationReport(
+) -> LinearCalibration:
+    return LinearCalibration(
         n_windows=n,
         noise_floor=NoiseFloor(copies=0, equation_error_ratio=1.0),
         residual_rms_before={"current_a": before_a},

@@ -17,7 +17,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ema.calibration.documents import CalibrationReport, Candidate, Change, HeldOut, NoiseFloor, Step
+from ema.calibration.documents import Candidate, Change, HeldOut, LinearCalibration, NoiseFloor, Step
 from ema.calibration.limits import NAME_Z
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import DIMENSIONLESS, ActuatorRead, Estimate
@@ -163,7 +163,7 @@ def baseline(actuator: LinearActuator) -> tuple[np.ndarray, np.ndarray]:
     return np.array(screw.stroke_profile_a, dtype=float), np.array(screw.stroke_profile_std_a, dtype=float)
 
 
-def compared(windows: Sequence[Window], runs: list[Run], actuator: LinearActuator) -> CalibrationReport:
+def compared(windows: Sequence[Window], runs: list[Run], actuator: LinearActuator) -> LinearCalibration:
     """The runs against the calibrated document (module docstring)."""
     started = time.perf_counter()
     read_with = ActuatorRead(name=actuator.name)
@@ -175,7 +175,7 @@ def compared(windows: Sequence[Window], runs: list[Run], actuator: LinearActuato
     step, candidate = stroke_step(runs, actuator)
     named = step.selected is not None
     fdj = float(np.mean([r.estimates.FDJ.value for r in results]))
-    return CalibrationReport(
+    return LinearCalibration(
         n_windows=len(runs),
         noise_floor=NoiseFloor(copies=0, equation_error_ratio=1.0),
         residual_rms_before={"current_a": 0.0},

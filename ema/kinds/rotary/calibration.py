@@ -27,7 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ema.calibration.documents import CalibrationReport, Step
+from ema.calibration.documents import RotaryCalibration, Step
 from ema.calibration.limits import MAX_EFFECTS
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import TARGETS, Estimate
@@ -188,7 +188,7 @@ class Calibrator:
             found, before, after, bias, held, truth=truth, seconds=time.perf_counter() - started
         )
         stds_after = stds if ambiguity is None else ambiguity.stds_after
-        self.report_: CalibrationReport = report.model_copy(
+        self.report_: RotaryCalibration = report.model_copy(
             update={"stds_before": stds, "stds_after": stds_after, "ambiguity": ambiguity}
         )
         return self

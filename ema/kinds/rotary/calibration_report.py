@@ -7,7 +7,7 @@ from dataclasses import asdict, dataclass, replace
 
 import numpy as np
 
-from ema.calibration.documents import CalibrationReport, Candidate, HeldOut, NoiseFloor, Step, Unexplained
+from ema.calibration.documents import Candidate, HeldOut, NoiseFloor, RotaryCalibration, Step, Unexplained
 from ema.estimate.documents import TARGETS
 from ema.estimate.physics.eta_search import ETA_O_SEARCH
 from ema.kinds.rotary.backlash import BacklashReading
@@ -182,14 +182,14 @@ def assemble(
     *,
     truth: Mapping[str, float] | None,
     seconds: float,
-) -> CalibrationReport:
+) -> RotaryCalibration:
     floor = floor_rms(found.copies)
     effects = adopted_effects(found)
     names = [c.family.name for c in found.chosen] + (["backlash"] if found.backlash.significant else [])
     first = next((e for e in found.evidence if found.chosen and e.family.name == found.chosen[0].family.name), None)
     errors_before, pct_before = _errors(before, truth)
     errors_after, pct_after = _errors(after, truth)
-    return CalibrationReport(
+    return RotaryCalibration(
         n_windows=int(found.measured.window.max()) + 1,
         noise_floor=NoiseFloor(copies=len(found.copies), equation_error_ratio=residual_rms(found.measured, []) / floor),
         residual_rms_before={"residual_torque": residual_rms(found.measured, [])},

@@ -33,11 +33,11 @@ from dataclasses import replace
 import numpy as np
 
 from ema.calibration.documents import (
-    CalibrationReport,
     Candidate,
     HeldOut,
     Learned,
     NoiseFloor,
+    ServoCalibration,
     Step,
 )
 from ema.calibration.limits import MAX_EFFECTS
@@ -227,7 +227,7 @@ def _own_controller(prepared: ServoPrepared) -> ServoPrepared:
 
 def calibrate_servo(
     windows: Sequence[Window], actuator: ServoActuator
-) -> tuple[CalibrationReport, ServoActuator, ResidualPlot]:
+) -> tuple[ServoCalibration, ServoActuator, ResidualPlot]:
     """The report (module docstring), the document completed with what the windows taught, and the figure."""
     started = time.perf_counter()
     prepared = [_own_controller(prepare_servo(w, actuator)) for w in windows]
@@ -253,7 +253,7 @@ def calibrate_servo(
     after = solved(problem(prepared, model))
     adopted = [name for name in model if name not in base_model]
     simulated, closed = _as_simulated(prepared, (base, base_model), (after, model))
-    report = CalibrationReport(
+    report = ServoCalibration(
         n_windows=len(windows),
         noise_floor=NoiseFloor(copies=COPIES, equation_error_ratio=ratio),
         residual_rms_before={"drive_force_n": rms(base.residual)},

@@ -4,7 +4,7 @@ from fastapi import APIRouter, Request
 from starlette.concurrency import run_in_threadpool
 
 from ema import kinds
-from ema.calibration.documents import CalibrationReport
+from ema.calibration.documents import AnyCalibration, CalibrationReport
 from ema.model.window import Window
 from ema.service.deps import RunnerDep, SettingsDep, StoreDep, actuator_of, stopper, stored_kind
 from ema.service.parsing import check_calibration_budget, read_body
@@ -20,7 +20,7 @@ def _windows_and_truth(body: CalibrateIn) -> tuple[list[Window], dict[str, float
 
 @router.post(
     "/calibrate",
-    response_model=CalibrationReport,
+    response_model=AnyCalibration,
     response_model_by_alias=True,
     responses=responses(401, 413, 422, 503),
     openapi_extra=json_body(CalibrateIn, "windows of one actuator, and their truth if synthetic"),
