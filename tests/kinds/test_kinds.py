@@ -161,3 +161,24 @@ def test_a_warmed_process_loads_nothing_new_for_the_first_window_of_any_kind():
     emps = str(PACKAGE.parent / "examples" / "emps")
     done = subprocess.run([sys.executable, "-c", probe, emps], capture_output=True, text=True, check=True)
     assert done.stderr.splitlines()[-1] == "[] True"
+
+
+def test_the_shared_method_names_no_kinds_document_class():
+    """The estimate's and the calibration's shared modules take the document every kind's class extends: a kind's
+    own class, and its section read through it, are its folder's (a quasi-static reading hands its own in)."""
+    from ema.model.actuator import ActuatorDocument
+
+    own = {cls.__name__ for cls in ActuatorDocument.__subclasses__()}
+    sections = {kind.section for kind in facts.KINDS.values()}
+    found = []
+    for folder in ("estimate", "calibration"):
+        for path in (PACKAGE / folder).rglob("*.py"):
+            tree = ast.parse(path.read_text())
+            names = {n.id for n in ast.walk(tree) if isinstance(n, ast.Name)}
+            names |= {alias.name for n in ast.walk(tree) if isinstance(n, ast.ImportFrom) for alias in n.names}
+            reads = {  # a section read off a document (``actuator.screw``), not any attribute of that name
+                n.attr for n in ast.walk(tree) if isinstance(n, ast.Attribute) and "actuator" in ast.unparse(n.value)
+            }
+            if names & own or reads & sections:
+                found.append(f"{path.relative_to(PACKAGE.parent)}: {sorted(names & own | reads & sections)}")
+    assert own and found == []

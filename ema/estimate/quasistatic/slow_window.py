@@ -28,7 +28,7 @@ from ema.estimate.documents import (
 )
 from ema.estimate.documents.window_facts import WindowInfo
 from ema.estimate.quasistatic.departure import DEPARTURE_Z, departure, inside
-from ema.estimate.quasistatic.drive_torque import QuasiStaticReading, screw_of
+from ema.estimate.quasistatic.drive_torque import HealthyRuns, QuasiStaticReading
 from ema.estimate.quasistatic.stretches import (
     MIN_STRETCH_S,
     QuasiStaticSolution,
@@ -80,9 +80,8 @@ def estimate_low_rate(
     torque, rest_note = reading.torque(actuator, rest)
     seconds["prepare"] = time.perf_counter() - started
     announce("solving Eq. 5.1 on the stretches")
-    nominal = actuator.health
-    screw = screw_of(actuator)
-    eta_std = (screw.eta_o_std if screw is not None else None) or 0.0
+    nominal, healthy = actuator.health, reading.healthy(actuator)
+    eta_std = healthy.eta_o_std if healthy is not None else 0.0
     solution = solve_stretches(
         found,
         torque,
@@ -100,10 +99,8 @@ def estimate_low_rate(
     seconds["physics"] = time.perf_counter() - started - seconds["prepare"]
     announce("writing the report")
     document = _document(window, actuator, solution, found, torque, digest=digest, read_with=read_with, config=config)
-    notes = [
-        n for n in (rest_note, *_notes(window, actuator, solution, torque), *departure_notes(actuator, solution, load))
-    ]
-    notes = [n for n in notes if n is not None]
+    said = (rest_note, *_notes(window, actuator, solution, torque), *departure_notes(actuator, solution, load, healthy))
+    notes = [n for n in said if n is not None]
     seconds["report"] = time.perf_counter() - started - seconds["prepare"] - seconds["physics"]
     return document.model_copy(
         update={"notes": [*document.notes, *notes], "timings_s": Timings(**seconds, total=sum(seconds.values()))}
@@ -185,11 +182,12 @@ def _document(
     )
 
 
-def departure_notes(actuator: ActuatorDocument, solution: QuasiStaticSolution, load_nm: np.ndarray) -> list[Note]:
+def departure_notes(
+    actuator: ActuatorDocument, solution: QuasiStaticSolution, load_nm: np.ndarray, healthy: HealthyRuns | None
+) -> list[Note]:
     """Where the window's FDJ departs from the nominal beyond what healthy runs allow (``departure``), either way,
     and where its load (``load_nm`` at the motor) lies outside those the healthy runs were learned at: said."""
-    screw = screw_of(actuator)
-    if screw is None or screw.healthy_set_nm is None:
+    if healthy is None or healthy.healthy_set_nm is None:
         return []
     load = float(np.mean(load_nm)) * actuator.gear_ratio
     shared = float(np.sqrt(max(solution.fdj_std_nm**2 - solution.fdj_repeatability_std_nm**2, 0.0)))
@@ -198,12 +196,12 @@ def departure_notes(actuator: ActuatorDocument, solution: QuasiStaticSolution, l
         actuator.health.fdj,
         repeatability_std=solution.fdj_repeatability_std_nm,
         shared_std=shared,
-        healthy_set=screw.healthy_set_nm,
-        extrapolated=not inside(load, screw.calibrated_loads_n),
+        healthy_set=healthy.healthy_set_nm,
+        extrapolated=not inside(load, healthy.loads_n),
     )
     notes = []
     if seen.extrapolated:
-        learned = ", ".join(f"{n:.0f}" for n in screw.calibrated_loads_n or [])
+        learned = ", ".join(f"{n:.0f}" for n in healthy.loads_n or [])
         notes.append(
             Note(
                 code="load_extrapolated",
@@ -214,7 +212,7 @@ def departure_notes(actuator: ActuatorDocument, solution: QuasiStaticSolution, l
             )
         )
     if seen.departed:
-        way = FELL if seen.change < 0 else ROSE
+        way = healthy.fell if seen.change < 0 else healthy.rose
         notes.append(
             Note(
                 code="fdj_departed",
@@ -224,10 +222,6 @@ def departure_notes(actuator: ActuatorDocument, solution: QuasiStaticSolution, l
             )
         )
     return notes
-
-
-FELL = "friction lost (a ball screw losing its preload: a spalled track, smaller balls)"
-ROSE = "friction gained (grease lost, a seal tightened, a track roughened)"
 
 
 def _notes(

@@ -12,10 +12,10 @@ from dataclasses import dataclass
 
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import Estimate
-from ema.estimate.quasistatic.drive_torque import STEPPER_READING
 from ema.estimate.quasistatic.slow_window import QUASI_STATIC_STAGES
 from ema.kinds.base import Calibrated, CalibrationRequest, Cost, Request, read_quasi_statically
 from ema.kinds.linear.calibration_report import calibrate_linear
+from ema.kinds.linear.slow_reading import STEPPER_READING
 from ema.model.actuator import LinearActuator, as_kind
 from ema.model.kinds import KINDS, KindFacts
 from ema.model.window import Window

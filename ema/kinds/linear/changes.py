@@ -22,10 +22,10 @@ from ema.calibration.limits import NAME_Z
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import DIMENSIONLESS, ActuatorRead, Estimate
 from ema.estimate.quasistatic.departure import DEPARTURE_Z, Departure, departure, inside
-from ema.estimate.quasistatic.drive_torque import STEPPER_READING
-from ema.estimate.quasistatic.slow_window import FELL, ROSE, estimate_low_rate
+from ema.estimate.quasistatic.slow_window import estimate_low_rate
 from ema.estimate.quasistatic.stretches import solve_stretches
 from ema.kinds.linear.drive_calibration import Run, profile_change, run_load_n
+from ema.kinds.linear.slow_reading import FELL, ROSE, STEPPER_READING
 from ema.model.actuator import LinearActuator
 from ema.model.window import Window
 

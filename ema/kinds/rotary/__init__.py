@@ -19,9 +19,9 @@ import numpy as np
 from ema.calibration.plot import ResidualPlot, Series
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import STAGES, Estimate
-from ema.estimate.quasistatic.drive_torque import MOTOR_READING
 from ema.estimate.quasistatic.slow_window import QUASI_STATIC_STAGES
 from ema.kinds.base import WARM_UP, Calibrated, CalibrationRequest, Cost, Request, read_quasi_statically
+from ema.kinds.rotary.slow_reading import MOTOR_READING
 from ema.kinds.rotary.synthetic import synthetic_window
 from ema.model.actuator import THESIS
 from ema.model.bounds import HIGH_RATE_HZ
