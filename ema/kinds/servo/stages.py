@@ -5,8 +5,10 @@
 2. **physics** (``ema.kinds.servo.inverse``): Eq. 5.1 in the load frame, F = M·q̈ + FDJ·sgn(q̇) + C·q̇ +
    F_offset, by least squares, Newey–West stds;
 3. **simulate** (``ema.kinds.servo.loop_dataset``): the window's own set point run in closed loop, its controller
-   at its rate, at constants drawn around the physics estimate;
-4. **learn**: the shallow network from the simulated force to the constants;
+   at its rate, at constants drawn around the physics estimate; the held-out runs read by physics, which screens
+   the window (its equation error against theirs, the rows a force the log lacks disturbs);
+4. **learn**: the shallow network from the simulated force to the constants (the training runs carrying the
+   window's misfit where the screen says the model misses part of it);
 5. **assess** (``ema.estimate.assess.weighing``): both estimators on held-out simulations, blended per
    constant, the window's equation error against the simulations';
 6. **check**: the window simulated in closed loop at the answer, its force and position against the log's;
@@ -301,8 +303,8 @@ def estimate_servo(
         refuse_reversed_signs(physics.values, physics.stds)
     with watch("simulate", f"simulating {config.total_simulations} runs of the window's set point in closed loop"):
         data = simulate_servo_dataset(prepared, physics, config)
-    with watch("learn", f"learning {config.members} network(s) of {config.hidden_units} neurons"):
         held = screened(prepared, physics, data, n)
+    with watch("learn", f"learning {config.members} network(s) of {config.hidden_units} neurons"):
         data, carried = misfit_carried(prepared, data, held, config.seed + MISFIT_SEED_OFFSET)
         network = learned(data, config)
     with watch("assess", "weighing the estimators on held-out simulations"):
