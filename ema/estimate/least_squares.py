@@ -39,10 +39,18 @@ def ridge_solved(gram: np.ndarray, rhs: np.ndarray, ridge: float) -> np.ndarray:
     tells from another solvable without moving a column the samples do tell."""
     if gram.ndim == 2:
         scale = np.maximum(np.diag(gram), 1e-300)
-        return np.linalg.solve(gram + ridge * np.diag(scale), rhs)
+        return _solved(gram + ridge * np.diag(scale), rhs)
     scale = np.maximum(np.einsum("gkk->gk", gram), 1e-300)
     regularized = gram + ridge * scale[:, :, None] * np.eye(gram.shape[1])[None]
-    return np.linalg.solve(regularized, rhs[..., None])[..., 0]
+    return _solved(regularized, rhs[..., None])[..., 0]
+
+
+def _solved(gram: np.ndarray, rhs: np.ndarray) -> np.ndarray:
+    """G⁻¹b; where G is singular (a column no row holds, with no ridge), the minimum-norm solution instead."""
+    try:
+        return np.linalg.solve(gram, rhs)
+    except np.linalg.LinAlgError:
+        return np.linalg.pinv(gram) @ rhs
 
 
 def newey_west_lags(n: int) -> int:

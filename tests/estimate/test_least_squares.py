@@ -62,3 +62,16 @@ def test_the_newey_west_std_covers_a_slopes_spread_under_correlated_noise():
     spread = float(np.std(slopes))
     assert np.mean(stds) == pytest.approx(spread, rel=0.25)  # the sandwich with lags sees the correlation
     assert np.mean(white) < 0.6 * spread  # without lags it does not
+
+
+def test_without_a_ridge_a_column_no_row_holds_gets_no_share():
+    """A fold without one direction of motion leaves that direction's column zero: the others are read as without
+    it, and it gets the minimum-norm share, 0, not an error."""
+    rng = np.random.default_rng(4)
+    x = _design(rng)
+    y = x @ np.array([1.0, 2.0, 3.0])
+    empty = np.column_stack([x, np.zeros(len(x))])
+    solved = ridge_solved(empty.T @ empty, empty.T @ y, 0.0)
+    assert solved == pytest.approx([1.0, 2.0, 3.0, 0.0], abs=1e-9)
+    stacked = ridge_solved(np.stack([empty.T @ empty] * 2), np.stack([empty.T @ y] * 2), 0.0)
+    assert stacked == pytest.approx(np.stack([solved, solved]), abs=1e-9)

@@ -15,7 +15,7 @@ from ema.estimate.documents import Estimate
 from ema.estimate.quasistatic.slow_window import QUASI_STATIC_STAGES
 from ema.kinds.base import Calibrated, CalibrationRequest, Cost, Request, read_quasi_statically
 from ema.kinds.linear.calibration_report import calibrate_linear
-from ema.kinds.linear.slow_reading import STEPPER_READING
+from ema.kinds.linear.stepper_reading import STEPPER_READING
 from ema.model.actuator import LinearActuator, as_kind
 from ema.model.kinds import KINDS, KindFacts
 from ema.model.window import Window

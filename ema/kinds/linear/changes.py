@@ -25,7 +25,7 @@ from ema.estimate.quasistatic.departure import DEPARTURE_Z, Departure, departure
 from ema.estimate.quasistatic.slow_window import estimate_low_rate
 from ema.estimate.quasistatic.stretches import solve_stretches
 from ema.kinds.linear.drive_calibration import Run, profile_change, run_load_n
-from ema.kinds.linear.slow_reading import FELL, ROSE, STEPPER_READING
+from ema.kinds.linear.stepper_reading import FELL, ROSE, STEPPER_READING
 from ema.model.actuator import LinearActuator
 from ema.model.window import Window
 

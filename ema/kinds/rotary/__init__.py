@@ -21,7 +21,7 @@ from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import STAGES, Estimate
 from ema.estimate.quasistatic.slow_window import QUASI_STATIC_STAGES
 from ema.kinds.base import WARM_UP, Calibrated, CalibrationRequest, Cost, Request, read_quasi_statically
-from ema.kinds.rotary.slow_reading import MOTOR_READING
+from ema.kinds.rotary.motor_reading import MOTOR_READING
 from ema.kinds.rotary.synthetic import synthetic_window
 from ema.model.actuator import THESIS
 from ema.model.bounds import HIGH_RATE_HZ
@@ -99,7 +99,7 @@ class Rotary:
 
 def residual_plot(calibrator: Calibrator) -> ResidualPlot:
     """The equation-error residual before and after, against the variable that explains it."""
-    from ema.kinds.rotary.fold_scores import score
+    from ema.calibration.held_out import score
     from ema.kinds.rotary.selection import problem
 
     e, report, chosen = calibrator.measured_, calibrator.report_, calibrator.chosen_

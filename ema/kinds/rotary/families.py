@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 
 from ema.kinds.rotary.equations import Equations
-from ema.kinds.rotary.fold_scores import hats, uniform_knots
+from ema.kinds.rotary.hats import hats, uniform_knots
 from ema.model.effects import EffectSet, FrictionTable
 
 KNOTS = 9  # piecewise-linear curves: 8 segments over the visited range

@@ -1,7 +1,7 @@
 """Stage 4, selection: which family explains held-out samples beyond the noise floor, and may it be named.
 
 For each family (``ema.kinds.rotary.families``) the statistic is the drop of held-out residual
-(``ema.kinds.rotary.fold_scores``), as a fraction of the base model's: on the measured windows, and on
+(``ema.calibration.held_out``), as a fraction of the base model's: on the measured windows, and on
 every noise copy (``ema.kinds.rotary.noise_floor``), where a family with a grid takes its best grid
 value on each copy as it does on the data (the look-elsewhere freedom is in the floor). Its
 evidence is z = (measured − mean of copies) / std of copies.
@@ -24,10 +24,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ema.calibration.held_out import Scored, score, score_grid, score_offsets
 from ema.calibration.limits import NAME_Z
 from ema.kinds.rotary.equations import Equations
 from ema.kinds.rotary.families import Family, Grid
-from ema.kinds.rotary.fold_scores import Scored, score, score_grid, score_offsets
 from ema.model import runtime
 
 # A floor under the copies' std: a family whose grid holds "no effect" (a gain of 1) drops exactly

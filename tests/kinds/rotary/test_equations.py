@@ -44,7 +44,7 @@ def test_the_tied_base_holds_eq_3_4_near_the_windows_efficiency(gear_ratio, eta_
     sits, reproduces it with k_opp as its load coefficient."""
     from dataclasses import replace
 
-    from ema.kinds.rotary.fold_scores import score
+    from ema.calibration.held_out import score
     from ema.model.params import load_factors
 
     rng = np.random.default_rng(7)
