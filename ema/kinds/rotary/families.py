@@ -44,7 +44,7 @@ class Family:
     # answers the friction itself, so a curve over it mimics any large effect and may not block a name.
     exogenous: bool = True
     stacked: Callable[[Equations], np.ndarray] | None = None  # (m, G, c): every grid value's columns at once
-    # For the tied refit (``ema.kinds.rotary.tied_solve``): columns of the base replaced (a hinge-moment bias
+    # For the tied solve (``ema.kinds.rotary.tied_solve``): columns of the base replaced (a hinge-moment bias
     # moves the load a and o are built from, and their coefficients stay k_aid and k_opp), and how
     # many of ``columns`` are left as free terms (the others are that replacement's first order).
     base_shift: Callable[[Equations, Grid], np.ndarray] | None = None

@@ -214,8 +214,8 @@ def loops_own(values: np.ndarray) -> np.ndarray:
 
 
 def trimmed_loop(servo: Servo, window: Window) -> LoopGains | None:
-    """The gains most of the logged command follows: ``log_loop`` refitted ``TRIMMED_SOLVES`` times, each without the
-    samples the last solution's gains leave beyond ``ADDED_MADS`` robust stds (an added command's)."""
+    """The gains most of the logged command follows: ``log_loop`` solved ``TRIMMED_SOLVES`` times more, each without
+    the samples the last solution's gains leave beyond ``ADDED_MADS`` robust stds (an added command's)."""
     gains = log_loop(servo, window)
     for _ in range(TRIMMED_SOLVES - 1):
         if gains is None:

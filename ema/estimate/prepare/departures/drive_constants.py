@@ -14,7 +14,7 @@ moment's term, and the noise the two columns share with the target would read on
 stand out alone, the likelihood ratio of the two readings decides if it can (``DECISIVE``); where it
 cannot (a heavier rotor in a window where the motor saturates as it accelerates, which a weaker
 motor explains as well), γ is read and the stds carry what ΔJ would change (``UNDECIDED_SHARE``).
-The current carries γ (I' = (1 + γ)·I, refitted up to ``ITERATIONS`` times, as the motor's peak
+The current carries γ (I' = (1 + γ)·I, solved again up to ``ITERATIONS`` times, as the motor's peak
 torque cuts k_T·I), the window's actuator carries ΔJ; FDJ's and η_O's stds grow by what each
 constant's std moves them.
 
@@ -40,8 +40,8 @@ from ema.model.checks import InputError
 from ema.model.params import DriveConstants
 from ema.model.window import Window
 
-ITERATIONS = 3  # refits of the corrected window at most: each settles what the peak torque's cut left
-SETTLED = 0.01  # of the constant's std: what a refit may leave
+ITERATIONS = 3  # solves of the corrected window at most: each settles what the peak torque's cut left
+SETTLED = 0.01  # of the constant's std: what a solve may leave
 BESIDE = SolveSettings(offset=True, viscous=True)  # what each constant is solved beside
 FIELDS = {"torque_scale": "torque_scale", "inertia": "inertia_kgm2"}  # the solution's nuisance -> the field it reads
 # Beyond these no drive runs (γ: k_T from −55 to 125 °C and a sensor's gain; ΔJ: of J_M): a read past them
@@ -198,7 +198,7 @@ def _stands_out(plain: FrictionSolution, alone: FrictionSolution, name: str, rat
 def _reading(
     window: Window, drive: DriveConstants, name: str, first: FrictionSolution
 ) -> tuple[DriveReading, FrictionSolution]:
-    """Constant ``name``, refitted on the corrected window until nothing is left, its std ΔJ's with the
+    """Constant ``name``, solved again on the corrected window until nothing is left, its std ΔJ's with the
     kernel's (``kernel_inertia_std``); and the last solution (its likelihood)."""
     settings, std = replace(BESIDE, **{name: True}), float(first.term_std(name)[0])
     kernel = kernel_inertia_std(window.sample_rate_hz, drive) if name == "inertia" else 0.0

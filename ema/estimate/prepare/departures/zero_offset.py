@@ -10,7 +10,7 @@ without (the likelihood ratio of their equation errors, ``equation_z``). The off
 std is no test: where one direction's samples gather in a few time blocks, leaving those out leaves
 c unread. Which sensor is off matters: a hinge moment off by b also shifts |T_ext|, whose k·|T_ext|
 term then moves FDJ by about k·b/n. The two readings differ only where |T_ext| comes near zero or
-varies, so both are made: the current corrected by i₀, or the hinge moment by b, each refitted until
+varies, so both are made: the current corrected by i₀, or the hinge moment by b, each solved again until
 no constant is left (|H − b| is not linear in b, and k_T·I is cut at the motor's peak torque). Their
 likelihoods (the equation errors' RSS, over about one independent value per reconstruction kernel)
 weigh them; the window is corrected by the weighted mix, which puts the answer between the readings,
@@ -46,8 +46,8 @@ HOLDS_Z = 3.0
 # being on zero, and its std carries the offset a Hall sensor keeps after its power-up zeroing (~0.2 % of
 # the thesis drive's 22.5 A).
 UNSEEN_CURRENT_OFFSET_A = 0.05
-# Refits of a sensor's offset: the hinge moment's moves |H − b| (each refit cuts what is left by ~k), the
-# current's is lost where k_T·I meets the motor's peak torque (worn windows saturate more, and need more refits).
+# Solves of a sensor's offset: the hinge moment's moves |H − b| (each solve cuts what is left by ~k), the
+# current's is lost where k_T·I meets the motor's peak torque (worn windows saturate more, and need more solves).
 OFFSET_ITERATIONS = 4
 OFFSET_SOLVE = SolveSettings(offset=True)
 
@@ -85,7 +85,7 @@ def sensor_offset(
     signals: dict[str, np.ndarray], rate: float, torque_nm: float, sensor: str, drive: DriveConstants
 ) -> float:
     """The offset of ``sensor`` (``hinge_nm`` or ``current_a``) that leaves no constant in T_R: from the
-    shaft's c in the sensor's unit, refitted as the reading moves (``OFFSET_ITERATIONS``)."""
+    shaft's c in the sensor's unit, solved again as the reading moves (``OFFSET_ITERATIONS``)."""
     per_nm = drive.gear_ratio if sensor == "hinge_nm" else 1.0 / drive.torque_constant_nm_per_a
     offset = per_nm * torque_nm
     for _ in range(OFFSET_ITERATIONS):
