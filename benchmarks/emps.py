@@ -114,34 +114,12 @@ def errors_on(window: Window, document: ServoActuator, completed: ServoActuator)
     }
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--held-out", type=Path, help="the benchmark's validation run (a .mat)")
-    parser.add_argument("--held-out-map", type=Path, help="its log map")
-    parser.add_argument("--docs", action="store_true", help="rewrite the section of docs/results.md")
-    args = parser.parse_args()
-    thread_budget.configure(None)
-    mapping, document_path = EMPS / "log-map.json", EMPS / "actuator.json"
-    window, document = read(EMPS / "DATA_EMPS.mat", mapping), as_kind(read_actuator(document_path), ServoActuator)
-    wall, answer = cli_seconds(EMPS / "DATA_EMPS.mat", mapping, document_path)
-    stages = answer["timings_s"]
-    calibrated = calibrate([window], CalibrationRequest(PipelineConfig(), document))
-    report = calibrated.report
-    assert isinstance(report, ServoCalibration), "a servo's calibration answers a servo's report"
+def calibration_lines(report: ServoCalibration, base: dict[str, dict]) -> list[str]:
+    """What ``ema calibrate`` learned of the log and named in it, and the model's errors before and after."""
     learned = {e.name: e.model_dump() for e in report.learned}
-    base = _base_model(window, document)
     before, after = report.model_error_pct_before, report.model_error_pct_after
     assert before is not None and after is not None, "a servo's calibration reports its model error"
-    lines = [
-        CITATION,
-        "",
-        f"`ema estimate` on the {window.duration_s:.1f} s log, as typed (one process, 2 cores): {wall:.1f} s wall; "
-        "stages " + ", ".join(f"{stage} {stages[stage]:.2f} s" for stage in STAGES) + ".",
-        f"It reads FDJ {answer['estimates']['FDJ']['value']:.3f} ± {answer['estimates']['FDJ']['std']:.3f} N; the "
-        f"closed loop at its answer follows the logged force within "
-        f"{answer['check']['output_error_pct']['drive_force_n']:.2f} % (the benchmark's Simulink model at its "
-        "constants: 5.85 %).",
-        "",
+    return [
         identification_table(learned, base, {e.name: e.value for e in report.as_simulated}),
         "",
         "*As simulated*: each constant moved by what Eq. 5.1 reads of the log simulated in closed loop at it (the "
@@ -159,6 +137,36 @@ def main() -> None:
         f"{before['drive_force_n_closed_loop']:.2f} % |",
         f"| ema, after ({', '.join(report.selected_effects)}) | {after['drive_force_n']:.2f} % "
         f"| {after['drive_force_n_closed_loop']:.2f} % |",
+    ]
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--held-out", type=Path, help="the benchmark's validation run (a .mat)")
+    parser.add_argument("--held-out-map", type=Path, help="its log map")
+    parser.add_argument("--docs", action="store_true", help="rewrite the section of docs/results.md")
+    args = parser.parse_args()
+    thread_budget.configure(None)
+    mapping, document_path = EMPS / "log-map.json", EMPS / "actuator.json"
+    window, document = read(EMPS / "DATA_EMPS.mat", mapping), as_kind(read_actuator(document_path), ServoActuator)
+    wall, answer = cli_seconds(EMPS / "DATA_EMPS.mat", mapping, document_path)
+    stages = answer["timings_s"]
+    calibrated = calibrate([window], CalibrationRequest(PipelineConfig(), document))
+    report = calibrated.report
+    assert isinstance(report, ServoCalibration), "a servo's calibration answers a servo's report"
+    base = _base_model(window, document)
+    lines = [
+        CITATION,
+        "",
+        f"`ema estimate` on the {window.duration_s:.1f} s log, as typed (one process, 2 cores): {wall:.1f} s wall; "
+        "stages " + ", ".join(f"{stage} {stages[stage]:.2f} s" for stage in STAGES) + ".",
+        f"It reads FDJ {answer['estimates']['FDJ']['value']:.3f} ± {answer['estimates']['FDJ']['std']:.3f} N; the "
+        f"closed loop at its answer follows the logged force within "
+        f"{answer['check']['output_error_pct']['drive_force_n']:.2f} % (the benchmark's Simulink model at its "
+        "constants: 5.85 %).",
+        "",
+        "",
+        *calibration_lines(report, base),
     ]
     lines += ["", reading(answer, base), ""]
     if calibrated.completed is not None:
