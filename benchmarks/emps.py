@@ -165,7 +165,6 @@ def main() -> None:
         f"{answer['check']['output_error_pct']['drive_force_n']:.2f} % (the benchmark's Simulink model at its "
         "constants: 5.85 %).",
         "",
-        "",
         *calibration_lines(report, base),
     ]
     lines += ["", reading(answer, base), ""]

@@ -25,14 +25,11 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ema.calibration.held_out import Scored, score, score_grid, score_offsets
-from ema.calibration.limits import NAME_Z
+from ema.calibration.limits import MIN_NULL_STD, NAME_Z
 from ema.kinds.rotary.equations import Equations
 from ema.kinds.rotary.families import Family, Grid
 from ema.model import runtime
 
-# A floor under the copies' std: a family whose grid holds "no effect" (a gain of 1) drops exactly
-# nothing on every copy, and a zero std would make any drop infinitely significant.
-MIN_NULL_STD = 1e-3
 NAME_MARGIN = 0.15  # a rival curve explaining ≥ 85 % as much leaves the name undecided
 
 

@@ -12,8 +12,9 @@ add it, and report the error before and after.
    ``ema.kinds.servo.load_effects`` is solved on four fifths of every window and
    predicts the fifth left out, in turn (its nonlinear constant chosen the same way). An effect is taken only
    where it is physical (its constants' signs), predicts every fold better (a real effect shows in each part
-   of a log, noise does not), and cuts the held-out residual by ``MIN_HELD_OUT_DROP`` at least; then the next,
-   on top of it, up to ``MAX_EFFECTS``.
+   of a log, noise does not), cuts the held-out residual by ``MIN_HELD_OUT_DROP`` at least, and by ``NAME_Z``
+   stds beyond what it cuts on the noise-only copies (its score, z, as every kind reports it: a term with a free
+   constant gains on any log, and the copies show how much); then the next, on top of it, up to ``MAX_EFFECTS``.
 3. **Add and report.** The learned list is one consistent model: the adopted effects' constants join it, a
    constant that differs with the direction of motion named ``_up`` and ``_down``. The document keeps them as
    the simulator takes them (``simulator_frame``: Eq. 5.1 reads a simulated pre-sliding smaller than it is). The
@@ -40,7 +41,7 @@ from ema.calibration.documents import (
     ServoCalibration,
     Step,
 )
-from ema.calibration.limits import MAX_EFFECTS
+from ema.calibration.limits import MAX_EFFECTS, MIN_NULL_STD, NAME_Z
 from ema.calibration.plot import ResidualPlot, Series
 from ema.estimate.assess.weighing import misfit_limit
 from ema.estimate.stats import rms
@@ -56,6 +57,7 @@ from ema.kinds.servo.stacked_solve import (
     FOLDS,
     FRAME_PHASES,
     Solved,
+    left_out_alike,
     noise_copies,
     problem,
     simulator_frame,
@@ -84,8 +86,21 @@ def _best_of(effect: ServoEffect, prepared: Sequence[ServoPrepared], model: dict
     return min(trials, key=lambda trial: float(trial[1].held_out_rss.sum()))
 
 
-def _candidate(effect: ServoEffect, value: float, solution: Solved, base: Solved) -> tuple[Candidate, bool]:
+def null_drops(
+    effect: ServoEffect, copies: Sequence[Sequence[ServoPrepared]], model: dict[str, float], without: np.ndarray
+) -> np.ndarray:
+    """(COPIES,) the held-out drop the effect gives on each noise-only copy (``without``: each copy's held-out residual
+    with ``model`` alone), at its best grid value there as on the logs (the freedom of choosing is in the floor): what
+    it gains where nothing is missing."""
+    with_it = np.array([_best_of(effect, twins, model)[1].held_out_rss.sum() for twins in copies])
+    return 1.0 - with_it / without
+
+
+def _candidate(
+    effect: ServoEffect, value: float, solution: Solved, base: Solved, null: np.ndarray
+) -> tuple[Candidate, bool]:
     drop = 1.0 - solution.held_out_rss.sum() / base.held_out_rss.sum()
+    z = float((drop - null.mean()) / max(float(null.std(ddof=1)), MIN_NULL_STD))
     every_fold = bool(np.all(solution.held_out_rss < base.held_out_rss))
     plausible = effect.plausible(solution.values)
     parameters = {name: solution.values[name] for name in solution.values if name not in base.values}
@@ -98,34 +113,40 @@ def _candidate(effect: ServoEffect, value: float, solution: Solved, base: Solved
         parameters=parameters,
         rms_reduction=float(1.0 - solution.error_pct / base.error_pct),
         held_out_drop=float(drop),
-        score=float(np.min(1.0 - solution.held_out_rss / base.held_out_rss)),
+        score=z,
         plausible=plausible,
     )
-    return candidate, plausible and every_fold and drop >= MIN_HELD_OUT_DROP
+    return candidate, plausible and every_fold and drop >= MIN_HELD_OUT_DROP and z >= NAME_Z
 
 
-def select(prepared: Sequence[ServoPrepared], base_model: dict[str, float]) -> tuple[dict[str, float], list, list]:
-    """The effects adopted on top of ``base_model``, every candidate considered, and the steps' reasons."""
+def select(
+    prepared: Sequence[ServoPrepared], base_model: dict[str, float], copies: Sequence[Sequence[ServoPrepared]]
+) -> tuple[dict[str, float], list, list]:
+    """The effects adopted on top of ``base_model``, every candidate considered (its score its z against the noise-only
+    ``copies``), and the steps' reasons."""
     model, candidates, steps = dict(base_model), [], []
     current = solved(problem(prepared, model))
     for _ in range(MAX_EFFECTS):
         trials = []
+        without = np.array([solved(problem(twins, model)).held_out_rss.sum() for twins in copies])
         for effect in (e for e in LOAD_EFFECTS if e.name not in model):
             value, solution = _best_of(effect, prepared, model)
-            candidate, earned = _candidate(effect, value, solution, current)
+            null = null_drops(effect, copies, model, without)
+            candidate, earned = _candidate(effect, value, solution, current, null)
             candidates.append(candidate)
-            trials.append((candidate.held_out_drop, earned, effect, value, solution))
+            trials.append((candidate.held_out_drop, earned, effect, value, solution, candidate.score))
         earned_trials = [t for t in trials if t[1]]
         if not earned_trials:
             steps.append(Step(selected=None, reason=_nothing_earned(trials)))
             break
-        drop, _, effect, value, solution = max(earned_trials, key=lambda t: t[0])
+        drop, _, effect, value, solution, z = max(earned_trials, key=lambda t: t[0])
         model[effect.name], current = value, solution
         steps.append(
             Step(
                 selected=effect.name,
                 reason=f"{effect.description}: predicts every fifth of the log(s) left out better, "
-                f"{100 * drop:.0f} % less held-out residual; its constants are physical",
+                f"{100 * drop:.0f} % less held-out residual, {z:.0f} noise-floor stds beyond what noise-only copies "
+                "gain; its constants are physical",
             )
         )
     return model, candidates, steps
@@ -137,8 +158,8 @@ def _nothing_earned(trials: list) -> str:
     best = max(trials, key=lambda t: t[0])
     return (
         f"no further effect earns its place: the best, {best[2].name}, cuts the held-out residual by "
-        f"{100 * best[0]:.1f} % (at least {100 * MIN_HELD_OUT_DROP:.0f} % in every fold, with physical constants, "
-        "is asked)"
+        f"{100 * best[0]:.1f} % (at least {100 * MIN_HELD_OUT_DROP:.0f} % in every fold, {NAME_Z:g} noise-floor stds "
+        "beyond what noise-only copies gain, with physical constants, is asked)"
     )
 
 
@@ -240,7 +261,7 @@ def calibrate_servo(
     ratio = rms(base.residual) / float(np.median(copies.rms))
     limit = misfit_limit(copies.rms)
     if ratio > limit:
-        model, candidates, steps = select(prepared, base_model)
+        model, candidates, steps = select(prepared, base_model, left_out_alike(copies, prepared))
     else:
         model, candidates = dict(base_model), []
         steps = [

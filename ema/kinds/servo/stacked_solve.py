@@ -91,18 +91,30 @@ class Copies:
 
     rms: np.ndarray  # (COPIES,) the stacked problem's residual RMS, one per phase
     by_row: list[np.ndarray]  # per window, (COPIES, rows): its copies' residual by decimated row
+    twins: list[list[ServoPrepared]]  # per phase, every window as the closed loop logs it: what a candidate is read on
 
 
 def noise_copies(prepared: Sequence[ServoPrepared], base: Solved, model: dict[str, float]) -> Copies:
     misfits: list[float] = []
     by_row: list[list[np.ndarray]] = [[] for _ in prepared]
+    copies = []
     for phase in np.linspace(0.0, 1.0, COPIES, endpoint=False):
         twins = [_simulated(p, base.values, model, phase) for p in prepared]
+        copies.append(twins)
         misfits.append(rms(solved(problem(twins, model)).residual))
         for i, twin in enumerate(twins):
             solution = solve_inverse(twin.force_n, inverse_columns(twin.motion, model), twin.motion)
             by_row[i].append(solution.residual_by_row)
-    return Copies(np.array(misfits), [np.array(rows) for rows in by_row])
+    return Copies(np.array(misfits), [np.array(rows) for rows in by_row], copies)
+
+
+def left_out_alike(copies: Copies, prepared: Sequence[ServoPrepared]) -> list[list[ServoPrepared]]:
+    """Each copy's windows with the rows their logs leave out (``undisturbed``) left out too: a candidate is read on
+    the copies as on the logs."""
+    return [
+        [replace(twin, disturbed=p.disturbed) for twin, p in zip(twins, prepared, strict=True)]
+        for twins in copies.twins
+    ]
 
 
 def _simulated(p: ServoPrepared, values: dict[str, float], model: dict[str, float], phase: float) -> ServoPrepared:

@@ -78,6 +78,19 @@ def test_the_emps_logs_misfit_is_traced_to_a_direction_dependent_viscous_frictio
     assert not [c for c in report.candidates if c.effect == "stribeck" and c.plausible]  # a negative excess
 
 
+def test_every_candidate_is_scored_against_the_noise_only_copies(emps):
+    """A candidate's score is the z every kind reports: its held-out drop against what it gains on the noise-only
+    copies. A term with a free constant gains on any log: the Stribeck term's first-step drop over 5 % on EMPS is
+    what it gains on the copies too, no evidence; the effects named stand far beyond."""
+    from ema.calibration.limits import NAME_Z
+
+    report = emps[1].report
+    first = {c.effect: c for c in reversed(report.candidates)}  # each effect's first-step candidate
+    assert first["stribeck"].held_out_drop >= 0.05 and abs(first["stribeck"].score) < NAME_Z
+    named = [max(c.score for c in report.candidates if c.effect == name) for name in report.selected_effects]
+    assert named and min(named) >= NAME_Z  # at the step that named it
+
+
 def test_the_completed_document_reads_the_log_closer(emps):
     window, calibrated = emps
     before = estimate(window, actuator=read_actuator(EMPS / "actuator.json"))
