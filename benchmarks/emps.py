@@ -225,8 +225,14 @@ def reading(answer: dict, base: dict[str, dict]) -> str:
         "learns from the window's own closed-loop runs each carrying the window's misfit at a random shift and "
         f"sign; it carries a weight of {max(used.values()):.2f} at most in the answer ({', '.join(notes)}): its "
         "held-out errors, misfit included, are no smaller than the physics solution's, which answers, corrected "
-        "by its bias on those simulations."
+        "by its bias on those simulations." + _form_said(answer)
     )
+
+
+def _form_said(answer: dict) -> str:
+    """The model-form note's words, where the answer's stds were widened by the effects the log holds."""
+    form = next((n["text"] for n in answer["notes"] if n["code"] == "model_form"), None)
+    return "" if form is None else f" Its std is wider than the solution's: {form} (`model_form`)."
 
 
 def network_line(name: str, answer: dict) -> str:

@@ -53,6 +53,7 @@ NoteCode = Literal[
     "physics_only",
     "model_misfit",
     "misfit_learned",
+    "model_form",
     "not_reproduced",
     "weakly_determined",
     "eta_o_at_bound",

@@ -45,6 +45,7 @@ from ema.calibration.limits import MAX_EFFECTS, MIN_NULL_STD, NAME_Z
 from ema.calibration.plot import ResidualPlot, Series
 from ema.estimate.assess.weighing import misfit_limit
 from ema.estimate.stats import rms
+from ema.kinds.servo.effect_readings import MIN_HELD_OUT_DROP, Reading, best_of, reading
 from ema.kinds.servo.fold_errors import closed_loop_error_pct, document_check
 from ema.kinds.servo.inverse import (
     UNITS,
@@ -68,7 +69,6 @@ from ema.model.actuator import Nominal, ServoActuator
 from ema.model.checks import InputError
 from ema.model.window import Window
 
-MIN_HELD_OUT_DROP = 0.05  # of the held-out residual sum of squares
 CLOSED_LOOPS = COPIES + 2 * FRAME_PHASES + 2  # per window: noise copies, twins before and after, the errors
 LEARNED_NAMES = {
     "fdj_n": "FDJ",
@@ -80,43 +80,35 @@ LEARNED_NAMES = {
 }
 
 
-def _best_of(effect: ServoEffect, prepared: Sequence[ServoPrepared], model: dict[str, float]) -> tuple[float, Solved]:
-    """The effect at the grid value that predicts the held-out folds best."""
-    trials = [(value, solved(problem(prepared, {**model, effect.name: value}))) for value in effect.grid]
-    return min(trials, key=lambda trial: float(trial[1].held_out_rss.sum()))
-
-
 def null_drops(
     effect: ServoEffect, copies: Sequence[Sequence[ServoPrepared]], model: dict[str, float], without: np.ndarray
 ) -> np.ndarray:
     """(COPIES,) the held-out drop the effect gives on each noise-only copy (``without``: each copy's held-out residual
     with ``model`` alone), at its best grid value there as on the logs (the freedom of choosing is in the floor): what
     it gains where nothing is missing."""
-    with_it = np.array([_best_of(effect, twins, model)[1].held_out_rss.sum() for twins in copies])
+    with_it = np.array([best_of(effect, twins, model)[1].held_out_rss.sum() for twins in copies])
     return 1.0 - with_it / without
 
 
-def _candidate(
-    effect: ServoEffect, value: float, solution: Solved, base: Solved, null: np.ndarray
-) -> tuple[Candidate, bool]:
-    drop = 1.0 - solution.held_out_rss.sum() / base.held_out_rss.sum()
-    z = float((drop - null.mean()) / max(float(null.std(ddof=1)), MIN_NULL_STD))
-    every_fold = bool(np.all(solution.held_out_rss < base.held_out_rss))
-    plausible = effect.plausible(solution.values)
+def _candidate(read: Reading, base: Solved, null: np.ndarray) -> tuple[Candidate, bool]:
+    """The reading as the report lists it, scored by its z against the noise-only copies' drops (``null``), and
+    whether it earns its place (held by the logs, and that far beyond what noise alone gains)."""
+    z = float((read.drop - null.mean()) / max(float(null.std(ddof=1)), MIN_NULL_STD))
+    solution, effect = read.solution, read.effect
     parameters = {name: solution.values[name] for name in solution.values if name not in base.values}
     if effect.constant is not None:
-        parameters[effect.constant[0]] = value
+        parameters[effect.constant[0]] = read.value
     candidate = Candidate(
         effect=effect.name,
         follows="speed_mps" if effect.name != "position_force" else "position_m",
         named=True,
         parameters=parameters,
         rms_reduction=float(1.0 - solution.error_pct / base.error_pct),
-        held_out_drop=float(drop),
+        held_out_drop=read.drop,
         score=z,
-        plausible=plausible,
+        plausible=read.plausible,
     )
-    return candidate, plausible and every_fold and drop >= MIN_HELD_OUT_DROP and z >= NAME_Z
+    return candidate, read.held and z >= NAME_Z
 
 
 def select(
@@ -130,11 +122,10 @@ def select(
         trials = []
         without = np.array([solved(problem(twins, model)).held_out_rss.sum() for twins in copies])
         for effect in (e for e in LOAD_EFFECTS if e.name not in model):
-            value, solution = _best_of(effect, prepared, model)
-            null = null_drops(effect, copies, model, without)
-            candidate, earned = _candidate(effect, value, solution, current, null)
+            read = reading(effect, prepared, model, current)
+            candidate, earned = _candidate(read, current, null_drops(effect, copies, model, without))
             candidates.append(candidate)
-            trials.append((candidate.held_out_drop, earned, effect, value, solution, candidate.score))
+            trials.append((read.drop, earned, effect, read.value, read.solution, candidate.score))
         earned_trials = [t for t in trials if t[1]]
         if not earned_trials:
             steps.append(Step(selected=None, reason=_nothing_earned(trials)))

@@ -31,6 +31,7 @@ from ema.estimate.learn.network import LearnConfig
 from ema.estimate.report import learned_info
 from ema.estimate.stats import MAX_RATIO, RESOLUTION_SHARE, rms
 from ema.estimate.stopwatch import Stopwatch
+from ema.kinds.servo.effect_readings import held_readings, widened
 from ema.kinds.servo.inverse import (
     EITHER_SIGN,
     UNITS,
@@ -81,11 +82,11 @@ def held_out_physics(prepared: ServoPrepared, data: ServoData, n: int) -> tuple[
 
 
 def undisturbed(
-    prepared: ServoPrepared, physics: InverseSolution, simulated_by_row: np.ndarray
+    prepared: ServoPrepared, physics: InverseSolution, disturbed: np.ndarray
 ) -> tuple[InverseSolution, doc.Note | None]:
-    """The physics solution again without the rows a force the log does not carry disturbs (``disturbed_rows``: the
-    window's residual beyond what its simulations leave there), and a note saying how long they last."""
-    disturbed = disturbed_rows(physics.residual_by_row, simulated_by_row)
+    """The physics solution again without the rows a force the log does not carry disturbs (``disturbed``: the
+    window's residual beyond what its simulations leave there, ``disturbed_rows``), and a note saying how long they
+    last."""
     if not disturbed.any():
         return physics, None
     seconds = int(disturbed.sum()) * prepared.motion.decimation / prepared.window.sample_rate_hz
@@ -109,14 +110,21 @@ class Screened:
     disturbed: doc.Note | None
     ratio: float
     limit: float
+    left_out: np.ndarray | None = None  # (rows,) the rows left out of the window's physics
+
+    @property
+    def misses(self) -> bool:
+        """The model misses part of the window: its equation error beyond what its simulations reach."""
+        return self.ratio > self.limit
 
 
 def screened(prepared: ServoPrepared, physics: InverseSolution, data: ServoData, n: int) -> Screened:
     """The window screened by its ``n``-th and later (held-out) simulations (``Screened``)."""
     check_physics, check_rms, check_by_row = held_out_physics(prepared, data, n)
-    physics, disturbed = undisturbed(prepared, physics, check_by_row)
+    left_out = disturbed_rows(physics.residual_by_row, check_by_row)
+    physics, disturbed = undisturbed(prepared, physics, left_out)
     ratio = physics.residual_rms_n / float(np.median(check_rms))
-    return Screened(check_physics, physics, disturbed, ratio, misfit_limit(check_rms))
+    return Screened(check_physics, physics, disturbed, ratio, misfit_limit(check_rms), left_out if disturbed else None)
 
 
 def misfit_carried(
@@ -124,7 +132,7 @@ def misfit_carried(
 ) -> tuple[ServoData, doc.Note | None]:
     """``data`` as the network learns from it: carrying the window's own misfit where the model misses part of the
     window (``ema.kinds.servo.loop_dataset``), with a note of its size; else as simulated."""
-    if held.ratio <= held.limit:
+    if not held.misses:
         return data, None
     misfit = window_misfit(prepared, held.physics, data.inputs.shape[1])
     share = 100.0 * rms(misfit) / max(rms(data.window_inputs), 1e-300)
@@ -309,8 +317,10 @@ def estimate_servo(
         network = learned(data, config)
     with watch("assess", "weighing the estimators on held-out simulations"):
         answer, physics = assessed(held, data, network, n), held.physics
-        if carried is not None:
-            answer = replace(answer, notes=[*answer.notes, carried])
+        answer = replace(answer, notes=[*answer.notes, *([carried] if carried else [])])
+        if held.misses:  # which effect the model lacks, one log cannot tell: the stds hold each one's reading
+            answer, form = widened(answer, *held_readings(prepared, held.left_out))
+            answer = replace(answer, notes=[*answer.notes, *([form] if form else [])])
     with watch("check", "simulating the window at the answer"):
         check = closed_loop_check(prepared, answer, held.ratio, held.limit)
     with watch("report", "writing the report"):
