@@ -8,8 +8,10 @@ On the estimation run: ``ema estimate`` as a user runs it (a subprocess, timed e
 seconds), then ``ema calibrate``: what it learned beside the benchmark's own identification, the effect it
 named, the model's error before and after (the benchmark's 100·‖y − ŷ‖/‖y‖, inverse and closed loop), and the
 published models' errors on the same file. With ``--held-out F.mat --held-out-map M.json``: that run estimated
-with the example document and with the completed one, both runs' FDJ against 2 std of their difference, and
-each model's error on it with its constants fixed: ema's learned ones and the published ones of each form.
+with the example document and with the completed one, each against the estimation run read with the same document
+(both runs' FDJ against 2 std of their difference, the held-out run's closed-loop check and verdict, whether the
+network disagrees with physics there), and each model's error on it with its constants fixed: ema's learned ones
+and the published ones of each form.
 
     python -m benchmarks.emps [--held-out F.mat --held-out-map M.json] [--docs]
 """
@@ -178,10 +180,10 @@ def main() -> None:
             "",
         ]
     lines += [recorded_gain_line(window, document, answer)]
-    if args.held_out is not None:
-        held_out_map = args.held_out_map or mapping
-        completed = None if calibrated.completed is None else as_kind(calibrated.completed, ServoActuator)
-        lines += ["", *held_out_lines(args.held_out, held_out_map, document, completed, answer)]
+    if args.held_out is not None and calibrated.completed is not None:
+        completed = as_kind(calibrated.completed, ServoActuator)
+        runs = {"bundled": (document, answer), "calibrated": (completed, again)}
+        lines += ["", *held_out_lines(args.held_out, args.held_out_map or mapping, runs)]
     body = "\n".join(lines)
     print(body)
     if args.docs:
@@ -250,24 +252,34 @@ def _base_model(window: Window, document: ServoActuator) -> dict[str, dict]:
     return {NAMES[n]: {"value": solution.values[n], "std": solution.stds[n], "unit": UNITS[n]} for n in NAMES}
 
 
-def held_out_lines(
-    path: Path, mapping: Path, document: ServoActuator, completed: ServoActuator | None, shared: dict
-) -> list[str]:
-    assert completed is not None
+def held_out_lines(path: Path, mapping: Path, runs: dict[str, tuple[ServoActuator, dict]]) -> list[str]:
+    """The held-out run read with each document (``runs``: the document and the estimation run's answer with it):
+    both runs' FDJ against 2 std of their difference, the held-out run's closed-loop check and whether the network
+    disagrees with physics there; then each model's error on it, its constants fixed."""
     window = read(path, mapping)
-    first, second = shared["estimates"]["FDJ"], estimate(window, actuator=document).estimates.FDJ
-    after = estimate(window, actuator=completed)
-    gap, allowed = abs(first["value"] - second.value), 2 * float(np.hypot(first["std"], second.std or 0.0))
     lines = [
-        f"The held-out run ({path.name}): FDJ {second.value:.3f} ± {second.std:.3f} N against the estimation run's "
-        f"{first['value']:.3f} ± {first['std']:.3f} N: {gap:.3f} N apart, {'within' if gap <= allowed else 'beyond'} "
-        f"2 std of their difference ({allowed:.3f} N). With the completed document: FDJ "
-        f"{after.estimates.FDJ.value:.3f} ± {after.estimates.FDJ.std:.3f} N; notes: "
-        f"{', '.join(n.code for n in after.notes) or 'none'}.",
+        f"The held-out run ({path.name}):",
         "",
-        "| model, constants fixed | inverse error | closed-loop force error |",
-        "|---|---:|---:|",
+        "| document | estimation run FDJ [N] | held-out run FDJ [N] | apart, against 2 std of the difference | "
+        "held-out closed loop: force error, verdict | network_disagrees |",
+        "|---|---:|---:|---:|---|---|",
     ]
+    for label, (document, first) in runs.items():
+        read_out = estimate(window, actuator=document)
+        second, check = read_out.estimates.FDJ, read_out.check
+        gap = abs(first["estimates"]["FDJ"]["value"] - second.value)
+        allowed = 2 * float(np.hypot(first["estimates"]["FDJ"]["std"], second.std or 0.0))
+        disagrees = [
+            n for n, m in read_out.methods.items() if m.network_note and m.network_note.code == "network_disagrees"
+        ]
+        lines.append(
+            f"| {label} | {first['estimates']['FDJ']['value']:.3f} ± {first['estimates']['FDJ']['std']:.3f} | "
+            f"{second.value:.3f} ± {second.std:.3f} | {gap:.3f} N, {'within' if gap <= allowed else 'beyond'} "
+            f"{allowed:.3f} N | {check.output_error_pct['drive_force_n']:.2f} %, "
+            f"{'reproduced' if check.reproduced else 'not reproduced'} | {', '.join(disagrees) or 'none'} |"
+        )
+    lines += ["", "| model, constants fixed | inverse error | closed-loop force error |", "|---|---:|---:|"]
+    document, completed = runs["bundled"][0], runs["calibrated"][0]
     for name, errors in errors_on(window, document, completed).items():
         lines.append(f"| {name} | {errors['drive_force_n']:.2f} % | {errors['drive_force_n_closed_loop']:.2f} % |")
     return lines
