@@ -1,6 +1,7 @@
 """One contract for every history: SQLite and PostgreSQL pass the same tests (``setting`` runs each on both)."""
 
 import concurrent.futures
+import json
 
 import pytest
 
@@ -203,10 +204,10 @@ def test_every_change_an_actuator_sees_moves_its_state_and_a_repeat_does_not(his
     assert before[2] == 2  # the document's version
 
 
-def test_calibrations_come_back_whole_latest_first(history):
+def _rig_windows_and_document():
+    """The rig's healthy runs at two loads, and its bundled document."""
     from pathlib import Path
 
-    from ema.kinds.linear.calibration_report import calibrate_linear
     from ema.model.actuator import read_actuator
     from ema.model.logmap import read_logmap, read_mapped
     from ema.model.window import window_from_dict
@@ -214,7 +215,13 @@ def test_calibrations_come_back_whole_latest_first(history):
     rig = Path(__file__).resolve().parents[2] / "examples" / "ballscrew-rig"
     paths = sorted((rig / "runs").glob("normal_load[24]0_run*.csv"))
     windows = [window_from_dict(read_mapped(p, read_logmap(rig / "log-map.json"))) for p in paths]
-    document = read_actuator(rig / "actuator.json")
+    return windows, read_actuator(rig / "actuator.json")
+
+
+def test_calibrations_come_back_whole_latest_first(history):
+    from ema.kinds.linear.calibration_report import calibrate_linear
+
+    windows, document = _rig_windows_and_document()
     reports = [calibrate_linear(windows[:n] + windows[-n:], document)[0] for n in (2, 3)]
     for report in reports:
         history.add_calibration("rig", report)
@@ -261,3 +268,21 @@ def test_a_round_three_history_upgraded_keeps_every_window_and_fills_its_lookups
         assert store.readings("a", "f").sensor_zero.window_id == "last"
     finally:
         store.close()
+
+
+def test_a_calibration_stored_before_reports_named_their_kind_comes_back_as_its_kinds(history):
+    """Reports were first stored with every kind's part in each (null or empty) and no ``kind``: they read as their
+    kind's report, nothing lost, with no migration."""
+    from ema.calibration.documents import LinearCalibration
+    from ema.history.tables import calibrations
+    from ema.kinds.linear.calibration_report import calibrate_linear
+
+    windows, document = _rig_windows_and_document()
+    report = calibrate_linear(windows, document)[0]
+    written = report.model_dump(mode="json", by_alias=True)
+    first_shape = {**{k: v for k, v in written.items() if k != "kind"}, "as_simulated": []}
+    with history._writing() as connection:  # as an earlier ema wrote it
+        row = calibrations.insert().values(actuator_id="rig", stored_at="then", report=json.dumps(first_shape))
+        connection.execute(row)
+    [(when, read)] = history.calibrations("rig")
+    assert when == "then" and isinstance(read, LinearCalibration) and read == report
