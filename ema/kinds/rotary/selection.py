@@ -25,7 +25,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ema.calibration.held_out import Scored, score, score_grid, score_offsets
-from ema.calibration.limits import MIN_NULL_STD, NAME_Z
+from ema.calibration.limits import NAME_Z, noise_z
 from ema.kinds.rotary.equations import Equations
 from ema.kinds.rotary.families import Family, Grid
 from ema.model import runtime
@@ -52,7 +52,7 @@ class Evidence:
 
     @property
     def z(self) -> float:
-        return (self.improvement - self.null_mean) / max(self.null_std, MIN_NULL_STD)
+        return noise_z(self.improvement, self.null_mean, self.null_std)
 
 
 def problem(e: Equations, chosen: Sequence[Chosen]) -> tuple[np.ndarray, np.ndarray]:

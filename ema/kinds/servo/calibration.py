@@ -41,7 +41,7 @@ from ema.calibration.documents import (
     ServoCalibration,
     Step,
 )
-from ema.calibration.limits import MAX_EFFECTS, MIN_NULL_STD, NAME_Z
+from ema.calibration.limits import MAX_EFFECTS, NAME_Z, noise_z
 from ema.calibration.plot import ResidualPlot, Series
 from ema.estimate.assess.weighing import misfit_limit
 from ema.estimate.stats import rms
@@ -93,7 +93,7 @@ def null_drops(
 def _candidate(read: Reading, base: Solved, null: np.ndarray) -> tuple[Candidate, bool]:
     """The reading as the report lists it, scored by its z against the noise-only copies' drops (``null``), and
     whether it earns its place (held by the logs, and that far beyond what noise alone gains)."""
-    z = float((read.drop - null.mean()) / max(float(null.std(ddof=1)), MIN_NULL_STD))
+    z = float(noise_z(read.drop, float(null.mean()), float(null.std(ddof=1))))
     solution, effect = read.solution, read.effect
     parameters = {name: solution.values[name] for name in solution.values if name not in base.values}
     if effect.constant is not None:

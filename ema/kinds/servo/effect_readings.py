@@ -63,7 +63,7 @@ def reading(effect: ServoEffect, prepared: Sequence[ServoPrepared], model: dict[
     )
 
 
-def held_readings(prepared: ServoPrepared, left_out: np.ndarray | None) -> tuple[Solved, list[Reading]]:
+def held_readings(prepared: ServoPrepared, left_out: np.ndarray) -> tuple[Solved, list[Reading]]:
     """The window's solution with its document's effects (less the ``left_out`` rows), and each further effect's
     reading the window holds evidence for."""
     window = [replace(prepared, disturbed=left_out)]

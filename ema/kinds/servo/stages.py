@@ -110,7 +110,7 @@ class Screened:
     disturbed: doc.Note | None
     ratio: float
     limit: float
-    left_out: np.ndarray | None = None  # (rows,) the rows left out of the window's physics
+    left_out: np.ndarray  # (rows,) bool: the rows left out of the window's physics
 
     @property
     def misses(self) -> bool:
@@ -124,7 +124,7 @@ def screened(prepared: ServoPrepared, physics: InverseSolution, data: ServoData,
     left_out = disturbed_rows(physics.residual_by_row, check_by_row)
     physics, disturbed = undisturbed(prepared, physics, left_out)
     ratio = physics.residual_rms_n / float(np.median(check_rms))
-    return Screened(check_physics, physics, disturbed, ratio, misfit_limit(check_rms), left_out if disturbed else None)
+    return Screened(check_physics, physics, disturbed, ratio, misfit_limit(check_rms), left_out)
 
 
 def misfit_carried(
@@ -317,10 +317,9 @@ def estimate_servo(
         network = learned(data, config)
     with watch("assess", "weighing the estimators on held-out simulations"):
         answer, physics = assessed(held, data, network, n), held.physics
-        answer = replace(answer, notes=[*answer.notes, *([carried] if carried else [])])
-        if held.misses:  # which effect the model lacks, one log cannot tell: the stds hold each one's reading
-            answer, form = widened(answer, *held_readings(prepared, held.left_out))
-            answer = replace(answer, notes=[*answer.notes, *([form] if form else [])])
+        # which effect the model lacks, one log cannot tell: the stds hold each one's reading
+        answer, form = widened(answer, *held_readings(prepared, held.left_out)) if held.misses else (answer, None)
+        answer = replace(answer, notes=[*answer.notes, *(note for note in (carried, form) if note)])
     with watch("check", "simulating the window at the answer"):
         check = closed_loop_check(prepared, answer, held.ratio, held.limit)
     with watch("report", "writing the report"):
