@@ -10,7 +10,9 @@ a force ``drive_gain_n_per_unit``·u on the load, held until the next sample. Th
 
     M·q̈ = F_drive − F_load − FDJ·sgn(q̇) − C(q̇)·q̇ − F_offset,
 
-C the viscous coefficient (``viscous_down_ns_per_m`` where moving towards decreasing position differs). The
+C the viscous coefficient (``viscous_down_ns_per_m`` where moving towards decreasing position differs). Where
+``travel_per_turn_m`` is given, ``ema calibrate`` also looks for a force that repeats once per turn of the motor
+(its cogging, a screw's or a coupling's eccentricity). The
 controller's constants are on its own data sheet or in the log (a log map may read them from the file); the
 load's (M, C, the offset, the nominal FDJ) are learned by ``ema calibrate`` where the document lacks them.
 """
@@ -23,8 +25,8 @@ from pydantic import Field, field_validator
 
 from ema.model.document import Document, Number
 
-SERVO_EFFECTS = ("viscous_down", "stribeck", "presliding", "position_force", "position_friction")  # what calibration
-# may adopt into the model (``ema.kinds.servo.load_effects`` says what each is)
+SERVO_EFFECTS = ("viscous_down", "stribeck", "presliding", "position_force", "position_friction", "turn_ripple")
+# what calibration may adopt into the model (``ema.kinds.servo.load_effects`` says what each is)
 SERVO_CONSTANTS = (
     "drive_gain_n_per_unit",
     "command_limit",
@@ -68,6 +70,13 @@ class Servo(Document):
     )
     position_resolution_m: Number | None = Field(
         None, gt=0, le=1e-2, description="the position sensor's step; null: read from the log"
+    )
+    travel_per_turn_m: Number | None = Field(
+        None,
+        gt=0,
+        le=10,
+        description="the load's travel per turn of the motor (a screw's lead, through any gear between): the period "
+        "of a force once per turn; null: not known, and no such force is looked for",
     )
     mass_kg: Number | None = Field(None, gt=0, le=1e6, description="M, everything the drive moves (learned)")
     mass_std_kg: Number | None = Field(None, ge=0, le=1e6)

@@ -4,7 +4,8 @@ its samples, and its own set points (smooth moves between random stations, not t
 Between controller samples the force is constant and, while the load slides one way, so is the friction's
 Coulomb level, so the speed is an exponential, v(t) = F'/C + (v₀ − F'/C)·e^(−C·t/M), solved in closed form
 (ema's simulator takes ten semi-implicit steps instead); a speed that would cross zero stops there, and a
-load at rest stays there while the net force is within FDJ. ``draw`` returns an ``ema-window/1`` document and
+load at rest stays there while the net force is within FDJ. A force once per turn of the motor (``Load.turn_n``)
+is held over each 100th of a sample, solved the same way. ``draw`` returns an ``ema-window/1`` document and
 the truth, never one of ema's objects.
 """
 
@@ -27,6 +28,16 @@ class Load:
     viscous_up_ns_per_m: float = 200.0
     viscous_down_ns_per_m: float = 200.0
     offset_n: float = -3.0
+    turn_n: tuple[float, float] = (0.0, 0.0)  # a force once per turn of the motor, A·sin + B·cos of 2π·x/period
+    travel_per_turn_m: float = 2.5e-3  # its period
+
+
+def _turn_force(x: float, load: Load) -> float:
+    angle = 2 * math.pi * x / load.travel_per_turn_m
+    return load.turn_n[0] * math.sin(angle) + load.turn_n[1] * math.cos(angle)
+
+
+TURN_PIECES = 100  # a force once per turn is held over this share of a sample (the load then travels < 1/200 turn)
 
 
 def set_point(seed: int, seconds: float = 12.0) -> np.ndarray:
@@ -84,9 +95,12 @@ def simulate(
     phase: float = 0.0,
     push_n: np.ndarray | None = None,
     added_v: np.ndarray | None = None,
+    gains: tuple[float, float, float] = (KP, KV, GAIN),
 ) -> tuple[np.ndarray, np.ndarray]:
     """(position as the encoder read it [m], the drive's force [N]) at each controller sample; ``push_n`` a force
-    on the load the log does not carry, ``added_v`` a command added to the controller's before its limit."""
+    on the load the log does not carry, ``added_v`` a command added to the controller's before its limit, ``gains``
+    the loop's kp [1/s], kv [V/(m/s)] and drive gain [N/V]."""
+    kp, kv, gain = gains
     dt = 1.0 / RATE_HZ
     x, v = float(reference[0]), 0.0
     previous = [x, x]
@@ -95,19 +109,30 @@ def simulate(
         q = STEP_M * round(x / STEP_M + phase) - phase * STEP_M
         filtered, filtered_before = 0.5 * (q + previous[0]), 0.5 * (previous[0] + previous[1])
         added = 0.0 if added_v is None else added_v[k]
-        u = min(max(KV * (KP * (r - q) - (filtered - filtered_before) / dt) + added, -LIMIT), LIMIT)
+        u = min(max(kv * (kp * (r - q) - (filtered - filtered_before) / dt) + added, -LIMIT), LIMIT)
         previous = [q, previous[0]]
-        positions[k], forces[k] = q, GAIN * u
-        net, left = GAIN * u - load.offset_n + (0.0 if push_n is None else push_n[k]), dt
-        while left > 1e-12:
-            if v == 0.0:
-                if abs(net) <= load.fdj_n:
-                    break  # stuck for the rest of the sample
-                v = math.copysign(1e-15, net)  # breaks away the way the net force pushes
-            travel, v, used = _slide(v, net, load, left)
-            x += travel
-            left -= used
+        positions[k], forces[k] = q, gain * u
+        net = gain * u - load.offset_n + (0.0 if push_n is None else push_n[k])
+        if load.turn_n == (0.0, 0.0):
+            x, v = _sample(x, v, net, load, dt)
+            continue
+        for _ in range(TURN_PIECES):
+            x, v = _sample(x, v, net - _turn_force(x, load), load, dt / TURN_PIECES)
     return positions, forces
+
+
+def _sample(x: float, v: float, net: float, load: Load, dt: float) -> tuple[float, float]:
+    """(position, speed) after ``dt`` under the net force ``net``, solved in closed form (module docstring)."""
+    left = dt
+    while left > 1e-12 * dt * RATE_HZ:
+        if v == 0.0:
+            if abs(net) <= load.fdj_n:
+                break  # stuck for the rest of it
+            v = math.copysign(1e-15, net)  # breaks away the way the net force pushes
+        travel, v, used = _slide(v, net, load, left)
+        x += travel
+        left -= used
+    return x, v
 
 
 def draw(seed: int, load: Load = Load(), seconds: float = 12.0, pushed: bool = False, excited: bool = False) -> dict:

@@ -51,7 +51,7 @@ from ema.kinds.servo.inverse import (
     UNITS,
     decimated,
 )
-from ema.kinds.servo.load_effects import LOAD_EFFECTS, ServoEffect
+from ema.kinds.servo.load_effects import LOAD_EFFECTS, ServoEffect, looked_for
 from ema.kinds.servo.log_reading import ServoPrepared, document_effects, prepare_servo, refuse_reversed_signs
 from ema.kinds.servo.stacked_solve import (
     COPIES,
@@ -70,6 +70,7 @@ from ema.model.checks import InputError
 from ema.model.window import Window
 
 CLOSED_LOOPS = COPIES + 2 * FRAME_PHASES + 2  # per window: noise copies, twins before and after, the errors
+FORCES_ALONG_TRAVEL = ("position_force", "turn_ripple")  # effects that follow the position, not the speed
 LEARNED_NAMES = {
     "fdj_n": "FDJ",
     "mass_kg": "mass",
@@ -100,7 +101,7 @@ def _candidate(read: Reading, base: Solved, null: np.ndarray) -> tuple[Candidate
         parameters[effect.constant[0]] = read.value
     candidate = Candidate(
         effect=effect.name,
-        follows="speed_mps" if effect.name != "position_force" else "position_m",
+        follows="position_m" if effect.name in FORCES_ALONG_TRAVEL else "speed_mps",
         named=True,
         parameters=parameters,
         rms_reduction=float(1.0 - solution.error_pct / base.error_pct),
@@ -121,7 +122,7 @@ def select(
     for _ in range(MAX_EFFECTS):
         trials = []
         without = np.array([solved(problem(twins, model)).held_out_rss.sum() for twins in copies])
-        for effect in (e for e in LOAD_EFFECTS if e.name not in model):
+        for effect in looked_for(prepared[0].servo, model):
             read = reading(effect, prepared, model, current)
             candidate, earned = _candidate(read, current, null_drops(effect, copies, model, without))
             candidates.append(candidate)

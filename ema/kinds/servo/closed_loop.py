@@ -11,9 +11,10 @@ own, ``ema.kinds.servo.log_reading.added_command``; 0 for a loop left to its con
 
 until k + 1, over which the load moves by (``ema.model.servo``)
 
-    M·ẍ = F_k − F_load,k − F_offset − (FDJ + F_S·exp(−(ẋ/v_S)²) − F_P·exp(−s/σ))·sgn(ẋ) − C(ẋ)·ẋ,
+    M·ẍ = F_k − F_load,k − F_offset − F_T(x) − (FDJ + F_S·exp(−(ẋ/v_S)²) − F_P·exp(−s/σ))·sgn(ẋ) − C(ẋ)·ẋ,
 
-s the travel since the motion last reversed (pre-sliding: the friction builds up over the first σ of it),
+s the travel since the motion last reversed (pre-sliding: the friction builds up over the first σ of it), F_T a
+force once per turn of the motor, A·sin(2π·x/p) + B·cos(2π·x/p) (p the load's travel per turn),
 
 in ``SUBSTEPS`` steps: the viscous term implicit, a step that would carry ẋ through zero stopping there,
 and a load at rest staying there while the net force is within its static level FDJ + F_S (Karnopp). What is
@@ -22,7 +23,7 @@ recorded is what the controller's log holds: q_k and F_k.
 Lanes are independent: the wrapper runs them in groups on the simulator's thread pool
 (``ema.model.runtime``). Parameters per lane, in ``LANE_PARAMETERS`` order: mass [kg], FDJ [N], C up and C
 down [N·s/m], the offset [N], the Stribeck excess F_S [N] and speed v_S [m/s], the pre-sliding deficit F_P [N] and
-travel σ [m] (0 where a lane has no such effect).
+travel σ [m], the turn's force A and B [N] and its period p [m] (0 where a lane has no such effect).
 """
 
 from __future__ import annotations
@@ -36,7 +37,8 @@ from ema.model import runtime
 from ema.model.checks import InputError, finite_array
 
 LANE_PARAMETERS = ("mass_kg", "fdj_n", "viscous_up_ns_per_m", "viscous_down_ns_per_m", "offset_n",
-                   "stribeck_n", "stribeck_speed_mps", "presliding_n", "presliding_travel_m")  # fmt: skip
+                   "stribeck_n", "stribeck_speed_mps", "presliding_n", "presliding_travel_m",
+                   "turn_ripple_sin_n", "turn_ripple_cos_n", "turn_ripple_travel_m")  # fmt: skip
 SUBSTEPS = 10  # load steps per controller sample: the load's own time constant M/C is hundreds of them
 GROUP_LANES = 8  # lanes a pool thread runs at a time
 
@@ -62,10 +64,20 @@ def _step_load(x, v, net, p, h, travel):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True)
+def _turn_force(x, p):  # pragma: no cover - compiled
+    """F_T(x) [N], the force once per turn of the motor at position x [m], p a lane's row (0 without one)."""
+    period = p[11]
+    if period <= 0.0:
+        return 0.0
+    angle = 2.0 * np.pi * x / period
+    return p[9] * np.sin(angle) + p[10] * np.cos(angle)
+
+
+@njit(cache=True, nogil=True)
 def run_lanes(
     reference, added, load, controller, taps, params, phase, start, first, count, q_out, f_out
 ):  # pragma: no cover
-    """Simulate lanes [first, first + count) of ``params`` (L, 9) over the reference (N,) [m], the added command
+    """Simulate lanes [first, first + count) of ``params`` (L, 12) over the reference (N,) [m], the added command
     (N,) [the command's unit] and the load (N,) [N]; ``controller`` = (kp, kv, gain, limit, Δt, δ), ``taps`` (T,),
     ``phase`` (L,), ``start`` = (x0, v0). Writes the recorded position (L, N) [m] and force (L, N) [N]."""
     kp, kv, gain, limit, dt, step = (
@@ -104,7 +116,7 @@ def run_lanes(
             f_out[lane, k] = force
             net = force - load[k] - p[4]
             for _ in range(SUBSTEPS):
-                x, v = _step_load(x, v, net, p, h, abs(x - reversed_at))
+                x, v = _step_load(x, v, net - _turn_force(x, p), p, h, abs(x - reversed_at))
                 if v * moving < 0.0:
                     reversed_at, moving = x, -moving
 
@@ -138,7 +150,7 @@ def simulate_servo(
     start: tuple[float, float] = (0.0, 0.0),
     phase: np.ndarray | None = None,
 ) -> ServoRuns:
-    """Each row of ``params`` (L, 9: ``LANE_PARAMETERS``) simulated over the set point (N,) in closed loop, with
+    """Each row of ``params`` (L, 12: ``LANE_PARAMETERS``) simulated over the set point (N,) in closed loop, with
     ``added_command`` (N,) added to the controller's (none: the controller alone)."""
     reference = finite_array("set_point_m", set_point_m, ndim=1)
     params = np.ascontiguousarray(finite_array("params", params, ndim=2))

@@ -19,7 +19,7 @@ import numpy as np
 from ema.estimate.assess.weighing import Assessed
 from ema.estimate.documents import Note
 from ema.kinds.servo.inverse import UNITS
-from ema.kinds.servo.load_effects import LOAD_EFFECTS, ServoEffect
+from ema.kinds.servo.load_effects import ServoEffect, looked_for
 from ema.kinds.servo.log_reading import ServoPrepared
 from ema.kinds.servo.stacked_solve import Solved, problem, solved
 
@@ -45,8 +45,9 @@ class Reading:
 
 
 def best_of(effect: ServoEffect, prepared: Sequence[ServoPrepared], model: dict[str, float]) -> tuple[float, Solved]:
-    """The effect at the grid value that predicts the held-out folds best."""
-    trials = [(value, solved(problem(prepared, {**model, effect.name: value}))) for value in effect.grid]
+    """The effect at the candidate constant (``ServoEffect.candidates``) that predicts the held-out folds best."""
+    values = effect.candidates(prepared[0].servo)
+    trials = [(value, solved(problem(prepared, {**model, effect.name: value}))) for value in values]
     return min(trials, key=lambda trial: float(trial[1].held_out_rss.sum()))
 
 
@@ -69,7 +70,7 @@ def held_readings(prepared: ServoPrepared, left_out: np.ndarray) -> tuple[Solved
     window = [replace(prepared, disturbed=left_out)]
     model = dict(prepared.effects)
     base = solved(problem(window, model))
-    found = [reading(effect, window, model, base) for effect in LOAD_EFFECTS if effect.name not in model]
+    found = [reading(effect, window, model, base) for effect in looked_for(prepared.servo, model)]
     return base, [r for r in found if r.held]
 
 

@@ -67,8 +67,12 @@ UNITS = {
     "presliding_n": "N",
     "presliding_travel_m": "m",
     **{f"position_{kind}_p{k}_n": "N" for kind in ("force", "friction") for k in range(1, POLYNOMIAL_ORDER + 1)},
+    "turn_ripple_sin_n": "N",
+    "turn_ripple_cos_n": "N",
 }
-EITHER_SIGN = frozenset(name for name in UNITS if name == "offset_n" or name.startswith("position_"))  # no sign
+EITHER_SIGN = frozenset(
+    name for name in UNITS if name == "offset_n" or name.startswith(("position_", "turn_ripple_"))
+)  # constants of either sign: an offset, a force along the stroke or the motor's turn
 
 
 @dataclass(frozen=True)
@@ -180,7 +184,7 @@ def inverse_columns(motion: Motion, effects: Mapping[str, float] | None = None) 
     nonlinear constant, ``ema.kinds.servo.load_effects`` says what each is): ``viscous_down`` splits C by
     direction; ``stribeck`` (v_S) adds sgn(q̇)·exp(−(q̇/v_S)²); ``presliding`` (σ) adds −sgn(q̇)·exp(−s/σ), s the
     travel since the last reversal; ``position_force`` adds P1..P3 of the position, ``position_friction``
-    sgn(q̇)·P1..P3."""
+    sgn(q̇)·P1..P3; ``turn_ripple`` (p, the travel per turn) sin(2π·q/p) and cos(2π·q/p)."""
     v, q = motion.speed_mps, motion.position_m
     sign = np.sign(v)
     columns = {"mass_kg": motion.acceleration_mps2, "viscous_ns_per_m": v, "fdj_n": sign, "offset_n": np.ones_like(v)}
@@ -196,6 +200,9 @@ def inverse_columns(motion: Motion, effects: Mapping[str, float] | None = None) 
         columns |= {f"position_force_p{k}_n": p for k, p in enumerate(_legendre(q), start=1)}
     if "position_friction" in effects:
         columns |= {f"position_friction_p{k}_n": sign * p for k, p in enumerate(_legendre(q), start=1)}
+    if "turn_ripple" in effects:
+        angle = 2.0 * np.pi * q / effects["turn_ripple"]
+        columns |= {"turn_ripple_sin_n": np.sin(angle), "turn_ripple_cos_n": np.cos(angle)}
     return columns
 
 

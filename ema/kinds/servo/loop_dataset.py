@@ -2,9 +2,9 @@
 around the physics estimate.
 
 Every constant the inverse model read that the simulator has (M, C or C per direction, FDJ, the offset, a
-Stribeck term) is drawn in a box centred on
-its estimate, ±``SPAN_SIGMAS`` of its std wide but never narrower than ``MIN_HALF_SHARE`` of FDJ (the offset
-may be near 0) or of itself, filled by a scrambled Halton sequence. Each simulation reads its position sensor
+Stribeck term, a force once per turn) is drawn in a box centred on its estimate, ±``SPAN_SIGMAS`` of its std wide
+but never narrower than ``MIN_HALF_SHARE`` of FDJ (a constant of either sign, which may be near 0) or of itself,
+filled by a scrambled Halton sequence. Each simulation reads its position sensor
 at its own phase of the sensor's step (the quantization a real log carries, drawn anew). The network's inputs
 are the drive's force, averaged into ``n_timesteps`` bins: what a window of this command shows of its
 constants.
@@ -27,7 +27,7 @@ import numpy as np
 from ema.estimate.config import PipelineConfig
 from ema.estimate.simulate.design import SPAN_SIGMAS, halton
 from ema.kinds.servo.closed_loop import LANE_PARAMETERS, ServoRuns
-from ema.kinds.servo.inverse import InverseSolution
+from ema.kinds.servo.inverse import EITHER_SIGN, InverseSolution
 from ema.kinds.servo.log_reading import ServoPrepared
 
 MIN_HALF_SHARE = 0.05
@@ -40,9 +40,12 @@ LANE_COLUMNS = {
     "offset_n": (4,),
     "stribeck_n": (5,),
     "presliding_n": (7,),
+    "turn_ripple_sin_n": (9,),
+    "turn_ripple_cos_n": (10,),
 }  # a constant of the inverse model the simulator has -> the lane parameters it sets (``LANE_PARAMETERS``)
 NONLINEAR_COLUMNS = {"stribeck": LANE_PARAMETERS.index("stribeck_speed_mps"),
-                     "presliding": LANE_PARAMETERS.index("presliding_travel_m")}  # fmt: skip
+                     "presliding": LANE_PARAMETERS.index("presliding_travel_m"),
+                     "turn_ripple": LANE_PARAMETERS.index("turn_ripple_travel_m")}  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -63,7 +66,7 @@ class ServoData:
 
 
 def lane_parameters(values: dict[str, float], effects: dict[str, float] | None = None) -> np.ndarray:
-    """(7,) a lane's parameters (``LANE_PARAMETERS``) from the inverse model's named constants and its effects'
+    """A lane's parameters (``LANE_PARAMETERS``) from the inverse model's named constants and its effects'
     nonlinear constants; the simulator leaves out what it has no parameter for."""
     lane = np.zeros(len(LANE_PARAMETERS))
     for name, value in values.items():
@@ -77,12 +80,13 @@ def lane_parameters(values: dict[str, float], effects: dict[str, float] | None =
 def box(physics: InverseSolution, targets: tuple[str, ...]) -> tuple[np.ndarray, np.ndarray]:
     """(low, high) of each target: its estimate ±max(``SPAN_SIGMAS`` stds, ``MIN_HALF_SHARE`` of its scale)."""
     scale = {name: abs(physics.values[name]) for name in targets}
-    scale["offset_n"] = abs(physics.values["fdj_n"])  # an offset near 0 is drawn on FDJ's scale
+    for name in EITHER_SIGN.intersection(targets):  # a constant of either sign, near 0, is drawn on FDJ's scale
+        scale[name] = abs(physics.values["fdj_n"])
     centre = np.array([physics.values[name] for name in targets])
     half = np.array([max(SPAN_SIGMAS * physics.stds[n], MIN_HALF_SHARE * scale[n], 1e-9) for n in targets])
     low = centre - half
     floor = np.array(
-        [-np.inf if name == "offset_n" else 1e-3 * abs(c) for name, c in zip(targets, centre, strict=True)]
+        [-np.inf if name in EITHER_SIGN else 1e-3 * abs(c) for name, c in zip(targets, centre, strict=True)]
     )
     shift = np.maximum(floor - low, 0.0)  # a box that would reach a negative mass or friction moves up, not shrinks
     return low + shift, centre + half + shift

@@ -20,11 +20,15 @@ def _lane(**values: float) -> np.ndarray:
 def test_the_compiled_kernel_is_its_python_twin():
     reference = foreign.set_point(3, seconds=1.5)
     params = np.vstack(
-        [_lane(), _lane(stribeck_n=4.0, stribeck_speed_mps=0.01, presliding_n=5.0, presliding_travel_m=1e-4)]
+        [
+            _lane(),
+            _lane(stribeck_n=4.0, stribeck_speed_mps=0.01, presliding_n=5.0, presliding_travel_m=1e-4),
+            _lane(turn_ripple_sin_n=1.5, turn_ripple_cos_n=-0.8, turn_ripple_travel_m=2.5e-3),
+        ]
     )
     outputs = []
     for kernel in (servo_sim.run_lanes, servo_sim.run_lanes.py_func):
-        q, f = np.empty((2, len(reference))), np.empty((2, len(reference)))
+        q, f = np.empty((3, len(reference))), np.empty((3, len(reference)))
         constants = np.array(
             [
                 LOOP.position_gain_per_s,
@@ -42,10 +46,10 @@ def test_the_compiled_kernel_is_its_python_twin():
             constants,
             np.array(LOOP.taps),
             params,
-            np.zeros(2),
+            np.zeros(3),
             np.array([reference[0], 0.0]),
             0,
-            2,
+            3,
             q,
             f,
         )
@@ -70,6 +74,20 @@ def test_the_closed_loop_follows_the_foreign_servo(seed):
     run = simulate_servo(reference, lane, LOOP, start=(reference[0], 0.0))
     assert np.sqrt(np.mean((run.position_m[0] - position) ** 2)) < 2e-6  # 2 µm on a 0.25 m stroke
     assert np.linalg.norm(run.drive_force_n[0] - force) / np.linalg.norm(force) < 0.02
+
+
+def test_a_force_once_per_turn_follows_the_foreign_servos():
+    """The foreign servo holds the turn's force over each 100th of a sample and solves the load between; ours takes it
+    at each of ten steps: the same force along the travel, read alike, and without it the loops part."""
+    load = foreign.Load(turn_n=(1.5, -0.8))
+    reference = foreign.set_point(0, seconds=6.0)
+    _, force = foreign.simulate(reference, load)
+    ripple = {"turn_ripple_sin_n": 1.5, "turn_ripple_cos_n": -0.8, "turn_ripple_travel_m": load.travel_per_turn_m}
+    errors = []
+    for lane in (_lane(**ripple), _lane()):
+        run = simulate_servo(reference, lane, LOOP, start=(reference[0], 0.0))
+        errors.append(np.linalg.norm(run.drive_force_n[0] - force) / np.linalg.norm(force))
+    assert errors[0] < 0.005 < 0.015 < errors[1]
 
 
 def test_a_command_added_to_the_controllers_is_logged_as_the_drive_applies_it():
