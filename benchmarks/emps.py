@@ -13,7 +13,8 @@ with the example document and with the completed one, each against the estimatio
 network disagrees with physics there), and each model's error on it with its constants fixed: ema's learned ones
 and the published ones of each form. Without it, a stand-in is read the same way: the estimation run with pulses
 added to its command and felt by the load (``pulsed_copy``), which shows how the three checks behave on a log whose
-command is not only its controller's, not what the held-out run reads.
+command is not only its controller's, not what the held-out run reads; then stand-ins of other excitations
+(``SWEEP``: 20 or 80 pulses of 1.5 to 8 V), each read with both documents.
 
     python -m benchmarks.emps [--held-out F.mat --held-out-map M.json] [--docs]
 """
@@ -33,10 +34,11 @@ from ema.cli.benchmark_docs import typed_command, write_section
 from ema.estimate import thread_budget
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import STAGES
+from ema.estimate.stats import rms
 from ema.kinds import CalibrationRequest, calibrate, estimate
 from ema.kinds.servo.fold_errors import model_errors_pct
 from ema.kinds.servo.inverse import UNITS
-from ema.kinds.servo.log_reading import completed, log_loop, prepare_servo
+from ema.kinds.servo.log_reading import completed, followed_loop, log_loop, prepare_servo
 from ema.kinds.servo.stages import physics_of
 from ema.model.actuator import ServoActuator, as_kind, read_actuator
 from ema.model.logmap import read_logmap, read_mapped
@@ -190,7 +192,15 @@ def main() -> None:
             held_out = read(args.held_out, args.held_out_map or mapping)
             lines += ["", f"The held-out run ({args.held_out.name}):", "", *held_out_lines(held_out, runs)]
         else:
-            lines += ["", PULSED_SAID, "", *held_out_lines(pulsed_copy(window), runs, name="stand-in")]
+            stand_in = pulsed_copy(window, PULSES)
+            lines += [
+                "",
+                PULSED_SAID,
+                "",
+                *held_out_lines(stand_in, runs, name="stand-in"),
+                "",
+                *sweep_lines(window, runs),
+            ]
     body = "\n".join(lines)
     print(body)
     if args.docs:
@@ -259,10 +269,11 @@ def _base_model(window: Window, document: ServoActuator) -> dict[str, dict]:
     return {NAMES[n]: {"value": solution.values[n], "std": solution.stds[n], "unit": UNITS[n]} for n in NAMES}
 
 
-PULSE_SEED, PULSE_COUNT, PULSE_HEIGHT_V = 7, 40, 3.0  # the stand-in's excitation (``foreign.excitation``)
+PULSES = (7, 40, 3.0)  # the stand-in's excitation (``foreign.excitation``): its seed, pulses and their height [V]
+SWEEP = tuple((seed, count, height) for seed in (1, 2) for count in (20, 80) for height in (1.5, 5.0, 8.0))
 PULSED_SAID = (
     "The held-out run is not here. A stand-in, read as it would be: the estimation run with an excitation added to "
-    f"its command ({PULSE_COUNT} pulses of {PULSE_HEIGHT_V:g} V for 10-40 ms and a slow sine, seed {PULSE_SEED}) "
+    f"its command ({PULSES[1]} pulses of {PULSES[2]:g} V for 10-40 ms and a slow sine, seed {PULSES[0]}) "
     "and felt by the load: its position and force moved by what the independent closed-form servo "
     "(`tests/foreign/servo.py`, at the benchmark's asymmetric constants and the log's gains) does under that "
     "excitation. Its misfit is the real log's; the pulses' response is a simulator's, so this shows how the checks "
@@ -270,10 +281,10 @@ PULSED_SAID = (
 )
 
 
-def pulsed_copy(window: Window) -> Window:
-    """The estimation run with the ``PULSE_*`` excitation added to its command and felt: the foreign servo's response
-    to it (its run with the excitation less its run without, over the log's set point) added to the logged position
-    and force."""
+def pulsed_copy(window: Window, pulses: tuple[int, int, float]) -> Window:
+    """The estimation run with an excitation (``PULSES``' form) added to its command and felt: the foreign servo's
+    response to it (its run with the excitation less its run without, over the log's set point) added to the logged
+    position and force, the force saturated where the sum passes the drive's limit."""
     s, c = window.signals, window.constants
     gains = (c["position_gain_per_s"], c["speed_gain_per_mps"], c["drive_gain_n_per_unit"])
     load = foreign.Load(
@@ -283,12 +294,54 @@ def pulsed_copy(window: Window) -> Window:
         viscous_down_ns_per_m=PUBLISHED_ASYMMETRIC["viscous_down_ns_per_m"],
         offset_n=PUBLISHED_ASYMMETRIC["offset_n"],
     )
-    excitation = foreign.excitation(PULSE_SEED, window.n_samples, PULSE_HEIGHT_V, PULSE_COUNT)
+    seed, count, height_v = pulses
+    excitation = foreign.excitation(seed, window.n_samples, height_v, count)
     plain = foreign.simulate(s["set_point_m"], load, gains=gains)
     pulsed = foreign.simulate(s["set_point_m"], load, added_v=excitation, gains=gains)
     moved = {"position_m": pulsed[0] - plain[0], "drive_force_n": pulsed[1] - plain[1]}
     signals = {name: values + moved.get(name, 0.0) for name, values in s.items()}
+    top = foreign.LIMIT * gains[2]  # the drive saturates the sum as it saturated each run
+    signals["drive_force_n"] = np.clip(signals["drive_force_n"], -top, top)
     return replace(window, signals=signals, window_id=f"{window.window_id} pulsed")
+
+
+def sweep_lines(window: Window, runs: dict[str, tuple[ServoActuator, dict]]) -> list[str]:
+    """Stand-ins of other excitations (``SWEEP``), each read with both documents: the lab's three checks on each."""
+    lines = [
+        "Stand-ins of other excitations, each read with the bundled / the calibrated document: the closed loop's force "
+        "error, FDJ apart from the estimation run's in stds of the difference, and any `network_disagrees`:",
+        "",
+        "| seed | pulses | height [V] | added command, share of the command's RMS | force error | FDJ apart | "
+        "network_disagrees |",
+        "|---:|---:|---:|---:|---|---|---|",
+    ]
+    for pulses in SWEEP:
+        copy = pulsed_copy(window, pulses)
+        errors, apart, disagree = [], [], []
+        for document, first in runs.values():
+            read_out = estimate(copy, actuator=document)
+            fdj = read_out.estimates.FDJ
+            errors.append(f"{read_out.check.output_error_pct['drive_force_n']:.2f} %")
+            gap = first["estimates"]["FDJ"]["value"] - fdj.value
+            apart.append(f"{abs(gap) / float(np.hypot(first['estimates']['FDJ']['std'], fdj.std or 0.0)):.2f}")
+            disagree += [
+                n for n, m in read_out.methods.items() if m.network_note and m.network_note.code == "network_disagrees"
+            ]
+        lines.append(
+            f"| {pulses[0]} | {pulses[1]} | {pulses[2]:g} | {_added_share(copy, runs['bundled'][0])} | "
+            f"{' / '.join(errors)} | {' / '.join(apart)} | {', '.join(sorted(set(disagree))) or 'none'} |"
+        )
+    return lines
+
+
+def _added_share(window: Window, document: ServoActuator) -> str:
+    """The command added to the loop's that the log shows, as a share of the logged command's RMS."""
+    servo = completed(document, window)
+    added = followed_loop(servo, window).added
+    if added is None:
+        return "not read"
+    logged = window.signals["drive_force_n"] / (servo.drive_gain_n_per_unit or 1.0)
+    return f"{100 * rms(added.values) / rms(logged):.0f} %"
 
 
 def held_out_lines(
