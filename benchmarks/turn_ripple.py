@@ -13,12 +13,12 @@ force as the completed document keeps it.
 from __future__ import annotations
 
 import argparse
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
 from benchmarks.foreign_accuracy import RESULTS_MD
+from benchmarks.two_runs import parts
 from ema.calibration.documents import ServoCalibration
 from ema.cli.benchmark_docs import typed_command, write_section
 from ema.estimate import thread_budget
@@ -77,16 +77,9 @@ def period_lines(window: Window) -> list[str]:
     ]
 
 
-def _parts(window: Window) -> list[tuple[str, Window]]:
-    n = window.n_samples
-    spans = [("whole", 0, n), ("first half", 0, n // 2), ("second half", n // 2, n)]
-    spans += [(f"quarter {i + 1}", i * n // 4, (i + 1) * n // 4) for i in range(4)]
-    return [(name, replace(window, signals={k: v[a:b] for k, v in window.signals.items()})) for name, a, b in spans]
-
-
 def part_rows(window: Window) -> list[str]:
     rows = []
-    for name, part in _parts(window):
+    for name, part in parts(window):
         before, after = solution(part, None), solution(part, TURN_M)
         a, b = after.values["turn_ripple_sin_n"], after.values["turn_ripple_cos_n"]
         rows.append(

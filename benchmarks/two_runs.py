@@ -69,7 +69,8 @@ def foreign_rows(seeds: int) -> tuple[list[str], dict[str, tuple[int, int, int]]
     return rows, counts
 
 
-def _parts(window: Window) -> list[tuple[str, Window]]:
+def parts(window: Window) -> list[tuple[str, Window]]:
+    """The log whole, its halves and its quarters, each named."""
     n = window.n_samples
     spans = [("whole", 0, n), ("first half", 0, n // 2), ("second half", n // 2, n)]
     spans += [(f"quarter {i + 1}", i * n // 4, (i + 1) * n // 4) for i in range(4)]
@@ -82,7 +83,7 @@ def _parts(window: Window) -> list[tuple[str, Window]]:
 def emps_rows(window: Window, documents: dict[str, ActuatorDocument]) -> list[str]:
     rows = []
     for label, document in documents.items():
-        for name, part in _parts(window):
+        for name, part in parts(window):
             value, std, widened = _fdj(estimate(part, actuator=document))
             rows.append(f"| {label} | {name} | {value:.3f} ± {std:.3f} | {'yes' if widened else 'no'} |")
     return rows
