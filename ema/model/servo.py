@@ -12,7 +12,7 @@ a force ``drive_gain_n_per_unit``·u on the load, held until the next sample. Th
 
 C the viscous coefficient (``viscous_down_ns_per_m`` where moving towards decreasing position differs). Where
 ``travel_per_turn_m`` is given, ``ema calibrate`` also looks for a force that repeats once per turn of the motor
-(its cogging, a screw's or a coupling's eccentricity). The
+(a screw's, a nut's or a coupling's eccentricity). The
 controller's constants are on its own data sheet or in the log (a log map may read them from the file); the
 load's (M, C, the offset, the nominal FDJ) are learned by ``ema calibrate`` where the document lacks them.
 """

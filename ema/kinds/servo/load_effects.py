@@ -10,8 +10,9 @@ when its solved constants are physical. Its columns of Eq. 5.1 are ``ema.kinds.s
 - ``position_force``: a force that changes along the stroke (a spring, a cable, a slope).
 - ``position_friction``: a friction that changes along the stroke (a preload that varies, a local defect).
 - ``turn_ripple``: a force that repeats once per turn of the motor, A·sin(2π·q/p) + B·cos(2π·q/p), p the load's
-  travel per turn (the document's ``travel_per_turn_m``: without it, not looked for): the motor's cogging, a
-  screw's or a coupling's eccentricity. Its phase is fixed to the motor's angle, so it is a force, not a friction.
+  travel per turn (the document's ``travel_per_turn_m``: without it, not looked for): a screw's, a nut's or a
+  coupling's eccentricity or misalignment (a motor's cogging repeats at its poles' count, not once a turn). Its
+  phase is fixed to the motor's angle, so it is a force, not a friction.
 
 A constant asymmetry of the Coulomb level is not among them: while the load moves, it is the offset itself.
 """
@@ -30,7 +31,7 @@ from ema.model.servo import Servo
 class ServoEffect:
     name: str
     description: str
-    grid: tuple[float, ...]  # its nonlinear constant's candidates (one value: it has none)
+    grid: tuple[float, ...]  # its nonlinear constant's candidates (one value: it has none; none: ``given_by``)
     plausible: Callable[[dict[str, float]], bool] = lambda _: True  # of the solved constants
     constant: tuple[str, str] | None = None  # its nonlinear constant's name and unit
     given_by: str | None = None  # the document's field that gives its one constant (the grid), not learned
@@ -69,7 +70,7 @@ LOAD_EFFECTS = (
     ServoEffect("position_friction", "a friction that changes along the stroke (a varying preload, a defect)", (1.0,)),
     ServoEffect(
         "turn_ripple",
-        "a force repeating once per turn of the motor (cogging, a screw's or a coupling's eccentricity)",
+        "a force repeating once per turn of the motor (a screw's, a nut's or a coupling's eccentricity)",
         (),
         given_by="travel_per_turn_m",
     ),
