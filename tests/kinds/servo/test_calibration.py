@@ -3,6 +3,7 @@ windows hold one (the closed-form foreign servo, several seeds), and the EMPS lo
 
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from ema.estimate.config import PipelineConfig
@@ -101,6 +102,17 @@ def test_the_emps_logs_misfit_is_traced_to_a_direction_dependent_viscous_frictio
     assert learned["FDJ"].value == pytest.approx(20.3935, rel=0.03)
     assert learned["viscous_up"].value < learned["viscous_down"].value
     assert not [c for c in report.candidates if c.effect == "stribeck" and c.plausible]  # a negative excess
+
+
+def test_the_emps_logs_force_once_per_turn_is_named_with_its_size(emps):
+    """EMPS's document gives the motor's turn (2.5 mm of travel): the log holds a force of about 1 N repeating with
+    it, named after the viscous friction by direction (benchmarks.turn_ripple: the same in every quarter)."""
+    report = emps[1].report
+    assert report.selected_effects == ["viscous_down", "turn_ripple"]
+    learned = {entry.name: entry for entry in report.learned}
+    amplitude = float(np.hypot(learned["turn_ripple_sin_n"].value, learned["turn_ripple_cos_n"].value))
+    assert 0.8 < amplitude < 1.2 and learned["turn_ripple_sin_n"].unit == "N"
+    assert emps[1].completed.servo.effects["turn_ripple"] == pytest.approx(2.5e-3)
 
 
 def test_every_candidate_is_scored_against_the_noise_only_copies(emps):
