@@ -21,7 +21,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from pydantic import Field, field_validator
+from pydantic import Field, field_validator, model_validator
 
 from ema.model.document import Document, Number
 
@@ -122,6 +122,17 @@ class Servo(Document):
         if any(value <= 0 for value in effects.values()):
             raise ValueError("an effect's constant is positive (a speed, a travel; 1 where it has none)")
         return effects
+
+    @model_validator(mode="after")
+    def _one_turn(self) -> Servo:
+        """An adopted force once per turn repeats at the machine's turn, where the document gives it."""
+        period, turn = self.effects.get("turn_ripple"), self.travel_per_turn_m
+        if period is not None and turn is not None and abs(period - turn) > 1e-9 * turn:
+            raise ValueError(
+                f"servo.effects.turn_ripple repeats every {period:g} m where servo.travel_per_turn_m is {turn:g} m: a "
+                "machine turns one way (calibrate again with the document's turn)"
+            )
+        return self
 
     @property
     def gear_ratio(self) -> float:

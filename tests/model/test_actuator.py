@@ -1,6 +1,7 @@
 """The ema-actuator/1 document: validated naming the field, the thesis's the default, what stages read of it."""
 
 import json
+import re
 from pathlib import Path
 
 import pytest
@@ -103,3 +104,12 @@ def test_a_document_as_first_written_still_reads_and_another_kinds_section_is_re
     with pytest.raises(InputError, match="gives its drive") as refused:
         actuator_from_dict({key: value for key, value in document.items() if key != "drive"})
     assert refused.value.field == "drive"
+
+
+def test_a_servos_force_once_per_turn_repeats_at_its_documents_turn():
+    servo = {"command_limit": 10.0, "travel_per_turn_m": 2.5e-3, "effects": {"turn_ripple": 2.5e-3}}
+    document = {"schema": "ema-actuator/1", "name": "a servo", "kind": "servo", "servo": servo}
+    assert actuator_from_dict(document).servo.effects == {"turn_ripple": 2.5e-3}
+    said = "servo.effects.turn_ripple repeats every 0.005 m where servo.travel_per_turn_m is 0.0025 m"
+    with pytest.raises(InputError, match=re.escape(said)):
+        actuator_from_dict({**document, "servo": {**servo, "effects": {"turn_ripple": 5e-3}}})
