@@ -38,6 +38,7 @@ SAME_SHARE = 1e-6  # a set point within this share of its stroke, RMS, of itself
 
 
 def twice_calibrated(window: Window) -> ActuatorDocument:
+    """The bundled document completed by ``ema calibrate`` on the log, and completed again on the completed one."""
     document = read_actuator(EMPS / "actuator.json")
     for _ in range(2):
         completed = calibrate([window], CalibrationRequest(PipelineConfig(), document)).completed
