@@ -40,7 +40,7 @@ from ema.kinds.servo.fold_errors import model_errors_pct
 from ema.kinds.servo.inverse import UNITS
 from ema.kinds.servo.log_reading import completed, followed_loop, log_loop, prepare_servo
 from ema.kinds.servo.stages import physics_of
-from ema.model.actuator import ServoActuator, as_kind, read_actuator
+from ema.model.actuator import ActuatorDocument, ServoActuator, as_kind, read_actuator
 from ema.model.logmap import read_logmap, read_mapped
 from ema.model.window import Window, window_from_dict
 from tests.foreign import servo as foreign
@@ -70,6 +70,22 @@ NAMES = {"mass_kg": "mass", "viscous_ns_per_m": "viscous", "fdj_n": "FDJ", "offs
 
 def read(path: Path, mapping: Path) -> Window:
     return window_from_dict(read_mapped(path, read_logmap(mapping)))
+
+
+def estimation_run() -> Window:
+    """The benchmark's estimation run, as the bundled log map reads it."""
+    return read(EMPS / "DATA_EMPS.mat", EMPS / "log-map.json")
+
+
+def calibrations(window: Window, times: int) -> list[ActuatorDocument]:
+    """The bundled document, then each document ``ema calibrate`` completes on ``window`` from the one before:
+    ``times`` + 1 documents."""
+    documents = [read_actuator(EMPS / "actuator.json")]
+    for _ in range(times):
+        completed = calibrate([window], CalibrationRequest(PipelineConfig(), documents[-1])).completed
+        assert completed is not None, "the EMPS log completes its document"
+        documents.append(completed)
+    return documents
 
 
 def cli_seconds(path: Path, mapping: Path, actuator: Path) -> tuple[float, dict]:
@@ -155,7 +171,7 @@ def main() -> None:
     args = parser.parse_args()
     thread_budget.configure(None)
     mapping, document_path = EMPS / "log-map.json", EMPS / "actuator.json"
-    window, document = read(EMPS / "DATA_EMPS.mat", mapping), as_kind(read_actuator(document_path), ServoActuator)
+    window, document = estimation_run(), as_kind(read_actuator(document_path), ServoActuator)
     wall, answer = cli_seconds(EMPS / "DATA_EMPS.mat", mapping, document_path)
     stages = answer["timings_s"]
     calibrated = calibrate([window], CalibrationRequest(PipelineConfig(), document))

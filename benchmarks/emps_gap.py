@@ -13,38 +13,23 @@ motion repeated cannot tell what that function follows.
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 
 import numpy as np
 
+from benchmarks.emps import calibrations, estimation_run
 from benchmarks.foreign_accuracy import RESULTS_MD
 from ema.cli.benchmark_docs import typed_command, write_section
 from ema.estimate import thread_budget
-from ema.estimate.config import PipelineConfig
 from ema.estimate.stats import rms
-from ema.kinds import CalibrationRequest, calibrate
 from ema.kinds.servo.inverse import decimated_problem, inverse_columns, solve_inverse
 from ema.kinds.servo.log_reading import ServoPrepared, prepare_servo
 from ema.kinds.servo.stacked_solve import noise_copies, problem, solved
-from ema.model.actuator import ActuatorDocument, ServoActuator, as_kind, read_actuator
-from ema.model.logmap import read_logmap, read_mapped
-from ema.model.window import Window, window_from_dict
+from ema.model.actuator import ServoActuator, as_kind
 
-EMPS = Path(__file__).resolve().parents[1] / "examples" / "emps"
 TITLE = "What is left of the EMPS log: a motion the model lacks, repeated with the set point"
 MIN_PERIOD_S = 1.0
 KNOTS = 160  # the map along the stroke tried: hat functions on this many knots, a force and a friction on each
 SAME_SHARE = 1e-6  # a set point within this share of its stroke, RMS, of itself a lag later repeats there
-
-
-def twice_calibrated(window: Window) -> ActuatorDocument:
-    """The bundled document completed by ``ema calibrate`` on the log, and completed again on the completed one."""
-    document = read_actuator(EMPS / "actuator.json")
-    for _ in range(2):
-        completed = calibrate([window], CalibrationRequest(PipelineConfig(), document)).completed
-        assert completed is not None, "the EMPS log completes its document"
-        document = completed
-    return document
 
 
 def period(set_point_m: np.ndarray) -> int | None:
@@ -127,8 +112,8 @@ def main() -> None:
     parser.add_argument("--docs", action="store_true", help="rewrite its section of docs/results.md")
     args = parser.parse_args()
     thread_budget.configure(None)
-    window = window_from_dict(read_mapped(EMPS / "DATA_EMPS.mat", read_logmap(EMPS / "log-map.json")))
-    document = as_kind(twice_calibrated(window), ServoActuator)
+    window = estimation_run()
+    document = as_kind(calibrations(window, 2)[-1], ServoActuator)
     prepared = prepare_servo(window, document)
     lag = period(window.signals["set_point_m"])
     assert lag is not None, "the EMPS set point is periodic"

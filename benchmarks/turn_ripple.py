@@ -13,10 +13,10 @@ force as the completed document keeps it.
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 
 import numpy as np
 
+from benchmarks.emps import calibrations, estimation_run
 from benchmarks.foreign_accuracy import RESULTS_MD
 from benchmarks.two_runs import parts
 from ema.calibration.documents import ServoCalibration
@@ -27,12 +27,10 @@ from ema.kinds import CalibrationRequest, calibrate, estimate
 from ema.kinds.servo.inverse import InverseSolution, inverse_columns, load_motion, solve_inverse
 from ema.kinds.servo.log_reading import prepare_servo
 from ema.kinds.servo.stages import physics_of
-from ema.model.actuator import ServoActuator, actuator_from_dict, as_kind, read_actuator
-from ema.model.logmap import read_logmap, read_mapped
+from ema.model.actuator import ServoActuator, actuator_from_dict, as_kind
 from ema.model.window import Window, window_from_dict
 from tests.foreign import servo as foreign
 
-EMPS = Path(__file__).resolve().parents[1] / "examples" / "emps"
 TITLE = "What else EMPS holds: a force once per turn of the motor"
 TURN_M = 2.5e-3  # 50,000 encoder counts of 50 nm
 BANDWIDTH_HZ, STEP_M = 20.0, 5e-8  # the EMPS document's loop bandwidth; the log's encoder step
@@ -115,20 +113,20 @@ def foreign_rows(seeds: int) -> list[str]:
 def chain_rows(window: Window) -> list[str]:
     """The bundled document, then ``ema calibrate`` on the log twice, each document's model read on it by an
     estimate: its effects, the inverse error, the Eq. 5.1 residual over its simulations', the closed loop's error."""
-    document, rows = read_actuator(EMPS / "actuator.json"), []
-    for label in ("bundled", "calibrated once", "calibrated twice"):
+    rows = []
+    for label, document in zip(
+        ("bundled", "calibrated once", "calibrated twice"), calibrations(window, 2), strict=True
+    ):
         answer = estimate(window, actuator=document)
-        servo = as_kind(document, ServoActuator).servo
+        servo_document = as_kind(document, ServoActuator)
+        servo = servo_document.servo
         effects = (["viscous_down"] if servo.viscous_down_ns_per_m is not None else []) + list(servo.effects)
         fdj, check = answer.estimates.FDJ, answer.check
-        error = physics_of(prepare_servo(window, as_kind(document, ServoActuator))).error_pct
+        error = physics_of(prepare_servo(window, servo_document)).error_pct
         rows.append(
             f"| {label} | {', '.join(effects) or '—'} | {error:.2f} % | {check.equation_error_ratio:.2f}x | "
             f"{check.output_error_pct['drive_force_n']:.2f} % | {fdj.value:.3f} ± {fdj.std:.3f} |"
         )
-        completed = calibrate([window], CalibrationRequest(PipelineConfig(), document)).completed
-        assert completed is not None, "the EMPS log completes its document"
-        document = completed
     return rows
 
 
@@ -138,7 +136,7 @@ def main() -> None:
     parser.add_argument("--docs", action="store_true", help="rewrite its section of docs/results.md")
     args = parser.parse_args()
     thread_budget.configure(None)
-    window = window_from_dict(read_mapped(EMPS / "DATA_EMPS.mat", read_logmap(EMPS / "log-map.json")))
+    window = estimation_run()
     body = "\n".join(
         [
             *period_lines(window),

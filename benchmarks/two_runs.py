@@ -14,22 +14,19 @@ from __future__ import annotations
 
 import argparse
 from dataclasses import replace
-from pathlib import Path
 
 import numpy as np
 
+from benchmarks.emps import calibrations, estimation_run
 from benchmarks.foreign_accuracy import RESULTS_MD
 from ema.cli.benchmark_docs import typed_command, write_section
 from ema.estimate import thread_budget
-from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import Estimate
-from ema.kinds import CalibrationRequest, calibrate, estimate
-from ema.model.actuator import ActuatorDocument, actuator_from_dict, read_actuator
-from ema.model.logmap import read_logmap, read_mapped
+from ema.kinds import estimate
+from ema.model.actuator import ActuatorDocument, actuator_from_dict
 from ema.model.window import Window, window_from_dict
 from tests.foreign import servo as foreign
 
-EMPS = Path(__file__).resolve().parents[1] / "examples" / "emps"
 TITLE = "Two runs of one machine, where the model misses part of it"
 ASYMMETRIC = foreign.Load(viscous_up_ns_per_m=160.0, viscous_down_ns_per_m=240.0)
 READING = """Reading it. Where the model misses part of a log (`model_misfit`: its Eq. 5.1 residual beyond what its
@@ -96,10 +93,8 @@ def main() -> None:
     args = parser.parse_args()
     thread_budget.configure(None)
     rows, counts = foreign_rows(args.seeds)
-    window = window_from_dict(read_mapped(EMPS / "DATA_EMPS.mat", read_logmap(EMPS / "log-map.json")))
-    bundled = read_actuator(EMPS / "actuator.json")
-    completed = calibrate([window], CalibrationRequest(PipelineConfig(), bundled)).completed
-    documents = {"bundled": bundled, **({"calibrated": completed} if completed is not None else {})}
+    window = estimation_run()
+    documents = dict(zip(("bundled", "calibrated"), calibrations(window, 1), strict=True))
     said = "; ".join(
         f"{label}: {pairs} of {total // 2} pairs within 2 std of their difference, {held} of {total} readings hold "
         "the truth within 2 std"
