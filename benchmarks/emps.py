@@ -22,7 +22,7 @@ command is not only its controller's, not what the held-out run reads; then stan
 from __future__ import annotations
 
 import argparse
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -33,7 +33,7 @@ from ema.calibration.documents import ServoCalibration
 from ema.cli.benchmark_docs import typed_command, write_section
 from ema.estimate import thread_budget
 from ema.estimate.config import PipelineConfig
-from ema.estimate.documents import STAGES
+from ema.estimate.documents import STAGES, Estimate
 from ema.estimate.stats import rms
 from ema.kinds import CalibrationRequest, calibrate, estimate
 from ema.kinds.servo.fold_errors import model_errors_pct
@@ -321,6 +321,28 @@ def pulsed_copy(window: Window, pulses: tuple[int, int, float]) -> Window:
     return replace(window, signals=signals, window_id=f"{window.window_id} pulsed")
 
 
+@dataclass(frozen=True)
+class Checked:
+    """A second run read with a document, against the estimation run's answer with it: the lab's three checks."""
+
+    answer: Estimate  # the second run's: its closed-loop check
+    gap_n: float  # |FDJ of one run − the other's|
+    std_n: float  # the std of that difference
+    disagrees: list[str]  # the constants the network disagrees with physics on
+
+
+def checked(window: Window, document: ServoActuator, first: dict) -> Checked:
+    """``window`` estimated with ``document``, against ``first`` (the estimation run's answer with it, as JSON)."""
+    answer = estimate(window, actuator=document)
+    fdj, before = answer.estimates.FDJ, first["estimates"]["FDJ"]
+    return Checked(
+        answer,
+        abs(before["value"] - fdj.value),
+        float(np.hypot(before["std"], fdj.std or 0.0)),
+        [n for n, m in answer.methods.items() if m.network_note and m.network_note.code == "network_disagrees"],
+    )
+
+
 def sweep_lines(window: Window, runs: dict[str, tuple[ServoActuator, dict]]) -> list[str]:
     """Stand-ins of other excitations (``SWEEP``), each read with both documents: the lab's three checks on each."""
     lines = [
@@ -335,14 +357,10 @@ def sweep_lines(window: Window, runs: dict[str, tuple[ServoActuator, dict]]) -> 
         copy = pulsed_copy(window, pulses)
         errors, apart, disagree = [], [], []
         for document, first in runs.values():
-            read_out = estimate(copy, actuator=document)
-            fdj = read_out.estimates.FDJ
-            errors.append(f"{read_out.check.output_error_pct['drive_force_n']:.2f} %")
-            gap = first["estimates"]["FDJ"]["value"] - fdj.value
-            apart.append(f"{abs(gap) / float(np.hypot(first['estimates']['FDJ']['std'], fdj.std or 0.0)):.2f}")
-            disagree += [
-                n for n, m in read_out.methods.items() if m.network_note and m.network_note.code == "network_disagrees"
-            ]
+            read_out = checked(copy, document, first)
+            errors.append(f"{read_out.answer.check.output_error_pct['drive_force_n']:.2f} %")
+            apart.append(f"{read_out.gap_n / read_out.std_n:.2f}")
+            disagree += read_out.disagrees
         lines.append(
             f"| {pulses[0]} | {pulses[1]} | {pulses[2]:g} | {_added_share(copy, runs['bundled'][0])} | "
             f"{' / '.join(errors)} | {' / '.join(apart)} | {', '.join(sorted(set(disagree))) or 'none'} |"
@@ -372,13 +390,9 @@ def held_out_lines(
         "|---|---:|---:|---:|---|---|",
     ]
     for label, (document, first) in runs.items():
-        read_out = estimate(window, actuator=document)
-        second, check = read_out.estimates.FDJ, read_out.check
-        gap = abs(first["estimates"]["FDJ"]["value"] - second.value)
-        allowed = 2 * float(np.hypot(first["estimates"]["FDJ"]["std"], second.std or 0.0))
-        disagrees = [
-            n for n, m in read_out.methods.items() if m.network_note and m.network_note.code == "network_disagrees"
-        ]
+        read_out = checked(window, document, first)
+        second, check = read_out.answer.estimates.FDJ, read_out.answer.check
+        gap, allowed, disagrees = read_out.gap_n, 2 * read_out.std_n, read_out.disagrees
         lines.append(
             f"| {label} | {first['estimates']['FDJ']['value']:.3f} ± {first['estimates']['FDJ']['std']:.3f} | "
             f"{second.value:.3f} ± {second.std:.3f} | {gap:.3f} N, {'within' if gap <= allowed else 'beyond'} "
