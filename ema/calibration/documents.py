@@ -237,11 +237,36 @@ class ServoCalibration(CalibrationReport):
     )
 
 
+class LoadReading(Document):
+    """One load's runs read with the completed document: how their health readings sit (a geared servo's)."""
+
+    load: str = Field(description="the load, for a person (its mass and arm)")
+    runs: int
+    median: dict[str, float] = Field(description="the runs' median FDJ (fdj_nm), η_O (eta_o), η_A (eta_a)")
+    z: dict[str, float] = Field(
+        description="(median − nominal) over the nominal's std: within ±2 the load reads the servo the others read"
+    )
+
+
+class GearedCalibration(CalibrationReport):
+    """A geared servo's report: its position error before and after, and its runs read per load."""
+
+    kind: Literal["geared"] = Field("geared", description=_KIND_DESCRIPTION)
+    position_error_rad: dict[str, float] = Field(
+        default_factory=dict,
+        description="mean |logged − simulated position| over the runs [rad]: before (a constant friction) and after "
+        "(the named effects), in sample and held out (runs a solution did not see)",
+    )
+    by_load: list[LoadReading] = Field(
+        default_factory=list, description="each load's runs read with the completed document, against its nominal"
+    )
+
+
 _PARTS = {  # each kind's own parts of a report, beside the shared ones
     report.model_fields["kind"].default: tuple(
         name for name in report.model_fields if name not in CalibrationReport.model_fields
     )
-    for report in (RotaryCalibration, LinearCalibration, ServoCalibration)
+    for report in (RotaryCalibration, LinearCalibration, ServoCalibration, GearedCalibration)
 }
 
 
@@ -259,7 +284,8 @@ def kind_written(report: dict) -> str:
 AnyCalibration = Annotated[
     Annotated[RotaryCalibration, Tag("rotary")]
     | Annotated[LinearCalibration, Tag("linear")]
-    | Annotated[ServoCalibration, Tag("servo")],
+    | Annotated[ServoCalibration, Tag("servo")]
+    | Annotated[GearedCalibration, Tag("geared")],
     tagged_by("kind", KIND_NAMES, kind_written),
 ]  # ``ema-calibration/1`` as read: one kind's report, by its ``kind``
 CALIBRATION_REPORT: TypeAdapter[CalibrationReport] = TypeAdapter(AnyCalibration)  # what parses and exports it

@@ -84,6 +84,15 @@ def _from_json(path: Path) -> list[Window]:
     return [window_from_dict(d) for d in documents]
 
 
+def _ema_document(path: Path) -> bool:
+    """Whether a JSON file is one of ema's documents (a window, or one that goes beside a log), not a recorder's log."""
+    document = load_json(path)
+    return isinstance(document, dict | list) and any(
+        isinstance(d, dict) and str(d.get("schema", "")).startswith("ema-")
+        for d in (document if isinstance(document, list) else [document])
+    )
+
+
 def _from_table(path: Path, defaults: Defaults) -> list[Window]:
     """A CSV or NPZ in ema's own columns, named as the signals of a window of its kind (the kind whose signals
     it holds: ``tabled_kind``; others ignored); a CSV's ``# key: value`` lines on top, an NPZ's text arrays, give
@@ -140,16 +149,16 @@ def _window(signals: dict[str, np.ndarray], meta: dict[str, Any], defaults: Defa
 
 def read_file(path: Path, defaults: Defaults = Defaults(), log_map: LogMap | None = None) -> list[Window]:
     """Every window in one file: a JSON window, a CSV or NPZ in ema's columns, or any logged file (CSV, MATLAB,
-    NPZ) through ``log_map`` (``ema.model.logmap``); errors name the file."""
+    NPZ, a recorder's JSON) through ``log_map`` (``ema.model.logmap``); errors name the file."""
     suffix = path.suffix.lower()
     if suffix not in SUFFIXES:
         raise InputError(str(path), f"is not a {'/'.join(SUFFIXES)} file")
     if suffix == ".mat" and log_map is None:
         raise InputError(str(path), "is a MATLAB file: its variables become a window's signals through --log-map")
     try:
-        if suffix == ".json":
+        if suffix == ".json" and (log_map is None or _ema_document(path)):
             return _from_json(path)
-        if log_map is not None:
+        if log_map is not None:  # a recorder's JSON too: its map names its fields
             return [window_from_dict(read_mapped(path, log_map))]
         return _from_table(path, defaults)
     except InputError as exc:
@@ -233,10 +242,6 @@ def read_actuators(folder: Path) -> dict[str, ActuatorDocument]:
 def read_one(path: Path, log_map: LogMap | None = None) -> Window:
     """The one window of a file (JSON, CSV or NPZ, any logged file through ``log_map``): what ``ema estimate`` reads; a
     file of several is refused naming it (``ema replay`` posts each)."""
-    if log_map is not None and Path(path).suffix.lower() == ".json":
-        raise InputError(
-            "--log-map", f"{path} is a JSON window, in ema's own signals: a log map reads a rig's CSV, MATLAB or NPZ"
-        )
     windows = read_file(Path(path), Defaults(), log_map)
     if len(windows) != 1:
         raise InputError(str(path), f"holds {len(windows)} windows: ema estimate reads one (ema replay posts each)")

@@ -23,6 +23,7 @@ from ema.model.aircraft import HingeGeometry
 from ema.model.checks import InputError, kind_named, read_document, tagged_by, validated
 from ema.model.document import Document, Number
 from ema.model.drive import Drive
+from ema.model.geared import Geared
 from ema.model.kinds import DEFAULT_KIND, KIND_NAMES, KINDS, KindFacts
 from ema.model.params import MAX_CORRELATION_S, DriveConstants, HealthRanges, eta_a_from_eta_o
 from ema.model.screw import Screw
@@ -38,7 +39,8 @@ MAX_HEALTHY_ETA_O = 0.98
 SECTIONS = tuple(kind.section for kind in KINDS.values())  # each kind's own field
 _KIND_DESCRIPTION = (
     "rotary: a gear train to a surface (drive); linear: a ball screw turned by a stepper (screw); servo: a linear "
-    "axis under a known position controller, logged on the load side (servo)"
+    "axis under a known position controller, logged on the load side (servo); geared: a DC motor, a gear train and its "
+    "own position loop, logged at the output shaft (geared)"
 )
 
 
@@ -55,6 +57,13 @@ class Nominal(Document):
     )
     eta_o: Number | None = Field(
         None, gt=0, lt=1, description="η_O, efficiency under opposing load (null: never shown, as without a load)"
+    )
+    eta_a: Number | None = Field(
+        None,
+        gt=-1,
+        lt=1,
+        description="η_A, efficiency under aiding load, where read on its own (null: by Eq. 3.4 from η_O and the "
+        "gear ratio)",
     )
 
     @model_validator(mode="after")
@@ -188,7 +197,7 @@ class ActuatorDocument(Document):
         return KINDS[self.kind]
 
     @property
-    def section(self) -> Drive | Screw | Servo:
+    def section(self) -> Drive | Screw | Servo | Geared:
         """The kind's own section of the document (its drive, its screw, its servo)."""
         raise NotImplementedError  # each kind's class
 
@@ -315,6 +324,17 @@ class ServoActuator(ActuatorDocument):
         return self.servo
 
 
+class GearedActuator(ActuatorDocument):
+    """A geared servo's document: a DC motor, a gear train and its own position loop, logged at the output shaft."""
+
+    kind: Literal["geared"] = Field(description=_KIND_DESCRIPTION)
+    geared: Geared = Field(description="the motor, its gear train and its loop")
+
+    @property
+    def section(self) -> Geared:
+        return self.geared
+
+
 def as_kind(actuator: ActuatorDocument, kind: type[KindDocument]) -> KindDocument:
     """``actuator`` as ``kind``'s class (a kind's method reading its own section); InputError naming ``kind`` where
     the document is another kind's."""
@@ -326,7 +346,8 @@ def as_kind(actuator: ActuatorDocument, kind: type[KindDocument]) -> KindDocumen
 AnyActuator = Annotated[
     Annotated[RotaryActuator, Tag("rotary")]
     | Annotated[LinearActuator, Tag("linear")]
-    | Annotated[ServoActuator, Tag("servo")],
+    | Annotated[ServoActuator, Tag("servo")]
+    | Annotated[GearedActuator, Tag("geared")],
     tagged_by("kind", KIND_NAMES, DEFAULT_KIND),
 ]  # ``ema-actuator/1`` as read: one kind's document, by its ``kind``
 ACTUATOR_DOCUMENT: TypeAdapter[ActuatorDocument] = TypeAdapter(AnyActuator)  # what parses and exports it

@@ -37,6 +37,11 @@ SIGNAL_LIMITS = {
     "set_point_m": (-100.0, 100.0),
     "position_m": (-100.0, 100.0),
     "drive_force_n": (-1e6, 1e6),
+    "set_point_rad": (-100.0, 100.0),  # an output shaft may turn several times
+    "position_rad": (-100.0, 100.0),
+    "duty_ratio": (-1.0, 1.0),  # a PWM duty: a share of the supply
+    "supply_v": (0.0, 1_000.0),  # as logged: a glitch of 0 V or twice the supply is repaired, not refused
+    "motor_on_flag": (0.0, 1.0),
 }
 CONSTANT_NAME = r"^[a-z][a-z0-9_]{0,63}$"
 NOISE_COPIES = 30  # noise-only copies of a rotary calibration's windows behind its noise floor

@@ -10,6 +10,9 @@ with a literal. How each kind is read, simulated and calibrated is declared besi
   shaft (N·m), the drive's current read through what ``ema calibrate`` learned.
 - **servo**: a linear axis whose drive takes a force command from a known position controller, everything
   logged on the load side (positions in m, forces in N): friction on the load (N).
+- **geared**: a DC motor fed by PWM from its supply, a gear train and its own position loop, logged at the output
+  shaft (angles in rad, the duty it applied, the supply) swinging a load of known mass and arm: friction at the
+  output shaft (N·m).
 """
 
 from __future__ import annotations
@@ -18,6 +21,7 @@ from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from types import MappingProxyType
 
+from ema.model.geared import GEARED_CONSTANTS
 from ema.model.servo import SERVO_CONSTANTS
 from ema.model.units import units_of
 
@@ -118,7 +122,21 @@ _SERVO = KindFacts(
     load_side=True,
     recorded=SERVO_CONSTANTS,
 )
-KINDS: Mapping[str, KindFacts] = MappingProxyType({k.name: k for k in (_ROTARY, _LINEAR, _SERVO)})
+_GEARED = KindFacts(
+    name="geared",
+    summary="a DC motor, a gear train and its own position loop, logged at the output shaft, swinging a known load",
+    section="geared",
+    roles=_roles(
+        set_point="set_point_rad",
+        position="position_rad",
+        duty="duty_ratio",
+        supply="supply_v",
+        motor_on="motor_on_flag",
+        optional=("motor_on",),
+    ),
+    recorded=GEARED_CONSTANTS,
+)
+KINDS: Mapping[str, KindFacts] = MappingProxyType({k.name: k for k in (_ROTARY, _LINEAR, _SERVO, _GEARED)})
 DEFAULT_KIND = _ROTARY.name
 KIND_NAMES = tuple(KINDS)
 ALL_SIGNALS = tuple(dict.fromkeys(name for k in KINDS.values() for name in k.all_signals))

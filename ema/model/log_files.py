@@ -1,4 +1,5 @@
-"""A logged file as named columns and constants: CSV (read as a stream), MATLAB (``.mat``) or NumPy (``.npz``).
+"""A logged file as named columns and constants: CSV (read as a stream), MATLAB (``.mat``), NumPy (``.npz``) or a
+recorder's JSON (a header of constants and one object a sample).
 
 Limits are checked before the work: a file over ``MAX_LOG_BYTES`` is refused from its size, and a CSV is
 read row by row and refused at its ``MAX_ROWS + 1``-th row (a window holds at most ``MAX_SAMPLES``), so a
@@ -17,11 +18,12 @@ from pathlib import Path
 import numpy as np
 
 from ema.model.bounds import MAX_SAMPLES
-from ema.model.checks import InputError
+from ema.model.checks import InputError, load_json
 
 MAX_LOG_BYTES = 256 * 2**20  # a logged file's size limit: ~4x the largest window's CSV
 MAX_ROWS = MAX_SAMPLES  # as many rows as a window's samples at most
-TABLE_SUFFIXES = (".csv", ".mat", ".npz")
+MAX_JSON_LOG_BYTES = 64 * 2**20  # a recorder's JSON is parsed whole: a smaller limit than a streamed CSV's
+TABLE_SUFFIXES = (".csv", ".mat", ".npz", ".json")
 
 
 @dataclass(frozen=True)
@@ -46,7 +48,7 @@ class Table:
 def read_table(path: str | Path) -> Table:
     """The table in ``path`` by its suffix; InputError naming the file where it cannot be read or is too large."""
     path = Path(path)
-    readers = {".csv": _csv, ".mat": _mat, ".npz": _npz}
+    readers = {".csv": _csv, ".mat": _mat, ".npz": _npz, ".json": _json}
     suffix = path.suffix.lower()
     if suffix not in readers:
         raise InputError(str(path), f"is not a {'/'.join(TABLE_SUFFIXES)} file")
@@ -56,6 +58,11 @@ def read_table(path: str | Path) -> Table:
         raise InputError(str(path), f"cannot be read ({exc.strerror})") from None
     if size == 0:
         raise InputError(str(path), "is empty (0 bytes)")
+    if suffix == ".json" and size > MAX_JSON_LOG_BYTES:
+        raise InputError(
+            str(path),
+            f"is {size / 2**20:.0f} MiB, over the {MAX_JSON_LOG_BYTES // 2**20} MiB a JSON log may be: cut it",
+        )
     if size > MAX_LOG_BYTES:
         raise InputError(
             str(path), f"is {size / 2**20:.0f} MiB, over the {MAX_LOG_BYTES // 2**20} MiB a logged file may be: cut it"
@@ -151,3 +158,63 @@ def _arrays(path: Path, variables: dict[str, np.ndarray]) -> Table:
                 raise InputError(f"{path}: {name}", f"has {array.size:,} samples, more than a window may hold")
             columns[name] = array.ravel().astype(np.float64)
     return Table(columns, scalars, meta)
+
+
+def _json(path: Path) -> Table:
+    """A recorder's JSON: an object whose numbers (and true/false, as 1/0) are constants, nested objects' under
+    ``outer.inner``, and whose one list of objects holds a sample each, their numbers the columns (a list alone: the
+    samples, no constants). A field missing from a sample, or not a number there, leaves its column out as text."""
+    document = load_json(path)
+    if isinstance(document, dict) and str(document.get("schema", "")).startswith("ema-"):
+        raise InputError(
+            str(path), f"is an {document['schema']} document, not a recorder's log: read it without a log map"
+        )
+    header: dict[str, object] = {} if isinstance(document, list) else document if isinstance(document, dict) else {}
+    lists = {name: value for name, value in header.items() if _samples(value)}
+    if isinstance(document, list) and _samples(document):
+        lists = {"": document}
+    if len(lists) != 1:
+        found = ", ".join(lists) or "none"
+        raise InputError(str(path), f"is not a recorder's JSON: it needs one list of samples (objects), found {found}")
+    (entries,) = lists.values()
+    assert isinstance(entries, list)
+    if len(entries) > MAX_ROWS:
+        raise InputError(str(path), f"has over {MAX_ROWS:,} samples, more than a window may hold: cut it")
+    scalars, meta = _header(header)
+    columns, unread = {}, {}
+    for name in dict.fromkeys(key for entry in entries[:1] for key in entry):
+        values = [_json_number(entry.get(name)) for entry in entries]
+        if None in values:
+            unread[name] = f"sample {values.index(None)} holds no number"
+        else:
+            columns[name] = np.array(values, dtype=np.float64)
+    return Table(columns, scalars, meta, unread)
+
+
+def _samples(value: object) -> bool:
+    return isinstance(value, list) and len(value) > 0 and all(isinstance(entry, dict) for entry in value)
+
+
+def _json_number(value: object) -> float | None:
+    """A sample's value as a number: true/false as 1/0, a number itself, else None (text, null, a list)."""
+    if isinstance(value, bool):
+        return float(value)
+    if isinstance(value, int | float) and np.isfinite(value):
+        return float(value)
+    return None
+
+
+def _header(header: dict[str, object], prefix: str = "") -> tuple[dict[str, float], dict[str, str]]:
+    """The header's numbers as constants and its text as metadata, nested objects' under ``outer.inner``."""
+    scalars: dict[str, float] = {}
+    meta: dict[str, str] = {}
+    for name, value in header.items():
+        if isinstance(value, dict):
+            inner_scalars, inner_meta = _header(value, f"{prefix}{name}.")
+            scalars |= inner_scalars
+            meta |= inner_meta
+        elif isinstance(value, str):
+            meta[prefix + name] = value
+        elif (number := _json_number(value)) is not None:
+            scalars[prefix + name] = number
+    return scalars, meta

@@ -22,11 +22,12 @@ from ema.model.checks import InputError, kind_named, read_document, tagged_by, v
 from ema.model.document import Number
 from ema.model.kinds import KIND_NAMES, KINDS, Role
 from ema.model.log_files import Table, read_table
-from ema.model.units import TIME_S
+from ema.model.units import FLAG, TIME_S, units_of
 
 LOGMAP_SCHEMA = "ema-logmap/1"
+SIGN_BIT_TOLERANCE = 1e-6  # a sign bit read from a float32 column: within this share of it is it
 UNIFORM = 0.01  # time steps within this share of the median step: uniformly sampled
-ROLES = ("set_point", "position", "error", "current", "force", "load", "motor_speed")
+ROLES = ("set_point", "position", "error", "current", "force", "load", "motor_speed", "duty", "supply", "motor_on")
 DEFAULT_LOG_KIND = "linear"  # a map that names no kind: a rig's, as the first log maps were
 _KIND_DESCRIPTION = "the actuator's kind (its signals)"
 
@@ -45,6 +46,12 @@ class Column(_Part):
         "of a constant stored in the file that holds it",
     )
     raw_unit: str | None = Field(None, description="the variable's own unit before the scale, for a person")
+    sign_bit: Number | None = Field(
+        None,
+        gt=0,
+        description="where the log writes a sign and a magnitude (a servo's register): a value at or above it is it "
+        "plus a magnitude of one sign (sign: 1, positive), one below it a magnitude of the other; null: signed",
+    )
 
 
 class Constant(_Part):
@@ -63,6 +70,13 @@ class LogMap(_Part):
     actuator_id: str = Field(min_length=1, max_length=200, description="the actuator every file of this rig logs")
     time: Column | None = Field(None, description="seconds (s or ms) from the start; or give sample_rate_hz")
     sample_rate_hz: Number | None = Field(None, gt=0, description="where the log has no time variable")
+    resample_hz: Number | None = Field(
+        None,
+        gt=0,
+        le=100_000,
+        description="a log whose time steps are uneven (a recorder's own time stamps) is resampled to this rate, "
+        "linearly (a switch: to its nearest sample); null: uneven steps are refused",
+    )
     set_point: Column = Field(description="the position set point (linear: mm, m, in; rotary: deg, rad; servo: m)")
     position: Column | None = Field(None, description="the measured position; or give error")
     error: Column | None = Field(None, description="set point minus measured position (sign -1: the other way)")
@@ -147,10 +161,20 @@ class ServoLogMap(LogMap):
     )
 
 
+class GearedLogMap(LogMap):
+    """A geared servo's log: the duty its loop applied, the supply, and where it records it, its motor switched on."""
+
+    kind: Literal["geared"] = Field(description=_KIND_DESCRIPTION)
+    duty: Column = Field(description="the PWM duty its loop applied (1: the whole supply, or %)")
+    supply: Column | Constant = Field(description="the supply voltage (V)")
+    motor_on: Column | None = Field(None, description="1 where the motor's torque is on (a log's true/false)")
+
+
 AnyLogMap = Annotated[
     Annotated[RotaryLogMap, Tag("rotary")]
     | Annotated[LinearLogMap, Tag("linear")]
-    | Annotated[ServoLogMap, Tag("servo")],
+    | Annotated[ServoLogMap, Tag("servo")]
+    | Annotated[GearedLogMap, Tag("geared")],
     tagged_by("kind", KIND_NAMES, DEFAULT_LOG_KIND),
 ]
 LOG_MAP: TypeAdapter[LogMap] = TypeAdapter(AnyLogMap)  # what parses and exports it
@@ -188,6 +212,9 @@ def _read(table: Table, part: Column | Constant, role: Role, what: str, path: Pa
     values = table.numeric(part.column, path, f"the log map's {what}.column")
     if len(values) != n:
         raise InputError(f"{path}: {part.column}", f"has {len(values)} samples, the set point has {n}")
+    if part.sign_bit is not None:  # sign and magnitude: at or above the bit one way, below it the other
+        bit = part.sign_bit * (1.0 - SIGN_BIT_TOLERANCE)  # a register written through a float32 lands a hair below
+        values = np.where(values >= bit, np.maximum(values - part.sign_bit, 0.0), -values)
     scale = part.scale if not isinstance(part.scale, str) else _scalar(table, part.scale, path, f"{what}.scale")
     return values * (1.0 if scale is None else scale) * factor * part.sign
 
@@ -208,8 +235,13 @@ def read_mapped(path: str | Path, log_map: LogMap) -> dict[str, Any]:
             signals[role.signal] = signals[roles["set_point"].signal] - error
         elif part is not None:
             signals[role.signal] = _read(table, part, role, name, path, n)
-    time = log_map.time
-    rate = log_map.sample_rate_hz or _rate(_read(table, time, Role("time_s"), "time", path, n), path)  # type: ignore[arg-type]
+    resampled: dict[str, Any] = {}
+    if log_map.time is None:
+        assert log_map.sample_rate_hz is not None  # LogMap._complete
+        rate = log_map.sample_rate_hz
+    else:
+        time_s = _read(table, log_map.time, Role("time_s"), "time", path, n)
+        rate, signals, resampled = _uniform(time_s, signals, log_map.resample_hz, path)
     constants = {
         field: _scalar(table, variable, path, f"constants.{field}") for field, variable in log_map.constants.items()
     }
@@ -221,7 +253,31 @@ def read_mapped(path: str | Path, log_map: LogMap) -> dict[str, Any]:
         "flight_condition": None,
         "signals": {name: values.tolist() for name, values in signals.items()},
         **({"constants": constants} if constants else {}),
+        **({"resampled": resampled} if resampled else {}),
     }
+
+
+def _uniform(
+    time_s: np.ndarray, signals: dict[str, np.ndarray], resample_hz: float | None, path: Path
+) -> tuple[float, dict[str, np.ndarray], dict[str, Any]]:
+    """(rate, signals, how they were resampled): as logged where the time steps are uniform (``UNIFORM``), else
+    resampled to ``resample_hz`` from the first time stamp (a switch's signal to its nearest sample, the others
+    linearly); uneven steps without a rate to resample to are refused (``_rate``)."""
+    steps = np.diff(time_s)
+    if resample_hz is None or len(steps) == 0 or np.all(np.abs(steps - np.median(steps)) <= UNIFORM * np.median(steps)):
+        return _rate(time_s, path), signals, {}
+    if np.any(~np.isfinite(time_s)) or np.any(steps <= 0):
+        row = int(np.argmax(~np.isfinite(steps) | (steps <= 0))) + 1
+        raise InputError(str(path), f"its time variable does not increase after row {row}: it cannot be resampled")
+    grid = time_s[0] + np.arange(int(np.floor((time_s[-1] - time_s[0]) * resample_hz)) + 1) / resample_hz
+    after = np.clip(np.searchsorted(time_s, grid), 1, len(time_s) - 1)
+    nearest = np.where(grid - time_s[after - 1] <= time_s[after] - grid, after - 1, after)
+    resampled = {
+        name: values[nearest] if units_of(name) is FLAG else np.interp(grid, time_s, values)
+        for name, values in signals.items()
+    }
+    said = {"logged_samples": len(time_s), "min_step_s": float(steps.min()), "max_step_s": float(steps.max())}
+    return float(resample_hz), resampled, said
 
 
 def _rate(time_s: np.ndarray, path: Path) -> float:

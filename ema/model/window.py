@@ -12,7 +12,7 @@ from __future__ import annotations
 import datetime as dt
 import hashlib
 import json
-from dataclasses import dataclass, field, replace
+from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 from typing import Annotated, Any, ClassVar, Literal
 
@@ -144,6 +144,20 @@ class ServoSignals(_Signals):
     )
 
 
+class GearedSignals(_Signals):
+    """A geared servo's signals at its output shaft: its set point, its position, the duty its loop applied and the
+    supply it applied it from, and whether its motor was on where the log records it."""
+
+    kind: ClassVar[str] = "geared"
+    set_point_rad: Samples = Field(description="the position set point at the output shaft [rad]")
+    position_rad: Samples = Field(description="the measured position at the output shaft [rad], 0 hanging down")
+    duty_ratio: Samples = Field(description="the PWM duty the loop applied, signed, a share of the supply (−1 to 1)")
+    supply_v: Samples = Field(description="the supply the duty switches [V]")
+    motor_on_flag: Samples | None = Field(
+        None, description="1 where the motor's torque is enabled, 0 where it is off and the shaft turns free"
+    )
+
+
 def _signals_kind(signals: Any) -> str | None:
     """The tag ``SignalsDocument`` dispatches on: the kind whose signals these are, else the one they come closest
     to (whose class then names what is missing or foreign)."""
@@ -156,9 +170,18 @@ def _signals_kind(signals: Any) -> str | None:
 SignalsDocument = Annotated[
     Annotated[RotarySignals, Tag("rotary")]
     | Annotated[LinearSignals, Tag("linear")]
-    | Annotated[ServoSignals, Tag("servo")],
+    | Annotated[ServoSignals, Tag("servo")]
+    | Annotated[GearedSignals, Tag("geared")],
     Discriminator(_signals_kind),
 ]  # one kind's signals, told by which it carries
+
+
+class ResamplingDocument(_Contract):
+    """How a log with uneven time stamps became this uniformly sampled window (its reader resampled it)."""
+
+    logged_samples: int = Field(ge=2, le=MAX_SAMPLES, description="the samples the log held")
+    min_step_s: Number = Field(ge=0, description="its shortest time step")
+    max_step_s: Number = Field(gt=0, description="its longest time step")
 
 
 class WindowDocument(_Contract):
@@ -194,6 +217,11 @@ class WindowDocument(_Contract):
         examples=["tail-123/2026-11-21T10:00:00Z"],
     )
 
+    resampled: ResamplingDocument | None = Field(
+        None,
+        description="where the log's own time stamps were uneven and its reader resampled it to sample_rate_hz: "
+        "their steps (null: logged at this rate)",
+    )
     constants: dict[Annotated[str, Field(pattern=CONSTANT_NAME)], Number] | None = Field(
         None,
         max_length=64,
@@ -222,6 +250,8 @@ class WindowDocument(_Contract):
         flight = self.flight_condition
         condition = None if flight is None else FlightCondition(flight.airspeed_mps, flight.altitude_m)
         recorded = None if self.recorded_at is None else self.recorded_at.isoformat()
+        steps = self.resampled
+        resampled = None if steps is None else Resampling(steps.logged_samples, steps.min_step_s, steps.max_step_s)
         return Window(
             arrays,
             self.sample_rate_hz,
@@ -232,7 +262,17 @@ class WindowDocument(_Contract):
             flight_hours=self.flight_hours,
             flight_id=self.flight_id,
             constants=dict(self.constants or {}),
+            resampled=resampled,
         )
+
+
+@dataclass(frozen=True)
+class Resampling:
+    """A log of uneven time steps resampled to the window's rate: how many samples it held, its steps' range [s]."""
+
+    logged_samples: int
+    min_step_s: float
+    max_step_s: float
 
 
 @dataclass(frozen=True)
@@ -249,6 +289,7 @@ class Window:
     flight_hours: float | None = None
     flight_id: str | None = None  # one power-on of the drive: its sensors keep one zero
     constants: dict[str, float] = field(default_factory=dict)  # what the log recorded beside its signals
+    resampled: Resampling | None = None  # a log of uneven time steps, resampled to sample_rate_hz
 
     def __post_init__(self) -> None:
         lengths = {name: len(self.signals[name]) for name in self.signal_names}
@@ -321,6 +362,7 @@ def window_to_dict(window: Window) -> dict[str, Any]:
         **({"flight_hours": window.flight_hours} if window.flight_hours is not None else {}),
         **({"flight_id": window.flight_id} if window.flight_id is not None else {}),
         **({"constants": dict(window.constants)} if window.constants else {}),
+        **({"resampled": asdict(window.resampled)} if window.resampled is not None else {}),
     }
 
 

@@ -144,6 +144,11 @@ class Check(Document):
         description="per signal: 100·‖measured − simulated‖/‖measured‖, the identification benchmarks' error "
         "(a servo's; empty where not computed)",
     )
+    mean_abs_error: dict[str, float] = Field(
+        default_factory=dict,
+        description="per signal: mean |measured − simulated at the estimates|, in the signal's unit (a geared servo's "
+        "position, rad; empty where not computed)",
+    )
     uncertainty_inflation: float = Field(description="factor applied to the stds for what the model did not reproduce")
     notes: Notes = Field(default_factory=list)
 

@@ -44,6 +44,9 @@ NoteCode = Literal[
     "fdj_departed",
     "load_extrapolated",
     "command_saturated",
+    "resampled",
+    "motor_off",
+    "position_quantized",
     # how the answer was reached, and how far to trust it
     "network_absent",
     "network_too_few_checks",
