@@ -10,7 +10,10 @@ A kind's documents (its window's signals, its actuator document's section, what 
   calibration (learned from healthy runs, faulted runs compared with it);
 - ``ema.kinds.servo``: a linear axis under a known position controller, logged on the load side, the whole
   method in the load frame (its log's reading, its inverse model, its closed-loop simulator and dataset, its
-  stages, its calibration and effects).
+  stages, its calibration and effects);
+- ``ema.kinds.geared``: a DC motor, a gear train and its own position loop, logged at the output shaft swinging a
+  known load, the whole method there (its loop's simulator, its output-error reading, its dataset, its stages, its
+  calibration and effects).
 
 ``estimate``, ``calibrate`` and ``cost`` are the entries the command line, the service and the fleet call; a
 fourth kind is a folder here, a row of ``ema.model.kinds`` and a line in ``REGISTRY``, not branches in the stages.
@@ -24,6 +27,7 @@ from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import Estimate
 from ema.estimate.documents.window_facts import HistoryReadings
 from ema.kinds.base import Calibrated, CalibrationRequest, Cost, Kind, Request
+from ema.kinds.geared import GEARED
 from ema.kinds.linear import LINEAR
 from ema.kinds.rotary import ROTARY
 from ema.kinds.servo import SERVO
@@ -47,7 +51,7 @@ __all__ = [
 ]
 
 
-REGISTRY: dict[str, Kind] = {kind.facts.name: kind for kind in (ROTARY, LINEAR, SERVO)}
+REGISTRY: dict[str, Kind] = {kind.facts.name: kind for kind in (ROTARY, LINEAR, SERVO, GEARED)}
 
 
 def warm_up(names: Sequence[str] = tuple(REGISTRY)) -> None:

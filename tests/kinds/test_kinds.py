@@ -64,9 +64,9 @@ def test_the_documents_kind_field_lists_every_kind():
 def test_each_kinds_window_signals_are_its_facts_signals():
     """ema-window/1's signals are one class per kind, joined by which signals a window carries: each class's
     required and optional signals are its facts' own, so a kind's row is the one place they are declared."""
-    from ema.model.window import LinearSignals, RotarySignals, ServoSignals
+    from ema.model.window import GearedSignals, LinearSignals, RotarySignals, ServoSignals
 
-    classes = {cls.kind: cls for cls in (RotarySignals, LinearSignals, ServoSignals)}
+    classes = {cls.kind: cls for cls in (RotarySignals, LinearSignals, ServoSignals, GearedSignals)}
     assert set(classes) == set(facts.KINDS)
     for name, cls in classes.items():
         fields = cls.model_fields
