@@ -86,9 +86,15 @@ def simulate(servo: Servo, load: Load, reference: np.ndarray, on: np.ndarray, ra
 
 
 def recorder_log(
-    path: Path, servo: Servo, load: Load, *, kind: str = "sines", seconds: float = 6.0, off_after_s: float | None = None,
+    path: Path,
+    servo: Servo,
+    load: Load,
+    *,
+    kind: str = "sines",
+    seconds: float = 6.0,
+    off_after_s: float | None = None,
     seed: int = 0,
-) -> Path:  # fmt: skip
+) -> Path:
     """A run as the sysid recorder writes it: a header, then one entry a sample (module docstring)."""
     rate, supply = 100.0, 12.0
     reference = set_point(kind, seconds, rate, seed)

@@ -3,8 +3,10 @@
 from ema.model.actuator import GearedActuator, actuator_from_dict
 from tests.foreign.geared import Servo
 
+FOREIGN = Servo()
 
-def calibrated_document(servo: Servo = Servo(), **geared: float) -> GearedActuator:
+
+def calibrated_document(servo: Servo = FOREIGN, **geared: float) -> GearedActuator:
     document = actuator_from_dict(
         {
             "schema": "ema-actuator/1",

@@ -2,15 +2,13 @@
 its motor's inductance, a Karnopp friction), at several loads, gains and set points."""
 
 import itertools
-import json
 
-import numpy as np
 import pytest
 
 from ema import kinds
 from ema.cli.logs import read_one
 from ema.estimate.config import PipelineConfig
-from ema.model.actuator import actuator_from_dict
+from ema.model.actuator import read_actuator
 from ema.model.logmap import read_logmap
 from tests.foreign.geared import Load, Servo, recorder_log
 
@@ -28,7 +26,7 @@ def calibrated(tmp_path_factory):
         path = recorder_log(folder / f"run{i:02d}.json", TRUTH, load, kind=shape, seed=i,
                             off_after_s=4.0 if shape == "rise" else None)  # fmt: skip
         windows.append(read_one(path, log_map))
-    document = actuator_from_dict(json.loads(open("examples/sts3215/actuator.json").read()))
+    document = read_actuator("examples/sts3215/actuator.json")
     request = kinds.CalibrationRequest(PipelineConfig(), document)
     return kinds.calibrate(windows, request), windows
 

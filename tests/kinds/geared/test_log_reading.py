@@ -7,7 +7,7 @@ import pytest
 
 from ema.cli.logs import read_one
 from ema.kinds.geared.log_reading import prepare_geared
-from ema.model.actuator import actuator_from_dict
+from ema.model.actuator import read_actuator
 from ema.model.checks import InputError
 from ema.model.logmap import read_logmap
 from tests.foreign.geared import Load, Servo, recorder_log
@@ -58,6 +58,6 @@ def test_a_log_without_its_gain_is_refused_naming_the_constant(logged, tmp_path)
 
 def test_an_uncalibrated_document_is_refused_naming_what_it_lacks(logged):
     window = read_one(logged, read_logmap(EXAMPLE))
-    bare = actuator_from_dict(json.loads(open("examples/sts3215/actuator.json").read()))
-    with pytest.raises(InputError, match="torque_constant_nm_per_a.*ema calibrate"):
+    bare = read_actuator("examples/sts3215/actuator.json")
+    with pytest.raises(InputError, match=r"torque_constant_nm_per_a.*ema calibrate"):
         prepare_geared(window, bare)
