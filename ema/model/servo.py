@@ -100,7 +100,8 @@ class Servo(Document):
     effect_constants: dict[str, Number] = Field(
         default_factory=dict,
         description="the adopted effects' solved constants, in the inverse model's names (presliding_n: the friction "
-        "short of FDJ right after a reversal [N])",
+        "short of FDJ right after a reversal [N]; turn_ripple_amplitude_n: the size of the force once per turn, whose "
+        "phase each log reads, the motor's angle at the load's zero moving from run to run)",
     )
     repeatability_n: Number | None = Field(
         None, ge=0, le=1e6, description="the run-to-run std of FDJ beyond each run's own noise (learned)"

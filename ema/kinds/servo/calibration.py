@@ -46,7 +46,7 @@ from ema.calibration.plot import ResidualPlot, Series
 from ema.estimate.assess.weighing import misfit_limit
 from ema.estimate.stats import rms
 from ema.kinds.servo.effect_readings import MIN_HELD_OUT_DROP, Reading, best_of, reading
-from ema.kinds.servo.fold_errors import closed_loop_error_pct, document_check
+from ema.kinds.servo.fold_errors import amplitudes, closed_loop_error_pct, document_check
 from ema.kinds.servo.inverse import (
     UNITS,
     decimated,
@@ -188,7 +188,7 @@ def completed(
             "force_offset_std_n": sd["offset_n"],
             "bandwidth_hz": prepared.bandwidth_hz,
             "effects": {name: value for name, value in model.items() if name != "viscous_down"},
-            "effect_constants": {name: v[name] for name in v if name not in LEARNED_NAMES},
+            "effect_constants": amplitudes({name: v[name] for name in v if name not in LEARNED_NAMES}),
         }
     )
     nominal = Nominal(fdj_n=round(v["fdj_n"], 6), eta_o=actuator.nominal.eta_o if actuator.nominal else None)
