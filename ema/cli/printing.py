@@ -57,7 +57,7 @@ def print_estimate(result: Any) -> None:
 
 
 SIGNAL_WORDS = {"residual_torque": "residual torque", "current_a": "stretches' current",
-                "drive_force_n": "drive force"}  # fmt: skip
+                "drive_force_n": "drive force", "position_rad": "position"}  # fmt: skip
 
 
 def check_line(check: Any) -> str:
@@ -67,7 +67,10 @@ def check_line(check: Any) -> str:
     signal = "residual_torque" if "residual_torque" in ratios else next(iter(ratios))
     output = ratios[signal]
     what = SIGNAL_WORDS.get(signal, signal)
-    if check.output_error_pct:
+    if check.mean_abs_error:
+        what += " (" + ", ".join(f"{value:.3g} rad on average" for value in list(check.mean_abs_error.values())[:1])
+        what += f", {next(iter(check.output_error_pct.values())):.3g} % from the log)"
+    elif check.output_error_pct:
         what += (
             " (" + ", ".join(f"{name} {pct:.3g} %" for name, pct in check.output_error_pct.items()) + " from the log)"
         )

@@ -25,9 +25,19 @@ import numpy as np
 
 from ema.calibration.documents import Candidate, HeldOut, NoiseFloor, Step
 from ema.calibration.limits import MAX_EFFECTS, NAME_Z, noise_z
-from ema.kinds.geared.effects import EFFECTS, EFFICIENCY, free_constants
-from ema.kinds.geared.log_reading import load_run, log_constants, position_step, repaired_supply
-from ema.kinds.geared.stacked_fit import LoggedRun, Solved, fold_spread, folds_of, held_out, positions, solve
+from ema.kinds.geared.duty_gain import gain_at
+from ema.kinds.geared.effects import EFFECTS, EFFICIENCY, NEUTRAL, free_constants
+from ema.kinds.geared.log_reading import load_run, position_step, repaired_supply
+from ema.kinds.geared.stacked_fit import (
+    LoggedRun,
+    Solved,
+    best_of,
+    fold_spread,
+    folds_of,
+    held_out,
+    positions,
+    solve,
+)
 from ema.model.geared import Geared
 from ema.model.window import Window
 
@@ -49,45 +59,36 @@ def logged_runs(windows: Sequence[Window], geared: Geared) -> list[LoggedRun]:
     runs = []
     for window in windows:
         supply, _ = repaired_supply(window.signals["supply_v"])
-        runs.append(LoggedRun(window.window_id, load_run(window, geared, supply), window.signals["position_rad"]))
+        s = window.signals
+        runs.append(LoggedRun(window.window_id, load_run(window, geared, supply), s["position_rad"], s["duty_ratio"]))
     return runs
 
 
-def starting_values(runs: Sequence[LoggedRun], windows: Sequence[Window], geared: Geared) -> dict[str, float]:
-    """Where the base model's solve starts, from physics of the runs themselves: a motor that stalls at three times
+def starting_values(runs: Sequence[LoggedRun], geared: Geared) -> list[dict[str, float]]:
+    """Where the base model's solves start, from physics of the runs themselves: a motor that stalls at three times
     the heaviest load's moment at full duty (b), reaches the fastest logged speed there (k_e), a servo as heavy as
-    its median load, the loop's gain from the logged duty against the logged error."""
+    its median load, the loop's gain read off the logged duty (``ema.kinds.geared.duty_gain``); its friction mostly
+    sliding (FDJ a tenth of that moment), or mostly viscous (C a fiftieth of it per rad/s), the two sides a solve
+    stays on (``best_of``)."""
     moment = max(r.run.load_moment_nm for r in runs)
     supply = float(np.median([np.median(r.run.supply_v) for r in runs]))
     speed = max(float(np.max(np.abs(np.diff(r.position_rad)))) / r.run.step_s for r in runs)
     b = 3.0 * moment / supply
-    return {
+    sliding = {
         "torque_per_volt": b,
         "back_emf": b * supply / max(speed, 1e-3),
         "inertia_kg_m2": float(np.median([r.run.load_inertia_kg_m2 for r in runs])),
-        "error_gain_per_rad": logged_gain(windows),
+        "error_gain_per_rad": gain_at([r.logged_duty for r in runs], geared.command_delay_s)[0],
         "duty_limit": geared.duty_limit,
         "min_duty": geared.min_duty,
-        "fdj_nm": 0.05 * moment,
-        "viscous_nm_s_per_rad": 0.01 * moment,
+        "fdj_nm": 0.1 * moment,
+        "viscous_nm_s_per_rad": 0.005 * moment,
         "k_opp": 0.0,
         "k_aid": 0.0,
         "static_friction_ratio": geared.static_friction_ratio,
         "command_delay_s": geared.command_delay_s,
     }
-
-
-def logged_gain(windows: Sequence[Window]) -> float:
-    """The loop's duty per rad of error per unit of kp, read off the logged duty where it is unsaturated."""
-    products, duties = [], []
-    for window in windows:
-        s, kp = window.signals, log_constants(window)["position_gain"]
-        error = kp * (s["set_point_rad"] - s["position_rad"])
-        keep = np.abs(s["duty_ratio"]) < 0.5 * np.max(np.abs(s["duty_ratio"]), initial=1e-9)
-        products.append(error[keep])
-        duties.append(s["duty_ratio"][keep])
-    x, y = np.concatenate(products), np.concatenate(duties)
-    return float(max(x @ y / max(float(x @ x), 1e-300), 1e-3))
+    return [sliding, {**sliding, "fdj_nm": 0.01 * moment, "viscous_nm_s_per_rad": 0.02 * moment}]
 
 
 def noise_copies(runs: Sequence[LoggedRun], values: dict[str, float], step: float) -> list[LoggedRun]:
@@ -98,23 +99,24 @@ def noise_copies(runs: Sequence[LoggedRun], values: dict[str, float], step: floa
     for run, simulated in zip(runs, positions(runs, values), strict=True):
         phase = rng.uniform()
         read = simulated if step <= 0 else step * (np.round(simulated / step + phase) - phase)
-        copies.append(LoggedRun(run.window_id, run.run, read))
+        copies.append(LoggedRun(run.window_id, run.run, read, run.duty_ratio))
     return copies
 
 
 def tried(
     runs: Sequence[LoggedRun], copies: Sequence[LoggedRun], effects: tuple[str, ...], start: dict[str, float]
 ) -> Trial:
-    """The model with ``effects`` scored held out on the runs and on the copies, its new constants started off
-    their neutral values."""
+    """The model with ``effects`` scored held out on the runs, its new constants started off their neutral values
+    (a flat start stays flat), and on the copies from their own truth, ``start`` (the model they were drawn from,
+    the new constants neutral): what the effect buys where it is absent."""
     begun = {**start}
     for name in effects:
         for constant, value in EFFECTS[name].start.items():
-            if start[constant] == 0.0 or (constant == "static_friction_ratio" and start[constant] == 1.0):
+            if start[constant] == NEUTRAL[constant]:
                 begun[constant] = value
     free = free_constants(effects)
     solved = solve(runs, free, begun, stds=False)
-    return Trial(effects, held_out(runs, free, solved.values), held_out(copies, free, solved.values), solved.values)
+    return Trial(effects, held_out(runs, free, solved.values), held_out(copies, free, start), solved.values)
 
 
 def scored(trial: Trial, against: Trial, folds: np.ndarray, effect: str) -> Candidate:
@@ -209,7 +211,7 @@ def learned_model(
     runs = logged_runs(windows, geared)
     step = position_step(np.concatenate([r.position_rad for r in runs]), geared)
     on_stage(f"solving a constant friction's model on {len(runs)} runs")
-    start = solve(runs, free_constants(()), starting_values(runs, windows, geared), stds=False).values
+    start = best_of(runs, free_constants(()), starting_values(runs, geared)).values
     copies = noise_copies(runs, start, step)
     base = Trial((), held_out(runs, free_constants(()), start), held_out(copies, free_constants(()), start), start)
     final, candidates, steps = selected(runs, base, step, on_stage)

@@ -16,6 +16,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from ema.calibration.limits import FOLDS
+from ema.kinds.geared.duty_gain import LoggedDuty
 from ema.kinds.geared.effects import CONSTANTS, bounds, diff_steps
 from ema.kinds.geared.loop import LANE_PARAMETERS, Packed, Run, pack, simulate_packed
 from ema.kinds.geared.output_error import DIFF_STEP, LOSS_SCALE_RAD, correlation_inflation
@@ -26,12 +27,17 @@ MAX_EVALUATIONS = 400  # a solve from afar; one warm-started from a neighbour's 
 
 @dataclass(frozen=True)
 class LoggedRun:
-    """A run as its calibration reads it: what the simulator takes (its set point undelayed) and the logged
-    position (N,)."""
+    """A run as its calibration reads it: what the simulator takes, the logged position (N,) and duty (N,)."""
 
     window_id: str
     run: Run
     position_rad: np.ndarray
+    duty_ratio: np.ndarray
+
+    @property
+    def logged_duty(self) -> LoggedDuty:
+        r = self.run
+        return LoggedDuty(self.duty_ratio, r.set_point_rad, self.position_rad, r.motor_on, r.position_gain, r.step_s)
 
 
 @dataclass(frozen=True)
@@ -39,6 +45,7 @@ class Solved:
     values: dict[str, float]  # every constant of ``CONSTANTS`` (the free ones solved)
     stds: dict[str, float]  # the free ones' Gauss–Newton stds, the residual's correlation counted
     free: tuple[str, ...]
+    cost: float = 0.0  # the solve's robust loss at its answer (what ``best_of`` compares)
 
 
 def lane(values: Mapping[str, float]) -> np.ndarray:
@@ -96,7 +103,8 @@ def solve(runs: Sequence[LoggedRun], free: tuple[str, ...], start: Mapping[str, 
     """``free`` of ``CONSTANTS`` solved on ``runs`` from ``start`` (every constant's value), the rest held there."""
     low, high = bounds(free)
     x0 = np.clip([start[name] for name in free], low, high)
-    residual = _residual(RunSet.of(runs), start, free)
+    run_set = RunSet.of(runs)
+    residual = _residual(run_set, start, free)
     solution = least_squares(
         residual,
         x0,
@@ -108,7 +116,14 @@ def solve(runs: Sequence[LoggedRun], free: tuple[str, ...], start: Mapping[str, 
         max_nfev=MAX_EVALUATIONS,
     )
     values = {**start, **dict(zip(free, map(float, solution.x), strict=True))}
-    return Solved(values, _stds(solution.jac, residual(solution.x), free) if stds else {}, free)
+    return Solved(values, _stds(solution.jac, residual(solution.x), free) if stds else {}, free, float(solution.cost))
+
+
+def best_of(runs: Sequence[LoggedRun], free: tuple[str, ...], starts: Sequence[Mapping[str, float]]) -> Solved:
+    """The model solved from each of ``starts``, the one whose answer fits the runs best: a friction read as
+    sliding (FDJ) or as viscous (C) leaves the runs about as well near either, and a solve from one side stays
+    there."""
+    return min((solve(runs, free, start, stds=False) for start in starts), key=lambda solved: solved.cost)
 
 
 def _stds(jacobian: np.ndarray, error: np.ndarray, free: tuple[str, ...]) -> dict[str, float]:

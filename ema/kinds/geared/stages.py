@@ -84,12 +84,13 @@ def assessed(
 
 
 def closed_loop_check(prepared: GearedPrepared, answer: Assessed) -> doc.Check:
-    """The window simulated at the answer: its position's mean absolute error [rad], RMS over the calibrated model's
-    floor on healthy runs (``position_error_rad``, a mean absolute error, as RMS of a normal residual: × √(π/2)), and
-    in % of the position."""
-    lane = prepared.lane(answer.values)
-    simulated = simulate_lanes(prepared.run, lane[None, :]).position_rad[0]
-    error = prepared.position_rad - simulated
+    """The window simulated at the answer: its position's mean absolute error [rad] (and at the document's nominal
+    health: what the document alone predicts of the run), RMS over the calibrated model's floor on healthy runs
+    (``position_error_rad``, a mean absolute error, as RMS of a normal residual: × √(π/2)), and in % of the
+    position."""
+    lanes = np.stack([prepared.lane(answer.values), prepared.lane(prepared.nominal)])
+    simulated = simulate_lanes(prepared.run, lanes).position_rad
+    error, at_nominal = prepared.position_rad - simulated[0], prepared.position_rad - simulated[1]
     floor = (prepared.geared.position_error_rad or 0.0) * np.sqrt(np.pi / 2)
     ratio = rms(error) / max(floor, prepared.resolution_rad / np.sqrt(12.0), 1e-300)
     notes = list(answer.notes)
@@ -109,7 +110,10 @@ def closed_loop_check(prepared: GearedPrepared, answer: Assessed) -> doc.Check:
         equation_error_limit=None,
         output_error_ratio={"position_rad": ratio},
         output_error_pct={"position_rad": pct},
-        mean_abs_error={"position_rad": float(np.mean(np.abs(error)))},
+        mean_abs_error={
+            "position_rad": float(np.mean(np.abs(error))),
+            "position_rad_at_nominal": float(np.mean(np.abs(at_nominal))),
+        },
         uncertainty_inflation=answer.inflation,
         notes=notes,
     )
