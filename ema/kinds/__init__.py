@@ -26,12 +26,13 @@ from collections.abc import Callable, Sequence
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import Estimate
 from ema.estimate.documents.window_facts import HistoryReadings
+from ema.estimate.information import out_of_bounds, refuse_empty_channels
 from ema.kinds.base import Calibrated, CalibrationRequest, Cost, Kind, Request
 from ema.kinds.geared import GEARED
 from ema.kinds.linear import LINEAR
 from ema.kinds.rotary import ROTARY
 from ema.kinds.servo import SERVO
-from ema.model.actuator import ActuatorDocument
+from ema.model.actuator import ActuatorDocument, Nominal
 from ema.model.checks import InputError
 from ema.model.window import Window
 
@@ -91,7 +92,23 @@ def estimate(
     """The ``ema-estimate/1`` result for ``window``, read by its actuator's kind; InputError where the window's
     signals are another kind's than its document's."""
     same_kind([window], actuator, listed=False)
-    return kind_of(actuator).estimate(window, Request(config, actuator, version, on_stage, history, spec_only))
+    refuse_empty_channels(window)
+    answer = kind_of(actuator).estimate(window, Request(config, actuator, version, on_stage, history, spec_only))
+    held_to_document(answer, actuator)
+    return answer
+
+
+def held_to_document(answer: Estimate, actuator: ActuatorDocument) -> None:
+    """InputError naming the first value of ``answer`` outside the bounds its document's field allows
+    (``ema.estimate.information.out_of_bounds``): an answer outside them is never a reading."""
+    e = actuator.facts
+    values = {e.friction_field("fdj"): answer.estimates.FDJ.value}
+    for name, field in (("eta_O", "eta_o"), ("eta_A", "eta_a"), ("FSJ", "fsj_nm")):
+        entry = getattr(answer.estimates, name)
+        if entry is not None:
+            values[field] = entry.value
+    values |= {name: entry.value for name, entry in answer.estimates.constants.items()}
+    out_of_bounds(values, (Nominal, type(actuator.section)), "estimates")
 
 
 def calibrate(windows: Sequence[Window], request: CalibrationRequest) -> Calibrated:
@@ -101,6 +118,7 @@ def calibrate(windows: Sequence[Window], request: CalibrationRequest) -> Calibra
         raise InputError("windows", "a calibration needs one window at least")
     same_kind(windows, request.actuator)
     for i, window in enumerate(windows):
+        refuse_empty_channels(window, f"windows.{i}.signals")
         if window.actuator_id != windows[0].actuator_id:
             raise InputError(
                 f"windows.{i}.actuator_id",

@@ -48,9 +48,14 @@ class Nominal(Document):
     """The health of this actuator new, FDJ in its kind's unit (``ema.model.kinds``: at the motor shaft, or on the
     load for a kind logged on the load side)."""
 
-    fdj_nm: Number | None = Field(None, gt=0, le=100, description="FDJ, dynamic friction at the motor shaft [N·m]")
+    fdj_nm: Number | None = Field(
+        None,
+        ge=1e-6,
+        le=100,
+        description="FDJ, dynamic friction at the motor shaft (a geared servo's: its output) [N·m]",
+    )
     fdj_n: Number | None = Field(
-        None, gt=0, le=1e6, description="FDJ, dynamic friction on the load [N] (a kind logged on the load side)"
+        None, ge=1e-6, le=1e6, description="FDJ, dynamic friction on the load [N] (a kind logged on the load side)"
     )
     fsj_nm: Number | None = Field(
         None, gt=0, le=100, description="FSJ, static (break-away) friction at the motor shaft (a rotary actuator's)"

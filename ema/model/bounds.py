@@ -6,6 +6,7 @@ import datetime as dt
 
 IDENTIFIER = r"^[!-~](?:[ -~]{0,198}[!-~])?$"  # printable ASCII, no surrounding blanks: safe in a URL and a CSV
 ROUTE_SEGMENTS = ("estimates", "prognosis")  # the service's routes below an actuator: no id may end in one
+RELATIVE_SEGMENTS = (".", "..", "")  # segments a browser or a file path resolves away: an id holds none
 # Times a trend computes with, bounded where they enter: no airframe flies a million hours, no log predates
 # 2000 or is stamped more than a day ahead of the clock that receives it.
 MAX_FLIGHT_HOURS = 1_000_000.0
@@ -49,8 +50,12 @@ NOISE_COPIES_RANGE = (8, 500)
 
 
 def route_collision(actuator_id: str) -> str | None:
-    """Why ``actuator_id`` would be read as another route of the service (``/v1/actuators/{id}/estimates``), or
-    None: no segment of it after the first may be a route's name."""
+    """Why ``actuator_id`` would be read as another route of the service (``/v1/actuators/{id}/estimates``), or as
+    another actuator's page once a browser resolves it (a segment ``.`` or ``..``: ``a/../b`` opens ``b``'s), or
+    None: no segment of it after the first may be a route's name, no segment a relative one, none empty."""
+    relative = next((segment for segment in actuator_id.split("/") if segment in RELATIVE_SEGMENTS), None)
+    if relative is not None:
+        return f"has a segment {relative!r}: a path resolves it to another actuator's (give each part a name)"
     segments = actuator_id.split("/")[1:]
     clash = next((segment for segment in segments if segment in ROUTE_SEGMENTS), None)
     if clash is None:

@@ -54,6 +54,7 @@ class KindFacts:
     static_friction: bool = False  # a window can show a break-away (FSJ)
     load_side: bool = False  # the log is on the load side: FDJ is the load's friction force
     recorded: tuple[str, ...] = ()  # the section's fields a log may record beside its signals (``constants``)
+    measured: tuple[str, ...] = ()  # the signals its answer is read from: a dead one refuses a window
     # How long the windows a recording of this kind is cut into unless told (the thesis's windows: a few commands of
     # the elevator each); None: a log is one window (a rig's run, a controller's log).
     cut_s: float | None = None
@@ -105,12 +106,14 @@ _ROTARY = KindFacts(
     ),
     nominal_given=True,
     static_friction=True,
+    measured=("position_deg", "motor_speed_radps", "current_a"),
 )
 _LINEAR = KindFacts(
     name="linear",
     summary="a ball screw turned by a stepper, its current read through what ema calibrate learned",
     section="screw",
     roles=_roles(set_point="command_mm", position="position_mm", current="current_a", load="load_n"),
+    measured=("position_mm", "current_a"),
 )
 _SERVO = KindFacts(
     name="servo",
@@ -121,6 +124,7 @@ _SERVO = KindFacts(
     ),
     load_side=True,
     recorded=SERVO_CONSTANTS,
+    measured=("position_m", "drive_force_n"),
 )
 _GEARED = KindFacts(
     name="geared",
@@ -135,6 +139,7 @@ _GEARED = KindFacts(
         optional=("motor_on",),
     ),
     recorded=GEARED_CONSTANTS,
+    measured=("position_rad", "duty_ratio", "supply_v"),
 )
 KINDS: Mapping[str, KindFacts] = MappingProxyType({k.name: k for k in (_ROTARY, _LINEAR, _SERVO, _GEARED)})
 DEFAULT_KIND = _ROTARY.name

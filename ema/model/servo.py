@@ -78,7 +78,9 @@ class Servo(Document):
         description="the load's travel per turn of the motor (a screw's lead, through any gear between): the period "
         "of a force once per turn; null: not known, and no such force is looked for",
     )
-    mass_kg: Number | None = Field(None, gt=0, le=1e6, description="M, everything the drive moves (learned)")
+    mass_kg: Number | None = Field(
+        None, ge=1e-3, le=1e6, description="M, everything the drive moves (learned; no drive moves less than a gram)"
+    )
     mass_std_kg: Number | None = Field(None, ge=0, le=1e6)
     viscous_ns_per_m: Number | None = Field(
         None, ge=0, le=1e7, description="C moving towards increasing position, and both ways where the next is null"

@@ -266,7 +266,9 @@ def test_a_servo_log_is_refused_until_its_document_is_stored_then_stored_once(tm
     key.write_text("a-key-of-sixteen-or-more\n")
     (tmp_path / "wrong.txt").write_text("not-the-key-0123456789\n")
     url, out = f"http://127.0.0.1:{port}", str(tmp_path / "answers.csv")
-    server = start_server(port, tmp_path / "history.sqlite3", EMA_API_KEY="a-key-of-sixteen-or-more")
+    server = start_server(
+        port, tmp_path / "history.sqlite3", EMA_API_KEY="a-key-of-sixteen-or-more", EMA_MAX_WINDOW_S="30"
+    )  # the 24.8 s log within its window limit
     try:
         replay = ["replay", *log, "--url", url, "--out", out, "--json"]
         assert main(replay) == EXIT_BAD_INPUT  # no key: the first post names the flag

@@ -304,7 +304,7 @@ def test_a_bad_actuator_document_is_a_422_naming_its_field(client):
     assert response.status_code == 422 and response.json()["detail"][0]["loc"] == ["body", "nominal", "fsj_nm"]
 
 
-def test_a_servo_window_without_its_stored_document_is_refused_saying_how_to_store_it(client):
+def test_a_servo_window_without_its_stored_document_is_refused_saying_how_to_store_it(tmp_path):
     """The EMPS log as a window, to an actuator with no document: not read as the default's rotary EMA, and the
     refusal names the path to PUT its document to, for an estimate and for a calibration alike."""
     from pathlib import Path
@@ -315,10 +315,12 @@ def test_a_servo_window_without_its_stored_document_is_refused_saying_how_to_sto
 
     emps = Path(__file__).resolve().parents[2] / "examples" / "emps"
     window = window_to_dict(read_one(emps / "DATA_EMPS.mat", read_logmap(emps / "log-map.json")))
-    for route, body, field in (
-        ("/v1/estimate", window, ["body", "signals"]),
-        ("/v1/calibrate", {"windows": [window]}, ["body", "windows", "0", "signals"]),
-    ):
-        refused = client.post(route, json=body)
-        assert refused.status_code == 422 and refused.json()["detail"][0]["loc"] == field
-        assert "PUT its document to /v1/actuators/emps/axis" in refused.json()["detail"][0]["msg"]
+    settings = settings_for(tmp_path, max_window_s=30.0, max_calibrate_s=30.0)  # the 24.8 s log within the limits
+    with TestClient(create_app(settings), base_url=LOCAL) as client:
+        for route, body, field in (
+            ("/v1/estimate", window, ["body", "signals"]),
+            ("/v1/calibrate", {"windows": [window]}, ["body", "windows", "0", "signals"]),
+        ):
+            refused = client.post(route, json=body)
+            assert refused.status_code == 422 and refused.json()["detail"][0]["loc"] == field
+            assert "PUT its document to /v1/actuators/emps/axis" in refused.json()["detail"][0]["msg"]

@@ -88,14 +88,18 @@ def test_windows_of_another_kind_than_the_document_are_a_422_naming_the_signals(
         assert answer.json()["detail"][0]["loc"] == ["body", "windows", "0", "signals"]
 
 
-def test_the_service_answers_a_servo_log_within_its_budget(tmp_path):
-    """A 24.8 s log at 1 kHz: over the window limit in seconds, but its simulations' work is what is counted."""
+def test_the_service_holds_a_servo_log_to_its_window_limit(tmp_path):
+    """A 24.8 s log at 1 kHz: a service's window limit, in seconds of log, holds for a servo as for any kind (over
+    it, refused naming the setting); within it, answered."""
     from tests.kinds.servo.test_stages import EMPS
 
     window = window_from_dict(read_mapped(EMPS / "DATA_EMPS.mat", read_logmap(EMPS / "log-map.json")))
+    document = read_actuator(EMPS / "actuator.json").model_dump(mode="json", by_alias=True)
     with TestClient(create_app(settings_for(tmp_path, max_window_s=4.0)), base_url=LOCAL) as client:
-        document = read_actuator(EMPS / "actuator.json").model_dump(mode="json", by_alias=True)
         assert client.put(f"/v1/actuators/{window.actuator_id}", json=document).is_success
+        refused = client.post("/v1/estimate", json=window_to_dict(window))
+        assert refused.status_code == 422 and "EMA_MAX_WINDOW_S" in refused.text
+    with TestClient(create_app(settings_for(tmp_path, max_window_s=30.0)), base_url=LOCAL) as client:
         answer = client.post("/v1/estimate", json=window_to_dict(window))
         assert answer.status_code == 200, answer.text
         assert set(answer.json()["stages"].values()) == {"run"} and answer.json()["estimates"]["FDJ"]["unit"] == "N"

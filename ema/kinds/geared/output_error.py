@@ -32,7 +32,7 @@ from ema.kinds.geared.log_reading import HEALTH, GearedPrepared
 from ema.kinds.geared.loop import Run, simulate_lanes
 
 LOSS_SCALE_RAD = 0.02  # soft-L1: a position error past this counts linearly (a slip, a knock), not squared
-BOUNDS = {"fdj_nm": (0.0, 100.0), "k_opp": (0.0, 9.0), "k_aid": (0.0, 2.0)}  # η_O ≥ 0.1, η_A ≥ −1
+BOUNDS = {"fdj_nm": (1e-6, 100.0), "k_opp": (1e-3, 9.0), "k_aid": (1e-3, 2.0)}  # η_O 0.1-0.999, η_A −1-0.999
 DIFF_STEP = 1e-3  # relative finite-difference step: the stick-slip map is flat below it
 MAX_EVALUATIONS = 200
 

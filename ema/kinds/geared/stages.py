@@ -83,6 +83,28 @@ def assessed(
     return assess(candidates, ratio, misfit_limit(check_rms))
 
 
+PHYSICAL = {"fdj_nm": (1e-6, np.inf), "eta_o": (0.1, 0.999), "eta_a": (-0.99, 0.999)}  # the reading's bounds
+
+
+def within_physics(answer: Assessed) -> Assessed:
+    """The answer with a value the blend carried past what is physical (an efficiency of 1 or more, a friction of
+    0) held at that end, and said (``eta_o_at_bound``): a bound, not a reading past it."""
+    values, notes = dict(answer.values), list(answer.notes)
+    for name, (low, high) in PHYSICAL.items():
+        if not low <= values[name] <= high:
+            held = min(max(values[name], low), high)
+            notes.append(
+                doc.Note(
+                    code="eta_o_at_bound",
+                    parameter=REPORTED[name],
+                    text=f"{REPORTED[name]} read {values[name]:.4g}, past what is physical: held at {held:g} (a "
+                    "bound, not a value; the run holds little of it)",
+                )
+            )
+            values[name] = held
+    return replace(answer, values=values, notes=notes)
+
+
 def closed_loop_check(prepared: GearedPrepared, answer: Assessed) -> doc.Check:
     """The window simulated at the answer: its position's mean absolute error [rad] (and at the document's nominal
     health: what the document alone predicts of the run), RMS over the calibrated model's floor on healthy runs
@@ -201,7 +223,7 @@ def estimate_geared(
     with watch("learn", f"learning {config.members} network(s) of {config.hidden_units} neurons"):
         network = learned(data, config)
     with watch("assess", "weighing the estimators on held-out simulations"):
-        answer = assessed(reading, data, network, check, n)
+        answer = within_physics(assessed(reading, data, network, check, n))
     with watch("check", "simulating the window at the answer"):
         verdict = closed_loop_check(prepared, answer)
     with watch("report", "writing the report"):

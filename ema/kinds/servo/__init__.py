@@ -50,13 +50,13 @@ class Servo:
 
     def cost(self, window: Window, config: PipelineConfig) -> Cost:
         """Its simulations' load steps, counted as as many of the rotary simulator's 1 µs steps (a lane-step of
-        either costs a few ns)."""
+        either costs a few ns); its window's seconds, which a service's window limit holds as it holds any kind's."""
         steps = (config.total_simulations + 1) * window.n_samples * SUBSTEPS
-        return Cost(simulated_s=steps * ROTARY_STEP_S, window_s=0.0)
+        return Cost(simulated_s=steps * ROTARY_STEP_S, window_s=window.duration_s)
 
     def calibration_cost(self, windows: Sequence[Window], config: PipelineConfig) -> Cost:
         steps = sum(window.n_samples * SUBSTEPS * CLOSED_LOOPS for window in windows)
-        return Cost(simulated_s=steps * ROTARY_STEP_S, window_s=0.0)
+        return Cost(simulated_s=steps * ROTARY_STEP_S, window_s=sum(window.duration_s for window in windows))
 
     def warm_up(self) -> None:
         """A tiny servo's window (``WARM_UP_SERVO``) simulated and estimated: its filters, its simulator and its
