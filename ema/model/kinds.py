@@ -139,7 +139,7 @@ _GEARED = KindFacts(
         optional=("motor_on",),
     ),
     recorded=GEARED_CONSTANTS,
-    measured=("position_rad", "duty_ratio", "supply_v"),
+    measured=("position_rad", "duty_ratio"),  # a regulated supply may read one value throughout
 )
 KINDS: Mapping[str, KindFacts] = MappingProxyType({k.name: k for k in (_ROTARY, _LINEAR, _SERVO, _GEARED)})
 DEFAULT_KIND = _ROTARY.name

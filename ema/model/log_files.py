@@ -36,12 +36,15 @@ class Table:
     unread: dict[str, str] = field(default_factory=dict)  # a CSV column left out as text -> its first such cell
 
     def numeric(self, name: str, path: Path, what: str) -> np.ndarray:
-        """The column ``name``; an InputError naming the file and, where the column holds text, its first
-        non-number (an empty cell is a sample the log lacks, not a column it lacks)."""
+        """The column ``name``; an InputError naming the file and the variable, saying what it holds instead (text, a
+        matrix, a struct: ``unread``), or where only the case of its name differs, the name the file has."""
         if name in self.columns:
             return self.columns[name]
         if name in self.unread:
-            raise InputError(f"{path}: {name}", f"is not numeric throughout: {self.unread[name]} ({what})")
+            raise InputError(f"{path}: {name}", f"{self.unread[name]} ({what})")
+        alike = [other for other in (*self.columns, *self.unread) if other.lower() == name.lower()]
+        if alike:
+            raise InputError(str(path), f"has no variable {name!r}, but {alike[0]!r}: names differ in case ({what})")
         raise InputError(str(path), f"has no numeric variable {name!r} ({what})")
 
 
@@ -106,9 +109,9 @@ def _csv(path: Path) -> Table:
     columns, unread = {}, {}
     for name, column in zip(header, values, strict=True):
         if len(column) < count:
-            unread[name.strip()] = f"data row {len(column) + 1} lacks it"
+            unread[name.strip()] = f"is not numeric throughout: data row {len(column) + 1} lacks it"
         elif None in column:
-            unread[name.strip()] = f"data row {column.index(None) + 1} holds no number"
+            unread[name.strip()] = f"is not numeric throughout: data row {column.index(None) + 1} holds no number"
         else:
             columns[name.strip()] = np.array(column, dtype=np.float64)
     return Table(columns, meta=meta, unread=unread)
@@ -144,20 +147,27 @@ def _npz(path: Path) -> Table:
 
 
 def _arrays(path: Path, variables: dict[str, np.ndarray]) -> Table:
-    columns, scalars, meta = {}, {}, {}
+    """The variables as columns (vectors of real numbers), constants (1×1) and metadata (text); any other kept in
+    ``unread`` with what it is (a struct, a cell, complex numbers, a matrix of its shape)."""
+    columns, scalars, meta, unread = {}, {}, {}, {}
     for name, value in variables.items():
         array = np.asarray(value)
         if array.dtype.kind in "US":
             meta[name] = str(array.ravel()[0]) if array.size else ""
-        elif array.dtype.kind not in "biuf":
-            continue  # a struct or a cell: not a signal
+        elif array.dtype.kind not in "biufc":
+            unread[name] = f"is a {'struct' if array.dtype.names else 'cell or object array'}: a signal is a vector"
+        elif array.dtype.kind == "c":
+            unread[name] = "holds complex numbers: a signal is real"
         elif array.size == 1:
             scalars[name] = float(array.ravel()[0])
         elif sum(d > 1 for d in array.shape) == 1:
             if array.size > MAX_ROWS:
                 raise InputError(f"{path}: {name}", f"has {array.size:,} samples, more than a window may hold")
             columns[name] = array.ravel().astype(np.float64)
-    return Table(columns, scalars, meta)
+        else:
+            shape = "×".join(str(d) for d in array.shape)
+            unread[name] = f"is a {shape} array: a signal is one vector (n×1 or 1×n)"
+    return Table(columns, scalars, meta, unread)
 
 
 def _json(path: Path) -> Table:
@@ -185,7 +195,7 @@ def _json(path: Path) -> Table:
     for name in dict.fromkeys(key for entry in entries[:1] for key in entry):
         values = [_json_number(entry.get(name)) for entry in entries]
         if None in values:
-            unread[name] = f"sample {values.index(None)} holds no number"
+            unread[name] = f"is not numeric throughout: sample {values.index(None)} holds no number"
         else:
             columns[name] = np.array(values, dtype=np.float64)
     return Table(columns, scalars, meta, unread)

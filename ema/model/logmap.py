@@ -11,6 +11,7 @@ one without a load, not a stuck sensor. A file that does not match its map is re
 
 from __future__ import annotations
 
+import re
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Annotated, Any, Literal
@@ -18,6 +19,7 @@ from typing import Annotated, Any, Literal
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, Tag, TypeAdapter, model_validator
 
+from ema.model.bounds import IDENTIFIER
 from ema.model.checks import InputError, kind_named, read_document, tagged_by, validated
 from ema.model.document import Number
 from ema.model.kinds import KIND_NAMES, KINDS, Role
@@ -241,6 +243,9 @@ def read_mapped(path: str | Path, log_map: LogMap) -> dict[str, Any]:
         rate = log_map.sample_rate_hz
     else:
         time_s = _read(table, log_map.time, Role("time_s"), "time", path, n)
+        if not np.all(np.isfinite(time_s)):
+            row = int(np.argmax(~np.isfinite(time_s)))
+            raise InputError(f"{path}: {log_map.time.column}", f"the time variable holds {time_s[row]} at sample {row}")
         rate, signals, resampled = _uniform(time_s, signals, log_map.resample_hz, path)
     constants = {
         field: _scalar(table, variable, path, f"constants.{field}") for field, variable in log_map.constants.items()
@@ -248,13 +253,24 @@ def read_mapped(path: str | Path, log_map: LogMap) -> dict[str, Any]:
     return {
         "schema": "ema-window/1",
         "actuator_id": log_map.actuator_id,
-        "window_id": path.stem,
+        "window_id": window_id_of(path),
         "sample_rate_hz": float(rate),
         "flight_condition": None,
         "signals": {name: values.tolist() for name, values in signals.items()},
         **({"constants": constants} if constants else {}),
         **({"resampled": resampled} if resampled else {}),
     }
+
+
+def window_id_of(path: Path) -> str:
+    """A logged file's window id: its name without the suffix; InputError naming the file where that is no id
+    (printable ASCII, 1 to 200 characters: a name in another script, a name of blanks)."""
+    if re.fullmatch(IDENTIFIER, path.stem) is None:
+        shown = path.stem.encode("ascii", "backslashreplace").decode()
+        raise InputError(
+            str(path), f"its name {shown!r} is no window id (1-200 printable ASCII characters): rename the file"
+        )
+    return path.stem
 
 
 def _uniform(
