@@ -10,15 +10,17 @@ from __future__ import annotations
 
 import csv
 import io
+import math
 import zipfile
-from collections.abc import Iterator
-from dataclasses import dataclass, field
+from collections.abc import Collection, Iterator
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
 
 from ema.model.bounds import MAX_SAMPLES
 from ema.model.checks import InputError, load_json
+from ema.model.mat_headers import variable_shapes
 
 MAX_LOG_BYTES = 256 * 2**20  # a logged file's size limit: ~4x the largest window's CSV
 MAX_ROWS = MAX_SAMPLES  # as many rows as a window's samples at most
@@ -34,6 +36,7 @@ class Table:
     scalars: dict[str, float] = field(default_factory=dict)
     meta: dict[str, str] = field(default_factory=dict)
     unread: dict[str, str] = field(default_factory=dict)  # a CSV column left out as text -> its first such cell
+    present: tuple[str, ...] = ()  # every variable's name, those left unloaded too (a MATLAB file's)
 
     def numeric(self, name: str, path: Path, what: str) -> np.ndarray:
         """The column ``name``; an InputError naming the file and the variable, saying what it holds instead (text, a
@@ -42,14 +45,16 @@ class Table:
             return self.columns[name]
         if name in self.unread:
             raise InputError(f"{path}: {name}", f"{self.unread[name]} ({what})")
-        alike = [other for other in (*self.columns, *self.unread) if other.lower() == name.lower()]
+        alike = [other for other in (*self.columns, *self.unread, *self.present) if other.lower() == name.lower()]
         if alike:
             raise InputError(str(path), f"has no variable {name!r}, but {alike[0]!r}: names differ in case ({what})")
         raise InputError(str(path), f"has no numeric variable {name!r} ({what})")
 
 
-def read_table(path: str | Path) -> Table:
-    """The table in ``path`` by its suffix; InputError naming the file where it cannot be read or is too large."""
+def read_table(path: str | Path, names: Collection[str] | None = None) -> Table:
+    """The table in ``path`` by its suffix; InputError naming the file where it cannot be read or is too large.
+    ``names``: the variables wanted (a log map's), where the format can leave the others unread (a MATLAB file's:
+    its others never loaded, whatever they would inflate to)."""
     path = Path(path)
     readers = {".csv": _csv, ".mat": _mat, ".npz": _npz, ".json": _json}
     suffix = path.suffix.lower()
@@ -70,7 +75,7 @@ def read_table(path: str | Path) -> Table:
         raise InputError(
             str(path), f"is {size / 2**20:.0f} MiB, over the {MAX_LOG_BYTES // 2**20} MiB a logged file may be: cut it"
         )
-    return readers[suffix](path)
+    return _mat(path, names) if suffix == ".mat" else readers[suffix](path)
 
 
 def _rows(handle: io.TextIOBase, meta: dict[str, str]) -> Iterator[str]:
@@ -124,18 +129,29 @@ def _number(text: str) -> float | None:
         return None
 
 
-def _mat(path: Path) -> Table:
-    """A MATLAB file's vectors (any n×1 or 1×n) as columns, its 1×1 values as constants."""
+def _mat(path: Path, names: Collection[str] | None = None) -> Table:
+    """A MATLAB file's vectors (any n×1 or 1×n) as columns, its 1×1 values as constants: of ``names`` only where
+    given, each refused from its header where it holds more numbers than a window may (``ema.model.mat_headers``:
+    before it is inflated, however well it compresses)."""
     from scipy.io import loadmat  # the reader of MATLAB's files; imported only for one
     from scipy.io.matlab import MatReadError
 
+    shapes = variable_shapes(path)
+    wanted = None if names is None or shapes is None else [name for name in names if name in shapes]
+    for name, shape in (shapes or {}).items():
+        if (wanted is None or name in wanted) and math.prod(shape) > MAX_ROWS:
+            dims = "×".join(f"{d:,}" for d in shape)
+            raise InputError(
+                f"{path}: {name}", f"is a {dims} array, more than a window may hold: refused before it is read"
+            )
     try:
-        variables = loadmat(path, squeeze_me=False)
+        variables = loadmat(path, squeeze_me=False, variable_names=wanted)
     except NotImplementedError:
         raise InputError(str(path), "is a MATLAB 7.3 (HDF5) file: save it with -v7 (scipy reads up to 7.2)") from None
     except (MatReadError, ValueError, TypeError, OSError, EOFError) as exc:  # EOFError: a file cut short
         raise InputError(str(path), f"is not a MATLAB file ({exc})") from None
-    return _arrays(path, {k: v for k, v in variables.items() if not k.startswith("__")})
+    table = _arrays(path, {k: v for k, v in variables.items() if not k.startswith("__")})
+    return replace(table, present=tuple(shapes or ()))
 
 
 def _npz(path: Path) -> Table:

@@ -225,7 +225,7 @@ def read_mapped(path: str | Path, log_map: LogMap) -> dict[str, Any]:
     """The ``ema-window/1`` document of one logged file, read through ``log_map``; InputError naming the file and
     the variable where they do not match."""
     path = Path(path)
-    table = read_table(path)
+    table = read_table(path, mapped_names(log_map))
     roles = KINDS[log_map.kind].roles
     n = len(table.numeric(log_map.set_point.column, path, "the log map's set_point"))
     signals: dict[str, np.ndarray] = {}
@@ -260,6 +260,17 @@ def read_mapped(path: str | Path, log_map: LogMap) -> dict[str, Any]:
         **({"constants": constants} if constants else {}),
         **({"resampled": resampled} if resampled else {}),
     }
+
+
+def mapped_names(log_map: LogMap) -> set[str]:
+    """Every variable of a file ``log_map`` reads: its roles' columns and scales, its time, its constants."""
+    names = set(log_map.constants.values())
+    for part in (log_map.time, *(log_map.part(name) for name in ROLES)):
+        if isinstance(part, Column):
+            names.add(part.column)
+            if isinstance(part.scale, str):
+                names.add(part.scale)
+    return names
 
 
 def window_id_of(path: Path) -> str:

@@ -54,3 +54,45 @@ def test_nan_in_the_time_variable_is_named_there(tmp_path):
 def test_a_file_whose_name_is_no_id_is_named_with_its_name(tmp_path):
     with pytest.raises(InputError, match=r"its name 'essai_\\\\xe9' is no window id.*rename the file"):
         read_mapped(emps_like(tmp_path / "essai_é.mat"), read_logmap(EMPS_MAP))
+
+
+def compressed_zeros(path, name: str, rows: int, columns: int, other: dict) -> None:
+    """A MATLAB v5 file whose variable ``name`` is a rows×columns array of zeros, compressed as MATLAB does, streamed
+    (never allocated here); ``other`` saved beside it by scipy."""
+    import struct
+    import zlib
+
+    savemat(path, other)
+    nbytes = rows * columns * 8
+    body = (
+        struct.pack("<II", 6, 8) + struct.pack("<II", 6, 0)  # array flags: a double array
+        + struct.pack("<II", 5, 8) + struct.pack("<ii", rows, columns)  # dimensions
+        + struct.pack("<HH", 1, len(name)) + name.encode().ljust(4, b"\0")  # its name, small format
+        + struct.pack("<II", 9, nbytes)  # the real part: miDOUBLE
+    )  # fmt: skip
+    packer = zlib.compressobj()
+    stream = packer.compress(struct.pack("<II", 14, len(body) + nbytes) + body)
+    chunk = bytes(2**20)
+    for _ in range(nbytes // len(chunk)):
+        stream += packer.compress(chunk)
+    stream += packer.compress(bytes(nbytes % len(chunk))) + packer.flush()
+    with open(path, "ab") as handle:
+        handle.write(struct.pack("<II", 15, len(stream)) + stream)
+
+
+def test_a_small_compressed_file_of_a_huge_array_is_refused_before_it_is_inflated(tmp_path):
+    """A file of a few hundred kB holding 4×5,000,000 zeros: refused from the variable's header, its 160 MB never
+    inflated."""
+    import resource
+
+    path = tmp_path / "bomb.mat"
+    t = np.arange(2000) * 1e-3
+    compressed_zeros(
+        path, "qm", 4, 5_000_000, {"t": t, "qg": np.sin(t), "vir": np.cos(t), "gtau": 1.0, "kp": 1.0, "kv": 1.0}
+    )
+    assert path.stat().st_size < 2**20
+    before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    with pytest.raises(InputError, match="4×5,000,000 array, more than a window may hold") as refused:
+        read_mapped(path, read_logmap(EMPS_MAP))
+    assert refused.value.field.endswith(": qm")
+    assert resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - before < 100 * 1024  # kB: far under its 160 MB
