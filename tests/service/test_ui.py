@@ -48,6 +48,22 @@ def test_an_actuator_page_plots_each_parameter_with_its_outlook(fleet_settings):
     assert 'class="threshold"' in page.text and 'class="rul"' in page.text and "backtest" in page.text
 
 
+def test_an_actuator_page_answers_while_every_job_place_is_taken(fleet_settings):
+    """The view costs the estimates nothing: its pages never take a job's place, so with every place held (as five
+    concurrent estimates hold them) a page still answers, and no page makes an estimate wait or be refused."""
+    with TestClient(create_app(fleet_settings), base_url=LOCAL) as client:
+        runner = client.app.state.runner
+        held = [runner.admit() for _ in range(runner.slots + runner.max_queue)]
+        try:
+            assert client.post("/v1/estimate", json={}).status_code == 503  # every place taken: estimates wait
+            for _ in range(5):  # five viewers, reloading
+                assert client.get("/ui/actuators/tail-1/elevator-right").status_code == 200
+            assert runner.admitted == len(held)  # no page took a place
+        finally:
+            for ticket in held:
+                ticket.__exit__(None, None, None)
+
+
 def test_an_actuator_nothing_is_stored_of_is_a_404_page_not_an_empty_history(fleet_settings):
     """A mistyped id must not read as an actuator with no windows (the API answers it 404 as well)."""
     with TestClient(create_app(fleet_settings), base_url=LOCAL) as client:

@@ -10,7 +10,8 @@ from fastapi import APIRouter, Query, Request, Response
 from fastapi.responses import HTMLResponse, RedirectResponse
 from starlette.concurrency import run_in_threadpool
 
-from ema.service.deps import ActuatorId, RunnerDep, SettingsDep, StoreDep, is_stored, prognosis_now
+from ema.history.open import History
+from ema.service.deps import ActuatorId, SettingsDep, StoreDep, is_stored, prognosis_now
 from ema.service.pages import actuator_page, fleet_page, missing_page
 from ema.service.share import Share
 from ema.service.view import FleetView
@@ -68,15 +69,19 @@ def revalidated(request: Request, body: str) -> Response:
 
 
 @router.get("/ui/actuators/{actuator_id:path}", response_class=HTMLResponse)
-async def actuator(actuator_id: ActuatorId, request: Request, store: StoreDep, runner: RunnerDep) -> HTMLResponse:
-    """One actuator's plots, notes, backtest, calibrations and document (its prognosis a job of the queue); a 404
-    page where nothing of it is stored."""
+async def actuator(actuator_id: ActuatorId, request: Request, store: StoreDep) -> HTMLResponse:
+    """One actuator's plots, notes, backtest, calibrations and document, read and drawn in the view's share of the
+    machine (``ema.service.share``), as the fleet's page is: a page never takes a job's place, however many viewers
+    reload it; a 404 page where nothing of it is stored."""
     if not await is_stored(store, actuator_id):
         return HTMLResponse(missing_page(actuator_id), status_code=404)
-    with runner.admit() as ticket:
-        prognosis, history = await runner.run(
-            ticket, request.is_disconnected, prognosis_now, request.app.state.prognoses, store, actuator_id
-        )
-    document = await run_in_threadpool(store.get_actuator, actuator_id)
-    reports = await run_in_threadpool(store.calibrations, actuator_id)
-    return HTMLResponse(actuator_page(actuator_id, history, prognosis, document, reports))
+    share: Share = request.app.state.view_share
+    async with share.turn():
+        page = await run_in_threadpool(_actuator_page, request, store, actuator_id)
+    return HTMLResponse(page)
+
+
+def _actuator_page(request: Request, store: History, actuator_id: str) -> str:
+    prognosis, history = prognosis_now(request.app.state.prognoses, store, actuator_id)
+    document, reports = store.get_actuator(actuator_id), store.calibrations(actuator_id)
+    return actuator_page(actuator_id, history, prognosis, document, reports)
