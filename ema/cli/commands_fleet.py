@@ -101,6 +101,7 @@ def fleet(
         documents=documents,
         pool=pool,
         started=started,
+        conflicts=read.conflicts,
     )
     result = {**run, "bad_files": read.bad_files}
     emit(result, as_json, _print_fleet_verbose if verbose else _print_fleet)

@@ -169,6 +169,9 @@ def report_log(read: Any) -> None:
         print(f"{window_id}: the last {dropped} sample(s) after it do not fill a window", file=sys.stderr)
     for window_id, reason in read.kept_whole.items():
         print(f"{window_id}: {reason}", file=sys.stderr)
+    for (actuator_id, window_id), files in read.conflicts.items():
+        print(f"conflict: ({actuator_id}, {window_id}) is in {' and '.join(files)} with different content: none read",
+              file=sys.stderr)  # fmt: skip
 
 
 def _number(value: float | None, width: int, digits: str) -> str:

@@ -22,7 +22,7 @@ from pathlib import Path
 from typing import Any
 
 from ema.cli.pool import LocalWorkers
-from ema.cli.results import ResultsWriter, done_windows, row_of
+from ema.cli.results import ResultsWriter, document_digest, done_windows, refused_under, row_of
 from ema.cli.workers import Answer, Documents, Job, in_process, on_ray
 from ema.estimate.config import PipelineConfig
 from ema.model.window import Window
@@ -132,17 +132,23 @@ def run_fleet(
     documents: Documents | None = None,
     pool: LocalWorkers | None = None,
     started: float | None = None,
+    conflicts: dict[tuple[str, str], list[str]] | None = None,
 ) -> dict[str, Any]:
     """Every window of ``windows`` not yet in ``out``, on ``workers`` workers of ``threads`` threads each (a Ray
     cluster's with an ``address``, else a local pool: ``pool`` where one was started already, in this process with
     one worker), each read with its actuator's document; with a ``database``, the documents go into that history
     first, and the answers record the versions they got there. ``started``: when the command began (the phases
-    the answer gives count from it)."""
+    the answer gives count from it). ``conflicts``: keys the archive holds in several files with different content
+    (``ema.cli.logs.Log.conflicts``), each a refused row naming its files, once, none read."""
     began = time.perf_counter() if started is None else started
     documents = Documents() if documents is None else documents
-    done = done_windows(out)
-    todo = [w for w in windows if (w.actuator_id, w.window_id) not in done]
+    done, refused = done_windows(out), refused_under(out)
+    retried = {  # refused under a document that has changed since: read again
+        key for key, digest in refused.items() if digest != document_digest(documents.of(key[0]))
+    }
+    todo = [w for w in windows if (key := (w.actuator_id, w.window_id)) not in done or key in retried]
     progress = Progress(len(todo), started=time.perf_counter())
+    conflicted = _conflict_rows(out, conflicts or {}, done)
     engine_name, pool = _engine(todo, workers=workers, threads=threads, address=address, pool=pool)
     store = _store(database)
     if store is not None:
@@ -156,16 +162,17 @@ def run_fleet(
         return on_ray(jobs, config, workers, threads, address, documents)
 
     try:
-        writing = _written(_with_history(todo, engine([(w, None) for w in todo]), engine), out, store, progress)
+        answers = _with_history(todo, engine([(w, None) for w in todo]), engine)
+        writing = _written(answers, out, store, progress, documents)
     finally:
         if pool is not None:
             pool.close()
     ended = time.perf_counter()
     return {
         "csv": str(out),
-        "skipped": len(done & {(w.actuator_id, w.window_id) for w in windows}),
+        "skipped": len((done - retried) & {(w.actuator_id, w.window_id) for w in windows}),
         "answered": progress.done - progress.refused,
-        "refused": progress.refused,
+        "refused": progress.refused + conflicted,
         "seconds": ended - began,
         "windows_per_s": progress.done / (ended - began) if ended > began else 0.0,
         "workers": workers,
@@ -202,8 +209,21 @@ def _engine(
     return f"in-process: {reason}", None
 
 
-def _written(results: Iterator[Answer], out: Path, store: Any, progress: Progress) -> float:
-    """Each answer into the CSV (and the history) as it comes; the seconds spent writing."""
+def _conflict_rows(out: Path, conflicts: dict[tuple[str, str], list[str]], done: set[tuple[str, str]]) -> int:
+    """A refused row for each conflicting key not in ``out`` yet, in the keys' order (the same file whatever the
+    workers do); how many were written."""
+    fresh = sorted(key for key in conflicts if key not in done)
+    with ResultsWriter(out) as writer:
+        for actuator_id, window_id in fresh:
+            files = " and ".join(conflicts[(actuator_id, window_id)])
+            error = f"conflict: {files} hold this window with different content: none is read (give each its own id)"
+            writer.write({"actuator_id": actuator_id, "window_id": window_id, "error": error})
+    return len(fresh)
+
+
+def _written(results: Iterator[Answer], out: Path, store: Any, progress: Progress, documents: Documents) -> float:
+    """Each answer into the CSV (and the history) as it comes, with the digest of the document it was read with;
+    the seconds spent writing."""
     writing = 0.0
     with ResultsWriter(out) as writer:
         for window, answer in results:
@@ -211,6 +231,7 @@ def _written(results: Iterator[Answer], out: Path, store: Any, progress: Progres
                 progress.first_at = time.perf_counter()
             begun = time.perf_counter()
             row = row_of(window.actuator_id, window.window_id, answer)
+            row["document"] = document_digest(documents.of(window.actuator_id))
             if store is not None and "error" not in answer:
                 row = _stored(store, row, answer)
             writer.write(row)

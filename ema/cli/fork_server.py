@@ -3,11 +3,14 @@ preload), run as a ``__main__`` is. It sets the cyclic collector for a program t
 modules (``ema.model.collector``), loads the pipeline's and the kernels' modules, then warms the kernels on one
 thread (``ema.kinds.remote.warm``): every worker forked from the server holds them from its start, loaded once
 while the driver still reads the archive, not once per worker after it. One thread: the warm-up runs inline, so
-no pool thread exists to be forked. Importing it does all this, so nothing else imports it.
+no pool thread exists to be forked. It dies with the command that started it (``ema.cli.lifeline``), and so does
+each worker with it. Importing it does all this, so nothing else imports it.
 """
 
+from ema.cli.lifeline import die_with_parent
 from ema.model.collector import collect_less_often
 
+die_with_parent()  # with the command that started it: a kill -9 of it leaves nothing running
 collect_less_often()
 
 import ema.kinds.rotary.pipeline  # noqa: E402, F401  (after the collector is set: the point of this module)

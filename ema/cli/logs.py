@@ -178,6 +178,8 @@ class Log:
     dropped: dict[str, int]  # window_id -> samples after it that did not fill a window
     bad_files: dict[str, str]  # file -> why it was skipped
     kept_whole: dict[str, str] = field(default_factory=dict)  # window_id -> why it was not cut (too_short_to_cut)
+    # (actuator_id, window_id) -> the files that hold that one key with different content: none of them is read
+    conflicts: dict[tuple[str, str], list[str]] = field(default_factory=dict)
 
 
 def read_log(path: Path, window_s: float | None, defaults: Defaults = Defaults(), log_map: LogMap | None = None) -> Log:
@@ -198,13 +200,15 @@ def read_log(path: Path, window_s: float | None, defaults: Defaults = Defaults()
     dropped: dict[str, int] = {}
     bad: dict[str, str] = {}
     kept_whole: dict[str, str] = {}
+    sources: dict[tuple[str, str], list[str]] = {}  # key -> the files it was read from
     for file in files:
         try:
             recordings = read_file(file, defaults, log_map)
         except InputError as exc:
             if not path.is_dir():
                 raise
-            bad[str(file)] = exc.message
+            variable = exc.field.removeprefix(str(file)).removeprefix(": ")  # the variable at fault, where named
+            bad[str(file)] = f"{variable}: {exc.message}" if variable else exc.message
             continue
         for recording in recordings:
             length = window_s if window_s is not None else KINDS[recording.kind].cut_s
@@ -213,12 +217,33 @@ def read_log(path: Path, window_s: float | None, defaults: Defaults = Defaults()
                 kept_whole[recording.window_id] = whole
             pieces, tail = cut(recording, length) if length is not None and whole is None else ([recording], 0)
             windows.extend(pieces)
+            for piece in pieces:
+                sources.setdefault((piece.actuator_id, piece.window_id), []).append(str(file))
             if tail:
                 dropped[pieces[-1].window_id] = tail
-    if not windows:
+    windows, conflicts = _one_file_a_key(windows, sources)
+    if not windows and not conflicts:
         first = next(iter(bad.items()), None)
         raise InputError(str(path), "holds no readable window" + (f" ({first[0]}: {first[1]})" if first else ""))
-    return Log(windows, dropped, bad, kept_whole)
+    return Log(windows, dropped, bad, kept_whole, conflicts)
+
+
+def _one_file_a_key(
+    windows: list[Window], sources: dict[tuple[str, str], list[str]]
+) -> tuple[list[Window], dict[tuple[str, str], list[str]]]:
+    """(the windows with every key (actuator_id, window_id) once, the keys read from none): a window met again with
+    the same content (a file copied) is read once; a key met in several files with different content is read from
+    none, and its files listed, whatever order they were read in."""
+    kept: dict[tuple[str, str], Window] = {}
+    differing: set[tuple[str, str]] = set()
+    for window in windows:
+        key = (window.actuator_id, window.window_id)
+        if key not in kept:
+            kept[key] = window
+        elif kept[key].content_sha256() != window.content_sha256():
+            differing.add(key)
+    conflicts = {key: sorted(set(sources[key])) for key in differing}
+    return [window for key, window in kept.items() if key not in differing], conflicts
 
 
 def read_actuators(folder: Path) -> dict[str, ActuatorDocument]:

@@ -89,8 +89,10 @@ def _stop_fork_server() -> None:
 def _warmed(threads: int) -> None:
     """A local worker's initializer, ``ema.kinds.remote.warm``, imported in the worker: the driver that only reads
     and writes never loads the pipeline or the kernels (a second of a core the workers need at start-up)."""
+    from ema.cli.lifeline import die_with_parent
     from ema.kinds.remote import warm
 
+    die_with_parent()  # with the fork server, which dies with the command
     warm(threads)
 
 

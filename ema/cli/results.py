@@ -33,6 +33,7 @@ COLUMNS = (
     "assess_s",
     "total_s",
     "error",
+    "document",
 )
 
 
@@ -57,6 +58,30 @@ def row_of(actuator_id: str, window_id: str, answer: dict[str, Any]) -> dict[str
     row["reproduced"] = (answer.get("check") or answer["fit_check"])["reproduced"]  # a first-stage service: fit_check
     row["replay"] = answer.get("replay", False)
     return row
+
+
+def refused_under(path: Path) -> dict[tuple[str, str], str]:
+    """(actuator_id, window_id) -> the document digest (``document_digest``) each window whose last row in ``path``
+    is a refusal was refused under ("" where the row predates the column): a window refused under a document that
+    has changed since is read again."""
+    if not path.exists():
+        return {}
+    last: dict[tuple[str, str], dict[str, str]] = {}
+    with path.open(newline="") as handle:
+        for row in csv.DictReader(handle):
+            last[(row["actuator_id"], row["window_id"])] = row
+    return {key: row.get("document") or "" for key, row in last.items() if row["error"]}
+
+
+def document_digest(document: Any) -> str:
+    """A short digest of the document a window is read with (``default`` for the thesis's): what a refusal was
+    made under."""
+    if document is None:
+        return "default"
+    import hashlib
+
+    text = document.model_dump_json(by_alias=True, exclude_none=True)
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
 def done_windows(path: Path, answered_only: bool = False) -> set[tuple[str, str]]:

@@ -332,3 +332,112 @@ def test_a_node_that_dies_mid_run_loses_no_window_and_duplicates_none(tmp_path):
     store = open_history(database)
     stored = [s.window_id for a in ("tail-0", "tail-1") for s in store.history(a)[0]]
     assert sorted(stored) == sorted(w.window_id for w in windows)
+
+
+def test_one_key_in_two_files_is_one_refused_row_naming_both_whatever_the_workers(tmp_path, capsys):
+    """Two files hold (tail-0, w1) with different content, a third a copy of one window: the copy is read once,
+    the conflicting key from neither, a row naming both files, the same on every run and worker count."""
+    folder = tmp_path / "archive"
+    folder.mkdir()
+    first = synthetic_window(HealthParams.single(), seed=1, duration_s=0.1, actuator_id="tail-0", window_id="w1")
+    other = synthetic_window(HealthParams.single(), seed=2, duration_s=0.1, actuator_id="tail-0", window_id="w1")
+    kept = synthetic_window(HealthParams.single(), seed=3, duration_s=0.1, actuator_id="tail-0", window_id="w2")
+    for name, window in (("a.json", first), ("b.json", other), ("c.json", kept), ("d.json", kept)):
+        (folder / name).write_text(json.dumps(window_to_dict(window)))
+    for workers in ("1", "2"):
+        out = tmp_path / f"r{workers}.csv"
+        assert main(["fleet", str(folder), "--out", str(out), "--workers", workers, *SIZES, "--json"]) == EXIT_OK
+        rows = _rows(out)
+        assert [(r["window_id"], bool(r["error"])) for r in sorted(rows, key=lambda r: r["window_id"])] == [
+            ("w1", True),
+            ("w2", False),
+        ]
+        conflict = next(r for r in rows if r["window_id"] == "w1")["error"]
+        assert f"{folder / 'a.json'} and {folder / 'b.json'}" in conflict
+        assert main(["fleet", str(folder), "--out", str(out), "--workers", workers, *SIZES]) == EXIT_OK
+        assert len(_rows(out)) == 2  # a rerun writes the conflict once
+    capsys.readouterr()
+
+
+def test_a_window_refused_under_a_document_since_changed_is_read_again(tmp_path, capsys):
+    """A window refused with the wrong actuator document: rerun with the same one, it stays refused and is not
+    tried again; rerun once the document is fixed, it is read (a row of its own)."""
+    from tests.foreign.actuators import DRIVES, NOMINAL, document
+    from tests.foreign.windows import Ground, draw
+
+    folder = tmp_path / "archive"
+    folder.mkdir()
+    bench = draw(31, "sweep", drive=DRIVES["smaller"], nominal=NOMINAL["smaller"], flight=Ground(-100.0, 500.0))
+    (folder / "a.json").write_text(json.dumps({**bench.document, "actuator_id": "small-1", "window_id": "b"}))
+    wrong = {**document("smaller"), "kind": "linear", "screw": {"lead_mm": 5.0}}
+    wrong.pop("drive", None)
+    (folder / "actuators.json").write_text(json.dumps({"small-1": wrong}))
+    out = tmp_path / "r.csv"
+    run = ["fleet", str(folder), "--out", str(out), "--workers", "1", *SIZES, "--json"]
+    assert main(run) == EXIT_BAD_INPUT  # refused: nothing answered
+    assert main(run) == EXIT_OK and len(_rows(out)) == 1  # the same document: not tried again (already in the CSV)
+    (folder / "actuators.json").write_text(json.dumps({"small-1": document("smaller")}))
+    assert main(run) == EXIT_OK
+    rows = _rows(out)
+    assert [bool(r["error"]) for r in rows] == [True, False] and rows[0]["document"] != rows[1]["document"]
+    capsys.readouterr()
+
+
+def test_a_fleet_killed_leaves_no_process_running(tmp_path):
+    """kill -9 of ema fleet mid-run: its fork server and its workers die with it (``ema.cli.lifeline``)."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    folder = tmp_path / "archive"
+    folder.mkdir()
+    for i in range(40):
+        window = synthetic_window(
+            HealthParams.single(), seed=i, duration_s=0.1, actuator_id="tail-0", window_id=f"w{i}"
+        )
+        (folder / f"{i:02d}.json").write_text(json.dumps(window_to_dict(window)))
+    out = tmp_path / "r.csv"
+    command = [sys.executable, "-m", "ema.cli.main", "fleet", str(folder), "--out", str(out), "--workers", "2", *SIZES]
+    driver = subprocess.Popen(command, stderr=subprocess.DEVNULL, stdout=subprocess.DEVNULL)
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline and not (out.exists() and len(_rows(out)) >= 2):
+        time.sleep(0.1)
+    family = _descendants(driver.pid)
+    assert len(family) >= 3  # the fork server and two workers
+    os.kill(driver.pid, signal.SIGKILL)
+    driver.wait(timeout=30)
+    deadline = time.monotonic() + 20
+    while time.monotonic() < deadline and any(_alive(pid) for pid in family):
+        time.sleep(0.2)
+    assert not [pid for pid in family if _alive(pid)]
+
+
+def _descendants(root: int) -> set[int]:
+    """Every process below ``root``, from /proc."""
+    from pathlib import Path
+
+    parents = {}
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        parents[int(stat.parent.name)] = int(fields[1])
+    found, frontier = set(), {root}
+    while frontier:
+        frontier = {pid for pid, parent in parents.items() if parent in frontier} - found
+        found |= frontier
+    return found
+
+
+def _alive(pid: int) -> bool:
+    """Whether ``pid`` runs (a zombie, dead and not yet reaped, does not)."""
+    from pathlib import Path
+
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except OSError:
+        return False
+    return state != "Z"
