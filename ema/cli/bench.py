@@ -32,8 +32,7 @@ from ema.estimate import thread_budget
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import STAGES as PIPELINE_STAGES
 from ema.estimate.report import share_of_range
-from ema.kinds.rotary.pipeline import estimate_window
-from ema.kinds.rotary.synthetic import synthetic_window
+from ema.kinds import estimate_thesis_window, thesis_window
 from ema.model.actuator import THESIS
 from ema.model.batch import default_lanes, simulate_batch
 from ema.model.bounds import DEFAULT_SAMPLE_RATE_HZ
@@ -65,8 +64,8 @@ def time_windows(config: PipelineConfig, duration_s: float, repeats: int, seed: 
     errors: dict[str, list[float]] = {"FDJ": [], "eta_O": []}
     for repeat in range(repeats):
         truth = HealthParams.uniform(1, DEFAULT_RANGES, rng)
-        window = synthetic_window(truth, seed=seed + repeat, duration_s=duration_s)
-        result = estimate_window(window, config, actuator=THESIS)
+        window = thesis_window(truth, seed=seed + repeat, duration_s=duration_s)
+        result = estimate_thesis_window(window, config)
         for stage in TIMED_STAGES:
             timings[stage].append(getattr(result.timings_s, stage))
         estimates, ranges = result.estimates, THESIS.ranges
@@ -178,7 +177,7 @@ def stage_factors(rows: list[dict[str, Any]]) -> list[str]:
 def markdown(rows: list[dict[str, Any]], config: PipelineConfig, refs: dict[str, float] | None = None) -> str:
     lines = [
         "One synthetic window (§5.6 command, realistic sensor noise, health uniform in Table 3.1's ranges) ->",
-        f"estimates, in-process (`ema.kinds.rotary.pipeline.estimate_window`, what the service runs), "
+        f"estimates, in-process (`ema.kinds.estimate_thesis_window`, what the service runs), "
         f"{config.n_simulations} + {config.check_simulations} simulations, {config.hidden_units} neurons.",
         "p50 (p95) seconds per stage; real-time factor = pipeline seconds per second of window (≤ 1: real time);",
         "error = mean |error| in % of the thesis's range (0.02 N·m for FDJ, 0.30 for η_O).",
@@ -204,7 +203,7 @@ def run_bench(
 ) -> dict[str, Any]:
     thread_budget.configure()
     print("warming up (JIT compile or cache load, imports)…", file=sys.stderr)
-    estimate_window(synthetic_window(HealthParams.single(), seed=0, duration_s=0.1), config, actuator=THESIS)
+    estimate_thesis_window(thesis_window(HealthParams.single(), seed=0, duration_s=0.1), config)
     gc.freeze()  # as the warm service does: what was loaded is never walked by a full collection again
     rows = [{**time_windows(config, d, repeats, seed=100), "load": "idle"} for d in durations]
     if under_load:

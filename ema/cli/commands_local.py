@@ -58,11 +58,11 @@ SIMULATE_FLAGS = {
 
 def history_of(window: Any, paths: tuple[Path, ...]) -> Any:
     """What the ema-estimate/1 results in ``paths``, of other windows of ``window``'s actuator, read that it may
-    not (``ema.kinds.rotary.other_windows``); InputError naming --history."""
+    not (``ema.kinds.readings_of_results``); InputError naming --history."""
     from pydantic import ValidationError
 
     from ema.estimate.documents import Estimate
-    from ema.kinds.rotary.other_windows import readings_of
+    from ema.kinds import readings_of_results
     from ema.model.checks import InputError, from_validation, load_json
 
     results = []
@@ -80,7 +80,7 @@ def history_of(window: Any, paths: tuple[Path, ...]) -> Any:
                 "--history", f"{path} is of actuator {result.actuator_id}, the window of {window.actuator_id}"
             )
         results.append(result)
-    return readings_of([result.window for result in results], window.flight_id)
+    return readings_of_results([result.window for result in results], window.flight_id)
 
 
 @click.command()

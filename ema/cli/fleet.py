@@ -67,15 +67,16 @@ class _Readings:
             self.inertias.setdefault(window.actuator_id, []).append(info.inertia_read)
 
     def lacked(self, window: Window, answer: dict[str, Any]) -> dict[str, Any] | None:
-        """What the run's other windows lend this one that it lacks (``ema.kinds.rotary.other_windows.wanted``), as
+        """What the run's other windows lend this one that it lacks (``ema.kinds.lacking``), as
         JSON; or None."""
         from ema.estimate.documents.window_facts import WindowInfo
-        from ema.kinds.rotary.other_windows import lent, wanted
+        from ema.kinds import lacking, other_windows_lent
 
         flight = self.zeros.get((window.actuator_id, window.flight_id), [])
-        others = lent((z for z in flight if z.window_id != window.window_id), self.inertias.get(window.actuator_id, []))
-        lacking = wanted(WindowInfo.model_validate(answer["window"]), others)
-        return None if lacking is None else lacking.model_dump()
+        own = [zero for zero in flight if zero.window_id != window.window_id]
+        others = other_windows_lent(own, self.inertias.get(window.actuator_id, []))
+        lacked = lacking(WindowInfo.model_validate(answer["window"]), others)
+        return None if lacked is None else lacked.model_dump()
 
 
 def _with_history(

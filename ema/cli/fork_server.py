@@ -13,7 +13,9 @@ from ema.model.collector import collect_less_often
 die_with_parent()  # with the command that started it: a kill -9 of it leaves nothing running
 collect_less_often()
 
-import ema.kinds.rotary.pipeline  # noqa: E402, F401  (after the collector is set: the point of this module)
+from ema.kinds import load_methods  # noqa: E402  (after the collector is set: the point of this module)
 from ema.kinds.remote import warm  # noqa: E402
+
+load_methods()
 
 warm(1)

@@ -11,7 +11,7 @@ from typing import Any
 import numpy as np
 
 from ema.cli.options import actuator_document
-from ema.kinds.rotary.synthetic import synthetic_window
+from ema.kinds import thesis_window
 from ema.model.actuator import ActuatorDocument, RotaryActuator
 from ema.model.aircraft import FlightCondition, GroundLoad
 from ema.model.checks import InputError
@@ -128,9 +128,11 @@ def _window(
 ) -> Window:
     """The ``index``-th window of ``draw`` at ``health`` (FDJ, η_O, FSJ), stamped ``index`` steps of
     ``every_hours`` on from ``flight_hours`` and ``recorded_at`` where a series or a time was asked for."""
-    window = synthetic_window(
+    window = thesis_window(
         HealthParams.single(fsj_nm=health["FSJ"], fdj_nm=health["FDJ"], eta_o=health["eta_O"]),
-        GroundLoad(draw.load_nm, draw.load_ramp_nmps) if draw.ground else FlightCondition(draw.airspeed, draw.altitude),
+        condition=GroundLoad(draw.load_nm, draw.load_ramp_nmps)
+        if draw.ground
+        else FlightCondition(draw.airspeed, draw.altitude),
         seed=draw.seed + index,
         duration_s=draw.duration,
         sample_rate_hz=draw.rate,

@@ -25,7 +25,7 @@ from ema.history.connection import now
 from ema.history.refusals import ConflictError, WithdrawnError
 from ema.history.tables import actuators, calibrations, estimates, summaries, withdrawals
 from ema.history.versions import VersionedDocuments
-from ema.kinds.rotary.other_windows import lent
+from ema.kinds import other_windows_lent
 from ema.prognosis.documents import Stored, Withdrawal
 
 
@@ -179,7 +179,7 @@ class SqlHistory(VersionedDocuments):
 
     def readings(self, actuator_id: str, flight_id: str | None) -> HistoryReadings:
         """What the stored windows of this actuator lend a window of ``flight_id``
-        (``ema.kinds.rotary.other_windows.lent``)."""
+        (``ema.kinds.other_windows_lent``)."""
         mine = estimates.c.actuator_id == actuator_id
         with self._reading() as connection:
             zeros: list[SensorZero] = []
@@ -195,7 +195,7 @@ class SqlHistory(VersionedDocuments):
                 .where(mine, estimates.c.inertia_read.is_not(None))
                 .order_by(estimates.c.id)
             ).scalars()
-            return lent(zeros, [InertiaReading.model_validate_json(reading) for reading in inertias])
+            return other_windows_lent(zeros, [InertiaReading.model_validate_json(reading) for reading in inertias])
 
     def history(self, actuator_id: str) -> tuple[list[Stored], list[dict[str, Any]]]:
         """Every stored result of one actuator, oldest first; rows of an earlier format apart, as stored."""

@@ -22,18 +22,20 @@ fourth kind is a folder here, a row of ``ema.model.kinds`` and a line in ``REGIS
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
+from typing import Any
 
 from ema.estimate.config import PipelineConfig
-from ema.estimate.documents import Estimate
-from ema.estimate.documents.window_facts import HistoryReadings
+from ema.estimate.documents import Estimate, Note
+from ema.estimate.documents.window_facts import HistoryReadings, InertiaReading, SensorZero, WindowInfo
 from ema.estimate.information import out_of_bounds, refuse_empty_channels
 from ema.kinds.base import Calibrated, CalibrationRequest, Cost, Kind, Request
 from ema.kinds.geared import GEARED
 from ema.kinds.linear import LINEAR
 from ema.kinds.rotary import ROTARY
 from ema.kinds.servo import SERVO
-from ema.model.actuator import ActuatorDocument, Nominal
+from ema.model.actuator import THESIS, ActuatorDocument, Nominal
 from ema.model.checks import InputError
+from ema.model.params import HealthParams
 from ema.model.window import Window
 
 __all__ = [
@@ -44,10 +46,18 @@ __all__ = [
     "Request",
     "calibrate",
     "calibration_cost",
+    "combined_inertia",
     "cost",
     "estimate",
+    "estimate_thesis_window",
+    "inertia_change_note",
     "kind_of",
+    "lacking",
     "learns",
+    "load_methods",
+    "other_windows_lent",
+    "readings_of_results",
+    "thesis_window",
     "warm_up",
 ]
 
@@ -142,3 +152,63 @@ def cost(window: Window, config: PipelineConfig) -> Cost:
 def calibration_cost(windows: Sequence[Window], config: PipelineConfig) -> Cost:
     """What calibrating ``windows`` asks of a service beside reading each (``Cost``), by their kind."""
     return REGISTRY[windows[0].kind].calibration_cost(windows, config) if windows else Cost(0.0, 0.0)
+
+
+# What the layers above reach of one kind's own, through the registry rather than the kind's modules: what an
+# actuator's other windows lend one of its windows (a rotary drive's sensor zero, kept for a power-on, and its J_M,
+# kept with the build: other kinds borrow nothing), and the thesis's own windows (``ema simulate`` and the latency
+# benchmark draw and read them). Each imports the kind's module at its call: the registry stays light.
+
+
+def other_windows_lent(zeros: Sequence[SensorZero], inertias: Sequence[InertiaReading]) -> HistoryReadings:
+    """What an actuator's stored windows lend another (``ema.kinds.rotary.other_windows.lent``)."""
+    from ema.kinds.rotary.other_windows import lent
+
+    return lent(zeros, inertias)
+
+
+def readings_of_results(windows: Sequence[WindowInfo], flight_id: str | None) -> HistoryReadings:
+    """What the results of other windows of an actuator lend a window of ``flight_id``."""
+    from ema.kinds.rotary.other_windows import readings_of
+
+    return readings_of(windows, flight_id)
+
+
+def lacking(read: WindowInfo, others: HistoryReadings) -> HistoryReadings | None:
+    """What a window answered alone would be answered again with, of what the others lend (None: nothing)."""
+    from ema.kinds.rotary.other_windows import wanted
+
+    return wanted(read, others)
+
+
+def combined_inertia(readings: Sequence[InertiaReading]) -> InertiaReading | None:
+    """An actuator's J_M as its windows read it since it last changed (``ema.kinds.rotary.inertia``)."""
+    from ema.kinds.rotary.inertia import combined_inertia as combined
+
+    return combined(readings)
+
+
+def inertia_change_note(readings: Sequence[InertiaReading]) -> Note | None:
+    """A note where an actuator's J_M changed along its windows, or scatters beyond their stds."""
+    from ema.kinds.rotary.inertia import inertia_change_note as note
+
+    return note(readings)
+
+
+def thesis_window(health: HealthParams, **drawn: Any) -> Window:
+    """A window of the thesis's elevator EMA drawn by its simulator (``ema.kinds.rotary.synthetic``)."""
+    from ema.kinds.rotary.synthetic import synthetic_window
+
+    return synthetic_window(health, **drawn)
+
+
+def estimate_thesis_window(window: Window, config: PipelineConfig) -> Estimate:
+    """The thesis's pipeline on a window of its actuator, in process (what the latency benchmark times)."""
+    from ema.kinds.rotary.pipeline import estimate_window
+
+    return estimate_window(window, config, actuator=THESIS)
+
+
+def load_methods() -> None:
+    """Every method module the default kind's first window would load, loaded now (a fork server's preload)."""
+    import ema.kinds.rotary.pipeline  # noqa: F401

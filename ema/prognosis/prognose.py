@@ -10,7 +10,7 @@ from dataclasses import replace
 import numpy as np
 
 from ema.estimate.documents import Note
-from ema.kinds.rotary.inertia import combined_inertia, inertia_change_note
+from ema.kinds import combined_inertia, inertia_change_note
 from ema.model.actuator import ActuatorDocument, Airframe
 from ema.prognosis.backtest import backtest
 from ema.prognosis.documents import MIN_SPAN, PARAMETERS, Prognosis, RemainingLife, Stored, TimeUnit, Trend

@@ -52,7 +52,7 @@ def test_bench_writes_nothing_unless_asked(tmp_path, monkeypatch):
     monkeypatch.setattr(bench, "time_windows", lambda *a, **k: {"p50_s": {}, "p95_s": {}})
     monkeypatch.setattr(bench, "references", lambda: {})
     monkeypatch.setattr(bench, "markdown", lambda *a, **k: "table")
-    monkeypatch.setattr(bench, "estimate_window", lambda *a, **k: None)
+    monkeypatch.setattr(bench, "estimate_thesis_window", lambda *a, **k: None)
     result = bench.run_bench(SMALL, [0.5], repeats=1, under_load=0, out=None, docs=False)
     assert result["json"] is None and list(tmp_path.iterdir()) == []
 
