@@ -34,11 +34,11 @@ from ema.estimate.physics.friction import SOLUTION_ARRAYS, FrictionSolution, sol
 from ema.estimate.physics.scenario import inside
 from ema.estimate.physics.static_friction import read_static_friction
 from ema.estimate.prepare.conditioning import Prepared, prepare, widened
-from ema.estimate.report import estimate_document
 from ema.estimate.simulate.dataset import Data, simulate_dataset
 from ema.estimate.stats import MAX_RATIO, rms
 from ema.estimate.stopwatch import Stopwatch
 from ema.kinds.rotary.other_windows import known_from
+from ema.kinds.rotary.report import estimate_document
 from ema.kinds.rotary.reproduction import output_error_ratios
 from ema.model.actuator import THESIS, ActuatorDocument
 from ema.model.window import Window

@@ -2,7 +2,8 @@
 
 from ema.estimate.assess.weighing import Assessed
 from ema.estimate.physics.static_friction import StaticFriction
-from ema.estimate.report import _estimates, weakly_determined
+from ema.estimate.report import weakly_determined
+from ema.kinds.rotary.report import _estimates
 from ema.model.actuator import THESIS
 
 NO_FSJ = StaticFriction(None, None, 0, "no rest in the window")
