@@ -40,8 +40,8 @@ from ema.cli.benchmark_docs import write_section
 from ema.estimate import thread_budget
 from ema.estimate.physics.features import as_read
 from ema.estimate.physics.friction import SolveSettings, regressors, solve_friction
-from ema.estimate.prepare.conditioning import prepare
 from ema.estimate.report import healthy_range
+from ema.kinds.rotary.prepare.conditioning import prepare
 from ema.model.actuator import THESIS
 from ema.model.hinge import HINGE_SMOOTHING_S, local_line
 from ema.model.params import DriveConstants, eta_a_from_eta_o

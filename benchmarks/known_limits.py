@@ -98,13 +98,13 @@ strain-gauge amplifier's filter delays the load the fit reads (signal and noise 
 moving average: `through_filters`). The window's equation error barely feels that lag; the filter's
 trace in the noise (0.70–1.15 of the delay) and the lag the deflection band reads from the moment
 weigh filtered against on time, and the moment is advanced by the weighted lag, its spread in the
-stds (`ema.estimate.prepare.hinge_lag`): what is left shows in the heaviest filters. The sensor chain's lag is the
+stds (`ema.kinds.rotary.prepare.hinge_lag`): what is left shows in the heaviest filters. The sensor chain's lag is the
 same in every window of an actuator; read across them, as a calibration term, it could be pinned.
 A sensor off zero and a viscous coefficient above the document's are read per window (groups of the
 accuracy table above), but each is a parameter more to read from the window, which a window holding
 little to begin with (a 1–2 kHz log, 0.1 s) often cannot: the answers past 10 % of range are all said
 weak. A C too unclear to read is weighed into the stds by the weight of the change the window leans
-to (`ema.estimate.prepare.departures.viscosity`: FDJ's ±2 std held the truth in 85 % of the slow logs
+to (`ema.kinds.rotary.prepare.departures.viscosity`: FDJ's ±2 std held the truth in 85 % of the slow logs
 without). An offset
 leaves a short window nothing to lean on, and there FDJ's ±2 std holds the truth less often than
 90 %. Of the 20 short windows 8 move (almost) one way,
@@ -113,12 +113,12 @@ offset is read in 11 and missed in 1. A drive keeps its sensors' zero for a powe
 row answers the same windows as the service answers a flight's (`flight_id`), after a 1 s cruise window
 of their flight (the same actuator, offset and flight condition) was read; its zero is taken off the
 windows moving one way, and off those moving both ways where it is the more precise and holds
-(`ema.estimate.prepare.departures.zero_offset`). *J_M heavier than the document's*: where the motor saturates as it
+(`ema.kinds.rotary.prepare.departures.zero_offset`). *J_M heavier than the document's*: where the motor saturates as it
 accelerates, a motor k_T·I a few % weaker explains the window about as well, and the likelihood ratio
 does not decide; a replay of the window with each tells them apart only where it follows the drive
 within the noise (thesis windows), and elsewhere γ is read with FDJ's std widened by 0.6 of what
-reading ΔJ would change (`ema.estimate.prepare.departures.read`): honest, but often weak. J_M stays with the build: the
-last row answers the same windows after a 0.5 s thesis window of the actuator (a pre-flight check) read
+reading ΔJ would change (`ema.kinds.rotary.prepare.departures.read`): honest, but often weak. J_M stays with the
+build: the last row answers the same windows after a 0.5 s thesis window of the actuator (a pre-flight check) read
 it, which decides between the two readings where one agrees with it (`ema.kinds.rotary.other_windows`)."""
 
 

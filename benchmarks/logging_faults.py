@@ -16,7 +16,7 @@ from benchmarks.foreign_accuracy import RESULTS_MD, run_one, summarize, table
 from benchmarks.foreign_groups import group_seed, groups
 from ema.cli.benchmark_docs import typed_command, write_section
 from ema.estimate import thread_budget
-from ema.estimate.prepare.stale import stale_runs
+from ema.kinds.rotary.prepare.stale import stale_runs
 from ema.model.actuator import THESIS
 from ema.model.window import window_from_dict
 from tests.foreign.faults import FAULTS, with_fault
@@ -36,7 +36,8 @@ def report(rows: dict[str, list[dict[str, Any]]], found: dict[str, int], per_fau
             "1–100 kHz, worn, filtered, off zero, drives unlike the document's), each logged once more with one fault",
             "(`tests/foreign/faults.py`): a sensor whose logger kept writing its last value after it stopped",
             "updating, or a gap filled with zeros, over 5–25 % of the window somewhere in it, or for 0.5–2 ms",
-            "where the motor slews past 300 rad/s. *Found in*: windows where `ema.estimate.prepare.stale` takes a run "
+            "where the motor slews past 300 rad/s. *Found in*: windows where `ema.kinds.rotary.prepare.stale` takes a "
+            "run "
             "of that",
             "sensor for one (a sensor quantized coarser than its noise, or a speed or position at rest, is left",
             "alone; a current at 0 a few noise stds from its flanks matters little). A run of up to 2 ms is",

@@ -34,13 +34,17 @@ SECTION = "A warm request, step by step"
 STAGES = ("prepare", "physics", "simulate", "learn", "assess", "check", "report")  # the pipeline's, in order
 SIMULATIONS = PipelineConfig().total_simulations
 PARTS = (  # (stage, "module:function" as the stage calls it, what the step does)
-    ("prepare", "ema.estimate.prepare.conditioning:without_stale", "cut to the stretch the sensors kept updating"),
-    ("prepare", "ema.estimate.prepare.conditioning:repaired", "glitches repaired"),
-    ("prepare", "ema.estimate.prepare.conditioning:check_consistency", "the signals checked against each other"),
-    ("prepare", "ema.estimate.prepare.conditioning:aligned", "the sensors put on one clock"),
-    ("prepare", "ema.estimate.prepare.conditioning:check_against_aircraft", "the hinge moment against the airframe"),
-    ("prepare", "ema.estimate.prepare.conditioning:read_departures", "departures from the actuator document"),
-    ("prepare", "ema.estimate.prepare.conditioning:step_lag", "the hinge moment's step lag"),
+    ("prepare", "ema.kinds.rotary.prepare.conditioning:without_stale", "cut to the stretch the sensors kept updating"),
+    ("prepare", "ema.kinds.rotary.prepare.conditioning:repaired", "glitches repaired"),
+    ("prepare", "ema.kinds.rotary.prepare.conditioning:check_consistency", "the signals checked against each other"),
+    ("prepare", "ema.kinds.rotary.prepare.conditioning:aligned", "the sensors put on one clock"),
+    (
+        "prepare",
+        "ema.kinds.rotary.prepare.conditioning:check_against_aircraft",
+        "the hinge moment against the airframe",
+    ),
+    ("prepare", "ema.kinds.rotary.prepare.conditioning:read_departures", "departures from the actuator document"),
+    ("prepare", "ema.kinds.rotary.prepare.conditioning:step_lag", "the hinge moment's step lag"),
     ("physics", "ema.kinds.rotary.pipeline:solve_window", "Eq. 5.1 on the window"),
     ("simulate", "ema.model.batch:run_groups", f"the kernel: {SIMULATIONS} simulations and the clean lane"),
     ("simulate", "ema.estimate.simulate.dataset:excess_noise", "the window's noise, read against the clean lane"),

@@ -42,8 +42,8 @@ from ema.estimate import thread_budget
 from ema.estimate.physics.features import as_read
 from ema.estimate.physics.friction import solve_friction
 from ema.estimate.physics.scenario import scenario_from_window
-from ema.estimate.prepare.conditioning import prepare
 from ema.estimate.report import healthy_range
+from ema.kinds.rotary.prepare.conditioning import prepare
 from ema.model.actuator import THESIS
 from ema.model.params import HealthParams
 from ema.model.window import Window, window_from_dict

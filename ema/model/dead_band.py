@@ -7,7 +7,7 @@ simulator's ``kernels.advance`` does the same at every step):
 
 for a half width h and a start s ∈ [−1, 1] (where in the band the window began). Its travel lags
 the motor's by up to 2h at every reversal, whatever the motion, so a slope of the elevator's
-angle on y is the drive's kinematic gain for any width of the band (``ema.estimate.prepare.consistency``).
+angle on y is the drive's kinematic gain for any width of the band (``ema.kinds.rotary.prepare.consistency``).
 """
 
 from __future__ import annotations

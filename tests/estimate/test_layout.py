@@ -17,7 +17,7 @@ RANKS = {
     "ema.estimate.least_squares": 0,
     "ema.estimate.stopwatch": 0,
     "ema.estimate.physics": 1,
-    "ema.estimate.prepare": 2,
+    "ema.kinds.rotary.prepare": 2,
     "ema.estimate.simulate": 3,
     "ema.estimate.learn": 4,
     "ema.estimate.assess": 5,
@@ -57,14 +57,14 @@ def test_every_module_imports_only_its_own_stage_or_lower_ones():
 
 def test_the_stages_are_subpackages_and_few_modules_remain_at_the_top():
     stages = [p.name for p in TRAINING.iterdir() if (p / "__init__.py").exists()]
-    assert {"physics", "prepare", "simulate", "learn", "assess"} <= set(stages)
+    assert {"physics", "simulate", "learn", "assess"} <= set(stages)  # prepare: each kind's own (the rotary's folder)
     assert len([p for p in TRAINING.glob("*.py") if p.name != "__init__.py"]) <= 12
 
 
 def test_the_documents_load_no_estimator():
     probe = (
         "import sys, ema.estimate.documents, ema.prognosis.documents; print(sorted(m for m in ('numpy', 'numba', "
-        "'scipy.optimize', 'ema.kinds.rotary.pipeline', 'ema.estimate.prepare') if m in sys.modules))"
+        "'scipy.optimize', 'ema.kinds.rotary.pipeline', 'ema.kinds.rotary.prepare') if m in sys.modules))"
     )
     loaded = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, check=True).stdout
     assert loaded.strip() == "['numpy']"  # prognosis's documents compute with numpy; nothing of the estimator

@@ -262,7 +262,7 @@ def test_a_ground_station_fans_out_to_ray(tmp_path, document):
         hold = {**document, "window_id": "hold", "signals": {k: [0.0] * 1000 for k in document["signals"]}}
         refused = client.post("/v1/estimate", json=hold)
     assert first.status_code == second.status_code == 200
-    # all zeros: no sensor logged anything (ema.estimate.prepare.consistency), named before any motion is looked for
+    # all zeros: no sensor logged anything (ema.kinds.rotary.prepare.consistency), named before any motion is looked for
     assert refused.status_code == 422 and refused.json()["detail"][0]["loc"] == ["body", "signals", "position_deg"]
 
 

@@ -12,7 +12,7 @@ from ema.model.window import Window
 
 
 class SensorZero(Document):
-    """The sensors' zero as a window moving both ways read it (``ema.estimate.prepare.departures.zero_offset``):
+    """The sensors' zero as a window moving both ways read it (``ema.kinds.rotary.prepare.departures.zero_offset``):
     what a window of
     the same flight that moves one way, and so cannot read it, is read with."""
 
@@ -24,7 +24,7 @@ class SensorZero(Document):
 
 class InertiaReading(Document):
     """J_M as windows of an actuator read it where each told a heavier rotor from a weaker motor itself
-    (``ema.estimate.prepare.departures.drive_constants``): a window that cannot is read with it (J_M stays with
+    (``ema.kinds.rotary.prepare.departures.drive_constants``): a window that cannot is read with it (J_M stays with
     the build)."""
 
     factor: float = Field(description="the inertia at the motor shaft over the document's J_M")

@@ -7,9 +7,9 @@ model linear in FDJ and k: with t = sgn(ω)·(T_R − C·ω), a and o the smooth
 |T_ext|, t = FDJ + k_aid·a + k_opp·o. η_A is tied to η_O by Eq. 3.4, so the solution is a search over
 η_O with FDJ in closed form at each point (``ema.estimate.physics.eta_search``). Where asked, nuisances
 join FDJ in that closed form (``nuisance_columns``): a constant torque c (a sensor off zero,
-``ema.estimate.prepare.departures.zero_offset``), a change ΔC of the viscous coefficient
-(``ema.estimate.prepare.departures.viscosity``), a scale γ of the motor torque and a change ΔJ of the
-inertia (k_T, a current sensor's gain or J_M off, ``ema.estimate.prepare.departures.drive_constants``).
+``ema.kinds.rotary.prepare.departures.zero_offset``), a change ΔC of the viscous coefficient
+(``ema.kinds.rotary.prepare.departures.viscosity``), a scale γ of the motor torque and a change ΔJ of the
+inertia (k_T, a current sensor's gain or J_M off, ``ema.kinds.rotary.prepare.departures.drive_constants``).
 
 Everything the search needs is the matrix of sums Σ z·zᵀ per window, z = (t, a, o, nuisances…, 1)
 (ten numbers without nuisances), so a batch of simulated windows is solved at the cost of one pass

@@ -1,7 +1,7 @@
 """A signal read later than logged, and Eq. 5.1's solution of the window so: what every reading of a
-sensor's lag compares (``ema.estimate.prepare.alignment``, ``ema.estimate.prepare.hinge_lag``,
-``ema.estimate.prepare.consistency``,
-``ema.estimate.prepare.step_lag``)."""
+sensor's lag compares (``ema.kinds.rotary.prepare.alignment``, ``ema.kinds.rotary.prepare.hinge_lag``,
+``ema.kinds.rotary.prepare.consistency``,
+``ema.kinds.rotary.prepare.step_lag``)."""
 
 from __future__ import annotations
 

@@ -32,7 +32,6 @@ from ema.calibration.limits import MAX_EFFECTS
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import TARGETS, Estimate
 from ema.estimate.physics.scenario import CLEAR_MARGIN
-from ema.estimate.prepare.conditioning import prepare
 from ema.estimate.report import healthy_range
 from ema.kinds.rotary import calibration_report as reporting
 from ema.kinds.rotary.backlash import read_backlash
@@ -40,6 +39,7 @@ from ema.kinds.rotary.equations import Equations, equations
 from ema.kinds.rotary.families import Family, generic_families
 from ema.kinds.rotary.noise_floor import clean_replicas, noise_copies
 from ema.kinds.rotary.pipeline import estimate_window
+from ema.kinds.rotary.prepare.conditioning import prepare
 from ema.kinds.rotary.readings import AMBIGUOUS_STDS, Contest, combined_stds, reading, settled
 from ema.kinds.rotary.selection import Chosen, Decision, Evidence, decide, evidence
 from ema.kinds.rotary.tied_solve import MIN_HELD_OUT_GAIN, corrected, held_out_rss, solve_with

@@ -1,9 +1,9 @@
 """What other windows of an actuator read that one window may not, gathered from their results.
 
 Two facts outlive a window: the sensors' zero, which a drive keeps for a power-on (a window of the
-same ``flight_id``, moving both ways, reads it: ``ema.estimate.prepare.departures.zero_offset``), and J_M,
+same ``flight_id``, moving both ways, reads it: ``ema.kinds.rotary.prepare.departures.zero_offset``), and J_M,
 which stays with the build (a window that tells a heavier rotor from a weaker motor reads it:
-``ema.estimate.prepare.departures.read``).
+``ema.kinds.rotary.prepare.departures.read``).
 The service gathers them from its history before it estimates a window, the fleet from the windows of
 its run; ``known_from`` hands them to conditioning. J_M's readings are combined as the prognosis reads them
 (``ema.kinds.rotary.inertia``).
@@ -14,9 +14,9 @@ from __future__ import annotations
 from collections.abc import Iterable, Sequence
 
 from ema.estimate.documents.window_facts import HistoryReadings, InertiaReading, SensorZero, WindowInfo
-from ema.estimate.prepare.departures.read import Known
-from ema.estimate.prepare.departures.zero_offset import ZeroOffset
 from ema.kinds.rotary.inertia import combined_inertia
+from ema.kinds.rotary.prepare.departures.read import Known
+from ema.kinds.rotary.prepare.departures.zero_offset import ZeroOffset
 
 
 def best_zero(zeros: Iterable[SensorZero]) -> SensorZero | None:

@@ -3,7 +3,7 @@
 The thesis's §6.3 proposal, made to hold on data our simulator did not draw:
 
 1. **prepare**: repair, average, align and zero the window's sensors, read its viscous coefficient
-   (``ema.estimate.prepare.conditioning``);
+   (``ema.kinds.rotary.prepare.conditioning``);
 2. **physics**: solve Eq. 5.1 by least squares (``ema.estimate.physics.friction``), a block-jackknife std beside;
 3. **simulate**: a Case-1B dataset of the window's own command, logged load and first state, its
    health drawn in a box around the physics estimate (``ema.estimate.simulate.design``: no fixed range, so no
@@ -33,11 +33,11 @@ from ema.estimate.physics.features import as_read
 from ema.estimate.physics.friction import SOLUTION_ARRAYS, FrictionSolution, solve_friction, solve_window
 from ema.estimate.physics.scenario import inside
 from ema.estimate.physics.static_friction import read_static_friction
-from ema.estimate.prepare.conditioning import Prepared, prepare, widened
 from ema.estimate.simulate.dataset import Data, simulate_dataset
 from ema.estimate.stats import MAX_RATIO, rms
 from ema.estimate.stopwatch import Stopwatch
 from ema.kinds.rotary.other_windows import known_from
+from ema.kinds.rotary.prepare.conditioning import Prepared, prepare, widened
 from ema.kinds.rotary.report import estimate_document
 from ema.kinds.rotary.reproduction import output_error_ratios
 from ema.model.actuator import THESIS, ActuatorDocument

@@ -5,7 +5,7 @@ import pytest
 
 from ema.estimate.physics.features import as_read
 from ema.estimate.physics.static_friction import read_static_friction
-from ema.estimate.prepare.conditioning import prepare
+from ema.kinds.rotary.prepare.conditioning import prepare
 from ema.model.actuator import THESIS
 from ema.model.aircraft import GroundLoad
 from ema.model.batch import simulate_batch

@@ -298,6 +298,6 @@ def test_a_window_into_the_stops_is_never_made_worse_nor_a_sensor_fault_made_mec
 @pytest.mark.slow
 def test_a_light_rotor_into_the_stops_is_not_named_a_mechanical_effect():
     """Named a wider dead band in 4/4 seeds until the copies' spread was widened by the base model's mismatch and
-    a light rotor was no longer read as a current 0.9 ms early (``ema.estimate.prepare.alignment``)."""
+    a light rotor was no longer read as a current 0.9 ms early (``ema.kinds.rotary.prepare.alignment``)."""
     report, _ = _into_the_stops(0, Effects(inertia_factor=0.8))
     assert not set(report.selected_effects) & MECHANICAL

@@ -13,7 +13,7 @@ then the later of the two signals is advanced (a filter only delays), by linear 
 end held.
 
 The hinge moment's lag barely shows in the equation error; it is read from its filter's trace in
-its noise, the deflection and Eq. 5.1 together (``ema.estimate.prepare.hinge_lag``), and advanced by it.
+its noise, the deflection and Eq. 5.1 together (``ema.kinds.rotary.prepare.hinge_lag``), and advanced by it.
 """
 
 from __future__ import annotations
@@ -24,7 +24,7 @@ import numpy as np
 
 from ema.estimate.physics.friction import SolveSettings
 from ema.estimate.physics.shifts import advanced, shifted_solutions
-from ema.estimate.prepare.hinge_lag import hinge_lag
+from ema.kinds.rotary.prepare.hinge_lag import hinge_lag
 from ema.model.params import DriveConstants
 from ema.model.window import Window
 
@@ -71,7 +71,7 @@ class Lags:
     behind the current), the hinge moment behind the load; and the std its read uncertainty adds, per target."""
 
     current_s: float = 0.0
-    hinge_s: float = 0.0  # the hinge moment advanced by (``ema.estimate.prepare.hinge_lag``)
+    hinge_s: float = 0.0  # the hinge moment advanced by (``ema.kinds.rotary.prepare.hinge_lag``)
     spread: dict[str, float] = field(default_factory=dict)
     hinge_filter_s: float = 0.0  # the delay of the filter its noise went through
     hinge_weight: float = 0.0  # how likely the moment is late at all (not only its noise filtered)
@@ -79,7 +79,7 @@ class Lags:
 
 def aligned(window: Window, drive: DriveConstants) -> tuple[Window, Lags]:
     """``window`` with the later of its current and speed advanced onto the other and its hinge moment
-    advanced by its lag's posterior mean (``ema.estimate.prepare.hinge_lag``), and those lags."""
+    advanced by its lag's posterior mean (``ema.kinds.rotary.prepare.hinge_lag``), and those lags."""
     rate, signals = window.sample_rate_hz, dict(window.signals)
     current = current_lag_samples(signals, rate, drive)
     if current != 0.0:

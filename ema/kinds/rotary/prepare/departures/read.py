@@ -1,10 +1,10 @@
 """What a window shows beyond the actuator document's model, read in turn, each on the window the
 last corrected: the hinge moment's gain against the aircraft's
-(``ema.estimate.prepare.departures.aircraft_check``), a sensor off zero
-(``ema.estimate.prepare.departures.zero_offset``), the drive's k_T and J_M
-(``ema.estimate.prepare.departures.drive_constants``), the hinge moment's gain its loads show
-(``ema.estimate.prepare.departures.hinge_gain``), the viscous coefficient
-(``ema.estimate.prepare.departures.viscosity``).
+(``ema.kinds.rotary.prepare.departures.aircraft_check``), a sensor off zero
+(``ema.kinds.rotary.prepare.departures.zero_offset``), the drive's k_T and J_M
+(``ema.kinds.rotary.prepare.departures.drive_constants``), the hinge moment's gain its loads show
+(``ema.kinds.rotary.prepare.departures.hinge_gain``), the viscous coefficient
+(``ema.kinds.rotary.prepare.departures.viscosity``).
 
 A drive constant, seen before it is read, passes in part for an offset, so where one is read the
 offset is read again on the corrected window (the logged current is s·I + i₀: corrected, then
@@ -27,12 +27,12 @@ from ema.estimate.documents import Note
 from ema.estimate.physics.features import solve_as_read
 from ema.estimate.physics.noise_reading import white_noise_std
 from ema.estimate.physics.scenario import CLEAR_MARGIN, following_error, inside, scenario_from_window
-from ema.estimate.prepare.departures.aircraft_check import AircraftCheck, banded, divided_out
-from ema.estimate.prepare.departures.drive_constants import UNDECIDED_SHARE, DriveReading, read_drive_constants
-from ema.estimate.prepare.departures.hinge_gain import HingeGain, read_hinge_gain
-from ema.estimate.prepare.departures.viscosity import Viscosity, read_viscosity
-from ema.estimate.prepare.departures.zero_offset import ZeroOffset, read_zero_offset, zeroed
 from ema.estimate.stats import MAX_RATIO
+from ema.kinds.rotary.prepare.departures.aircraft_check import AircraftCheck, banded, divided_out
+from ema.kinds.rotary.prepare.departures.drive_constants import UNDECIDED_SHARE, DriveReading, read_drive_constants
+from ema.kinds.rotary.prepare.departures.hinge_gain import HingeGain, read_hinge_gain
+from ema.kinds.rotary.prepare.departures.viscosity import Viscosity, read_viscosity
+from ema.kinds.rotary.prepare.departures.zero_offset import ZeroOffset, read_zero_offset, zeroed
 from ema.model.actuator import ActuatorDocument
 from ema.model.checks import InputError
 from ema.model.noise import SensorNoise

@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 from ema.estimate.physics.features import solve_as_read
-from ema.estimate.prepare.conditioning import conditioning_done, prepare, widened
-from ema.estimate.prepare.departures.aircraft_check import (
+from ema.kinds.rotary.prepare.conditioning import conditioning_done, prepare, widened
+from ema.kinds.rotary.prepare.departures.aircraft_check import (
     DEPART_STDS,
     TOLERANCE,
     aircraft_note,
@@ -17,7 +17,7 @@ from ema.estimate.prepare.departures.aircraft_check import (
     divided_out,
     slope,
 )
-from ema.estimate.prepare.departures.read import read_departures
+from ema.kinds.rotary.prepare.departures.read import read_departures
 from ema.model.actuator import THESIS
 from ema.model.checks import InputError
 from ema.model.window import window_from_dict
@@ -86,8 +86,8 @@ def test_a_moment_exported_out_of_step_is_refused_with_its_lag():
 
 
 def test_a_moment_in_lbf_ft_is_refused_or_its_gain_read():
-    """Eq. 5.1 fits it 3x better read from lbf·ft (``ema.estimate.prepare.consistency``), or the aircraft reads the
-    gain, or the loads do (``ema.estimate.prepare.departures.hinge_gain``); missed where the deflection hardly
+    """Eq. 5.1 fits it 3x better read from lbf·ft (``ema.kinds.rotary.prepare.consistency``), or the aircraft reads the
+    gain, or the loads do (``ema.kinds.rotary.prepare.departures.hinge_gain``); missed where the deflection hardly
     moves fast."""
     caught = 0
     for seed in SEEDS:

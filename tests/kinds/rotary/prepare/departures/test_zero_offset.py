@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 
 from ema.estimate.documents.window_facts import HistoryReadings, SensorZero
-from ema.estimate.prepare.conditioning import prepare
-from ema.estimate.prepare.departures.zero_offset import ZeroOffset
 from ema.kinds.rotary.other_windows import known_from
+from ema.kinds.rotary.prepare.conditioning import prepare
+from ema.kinds.rotary.prepare.departures.zero_offset import ZeroOffset
 from ema.model.actuator import THESIS
 from ema.model.window import window_from_dict
 from tests.foreign.windows import Draw, Effects, draw, of_the_same_flight

@@ -4,8 +4,8 @@ gain, noise and all, as a strain gauge calibrated off would)."""
 import numpy as np
 import pytest
 
-from ema.estimate.prepare.conditioning import conditioning_done, conditioning_notes, prepare
-from ema.estimate.prepare.departures.hinge_gain import eta_o_from_product, read_hinge_gain
+from ema.kinds.rotary.prepare.conditioning import conditioning_done, conditioning_notes, prepare
+from ema.kinds.rotary.prepare.departures.hinge_gain import eta_o_from_product, read_hinge_gain
 from ema.model.actuator import THESIS
 from ema.model.params import eta_a_from_eta_o
 from ema.model.window import window_from_dict

@@ -3,9 +3,9 @@ sensor gain, fed back through its loop, and inertia)."""
 
 import pytest
 
-from ema.estimate.prepare.conditioning import prepare
-from ema.estimate.prepare.departures.drive_constants import DriveReading
 from ema.kinds.rotary.pipeline import estimate_window
+from ema.kinds.rotary.prepare.conditioning import prepare
+from ema.kinds.rotary.prepare.departures.drive_constants import DriveReading
 from ema.model.actuator import THESIS
 from ema.model.checks import InputError
 from ema.model.window import window_from_dict

@@ -1,4 +1,4 @@
-"""Which field an inconsistent window names: the relations of ``ema.estimate.prepare.consistency`` read together.
+"""Which field an inconsistent window names: the relations of ``ema.kinds.rotary.prepare.consistency`` read together.
 
 A relation that fails alone points to one field; some fail together for one cause (a speed of the other
 sign breaks the kinematics and reads Eq. 5.1 against the motion), so the order of the checks and the
@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from ema.estimate.documents import Note
-from ema.estimate.prepare.consistency import (
+from ema.kinds.rotary.prepare.consistency import (
     FOLLOW_GAP_DEG,
     FOLLOW_STEP_S,
     READINGS,

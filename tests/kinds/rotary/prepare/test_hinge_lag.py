@@ -1,12 +1,12 @@
-"""The hinge moment's lag as a model average (``ema.estimate.prepare.hinge_lag``), on foreign windows whose hinge
+"""The hinge moment's lag as a model average (``ema.kinds.rotary.prepare.hinge_lag``), on foreign windows whose hinge
 moment passes, signal and noise, through a causal moving average here (tests/foreign's own
 ``filter_samples`` filters the noise alone: ``test_alignment``)."""
 
 import numpy as np
 import pytest
 
-from ema.estimate.prepare.departures.aircraft_band import band_lag_s
-from ema.estimate.prepare.hinge_lag import PRIOR, HingeLag, hinge_lag, lag_grid
+from ema.kinds.rotary.prepare.departures.aircraft_band import band_lag_s
+from ema.kinds.rotary.prepare.hinge_lag import PRIOR, HingeLag, hinge_lag, lag_grid
 from ema.model.actuator import THESIS
 from tests.foreign.windows import Effects, draw, through_filters
 

@@ -1,7 +1,7 @@
 """A hinge moment that may be out of step with the other channels, where Eq. 5.1 leans that way
 without deciding.
 
-``ema.estimate.prepare.consistency`` refuses a window whose hinge moment, read 3–50 ms away
+``ema.kinds.rotary.prepare.consistency`` refuses a window whose hinge moment, read 3–50 ms away
 (``STEP_LAGS_S``), follows Eq. 5.1 ``MIN_BETTER`` times better: exported on another clock. Below that
 the window is answered as logged, yet where the deflection moves slowly Eq. 5.1 hardly feels 20 ms,
 and an answer read at the wrong lag is off by what reading the moment at the right one changes.
@@ -22,7 +22,7 @@ likelihood at the best lag against none joins the ratio; it weighs against any l
 is in step. Where the deflection moves too slowly for the band, the ratio alone stays the limit.
 
 The current needs no such reading: its lag breaks Eq. 5.1 at every acceleration, and
-``ema.estimate.prepare.consistency`` refuses it.
+``ema.kinds.rotary.prepare.consistency`` refuses it.
 """
 
 from __future__ import annotations
@@ -33,9 +33,9 @@ import numpy as np
 
 from ema.estimate.documents import Note
 from ema.estimate.physics.shifts import shifted_solutions
-from ema.estimate.prepare.consistency import step_lags
-from ema.estimate.prepare.hinge_lag import band_log_likelihood
 from ema.estimate.stats import UNDECIDED_NOTE_WEIGHT, UNDECIDED_PRIOR_LOG_ODDS, odds_weight, rms_log_likelihood_ratio
+from ema.kinds.rotary.prepare.consistency import step_lags
+from ema.kinds.rotary.prepare.hinge_lag import band_log_likelihood
 from ema.model.params import DriveConstants
 from ema.model.window import Window
 

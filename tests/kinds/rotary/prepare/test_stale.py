@@ -9,9 +9,9 @@ import pytest
 from benchmarks.foreign_groups import group_seed, groups
 from ema.estimate.physics.features import as_read
 from ema.estimate.physics.friction import solve_window
-from ema.estimate.prepare.conditioning import Prepared, conditioning_done, conditioning_notes, prepare, widened
-from ema.estimate.prepare.stale import MIN_STALE_SAMPLES, equal_runs, stale_runs
 from ema.estimate.report import share_of_range
+from ema.kinds.rotary.prepare.conditioning import Prepared, conditioning_done, conditioning_notes, prepare, widened
+from ema.kinds.rotary.prepare.stale import MIN_STALE_SAMPLES, equal_runs, stale_runs
 from ema.model.actuator import THESIS
 from ema.model.checks import InputError
 from ema.model.window import window_from_dict

@@ -5,8 +5,8 @@ import pytest
 from ema.estimate.documents.window_facts import HistoryReadings, InertiaReading
 from ema.estimate.physics.features import as_read
 from ema.estimate.physics.friction import solve_window
-from ema.estimate.prepare.conditioning import prepare, widened
 from ema.kinds.rotary.other_windows import known_from
+from ema.kinds.rotary.prepare.conditioning import prepare, widened
 from ema.model.actuator import THESIS
 from ema.model.window import window_from_dict
 from tests.foreign.windows import Effects, draw, of_the_same_flight, worn
@@ -101,7 +101,7 @@ def test_a_window_without_noise_reads_no_departure_under_the_models_resolution(s
     """The foreign simulator and ema's reconstruction differ by 0.04 % of the motor torque, which against no noise
     once read as a γ of −0.03 % and a ΔJ of +0.1 % (z 4–11), undecided, replayed three times. Under the model's
     resolution (``RESOLUTION_SHARE``) nothing is evidence: no constant read, nothing replayed."""
-    import ema.estimate.prepare.departures.read as read
+    import ema.kinds.rotary.prepare.departures.read as read
 
     replays = []
     monkeypatch.setattr(read, "_told_apart", lambda *args: replays.append(1))

@@ -1,7 +1,7 @@
 """The band where the logged hinge moment follows the logged deflection as the aircraft model says:
 between 10 and 400 Hz (``BAND_S``), slower than the sensors' noise and faster than the aircraft's own
-motion (``ema.estimate.prepare.departures.aircraft_check`` reads the gauge's gain there,
-``ema.estimate.prepare.alignment`` its lag).
+motion (``ema.kinds.rotary.prepare.departures.aircraft_check`` reads the gauge's gain there,
+``ema.kinds.rotary.prepare.alignment`` its lag).
 """
 
 from __future__ import annotations

@@ -34,8 +34,8 @@ import numpy as np
 from ema.estimate.documents import Note
 from ema.estimate.physics.features import solve_as_read
 from ema.estimate.physics.friction import FrictionSolution, SolveSettings
-from ema.estimate.prepare.departures.zero_offset import equation_z, log_likelihood_ratio
 from ema.estimate.stats import DECISIVE_Z
+from ema.kinds.rotary.prepare.departures.zero_offset import equation_z, log_likelihood_ratio
 from ema.model.checks import InputError
 from ema.model.params import DriveConstants
 from ema.model.window import Window
@@ -55,7 +55,7 @@ SCALE_STDS = 2.0
 # saturates the motor as a weaker one would leans far towards γ. Short of these, the window cannot tell them apart.
 DECISIVE = {"inertia": 12.0, "torque_scale": -30.0}
 # Undecided, γ is read (k_T moves with temperature from flight to flight, J_M stays with the build), and the
-# stds grow by this share of what reading ΔJ instead would change (``ema.estimate.prepare.departures.read``).
+# stds grow by this share of what reading ΔJ instead would change (``ema.kinds.rotary.prepare.departures.read``).
 UNDECIDED_SHARE = 0.6
 # The 2 ms reconstruction reads J_M low where its kernel spans few samples (the bias shrinks as h²). ΔJ's std
 # carries this share of J_M at 1 kHz, scaled by (1 kHz / rate)². The bias is systematic, so averaging windows does
@@ -111,7 +111,7 @@ def _solve(window: Window, drive: DriveConstants, settings: SolveSettings) -> Fr
 def read_drive_constants(window: Window, drive: DriveConstants) -> DriveReading:
     """γ or ΔJ where it stands out (module docstring), with FDJ's and η_O's change across it ± its std. Where
     both do, the likelier if the window decides (``DECISIVE``); else γ, with ΔJ beside it as the
-    ``alternative`` (``ema.estimate.prepare.departures.read`` replays both, or widens the stds by their gap)."""
+    ``alternative`` (``ema.kinds.rotary.prepare.departures.read`` replays both, or widens the stds by their gap)."""
     rate = window.sample_rate_hz
     plain = _solve(window, drive, BESIDE)
     alone = {name: _solve(window, drive, replace(BESIDE, **{name: True})) for name in FIELDS}

@@ -7,7 +7,7 @@ part hardly moves (α_t's response to δ adds under 1 % there) and the sensors' 
 averaged away, so the logged moment and the logged deflection stand in the ratio
 b = q̄·S_e·c_e·C_hδ in that band. Their least-squares slope over b, the *ratio*, reads the strain
 gauge's gain where Eq. 5.1 cannot: there a gain is η_O's twin wherever the load is small
-(``ema.estimate.prepare.departures.hinge_gain``), here it needs only a deflection that moves. What the
+(``ema.kinds.rotary.prepare.departures.hinge_gain``), here it needs only a deflection that moves. What the
 position sensor's noise keeps in the band is taken out of the deflection's spread (it would
 attenuate the slope); the std is the larger of the white-noise one and a jackknife over
 ``JACKKNIFE_BLOCKS`` (which sees a filter's correlated noise).
@@ -28,7 +28,7 @@ In turn:
    and η_O (``banded``). Beyond the tolerance by ``SUSPECT_STDS`` only, or in a shorter window, the
    gauge is in doubt (``in_doubt``): the moment is read as logged and the stds grow by
    ``UNDECIDED_SHARE`` of what reading the window with the ratio divided out first would move
-   (``ema.estimate.prepare.departures.read``).
+   (``ema.kinds.rotary.prepare.departures.read``).
 """
 
 from __future__ import annotations
@@ -41,11 +41,11 @@ import numpy as np
 
 from ema.estimate.documents import Note
 from ema.estimate.physics.features import solve_as_read
-from ema.estimate.prepare.consistency import STEP_LAGS_S
-from ema.estimate.prepare.departures.aircraft_band import BAND_S, band_noise_variance, band_part
-from ema.estimate.prepare.departures.drive_constants import BESIDE
-from ema.estimate.prepare.departures.hinge_gain import divided_hinge, free_load_solution
 from ema.estimate.stats import JACKKNIFE_BLOCKS, jackknife_std
+from ema.kinds.rotary.prepare.consistency import STEP_LAGS_S
+from ema.kinds.rotary.prepare.departures.aircraft_band import BAND_S, band_noise_variance, band_part
+from ema.kinds.rotary.prepare.departures.drive_constants import BESIDE
+from ema.kinds.rotary.prepare.departures.hinge_gain import divided_hinge, free_load_solution
 from ema.model.actuator import Airframe
 from ema.model.aircraft import HingeGeometry
 from ema.model.checks import InputError
@@ -205,10 +205,10 @@ def divided_out(read: AircraftCheck) -> AircraftCheck:
 
 def banded(read: AircraftCheck, window: Window, gain: float, drive: DriveConstants) -> AircraftCheck:
     """``read`` with the stds it adds to FDJ and η_O of ``window`` (its ratio divided out already, where
-    it departs) where the window's own loads read no ``gain`` (``ema.estimate.prepare.departures.hinge_gain``); as it is
-    otherwise. Divided out: half of what the ends of the ratio's band move them (the tolerance and the
-    ratio's std, narrowed by what the loads' free solution knows of the gain where it agrees within 2 stds).
-    In doubt, the whole reading moves (``ema.estimate.prepare.departures.read``)."""
+    it departs) where the window's own loads read no ``gain``
+    (``ema.kinds.rotary.prepare.departures.hinge_gain``); as it is otherwise. Divided out: half of what the ends of
+    the ratio's band move them (the tolerance and the ratio's std, narrowed by what the loads' free solution knows of
+    the gain where it agrees within 2 stds). In doubt, the whole reading moves (``ema.kinds.rotary.prepare.departures.read``)."""
     if gain != 1.0 or read.factor == 1.0 or not read.beyond(SUSPECT_STDS):
         return read
     band = math.hypot(read.tolerance, read.ratio_std / read.ratio)

@@ -3,8 +3,8 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from ema.estimate.prepare.alignment import Lags
-from ema.estimate.prepare.conditioning import (
+from ema.kinds.rotary.prepare.alignment import Lags
+from ema.kinds.rotary.prepare.conditioning import (
     GLITCH_ACTIVITY,
     MAX_RATE_HZ,
     RESAMPLED_MAX_SAMPLES,
@@ -12,9 +12,9 @@ from ema.estimate.prepare.conditioning import (
     prepare,
     widened,
 )
-from ema.estimate.prepare.departures.viscosity import Viscosity
-from ema.estimate.prepare.departures.zero_offset import ZeroOffset
-from ema.estimate.prepare.step_lag import StepLag
+from ema.kinds.rotary.prepare.departures.viscosity import Viscosity
+from ema.kinds.rotary.prepare.departures.zero_offset import ZeroOffset
+from ema.kinds.rotary.prepare.step_lag import StepLag
 from ema.kinds.rotary.synthetic import synthetic_window
 from ema.model.actuator import THESIS
 from ema.model.params import HealthParams

@@ -1,10 +1,10 @@
 """A logged window made ready for the pipeline: isolated glitches repaired, a bounded number of
-samples, its signals checked to tell one story (``ema.estimate.prepare.consistency``: a sign, unit or
+samples, its signals checked to tell one story (``ema.kinds.rotary.prepare.consistency``: a sign, unit or
 sample rate the log got wrong is refused, naming the field), its sensors on one clock
-(``ema.estimate.prepare.alignment``), what it shows beyond the actuator document's model read and undone
-(``ema.estimate.prepare.departures.read``: a sensor off zero, the drive's k_T and J_M, the hinge moment's
+(``ema.kinds.rotary.prepare.alignment``), what it shows beyond the actuator document's model read and undone
+(``ema.kinds.rotary.prepare.departures.read``: a sensor off zero, the drive's k_T and J_M, the hinge moment's
 gain, the viscous coefficient), how likely its hinge moment is out of step
-(``ema.estimate.prepare.step_lag``), and what was done to it.
+(``ema.kinds.rotary.prepare.step_lag``), and what was done to it.
 
 A sensor's sample that jumps away from both neighbours and straight back (an EMI spike, a bit
 error) is no measurement, nor is a burst of a few of them (``MAX_GLITCH_RUN``, ``MAX_GLITCH_S``: at
@@ -24,7 +24,7 @@ record at the lower rate. ``f`` keeps the rate at or below ``MAX_RATE_HZ`` (the 
 needs no more) and the samples at or below ``RESAMPLED_MAX_SAMPLES``: memory and time grow at most linearly
 with the duration, and are bounded. A window of up to 10 s is kept at ``KERNEL_FREE_RATE_HZ`` or more
 where it was logged so: below it the 2 ms kernel spans few samples and reads J_M low
-(``ema.estimate.prepare.departures.drive_constants``), and a long window's stds are small enough to show it.
+(``ema.kinds.rotary.prepare.departures.drive_constants``), and a long window's stds are small enough to show it.
 """
 
 from __future__ import annotations
@@ -37,17 +37,17 @@ import numpy as np
 
 from ema.estimate.documents import Note
 from ema.estimate.physics.noise_reading import white_noise_std
-from ema.estimate.prepare.alignment import Lags, aligned
-from ema.estimate.prepare.consistency import Consistency
-from ema.estimate.prepare.departures.aircraft_check import TOLERANCE, aircraft_note, check_against_aircraft
-from ema.estimate.prepare.departures.drive_constants import KERNEL_FREE_RATE_HZ, DriveReading, drive_constants_note
-from ema.estimate.prepare.departures.hinge_gain import hinge_gain_note
-from ema.estimate.prepare.departures.read import Departures, Known, history_note, read_departures
-from ema.estimate.prepare.departures.viscosity import viscosity_note
-from ema.estimate.prepare.departures.zero_offset import offset_note
-from ema.estimate.prepare.stale import Stale, line_between_flanks, stale_note, without_stale
-from ema.estimate.prepare.step_lag import StepLag, step_lag, step_lag_note
-from ema.estimate.prepare.verdict import check_consistency, kinematics_note
+from ema.kinds.rotary.prepare.alignment import Lags, aligned
+from ema.kinds.rotary.prepare.consistency import Consistency
+from ema.kinds.rotary.prepare.departures.aircraft_check import TOLERANCE, aircraft_note, check_against_aircraft
+from ema.kinds.rotary.prepare.departures.drive_constants import KERNEL_FREE_RATE_HZ, DriveReading, drive_constants_note
+from ema.kinds.rotary.prepare.departures.hinge_gain import hinge_gain_note
+from ema.kinds.rotary.prepare.departures.read import Departures, Known, history_note, read_departures
+from ema.kinds.rotary.prepare.departures.viscosity import viscosity_note
+from ema.kinds.rotary.prepare.departures.zero_offset import offset_note
+from ema.kinds.rotary.prepare.stale import Stale, line_between_flanks, stale_note, without_stale
+from ema.kinds.rotary.prepare.step_lag import StepLag, step_lag, step_lag_note
+from ema.kinds.rotary.prepare.verdict import check_consistency, kinematics_note
 from ema.model.actuator import ActuatorDocument
 from ema.model.batch import COMMAND_MARGIN_DEG
 from ema.model.bounds import DEFAULT_SAMPLE_RATE_HZ
@@ -145,11 +145,12 @@ def repaired(window: Window) -> tuple[Window, dict[str, int]]:
 def prepare(
     window: Window, actuator: ActuatorDocument, spec_only: bool = False, known: Known | None = None
 ) -> Prepared:
-    """Cut ``window`` to a stretch its sensors kept updating in (``ema.estimate.prepare.stale``), repair its glitches,
-    average it down to the pipeline's sizes, check its signals agree (``ema.estimate.prepare.consistency``: InputError
-    naming the field), put its sensors on one clock (``ema.estimate.prepare.alignment``), read what it shows beyond
-    ``actuator`` (``ema.estimate.prepare.departures.read``) and weigh whether its hinge moment is out of step
-    (``ema.estimate.prepare.step_lag``); say what it found. ``spec_only`` skips the departures and the step:
+    """Cut ``window`` to a stretch its sensors kept updating in (``ema.kinds.rotary.prepare.stale``), repair its
+    glitches, average it down to the pipeline's sizes, check its signals agree
+    (``ema.kinds.rotary.prepare.consistency``: InputError naming the field), put its sensors on one clock
+    (``ema.kinds.rotary.prepare.alignment``), read what it shows beyond ``actuator``
+    (``ema.kinds.rotary.prepare.departures.read``) and weigh whether its hinge moment is out of step
+    (``ema.kinds.rotary.prepare.step_lag``); say what it found. ``spec_only`` skips the departures and the step:
     ``calibration`` reads the document's model alone and names what departs. ``known``: what other windows of
     the actuator read (``departures.read_departures``)."""
     logged, spec = window.n_samples, actuator.params

@@ -14,7 +14,7 @@ bias follows the speed a little).
 Where the speed hardly varies (one way, at slew), ΔC cannot be solved at all, and the stds carry a C
 ``UNSEEN_SHARE`` off the document's either way, as the offset stage carries an unseen sensor offset.
 Where the change does not stand out, the window is read with the document's C, but not as if it had
-shown C to be right: as for a hinge moment out of step (``ema.estimate.prepare.step_lag``), the story
+shown C to be right: as for a hinge moment out of step (``ema.kinds.rotary.prepare.step_lag``), the story
 "C is off by the change the window leans to" is weighed against the document's by the likelihood
 ratio of the nested solution (z²/2, z over the std with its floor) and a prior of e⁻⁴: its weight w.
 Each target's std grows by √w·|gap|, the gap what reading C so would change, and a note says so
@@ -30,8 +30,8 @@ import numpy as np
 from ema.estimate.documents import Note
 from ema.estimate.physics.features import as_read
 from ema.estimate.physics.friction import SolveSettings, solve_friction
-from ema.estimate.prepare.departures.drive_constants import UNDECIDED_SHARE
 from ema.estimate.stats import DECISIVE_Z, UNDECIDED_NOTE_WEIGHT, UNDECIDED_PRIOR_LOG_ODDS, odds_weight
+from ema.kinds.rotary.prepare.departures.drive_constants import UNDECIDED_SHARE
 from ema.model.effects import EffectSet
 from ema.model.params import DriveConstants
 from ema.model.window import Window

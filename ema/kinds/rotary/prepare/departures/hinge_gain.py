@@ -13,7 +13,7 @@ of the two equation errors, as for the offset) and lies in ``GAIN_PLAUSIBLE``; t
 divided by it before every estimator, and FDJ's and η_O's stds grow by what g's jackknife std moves
 them (``spread``).
 
-A k_T or J_M off (``ema.estimate.prepare.departures.drive_constants``) and g each take a part of the
+A k_T or J_M off (``ema.kinds.rotary.prepare.departures.drive_constants``) and g each take a part of the
 other, whichever is read first. So g is read before them only where it explains the window
 decisively better than γ or ΔJ alone (``leading``, as ΔJ must beat γ), and after them otherwise.
 Every solution of g sits beside a sensor offset and a change of C, and leads on the window the offset
@@ -31,8 +31,8 @@ from ema.estimate.documents import Note
 from ema.estimate.least_squares import coefficients
 from ema.estimate.physics.features import as_read, solve_as_read
 from ema.estimate.physics.friction import MIN_SLIDING_KERNELS, SolveSettings, nuisance_columns, regressors
-from ema.estimate.prepare.departures.drive_constants import BESIDE, FIELDS
 from ema.estimate.stats import DECISIVE_Z, JACKKNIFE_BLOCKS, jackknife_std, rms, rms_log_likelihood_ratio
+from ema.kinds.rotary.prepare.departures.drive_constants import BESIDE, FIELDS
 from ema.model.params import DriveConstants
 from ema.model.residual import DERIVATIVE_SPAN_S, kernel_samples
 from ema.model.window import Window

@@ -22,7 +22,7 @@ in every window of a working drive, whatever its health:
    better only if that field is wrong. A load 0.74x (lbf·ft) is much what η_O 0.74x as high reads
    (Eq. 5.1's load term), and seldom told; what is missed, the check still flags.
 
-4. One clock: a sensor's filter logs it up to ~1 ms late (``ema.estimate.prepare.alignment`` reads
+4. One clock: a sensor's filter logs it up to ~1 ms late (``ema.kinds.rotary.prepare.alignment`` reads
    that), but a channel exported out of step by 5–20 ms puts FDJ ranges off. Where Eq. 5.1 explains
    ``MIN_BETTER`` times better with the current or the hinge moment read ``STEP_LAGS_S`` away, the
    window is refused naming it and the lag.
@@ -32,7 +32,7 @@ values over a window (its noise, its quantization). A hinge moment logged as zer
 without the strain gauge) or stuck at one value would be read as a load of nothing. The command
 may hold still.
 
-Which field is named follows from which relations fail together (``ema.estimate.prepare.verdict``).
+Which field is named follows from which relations fail together (``ema.kinds.rotary.prepare.verdict``).
 """
 
 from __future__ import annotations
@@ -44,7 +44,7 @@ import numpy as np
 from ema.estimate.physics.features import as_read
 from ema.estimate.physics.friction import solve_friction
 from ema.estimate.physics.shifts import shifted_solutions
-from ema.estimate.prepare.departures.zero_offset import OFFSET_SOLVE
+from ema.kinds.rotary.prepare.departures.zero_offset import OFFSET_SOLVE
 from ema.model.dead_band import dead_band_paths
 from ema.model.params import DriveConstants
 from ema.model.window import Window

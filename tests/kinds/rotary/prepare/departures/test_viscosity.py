@@ -6,8 +6,8 @@ import pytest
 from ema.estimate.documents.window_facts import SensorZero
 from ema.estimate.physics.features import as_read
 from ema.estimate.physics.friction import solve_friction
-from ema.estimate.prepare.conditioning import prepare
-from ema.estimate.prepare.departures.viscosity import NOTE_WEIGHT, Viscosity, viscosity_note
+from ema.kinds.rotary.prepare.conditioning import prepare
+from ema.kinds.rotary.prepare.departures.viscosity import NOTE_WEIGHT, Viscosity, viscosity_note
 from ema.model.actuator import THESIS
 from ema.model.params import DriveConstants
 from ema.model.window import window_from_dict
@@ -70,9 +70,9 @@ def test_where_the_speed_hardly_varies_an_unseen_coefficient_is_in_the_stds(fact
     range high at 10 std (foreign history, actuator 407)."""
     from ema.estimate.documents.window_facts import HistoryReadings
     from ema.estimate.physics.friction import solve_window
-    from ema.estimate.prepare.conditioning import widened
     from ema.estimate.report import weakly_determined
     from ema.kinds.rotary.other_windows import known_from
+    from ema.kinds.rotary.prepare.conditioning import widened
 
     effects = Effects(viscous_factor=factor, current_bias_a=0.2)
     gust = draw(318, "gust", duration_s=0.1, effects=effects)

@@ -4,11 +4,11 @@ its tail continued by point reflection: not ``tests.foreign.careless``'s held va
 import numpy as np
 import pytest
 
-from ema.estimate.prepare import step_lag as step_lag_module
-from ema.estimate.prepare.conditioning import conditioning_notes, prepare
-from ema.estimate.prepare.hinge_lag import band_log_likelihood
-from ema.estimate.prepare.step_lag import NOTE_WEIGHT, step_lag
 from ema.kinds.rotary.pipeline import estimate_window
+from ema.kinds.rotary.prepare import step_lag as step_lag_module
+from ema.kinds.rotary.prepare.conditioning import conditioning_notes, prepare
+from ema.kinds.rotary.prepare.hinge_lag import band_log_likelihood
+from ema.kinds.rotary.prepare.step_lag import NOTE_WEIGHT, step_lag
 from ema.model.actuator import THESIS
 from ema.model.window import window_from_dict
 from tests.foreign.windows import draw

@@ -4,8 +4,8 @@ careless export is refused naming its field, and no window of a working drive is
 import numpy as np
 import pytest
 
-from ema.estimate.prepare.conditioning import conditioning_notes, prepare
-from ema.estimate.prepare.verdict import check_consistency
+from ema.kinds.rotary.prepare.conditioning import conditioning_notes, prepare
+from ema.kinds.rotary.prepare.verdict import check_consistency
 from ema.model.actuator import THESIS
 from ema.model.bounds import COMMAND_FAMILIES
 from ema.model.checks import InputError
@@ -57,10 +57,10 @@ CAUGHT = {  # of the five windows, fewer than all where the window cannot show t
     # 0.74x the load is much as η_O 0.74x as high would be (Eq. 5.1's load term): the answer then says it is weak
     "hinge moment in lbf·ft": 1,
     # the load moves slowly beside the torques: 5–20 ms early hardly changes Eq. 5.1's fit
-    # (``ema.estimate.prepare.step_lag``);
+    # (``ema.kinds.rotary.prepare.step_lag``);
     # what is asserted is that no other field is blamed
     # Eq. 5.1 balances these with the drive's constants beside: refused (a tenth) or said weak later
-    # (``ema.estimate.prepare.departures.drive_constants``, tests/training/test_drive_constants.py)
+    # (``ema.kinds.rotary.prepare.departures.drive_constants``, tests/training/test_drive_constants.py)
     "current a tenth (a shunt's volts)": 0,
     "current 0.71x (RMS for amplitude)": 0,
     "hinge moment 5 ms out of step": 0,

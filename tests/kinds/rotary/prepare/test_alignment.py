@@ -4,7 +4,7 @@ filter acts on the signal and its noise, as a real one does: tests/foreign filte
 import numpy as np
 import pytest
 
-from ema.estimate.prepare.alignment import Lags, aligned
+from ema.kinds.rotary.prepare.alignment import Lags, aligned
 from ema.model.actuator import THESIS
 from ema.model.window import window_from_dict
 from tests.foreign.physics import Effects, Flight
@@ -53,7 +53,7 @@ def test_a_filtered_current_or_speed_is_read_late_by_its_filters_delay(seed):
 def test_a_filtered_hinge_moment_is_read_late_by_about_its_filters_delay():
     """The filter's delay read from its noise's correlation: 0.70–1.15 of it on 20 foreign windows, median
     0.91; that it delays the moment too, from the deflection and the equation error
-    (``ema.estimate.prepare.hinge_lag``)."""
+    (``ema.kinds.rotary.prepare.hinge_lag``)."""
     read, weights = [], []
     for seed in range(5):
         width = 10 + 7 * seed  # 0.45–1.8 ms late
