@@ -208,7 +208,8 @@ def banded(read: AircraftCheck, window: Window, gain: float, drive: DriveConstan
     it departs) where the window's own loads read no ``gain``
     (``ema.kinds.rotary.prepare.departures.hinge_gain``); as it is otherwise. Divided out: half of what the ends of
     the ratio's band move them (the tolerance and the ratio's std, narrowed by what the loads' free solution knows of
-    the gain where it agrees within 2 stds). In doubt, the whole reading moves (``ema.kinds.rotary.prepare.departures.read``)."""
+    the gain where it agrees within 2 stds). In doubt, the whole reading moves
+    (``ema.kinds.rotary.prepare.departures.read``)."""
     if gain != 1.0 or read.factor == 1.0 or not read.beyond(SUSPECT_STDS):
         return read
     band = math.hypot(read.tolerance, read.ratio_std / read.ratio)
