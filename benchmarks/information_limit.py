@@ -38,9 +38,9 @@ from benchmarks.foreign_groups import group_seed, groups
 from benchmarks.tails import expected_over
 from ema.cli.benchmark_docs import write_section
 from ema.estimate import thread_budget
-from ema.estimate.physics.features import as_read
-from ema.estimate.physics.friction import SolveSettings, regressors, solve_friction
 from ema.estimate.report import healthy_range
+from ema.kinds.rotary.physics.features import as_read
+from ema.kinds.rotary.physics.friction import SolveSettings, regressors, solve_friction
 from ema.kinds.rotary.prepare.conditioning import prepare
 from ema.model.actuator import THESIS
 from ema.model.hinge import HINGE_SMOOTHING_S, local_line
@@ -129,7 +129,7 @@ def efficient_std(
 
 
 def our_rms(clean: Window, truth: dict[str, float], levels: dict[str, float], draws: int, seed: int) -> np.ndarray:
-    """(2,) RMS error (share of range) of ``ema.estimate.physics.friction`` on ``draws`` Gaussian noise draws at
+    """(2,) RMS error (share of range) of ``ema.kinds.rotary.physics.friction`` on ``draws`` Gaussian noise draws at
     ``levels``."""
     rng = np.random.default_rng(seed)
     signals = {name: np.repeat(values[None], draws, axis=0) for name, values in clean.signals.items()}
@@ -178,7 +178,7 @@ def report(rows: dict[str, list[dict[str, np.ndarray]]], draws: int) -> str:
         [
             "The limit the sensor noise sets on windows of `benchmarks.foreign_accuracy`'s seeds (module",
             "docstring: GLS on Eq. 5.1's raw samples, each sensor's realized noise, linearized at the true",
-            "health). Mean error in % of the range; *ours*: `ema/estimate/physics/friction.py` over "
+            "health). Mean error in % of the range; *ours*: `ema/kinds/rotary/physics/friction.py` over "
             f"{draws} fresh noise draws on each clean twin.",
             "",
             table(rows),

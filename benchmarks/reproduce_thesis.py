@@ -23,10 +23,10 @@ import numpy as np
 from ema.cli.benchmark_docs import write_section
 from ema.estimate import thread_budget
 from ema.estimate.learn.network import LearnConfig, learn_network, predict
-from ema.estimate.physics.features import features
-from ema.estimate.physics.friction import solve_window
-from ema.estimate.physics.scenario import Scenario
 from ema.estimate.simulate.design import Box
+from ema.kinds.rotary.physics.features import features
+from ema.kinds.rotary.physics.friction import solve_window
+from ema.kinds.rotary.physics.scenario import Scenario
 from ema.kinds.rotary.synthetic import synthetic_window
 from ema.model.aircraft import FlightCondition, GroundLoad
 from ema.model.commands import random_command_knots
@@ -225,7 +225,7 @@ def write_results(results: list[dict], comparison: list[str], command: str) -> N
         "",
         "Mean absolute relative error (physical units) over synthetic 0.5 s in-flight windows with",
         "realistic sensor noise: the window's network, the least-squares baseline of Eq. 5.1",
-        "(`ema/estimate/physics/friction.py`, no simulation), and the answer the product reports (the baseline,",
+        "(`ema/kinds/rotary/physics/friction.py`, no simulation), and the answer the product reports (the baseline,",
         "less its bias on held-out simulations, blended with the network where it earns it: "
         "`ema/estimate/assess/weighing.py`).",
         "",
@@ -235,7 +235,7 @@ def write_results(results: list[dict], comparison: list[str], command: str) -> N
         "",
         "FSJ: in flight the position loop keeps the shaft hunting in the backlash and it rarely rests;",
         "after a pilot's step the drive jumps past the static level within one log interval. FSJ is",
-        "read only at quasi-static break-aways (`ema/estimate/physics/static_friction.py`); otherwise the product",
+        "read only at quasi-static break-aways (`ema/kinds/rotary/physics/static_friction.py`); otherwise the product",
         "reports `FSJ: null` with the reason. On the ground with a slowly rising load the shaft rests",
         "and breaks away: FSJ is read within 2 % there, within its ±2 std under sensor noise; a shaft held",
         "and then stepped away shows only a lower bound, not read (tests/estimate/physics/test_static_friction.py).",

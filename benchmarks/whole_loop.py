@@ -16,10 +16,10 @@ range), this computes:
   and the same with the loop's bus voltage, lag and position gain fitted as unknowns too;
 - its first-order bias b = F⁻¹ Σ_s J_sᵀ Δs / σ_s² when the model it trusts is *our* simulator of
   the same model (started where the window starts, fed its command and logged hinge moment: what
-  ``ema.estimate.simulate.dataset`` simulates), and when the real loop departs from the document's by less than any
+  ``ema.kinds.rotary.dataset`` simulates), and when the real loop departs from the document's by less than any
   log shows: the PWM bus 1 % high, the command reaching the loop 10 µs late, the position gain
   0.1 % high, the loop reading a speed as noisy as the logged one (``tests.foreign.physics.Effects``);
-- how far our Eq. 5.1 fit (``ema.estimate.physics.friction``) moves on the same departures, noise-free;
+- how far our Eq. 5.1 fit (``ema.kinds.rotary.physics.friction``) moves on the same departures, noise-free;
 - where the whole-loop information lies: its share in the richest 2 % of the samples.
 
     python -m benchmarks.whole_loop [--per-group 60] [--docs]
@@ -39,10 +39,10 @@ from benchmarks.information_limit import GROUPS, SENSORS, noise_levels
 from benchmarks.tails import expected_over
 from ema.cli.benchmark_docs import typed_command, write_section
 from ema.estimate import thread_budget
-from ema.estimate.physics.features import as_read
-from ema.estimate.physics.friction import solve_friction
-from ema.estimate.physics.scenario import scenario_from_window
 from ema.estimate.report import healthy_range
+from ema.kinds.rotary.physics.features import as_read
+from ema.kinds.rotary.physics.friction import solve_friction
+from ema.kinds.rotary.physics.scenario import scenario_from_window
 from ema.kinds.rotary.prepare.conditioning import prepare
 from ema.model.actuator import THESIS
 from ema.model.params import HealthParams
@@ -87,7 +87,7 @@ def _as_window(window: Draw, signals: dict[str, np.ndarray]) -> Window:
 
 def our_simulator_bias(window: Draw, clean: dict[str, np.ndarray], levels: dict[str, float]) -> np.ndarray:
     """(2,) first-order bias of a whole-loop reading that simulates the window with *our* simulator
-    (``ema.estimate.simulate.dataset``'s scenario of the noise-free window: its command, start and logged load)."""
+    (``ema.kinds.rotary.dataset``'s scenario of the noise-free window: its command, start and logged load)."""
     scenario = scenario_from_window(_as_window(window, clean), drive=THESIS.params, hinge=THESIS.hinge)
     truth, (d_fdj, d_eta) = window.truth, STEP * WIDTH
     fdj, eta_o = truth["FDJ"] + np.array([0, d_fdj, -d_fdj, 0, 0]), truth["eta_O"] + np.array([0, 0, 0, d_eta, -d_eta])

@@ -1,2 +1,2 @@
-"""The physics every stage reads a window with: Eq. 5.1's residual torque and its least-squares solution, the
-window's own scenario simulated at a health, its sensors' noise, and FSJ at a break-away."""
+"""The physics every kind's reading shares: η's search between its bounds (``eta_search``) and a sensor's noise read
+off its own signal (``noise_reading``); each kind's own equations lie in its folder."""

@@ -3,7 +3,7 @@
 The thesis samples fixed ranges (FDJ 0.04–0.06 N·m, η_O 0.68–0.98), and a network trained there
 cannot answer outside them: a worn actuator's friction is read near the edge of the box, with a
 std that does not notice. Here every window gets its own box, centred on the Eq. 5.1 estimate
-(``ema.estimate.physics.friction``), ±``SPAN_SIGMAS`` of its jackknife std wide but never narrower than
+(``ema.kinds.rotary.physics.friction``), ±``SPAN_SIGMAS`` of its jackknife std wide but never narrower than
 ``MIN_HALF_SPAN``, and clipped only to what is physical (``PHYSICAL``): FDJ from a tenth of
 nominal to ten times it, η_O down into Case 1C's irreversible range, FSJ ≥ FDJ. The points fill
 the box with a scrambled Halton sequence: a few dozen simulations cover it evenly where uniform
@@ -16,10 +16,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ema.estimate.physics.scenario import PHYSICAL_ETA_O, physical_fdj_nm
 from ema.model.checks import InputError
 from ema.model.params import HealthParams
 
+# What is physical, whatever the window: FDJ from a tenth of the actuator's nominal to ten times it, η_O
+# down into the irreversible range (thesis Case 1C).
+PHYSICAL_FDJ_SHARE = (0.1, 10.0)
+PHYSICAL_ETA_O = (0.25, 0.995)
 SPAN_SIGMAS = 6.0  # the box's half-width in jackknife standard deviations of the centre
 MIN_HALF_SPAN = {"fdj_nm": 0.05, "eta_o": 0.025}  # FDJ relative to the centre, η_O absolute
 HALTON_PRIMES = (2, 3, 5, 7, 11, 13, 17, 19)
@@ -48,8 +51,13 @@ class Box:
         return _scale(normalized[:, 0], self.fdj_nm), _scale(normalized[:, 1], self.eta_o)
 
 
+def physical_fdj_nm(nominal_fdj_nm: float) -> tuple[float, float]:
+    """The FDJ an actuator of this nominal can physically have."""
+    return PHYSICAL_FDJ_SHARE[0] * nominal_fdj_nm, PHYSICAL_FDJ_SHARE[1] * nominal_fdj_nm
+
+
 def physical(nominal_fdj_nm: float) -> Box:
-    """What an actuator of this nominal FDJ can physically be (``ema.estimate.physics.scenario``)."""
+    """What an actuator of this nominal FDJ can physically be (``physical_fdj_nm``, ``PHYSICAL_ETA_O``)."""
     return Box(fdj_nm=physical_fdj_nm(nominal_fdj_nm), eta_o=PHYSICAL_ETA_O)
 
 

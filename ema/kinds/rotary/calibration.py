@@ -31,13 +31,13 @@ from ema.calibration.documents import RotaryCalibration, Step
 from ema.calibration.limits import MAX_EFFECTS
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import TARGETS, Estimate
-from ema.estimate.physics.scenario import CLEAR_MARGIN
 from ema.estimate.report import healthy_range
 from ema.kinds.rotary import calibration_report as reporting
 from ema.kinds.rotary.backlash import read_backlash
 from ema.kinds.rotary.equations import Equations, equations
 from ema.kinds.rotary.families import Family, generic_families
 from ema.kinds.rotary.noise_floor import clean_replicas, noise_copies
+from ema.kinds.rotary.physics.scenario import CLEAR_MARGIN
 from ema.kinds.rotary.pipeline import estimate_window
 from ema.kinds.rotary.prepare.conditioning import prepare
 from ema.kinds.rotary.readings import AMBIGUOUS_STDS, Contest, combined_stds, reading, settled

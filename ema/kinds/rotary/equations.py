@@ -8,7 +8,7 @@ states, sample by sample, over the sliding samples:
     t = sgn(ω)·(T_R − C_M·ω) = FDJ + k_aid·a + k_opp·o + Σ effect columns + noise,
 
 with a and o the smoothed aiding and opposing |T_ext|, the hinge moment read as the estimators
-read it (``ema.estimate.physics.features.as_read``), k_aid and k_opp tied by Eq. 3.4
+read it (``ema.kinds.rotary.physics.features.as_read``), k_aid and k_opp tied by Eq. 3.4
 (``Equations.tied``). A second channel carries the backlash: the motor angle (integrated measured
 speed) minus the elevator angle, d = θ_m/n − θ_u, sits at c ± BLK/2 depending on which side of the
 dead band the motor pushes. Simulated windows go through this very function, so the noise floor
@@ -26,8 +26,8 @@ import numpy as np
 from ema.calibration.limits import FOLDS
 from ema.estimate.least_squares import coefficients
 from ema.estimate.physics.eta_search import ETA_O_SEARCH
-from ema.estimate.physics.features import as_read
-from ema.estimate.physics.friction import SolveSettings, regressors
+from ema.kinds.rotary.physics.features import as_read
+from ema.kinds.rotary.physics.friction import SolveSettings, regressors
 from ema.model.params import DriveConstants, load_factors
 from ema.model.residual import smooth_derivative, smoothed
 

@@ -15,8 +15,8 @@ from collections.abc import Callable, Mapping, Sequence
 
 import numpy as np
 
-from ema.estimate.physics.scenario import inside, scenario_from_window
 from ema.kinds.rotary.equations import Equations, equations
+from ema.kinds.rotary.physics.scenario import inside, scenario_from_window
 from ema.model import runtime
 from ema.model.actuator import ActuatorDocument
 from ema.model.bounds import NOISE_COPIES

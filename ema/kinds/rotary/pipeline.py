@@ -4,7 +4,7 @@ The thesis's §6.3 proposal, made to hold on data our simulator did not draw:
 
 1. **prepare**: repair, average, align and zero the window's sensors, read its viscous coefficient
    (``ema.kinds.rotary.prepare.conditioning``);
-2. **physics**: solve Eq. 5.1 by least squares (``ema.estimate.physics.friction``), a block-jackknife std beside;
+2. **physics**: solve Eq. 5.1 by least squares (``ema.kinds.rotary.physics.friction``), a block-jackknife std beside;
 3. **simulate**: a Case-1B dataset of the window's own command, logged load and first state, its
    health drawn in a box around the physics estimate (``ema.estimate.simulate.design``: no fixed range, so no
    cap on a worn actuator), with the window's own sensor noise;
@@ -12,7 +12,7 @@ The thesis's §6.3 proposal, made to hold on data our simulator did not draw:
 5. **assess**: both estimators scored on held-out simulations and blended per parameter, checked against the
    window itself (``assessed``, ``ema.estimate.assess.weighing``);
 6. **check**: the window simulated at the answer (``checked``, ``ema.kinds.rotary.reproduction``);
-7. **report**: FSJ where the window shows a quasi-static break-away (``ema.estimate.physics.static_friction``),
+7. **report**: FSJ where the window shows a quasi-static break-away (``ema.kinds.rotary.physics.static_friction``),
    and the document.
 """
 
@@ -29,14 +29,14 @@ from ema.estimate.documents import ActuatorRead, Check, Estimate, Note
 from ema.estimate.documents.window_facts import HistoryReadings
 from ema.estimate.learn.estimator import NetworkEstimator
 from ema.estimate.learn.network import LearnConfig
-from ema.estimate.physics.features import as_read
-from ema.estimate.physics.friction import SOLUTION_ARRAYS, FrictionSolution, solve_friction, solve_window
-from ema.estimate.physics.scenario import inside
-from ema.estimate.physics.static_friction import read_static_friction
-from ema.estimate.simulate.dataset import Data, simulate_dataset
 from ema.estimate.stats import MAX_RATIO, rms
 from ema.estimate.stopwatch import Stopwatch
+from ema.kinds.rotary.dataset import Data, simulate_dataset
 from ema.kinds.rotary.other_windows import known_from
+from ema.kinds.rotary.physics.features import as_read
+from ema.kinds.rotary.physics.friction import SOLUTION_ARRAYS, FrictionSolution, solve_friction, solve_window
+from ema.kinds.rotary.physics.scenario import inside
+from ema.kinds.rotary.physics.static_friction import read_static_friction
 from ema.kinds.rotary.prepare.conditioning import Prepared, prepare, widened
 from ema.kinds.rotary.report import estimate_document
 from ema.kinds.rotary.reproduction import output_error_ratios

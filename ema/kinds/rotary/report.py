@@ -24,11 +24,11 @@ from ema.estimate.documents import (
     parameter,
 )
 from ema.estimate.documents.window_facts import InertiaReading, SensorZero, WindowInfo
-from ema.estimate.physics.friction import FrictionSolution, sliding_mask
-from ema.estimate.physics.static_friction import StaticFriction
 from ema.estimate.report import healthy_range, learned_info, share_of_range, weakly_determined
-from ema.estimate.simulate.dataset import Data
 from ema.estimate.stats import rms
+from ema.kinds.rotary.dataset import Data
+from ema.kinds.rotary.physics.friction import FrictionSolution, sliding_mask
+from ema.kinds.rotary.physics.static_friction import StaticFriction
 from ema.kinds.rotary.prepare.conditioning import Prepared, conditioning_done, conditioning_notes
 from ema.kinds.rotary.prepare.departures.drive_constants import KERNEL_FREE_RATE_HZ
 from ema.model.actuator import ActuatorDocument

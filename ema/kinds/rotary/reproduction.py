@@ -16,9 +16,9 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from ema.estimate.physics.features import as_read
-from ema.estimate.physics.scenario import SETTLE_S, Scenario
 from ema.estimate.stats import rms
+from ema.kinds.rotary.physics.features import as_read
+from ema.kinds.rotary.physics.scenario import SETTLE_S, Scenario
 from ema.model.noise import SensorNoise
 from ema.model.params import DriveConstants, HealthParams
 from ema.model.residual import residual_torque_nm

@@ -1,6 +1,6 @@
 """Stage 6, the estimates once the effect is in: Eq. 5.1 with its columns, η_A tied by Eq. 3.4.
 
-The same profile search over η_O as ``ema.estimate.physics.friction``, with FDJ and the effect's
+The same profile search over η_O as ``ema.kinds.rotary.physics.friction``, with FDJ and the effect's
 coefficients solved in closed form at each point. The physics solution's bias on this window's
 scenario, measured by the base pipeline on its held-out simulations, is subtracted as it is
 there, so that before and after differ only by the effect. "Never worse" is judged the same

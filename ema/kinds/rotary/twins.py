@@ -19,7 +19,7 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 
 from ema.calibration.limits import NAME_Z
-from ema.estimate.physics.scenario import CLEAR_MARGIN, following_error, inside, scenario_from_window
+from ema.kinds.rotary.physics.scenario import CLEAR_MARGIN, following_error, inside, scenario_from_window
 from ema.kinds.rotary.selection import NAME_MARGIN, Evidence
 from ema.model.actuator import ActuatorDocument
 from ema.model.effects import EffectSet

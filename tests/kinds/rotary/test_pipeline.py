@@ -387,7 +387,7 @@ def test_a_torque_constant_current_gain_or_inertia_off_the_specs_is_read_and_the
 def test_the_check_reuses_the_simulation_at_the_physics_answer_with_the_same_result(monkeypatch):
     """Where the physics estimate carries the answer, the dataset's batch simulated it already (the lane the
     noise is measured against): the check runs no simulation of its own and reads the same ratios."""
-    from ema.estimate.physics.scenario import Scenario
+    from ema.kinds.rotary.physics.scenario import Scenario
 
     own_runs = []
     simulate = Scenario.simulate

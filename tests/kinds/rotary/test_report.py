@@ -1,8 +1,8 @@
 """The ema-estimate/1 document's verdicts: what "weakly determined" covers."""
 
 from ema.estimate.assess.weighing import Assessed
-from ema.estimate.physics.static_friction import StaticFriction
 from ema.estimate.report import weakly_determined
+from ema.kinds.rotary.physics.static_friction import StaticFriction
 from ema.kinds.rotary.report import _estimates
 from ema.model.actuator import THESIS
 

@@ -22,8 +22,8 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ema.estimate.physics.friction import SolveSettings
-from ema.estimate.physics.shifts import advanced, shifted_solutions
+from ema.kinds.rotary.physics.friction import SolveSettings
+from ema.kinds.rotary.physics.shifts import advanced, shifted_solutions
 from ema.kinds.rotary.prepare.hinge_lag import hinge_lag
 from ema.model.params import DriveConstants
 from ema.model.window import Window

@@ -41,9 +41,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ema.estimate.physics.features import as_read
-from ema.estimate.physics.friction import solve_friction
-from ema.estimate.physics.shifts import shifted_solutions
+from ema.kinds.rotary.physics.features import as_read
+from ema.kinds.rotary.physics.friction import solve_friction
+from ema.kinds.rotary.physics.shifts import shifted_solutions
 from ema.kinds.rotary.prepare.departures.zero_offset import OFFSET_SOLVE
 from ema.model.dead_band import dead_band_paths
 from ema.model.params import DriveConstants

@@ -25,10 +25,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ema.estimate.physics.friction import SolveSettings
 from ema.estimate.physics.noise_reading import MAX_LAG, noise_of, white_noise_std
-from ema.estimate.physics.shifts import shifted_solutions
 from ema.estimate.stats import JACKKNIFE_BLOCKS, rms_log_likelihood_ratio
+from ema.kinds.rotary.physics.friction import SolveSettings
+from ema.kinds.rotary.physics.shifts import shifted_solutions
 from ema.kinds.rotary.prepare.departures.aircraft_band import band_lag_s
 from ema.model.hinge import denoised_hinge_nm
 from ema.model.params import DriveConstants

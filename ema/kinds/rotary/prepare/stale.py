@@ -26,8 +26,8 @@ line between its flanking samples, as a glitch is: the kernel averages over as m
 the window there would lose more than the bridge costs. A longer one cuts the window to the stretch
 between such runs with the most sliding samples (``window.read_span``); both are counted
 (``window.stale_samples``) and said in a note. Where that stretch holds fewer than
-``ema.estimate.physics.friction.MIN_SLIDING_KERNELS`` kernel widths of sliding samples, the window is refused naming the
-sensor and its run. A sensor that repeats one value over the whole window is left to
+``ema.kinds.rotary.physics.friction.MIN_SLIDING_KERNELS`` kernel widths of sliding samples, the window is refused
+naming the sensor and its run. A sensor that repeats one value over the whole window is left to
 ``verdict.check_logged``, which names it as not logged.
 """
 
@@ -39,8 +39,8 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ema.estimate.documents import Note
-from ema.estimate.physics.friction import MIN_SLIDING_KERNELS, SolveSettings, sliding_mask
 from ema.estimate.physics.noise_reading import white_noise_std
+from ema.kinds.rotary.physics.friction import MIN_SLIDING_KERNELS, SolveSettings, sliding_mask
 from ema.model.checks import InputError
 from ema.model.noise import NOISY_SIGNALS
 from ema.model.params import DriveConstants

@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 
 from benchmarks.foreign_groups import group_seed, groups
-from ema.estimate.physics.features import as_read
-from ema.estimate.physics.friction import solve_window
 from ema.estimate.report import share_of_range
+from ema.kinds.rotary.physics.features import as_read
+from ema.kinds.rotary.physics.friction import solve_window
 from ema.kinds.rotary.prepare.conditioning import Prepared, conditioning_done, conditioning_notes, prepare, widened
 from ema.kinds.rotary.prepare.stale import MIN_STALE_SAMPLES, equal_runs, stale_runs
 from ema.model.actuator import THESIS

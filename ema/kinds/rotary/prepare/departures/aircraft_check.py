@@ -40,8 +40,8 @@ from typing import Literal
 import numpy as np
 
 from ema.estimate.documents import Note
-from ema.estimate.physics.features import solve_as_read
 from ema.estimate.stats import JACKKNIFE_BLOCKS, jackknife_std
+from ema.kinds.rotary.physics.features import solve_as_read
 from ema.kinds.rotary.prepare.consistency import STEP_LAGS_S
 from ema.kinds.rotary.prepare.departures.aircraft_band import BAND_S, band_noise_variance, band_part
 from ema.kinds.rotary.prepare.departures.drive_constants import BESIDE

@@ -32,9 +32,9 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ema.estimate.documents import Note
-from ema.estimate.physics.features import solve_as_read
-from ema.estimate.physics.friction import FrictionSolution, SolveSettings
 from ema.estimate.stats import DECISIVE_Z
+from ema.kinds.rotary.physics.features import solve_as_read
+from ema.kinds.rotary.physics.friction import FrictionSolution, SolveSettings
 from ema.kinds.rotary.prepare.departures.zero_offset import equation_z, log_likelihood_ratio
 from ema.model.checks import InputError
 from ema.model.params import DriveConstants

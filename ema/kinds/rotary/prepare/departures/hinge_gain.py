@@ -2,7 +2,7 @@
 calibrated off, or a log in lbf·ft taken for N·m.
 
 Eq. 5.1 reads the load as t = FDJ + k_aid·a + k_opp·o, with k_aid = 1 − η_A and k_opp = 1/η_O − 1
-over the aiding and opposing |T_ext| (``ema.estimate.physics.friction``), η_A tied to η_O by Eq. 3.4. A
+over the aiding and opposing |T_ext| (``ema.kinds.rotary.physics.friction``), η_A tied to η_O by Eq. 3.4. A
 hinge moment logged g times the true one puts (g − 1)·H/n into T_R and g into a and o, so the window
 holds c_aid = 1 − η_A/g and c_opp = 1/(g·η_O) − 1 instead. Solved freely (both are linear), they
 give η_A·η_O = (1 − c_aid)/(1 + c_opp), whence η_O by Eq. 3.4 (a quadratic), and
@@ -29,9 +29,9 @@ import numpy as np
 
 from ema.estimate.documents import Note
 from ema.estimate.least_squares import coefficients
-from ema.estimate.physics.features import as_read, solve_as_read
-from ema.estimate.physics.friction import MIN_SLIDING_KERNELS, SolveSettings, nuisance_columns, regressors
 from ema.estimate.stats import DECISIVE_Z, JACKKNIFE_BLOCKS, jackknife_std, rms, rms_log_likelihood_ratio
+from ema.kinds.rotary.physics.features import as_read, solve_as_read
+from ema.kinds.rotary.physics.friction import MIN_SLIDING_KERNELS, SolveSettings, nuisance_columns, regressors
 from ema.kinds.rotary.prepare.departures.drive_constants import BESIDE, FIELDS
 from ema.model.params import DriveConstants
 from ema.model.residual import DERIVATIVE_SPAN_S, kernel_samples

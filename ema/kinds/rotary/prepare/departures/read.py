@@ -24,10 +24,10 @@ from functools import cached_property
 import numpy as np
 
 from ema.estimate.documents import Note
-from ema.estimate.physics.features import solve_as_read
 from ema.estimate.physics.noise_reading import white_noise_std
-from ema.estimate.physics.scenario import CLEAR_MARGIN, following_error, inside, scenario_from_window
 from ema.estimate.stats import MAX_RATIO
+from ema.kinds.rotary.physics.features import solve_as_read
+from ema.kinds.rotary.physics.scenario import CLEAR_MARGIN, following_error, inside, scenario_from_window
 from ema.kinds.rotary.prepare.departures.aircraft_check import AircraftCheck, banded, divided_out
 from ema.kinds.rotary.prepare.departures.drive_constants import UNDECIDED_SHARE, DriveReading, read_drive_constants
 from ema.kinds.rotary.prepare.departures.hinge_gain import HingeGain, read_hinge_gain

@@ -28,9 +28,9 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ema.estimate.documents import Note
-from ema.estimate.physics.features import as_read
-from ema.estimate.physics.friction import SolveSettings, solve_friction
 from ema.estimate.stats import DECISIVE_Z, UNDECIDED_NOTE_WEIGHT, UNDECIDED_PRIOR_LOG_ODDS, odds_weight
+from ema.kinds.rotary.physics.features import as_read
+from ema.kinds.rotary.physics.friction import SolveSettings, solve_friction
 from ema.kinds.rotary.prepare.departures.drive_constants import UNDECIDED_SHARE
 from ema.model.effects import EffectSet
 from ema.model.params import DriveConstants

@@ -6,7 +6,7 @@ import math
 import numpy as np
 import pytest
 
-from ema.estimate.physics.features import solve_as_read
+from ema.kinds.rotary.physics.features import solve_as_read
 from ema.kinds.rotary.prepare.conditioning import conditioning_done, prepare, widened
 from ema.kinds.rotary.prepare.departures.aircraft_check import (
     DEPART_STDS,

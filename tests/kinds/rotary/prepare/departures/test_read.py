@@ -3,9 +3,9 @@
 import pytest
 
 from ema.estimate.documents.window_facts import HistoryReadings, InertiaReading
-from ema.estimate.physics.features import as_read
-from ema.estimate.physics.friction import solve_window
 from ema.kinds.rotary.other_windows import known_from
+from ema.kinds.rotary.physics.features import as_read
+from ema.kinds.rotary.physics.friction import solve_window
 from ema.kinds.rotary.prepare.conditioning import prepare, widened
 from ema.model.actuator import THESIS
 from ema.model.window import window_from_dict

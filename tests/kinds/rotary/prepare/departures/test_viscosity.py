@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 
 from ema.estimate.documents.window_facts import SensorZero
-from ema.estimate.physics.features import as_read
-from ema.estimate.physics.friction import solve_friction
+from ema.kinds.rotary.physics.features import as_read
+from ema.kinds.rotary.physics.friction import solve_friction
 from ema.kinds.rotary.prepare.conditioning import prepare
 from ema.kinds.rotary.prepare.departures.viscosity import NOTE_WEIGHT, Viscosity, viscosity_note
 from ema.model.actuator import THESIS
@@ -69,9 +69,9 @@ def test_where_the_speed_hardly_varies_an_unseen_coefficient_is_in_the_stds(fact
     its flight: C·|ω| is FDJ's twin. Read with the spec's C and a std without it, C 1.24x put FDJ 40 % of
     range high at 10 std (foreign history, actuator 407)."""
     from ema.estimate.documents.window_facts import HistoryReadings
-    from ema.estimate.physics.friction import solve_window
     from ema.estimate.report import weakly_determined
     from ema.kinds.rotary.other_windows import known_from
+    from ema.kinds.rotary.physics.friction import solve_window
     from ema.kinds.rotary.prepare.conditioning import widened
 
     effects = Effects(viscous_factor=factor, current_bias_a=0.2)

@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from ema.estimate.physics.features import as_read
-from ema.estimate.physics.static_friction import read_static_friction
+from ema.kinds.rotary.physics.features import as_read
+from ema.kinds.rotary.physics.static_friction import read_static_friction
 from ema.kinds.rotary.prepare.conditioning import prepare
 from ema.model.actuator import THESIS
 from ema.model.aircraft import GroundLoad

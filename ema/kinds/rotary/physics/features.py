@@ -13,7 +13,7 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from ema.estimate.physics.friction import FrictionSolution, SolveSettings, solve_friction
+from ema.kinds.rotary.physics.friction import FrictionSolution, SolveSettings, solve_friction
 from ema.model.checks import InputError
 from ema.model.hinge import denoised_hinge_nm
 from ema.model.params import DriveConstants
@@ -40,7 +40,8 @@ def solve_as_read(
     drive: DriveConstants,
     settings: SolveSettings = SolveSettings(),
 ) -> FrictionSolution:
-    """Eq. 5.1 solved (``ema.estimate.physics.friction``) on a window's signals read as every estimator reads them."""
+    """Eq. 5.1 solved (``ema.kinds.rotary.physics.friction``) on a window's signals read as every estimator reads
+    them."""
     return solve_friction(as_read(signals, sample_rate_hz), sample_rate_hz, drive, settings)
 
 

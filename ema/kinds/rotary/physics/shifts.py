@@ -7,8 +7,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ema.estimate.physics.features import as_read
-from ema.estimate.physics.friction import FrictionSolution, SolveSettings, solve_friction
+from ema.kinds.rotary.physics.features import as_read
+from ema.kinds.rotary.physics.friction import FrictionSolution, SolveSettings, solve_friction
 from ema.model.params import DriveConstants
 
 

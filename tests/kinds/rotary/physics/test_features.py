@@ -1,8 +1,8 @@
 import numpy as np
 import pytest
 
-from ema.estimate.physics.features import as_read, bin_means, features
-from ema.estimate.physics.friction import solve_friction
+from ema.kinds.rotary.physics.features import as_read, bin_means, features
+from ema.kinds.rotary.physics.friction import solve_friction
 from ema.kinds.rotary.synthetic import synthetic_window
 from ema.model.actuator import THESIS
 from ema.model.checks import InputError

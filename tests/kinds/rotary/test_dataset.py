@@ -1,8 +1,8 @@
 import numpy as np
 import pytest
 
-from ema.estimate.physics.scenario import initial_state, scenario_from_window
-from ema.estimate.simulate.dataset import simulate_noisy
+from ema.kinds.rotary.dataset import simulate_noisy
+from ema.kinds.rotary.physics.scenario import initial_state, scenario_from_window
 from ema.kinds.rotary.synthetic import synthetic_window
 from ema.model.actuator import THESIS
 from ema.model.batch import InitialState

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from ema.estimate.physics.friction import SolveSettings, solve_friction, solve_window
+from ema.kinds.rotary.physics.friction import SolveSettings, solve_friction, solve_window
 from ema.kinds.rotary.synthetic import synthetic_window
 from ema.model.actuator import THESIS
 from ema.model.aircraft import GroundLoad
@@ -36,7 +36,7 @@ def test_recovers_the_truth_of_foreign_windows_within_a_few_jackknife_stds(seed)
 def test_a_batch_fits_each_window_as_alone_and_jackknife_stds_are_honest():
     health = HealthParams(np.full(40, 0.1), np.full(40, 0.052), np.full(40, 0.8))
     window = synthetic_window(HealthParams.single(0.1, 0.052, 0.8), seed=4)
-    from ema.estimate.physics.scenario import scenario_from_window
+    from ema.kinds.rotary.physics.scenario import scenario_from_window
 
     clean = scenario_from_window(window, drive=THESIS.params, hinge=THESIS.hinge).simulate(health).signals
     noisy = add_sensor_noise(clean, SensorNoise(), np.random.default_rng(1))

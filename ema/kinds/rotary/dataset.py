@@ -8,11 +8,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from ema.estimate.config import PipelineConfig
-from ema.estimate.physics.features import as_read, sliding_features
-from ema.estimate.physics.friction import FrictionSolution, SolveSettings, regressors
 from ema.estimate.physics.noise_reading import excess_noise
-from ema.estimate.physics.scenario import Scenario, scenario_from_window
 from ema.estimate.simulate import design
+from ema.kinds.rotary.physics.features import as_read, sliding_features
+from ema.kinds.rotary.physics.friction import FrictionSolution, SolveSettings, regressors
+from ema.kinds.rotary.physics.scenario import Scenario, scenario_from_window
 from ema.model.actuator import ActuatorDocument
 from ema.model.effects import EffectSet
 from ema.model.noise import SensorNoise, add_seeded_noise

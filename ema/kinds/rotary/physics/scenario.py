@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ema.estimate.simulate.design import PHYSICAL_ETA_O, physical_fdj_nm
 from ema.estimate.stats import rms
 from ema.model.aircraft import FlightCondition, HingeGeometry, Load, LoggedLoad
 from ema.model.batch import BatchResult, InitialState, simulate_batch
@@ -25,15 +26,6 @@ from ema.model.window import Window
 INITIAL_SOLVE_SAMPLES = 8
 SETTLE_S = 0.02  # the simulation settles from an estimated first state: compared after this
 CLEAR_MARGIN = 0.05  # of two models, the loser's ``following_error`` this far above the winner's: a clear call
-# What is physical, whatever the window: FDJ from a tenth of the actuator's nominal to ten times it, η_O
-# down into the irreversible range (thesis Case 1C).
-PHYSICAL_FDJ_SHARE = (0.1, 10.0)
-PHYSICAL_ETA_O = (0.25, 0.995)
-
-
-def physical_fdj_nm(nominal_fdj_nm: float) -> tuple[float, float]:
-    """The FDJ an actuator of this nominal can physically have."""
-    return PHYSICAL_FDJ_SHARE[0] * nominal_fdj_nm, PHYSICAL_FDJ_SHARE[1] * nominal_fdj_nm
 
 
 @dataclass(frozen=True)
