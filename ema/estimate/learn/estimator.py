@@ -12,9 +12,22 @@ from dataclasses import replace
 
 import numpy as np
 
+from ema.estimate.config import PipelineConfig
 from ema.estimate.learn.network import LearnConfig, LearnedNetwork, learn_network
 from ema.estimate.simulate.design import Box
 from ema.model.checks import InputError
+
+WINDOW_LEARNING = LearnConfig(max_epochs=60, max_validation_failures=6)  # a window's own few dozen simulations
+
+
+def window_learning(config: PipelineConfig) -> LearnConfig:
+    """How every kind trains a window's network: ``WINDOW_LEARNING`` at the request's hidden units and seed."""
+    return replace(WINDOW_LEARNING, hidden=config.hidden_units, seed=config.seed)
+
+
+def trained(inputs: np.ndarray, unit_targets: np.ndarray, config: PipelineConfig) -> NetworkRegressor:
+    """A window's network trained on its simulations (``inputs``, targets in box units), as ``config`` asks."""
+    return NetworkRegressor(window_learning(config), config.members).fit(inputs, unit_targets)
 
 
 class NetworkRegressor:

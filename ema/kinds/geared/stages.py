@@ -25,8 +25,7 @@ import ema.estimate.documents as doc
 from ema.estimate.assess.weighing import Assessed, Candidates, assess, misfit_limit
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents.window_facts import WindowInfo
-from ema.estimate.learn.estimator import NetworkRegressor
-from ema.estimate.learn.network import LearnConfig
+from ema.estimate.learn.estimator import NetworkRegressor, trained
 from ema.estimate.report import learned_info
 from ema.estimate.stats import MAX_RATIO, rms
 from ema.estimate.stopwatch import Stopwatch
@@ -37,7 +36,6 @@ from ema.kinds.geared.output_error import HealthReading, read_health
 from ema.model.actuator import GearedActuator
 from ema.model.window import Window
 
-GEARED_LEARNING = LearnConfig(max_epochs=60, max_validation_failures=6)  # as the servo's: a few dozen runs
 REPORTED = {"fdj_nm": "FDJ", "eta_o": "eta_O", "eta_a": "eta_A"}
 UNITS = {"fdj_nm": "N·m", "eta_o": doc.DIMENSIONLESS, "eta_a": doc.DIMENSIONLESS}
 
@@ -55,9 +53,8 @@ def held_out_physics(
 
 
 def learned(data: GearedData, config: PipelineConfig) -> NetworkRegressor:
-    settings = replace(GEARED_LEARNING, hidden=config.hidden_units, seed=config.seed)
     n = config.n_simulations
-    return NetworkRegressor(settings, config.members).fit(data.inputs[:n], data.normalize(data.truth[:n]))
+    return trained(data.inputs[:n], data.normalize(data.truth[:n]), config)
 
 
 def assessed(

@@ -27,8 +27,7 @@ from ema.estimate.assess.weighing import Assessed, Candidates, assess, misfit_li
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import ActuatorRead, Check, Estimate, Note
 from ema.estimate.documents.window_facts import HistoryReadings
-from ema.estimate.learn.estimator import NetworkEstimator
-from ema.estimate.learn.network import LearnConfig
+from ema.estimate.learn.estimator import NetworkEstimator, window_learning
 from ema.estimate.stats import MAX_RATIO, rms
 from ema.estimate.stopwatch import Stopwatch
 from ema.kinds.rotary.dataset import Data, simulate_dataset
@@ -46,14 +45,12 @@ from ema.model.window import Window
 # On a few dozen noisy simulations the network stops improving within a few epochs, and the physics solution
 # carries most of the answer (ema.estimate.assess.weighing): the thesis's 12 failures and 1000 epochs made its time
 # the pipeline's least predictable.
-PIPELINE_LEARNING = LearnConfig(max_epochs=60, max_validation_failures=6)
 
 
 def learned(data: Data, config: PipelineConfig) -> NetworkEstimator:
     n = config.n_simulations
-    settings = replace(PIPELINE_LEARNING, hidden=config.hidden_units, seed=config.seed)
     health = data.sims.health
-    return NetworkEstimator(settings, config.members).fit(
+    return NetworkEstimator(window_learning(config), config.members).fit(
         data.inputs[:n], health.fdj_nm[:n], health.eta_o[:n], data.box
     )
 

@@ -26,8 +26,7 @@ import ema.estimate.documents as doc
 from ema.estimate.assess.weighing import Assessed, Candidates, assess, misfit_limit
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents.window_facts import WindowInfo
-from ema.estimate.learn.estimator import NetworkRegressor
-from ema.estimate.learn.network import LearnConfig
+from ema.estimate.learn.estimator import NetworkRegressor, trained
 from ema.estimate.report import learned_info
 from ema.estimate.stats import MAX_RATIO, RESOLUTION_SHARE, rms
 from ema.estimate.stopwatch import Stopwatch
@@ -46,7 +45,6 @@ from ema.kinds.servo.loop_dataset import ServoData, carrying, lane_parameters, s
 from ema.model.actuator import ServoActuator
 from ema.model.window import Window
 
-SERVO_LEARNING = LearnConfig(max_epochs=60, max_validation_failures=6)  # as the rotary pipeline's (a few dozen runs)
 MISFIT_SEED_OFFSET = 7919  # the misfit's shifts and signs draw from the window's seed plus this: a stream of their own
 CHECK_PHASES = (0.0, 0.5)  # the position sensor's phases of its step the check simulates: the answer's, its twin's
 FDJ = "fdj_n"
@@ -146,9 +144,8 @@ def misfit_carried(
 
 
 def learned(data: ServoData, config: PipelineConfig) -> NetworkRegressor:
-    settings = replace(SERVO_LEARNING, hidden=config.hidden_units, seed=config.seed)
     n = config.n_simulations
-    return NetworkRegressor(settings, config.members).fit(data.inputs[:n], data.normalize(data.truth[:n]))
+    return trained(data.inputs[:n], data.normalize(data.truth[:n]), config)
 
 
 def assessed(held: Screened, data: ServoData, network: NetworkRegressor, n: int) -> Assessed:
