@@ -23,6 +23,7 @@ from ema.kinds.geared.loop import GRAVITY, LANE_PARAMETERS, Run
 from ema.model.actuator import GearedActuator
 from ema.model.checks import InputError
 from ema.model.geared import GEARED_CONSTANTS, Geared
+from ema.model.params import HealthRanges
 from ema.model.window import Window
 
 SUPPLY_BAND = 0.25  # a supply sample more than this share off the log's median is a glitch of its reading
@@ -37,6 +38,7 @@ class GearedPrepared:
     resolution_rad: float  # the position's step
     nominal: dict[str, float]  # HEALTH, the document's
     failure_levels: dict[str, float]  # FDJ's upper level, η_O's lower one (the document's thresholds)
+    ranges: HealthRanges  # the healthy ranges around the nominal (what "weakly determined" is judged against)
     notes: list[doc.Note]
 
     @property
@@ -194,7 +196,7 @@ def prepare_geared(window: Window, actuator: GearedActuator) -> GearedPrepared:
     resolution = position_step(window.signals["position_rad"], geared)
     notes = ([glitches] if glitches else []) + _notes(window, run, resolution)
     levels = {"fdj_nm": actuator.threshold("FDJ")[0], "eta_o": actuator.threshold("eta_O")[0]}
-    return GearedPrepared(window, geared, run, resolution, nominal_health(actuator), levels, notes)
+    return GearedPrepared(window, geared, run, resolution, nominal_health(actuator), levels, actuator.ranges, notes)
 
 
 def nominal_health(actuator: GearedActuator) -> dict[str, float]:

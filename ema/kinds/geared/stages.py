@@ -26,7 +26,7 @@ from ema.estimate.assess.weighing import Assessed, Candidates, assess, misfit_li
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents.window_facts import WindowInfo
 from ema.estimate.learn.estimator import NetworkRegressor, trained
-from ema.estimate.report import learned_info
+from ema.estimate.report import learned_info, weakly_determined
 from ema.estimate.stats import MAX_RATIO, rms
 from ema.estimate.stopwatch import Stopwatch
 from ema.kinds.geared.dataset import GearedData, simulate_geared_dataset
@@ -139,13 +139,15 @@ def closed_loop_check(prepared: GearedPrepared, answer: Assessed) -> doc.Check:
 
 
 def _estimates(prepared: GearedPrepared, answer: Assessed) -> doc.Estimates:
-    """FDJ, η_O and η_A against the nominal, each std widened by the document's repeatability."""
+    """FDJ, η_O and η_A against the nominal, each std widened by the document's repeatability, and weakly
+    determined where ±2 std span over a tenth of its healthy range (η_A judged against η_O's)."""
     repeatability = prepared.geared.repeatability
     entries = {}
     for name in HEALTH:
         std = float(np.hypot(answer.stds[name], repeatability.get(name, 0.0)))
+        weak = weakly_determined("FDJ" if name == "fdj_nm" else "eta_O", std, prepared.ranges)
         entries[REPORTED[name]] = doc.parameter(
-            answer.values[name], std, prepared.nominal[name], unit=UNITS[name], repeatability_std=std
+            answer.values[name], std, prepared.nominal[name], weak, unit=UNITS[name], repeatability_std=std
         )
     return doc.Estimates(FSJ=None, **entries)
 
