@@ -324,3 +324,12 @@ def test_a_servo_window_without_its_stored_document_is_refused_saying_how_to_sto
             refused = client.post(route, json=body)
             assert refused.status_code == 422 and refused.json()["detail"][0]["loc"] == field
             assert "PUT its document to /v1/actuators/emps/axis" in refused.json()["detail"][0]["msg"]
+
+
+def test_a_window_with_a_dead_channel_is_refused_and_never_stored(client, document):
+    """A dead current sensor (a constant): 422 naming the signal, and nothing of the window is stored, so it
+    never enters a trend, a status or a remaining life."""
+    dead = {**document, "signals": {**document["signals"], "current_a": [0.0] * len(document["signals"]["current_a"])}}
+    refused = client.post("/v1/estimate", json=dead)
+    assert refused.status_code == 422 and refused.json()["detail"][0]["loc"] == ["body", "signals", "current_a"]
+    assert client.get(f"/v1/actuators/{document['actuator_id']}/estimates").status_code == 404
