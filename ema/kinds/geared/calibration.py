@@ -193,7 +193,7 @@ def _unnamed(scores: dict[str, Candidate]) -> str:
 
 
 @dataclass(frozen=True)
-class Learned:
+class LearnedModel:
     solved: Solved
     stds: dict[str, float]
     base: Trial
@@ -206,7 +206,7 @@ class Learned:
 
 def learned_model(
     windows: Sequence[Window], geared: Geared, on_stage: Callable[[str], None]
-) -> tuple[Learned, list[LoggedRun]]:
+) -> tuple[LearnedModel, list[LoggedRun]]:
     """The selection and the final solve (steps 1 to 3 of the module docstring)."""
     runs = logged_runs(windows, geared)
     step = position_step(np.concatenate([r.position_rad for r in runs]), geared)
@@ -228,4 +228,4 @@ def learned_model(
         note=f"mean |position error| of runs simulated by solutions that did not see them: {base.held.score:.4f} "
         f"rad with a constant friction, {final.held.score:.4f} rad with {', '.join(final.effects) or 'nothing named'}",
     )
-    return Learned(solved, stds, base, final, candidates, steps, floor, held), runs
+    return LearnedModel(solved, stds, base, final, candidates, steps, floor, held), runs

@@ -15,7 +15,7 @@ from collections.abc import Callable, Sequence
 import numpy as np
 
 from ema.calibration.documents import GearedCalibration, Learned, LoadReading
-from ema.kinds.geared.calibration import Learned as Model
+from ema.kinds.geared.calibration import LearnedModel as Model
 from ema.kinds.geared.calibration import learned_model
 from ema.kinds.geared.effects import CONSTANTS
 from ema.kinds.geared.log_reading import HEALTH, log_constants, prepare_geared
