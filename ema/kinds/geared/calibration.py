@@ -19,7 +19,6 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 
@@ -28,6 +27,7 @@ from ema.calibration.limits import MAX_EFFECTS, NAME_Z, noise_z
 from ema.kinds.geared.duty_gain import gain_at
 from ema.kinds.geared.effects import EFFECTS, EFFICIENCY, NEUTRAL, free_constants
 from ema.kinds.geared.log_reading import load_run, position_step, repaired_supply
+from ema.kinds.geared.stacked_fit import HeldOut as ScoredHeldOut
 from ema.kinds.geared.stacked_fit import (
     LoggedRun,
     Solved,
@@ -49,8 +49,8 @@ class Trial:
     """A model tried on the runs: its effects, its held-out score, and where its solves start."""
 
     effects: tuple[str, ...]
-    held: Any  # stacked_fit.HeldOut on the runs
-    copies: Any  # on the noise-only copies of the model it is tried against
+    held: ScoredHeldOut  # on the runs
+    copies: ScoredHeldOut  # on the noise-only copies of the model it is tried against
     start: dict[str, float]
 
 
@@ -194,6 +194,10 @@ def _unnamed(scores: dict[str, Candidate]) -> str:
 
 @dataclass(frozen=True)
 class LearnedModel:
+    """The calibration's model: its final solve with every constant's std (the larger of the Gauss–Newton one and
+    the folds' spread), the base and the final trials, what each round scored and named, the noise floor and the
+    held-out errors before and after."""
+
     solved: Solved
     stds: dict[str, float]
     base: Trial
