@@ -37,16 +37,28 @@ def longest_run(values: np.ndarray) -> int:
     return int(np.max(np.diff(edges)))
 
 
+def too_few_levels(values: np.ndarray) -> str | None:
+    """Why ``values`` take fewer than three distinct values (one throughout, or two: a step of its resolution; a
+    working sensor shows its noise), or None; in one pass each, no sort (a window's every channel, before every
+    reading)."""
+    first = values[0]
+    others = values[values != first]
+    if others.size == 0:
+        return f"is {first:g} throughout: a dead or stuck sensor, or a log map's scale of 0; nothing to read"
+    if np.all(others == others[0]):
+        low, high = sorted((float(first), float(others[0])))
+        return f"holds two values only ({low:g}, {high:g}): stuck at a step of its resolution, not a measurement"
+    return None
+
+
 def dead_channel(name: str, values: np.ndarray) -> str | None:
     """Why signal ``name`` carries nothing to read (module docstring), or None."""
-    distinct = np.unique(values)
-    if len(distinct) == 1:
-        return f"is {distinct[0]:g} throughout: a dead sensor, or a log map's scale of 0; nothing to read"
+    why = too_few_levels(values)
+    if why is not None:
+        return why
     run = longest_run(values)
     if run >= STUCK_SHARE * len(values):
         return f"holds one value for {run} of its {len(values)} samples in a row: a frozen sensor"
-    if len(distinct) == 2:
-        return f"holds two values only ({distinct[0]:g}, {distinct[1]:g}): a step of its resolution, not a measurement"
     return None
 
 

@@ -27,7 +27,7 @@ in every window of a working drive, whatever its health:
    ``MIN_BETTER`` times better with the current or the hinge moment read ``STEP_LAGS_S`` away, the
    window is refused naming it and the lag.
 
-Before these, every sensor must show that it logs: a working one shows at least ``verdict.MIN_LEVELS``
+Before these, every sensor must show that it logs: a working one shows at least three
 values over a window (its noise, its quantization). A hinge moment logged as zeros (an aircraft
 without the strain gauge) or stuck at one value would be read as a load of nothing. The command
 may hold still.

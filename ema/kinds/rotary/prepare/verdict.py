@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from ema.estimate.documents import Note
+from ema.estimate.information import too_few_levels
 from ema.kinds.rotary.prepare.consistency import (
     FOLLOW_GAP_DEG,
     FOLLOW_STEP_S,
@@ -36,20 +37,15 @@ UNIT_SLIP_TOLERANCE = 0.1
 RATE_SLIPS = (2.0, 0.5, 4.0, 0.25, 5.0, 0.2, 10.0, 0.1, 1.024, 1 / 1.024, 1e3, 1e-3)
 RATE_SLIP_TOLERANCE = 0.02
 AGAINST_THE_MOTION = ("current sign", "torque signs")  # readings that say the motor's motion runs backwards
-MIN_LEVELS = 3  # distinct values a logged sensor shows over a window
 
 
 def check_logged(window: Window) -> None:
-    """An InputError naming the first sensor with fewer than ``MIN_LEVELS`` distinct values over ``window``."""
+    """An InputError naming the first sensor with fewer than three distinct values over ``window``
+    (``ema.estimate.information.too_few_levels``, the rule every kind's channels are held to), its load's too."""
     for name in ("position_deg", "motor_speed_radps", "current_a", "hinge_moment_nm"):
-        levels = np.unique(window.signals[name])
-        if len(levels) < MIN_LEVELS:
-            values = ", ".join(f"{v:g}" for v in levels)
-            raise InputError(
-                f"signals.{name}",
-                f"takes only {values} over the window: a sensor not logged or stuck (a working one shows its noise); "
-                "nothing can be read through it",
-            )
+        why = too_few_levels(window.signals[name])
+        if why is not None:
+            raise InputError(f"signals.{name}", why)
 
 
 def kinematics_note(found: Consistency) -> list[Note]:
