@@ -12,6 +12,7 @@ draws leave holes and clusters.
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass
 
 import numpy as np
@@ -127,3 +128,18 @@ def draw(box: Box, n: int, seed: int) -> HealthParams:
     unit = halton(n, seed)
     fdj = _scale(unit[:, 0], box.fdj_nm)
     return HealthParams(fsj_nm=fdj * _scale(unit[:, 2], box.fsd), fdj_nm=fdj, eta_o=_scale(unit[:, 1], box.eta_o))
+
+
+def binned(values: np.ndarray, bins: int) -> np.ndarray:
+    """(…, bins) means of ``values`` over ``bins`` equal parts of the window: a network's inputs."""
+    edges = np.linspace(0, values.shape[-1], bins + 1).astype(int)
+    return np.stack([values[..., a:b].mean(axis=-1) for a, b in itertools.pairwise(edges)], axis=-1)
+
+
+def shifted_copies(misfit: np.ndarray, count: int, seed: int) -> np.ndarray:
+    """(count, N) a window's ``misfit`` (N,), each row at its own circular shift and sign (drawn from ``seed``): a
+    disturbance of the window's own size and spectrum, at no fixed place, for its simulations to carry."""
+    rng = np.random.default_rng(seed)
+    shifts = rng.integers(0, len(misfit), size=count)
+    signs = rng.choice([-1.0, 1.0], size=count)
+    return signs[:, None] * np.stack([np.roll(misfit, shift) for shift in shifts])

@@ -24,6 +24,7 @@ import numpy as np
 
 from ema.calibration.documents import Candidate, HeldOut, NoiseFloor, Step
 from ema.calibration.limits import MAX_EFFECTS, NAME_Z, noise_z
+from ema.kinds.geared.dataset import read_through
 from ema.kinds.geared.duty_gain import gain_at
 from ema.kinds.geared.effects import EFFECTS, EFFICIENCY, NEUTRAL, free_constants
 from ema.kinds.geared.log_reading import load_run, position_step, repaired_supply
@@ -94,13 +95,10 @@ def starting_values(runs: Sequence[LoggedRun], geared: Geared) -> list[dict[str,
 def noise_copies(runs: Sequence[LoggedRun], values: dict[str, float], step: float) -> list[LoggedRun]:
     """Each run as the model at ``values`` would log it: simulated, read through the encoder's ``step`` at a
     phase of its own (``COPY_SEED``): what the runs would show if the model were the whole truth."""
-    rng = np.random.default_rng(COPY_SEED)
-    copies = []
-    for run, simulated in zip(runs, positions(runs, values), strict=True):
-        phase = rng.uniform()
-        read = simulated if step <= 0 else step * (np.round(simulated / step + phase) - phase)
-        copies.append(LoggedRun(run.window_id, run.run, read, run.duty_ratio))
-    return copies
+    simulated = positions(runs, values)
+    phases = np.random.default_rng(COPY_SEED).uniform(size=len(runs))
+    read = [read_through(q[None, :], step, phase[None])[0] for q, phase in zip(simulated, phases, strict=True)]
+    return [LoggedRun(r.window_id, r.run, q, r.duty_ratio) for r, q in zip(runs, read, strict=True)]
 
 
 def tried(

@@ -12,13 +12,12 @@ it too, say what it costs. The network's inputs are the position's error to the 
 
 from __future__ import annotations
 
-import itertools
 from dataclasses import dataclass
 
 import numpy as np
 
 from ema.estimate.config import PipelineConfig
-from ema.estimate.simulate.design import SPAN_SIGMAS, halton
+from ema.estimate.simulate.design import SPAN_SIGMAS, binned, halton, shifted_copies
 from ema.kinds.geared.log_reading import HEALTH, GearedPrepared
 from ema.kinds.geared.loop import simulate_lanes
 from ema.kinds.geared.output_error import HealthReading
@@ -61,25 +60,11 @@ def box(reading: HealthReading) -> tuple[np.ndarray, np.ndarray]:
     return inside - half, inside + half
 
 
-def binned(values: np.ndarray, bins: int) -> np.ndarray:
-    """(…, bins) means of ``values`` over ``bins`` equal parts of the window."""
-    edges = np.linspace(0, values.shape[-1], bins + 1).astype(int)
-    return np.stack([values[..., a:b].mean(axis=-1) for a, b in itertools.pairwise(edges)], axis=-1)
-
-
 def read_through(position: np.ndarray, step: float, phase: np.ndarray) -> np.ndarray:
     """(S, N) positions as an encoder of ``step`` reads them, each row at its own ``phase`` of the step."""
     if step <= 0:
         return position
     return step * (np.round(position / step + phase[:, None]) - phase[:, None])
-
-
-def carried(misfit: np.ndarray, count: int, seed: int) -> np.ndarray:
-    """(count, N) the window's misfit, each row at its own circular shift and sign."""
-    rng = np.random.default_rng(seed)
-    shifts = rng.integers(0, len(misfit), size=count)
-    signs = rng.choice([-1.0, 1.0], size=count)
-    return signs[:, None] * np.stack([np.roll(misfit, shift) for shift in shifts])
 
 
 def simulate_geared_dataset(prepared: GearedPrepared, reading: HealthReading, config: PipelineConfig) -> GearedData:
@@ -91,7 +76,7 @@ def simulate_geared_dataset(prepared: GearedPrepared, reading: HealthReading, co
     simulated = simulate_lanes(prepared.run, lanes).position_rad
     phases = np.random.default_rng(config.seed).uniform(size=count)
     logged = read_through(simulated, prepared.resolution_rad, phases)
-    logged = logged + carried(reading.error_rad, count, config.seed + MISFIT_SEED_OFFSET)
+    logged = logged + shifted_copies(reading.error_rad, count, config.seed + MISFIT_SEED_OFFSET)
     set_point = prepared.window.signals["set_point_rad"]
     bins = min(config.n_timesteps, len(set_point) // 2)
     inputs = binned(logged - set_point, bins)

@@ -19,13 +19,12 @@ on the held-out simulations, which carry it too, say what it costs.
 
 from __future__ import annotations
 
-import itertools
 from dataclasses import dataclass, replace
 
 import numpy as np
 
 from ema.estimate.config import PipelineConfig
-from ema.estimate.simulate.design import SPAN_SIGMAS, halton
+from ema.estimate.simulate.design import SPAN_SIGMAS, binned, halton, shifted_copies
 from ema.kinds.servo.closed_loop import LANE_PARAMETERS, ServoRuns
 from ema.kinds.servo.inverse import EITHER_SIGN, InverseSolution
 from ema.kinds.servo.log_reading import ServoPrepared
@@ -92,12 +91,6 @@ def box(physics: InverseSolution, targets: tuple[str, ...]) -> tuple[np.ndarray,
     return low + shift, centre + half + shift
 
 
-def binned(force: np.ndarray, bins: int) -> np.ndarray:
-    """(…, bins) means of the force over ``bins`` equal parts of the window."""
-    edges = np.linspace(0, force.shape[-1], bins + 1).astype(int)
-    return np.stack([force[..., a:b].mean(axis=-1) for a, b in itertools.pairwise(edges)], axis=-1)
-
-
 def simulate_servo_dataset(prepared: ServoPrepared, physics: InverseSolution, config: PipelineConfig) -> ServoData:
     """The window's ``config.total_simulations`` closed-loop runs, their constants and the network's inputs."""
     targets = tuple(name for name in physics.values if name in LANE_COLUMNS)
@@ -127,8 +120,4 @@ def window_misfit(prepared: ServoPrepared, physics: InverseSolution, bins: int) 
 def carrying(data: ServoData, misfit: np.ndarray, seed: int) -> ServoData:
     """``data`` with ``misfit`` (bins,) added to every simulation's inputs, each at its own circular shift and sign
     (drawn from ``seed``): a disturbance of the window's own size and spectrum, at no fixed place."""
-    rng = np.random.default_rng(seed)
-    shifts = rng.integers(0, len(misfit), size=len(data.inputs))
-    signs = rng.choice([-1.0, 1.0], size=len(data.inputs))
-    added = signs[:, None] * np.stack([np.roll(misfit, shift) for shift in shifts])
-    return replace(data, inputs=data.inputs + added)
+    return replace(data, inputs=data.inputs + shifted_copies(misfit, len(data.inputs), seed))
