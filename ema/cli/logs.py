@@ -20,7 +20,7 @@ from ema.model.bounds import DEFAULT_SAMPLE_RATE_HZ, MIN_SAMPLES
 from ema.model.checks import InputError, load_json
 from ema.model.envelope import DEFAULT_AIRSPEED_MPS
 from ema.model.kinds import ALL_SIGNALS, KINDS, KindFacts, nearest_kind
-from ema.model.log_files import TABLE_SUFFIXES, read_table
+from ema.model.log_files import TABLE_SUFFIXES, EmaDocumentError, read_table
 from ema.model.logmap import LOGMAP_SCHEMA, LogMap, read_mapped
 from ema.model.window import WINDOW_SCHEMA, Window, window_from_dict
 
@@ -82,15 +82,6 @@ def _from_json(path: Path) -> list[Window]:
         )
     documents = document if isinstance(document, list) else [document]
     return [window_from_dict(d) for d in documents]
-
-
-def _ema_document(path: Path) -> bool:
-    """Whether a JSON file is one of ema's documents (a window, or one that goes beside a log), not a recorder's log."""
-    document = load_json(path)
-    return isinstance(document, dict | list) and any(
-        isinstance(d, dict) and str(d.get("schema", "")).startswith("ema-")
-        for d in (document if isinstance(document, list) else [document])
-    )
 
 
 def _from_table(path: Path, defaults: Defaults) -> list[Window]:
@@ -156,10 +147,13 @@ def read_file(path: Path, defaults: Defaults = Defaults(), log_map: LogMap | Non
     if suffix == ".mat" and log_map is None:
         raise InputError(str(path), "is a MATLAB file: its variables become a window's signals through --log-map")
     try:
-        if suffix == ".json" and (log_map is None or _ema_document(path)):
+        if suffix == ".json" and log_map is None:
             return _from_json(path)
-        if log_map is not None:  # a recorder's JSON too: its map names its fields
-            return [window_from_dict(read_mapped(path, log_map))]
+        if log_map is not None:  # a recorder's JSON too, parsed once: its map names its fields
+            try:
+                return [window_from_dict(read_mapped(path, log_map))]
+            except EmaDocumentError:  # one of ema's documents beside the logs: read, or refused naming its flag
+                return _from_json(path)
         return _from_table(path, defaults)
     except InputError as exc:
         if exc.field.startswith(str(path)):

@@ -191,10 +191,9 @@ def _json(path: Path) -> Table:
     ``outer.inner``, and whose one list of objects holds a sample each, their numbers the columns (a list alone: the
     samples, no constants). A field missing from a sample, or not a number there, leaves its column out as text."""
     document = load_json(path)
-    if isinstance(document, dict) and str(document.get("schema", "")).startswith("ema-"):
-        raise InputError(
-            str(path), f"is an {document['schema']} document, not a recorder's log: read it without a log map"
-        )
+    schema = ema_schema(document)
+    if schema is not None:
+        raise EmaDocumentError(str(path), f"is an {schema} document, not a recorder's log: read it without a log map")
     header: dict[str, object] = {} if isinstance(document, list) else document if isinstance(document, dict) else {}
     lists = {name: value for name, value in header.items() if _samples(value)}
     if isinstance(document, list) and _samples(document):
@@ -215,6 +214,18 @@ def _json(path: Path) -> Table:
         else:
             columns[name] = np.array(values, dtype=np.float64)
     return Table(columns, scalars, meta, unread)
+
+
+class EmaDocumentError(InputError):
+    """A JSON file given as a recorder's log is one of ema's own documents (a window, or one that goes beside a
+    log): its reader may read it as such instead."""
+
+
+def ema_schema(document: object) -> str | None:
+    """The ``ema-…`` schema a parsed JSON document (or the first of a list) names, or None: not one of ema's."""
+    first = document[0] if isinstance(document, list) and document else document
+    schema = first.get("schema") if isinstance(first, dict) else None
+    return schema if isinstance(schema, str) and schema.startswith("ema-") else None
 
 
 def _samples(value: object) -> bool:
