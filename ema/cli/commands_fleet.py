@@ -5,6 +5,7 @@ from __future__ import annotations
 import sys
 import time
 from pathlib import Path
+from typing import Any
 
 import click
 
@@ -75,15 +76,10 @@ def fleet(
     try:
         from ema.cli.commands_remote import report_log
         from ema.cli.fleet import check_engine, run_fleet
-        from ema.cli.logs import read_actuators, read_log
-        from ema.cli.workers import Documents
-        from ema.model.actuator import read_actuator
 
         check_engine(workers, ray_address)
         config = pipeline_config(size_values)
-        documents = Documents(read_actuators(archive), None if actuator_file is None else read_actuator(actuator_file))
-        mapping = log_map_document(log_map_file)
-        read = read_log(archive, window_s, log_map=mapping)
+        read, documents = _archive(archive, window_s, actuator_file, log_map_file)
     except BaseException:
         if pool is not None:
             pool.close()
@@ -107,6 +103,17 @@ def fleet(
     emit(result, as_json, _print_fleet_verbose if verbose else _print_fleet)
     if result["answered"] + result["skipped"] == 0 and result["refused"]:
         raise NothingAnsweredError(f"none of the {result['refused']} window(s) was answered (see {out})")
+
+
+def _archive(archive: Path, window_s: float | None, actuator_file: Path | None, log_map_file: Path | None) -> Any:
+    """(the archive's windows as read, the documents they are read with: the folder's actuators.json, else
+    ``--actuator``)."""
+    from ema.cli.logs import read_actuators, read_log
+    from ema.cli.workers import Documents
+    from ema.model.actuator import read_actuator
+
+    documents = Documents(read_actuators(archive), None if actuator_file is None else read_actuator(actuator_file))
+    return read_log(archive, window_s, log_map=log_map_document(log_map_file)), documents
 
 
 def _print_fleet_verbose(result: dict) -> None:

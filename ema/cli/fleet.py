@@ -143,10 +143,7 @@ def run_fleet(
     (``ema.cli.logs.Log.conflicts``), each a refused row naming its files, once, none read."""
     began = time.perf_counter() if started is None else started
     documents = Documents() if documents is None else documents
-    done, refused = done_windows(out), refused_under(out)
-    retried = {  # refused under a document that has changed since: read again
-        key for key, digest in refused.items() if digest != document_digest(documents.of(key[0]))
-    }
+    done, retried = done_windows(out), refused_since(out, documents)
     todo = [w for w in windows if (key := (w.actuator_id, w.window_id)) not in done or key in retried]
     progress = Progress(len(todo), started=time.perf_counter())
     conflicted = _conflict_rows(out, conflicts or {}, done)
@@ -168,16 +165,30 @@ def run_fleet(
     finally:
         if pool is not None:
             pool.close()
+    skipped = len((done - retried) & {(w.actuator_id, w.window_id) for w in windows})
+    return _summary(out, progress, skipped, conflicted, began=began, writing=writing, engine=(engine_name, workers))
+
+
+def refused_since(out: Path, documents: Documents) -> set[tuple[str, str]]:
+    """The windows ``out`` holds refused under a document that has changed since: read again."""
+    refused = refused_under(out)
+    return {key for key, digest in refused.items() if digest != document_digest(documents.of(key[0]))}
+
+
+def _summary(
+    out: Path, progress: Progress, skipped: int, conflicted: int, *, began: float, writing: float, engine: tuple
+) -> dict[str, Any]:
+    """What the run did: its counts, its rate, its engine, and how its wall time split (from ``began``)."""
     ended = time.perf_counter()
     return {
         "csv": str(out),
-        "skipped": len((done - retried) & {(w.actuator_id, w.window_id) for w in windows}),
+        "skipped": skipped,
         "answered": progress.done - progress.refused,
         "refused": progress.refused + conflicted,
         "seconds": ended - began,
         "windows_per_s": progress.done / (ended - began) if ended > began else 0.0,
-        "workers": workers,
-        "engine": engine_name,
+        "workers": engine[1],
+        "engine": engine[0],
         "phases_s": {
             "start-up": (progress.first_at or ended) - began,
             "windows": ended - (progress.first_at or ended),
