@@ -9,7 +9,7 @@ twin, linearized at the true health, Eq. 5.1 on raw samples reads
     y_k = sgn(ω_k)·(k_T·I_k + H_k/n − J·(ω_{k+1} − ω_{k−1})/2h) = FDJ + k(η_O)·|H_k/n|    (sliding k)
 
 and each sensor's noise enters y through a known linear map A_s (current: diagonal; speed: the
-central difference; hinge and position: through the hinge reading of ``ema.model.hinge``, its measured
+central difference; hinge and position: through the hinge reading of ``ema.kinds.rotary.simulator.hinge``, its measured
 slope b included). With Σ = Σ_s σ_s² A_s A_sᵀ, generalized least squares has covariance
 (Xᵀ Σ⁻¹ X)⁻¹ (X: ∂y/∂(FDJ, η_O)): the smallest any linear unbiased reading of these equations
 reaches, because it weighs every sample by what the noise leaves of it. *Current sensor alone*
@@ -42,10 +42,10 @@ from ema.estimate.report import healthy_range
 from ema.kinds.rotary.physics.features import as_read
 from ema.kinds.rotary.physics.friction import SolveSettings, regressors, solve_friction
 from ema.kinds.rotary.prepare.conditioning import prepare
+from ema.kinds.rotary.simulator.hinge import HINGE_SMOOTHING_S, local_line
+from ema.kinds.rotary.simulator.residual import kernel_samples
 from ema.model.actuator import THESIS
-from ema.model.hinge import HINGE_SMOOTHING_S, local_line
 from ema.model.params import DriveConstants, eta_a_from_eta_o
-from ema.model.residual import kernel_samples
 from ema.model.window import Window, window_from_dict
 
 GROUPS = ("short window (0.1 s, gust)", "low log rate (1-2 kHz)")  # the groups with errors past 10 % of range
@@ -100,7 +100,7 @@ def linearized(clean: Window, truth: dict[str, float]) -> tuple[np.ndarray, np.n
 
 
 def _hinge_read_maps(signals: dict[str, np.ndarray], rate: float) -> tuple[np.ndarray, np.ndarray]:
-    """∂H_read/∂H_e and ∂H_read/∂δ (n, n) of ``ema.model.hinge`` at these signals, the slope b's own
+    """∂H_read/∂H_e and ∂H_read/∂δ (n, n) of ``ema.kinds.rotary.simulator.hinge`` at these signals, the slope b's own
     response to the noise included (to first order)."""
     n = len(signals["hinge_moment_nm"])
     line = local_line(np.eye(n), kernel_samples(rate, HINGE_SMOOTHING_S)).T  # [i, j] = ∂(line at i)/∂(sample j)

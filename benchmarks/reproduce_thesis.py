@@ -27,10 +27,11 @@ from ema.estimate.simulate.design import Box
 from ema.kinds.rotary.physics.features import features
 from ema.kinds.rotary.physics.friction import solve_window
 from ema.kinds.rotary.physics.scenario import Scenario
+from ema.kinds.rotary.simulator.commands import random_command_knots
+from ema.kinds.rotary.simulator.sensor_noise import add_sensor_noise
 from ema.kinds.rotary.synthetic import synthetic_window
 from ema.model.aircraft import FlightCondition, GroundLoad
-from ema.model.commands import random_command_knots
-from ema.model.noise import NO_NOISE, SensorNoise, add_sensor_noise
+from ema.model.noise import NO_NOISE, SensorNoise
 from ema.model.params import DEFAULT_RANGES, IRREVERSIBLE_RANGES, HealthParams, HealthRanges
 
 DOCS = Path(__file__).resolve().parent.parent / "docs"
@@ -237,8 +238,9 @@ def write_results(results: list[dict], comparison: list[str], command: str) -> N
         "after a pilot's step the drive jumps past the static level within one log interval. FSJ is",
         "read only at quasi-static break-aways (`ema/kinds/rotary/physics/static_friction.py`); otherwise the product",
         "reports `FSJ: null` with the reason. On the ground with a slowly rising load the shaft rests",
-        "and breaks away: FSJ is read within 2 % there, within its ±2 std under sensor noise; a shaft held",
-        "and then stepped away shows only a lower bound, not read (tests/estimate/physics/test_static_friction.py).",
+        "and breaks away: FSJ is read within 2 % there, within its ±2 std under sensor noise; a shaft",
+        "held and then stepped away shows only a lower bound, not read",
+        "(tests/kinds/rotary/physics/test_static_friction.py).",
     ]
     write_section("Thesis chapter 6, reproduced", command, "\n".join(lines), DOCS / "results.md")
 

@@ -17,13 +17,14 @@ import numpy as np
 
 from ema.cli.benchmark_docs import typed_command, write_section
 from ema.estimate import thread_budget
+from ema.kinds.rotary.simulator.batch import default_lanes, kernel_constants, simulate_batch
+from ema.kinds.rotary.simulator.commands import random_command_knots
+from ema.kinds.rotary.simulator.effects import EffectSet
+from ema.kinds.rotary.simulator.loads import load_model
+from ema.kinds.rotary.simulator.reference import simulate_numpy
 from ema.model.actuator import THESIS
-from ema.model.aircraft import FlightCondition, load_model
-from ema.model.batch import default_lanes, kernel_constants, simulate_batch
-from ema.model.commands import random_command_knots
-from ema.model.effects import EffectSet
+from ema.model.aircraft import FlightCondition
 from ema.model.params import DEFAULT_RANGES, DriveConstants, HealthParams
-from ema.model.reference import simulate_numpy
 
 RATE_HZ = 10_000.0
 STEPS_PER_SAMPLE = 100
@@ -47,7 +48,7 @@ def lane_sweep(health: HealthParams, knots: np.ndarray, samples: int, repeats: i
     lines = [
         "",
         f"Cost per simulation-step by lanes per group (one group on one thread, {samples} samples): below",
-        "`ema.model.batch.MIN_VECTOR_LANES` the lane loop runs its scalar path.",
+        "`ema.kinds.rotary.simulator.batch.MIN_VECTOR_LANES` the lane loop runs its scalar path.",
         "",
         "| lanes per group | ns / sim-step |",
         "|---:|---:|",

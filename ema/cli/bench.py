@@ -18,7 +18,6 @@ import json
 import math
 import subprocess
 import sys
-import time
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -32,11 +31,9 @@ from ema.estimate import thread_budget
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import STAGES as PIPELINE_STAGES
 from ema.estimate.report import share_of_range
-from ema.kinds import estimate_thesis_window, thesis_window
+from ema.kinds import estimate_thesis_window, thesis_kernel_seconds, thesis_window
 from ema.model.actuator import THESIS
-from ema.model.batch import default_lanes, simulate_batch
 from ema.model.bounds import DEFAULT_SAMPLE_RATE_HZ
-from ema.model.commands import random_command_knots
 from ema.model.params import DEFAULT_RANGES, HealthParams
 
 TIMED_STAGES = (*PIPELINE_STAGES, "total")
@@ -88,21 +85,14 @@ def references() -> dict[str, float]:
     """The yardstick's seconds and our kernel's ns per simulation-step on the same ``SIMS`` × 0.5 s, this run."""
     rate_hz, steps_per_sample = DEFAULT_SAMPLE_RATE_HZ, 100
     samples = round(DURATION_S * rate_hz)
-    rng = np.random.default_rng(0)
-    health = HealthParams.uniform(SIMS, DEFAULT_RANGES, rng)
-    knots = random_command_knots(samples, rate_hz, rng)[0]
-    simulate_batch(knots[:11], health, drive=THESIS.params)  # compiled or loaded outside the timing
-    best = np.inf
-    for _ in range(2):
-        started = time.perf_counter()
-        simulate_batch(knots, health, drive=THESIS.params)
-        best = min(best, time.perf_counter() - started)
+    best, lanes = thesis_kernel_seconds(SIMS, samples, rate_hz)
     steps = SIMS * samples * steps_per_sample
     return {
         "yardstick_s": yardstick_seconds(threads=1),
         "yardstick_every_thread_s": yardstick_seconds(),
         "kernel_s": float(best),
         "kernel_ns_per_step": 1e9 * best / steps,
+        "lanes": lanes,
     }
 
 
@@ -139,7 +129,7 @@ def reference_lines(rows: list[dict[str, Any]], refs: dict[str, float]) -> list[
     (the target's measure) and on every thread (twice as fast on two cores, so a share twice as strict)."""
     lines = [
         f"Same run: our kernel simulates {SIMS} x {DURATION_S:g} s in {refs['kernel_s']:.3f} s "
-        f"({refs['kernel_ns_per_step']:.2f} ns per simulation-step, {default_lanes(SIMS)} lanes a group, every thread "
+        f"({refs['kernel_ns_per_step']:.2f} ns per simulation-step, {refs['lanes']} lanes a group, every thread "
         "of the budget); "
         f"the yardstick (`ema/cli/yardstick.py`, an independent 16-lane kernel) in {refs['yardstick_s']:.3f} s on one "
         f"thread, {refs['yardstick_every_thread_s']:.3f} s on every thread.",

@@ -184,14 +184,16 @@ def estimate(
 @as_json
 def simulate(as_json: bool, **options: Any) -> None:
     """Write a synthetic ema-window/1 file from the model (sensor noise unless --clean), or --series of them."""
+    from ema.cli.options import actuator_document
     from ema.cli.printing import print_simulate
-    from ema.cli.synthesis import Draw, synthesize
+    from ema.kinds import synthesize
 
     stamp = options["recorded_at"]
     if stamp is not None and stamp.tzinfo is None:
         options["recorded_at"] = stamp.replace(tzinfo=dt.UTC)
     with flags_named(SIMULATE_FLAGS):
-        result = synthesize(Draw(**options))
+        actuator = actuator_document(options.pop("actuator_file"))
+        result = synthesize(actuator, options)
     emit(result, as_json, print_simulate)
 
 

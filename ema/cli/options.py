@@ -96,13 +96,9 @@ def say_if_compiling(windows: Any) -> None:
 
     if not any(learns(window) for window in windows):
         return
-    from ema.model import kernels
+    from ema.kinds import thesis_kernel_cached
 
-    try:  # Numba's cache file of the dispatcher: private, so a layout it does not have says nothing
-        index = Path(kernels.run_group._cache._cache_file._index_path)  # type: ignore[attr-defined]
-    except AttributeError:
-        return
-    if not index.exists():
+    if thesis_kernel_cached() is False:
         print("ema: first run: compiling the simulation kernels into Numba's cache (about 30 s, once)", file=sys.stderr)
 
 

@@ -1,7 +1,7 @@
 """A reference for speed figures: a plain 16-lane Numba kernel of the same EMA, timed in the same run.
 
 These machines drift ~2x from day to day, so an absolute latency says little; a ratio to work of the
-same kind measured in the same run does. The yardstick is written apart from ``ema.model.kernels``, in
+same kind measured in the same run does. The yardstick is written apart from ``ema.kinds.rotary.simulator.kernels``, in
 the form a careful engineer would write first, so that it moves with the machine, not with our
 optimizations. It simulates ``SIMS`` windows of 0.5 s at h = 1 µs, 16 lanes per group, recording
 10 kHz interval means of the position. The latency target is a share of its time with the groups run

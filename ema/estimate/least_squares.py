@@ -9,13 +9,17 @@
 - ``newey_west_std``: each coefficient's std where the residual is correlated over samples (Newey and West's
   sandwich with Bartlett weights, their plug-in number of lags).
 
-Eq. 5.1's profile search over η_O (``ema.estimate.physics.eta_search``) solves its few normal equations inside
+Eq. 5.1's profile search over η_O (``ema.kinds.rotary.physics.eta_search``) solves its few normal equations inside
 its compiled kernel, row by row of a batch, for speed.
 """
 
 from __future__ import annotations
 
 import numpy as np
+
+# An offset needs motion both ways: with fewer than this share of the samples in the rarer direction,
+# it cannot be told from the dry friction and is not solved (every kind's least squares holds to it).
+MIN_OFFSET_BALANCE = 0.05
 
 
 def coefficients(design: np.ndarray, y: np.ndarray) -> np.ndarray:

@@ -21,7 +21,7 @@ fourth kind is a folder here, a row of ``ema.model.kinds`` and a line in ``REGIS
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 from ema.estimate.config import PipelineConfig
@@ -57,6 +57,9 @@ __all__ = [
     "load_methods",
     "other_windows_lent",
     "readings_of_results",
+    "synthesize",
+    "thesis_kernel_cached",
+    "thesis_kernel_seconds",
     "thesis_window",
     "warm_up",
 ]
@@ -200,6 +203,26 @@ def thesis_window(health: HealthParams, **drawn: Any) -> Window:
     from ema.kinds.rotary.synthetic import synthetic_window
 
     return synthetic_window(health, **drawn)
+
+
+def thesis_kernel_seconds(simulations: int, samples: int, rate_hz: float) -> tuple[float, int]:
+    """The rotary simulator's kernel timed alone (``ema.kinds.rotary.simulator.timing``): (best seconds, lanes)."""
+    from ema.kinds.rotary.simulator.timing import kernel_seconds
+
+    return kernel_seconds(simulations, samples, rate_hz)
+
+
+def thesis_kernel_cached() -> bool | None:
+    """Whether Numba's cache holds the rotary simulator's kernel (None: unknown)."""
+    from ema.kinds.rotary.simulator.timing import kernel_cached
+
+    return kernel_cached()
+
+
+def synthesize(actuator: ActuatorDocument, flags: Mapping[str, Any]) -> dict[str, Any]:
+    """``ema simulate``: windows of ``actuator`` drawn by its kind's simulator, as ``flags`` ask (``Kind.synthesize``);
+    InputError naming ``--actuator`` for a kind that draws none."""
+    return kind_of(actuator).synthesize(actuator, flags)
 
 
 def estimate_thesis_window(window: Window, config: PipelineConfig) -> Estimate:

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
-from typing import Protocol
+from typing import Any, Protocol
 
 from ema.calibration.documents import CalibrationReport
 from ema.calibration.plot import ResidualPlot
@@ -15,6 +15,7 @@ from ema.estimate.quasistatic.drive_torque import QuasiStaticReading
 from ema.estimate.quasistatic.slow_window import estimate_low_rate
 from ema.model.actuator import THESIS, ActuatorDocument
 from ema.model.bounds import NOISE_COPIES
+from ema.model.checks import InputError
 from ema.model.kinds import KindFacts
 from ema.model.window import Window
 
@@ -80,6 +81,13 @@ def read_quasi_statically(window: Window, request: Request, reading: QuasiStatic
     )
 
 
+def not_drawn(facts: KindFacts) -> InputError:
+    """The refusal of a kind without a simulator of its own windows (``ema simulate``), naming the flag."""
+    return InputError(
+        "--actuator", f"is a {facts.name} actuator's document: ema simulate draws the windows of a rotary EMA only"
+    )
+
+
 class Kind(Protocol):
     @property
     def facts(self) -> KindFacts: ...
@@ -89,3 +97,5 @@ class Kind(Protocol):
     def cost(self, window: Window, config: PipelineConfig) -> Cost: ...
     def calibration_cost(self, windows: Sequence[Window], config: PipelineConfig) -> Cost: ...
     def warm_up(self) -> None: ...  # what its first window would load, loaded now (a service before it answers)
+    # ``ema simulate``: its windows drawn by its simulator as the flags ask; ``not_drawn`` where it has none
+    def synthesize(self, actuator: ActuatorDocument, flags: Mapping[str, Any]) -> dict[str, Any]: ...

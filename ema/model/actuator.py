@@ -13,7 +13,7 @@ class, and a rotary document may omit ``kind`` (as first published). ``THESIS`` 
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated, Any, Literal, TypeVar
+from typing import Annotated, Any, Literal, TypeVar
 
 import numpy as np
 from pydantic import Field, Tag, TypeAdapter, model_validator
@@ -25,12 +25,10 @@ from ema.model.document import Document, Number
 from ema.model.drive import Drive
 from ema.model.geared import Geared
 from ema.model.kinds import DEFAULT_KIND, KIND_NAMES, KINDS, KindFacts
+from ema.model.noise import SensorNoise
 from ema.model.params import MAX_CORRELATION_S, DriveConstants, HealthRanges, eta_a_from_eta_o
 from ema.model.screw import Screw
 from ema.model.servo import Servo
-
-if TYPE_CHECKING:
-    from ema.model.noise import SensorNoise
 
 ACTUATOR_SCHEMA = "ema-actuator/1"
 DEFAULT_ETA_O_BELOW, THESIS_ETA_O = 0.70, 0.85  # the prognosis's default η_O threshold, at the thesis's nominal
@@ -284,8 +282,6 @@ class ActuatorDocument(Document):
     @property
     def noise(self) -> SensorNoise:
         """The sensors' noise as the document gives it, else the thesis's levels."""
-        from ema.model.noise import SensorNoise  # Numba's: kept out of the document's import (clients read it)
-
         return SensorNoise() if self.sensor_noise is None else SensorNoise(**self.sensor_noise.model_dump())
 
 

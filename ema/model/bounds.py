@@ -19,7 +19,13 @@ SAMPLE_RATE_RANGE_HZ = (1_000.0, 100_000.0)  # the rates the simulator draws a w
 DURATION_RANGE_S = (0.01, 60.0)  # the lengths the simulator draws a window at (its samples bounded as well)
 MAX_THREADS = 256  # a thread budget's ceiling: more than any onboard computer or server has cores
 MIN_SAMPLES = 100
-COMMAND_FAMILIES = ("thesis", "cruise", "gust", "doublet", "steps")  # the simulator's commands (ema.model.commands)
+COMMAND_FAMILIES = (
+    "thesis",
+    "cruise",
+    "gust",
+    "doublet",
+    "steps",
+)  # the simulator's commands (the rotary simulator's)
 MAX_SAMPLES = 1_000_000
 # A window may be logged at 10 Hz (a test rig's logger) to 100 kHz; below HIGH_RATE_HZ it is read quasi-statically
 # (``ema.estimate.quasistatic.stretches``), at or above it through the whole pipeline.

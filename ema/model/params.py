@@ -44,7 +44,7 @@ def eta_a_from_eta_o(eta_o: np.ndarray | float, gear_ratio: float) -> np.ndarray
 
 def eta_a_of(eta_o: Any, n: float) -> Any:
     """Eq. 3.4 itself, η_A = (2n²η_O − n² + n) / (n²η_O + n − η_O + 1), on scalars or arrays (and compiled in
-    ``ema.estimate.physics.eta_search``)."""
+    ``ema.kinds.rotary.physics.eta_search``)."""
     return (2 * n * n * eta_o - n * n + n) / (n * n * eta_o + n - eta_o + 1)
 
 

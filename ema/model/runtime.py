@@ -16,7 +16,7 @@
   the CPU's scheduler holds little more than one such chain; with ``INTERLEAVE`` independent
   vectors per iteration it works on three at once (48 lanes: 3.2-3.6 -> 2.8 ns per lane-step, the
   same arithmetic, docs/benchmarks.md). Groups are then whole multiples of ``INTERLEAVE`` vectors
-  (``ema.model.batch.LANE_MULTIPLE``), or their remainder runs scalar. The option is LLVM's, for every
+  (``ema.kinds.rotary.simulator.batch.LANE_MULTIPLE``), or their remainder runs scalar. The option is LLVM's, for every
   loop compiled afterwards (interleaving never changes a loop's result, and a loop of fewer
   iterations keeps its scalar path). Numba's cache does not key on it: a kernel compiled without it
   (by a test, a notebook) would be the cache's, ~1.3x slower, for every later process until its source

@@ -1,1 +1,2 @@
-"""The HTTP service: a thin FastAPI shell over ``ema.kinds.rotary.pipeline``."""
+"""The HTTP service: a FastAPI shell over the kinds' registry (``ema.kinds``): it parses the documents, asks each
+window's kind for its answer within the settings' limits, and stores it in the history."""

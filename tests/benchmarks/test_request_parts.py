@@ -41,7 +41,7 @@ def test_every_step_is_reached_on_foreign_windows():
     parts, stages = measure(4, seed=390_000)
     reached = {key for key, seconds in parts.items() if seconds > 0}
     maybe = {
-        ("check", "ema.model.batch:run_groups"),
+        ("check", "ema.kinds.rotary.simulator.batch:run_groups"),
         ("check", "ema.kinds.rotary.reproduction:as_read"),
     }  # reused lane
     assert {(stage, key) for stage, key, _ in PARTS} - maybe <= reached

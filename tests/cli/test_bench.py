@@ -21,7 +21,7 @@ def _row(load: str, duration_s: float, total_s: float, n: int = 60) -> dict:
 
 def test_latency_is_stated_as_a_share_of_the_yardstick_and_the_target_named_once():
     rows = [_row("idle", 0.5, 0.1), _row("idle", 2.0, 0.4), _row("2 busy processes", 0.5, 0.2)]
-    refs = {"yardstick_s": 1.0, "yardstick_every_thread_s": 0.5, "kernel_s": 0.5, "kernel_ns_per_step": 2.0}
+    refs = {"yardstick_s": 1.0, "yardstick_every_thread_s": 0.5, "kernel_s": 0.5, "kernel_ns_per_step": 2.0, "lanes": 8}
     lines = reference_lines(rows, refs)
     assert "2.00 ns per simulation-step" in lines[0]
     table = [line for line in lines if line.startswith("| idle") or line.startswith("| 2 busy")]

@@ -330,8 +330,8 @@ def test_simulate_stamps_a_time_and_draws_a_degrading_series(tmp_path, capsys):
 
 def test_a_first_run_says_it_compiles_and_a_warm_one_says_nothing(tmp_path, capsys, monkeypatch):
     from ema.cli.options import say_if_compiling
+    from ema.kinds.rotary.simulator import kernels
     from ema.kinds.rotary.synthetic import synthetic_window
-    from ema.model import kernels
     from ema.model.params import HealthParams
 
     window = synthetic_window(HealthParams.single(), seed=1, duration_s=0.05)

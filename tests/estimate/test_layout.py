@@ -16,7 +16,7 @@ RANKS = {
     "ema.estimate.stats": 0,
     "ema.estimate.least_squares": 0,
     "ema.estimate.stopwatch": 0,
-    "ema.estimate.physics": 1,
+    "ema.estimate.profile": 0,
     "ema.kinds.rotary.prepare": 2,
     "ema.estimate.simulate": 3,
     "ema.estimate.learn": 4,
@@ -57,7 +57,7 @@ def test_every_module_imports_only_its_own_stage_or_lower_ones():
 
 def test_the_stages_are_subpackages_and_few_modules_remain_at_the_top():
     stages = [p.name for p in TRAINING.iterdir() if (p / "__init__.py").exists()]
-    assert {"physics", "simulate", "learn", "assess"} <= set(stages)  # prepare: each kind's own (the rotary's folder)
+    assert {"simulate", "learn", "assess"} <= set(stages)  # prepare and physics: each kind's own (its folder)
     assert len([p for p in TRAINING.glob("*.py") if p.name != "__init__.py"]) <= 12
 
 

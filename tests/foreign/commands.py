@@ -1,4 +1,4 @@
-"""Command families of real flight windows, drawn independently of ``ema.model.commands`` (test-only).
+"""Command families of real flight windows, drawn independently of ``ema.kinds.rotary.simulator.commands`` (test-only).
 
 Each family returns ``command(t)``, a vectorized function of time [s] (t may start before 0: a
 window cut from a longer flight), and is what a pilot, an autopilot or the thesis would send.

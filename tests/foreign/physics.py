@@ -1,6 +1,6 @@
 """The EMA of ``docs/model.md`` written again, independently of ``sim/``, for tests only.
 
-Deliberate differences in form from ``ema.model.kernels`` (each one a legitimate reading of the spec):
+Deliberate differences in form from ``ema.kinds.rotary.simulator.kernels`` (each one a legitimate reading of the spec):
 
 - one scalar loop per window, branches and all, no lock-step lanes;
 - the RL phase integrated exactly over each 1 µs step (exponential), not by explicit Euler;
@@ -9,7 +9,7 @@ Deliberate differences in form from ``ema.model.kernels`` (each one a legitimate
   moment evaluated at every step, trim interpolated at the *true* airspeed;
 - the command held in a 100 kHz table, linearly interpolated;
 - log intervals of any length (a 3 kHz log has 333 or 334 steps per interval);
-- effects in forms ``ema.model.effects`` does not have: a Gaussian friction bump over elevator position,
+- effects in forms the rotary simulator's ``effects`` has not: a Gaussian friction bump over elevator position,
   a tanh Stribeck curve, dynamic friction drifting in time, cogging as a cosine of any order;
 - a loop that may depart from the spec's, unlogged: bus voltage, position gain, a lag between the
   logged command and the one the loop follows, a noisy speed reading;

@@ -1,18 +1,16 @@
 import numpy as np
 import pytest
 
-from ema.model.aircraft import (
+from ema.kinds.rotary.simulator.loads import (
     A_DEFAULT,
     B_DEFAULT,
-    FlightCondition,
-    GroundLoad,
-    HingeGeometry,
     discretize,
     expm,
     flight_load_model,
     state_space,
     trim,
 )
+from ema.model.aircraft import FlightCondition, GroundLoad, HingeGeometry
 from ema.model.checks import InputError
 
 

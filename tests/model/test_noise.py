@@ -1,7 +1,8 @@
 import numpy as np
 import pytest
 
-from ema.model.noise import SensorNoise, _correlate, add_seeded_noise, add_sensor_noise, ar1_mean_variance
+from ema.kinds.rotary.simulator.sensor_noise import _correlate, add_seeded_noise, add_sensor_noise
+from ema.model.noise import SensorNoise, ar1_mean_variance
 
 RATE = 10_000.0
 

@@ -101,7 +101,8 @@ def test_the_interleaved_lane_loop_computes_what_the_plain_one_does():
     (each process compiles afresh in a cache of its own: the plain kernel never reaches the shared cache)."""
     script = (
         "import sys, numpy as np; from ema.model import runtime; from ema.model.actuator import THESIS; "
-        "from ema.model.batch import simulate_batch; from ema.model.commands import random_command_knots; "
+        "from ema.kinds.rotary.simulator.batch import simulate_batch; "
+        "from ema.kinds.rotary.simulator.commands import random_command_knots; "
         "from ema.model.params import DEFAULT_RANGES, HealthParams; "
         "runtime.configure_simulator(1) if sys.argv[1] == 'configured' "
         "else setattr(runtime._BUDGET, 'compiler_set', True); "

@@ -33,7 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ema.estimate.physics.eta_search import profile_grid, profile_std
+from ema.estimate.profile import profile_grid, profile_std
 from ema.estimate.stats import rms
 from ema.model.params import eta_a_of, load_factors
 from ema.model.window import Window

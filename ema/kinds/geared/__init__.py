@@ -11,15 +11,16 @@ misses.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import STAGES, Estimate
-from ema.kinds.base import WARM_UP, Calibrated, CalibrationRequest, Cost, Request
-from ema.model.actuator import GearedActuator, actuator_from_dict, as_kind
+from ema.kinds.base import WARM_UP, Calibrated, CalibrationRequest, Cost, Request, not_drawn
+from ema.model.actuator import ActuatorDocument, GearedActuator, actuator_from_dict, as_kind
 from ema.model.kinds import KINDS, KindFacts
 from ema.model.params import DriveConstants
 from ema.model.window import Window
@@ -60,6 +61,9 @@ class Geared:
     def calibration_cost(self, windows: Sequence[Window], config: PipelineConfig) -> Cost:
         steps = sum(window.n_samples for window in windows) * CALIBRATION_RUNS
         return Cost(simulated_s=steps * ROTARY_STEP_S, window_s=sum(window.duration_s for window in windows))
+
+    def synthesize(self, actuator: ActuatorDocument, flags: Mapping[str, Any]) -> dict[str, Any]:
+        raise not_drawn(self.facts)
 
     def warm_up(self) -> None:
         """A tiny geared servo's window simulated and estimated: its simulator, its solves and its network loaded."""

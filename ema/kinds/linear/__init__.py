@@ -7,16 +7,17 @@ current loop ema can simulate), its torque from the drive's current as ``ema cal
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import Estimate
 from ema.estimate.quasistatic.slow_window import QUASI_STATIC_STAGES
-from ema.kinds.base import Calibrated, CalibrationRequest, Cost, Request, read_quasi_statically
+from ema.kinds.base import Calibrated, CalibrationRequest, Cost, Request, not_drawn, read_quasi_statically
 from ema.kinds.linear.calibration_report import calibrate_linear
 from ema.kinds.linear.stepper_reading import STEPPER_READING
-from ema.model.actuator import LinearActuator, as_kind
+from ema.model.actuator import ActuatorDocument, LinearActuator, as_kind
 from ema.model.kinds import KINDS, KindFacts
 from ema.model.window import Window
 
@@ -40,6 +41,9 @@ class Linear:
 
     def calibration_cost(self, windows: Sequence[Window], config: PipelineConfig) -> Cost:
         return Cost(simulated_s=0.0, window_s=0.0)
+
+    def synthesize(self, actuator: ActuatorDocument, flags: Mapping[str, Any]) -> dict[str, Any]:
+        raise not_drawn(self.facts)
 
     def warm_up(self) -> None:
         """Nothing: a stepper's window is read quasi-statically in NumPy, milliseconds from the first."""

@@ -31,7 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ema.estimate.least_squares import weighted
-from ema.estimate.physics.eta_search import profile_std
+from ema.estimate.profile import profile_std
 from ema.estimate.quasistatic.stretches import ETA_GRID, Stretch, set_point_motion, stretches
 from ema.estimate.stats import below_zero, rms
 from ema.model.actuator import LinearActuator

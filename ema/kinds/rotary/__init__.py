@@ -10,9 +10,9 @@ that runs it, so that a process that reads only slow logs, or another kind's, ne
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -23,7 +23,7 @@ from ema.estimate.quasistatic.slow_window import QUASI_STATIC_STAGES
 from ema.kinds.base import WARM_UP, Calibrated, CalibrationRequest, Cost, Request, read_quasi_statically
 from ema.kinds.rotary.motor_reading import MOTOR_READING
 from ema.kinds.rotary.synthetic import synthetic_window
-from ema.model.actuator import THESIS
+from ema.model.actuator import THESIS, ActuatorDocument
 from ema.model.bounds import HIGH_RATE_HZ
 from ema.model.checks import InputError
 from ema.model.kinds import KINDS, KindFacts
@@ -89,6 +89,12 @@ class Rotary:
     def calibration_cost(self, windows: Sequence[Window], config: PipelineConfig) -> Cost:
         seconds = sum(w.duration_s for w in windows)
         return Cost(simulated_s=config.total_simulations * seconds, window_s=seconds)
+
+    def synthesize(self, actuator: ActuatorDocument, flags: Mapping[str, Any]) -> dict[str, Any]:
+        """``ema simulate``'s windows drawn by the simulator at the health ``flags`` ask (``synthesis.Draw``)."""
+        from ema.kinds.rotary.synthesis import Draw, synthesize
+
+        return synthesize(Draw(**flags), actuator)
 
     def warm_up(self) -> None:
         """A tiny pipeline run: simulation kernels, residual, network and the physics solution all exercised once

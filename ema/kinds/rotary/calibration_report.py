@@ -9,12 +9,12 @@ import numpy as np
 
 from ema.calibration.documents import Candidate, HeldOut, NoiseFloor, RotaryCalibration, Step, Unexplained
 from ema.estimate.documents import TARGETS
-from ema.estimate.physics.eta_search import ETA_O_SEARCH
+from ema.estimate.profile import ETA_O_SEARCH
 from ema.kinds.rotary.backlash import BacklashReading
 from ema.kinds.rotary.equations import Equations
 from ema.kinds.rotary.selection import Chosen, Evidence, floor_rms, residual_rms
+from ema.kinds.rotary.simulator.effects import EffectSet
 from ema.kinds.rotary.tied_solve import MIN_HELD_OUT_GAIN, corrected, held_out_rss, solve_with
-from ema.model.effects import EffectSet
 
 # How much further noise alone may move FDJ or η_O with a described term than without it before the
 # estimates with it are withheld: a time drift inflates them 1–2.5x, a ramp over deflection 13–32x.

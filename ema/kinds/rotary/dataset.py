@@ -8,20 +8,21 @@ from dataclasses import dataclass
 import numpy as np
 
 from ema.estimate.config import PipelineConfig
-from ema.estimate.physics.noise_reading import excess_noise
 from ema.estimate.simulate import design
 from ema.kinds.rotary.physics.features import as_read, sliding_features
 from ema.kinds.rotary.physics.friction import FrictionSolution, SolveSettings, regressors
+from ema.kinds.rotary.physics.noise_reading import excess_noise
 from ema.kinds.rotary.physics.scenario import Scenario, scenario_from_window
+from ema.kinds.rotary.simulator.effects import EffectSet
+from ema.kinds.rotary.simulator.residual import residual_torque_nm
+from ema.kinds.rotary.simulator.sensor_noise import add_seeded_noise
 from ema.model.actuator import ActuatorDocument
-from ema.model.effects import EffectSet
-from ema.model.noise import SensorNoise, add_seeded_noise
+from ema.model.noise import SensorNoise
 from ema.model.params import DriveConstants, HealthParams
-from ema.model.residual import residual_torque_nm
 from ema.model.window import Window
 
 # All the estimators read, and so all drawn with the window's noise (position too: the hinge
-# moment is read along it, ema.model.hinge, and b·0.01° ≈ 0.1 N·m).
+# moment is read along it, ema.kinds.rotary.simulator.hinge, and b·0.01° ≈ 0.1 N·m).
 SIGNALS_READ = ("current_a", "motor_speed_radps", "hinge_moment_nm", "position_deg")
 
 

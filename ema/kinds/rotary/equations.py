@@ -25,11 +25,11 @@ import numpy as np
 
 from ema.calibration.limits import FOLDS
 from ema.estimate.least_squares import coefficients
-from ema.estimate.physics.eta_search import ETA_O_SEARCH
+from ema.estimate.profile import ETA_O_SEARCH
 from ema.kinds.rotary.physics.features import as_read
 from ema.kinds.rotary.physics.friction import SolveSettings, regressors
+from ema.kinds.rotary.simulator.residual import smooth_derivative, smoothed
 from ema.model.params import DriveConstants, load_factors
-from ema.model.residual import smooth_derivative, smoothed
 
 FOLD_BLOCK_S = 0.02  # held-out folds are interleaved 20 ms blocks: each fold sees every regime of the window
 VARIABLES = ("speed_radps", "position_rad", "time_s", "load_nm", "current_a", "direction")

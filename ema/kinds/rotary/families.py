@@ -4,7 +4,7 @@ A ``Family`` is one candidate: its columns in Eq. 5.1's equation error given its
 (a grid value), what its coefficients mean, and the term the simulator adds for it. The named effects
 are the vocabulary (``ema.kinds.rotary.vocabulary``); beside them, generic families (piecewise-linear
 curves over time, speed, load and current) say what the residual follows when no name matches; over
-time, speed or position they are also a term the simulator can add (``ema.model.effects.FrictionTable``).
+time, speed or position they are also a term the simulator can add (``simulator.effects.FrictionTable``).
 """
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ import numpy as np
 
 from ema.kinds.rotary.equations import Equations
 from ema.kinds.rotary.hats import hats, uniform_knots
-from ema.model.effects import EffectSet, FrictionTable
+from ema.kinds.rotary.simulator.effects import EffectSet, FrictionTable
 
 KNOTS = 9  # piecewise-linear curves: 8 segments over the visited range
 # A friction that changes in time (warming, wear-in) does so smoothly over one log: a line with one

@@ -17,10 +17,11 @@ import numpy as np
 
 from ema.kinds.rotary.equations import Equations, equations
 from ema.kinds.rotary.physics.scenario import inside, scenario_from_window
+from ema.kinds.rotary.simulator.sensor_noise import add_sensor_noise
 from ema.model import runtime
 from ema.model.actuator import ActuatorDocument
 from ema.model.bounds import NOISE_COPIES
-from ema.model.noise import SensorNoise, add_sensor_noise
+from ema.model.noise import SensorNoise
 from ema.model.params import DriveConstants
 from ema.model.window import Window
 

@@ -31,8 +31,8 @@ from ema.kinds.rotary.physics.friction import FrictionSolution, sliding_mask
 from ema.kinds.rotary.physics.static_friction import StaticFriction
 from ema.kinds.rotary.prepare.conditioning import Prepared, conditioning_done, conditioning_notes
 from ema.kinds.rotary.prepare.departures.drive_constants import KERNEL_FREE_RATE_HZ
+from ema.kinds.rotary.simulator.hinge import denoised_hinge_nm
 from ema.model.actuator import ActuatorDocument
-from ema.model.hinge import denoised_hinge_nm
 
 if TYPE_CHECKING:  # SciPy's optimizers: a window read without a network (quasi-static) never loads it
     from ema.estimate.learn.estimator import NetworkEstimator

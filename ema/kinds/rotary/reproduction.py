@@ -19,9 +19,9 @@ import numpy as np
 from ema.estimate.stats import rms
 from ema.kinds.rotary.physics.features import as_read
 from ema.kinds.rotary.physics.scenario import SETTLE_S, Scenario
+from ema.kinds.rotary.simulator.residual import residual_torque_nm
 from ema.model.noise import SensorNoise
 from ema.model.params import DriveConstants, HealthParams
-from ema.model.residual import residual_torque_nm
 from ema.model.window import Window
 
 

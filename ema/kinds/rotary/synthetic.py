@@ -6,9 +6,12 @@ from dataclasses import replace
 
 import numpy as np
 
+from ema.kinds.rotary.simulator.batch import InitialState, simulate_batch
+from ema.kinds.rotary.simulator.commands import family_knots
+from ema.kinds.rotary.simulator.effects import EffectSet
+from ema.kinds.rotary.simulator.sensor_noise import add_sensor_noise
 from ema.model.actuator import THESIS, ActuatorDocument
 from ema.model.aircraft import FlightCondition, GroundLoad
-from ema.model.batch import InitialState, simulate_batch
 from ema.model.bounds import (
     DEFAULT_SAMPLE_RATE_HZ,
     DURATION_RANGE_S,
@@ -17,9 +20,7 @@ from ema.model.bounds import (
     SAMPLE_RATE_RANGE_HZ,
 )
 from ema.model.checks import InputError, in_range
-from ema.model.commands import family_knots
-from ema.model.effects import EffectSet
-from ema.model.noise import SensorNoise, add_sensor_noise
+from ema.model.noise import SensorNoise
 from ema.model.params import HealthParams
 from ema.model.window import Window
 
@@ -39,7 +40,7 @@ def synthetic_window(
     actuator: ActuatorDocument = THESIS,
 ) -> Window:
     """One window logged from the model of ``actuator``: a command of ``command``'s family
-    (``ema.model.commands.COMMAND_FAMILIES``), the actuator at rest where the command starts, sensor noise; in flight at
+    (``simulator.commands.COMMAND_FAMILIES``), the actuator at rest where the command starts, sensor noise; in flight at
     ``condition``, or on the ground under a load cell's ``GroundLoad`` (the window then names no flight
     condition).
 

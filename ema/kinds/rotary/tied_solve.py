@@ -17,8 +17,8 @@ import numpy as np
 
 from ema.calibration.limits import FOLDS
 from ema.estimate.least_squares import coefficients
-from ema.estimate.physics.eta_search import coarse_to_fine
 from ema.kinds.rotary.equations import Equations
+from ema.kinds.rotary.physics.eta_search import coarse_to_fine
 from ema.kinds.rotary.selection import Chosen
 from ema.model.params import load_factors
 

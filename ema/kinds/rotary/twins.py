@@ -21,8 +21,8 @@ import numpy as np
 from ema.calibration.limits import NAME_Z
 from ema.kinds.rotary.physics.scenario import CLEAR_MARGIN, following_error, inside, scenario_from_window
 from ema.kinds.rotary.selection import NAME_MARGIN, Evidence
+from ema.kinds.rotary.simulator.effects import EffectSet
 from ema.model.actuator import ActuatorDocument
-from ema.model.effects import EffectSet
 from ema.model.noise import SensorNoise
 from ema.model.window import Window
 

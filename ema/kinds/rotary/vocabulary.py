@@ -19,7 +19,7 @@ import numpy as np
 
 from ema.kinds.rotary.equations import Equations
 from ema.kinds.rotary.families import Family
-from ema.model.effects import EffectSet, FrictionTable
+from ema.kinds.rotary.simulator.effects import EffectSet, FrictionTable
 from ema.model.params import DriveConstants
 
 # A Stribeck curve exp(−(|ω|/ω_s)^δ): Tustin's δ = 1, the Gaussian δ = 2, a slower δ = ½ and the

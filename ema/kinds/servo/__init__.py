@@ -9,17 +9,18 @@ constants and traces what the model still misses to a named effect.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import STAGES, Estimate
-from ema.kinds.base import WARM_UP, Calibrated, CalibrationRequest, Cost, Request
+from ema.kinds.base import WARM_UP, Calibrated, CalibrationRequest, Cost, Request, not_drawn
 from ema.kinds.servo.calibration import CLOSED_LOOPS, calibrate_servo
 from ema.kinds.servo.closed_loop import SUBSTEPS, ServoLoop, simulate_servo
-from ema.model.actuator import ServoActuator, actuator_from_dict, as_kind
+from ema.model.actuator import ActuatorDocument, ServoActuator, actuator_from_dict, as_kind
 from ema.model.kinds import KINDS, KindFacts
 from ema.model.params import DriveConstants
 from ema.model.window import Window
@@ -57,6 +58,9 @@ class Servo:
     def calibration_cost(self, windows: Sequence[Window], config: PipelineConfig) -> Cost:
         steps = sum(window.n_samples * SUBSTEPS * CLOSED_LOOPS for window in windows)
         return Cost(simulated_s=steps * ROTARY_STEP_S, window_s=sum(window.duration_s for window in windows))
+
+    def synthesize(self, actuator: ActuatorDocument, flags: Mapping[str, Any]) -> dict[str, Any]:
+        raise not_drawn(self.facts)
 
     def warm_up(self) -> None:
         """A tiny servo's window (``WARM_UP_SERVO``) simulated and estimated: its filters, its simulator and its

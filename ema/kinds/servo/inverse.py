@@ -34,10 +34,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ema.estimate.least_squares import coefficients, newey_west_lags, newey_west_std
-from ema.estimate.physics.eta_search import MIN_OFFSET_BALANCE
-from ema.estimate.physics.noise_reading import robust_variance, white_noise_std
-from ema.estimate.stats import rms
+from ema.estimate.least_squares import MIN_OFFSET_BALANCE, coefficients, newey_west_lags, newey_west_std
+from ema.estimate.stats import rms, robust_variance, white_noise_std
 from ema.kinds.servo.zero_phase import butter_lowpass, cheby1_lowpass, filtfilt
 from ema.model.checks import InputError
 

@@ -34,8 +34,7 @@ import numpy as np
 
 from ema.estimate.documents import Note
 from ema.estimate.least_squares import coefficients
-from ema.estimate.physics.noise_reading import robust_variance
-from ema.estimate.stats import below_zero, rms
+from ema.estimate.stats import below_zero, rms, robust_variance
 from ema.kinds.servo.closed_loop import ServoLoop, ServoRuns, simulate_servo
 from ema.kinds.servo.inverse import Motion, inverse_columns, load_motion, refuse_still, solve_inverse
 from ema.model.actuator import ServoActuator

@@ -3,9 +3,9 @@ import pytest
 
 from ema.kinds.rotary.dataset import simulate_noisy
 from ema.kinds.rotary.physics.scenario import initial_state, scenario_from_window
+from ema.kinds.rotary.simulator.batch import InitialState
 from ema.kinds.rotary.synthetic import synthetic_window
 from ema.model.actuator import THESIS
-from ema.model.batch import InitialState
 from ema.model.noise import NO_NOISE, SensorNoise
 from ema.model.params import HealthParams
 from ema.model.window import window_from_dict

@@ -24,7 +24,7 @@ def test_a_cogging_column_carries_the_logs_interval_mean_attenuation():
     # The interval mean of sin(pθ) over an interval where θ advances by ω/f is sinc(pω/2f) times the centre value.
     exact = np.array([np.mean(np.sin(order * speed * (k / rate + np.arange(1000) / 1000 / rate))) for k in range(4000)])
     middle = slice(100, 3900)  # the 2 ms smoothing attenuates further; compare after it, away from the ends
-    from ema.model.residual import smoothed
+    from ema.kinds.rotary.simulator.residual import smoothed
 
     np.testing.assert_allclose(columns[middle, 0], smoothed(exact, rate)[middle], atol=2e-3)
 

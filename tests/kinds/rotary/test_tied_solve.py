@@ -4,9 +4,10 @@ import numpy as np
 import pytest
 
 from ema.calibration.limits import FOLDS
-from ema.estimate.physics.eta_search import ETA_O_SEARCH, GRID_POINTS, REFINEMENTS
+from ema.estimate.profile import ETA_O_SEARCH
 from ema.kinds.rotary.equations import Equations, equations
 from ema.kinds.rotary.families import generic_families
+from ema.kinds.rotary.physics.eta_search import GRID_POINTS, REFINEMENTS
 from ema.kinds.rotary.selection import Chosen
 from ema.kinds.rotary.tied_solve import solve_with
 from ema.kinds.rotary.vocabulary import named_families

@@ -1,5 +1,5 @@
 """One preprocessing for simulated and measured windows alike: the signals as read (the hinge moment
-denoised, ``ema.model.hinge``), residual torque, then resampling.
+denoised, ``simulator.hinge``), residual torque, then resampling.
 
 Measured and simulated data must go through the very same function (thesis §5.7); this module
 is that function. Resampling to K timesteps takes the mean over K equal bins rather than
@@ -14,10 +14,10 @@ from collections.abc import Mapping
 import numpy as np
 
 from ema.kinds.rotary.physics.friction import FrictionSolution, SolveSettings, solve_friction
+from ema.kinds.rotary.simulator.hinge import denoised_hinge_nm
+from ema.kinds.rotary.simulator.residual import residual_torque_nm
 from ema.model.checks import InputError
-from ema.model.hinge import denoised_hinge_nm
 from ema.model.params import DriveConstants
-from ema.model.residual import residual_torque_nm
 
 INPUT_SETS = {
     # the thesis's two input sets (§5.5): residual torque alone, and its "input map"
@@ -28,7 +28,7 @@ INPUT_SETS = {
 
 def as_read(signals: Mapping[str, np.ndarray], sample_rate_hz: float) -> dict[str, np.ndarray]:
     """The signals as every estimator reads them: the hinge moment denoised along the deflection
-    (``ema.model.hinge``), the rest as logged. One window (n,) or a batch (N, n) per signal."""
+    (``simulator.hinge``), the rest as logged. One window (n,) or a batch (N, n) per signal."""
     out = dict(signals)
     out["hinge_moment_nm"] = denoised_hinge_nm(signals["hinge_moment_nm"], signals["position_deg"], sample_rate_hz)
     return out

@@ -2,10 +2,10 @@
 
 While sliding, the residual torque is T_R = sgn(ω)·(FDJ + k·|T_ext|) + C·ω with k = 1 − η_A when
 the load aids the motion and 1/η_O − 1 when it opposes it (T_ext = H_e / n). Both sides go
-through the same smoothing kernel as the reconstruction (``ema.model.residual``), which keeps the
+through the same smoothing kernel as the reconstruction (``simulator.residual``), which keeps the
 model linear in FDJ and k: with t = sgn(ω)·(T_R − C·ω), a and o the smoothed aiding and opposing
 |T_ext|, t = FDJ + k_aid·a + k_opp·o. η_A is tied to η_O by Eq. 3.4, so the solution is a search over
-η_O with FDJ in closed form at each point (``ema.estimate.physics.eta_search``). Where asked, nuisances
+η_O with FDJ in closed form at each point (``ema.kinds.rotary.physics.eta_search``). Where asked, nuisances
 join FDJ in that closed form (``nuisance_columns``): a constant torque c (a sensor off zero,
 ``ema.kinds.rotary.prepare.departures.zero_offset``), a change ΔC of the viscous coefficient
 (``ema.kinds.rotary.prepare.departures.viscosity``), a scale γ of the motor torque and a change ΔJ of the
@@ -26,11 +26,11 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from ema.estimate.physics.eta_search import ETA_O_SEARCH, solve
-from ema.estimate.stats import JACKKNIFE_BLOCKS, RESOLUTION_SHARE, jackknife_std
-from ema.model.checks import InputError
-from ema.model.params import DriveConstants
-from ema.model.residual import (
+from ema.estimate.profile import ETA_O_SEARCH
+from ema.estimate.stats import RESOLUTION_SHARE
+from ema.kinds.rotary.evidence import JACKKNIFE_BLOCKS, jackknife_std
+from ema.kinds.rotary.physics.eta_search import solve
+from ema.kinds.rotary.simulator.residual import (
     DERIVATIVE_SPAN_S,
     END_STOP_MARGIN_DEG,
     above_throughout,
@@ -39,6 +39,8 @@ from ema.model.residual import (
     smooth_derivative,
     smoothed,
 )
+from ema.model.checks import InputError
+from ema.model.params import DriveConstants
 
 MIN_SLIDING_KERNELS = 10  # fewer sliding samples than 10 kernel widths: too little motion to solve
 NUISANCES = ("offset", "viscous", "torque_scale", "inertia")  # the terms a solution may carry beside FDJ, in this order

@@ -13,14 +13,15 @@ import numpy as np
 
 from ema.estimate.simulate.design import PHYSICAL_ETA_O, physical_fdj_nm
 from ema.estimate.stats import rms
-from ema.model.aircraft import FlightCondition, HingeGeometry, Load, LoggedLoad
-from ema.model.batch import BatchResult, InitialState, simulate_batch
+from ema.kinds.rotary.simulator.batch import BatchResult, InitialState, simulate_batch
+from ema.kinds.rotary.simulator.commands import knots_from_samples
+from ema.kinds.rotary.simulator.effects import EffectSet
+from ema.kinds.rotary.simulator.loads import Load, LoggedLoad
+from ema.kinds.rotary.simulator.residual import smoothed
+from ema.model.aircraft import FlightCondition, HingeGeometry
 from ema.model.bounds import DEFAULT_SAMPLE_RATE_HZ
-from ema.model.commands import knots_from_samples
-from ema.model.effects import EffectSet
 from ema.model.noise import SensorNoise
 from ema.model.params import DriveConstants, HealthParams
-from ema.model.residual import smoothed
 from ema.model.window import Window
 
 INITIAL_SOLVE_SAMPLES = 8

@@ -30,10 +30,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from ema.estimate.documents import Note
-from ema.estimate.physics.noise_reading import white_noise_std
+from ema.estimate.stats import white_noise_std
+from ema.kinds.rotary.simulator.residual import END_STOP_MARGIN_DEG, smoothed
 from ema.model.noise import NO_NOISE, SensorNoise, ar1_mean_variance
 from ema.model.params import DriveConstants, load_factors
-from ema.model.residual import END_STOP_MARGIN_DEG, smoothed
 
 REST_SPEED_RADPS = 0.5  # at rest: the smoothed speed below this (the sensor noise alone exceeds a creep of 1 rad/s)
 MIN_RUN_S = 1e-3  # a rest and the motion after it must each last this long

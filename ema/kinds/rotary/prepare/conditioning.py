@@ -36,7 +36,7 @@ from typing import Any
 import numpy as np
 
 from ema.estimate.documents import Note
-from ema.estimate.physics.noise_reading import white_noise_std
+from ema.estimate.stats import white_noise_std
 from ema.kinds.rotary.prepare.alignment import Lags, aligned
 from ema.kinds.rotary.prepare.consistency import Consistency
 from ema.kinds.rotary.prepare.departures.aircraft_check import TOLERANCE, aircraft_note, check_against_aircraft
@@ -48,8 +48,8 @@ from ema.kinds.rotary.prepare.departures.zero_offset import offset_note
 from ema.kinds.rotary.prepare.stale import Stale, line_between_flanks, stale_note, without_stale
 from ema.kinds.rotary.prepare.step_lag import StepLag, step_lag, step_lag_note
 from ema.kinds.rotary.prepare.verdict import check_consistency, kinematics_note
+from ema.kinds.rotary.simulator.batch import COMMAND_MARGIN_DEG
 from ema.model.actuator import ActuatorDocument
-from ema.model.batch import COMMAND_MARGIN_DEG
 from ema.model.bounds import DEFAULT_SAMPLE_RATE_HZ
 from ema.model.noise import NOISY_SIGNALS
 from ema.model.params import DriveConstants

@@ -7,7 +7,7 @@ in every window of a working drive, whatever its health:
 
 1. Kinematics: the surface turns as the motor does, θ_u = θ_m / n behind the backlash's dead band.
    The position is ``g`` times the speed's integral over n carried through a dead band
-   (``ema.model.dead_band``, its width solved: a worn band as well); a working drive reads g within a
+   (``simulator.dead_band``, its width solved: a worn band as well); a working drive reads g within a
    percent of 1. A speed of the other sign gives g = −1, a sample rate stated twice the log's g = 2,
    a position in radians 1/57.3.
    Refused outside ``verdict.TRAVEL_GAIN``: a position sensor's gain a few % off is no unit error.
@@ -45,7 +45,7 @@ from ema.kinds.rotary.physics.features import as_read
 from ema.kinds.rotary.physics.friction import solve_friction
 from ema.kinds.rotary.physics.shifts import shifted_solutions
 from ema.kinds.rotary.prepare.departures.zero_offset import OFFSET_SOLVE
-from ema.model.dead_band import dead_band_paths
+from ema.kinds.rotary.simulator.dead_band import dead_band_paths
 from ema.model.params import DriveConstants
 from ema.model.window import Window
 
@@ -105,7 +105,7 @@ def _best_band(travel: np.ndarray, y: np.ndarray, halves: np.ndarray) -> tuple[f
 
 def travel_gain(window: Window, drive: DriveConstants) -> float | None:
     """The drive's kinematic gain g: the least-squares slope (with an intercept) of the position (rad) on
-    the speed's integral / n carried through a dead band (``ema.model.dead_band``) whose width (any the travel
+    the speed's integral / n carried through a dead band (``simulator.dead_band``) whose width (any the travel
     shows: a worn band too; a coarse grid, then a fine one about the best) and start the least squares
     choose; None where that explains under ``MIN_EXPLAINED`` of the position's variance (a surface that
     hardly moves, or not with the motor)."""

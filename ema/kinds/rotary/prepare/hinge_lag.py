@@ -3,7 +3,7 @@ weighed together.
 
 The hinge moment's lag barely shows in Eq. 5.1's equation error (lags of a few ms explain it about as well as none), yet
 a strain-gauge filter's delay of 1–4 ms moves FDJ beyond its std. It shows in the noise: the filter that delays the
-signal correlates the noise it passes, and ``ema.estimate.physics.noise_reading`` reads that correlation as a
+signal correlates the noise it passes, and ``ema.kinds.rotary.physics.noise_reading`` reads that correlation as a
 filter's delay D (``filter_delay_samples``; 0 on white noise). But noise correlated after the signal (an amplifier's
 own noise behind its output filter) reads the same, and advancing an unfiltered moment by it would move FDJ as much
 the other way; and now and then the read misses a filter. So where the noise shows a filter, the lag is a model
@@ -25,12 +25,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ema.estimate.physics.noise_reading import MAX_LAG, noise_of, white_noise_std
-from ema.estimate.stats import JACKKNIFE_BLOCKS, rms_log_likelihood_ratio
+from ema.estimate.stats import white_noise_std
+from ema.kinds.rotary.evidence import JACKKNIFE_BLOCKS, rms_log_likelihood_ratio
 from ema.kinds.rotary.physics.friction import SolveSettings
+from ema.kinds.rotary.physics.noise_reading import MAX_LAG, noise_of
 from ema.kinds.rotary.physics.shifts import shifted_solutions
 from ema.kinds.rotary.prepare.departures.aircraft_band import band_lag_s
-from ema.model.hinge import denoised_hinge_nm
+from ema.kinds.rotary.simulator.hinge import denoised_hinge_nm
 from ema.model.params import DriveConstants
 
 MAX_HINGE_LAG_S = 3e-3

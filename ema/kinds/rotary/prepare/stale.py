@@ -39,12 +39,12 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ema.estimate.documents import Note
-from ema.estimate.physics.noise_reading import white_noise_std
+from ema.estimate.stats import white_noise_std
 from ema.kinds.rotary.physics.friction import MIN_SLIDING_KERNELS, SolveSettings, sliding_mask
+from ema.kinds.rotary.simulator.residual import DERIVATIVE_SPAN_S, kernel_samples
 from ema.model.checks import InputError
 from ema.model.noise import NOISY_SIGNALS
 from ema.model.params import DriveConstants
-from ema.model.residual import DERIVATIVE_SPAN_S, kernel_samples
 from ema.model.window import Window
 
 MIN_STALE_SAMPLES = 4  # equal samples: fewer is the glitch repair's (3 at most)

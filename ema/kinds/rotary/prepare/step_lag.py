@@ -32,7 +32,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ema.estimate.documents import Note
-from ema.estimate.stats import UNDECIDED_NOTE_WEIGHT, UNDECIDED_PRIOR_LOG_ODDS, odds_weight, rms_log_likelihood_ratio
+from ema.estimate.stats import odds_weight
+from ema.kinds.rotary.evidence import UNDECIDED_NOTE_WEIGHT, UNDECIDED_PRIOR_LOG_ODDS, rms_log_likelihood_ratio
 from ema.kinds.rotary.physics.shifts import shifted_solutions
 from ema.kinds.rotary.prepare.consistency import step_lags
 from ema.kinds.rotary.prepare.hinge_lag import band_log_likelihood

@@ -4,12 +4,13 @@ import numpy as np
 import pytest
 
 from ema.kinds.rotary.physics.friction import SolveSettings, solve_friction, solve_window
+from ema.kinds.rotary.simulator.batch import simulate_batch
+from ema.kinds.rotary.simulator.sensor_noise import add_sensor_noise
 from ema.kinds.rotary.synthetic import synthetic_window
 from ema.model.actuator import THESIS
 from ema.model.aircraft import GroundLoad
-from ema.model.batch import simulate_batch
 from ema.model.checks import InputError
-from ema.model.noise import NO_NOISE, SensorNoise, add_sensor_noise
+from ema.model.noise import NO_NOISE, SensorNoise
 from ema.model.params import DriveConstants, HealthParams
 from ema.model.window import window_from_dict
 from tests.foreign.windows import draw

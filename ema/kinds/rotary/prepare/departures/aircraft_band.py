@@ -11,16 +11,16 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from ema.estimate.physics.noise_reading import MAX_LAG, noise_of
-from ema.estimate.stats import JACKKNIFE_BLOCKS, jackknife_std
-from ema.model.hinge import local_line
-from ema.model.residual import kernel_samples
+from ema.kinds.rotary.evidence import JACKKNIFE_BLOCKS, jackknife_std
+from ema.kinds.rotary.physics.noise_reading import MAX_LAG, noise_of
+from ema.kinds.rotary.simulator.hinge import local_line
+from ema.kinds.rotary.simulator.residual import kernel_samples
 
 BAND_S = (0.0025, 0.1)  # the band compared: slower than the noise, faster than the aircraft's own motion
 
 
 def band_part(values: np.ndarray, rate: float) -> np.ndarray:
-    """``values`` between ``BAND_S``: their local line over the shorter span (``ema.model.hinge.local_line``)
+    """``values`` between ``BAND_S``: their local line over the shorter span (``simulator.hinge.local_line``)
     minus that over the longer, i.e. what moves faster than the aircraft and slower than the noise."""
     short, long = (kernel_samples(rate, span) for span in BAND_S)
     return local_line(values, short) - local_line(values, long)
@@ -28,7 +28,7 @@ def band_part(values: np.ndarray, rate: float) -> np.ndarray:
 
 def band_noise_variance(position_deg: np.ndarray, rate: float) -> float:
     """The variance a sample the position sensor's noise keeps in ``band_part``: σ² of its AR(1) reading
-    (``ema.estimate.physics.noise_reading``), over the independent values in the shorter span."""
+    (``ema.kinds.rotary.physics.noise_reading``), over the independent values in the shorter span."""
     sigma, tau_s = noise_of(position_deg, rate, MAX_LAG["position_deg"])
     rho = math.exp(-1.0 / (tau_s * rate)) if tau_s > 0 else 0.0
     span = kernel_samples(rate, BAND_S[0])

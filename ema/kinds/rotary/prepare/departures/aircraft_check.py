@@ -40,17 +40,17 @@ from typing import Literal
 import numpy as np
 
 from ema.estimate.documents import Note
-from ema.estimate.stats import JACKKNIFE_BLOCKS, jackknife_std
+from ema.kinds.rotary.evidence import JACKKNIFE_BLOCKS, jackknife_std
 from ema.kinds.rotary.physics.features import solve_as_read
 from ema.kinds.rotary.prepare.consistency import STEP_LAGS_S
 from ema.kinds.rotary.prepare.departures.aircraft_band import BAND_S, band_noise_variance, band_part
 from ema.kinds.rotary.prepare.departures.drive_constants import BESIDE
 from ema.kinds.rotary.prepare.departures.hinge_gain import divided_hinge, free_load_solution
+from ema.kinds.rotary.simulator.residual import kernel_samples
 from ema.model.actuator import Airframe
 from ema.model.aircraft import HingeGeometry
 from ema.model.checks import InputError
 from ema.model.params import DriveConstants
-from ema.model.residual import kernel_samples
 from ema.model.window import Window
 
 TOLERANCE = Airframe.model_fields["tolerance"].default  # how far the airframe's C_hδ may be off: the document's default

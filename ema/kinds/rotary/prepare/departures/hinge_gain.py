@@ -29,12 +29,13 @@ import numpy as np
 
 from ema.estimate.documents import Note
 from ema.estimate.least_squares import coefficients
-from ema.estimate.stats import DECISIVE_Z, JACKKNIFE_BLOCKS, jackknife_std, rms, rms_log_likelihood_ratio
+from ema.estimate.stats import DECISIVE_Z, rms
+from ema.kinds.rotary.evidence import JACKKNIFE_BLOCKS, jackknife_std, rms_log_likelihood_ratio
 from ema.kinds.rotary.physics.features import as_read, solve_as_read
 from ema.kinds.rotary.physics.friction import MIN_SLIDING_KERNELS, SolveSettings, nuisance_columns, regressors
 from ema.kinds.rotary.prepare.departures.drive_constants import BESIDE, FIELDS
+from ema.kinds.rotary.simulator.residual import DERIVATIVE_SPAN_S, kernel_samples
 from ema.model.params import DriveConstants
-from ema.model.residual import DERIVATIVE_SPAN_S, kernel_samples
 from ema.model.window import Window
 
 GAIN_PLAUSIBLE = (0.7, 1.35)  # lbf·ft for N·m is 0.74; outside, no sensor's: not taken

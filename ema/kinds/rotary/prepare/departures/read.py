@@ -24,8 +24,7 @@ from functools import cached_property
 import numpy as np
 
 from ema.estimate.documents import Note
-from ema.estimate.physics.noise_reading import white_noise_std
-from ema.estimate.stats import MAX_RATIO
+from ema.estimate.stats import MAX_RATIO, white_noise_std
 from ema.kinds.rotary.physics.features import solve_as_read
 from ema.kinds.rotary.physics.scenario import CLEAR_MARGIN, following_error, inside, scenario_from_window
 from ema.kinds.rotary.prepare.departures.aircraft_check import AircraftCheck, banded, divided_out

@@ -28,11 +28,12 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ema.estimate.documents import Note
-from ema.estimate.stats import DECISIVE_Z, UNDECIDED_NOTE_WEIGHT, UNDECIDED_PRIOR_LOG_ODDS, odds_weight
+from ema.estimate.stats import DECISIVE_Z, odds_weight
+from ema.kinds.rotary.evidence import UNDECIDED_NOTE_WEIGHT, UNDECIDED_PRIOR_LOG_ODDS
 from ema.kinds.rotary.physics.features import as_read
 from ema.kinds.rotary.physics.friction import SolveSettings, solve_friction
 from ema.kinds.rotary.prepare.departures.drive_constants import UNDECIDED_SHARE
-from ema.model.effects import EffectSet
+from ema.kinds.rotary.simulator.effects import EffectSet
 from ema.model.params import DriveConstants
 from ema.model.window import Window
 
@@ -43,7 +44,10 @@ READ_ERROR_OF_C = 0.025
 # Where the speed hardly varies (one way at slew) C·|ω| is FDJ's twin and ΔC cannot be solved: the stds then
 # carry a C this share of the document's off, either way (the spread of C over a fleet a third of it cold).
 UNSEEN_SHARE = 0.3
-CHANGE_BOUNDS_NMS = (-5e-5, 5e-3)  # what the simulator's viscous effect accepts (``ema.model.effects``)
+CHANGE_BOUNDS_NMS = (
+    -5e-5,
+    5e-3,
+)  # what the simulator's viscous effect accepts (``simulator.effects``)
 VISCOUS_SOLVE = SolveSettings(offset=True, viscous=True)
 # A change that stands out is solved again beside a scale of the motor torque: at the drive's top speed the
 # speed falls as the load grows, so C·|ω| follows the load, and a current read a few per cent high (which scales

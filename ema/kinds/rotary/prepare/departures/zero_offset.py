@@ -33,7 +33,8 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ema.estimate.documents import Note
-from ema.estimate.stats import DECISIVE_Z, odds_weight, rms_log_likelihood_ratio
+from ema.estimate.stats import DECISIVE_Z, odds_weight
+from ema.kinds.rotary.evidence import rms_log_likelihood_ratio
 from ema.kinds.rotary.physics.features import solve_as_read
 from ema.kinds.rotary.physics.friction import FrictionSolution, SolveSettings
 from ema.model.params import DriveConstants

@@ -1,14 +1,9 @@
 import numpy as np
 import pytest
 
-from ema.model.actuator import THESIS
-from ema.model.aircraft import GroundLoad
-from ema.model.batch import simulate_batch
-from ema.model.checks import InputError
-from ema.model.commands import random_command_knots
-from ema.model.noise import SensorNoise, add_sensor_noise
-from ema.model.params import HealthParams
-from ema.model.residual import (
+from ema.kinds.rotary.simulator.batch import simulate_batch
+from ema.kinds.rotary.simulator.commands import random_command_knots
+from ema.kinds.rotary.simulator.residual import (
     above_throughout,
     derivative_weights,
     kernel_samples,
@@ -17,6 +12,12 @@ from ema.model.residual import (
     smoothed,
     smoothing_weights,
 )
+from ema.kinds.rotary.simulator.sensor_noise import add_sensor_noise
+from ema.model.actuator import THESIS
+from ema.model.aircraft import GroundLoad
+from ema.model.checks import InputError
+from ema.model.noise import SensorNoise
+from ema.model.params import HealthParams
 
 RATE = 10_000.0
 

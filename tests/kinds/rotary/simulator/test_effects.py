@@ -3,13 +3,13 @@
 import numpy as np
 import pytest
 
+from ema.kinds.rotary.simulator.batch import simulate_batch
+from ema.kinds.rotary.simulator.effects import EFFECTS, EffectSet, FrictionTable
 from ema.model.actuator import THESIS
 from ema.model.aircraft import GroundLoad
-from ema.model.batch import simulate_batch
 from ema.model.checks import InputError
-from ema.model.effects import EFFECTS, EffectSet, FrictionTable
 from ema.model.params import HealthParams
-from tests.model.conftest import ramp_knots
+from tests.kinds.rotary.simulator.conftest import ramp_knots
 
 STEADY = slice(1000, 3000)
 NOMINAL = HealthParams.single()

@@ -2,7 +2,7 @@
 estimator will see.
 
 The noise is read from the difference between the window and a clean simulation of it (the hinge
-moment: its own denoised reading, ``ema.model.hinge``, since the simulations feel the logged load),
+moment: its own denoised reading, ``ema.kinds.rotary.simulator.hinge``, since the simulations feel the logged load),
 through its second difference at each lag L up to ``MAX_LAG`` samples: for stationary noise of
 autocovariance R,
 
@@ -30,8 +30,9 @@ from collections.abc import Mapping
 import numpy as np
 from numba import njit
 
+from ema.estimate.stats import MAD_TO_STD
+from ema.kinds.rotary.simulator.hinge import denoised_hinge_nm
 from ema.model import runtime
-from ema.model.hinge import denoised_hinge_nm
 from ema.model.noise import NOISY_SIGNALS, SensorNoise
 from ema.model.params import MAX_CORRELATION_S
 
@@ -48,22 +49,6 @@ DIP = 0.1
 # correlation longer than the span rises ~0.67 there). The fewest flat lags keep the mismatch's rise out.
 RISE = 0.25
 MIN_LAGS = 8
-MAD_TO_STD = 1.4826  # σ of Gaussian data over its median absolute deviation
-
-
-def robust_variance(values: np.ndarray) -> float:
-    """(1.4826 · MAD)²: the variance of Gaussian data, unmoved by a few outliers."""
-    mad = np.median(np.abs(values - np.median(values)))
-    return float((MAD_TO_STD * mad) ** 2)
-
-
-def white_noise_std(values: np.ndarray) -> float:
-    """Robust std of white noise on a smooth signal: √(robust variance of the second difference / 6).
-
-    Δ²x of white noise has variance 6σ²; the smooth signal contributes little to it at 10 kHz, and
-    the median ignores the few samples where the motion itself turns sharply.
-    """
-    return float(np.sqrt(robust_variance(np.diff(values, n=2)) / 6.0))
 
 
 def second_difference_variance(values: np.ndarray, lag: int) -> float:

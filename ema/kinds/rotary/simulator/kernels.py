@@ -1,6 +1,6 @@
 """The Numba kernels: one 1 µs step of the EMA, and the lock-step loop over groups of simulations.
 
-Pure functions of their arguments: ``ema.model.batch`` validates, packs the constants, allocates
+Pure functions of their arguments: ``simulator.batch`` validates, packs the constants, allocates
 ``out`` and runs :func:`run_group` for each group of simulations on its own threads. The step is
 written once (:func:`advance`) and every loop uses it, so the vectorized lock-step path and the
 one-lane path run the same arithmetic. The branches in :func:`advance` are simple enough for
@@ -37,7 +37,7 @@ N_LANE_ROWS = 18
 
 
 class KernelConstants(NamedTuple):
-    """Everything constant over a batch, in the form the step uses (derived once, in ema.model.batch)."""
+    """Everything constant over a batch, in the form the step uses (derived once, in simulator.batch)."""
 
     step_s: float  # h [s]
     step_over_gear: float  # h / n [s]

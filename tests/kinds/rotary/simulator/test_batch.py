@@ -3,10 +3,8 @@
 import numpy as np
 import pytest
 
-from ema.model import kernels, runtime
-from ema.model.actuator import THESIS
-from ema.model.aircraft import FlightCondition, GroundLoad, LoggedLoad, load_model
-from ema.model.batch import (
+from ema.kinds.rotary.simulator import kernels
+from ema.kinds.rotary.simulator.batch import (
     LANE_MULTIPLE,
     MAX_LANES,
     MIN_VECTOR_LANES,
@@ -16,13 +14,17 @@ from ema.model.batch import (
     kernel_constants,
     simulate_batch,
 )
+from ema.kinds.rotary.simulator.commands import random_command_knots
+from ema.kinds.rotary.simulator.effects import EffectSet
+from ema.kinds.rotary.simulator.loads import LoggedLoad, load_model
+from ema.kinds.rotary.simulator.reference import simulate_numpy
+from ema.kinds.rotary.simulator.residual import residual_torque_nm
+from ema.model import runtime
+from ema.model.actuator import THESIS
+from ema.model.aircraft import FlightCondition, GroundLoad
 from ema.model.checks import InputError
-from ema.model.commands import random_command_knots
-from ema.model.effects import EffectSet
 from ema.model.params import DEFAULT_RANGES, DriveConstants, HealthParams, eta_a_from_eta_o
-from ema.model.reference import simulate_numpy
-from ema.model.residual import residual_torque_nm
-from tests.model.conftest import ramp_knots
+from tests.kinds.rotary.simulator.conftest import ramp_knots
 
 RATE = 10_000.0
 
@@ -259,7 +261,8 @@ def test_an_interrupted_batch_runs_none_of_its_queued_groups(monkeypatch):
     import threading
     import time
 
-    from ema.model import batch, runtime
+    from ema.kinds.rotary.simulator import batch
+    from ema.model import runtime
 
     ran = []
 

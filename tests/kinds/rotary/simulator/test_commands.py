@@ -3,15 +3,15 @@ import signal
 import numpy as np
 import pytest
 
-from ema.model.bounds import COMMAND_FAMILIES
-from ema.model.checks import InputError
-from ema.model.commands import (
+from ema.kinds.rotary.simulator.commands import (
     COMMAND_LIMIT_DEG,
     family_knots,
     knots_from_samples,
     random_command_coefficients,
     random_command_knots,
 )
+from ema.model.bounds import COMMAND_FAMILIES
+from ema.model.checks import InputError
 
 
 def test_random_command_starts_at_zero_and_passes_its_nodes_within_25_degrees():

@@ -28,9 +28,9 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from ema.kinds.rotary.simulator.residual import kernel_samples
 from ema.model import runtime
 from ema.model.checks import InputError
-from ema.model.residual import kernel_samples
 
 # A 3 Hz short-period swing loses 2.4 % of its amplitude to a 40 ms mean; 10 kHz noise, 20x.
 HINGE_SMOOTHING_S = 0.04

@@ -4,7 +4,7 @@ With η_A tied to η_O by Eq. 3.4, the model t = FDJ + k_aid·a + k_opp·o (+ nu
 everything but η_O. At each η_O of a grid, u = t − k_aid·a − k_opp·o is regressed on (1, nuisances…)
 in closed form from the sums alone, and the grid is refined around its best point (the SSE is smooth
 and unimodal in η_O). A solution and its block jackknife solve thousands of such rows per window, so the
-search runs in one compiled pass (``_search``); ``tests/estimate/physics`` holds the plain vectorized
+search runs in one compiled pass (``_search``); ``tests/kinds/rotary/physics`` holds the plain vectorized
 form it must equal.
 """
 
@@ -16,16 +16,14 @@ import numpy as np
 from numba import njit
 from numba.extending import register_jitable
 
+from ema.estimate.least_squares import MIN_OFFSET_BALANCE
+from ema.estimate.profile import ETA_O_SEARCH
 from ema.model.params import eta_a_of, load_factors
 
-ETA_O_SEARCH = (0.20, 0.999)  # η_O searched over, by every search and profile of it in ema; Case 1C reaches 0.44
 GRID_POINTS = 41
 REFINEMENTS = 3  # coarse-to-fine passes: η_O to ~1e-5
-PROFILE_STEP = 0.005  # a likelihood profile over η_O (its width gives the std) is drawn at this step
-# An offset needs motion both ways: with fewer than this share of the samples in the rarer direction,
-# it cannot be told from FDJ and is not solved. ΔC, γ and ΔJ need columns that vary: a coefficient of
-# variation below this, and they cannot be told from FDJ either.
-MIN_OFFSET_BALANCE = 0.05
+# ΔC, γ and ΔJ need columns that vary: with a coefficient of variation below this, they cannot be told
+# from FDJ and are not solved (an offset's motion both ways: ``MIN_OFFSET_BALANCE``).
 MIN_VARIATION = 0.05
 RIDGE = 1e-12  # relative: two nuisances nearly dependent (speeds set by the direction) stay solvable
 
@@ -41,21 +39,6 @@ def coarse_to_fine(score: Callable[[np.ndarray], np.ndarray]) -> tuple[float, np
         step = grid[1] - grid[0]
         low, high = max(grid[best] - step, ETA_O_SEARCH[0]), min(grid[best] + step, ETA_O_SEARCH[1])
     return float(grid[best]), grid, best
-
-
-def profile_grid() -> np.ndarray:
-    """η_O every ``PROFILE_STEP`` over ``ETA_O_SEARCH``: where a likelihood profile is drawn whole (the
-    quasi-static reading's, the drive solution's), its width being the std."""
-    low, high = ETA_O_SEARCH
-    return low + PROFILE_STEP * np.arange(int((high - low) / PROFILE_STEP + 1e-9) + 1)
-
-
-def profile_std(grid: np.ndarray, chi2: np.ndarray, rise: float = 1.0) -> float:
-    """η_O's std from its χ² profile over ``grid``: half the width where χ² lies within ``rise`` of its minimum
-    (1: one std; a Birge ratio's square where the scatter exceeds the stated noise), never under one grid step
-    (a profile no wider than its step is resolved only to it)."""
-    inside = grid[chi2 <= np.min(chi2) + rise]
-    return float(max((inside.max() - inside.min()) / 2.0, grid[1] - grid[0]))
 
 
 def solved_terms(stats: np.ndarray, nuisances: tuple[str, ...]) -> np.ndarray:

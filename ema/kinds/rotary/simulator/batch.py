@@ -7,11 +7,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ema.model import kernels, runtime
-from ema.model.aircraft import FlightCondition, HingeGeometry, Load, load_model
+from ema.kinds.rotary.simulator import kernels
+from ema.kinds.rotary.simulator.effects import TABLE_VARIABLES, EffectSet
+from ema.kinds.rotary.simulator.loads import Load, load_model
+from ema.model import runtime
+from ema.model.aircraft import FlightCondition, HingeGeometry
 from ema.model.bounds import DEFAULT_SAMPLE_RATE_HZ, SAMPLE_RATE_RANGE_HZ
 from ema.model.checks import InputError, finite_array, in_range
-from ema.model.effects import TABLE_VARIABLES, EffectSet
 from ema.model.params import DriveConstants, HealthParams, load_factors
 
 VECTOR_LANES = 8  # float64 in one AVX-512 register
@@ -206,7 +208,7 @@ def simulate_batch(
 ) -> BatchResult:
     """Simulate one simulation per entry of ``health`` and record interval means at ``sample_rate_hz``.
 
-    ``command_knots_deg`` is the command at the log-interval boundaries (see ``ema.model.commands``):
+    ``command_knots_deg`` is the command at the log-interval boundaries (see ``simulator.commands``):
     (n_samples + 1,) shared by the batch (Case 1) or (n_simulations, n_samples + 1) (Case 2).
     ``drive``: the drive's constants; ``hinge``: the airframe's hinge-moment model where ``load`` is a
     flight condition (the thesis's elevator by default). The 1 µs trajectory is never stored.

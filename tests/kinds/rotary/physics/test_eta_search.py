@@ -3,7 +3,8 @@
 import numpy as np
 import pytest
 
-from ema.estimate.physics.eta_search import ETA_O_SEARCH, GRID_POINTS, REFINEMENTS, solve, solved_terms
+from ema.estimate.profile import ETA_O_SEARCH
+from ema.kinds.rotary.physics.eta_search import GRID_POINTS, REFINEMENTS, solve, solved_terms
 from ema.model.params import eta_a_from_eta_o
 
 GEAR = 500.0

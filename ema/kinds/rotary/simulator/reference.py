@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ema.model.aircraft import LoadModel
-from ema.model.kernels import KernelConstants
+from ema.kinds.rotary.simulator.kernels import KernelConstants
+from ema.kinds.rotary.simulator.loads import LoadModel
 
 
 def _hinge_slow(load: LoadModel, aircraft: np.ndarray, time_s: float) -> np.ndarray:
@@ -65,7 +65,7 @@ def simulate_numpy(
     initial: np.ndarray,
     interval_steps: np.ndarray,
 ) -> np.ndarray:
-    """(6, N, n_samples) interval means, rows as ``ema.model.kernels`` (position, speed, current, hinge, command, loss).
+    """(6, N, n_samples) interval means, rows as ``simulator.kernels`` (position, speed, current, hinge, command, loss).
 
     Base model only: the effects that act inside the step (cogging, Stribeck, position friction)
     are not modelled here; those folded into ``c`` (viscous, gains, sensor bias, backlash) are.

@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
+from ema.kinds.rotary.simulator.dead_band import dead_band_paths
 from ema.model.checks import InputError
-from ema.model.dead_band import dead_band_paths
 
 
 def _plain(travel: np.ndarray, half_width: float, start: float) -> np.ndarray:

@@ -4,10 +4,11 @@ sit behind moving-average filters (``ema.model.noise`` draws AR(1) noise: anothe
 import numpy as np
 import pytest
 
-from ema.estimate.physics.noise_reading import noise_of, robust_variance, second_difference_variances
+from ema.estimate.stats import robust_variance
 from ema.kinds.rotary.dataset import simulate_noisy
 from ema.kinds.rotary.physics.features import as_read
 from ema.kinds.rotary.physics.friction import solve_window
+from ema.kinds.rotary.physics.noise_reading import noise_of, second_difference_variances
 from ema.kinds.rotary.physics.scenario import scenario_from_window
 from ema.model.actuator import THESIS
 from ema.model.params import HealthParams

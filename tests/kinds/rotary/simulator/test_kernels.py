@@ -3,9 +3,9 @@
 import numpy as np
 import pytest
 
-from ema.model.batch import kernel_constants
-from ema.model.effects import EffectSet
-from ema.model.kernels import advance
+from ema.kinds.rotary.simulator.batch import kernel_constants
+from ema.kinds.rotary.simulator.effects import EffectSet
+from ema.kinds.rotary.simulator.kernels import advance
 from ema.model.params import DriveConstants, eta_a_from_eta_o
 
 ACTUATOR = DriveConstants()

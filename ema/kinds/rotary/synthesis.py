@@ -1,4 +1,5 @@
-"""``ema simulate``: a synthetic window written as the contract's JSON, with its truth and a summary."""
+"""``ema simulate`` for the rotary kind: synthetic windows of its simulator written as the contract's JSON, with their
+truth and a summary."""
 
 from __future__ import annotations
 
@@ -10,15 +11,14 @@ from typing import Any
 
 import numpy as np
 
-from ema.cli.options import actuator_document
-from ema.kinds import thesis_window
+from ema.kinds.rotary.simulator.effects import EFFECTS, EffectSet
+from ema.kinds.rotary.simulator.residual import residual_torque_nm
+from ema.kinds.rotary.synthetic import synthetic_window
 from ema.model.actuator import ActuatorDocument, RotaryActuator
 from ema.model.aircraft import FlightCondition, GroundLoad
 from ema.model.checks import InputError
-from ema.model.effects import EFFECTS, EffectSet
 from ema.model.noise import NO_NOISE, SensorNoise
 from ema.model.params import HealthParams
-from ema.model.residual import residual_torque_nm
 from ema.model.window import Window, write_window
 
 
@@ -108,7 +108,6 @@ class Draw:
     effect: tuple[str, ...]
     actuator_id: str
     truth_out: Path | None
-    actuator_file: Path | None
     recorded_at: dt.datetime | None = None
     flight_hours: float | None = None
     series: int = 1
@@ -128,7 +127,7 @@ def _window(
 ) -> Window:
     """The ``index``-th window of ``draw`` at ``health`` (FDJ, η_O, FSJ), stamped ``index`` steps of
     ``every_hours`` on from ``flight_hours`` and ``recorded_at`` where a series or a time was asked for."""
-    window = thesis_window(
+    window = synthetic_window(
         HealthParams.single(fsj_nm=health["FSJ"], fdj_nm=health["FDJ"], eta_o=health["eta_O"]),
         condition=GroundLoad(draw.load_nm, draw.load_ramp_nmps)
         if draw.ground
@@ -149,12 +148,11 @@ def _window(
     return replace(window, window_id=window_id, flight_hours=hours, recorded_at=stamp)
 
 
-def synthesize(draw: Draw) -> dict[str, Any]:
-    """Simulate the actuator of ``actuator_file`` (the thesis's by default) at the given health (its nominal
+def synthesize(draw: Draw, actuator: ActuatorDocument) -> dict[str, Any]:
+    """Simulate ``actuator`` at the given health (its nominal
     where none is given), write the window (and the truth), return what was written. With ``series`` > 1,
     ``out`` is a folder of that many windows of a degrading actuator, its health moving linearly to
     ``fdj_end`` and ``eta_o_end``, ``every_hours`` flight hours apart (and as many hours apart in recorded_at)."""
-    actuator = actuator_document(draw.actuator_file)
     noise = NO_NOISE if draw.clean else actuator.noise
     effects = EffectSet(dict(parse_effect(text) for text in draw.effect))  # a malformed flag named before any write
     start, end = (draw.fdj, draw.eta_o, draw.fsj), (draw.fdj_end, draw.eta_o_end)

@@ -1,7 +1,7 @@
 """Optional physical effects the base model lacks, off by default.
 
 Each effect is a few named parameters whose neutral values leave the base model exactly as it
-is; the kernel reads them from its constants (see ``ema.model.kernels.advance``), so switching an
+is; the kernel reads them from its constants (see ``simulator.kernels.advance``), so switching an
 effect on is a parameter change, never a fork of the kernel. Beside the named effects, a
 :class:`FrictionTable` adds dry friction of any shape against motor speed, elevator position or
 time: the data-driven term the calibration loop offers when no named effect matches.

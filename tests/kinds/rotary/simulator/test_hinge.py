@@ -1,8 +1,8 @@
 import numpy as np
 import pytest
 
+from ema.kinds.rotary.simulator.hinge import denoised_hinge_nm, local_line
 from ema.model.checks import InputError
-from ema.model.hinge import denoised_hinge_nm, local_line
 
 RATE_HZ = 10_000.0
 
