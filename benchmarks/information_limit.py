@@ -38,7 +38,6 @@ from benchmarks.foreign_groups import group_seed, groups
 from benchmarks.tails import expected_over
 from ema.cli.benchmark_docs import write_section
 from ema.estimate import thread_budget
-from ema.estimate.report import healthy_range
 from ema.kinds.rotary.physics.features import as_read
 from ema.kinds.rotary.physics.friction import SolveSettings, regressors, solve_friction
 from ema.kinds.rotary.prepare.conditioning import prepare
@@ -125,7 +124,7 @@ def efficient_std(
     covariance = sum(r @ r.T for r in rows)
     information = X.T @ np.linalg.solve(covariance, X)
     std = np.sqrt(np.diag(np.linalg.inv(information)))
-    return std / np.array([np.ptp(healthy_range("FDJ", THESIS.ranges)), np.ptp(healthy_range("eta_O", THESIS.ranges))])
+    return std / np.array([np.ptp(THESIS.ranges.of("FDJ")), np.ptp(THESIS.ranges.of("eta_O"))])
 
 
 def our_rms(clean: Window, truth: dict[str, float], levels: dict[str, float], draws: int, seed: int) -> np.ndarray:
@@ -137,9 +136,7 @@ def our_rms(clean: Window, truth: dict[str, float], levels: dict[str, float], dr
         signals[name] = signals[name] + levels[name] * rng.standard_normal(signals[name].shape)
     solution = solve_friction(as_read(signals, clean.sample_rate_hz), clean.sample_rate_hz, drive=THESIS.params)
     errors = np.stack([solution.fdj_nm - truth["FDJ"], solution.eta_o - truth["eta_O"]])
-    return np.sqrt(np.nanmean(errors**2, axis=1)) / np.array(
-        [np.ptp(healthy_range(k, THESIS.ranges)) for k in ("FDJ", "eta_O")]
-    )
+    return np.sqrt(np.nanmean(errors**2, axis=1)) / np.array([np.ptp(THESIS.ranges.of(k)) for k in ("FDJ", "eta_O")])
 
 
 def one_window(group: str, i: int, draws: int) -> dict[str, np.ndarray]:

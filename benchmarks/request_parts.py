@@ -58,7 +58,7 @@ PARTS = (  # (stage, "module:function" as the stage calls it, what the step does
     ("simulate", "ema.kinds.rotary.dataset:sliding_features", "the network's inputs"),
     ("learn", "ema.kinds.rotary.pipeline:learned", "the network trained"),
     ("assess", "ema.kinds.rotary.pipeline:solve_friction", "Eq. 5.1 on the held-out simulations"),
-    ("assess", "ema.estimate.learn.estimator:NetworkEstimator.predict_unit", "the network on them and the window"),
+    ("assess", "ema.kinds.rotary.network:NetworkEstimator.predict_unit", "the network on them and the window"),
     ("assess", "ema.kinds.rotary.pipeline:assess", "the estimators weighed and blended"),
     ("check", "ema.kinds.rotary.simulator.batch:run_groups", "the window simulated at the answer (where not reused)"),
     ("check", "ema.kinds.rotary.reproduction:as_read", "that simulation read as the window is"),

@@ -39,7 +39,6 @@ from benchmarks.information_limit import GROUPS, SENSORS, noise_levels
 from benchmarks.tails import expected_over
 from ema.cli.benchmark_docs import typed_command, write_section
 from ema.estimate import thread_budget
-from ema.estimate.report import healthy_range
 from ema.kinds.rotary.physics.features import as_read
 from ema.kinds.rotary.physics.friction import solve_friction
 from ema.kinds.rotary.physics.scenario import scenario_from_window
@@ -50,9 +49,7 @@ from ema.model.window import Window, window_from_dict
 from tests.foreign.physics import Effects
 from tests.foreign.windows import Draw
 
-WIDTH = np.array(
-    [np.ptp(healthy_range("FDJ", THESIS.ranges)), np.ptp(healthy_range("eta_O", THESIS.ranges))]
-)  # the ranges, for shares
+WIDTH = np.array([np.ptp(THESIS.ranges.of("FDJ")), np.ptp(THESIS.ranges.of("eta_O"))])  # the ranges, for shares
 STEP = 0.025  # central-difference step, share of each range
 DEPARTURES = {
     "bus +1 %": Effects(supply_voltage_factor=1.01),

@@ -24,3 +24,6 @@ def profile_std(grid: np.ndarray, chi2: np.ndarray, rise: float = 1.0) -> float:
     (a profile no wider than its step is resolved only to it)."""
     inside = grid[chi2 <= np.min(chi2) + rise]
     return float(max((inside.max() - inside.min()) / 2.0, grid[1] - grid[0]))
+
+
+ETA_GRID = profile_grid()  # η_O every PROFILE_STEP over the search's range: where a whole profile is drawn

@@ -19,14 +19,9 @@ if TYPE_CHECKING:  # SciPy's optimizers: a window read without a network (quasi-
 WEAK_SHARE_OF_RANGE = 0.10
 
 
-def healthy_range(name: str, ranges: HealthRanges) -> tuple[float, float]:
-    """The healthy range of FDJ or eta_O (``ema.model.actuator.ActuatorDocument.ranges``)."""
-    return ranges.fdj_nm if name == "FDJ" else ranges.eta_o
-
-
 def share_of_range(name: str, amount: float, ranges: HealthRanges) -> float:
     """``amount`` (in the parameter's unit) as a share of the width of its healthy range."""
-    low, high = healthy_range(name, ranges)
+    low, high = ranges.of(name)
     return amount / (high - low)
 
 

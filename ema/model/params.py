@@ -66,6 +66,10 @@ class HealthRanges:
     nominal_fdj_nm: float = 0.05  # FDJ [N·m] of a healthy actuator
     nominal_eta_o: float = 0.85  # η_O [-] of a healthy actuator
 
+    def of(self, name: str) -> tuple[float, float]:
+        """The healthy range of the estimate ``name`` (``FDJ`` or ``eta_O``), in its unit."""
+        return self.fdj_nm if name == "FDJ" else self.eta_o
+
     def __post_init__(self) -> None:
         for name in ("fsj_nm", "fdj_nm", "eta_o"):
             low, high = getattr(self, name)

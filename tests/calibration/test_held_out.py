@@ -4,8 +4,9 @@ it leaves there."""
 import numpy as np
 import pytest
 
-from ema.calibration.held_out import score, score_grid
+from ema.calibration.held_out import score
 from ema.calibration.limits import FOLDS
+from ema.kinds.rotary.candidate_scores import score_grid
 
 
 def _problem(seed: int, m: int = 600):

@@ -14,7 +14,6 @@ import numpy as np
 
 from ema.estimate.config import PipelineConfig
 from ema.estimate.learn.network import LearnConfig, LearnedNetwork, learn_network
-from ema.estimate.simulate.design import Box
 from ema.model.checks import InputError
 
 WINDOW_LEARNING = LearnConfig(max_epochs=60, max_validation_failures=6)  # a window's own few dozen simulations
@@ -50,25 +49,3 @@ class NetworkRegressor:
     def predict_unit(self, inputs: np.ndarray) -> np.ndarray:
         """(N, T) the targets in box units, the members' mean, unclipped."""
         return np.mean([member.model(inputs) for member in self.members_], axis=0)
-
-
-class NetworkEstimator:
-    """FDJ and η_O through a ``Box`` (the rotary pipeline's targets), by a ``NetworkRegressor``."""
-
-    def __init__(self, learn: LearnConfig = LearnConfig(), members: int = 1) -> None:
-        self.learn = learn
-        self.members = members
-
-    def fit(self, inputs: np.ndarray, fdj_nm: np.ndarray, eta_o: np.ndarray, box: Box) -> NetworkEstimator:
-        self.regressor_ = NetworkRegressor(self.learn, self.members).fit(inputs, box.normalize(fdj_nm, eta_o))
-        self.members_ = self.regressor_.members_
-        self.box_ = box
-        return self
-
-    def predict_unit(self, inputs: np.ndarray) -> np.ndarray:
-        """(N, 2) FDJ, η_O in box units, the members' mean, unclipped."""
-        return self.regressor_.predict_unit(inputs)
-
-    def predict(self, inputs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """FDJ [N·m] and η_O for each row of ``inputs`` (N, F)."""
-        return self.box_.denormalize(self.predict_unit(inputs))

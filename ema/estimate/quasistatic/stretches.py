@@ -33,17 +33,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ema.estimate.profile import profile_grid, profile_std
+from ema.estimate.profile import ETA_GRID, profile_std
 from ema.estimate.stats import rms
 from ema.model.params import eta_a_of, load_factors
-from ema.model.window import Window
 
 BLOCKS = 5  # a stretch's mean and its std from this many blocks (the current is correlated over samples)
 STRETCH_SETTLE_S = 0.4  # after a change of speed, the drive settles this long before a stretch is read
 REST_SETTLE_S = 1.5  # after the motion stops, the drive's current settles this long before it reads I0
 MIN_STRETCH_S = 1.0  # a stretch at constant speed, or at rest, this long at least (after settling)
 SPEED_TOLERANCE = 0.02  # constant speed: within this share of the stretch's own speed
-ETA_GRID = profile_grid()  # η_O's profile, over the search's range
 MIN_LOAD_SPREAD = 0.2  # |T_L| must vary by this share of its mean for a window to read η_O beside FDJ
 
 
@@ -221,16 +219,3 @@ def _per_nm_read(
     torque_gap = float(np.mean(np.abs(load)) * (1.0 / eta + eta_a_of(eta, gear_ratio)))
     gap_std = float(np.hypot(rms(stds[opposing]), rms(stds[~opposing])))
     return gap / torque_gap, gap_std / torque_gap
-
-
-def set_point_motion(window: Window, gear_ratio: float) -> tuple[np.ndarray, np.ndarray]:
-    """A linear window's motion by its set point's speed (exact where a potentiometer's is noise) and its load
-    torque at the motor in the positive direction (F·lead/2π = F/n)."""
-    s = window.signals
-    return np.gradient(s["command_mm"]) * window.sample_rate_hz, s["load_n"] / gear_ratio
-
-
-def logged_motion(window: Window, gear_ratio: float) -> tuple[np.ndarray, np.ndarray]:
-    """A rotary window's motion by its logged motor speed, and its hinge moment at the motor (H/n)."""
-    s = window.signals
-    return s["motor_speed_radps"], s["hinge_moment_nm"] / gear_ratio

@@ -31,9 +31,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from ema.estimate.least_squares import weighted
-from ema.estimate.profile import profile_std
-from ema.estimate.quasistatic.stretches import ETA_GRID, Stretch, set_point_motion, stretches
+from ema.estimate.profile import ETA_GRID, profile_std
+from ema.estimate.quasistatic.stretches import Stretch, stretches
 from ema.estimate.stats import below_zero, rms
+from ema.kinds.linear.stepper_reading import set_point_motion
 from ema.model.actuator import LinearActuator
 from ema.model.checks import InputError
 from ema.model.params import load_factors

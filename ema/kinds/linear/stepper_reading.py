@@ -3,11 +3,22 @@ drive its healthy runs taught (``ema.kinds.linear.drive_calibration``), and how 
 
 from __future__ import annotations
 
+import numpy as np
+
 from ema.estimate.documents import Note
 from ema.estimate.quasistatic.drive_torque import HealthyRuns, QuasiStaticReading
-from ema.estimate.quasistatic.stretches import Repeatability, Rest, TorqueReading, set_point_motion
+from ema.estimate.quasistatic.stretches import Repeatability, Rest, TorqueReading
 from ema.model.actuator import ActuatorDocument, LinearActuator, as_kind
 from ema.model.checks import InputError
+from ema.model.window import Window
+
+
+def set_point_motion(window: Window, gear_ratio: float) -> tuple[np.ndarray, np.ndarray]:
+    """A linear window's motion by its set point's speed (exact where a potentiometer's is noise) and its load
+    torque at the motor in the positive direction (F·lead/2π = F/n)."""
+    s = window.signals
+    return np.gradient(s["command_mm"]) * window.sample_rate_hz, s["load_n"] / gear_ratio
+
 
 REST_DEPARTURE = 4.0  # a window's current at rest this many day-to-day spreads off the document's: said
 FELL = "friction lost (a ball screw losing its preload: a spalled track, smaller balls)"

@@ -31,7 +31,6 @@ from ema.calibration.documents import RotaryCalibration, Step
 from ema.calibration.limits import MAX_EFFECTS
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import TARGETS, Estimate
-from ema.estimate.report import healthy_range
 from ema.kinds.rotary import calibration_report as reporting
 from ema.kinds.rotary.backlash import read_backlash
 from ema.kinds.rotary.equations import Equations, equations
@@ -94,7 +93,7 @@ class Context:
         return any(abs(estimates[t] - reference[t]) > AMBIGUOUS_STDS * self._scale(t) for t in TARGETS)
 
     def _scale(self, target: str) -> float:
-        low, high = healthy_range(target, self.ranges)
+        low, high = self.ranges.of(target)
         return min(self.stds[target], MOVE_SHARE_OF_RANGE * (high - low))
 
 

@@ -2,10 +2,19 @@
 
 from __future__ import annotations
 
+import numpy as np
+
 from ema.estimate.documents import Note
 from ema.estimate.quasistatic.drive_torque import QuasiStaticReading
-from ema.estimate.quasistatic.stretches import Rest, TorqueReading, logged_motion
+from ema.estimate.quasistatic.stretches import Rest, TorqueReading
 from ema.model.actuator import ActuatorDocument, RotaryActuator, as_kind
+from ema.model.window import Window
+
+
+def logged_motion(window: Window, gear_ratio: float) -> tuple[np.ndarray, np.ndarray]:
+    """A rotary window's motion by its logged motor speed, and its hinge moment at the motor (H/n)."""
+    s = window.signals
+    return s["motor_speed_radps"], s["hinge_moment_nm"] / gear_ratio
 
 
 def motor_torque(actuator: ActuatorDocument, rest: Rest | None) -> tuple[TorqueReading, Note | None]:

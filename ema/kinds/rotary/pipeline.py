@@ -27,10 +27,10 @@ from ema.estimate.assess.weighing import Assessed, Candidates, assess, misfit_li
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import ActuatorRead, Check, Estimate, Note
 from ema.estimate.documents.window_facts import HistoryReadings
-from ema.estimate.learn.estimator import NetworkEstimator, window_learning
 from ema.estimate.stats import MAX_RATIO, rms
 from ema.estimate.stopwatch import Stopwatch
 from ema.kinds.rotary.dataset import Data, simulate_dataset
+from ema.kinds.rotary.network import NetworkEstimator
 from ema.kinds.rotary.other_windows import known_from
 from ema.kinds.rotary.physics.features import as_read
 from ema.kinds.rotary.physics.friction import SOLUTION_ARRAYS, FrictionSolution, solve_friction, solve_window
@@ -50,9 +50,7 @@ from ema.model.window import Window
 def learned(data: Data, config: PipelineConfig) -> NetworkEstimator:
     n = config.n_simulations
     health = data.sims.health
-    return NetworkEstimator(window_learning(config), config.members).fit(
-        data.inputs[:n], health.fdj_nm[:n], health.eta_o[:n], data.box
-    )
+    return NetworkEstimator(config).fit(data.inputs[:n], health.fdj_nm[:n], health.eta_o[:n], data.box)
 
 
 def candidates(

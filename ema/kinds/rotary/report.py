@@ -24,7 +24,7 @@ from ema.estimate.documents import (
     parameter,
 )
 from ema.estimate.documents.window_facts import InertiaReading, SensorZero, WindowInfo
-from ema.estimate.report import healthy_range, learned_info, share_of_range, weakly_determined
+from ema.estimate.report import learned_info, share_of_range, weakly_determined
 from ema.estimate.stats import rms
 from ema.kinds.rotary.dataset import Data
 from ema.kinds.rotary.physics.friction import FrictionSolution, sliding_mask
@@ -35,7 +35,7 @@ from ema.kinds.rotary.simulator.hinge import denoised_hinge_nm
 from ema.model.actuator import ActuatorDocument
 
 if TYPE_CHECKING:  # SciPy's optimizers: a window read without a network (quasi-static) never loads it
-    from ema.estimate.learn.estimator import NetworkEstimator
+    from ema.kinds.rotary.network import NetworkEstimator
 
 
 def _estimates(
@@ -82,7 +82,7 @@ def _notes(prepared: Prepared, physics: FrictionSolution, estimates: Estimates, 
     for name in TARGETS:
         entry = getattr(estimates, name)
         if entry is not None and weakly_determined(name, entry.std, ranges):
-            low, high = healthy_range(name, ranges)
+            low, high = ranges.of(name)
             spread = share_of_range(name, 2 * entry.std, ranges)
             notes.append(
                 Note(

@@ -24,8 +24,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ema.calibration.held_out import Scored, score, score_grid, score_offsets
+from ema.calibration.held_out import Scored, score
 from ema.calibration.limits import NAME_Z, noise_z
+from ema.kinds.rotary.candidate_scores import score_grid, score_offsets
 from ema.kinds.rotary.equations import Equations
 from ema.kinds.rotary.families import Family, Grid
 from ema.model import runtime

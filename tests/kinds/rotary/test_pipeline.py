@@ -326,7 +326,7 @@ def test_a_slow_log_gives_the_history_no_j_m():
 
 def test_a_network_that_disagrees_with_the_window_is_set_aside(monkeypatch):
     # A network that reads nonsense: the window's own consistency check must not trust it.
-    from ema.estimate.learn import estimator
+    from ema.kinds.rotary import network as estimator
 
     real = estimator.NetworkEstimator.predict_unit
 

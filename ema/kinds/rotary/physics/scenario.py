@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ema.estimate.simulate.design import PHYSICAL_ETA_O, physical_fdj_nm
+from ema.estimate.simulate.design import physical
 from ema.estimate.stats import rms
 from ema.kinds.rotary.simulator.batch import BatchResult, InitialState, simulate_batch
 from ema.kinds.rotary.simulator.commands import knots_from_samples
@@ -108,8 +108,9 @@ def scenario_from_window(
 def inside(fdj_nm: float, eta_o: float, nominal_fdj_nm: float, fsd: float = 2.0) -> HealthParams:
     """One health point at (FDJ, η_O), held inside the physical limits of an actuator of ``nominal_fdj_nm`` (a
     window the model cannot explain may be solved with a negative FDJ: it is still simulated, at the limit)."""
-    fdj = float(np.clip(fdj_nm, *physical_fdj_nm(nominal_fdj_nm)))
-    return HealthParams.single(fsd * fdj, fdj, float(np.clip(eta_o, *PHYSICAL_ETA_O)))
+    limits = physical(nominal_fdj_nm)
+    fdj = float(np.clip(fdj_nm, *limits.fdj_nm))
+    return HealthParams.single(fsd * fdj, fdj, float(np.clip(eta_o, *limits.eta_o)))
 
 
 def following_error(scenario: Scenario, window: Window, health: HealthParams, noise: SensorNoise) -> float:
