@@ -109,8 +109,9 @@ def estimate(
     as_json: bool,
     **size_values: int,
 ) -> None:
-    """Estimate FDJ, η_O, η_A (FSJ where it shows) of one window, in-process: an ema-window/1 JSON file, a CSV or
-    NPZ in ema's columns (docs/model.md), or a rig's own CSV with --log-map."""
+    """Read the health of one window, in-process: FDJ and the efficiencies its kind reports (FSJ where it shows), each
+    with a std: an ema-window/1 JSON file, a CSV or NPZ in ema's columns (docs/model.md), or a log in its own columns
+    and units (CSV, MATLAB, NPZ, a recorder's JSON) with --log-map."""
     from ema.cli.logs import read_one
     from ema.cli.printing import print_estimate
     from ema.estimate import thread_budget
@@ -199,7 +200,12 @@ def simulate(as_json: bool, **options: Any) -> None:
 
 @click.command()
 @click.argument("windows", type=EXISTING, nargs=-1, required=True)
-@click.option("--truth", type=EXISTING, help='JSON {"FDJ": ..., "eta_O": ...} of synthetic windows')
+@click.option(
+    "--truth",
+    type=EXISTING,
+    help='JSON of what synthetic windows were drawn at, by name ({"FDJ": ..., "eta_O": ...} for a rotary EMA): '
+    "the report states its errors against it",
+)
 @click.option("--figure", type=FIGURE_FILE, help="also write a PNG of the residual before and after (needs [plots])")
 @click.option(
     "--copies",
@@ -234,7 +240,8 @@ def calibrate(
     **size_values: int,
 ) -> None:
     """Trace what the model misses in windows of one actuator to an effect, add it, re-estimate; learn what the
-    document lacks (a linear actuator's drive, a servo's load: --out-actuator), or say what faulted runs changed."""
+    document lacks (a ball screw's drive, a servo's load, a geared servo's loop and health: --out-actuator), or say
+    what faulted runs changed."""
     from ema import kinds
     from ema.cli.figures import residual_figure
     from ema.cli.logs import read_one
@@ -248,7 +255,9 @@ def calibrate(
     mapping = log_map_document(log_map_file)
     loaded = [read_one(path, mapping) for path in windows]
     kind_given(loaded, actuator_file)
-    request = kinds.CalibrationRequest(config, document, read_truth(truth), copies=copies, on_stage=progress)
+    request = kinds.CalibrationRequest(
+        config, document, read_truth(truth, document.facts), copies=copies, on_stage=progress
+    )
     calibrated = kinds.calibrate(loaded, request)
     written: dict[str, str | None] = {"figure": None, "actuator_written": None}
     if out_actuator is not None:

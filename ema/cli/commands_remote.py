@@ -49,10 +49,18 @@ def api_key(path: Path | None) -> str | None:
 @window_s
 @click.option("--actuator-id", default="unknown", help="for CSV/NPZ logs that carry none")
 @click.option(
-    "--rate", type=float, default=DEFAULT_SAMPLE_RATE_HZ, help="sample rate [Hz] for CSV/NPZ logs that carry none"
+    "--rate",
+    type=float,
+    default=DEFAULT_SAMPLE_RATE_HZ,
+    help="sample rate [Hz] of a rotary log in ema's columns that carries none",
 )
-@click.option("--airspeed", type=float, default=DEFAULT_AIRSPEED_MPS, help="[m/s] for CSV/NPZ logs that carry none")
-@click.option("--altitude", type=float, default=0.0, help="[m] for CSV/NPZ logs that carry none")
+@click.option(
+    "--airspeed",
+    type=float,
+    default=DEFAULT_AIRSPEED_MPS,
+    help="[m/s] of a rotary log in ema's columns that carries none",
+)
+@click.option("--altitude", type=float, default=0.0, help="[m] of a rotary log in ema's columns that carries none")
 @click.option(
     "--actuator",
     "actuator_file",
@@ -199,7 +207,9 @@ def _print_replay(result: dict[str, Any]) -> None:
 @click.argument("actuator_id")
 @service
 @click.option("--plot", type=FIGURE_FILE, default=None, help="PNG of the prognosis (needs [plots])")
-@click.option("--parameter", type=click.Choice(["FDJ", "eta_O", "eta_A"]), default="FDJ", help="what --plot draws")
+@click.option(
+    "--parameter", default="FDJ", help="what --plot draws: any estimate the prognosis trends (its names are listed)"
+)
 @as_json
 def history(
     actuator_id: str, url: str, api_key_file: Path | None, plot: Path | None, parameter: str, as_json: bool
@@ -225,6 +235,10 @@ def history(
             ) from None
         raise ServiceError(f"HTTP {error.code} from {url}") from None
     prognosis = Prognosis.model_validate(request(f"{base}/prognosis", key, timeout=60))
+    read = {"FDJ", "eta_O", "eta_A", *prognosis.trends}
+    read |= {name for entry in stored.estimates for name in entry.estimates.constants}
+    if plot is not None and parameter not in read:
+        raise InputError("--parameter", f"{parameter!r} is not one of this actuator's: {', '.join(sorted(read))}")
     drawn = plot if plot is not None and parameter in prognosis.trends else None
     if drawn is not None:
         prognosis_figure(prognosis, parameter, drawn, unit=value_units(stored).get(parameter, "").strip())

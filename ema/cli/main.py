@@ -9,6 +9,7 @@ standard output holds exactly one JSON document; progress and warnings go to sta
 from __future__ import annotations
 
 import gc
+import inspect
 import os
 import sys
 from collections.abc import Sequence
@@ -25,13 +26,30 @@ EXIT_OK, EXIT_INTERNAL, EXIT_BAD_INPUT, EXIT_SERVICE, EXIT_INTERRUPTED = 0, 1, 2
 @click.group(context_settings={"help_option_names": ["-h", "--help"], "show_default": True})
 @click.version_option(package_name="ema", message="%(prog)s %(version)s")
 def ema() -> None:
-    """Onboard health monitor for electromechanical actuators (EMAs): a rotary EMA on a gear train (the thesis's
-    elevator actuator), a ball screw turned by a stepper, and a linear servo axis under its position controller."""
+    """Onboard health monitor for electromechanical actuators (EMAs) of several kinds: the thesis's rotary EMA on a
+    gear train, a ball screw, servo axes; each command's --help names the kinds it serves and what each one is."""
 
 
 for module in (commands_local, commands_serve, commands_remote, commands_fleet):
     for command in module.COMMANDS:
         ema.add_command(command)
+
+# The kinds a command serves where not every kind (none: the command reads no actuator's windows), by a kind's fact
+SERVES_ONLY = {"simulate": "simulated", "bench": "default", "schemas": None}
+
+
+def say_kinds() -> None:
+    """Each command's help closed by the kinds it serves, from the kinds' facts: loaded only for a help page, as the
+    facts load the documents (``ema --help`` stays quick)."""
+    from ema.model.kinds import DEFAULT_KIND, KINDS, kinds_with
+
+    for name, command in ema.commands.items():
+        fact = SERVES_ONLY.get(name, "all")
+        if fact is None:
+            continue
+        served = (DEFAULT_KIND,) if fact == "default" else tuple(KINDS) if fact == "all" else kinds_with(fact)
+        said = "\n".join(f"  {kind}: {KINDS[kind].summary}" for kind in served)
+        command.help = f"{inspect.cleandoc(command.help or '')}\n\nKinds:\n\n\b\n{said}"
 
 
 EXTRAS = {  # a module an optional extra brings -> the extra
@@ -77,6 +95,8 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 def _run(arguments: list[str]) -> int:
     name = next((a for a in arguments if not a.startswith("-")), "")
+    if name and {"-h", "--help"} & set(arguments):
+        say_kinds()
     try:
         ema.main(args=arguments, prog_name="ema", standalone_mode=False)
         return EXIT_OK

@@ -104,17 +104,21 @@ def say_if_compiling(windows: Any) -> None:
 
 def kind_given(windows: Any, path: Path | None) -> None:
     """Where no --actuator was given, an InputError naming the flag for a window of another kind than the default
-    document's (a ball screw's or a servo's log read with the thesis's rotary EMA)."""
+    document's: only the default kind has a document ema can assume (the thesis's); a ball screw's, a servo's or a
+    geared servo's constants are its own, and reading its log with another's would answer confidently and wrongly."""
     if path is not None:
         return
-    from ema.kinds import same_kind
     from ema.model.actuator import THESIS
     from ema.model.checks import InputError
 
-    try:
-        same_kind(windows, THESIS)
-    except InputError as error:
-        raise InputError("--actuator", f"the signals {error.message}, given with --actuator") from None
+    for window in windows:
+        if window.kind != THESIS.kind:
+            raise InputError(
+                "--actuator",
+                f"is needed: window {window.window_id} is a {window.kind} actuator's "
+                f"({', '.join(window.signal_names)}), and only a {THESIS.kind} one has a default document (the "
+                "thesis's): give the actuator's own ema-actuator/1 document",
+            )
 
 
 def log_map(function: F) -> F:

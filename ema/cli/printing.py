@@ -9,17 +9,21 @@ from typing import Any
 import click
 
 from ema.model.checks import InputError
+from ema.model.kinds import KindFacts
 
 
-def read_truth(path: Path | None) -> dict[str, float] | None:
-    """``{"FDJ": 0.05, "eta_O": 0.85, "FSJ": 0.1}`` (FSJ optional); errors name the file."""
+def read_truth(path: Path | None, facts: KindFacts) -> dict[str, float] | None:
+    """What ``facts``' kind's calibration report compares with a truth, read from ``path`` (``{"FDJ": 0.05, "eta_O":
+    0.85}`` for a rotary EMA; other keys ignored); errors name the file, or --truth for a kind that compares none."""
     if path is None:
         return None
+    if not facts.truth:
+        raise InputError("--truth", f"a {facts.name} actuator's calibration compares no truth: leave it out")
     try:
         truth = json.loads(Path(path).read_text())
-        return {key: float(truth[key]) for key in ("FDJ", "eta_O")}
+        return {key: float(truth[key]) for key in facts.truth}
     except (OSError, ValueError, KeyError, TypeError) as exc:
-        raise InputError(str(path), f"is not a truth file with FDJ and eta_O ({exc!r})") from None
+        raise InputError(str(path), f"is not a truth file with {' and '.join(facts.truth)} ({exc!r})") from None
 
 
 def _std(std: float | None) -> str:

@@ -16,7 +16,7 @@ from ema.estimate.quasistatic.slow_window import estimate_low_rate
 from ema.model.actuator import THESIS, ActuatorDocument
 from ema.model.bounds import NOISE_COPIES
 from ema.model.checks import InputError
-from ema.model.kinds import KindFacts
+from ema.model.kinds import KindFacts, kinds_with
 from ema.model.window import Window
 
 WARM_UP = PipelineConfig(n_simulations=16, check_simulations=8, n_timesteps=20, hidden_units=4)  # a warm-up's sizes
@@ -83,9 +83,8 @@ def read_quasi_statically(window: Window, request: Request, reading: QuasiStatic
 
 def not_drawn(facts: KindFacts) -> InputError:
     """The refusal of a kind without a simulator of its own windows (``ema simulate``), naming the flag."""
-    return InputError(
-        "--actuator", f"is a {facts.name} actuator's document: ema simulate draws the windows of a rotary EMA only"
-    )
+    drawn = ", ".join(kinds_with("simulated"))
+    return InputError("--actuator", f"is a {facts.name} actuator's document: ema simulate draws {drawn} windows only")
 
 
 class Kind(Protocol):

@@ -55,6 +55,8 @@ class KindFacts:
     load_side: bool = False  # the log is on the load side: FDJ is the load's friction force
     recorded: tuple[str, ...] = ()  # the section's fields a log may record beside its signals (``constants``)
     measured: tuple[str, ...] = ()  # the signals its answer is read from: a dead one refuses a window
+    simulated: bool = False  # ema simulate draws its windows (its simulator runs from a document alone)
+    truth: tuple[str, ...] = ()  # what its calibration report compares with a known truth (``ema calibrate --truth``)
     # How long the windows a recording of this kind is cut into unless told (the thesis's windows: a few commands of
     # the elevator each); None: a log is one window (a rig's run, a controller's log).
     cut_s: float | None = None
@@ -107,6 +109,8 @@ _ROTARY = KindFacts(
     nominal_given=True,
     static_friction=True,
     measured=("position_deg", "motor_speed_radps", "current_a"),
+    simulated=True,
+    truth=("FDJ", "eta_O"),
 )
 _LINEAR = KindFacts(
     name="linear",
@@ -145,6 +149,11 @@ KINDS: Mapping[str, KindFacts] = MappingProxyType({k.name: k for k in (_ROTARY, 
 DEFAULT_KIND = _ROTARY.name
 KIND_NAMES = tuple(KINDS)
 ALL_SIGNALS = tuple(dict.fromkeys(name for k in KINDS.values() for name in k.all_signals))
+
+
+def kinds_with(fact: str) -> tuple[str, ...]:
+    """The names of the kinds whose ``fact`` (a field of ``KindFacts``) is set: what a command serves."""
+    return tuple(name for name, kind in KINDS.items() if getattr(kind, fact))
 
 
 def facts(kind: str) -> KindFacts:

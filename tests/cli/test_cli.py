@@ -342,3 +342,33 @@ def test_a_first_run_says_it_compiles_and_a_warm_one_says_nothing(tmp_path, caps
     (tmp_path / "absent.nbi").write_bytes(b"")
     say_if_compiling([window])
     assert capsys.readouterr().err == ""
+
+
+EMPS = Path(__file__).resolve().parents[2] / "examples" / "emps"
+
+
+def test_each_command_says_the_kinds_it_serves_from_their_facts(capsys):
+    from ema.model.kinds import KINDS, kinds_with
+
+    assert main(["estimate", "--help"]) == EXIT_OK
+    said = capsys.readouterr().out
+    assert all(f"{name}: {kind.summary}" in said for name, kind in KINDS.items())
+    assert main(["simulate", "--help"]) == EXIT_OK
+    said = capsys.readouterr().out
+    assert [name for name in KINDS if f"{name}: " in said] == list(kinds_with("simulated")) == ["rotary"]
+
+
+def test_another_kind_s_log_without_its_document_or_with_a_flag_it_has_not_is_named(tmp_path, capsys):
+    log = [str(EMPS / "DATA_EMPS.mat"), "--log-map", str(EMPS / "log-map.json")]
+    assert main(["estimate", *log]) == EXIT_BAD_INPUT  # a servo's log: the thesis's document is no default for it
+    said = capsys.readouterr().err
+    assert "--actuator: is needed" in said and "servo" in said
+    out = tmp_path / "w.json"
+    assert main(["simulate", "--out", str(out), "--actuator", str(EMPS / "actuator.json")]) == EXIT_BAD_INPUT
+    assert "is a servo actuator's document: ema simulate draws rotary windows only" in capsys.readouterr().err
+    assert not out.exists()
+    truth = tmp_path / "truth.json"
+    truth.write_text('{"FDJ": 1.0, "eta_O": 0.9}')
+    calibrate = ["calibrate", *log, "--actuator", str(EMPS / "actuator.json"), "--truth", str(truth)]
+    assert main(calibrate) == EXIT_BAD_INPUT  # a servo's report compares no truth: never silently ignored
+    assert "--truth: a servo actuator's calibration compares no truth" in capsys.readouterr().err
