@@ -23,7 +23,7 @@ import numpy as np
 from ema.cli.benchmark_docs import write_section
 from ema.estimate import thread_budget
 from ema.kinds.rotary.pipeline import estimate_window
-from ema.model.actuator import THESIS, actuator_from_dict
+from ema.model.actuator import THESIS, RotaryActuator, actuator_from_dict, as_kind
 from ema.model.checks import InputError
 from ema.model.window import window_from_dict
 from tests.foreign.actuators import DRIVES, NOMINAL, document
@@ -48,7 +48,7 @@ def run_one(name: str, condition: str, seed: int) -> dict[str, Any]:
     rng = np.random.default_rng(seed)
     family = "thesis" if condition == "in flight" else "sweep"
     drawn = draw(seed, family, drive=DRIVES[name], nominal=NOMINAL[name], flight=where(condition, rng))
-    actuator = THESIS if name == "thesis" else actuator_from_dict(document(name))
+    actuator = THESIS if name == "thesis" else as_kind(actuator_from_dict(document(name)), RotaryActuator)
     try:
         result = estimate_window(window_from_dict(drawn.document), actuator=actuator)
     except InputError as exc:

@@ -140,6 +140,9 @@ class Airframe(Document):
     )
 
 
+LOAD_MODEL_TOLERANCE = Airframe.model_fields["tolerance"].default
+
+
 class ActuatorDocument(Document):
     """``ema-actuator/1``: what every kind's document holds. A document is one kind's class (``RotaryActuator``,
     ``LinearActuator``, ``ServoActuator``), which adds its own section; ``AnyActuator`` joins them on ``kind``."""
@@ -151,8 +154,6 @@ class ActuatorDocument(Document):
         None, description="the health new; a linear actuator's or a servo's is learned by ema calibrate"
     )
     thresholds: Thresholds = Field(default_factory=Thresholds)
-    sensor_noise: SensorNoiseDocument | None = Field(None, description="null: the thesis's levels")
-    airframe: Airframe | None = Field(None, description="null: the hinge moment is not checked against an aircraft")
 
     @model_validator(mode="before")
     @classmethod
@@ -163,7 +164,7 @@ class ActuatorDocument(Document):
         if kind is None:
             return values
         own = KINDS[kind].section
-        values = {k: v for k, v in values.items() if v is not None or k == own or k not in SECTIONS}
+        values = {k: v for k, v in values.items() if v is not None or k == own or k in cls.model_fields}
         for other in SECTIONS:
             if other != own and other in values:
                 raise ValueError(f"{other}: a {kind} actuator has no {other} (kind: {kind})")
@@ -243,6 +244,12 @@ class ActuatorDocument(Document):
             nominal_eta_o=eta_o,
         )
 
+    @property
+    def load_model_tolerance(self) -> float:
+        """How far the model a logged load is checked against may be from the real one, relative: a trend of the
+        load sensor's gain against it is said only beyond this (a kind without such a model: the default)."""
+        return LOAD_MODEL_TOLERANCE
+
     def eta_a(self, eta_o: np.ndarray | float) -> np.ndarray:
         """η_A from η_O by Eq. 3.4 with this actuator's gear ratio."""
         return eta_a_from_eta_o(eta_o, self.gear_ratio)
@@ -272,6 +279,31 @@ class ActuatorDocument(Document):
             raise InputError(f"thresholds.{parameter}", "has no level: the document gives none and no nominal")
         return found[0]
 
+
+KindDocument = TypeVar("KindDocument", bound=ActuatorDocument)
+
+
+class RotaryActuator(ActuatorDocument):
+    """A rotary actuator's document: a gear train to a surface, its drive simulated at 1 µs."""
+
+    kind: Literal["rotary"] = Field("rotary", description=_KIND_DESCRIPTION)
+    drive: Drive = Field(description="the drive and its gear train")
+    sensor_noise: SensorNoiseDocument | None = Field(None, description="null: the thesis's levels")
+    airframe: Airframe | None = Field(None, description="null: the hinge moment is not checked against an aircraft")
+
+    @property
+    def section(self) -> Drive:
+        return self.drive
+
+    @property
+    def params(self) -> DriveConstants:
+        return DriveConstants(**self.drive.model_dump())
+
+    @property
+    def load_model_tolerance(self) -> float:
+        """The airframe's tolerance on its hinge-moment model (the default without an airframe)."""
+        return LOAD_MODEL_TOLERANCE if self.airframe is None else self.airframe.tolerance
+
     @property
     def hinge(self) -> HingeGeometry | None:
         """The airframe's hinge-moment model, or None without an airframe."""
@@ -283,24 +315,6 @@ class ActuatorDocument(Document):
     def noise(self) -> SensorNoise:
         """The sensors' noise as the document gives it, else the thesis's levels."""
         return SensorNoise() if self.sensor_noise is None else SensorNoise(**self.sensor_noise.model_dump())
-
-
-KindDocument = TypeVar("KindDocument", bound=ActuatorDocument)
-
-
-class RotaryActuator(ActuatorDocument):
-    """A rotary actuator's document: a gear train to a surface, its drive simulated at 1 µs."""
-
-    kind: Literal["rotary"] = Field("rotary", description=_KIND_DESCRIPTION)
-    drive: Drive = Field(description="the drive and its gear train")
-
-    @property
-    def section(self) -> Drive:
-        return self.drive
-
-    @property
-    def params(self) -> DriveConstants:
-        return DriveConstants(**self.drive.model_dump())
 
 
 class LinearActuator(ActuatorDocument):

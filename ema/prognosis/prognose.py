@@ -11,13 +11,12 @@ import numpy as np
 
 from ema.estimate.documents import Note
 from ema.kinds import combined_inertia, inertia_change_note
-from ema.model.actuator import ActuatorDocument, Airframe
+from ema.model.actuator import ActuatorDocument
 from ema.prognosis.backtest import backtest
 from ema.prognosis.documents import MIN_SPAN, PARAMETERS, Prognosis, RemainingLife, Stored, TimeUnit, Trend
 from ema.prognosis.outlook import Outlook, outlook
 from ema.prognosis.trend import Series, trend_of
 
-AIRFRAME_TOLERANCE = Airframe.model_fields["tolerance"].default
 SENSOR_STDS = 3.0  # stds by which a sensor's level or drift must stand out to be said
 AWAY_STDS = 3.0  # stds by which a trend's slope away from its failure level must stand out to be said
 
@@ -64,8 +63,7 @@ def prognose(
         for name in PARAMETERS
         if (seen := _outlook(name, stored, times, actuator, unit, backtested)) is not None
     }
-    tolerance = actuator.airframe.tolerance if actuator.airframe is not None else AIRFRAME_TOLERANCE
-    sensors, said = sensor_trends(stored, times, unit, tolerance)
+    sensors, said = sensor_trends(stored, times, unit, actuator.load_model_tolerance)
     inertias = [s.window.inertia_read for s in stored if s.window.inertia_read is not None]
     faster = [speeding_note(name) for name, seen in outlooks.items() if seen.life.speeding_up]
     away = [away_note(name, seen, actuator, unit) for name, seen in outlooks.items()]

@@ -106,6 +106,18 @@ def test_a_document_as_first_written_still_reads_and_another_kinds_section_is_re
     assert refused.value.field == "drive"
 
 
+def test_the_rotarys_own_fields_are_its_own_and_a_null_one_in_another_kinds_document_reads_as_absent():
+    """The airframe and the sensors' noise are a rotary document's; another kind's document written with them null
+    (as every document once was) still reads, and one that gives them is refused naming the field."""
+    servo = json.loads((EXAMPLE.parent / "emps" / "actuator.json").read_text())
+    read = actuator_from_dict({**servo, "airframe": None, "sensor_noise": None})
+    assert read == actuator_from_dict(servo) and "airframe" not in read.model_dump()
+    with pytest.raises(InputError, match="Extra inputs") as refused:
+        actuator_from_dict({**servo, "sensor_noise": THESIS.model_dump()["drive"]})
+    assert refused.value.field == "sensor_noise"
+    assert THESIS.load_model_tolerance == THESIS.airframe.tolerance and read.load_model_tolerance == 0.1
+
+
 def test_a_servos_force_once_per_turn_repeats_at_its_documents_turn():
     servo = {"command_limit": 10.0, "travel_per_turn_m": 2.5e-3, "effects": {"turn_ripple": 2.5e-3}}
     document = {"schema": "ema-actuator/1", "name": "a servo", "kind": "servo", "servo": servo}

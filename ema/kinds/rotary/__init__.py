@@ -23,7 +23,7 @@ from ema.estimate.quasistatic.slow_window import QUASI_STATIC_STAGES
 from ema.kinds.base import WARM_UP, Calibrated, CalibrationRequest, Cost, Request, read_quasi_statically
 from ema.kinds.rotary.motor_reading import MOTOR_READING
 from ema.kinds.rotary.synthetic import synthetic_window
-from ema.model.actuator import THESIS, ActuatorDocument
+from ema.model.actuator import THESIS, ActuatorDocument, RotaryActuator, as_kind
 from ema.model.bounds import HIGH_RATE_HZ
 from ema.model.checks import InputError
 from ema.model.kinds import KINDS, KindFacts
@@ -59,7 +59,7 @@ class Rotary:
         return estimate_window(
             window,
             request.config,
-            actuator=request.actuator,
+            actuator=as_kind(request.actuator, RotaryActuator),
             version=request.version,
             on_stage=request.on_stage,
             spec_only=request.spec_only,
@@ -77,7 +77,8 @@ class Rotary:
         from ema.kinds.rotary.calibration import Calibrator  # the network's (module docstring)
 
         config = request.config
-        calibrator = Calibrator(config, copies=request.copies, seed=config.seed, actuator=request.actuator)
+        actuator = as_kind(request.actuator, RotaryActuator)
+        calibrator = Calibrator(config, copies=request.copies, seed=config.seed, actuator=actuator)
         calibrator.fit(windows, request.truth, on_stage=request.on_stage, checkpoint=request.checkpoint)
         return Calibrated(calibrator.report_, None, residual_plot(calibrator))
 
@@ -94,7 +95,7 @@ class Rotary:
         """``ema simulate``'s windows drawn by the simulator at the health ``flags`` ask (``synthesis.Draw``)."""
         from ema.kinds.rotary.synthesis import Draw, synthesize
 
-        return synthesize(Draw(**flags), actuator)
+        return synthesize(Draw(**flags), as_kind(actuator, RotaryActuator))
 
     def warm_up(self) -> None:
         """A tiny pipeline run: simulation kernels, residual, network and the physics solution all exercised once

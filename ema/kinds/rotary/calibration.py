@@ -44,7 +44,7 @@ from ema.kinds.rotary.selection import Chosen, Decision, Evidence, decide, evide
 from ema.kinds.rotary.tied_solve import MIN_HELD_OUT_GAIN, corrected, held_out_rss, solve_with
 from ema.kinds.rotary.twins import TWINS, output_error, runners_up, tell_apart
 from ema.kinds.rotary.vocabulary import COGGING_ORDERS, named_families
-from ema.model.actuator import ActuatorDocument
+from ema.model.actuator import RotaryActuator
 from ema.model.bounds import DEFAULT_SAMPLE_RATE_HZ, NOISE_COPIES
 from ema.model.checks import InputError
 from ema.model.noise import SensorNoise
@@ -57,7 +57,7 @@ MOVE_SHARE_OF_RANGE = 0.5
 SEPARATION = 0.5  # a rival's excess output error, as a share of the pick's gain over no effect, that tells them apart
 
 
-def combined(results: Sequence[Estimate], actuator: ActuatorDocument) -> dict[str, float]:
+def combined(results: Sequence[Estimate], actuator: RotaryActuator) -> dict[str, float]:
     """Inverse-variance mean of FDJ and η_O over windows (one actuator, one health); η_O the nominal where no
     window carries a load to read it by."""
     out = {}
@@ -118,7 +118,7 @@ class Calibrator:
         copies: int = NOISE_COPIES,
         seed: int = 0,
         *,
-        actuator: ActuatorDocument,
+        actuator: RotaryActuator,
     ) -> None:
         self.actuator = actuator
         self.pipeline = pipeline

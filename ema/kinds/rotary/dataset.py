@@ -16,7 +16,7 @@ from ema.kinds.rotary.physics.scenario import Scenario, scenario_from_window
 from ema.kinds.rotary.simulator.effects import EffectSet
 from ema.kinds.rotary.simulator.residual import residual_torque_nm
 from ema.kinds.rotary.simulator.sensor_noise import add_seeded_noise
-from ema.model.actuator import ActuatorDocument
+from ema.model.actuator import RotaryActuator
 from ema.model.noise import SensorNoise
 from ema.model.params import DriveConstants, HealthParams
 from ema.model.window import Window
@@ -87,7 +87,7 @@ def simulate_dataset(
     physics: FrictionSolution,
     config: PipelineConfig,
     *,
-    document: ActuatorDocument,
+    document: RotaryActuator,
     drive: DriveConstants,
     effects: EffectSet,
 ) -> Data:

@@ -19,7 +19,7 @@ from ema.kinds.rotary.equations import Equations, equations
 from ema.kinds.rotary.physics.scenario import inside, scenario_from_window
 from ema.kinds.rotary.simulator.sensor_noise import add_sensor_noise
 from ema.model import runtime
-from ema.model.actuator import ActuatorDocument
+from ema.model.actuator import RotaryActuator
 from ema.model.bounds import NOISE_COPIES
 from ema.model.noise import SensorNoise
 from ema.model.params import DriveConstants
@@ -27,7 +27,7 @@ from ema.model.window import Window
 
 
 def clean_replicas(
-    windows: Sequence[Window], estimates: Mapping[str, float], actuator: ActuatorDocument
+    windows: Sequence[Window], estimates: Mapping[str, float], actuator: RotaryActuator
 ) -> list[dict[str, np.ndarray]]:
     """Each window simulated at ``estimates`` (FSJ at twice FDJ), without noise."""
     health = inside(estimates["FDJ"], estimates["eta_O"], actuator.health.fdj)

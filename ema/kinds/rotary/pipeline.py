@@ -39,7 +39,7 @@ from ema.kinds.rotary.physics.static_friction import read_static_friction
 from ema.kinds.rotary.prepare.conditioning import Prepared, prepare, widened
 from ema.kinds.rotary.report import estimate_document
 from ema.kinds.rotary.reproduction import output_error_ratios
-from ema.model.actuator import THESIS, ActuatorDocument
+from ema.model.actuator import THESIS, RotaryActuator
 from ema.model.window import Window
 
 # On a few dozen noisy simulations the network stops improving within a few epochs, and the physics solution
@@ -148,7 +148,7 @@ def estimate_window(
     window: Window,
     config: PipelineConfig = PipelineConfig(),
     *,
-    actuator: ActuatorDocument,
+    actuator: RotaryActuator,
     version: int | None = None,
     on_stage: Callable[[str], None] | None = None,
     spec_only: bool = False,

@@ -32,14 +32,14 @@ from ema.kinds.rotary.physics.static_friction import StaticFriction
 from ema.kinds.rotary.prepare.conditioning import Prepared, conditioning_done, conditioning_notes
 from ema.kinds.rotary.prepare.departures.drive_constants import KERNEL_FREE_RATE_HZ
 from ema.kinds.rotary.simulator.hinge import denoised_hinge_nm
-from ema.model.actuator import ActuatorDocument
+from ema.model.actuator import RotaryActuator
 
 if TYPE_CHECKING:  # SciPy's optimizers: a window read without a network (quasi-static) never loads it
     from ema.kinds.rotary.network import NetworkEstimator
 
 
 def _estimates(
-    answer: Assessed, fsj: StaticFriction, eta_o_bound: bool, actuator: ActuatorDocument, loaded: bool
+    answer: Assessed, fsj: StaticFriction, eta_o_bound: bool, actuator: RotaryActuator, loaded: bool
 ) -> Estimates:
     """FDJ and η_O as assessed, η_A by Eq. 3.4 with the actuator's gear ratio (its std through the derivative),
     FSJ and FSD if read; each weakly determined where its std says so, and both where Eq. 5.1 put η_O at a

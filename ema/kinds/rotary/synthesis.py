@@ -14,7 +14,7 @@ import numpy as np
 from ema.kinds.rotary.simulator.effects import EFFECTS, EffectSet
 from ema.kinds.rotary.simulator.residual import residual_torque_nm
 from ema.kinds.rotary.synthetic import synthetic_window
-from ema.model.actuator import ActuatorDocument, RotaryActuator
+from ema.model.actuator import RotaryActuator
 from ema.model.aircraft import FlightCondition, GroundLoad
 from ema.model.checks import InputError
 from ema.model.noise import NO_NOISE, SensorNoise
@@ -40,7 +40,7 @@ def parse_effect(text: str) -> tuple[str, dict[str, float]]:
     return name, parameters
 
 
-def summary(window: Window, actuator: ActuatorDocument) -> dict[str, Any]:
+def summary(window: Window, actuator: RotaryActuator) -> dict[str, Any]:
     """Ranges of the signals and of the reconstructed residual torque, for a human or a script."""
     s = window.signals
     residual = residual_torque_nm(
@@ -61,7 +61,7 @@ def summary(window: Window, actuator: ActuatorDocument) -> dict[str, Any]:
 
 
 def _healths(
-    actuator: ActuatorDocument,
+    actuator: RotaryActuator,
     *,
     start: tuple[float | None, float | None, float | None],
     end: tuple[float | None, float | None],
@@ -118,7 +118,7 @@ class Draw:
 
 def _window(
     draw: Draw,
-    actuator: ActuatorDocument,
+    actuator: RotaryActuator,
     health: dict[str, float],
     index: int,
     *,
@@ -148,7 +148,7 @@ def _window(
     return replace(window, window_id=window_id, flight_hours=hours, recorded_at=stamp)
 
 
-def synthesize(draw: Draw, actuator: ActuatorDocument) -> dict[str, Any]:
+def synthesize(draw: Draw, actuator: RotaryActuator) -> dict[str, Any]:
     """Simulate ``actuator`` at the given health (its nominal
     where none is given), write the window (and the truth), return what was written. With ``series`` > 1,
     ``out`` is a folder of that many windows of a degrading actuator, its health moving linearly to

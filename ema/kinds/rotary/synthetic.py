@@ -10,7 +10,7 @@ from ema.kinds.rotary.simulator.batch import InitialState, simulate_batch
 from ema.kinds.rotary.simulator.commands import family_knots
 from ema.kinds.rotary.simulator.effects import EffectSet
 from ema.kinds.rotary.simulator.sensor_noise import add_sensor_noise
-from ema.model.actuator import THESIS, ActuatorDocument
+from ema.model.actuator import THESIS, RotaryActuator
 from ema.model.aircraft import FlightCondition, GroundLoad
 from ema.model.bounds import (
     DEFAULT_SAMPLE_RATE_HZ,
@@ -37,7 +37,7 @@ def synthetic_window(
     actuator_id: str = "synthetic/elevator",
     window_id: str | None = None,
     command: str = "thesis",
-    actuator: ActuatorDocument = THESIS,
+    actuator: RotaryActuator = THESIS,
 ) -> Window:
     """One window logged from the model of ``actuator``: a command of ``command``'s family
     (``simulator.commands.COMMAND_FAMILIES``), the actuator at rest where the command starts, sensor noise; in flight at

@@ -22,7 +22,7 @@ from ema.calibration.limits import NAME_Z
 from ema.kinds.rotary.physics.scenario import CLEAR_MARGIN, following_error, inside, scenario_from_window
 from ema.kinds.rotary.selection import NAME_MARGIN, Evidence
 from ema.kinds.rotary.simulator.effects import EffectSet
-from ema.model.actuator import ActuatorDocument
+from ema.model.actuator import RotaryActuator
 from ema.model.noise import SensorNoise
 from ema.model.window import Window
 
@@ -39,7 +39,7 @@ def output_error(
     estimates: Mapping[str, float],
     option: Evidence | None,
     noise: Sequence[SensorNoise],
-    actuator: ActuatorDocument,
+    actuator: RotaryActuator,
     beside: Sequence[Evidence] = (),
 ) -> float:
     """Mean over windows of RMS(speed)/σ_speed + RMS(current)/σ_current, simulated at ``estimates`` with
@@ -67,7 +67,7 @@ def tell_apart(
     readings: Mapping[str, Mapping[str, float]],
     options: Sequence[Evidence],
     noise: Sequence[SensorNoise],
-    actuator: ActuatorDocument,
+    actuator: RotaryActuator,
     beside: Sequence[Evidence] = (),
 ) -> tuple[Evidence, dict[str, float], bool]:
     """The reading whose simulation follows the windows best, each simulated at its own estimates

@@ -49,7 +49,7 @@ from ema.kinds.rotary.prepare.stale import Stale, line_between_flanks, stale_not
 from ema.kinds.rotary.prepare.step_lag import StepLag, step_lag, step_lag_note
 from ema.kinds.rotary.prepare.verdict import check_consistency, kinematics_note
 from ema.kinds.rotary.simulator.batch import COMMAND_MARGIN_DEG
-from ema.model.actuator import ActuatorDocument
+from ema.model.actuator import RotaryActuator
 from ema.model.bounds import DEFAULT_SAMPLE_RATE_HZ
 from ema.model.noise import NOISY_SIGNALS
 from ema.model.params import DriveConstants
@@ -66,7 +66,7 @@ MAX_GLITCH_S = 3e-4  # ... and so may a shorter one at a low rate: a current pul
 
 @dataclass(frozen=True)
 class Prepared:
-    document: ActuatorDocument  # the actuator's document the window is read with
+    document: RotaryActuator  # the actuator's document the window is read with
     factor: int  # adjacent samples averaged into one
     original_samples: int
     original_rate_hz: float
@@ -142,9 +142,7 @@ def repaired(window: Window) -> tuple[Window, dict[str, int]]:
     return (replace(window, signals=signals) if counts else window), counts
 
 
-def prepare(
-    window: Window, actuator: ActuatorDocument, spec_only: bool = False, known: Known | None = None
-) -> Prepared:
+def prepare(window: Window, actuator: RotaryActuator, spec_only: bool = False, known: Known | None = None) -> Prepared:
     """Cut ``window`` to a stretch its sensors kept updating in (``ema.kinds.rotary.prepare.stale``), repair its
     glitches, average it down to the pipeline's sizes, check its signals agree
     (``ema.kinds.rotary.prepare.consistency``: InputError naming the field), put its sensors on one clock

@@ -32,7 +32,7 @@ from ema.kinds.rotary.prepare.departures.drive_constants import UNDECIDED_SHARE,
 from ema.kinds.rotary.prepare.departures.hinge_gain import HingeGain, read_hinge_gain
 from ema.kinds.rotary.prepare.departures.viscosity import Viscosity, read_viscosity
 from ema.kinds.rotary.prepare.departures.zero_offset import ZeroOffset, read_zero_offset, zeroed
-from ema.model.actuator import ActuatorDocument
+from ema.model.actuator import RotaryActuator
 from ema.model.checks import InputError
 from ema.model.noise import SensorNoise
 from ema.model.params import DriveConstants
@@ -76,7 +76,7 @@ class Departures:
 
 def read_departures(
     window: Window,
-    actuator: ActuatorDocument,
+    actuator: RotaryActuator,
     aircraft: AircraftCheck = AircraftCheck(),
     known: Known = Known(),
 ) -> Departures:
@@ -109,7 +109,7 @@ def _doubted(read: Departures, divided: Departures) -> Departures:
     return replace(read, aircraft=replace(read.aircraft, spread=spread))
 
 
-def _read(window: Window, actuator: ActuatorDocument, aircraft: AircraftCheck, known: Known) -> Departures:
+def _read(window: Window, actuator: RotaryActuator, aircraft: AircraftCheck, known: Known) -> Departures:
     """``read_departures`` with ``aircraft``'s factor as decided."""
     zero, spec = known.zero, actuator.params
     window = aircraft.corrected(window)
@@ -134,9 +134,7 @@ def _read(window: Window, actuator: ActuatorDocument, aircraft: AircraftCheck, k
 NOISELESS_SPEED = 1e-6  # a speed's white-noise std under this share of its range: logged without noise
 
 
-def _told_apart(
-    window: Window, scale: Departures, inertia: Departures, actuator: ActuatorDocument
-) -> Departures | None:
+def _told_apart(window: Window, scale: Departures, inertia: Departures, actuator: RotaryActuator) -> Departures | None:
     """The reading whose simulation follows the window's motor speed and current clearly better
     (``CLEAR_MARGIN``), or None: γ as a torque constant or as a current sensor's gain, whichever
     follows better, against ΔJ; each at its own answer, with the viscous coefficient it read. Only
