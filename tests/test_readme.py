@@ -33,6 +33,43 @@ def readme_commands() -> list[str]:
     return found
 
 
+def readme_samples() -> dict[str, str]:
+    """Each sample output the README shows, by its command (as ``readme_commands`` spells it): the lines under its
+    ``$ `` line up to the next one."""
+    samples: dict[str, str] = {}
+    for kind, body in BLOCK.findall((ROOT / "README.md").read_text()):
+        if kind != "text":
+            continue
+        for part in re.split(r"^\$ ", re.sub(r"\\\n\s*", " ", body), flags=re.M)[1:]:
+            command, _, shown = part.partition("\n")
+            samples[" ".join(command.split())] = shown
+    return samples
+
+
+def sample_pattern(shown: str) -> re.Pattern[str]:
+    """What a sample promises, digit for digit: its text with any run of spaces or line breaks matching any other
+    (the README wraps long lines), ``...`` and ``(...)`` standing for what it leaves out, and a time line's seconds
+    for any (they are this machine's, that day's)."""
+    lines = shown.strip().splitlines()
+    timed = "\n".join(re.sub(r"\d+\.\d+(?= s\b)", "\0", line) if line.startswith("time:") else line for line in lines)
+    pattern = ""
+    for part in re.split(r"(\(\.\.\.\)|\.\.\.)", timed):
+        if part in ("...", "(...)"):
+            pattern += ".*?"
+            continue
+        words = (re.escape(word).replace("\0", r"[\d.]+") for word in part.split())
+        pattern += r"\s+".join(words)
+        pattern += r"\s+" if part[-1:].isspace() else ""
+    return re.compile(pattern, re.S)
+
+
+def test_a_sample_is_matched_digit_for_digit():
+    shown = "parameter   value\nFDJ   0.05515\n...\ntime: prepare 0.41 s  total 0.54 s"
+    pattern = sample_pattern(shown)
+    assert pattern.search("parameter value\nFDJ 0.05515\nnote x\ntime: prepare 1.20 s  total 3.00 s")
+    assert not pattern.search("parameter value\nFDJ 0.05516\nnote x\ntime: prepare 1.20 s  total 3.00 s")
+
+
 def _port_free() -> bool:
     with contextlib.closing(socket.socket()) as probe:
         return probe.connect_ex(("127.0.0.1", 8000)) != 0
@@ -82,7 +119,7 @@ def test_every_readme_command_runs_as_written(tmp_path, group):
     (tmp_path / "shared").symlink_to(ROOT.parent / "shared")
     tmp_path = work
     (tmp_path / "examples").symlink_to(ROOT / "examples")
-    server = None
+    server, samples = None, readme_samples()
     try:
         for command in command_groups()[group]:
             if command == "ema serve &":
@@ -92,6 +129,8 @@ def test_every_readme_command_runs_as_written(tmp_path, group):
                 continue
             done = subprocess.run(["bash", "-c", command], cwd=tmp_path, capture_output=True, text=True, timeout=600)
             assert done.returncode == 0, f"{command}\n{done.stderr[-2000:]}"
+            if command in samples:  # what the README shows it print, digits and notes
+                assert sample_pattern(samples[command]).search(done.stdout), f"{command}\n{done.stdout}"
         if server is not None:
             listed = httpx.get(f"{DEFAULT_URL}/v1/actuators", timeout=30).json()  # step 4, as curl would
             assert "tail-7/elevator-left" in {line["actuator_id"] for line in listed}
