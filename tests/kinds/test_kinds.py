@@ -12,8 +12,18 @@ from ema.kinds import REGISTRY
 from ema.model import kinds as facts
 
 PACKAGE = Path(__file__).resolve().parents[2] / "ema"
-OWN = {PACKAGE / "model" / "kinds.py", *(PACKAGE / "kinds" / f"{name}.py" for name in facts.KINDS)}
+OWN = {PACKAGE / "model" / "kinds.py"}  # beside each kind's own folder (``_in_a_kinds_folder``)
 SIGNALS = {name for kind in facts.KINDS.values() for name in kind.all_signals}
+
+
+def _in_a_kinds_folder(path: Path) -> bool:
+    parts = path.relative_to(PACKAGE).parts
+    return len(parts) > 2 and parts[0] == "kinds" and parts[1] in facts.KINDS
+
+
+def _shared_modules() -> list[Path]:
+    """Every module of the package outside a kind's folder (the registry, ``ema/kinds/__init__.py``, included)."""
+    return [path for path in sorted(PACKAGE.rglob("*.py")) if not _in_a_kinds_folder(path)]
 
 
 def _literals(node: ast.AST) -> set[str]:
@@ -23,7 +33,7 @@ def _literals(node: ast.AST) -> set[str]:
 def test_no_kind_is_compared_with_a_literal_outside_its_own_module():
     found = []
     for path in PACKAGE.rglob("*.py"):
-        if path in OWN:
+        if path in OWN or _in_a_kinds_folder(path):
             continue
         for node in ast.walk(ast.parse(path.read_text())):
             if isinstance(node, ast.Compare) and _literals(node) & set(facts.KINDS) and "kind" in ast.unparse(node):
@@ -31,6 +41,43 @@ def test_no_kind_is_compared_with_a_literal_outside_its_own_module():
             told_by_signal = isinstance(node, ast.Compare) and bool(_literals(node.left) & SIGNALS)
             if told_by_signal and any(isinstance(op, ast.In | ast.NotIn) for op in node.ops):
                 found.append(f"{path.relative_to(PACKAGE.parent)}:{node.lineno}")
+    assert found == []
+
+
+def test_no_shared_module_imports_a_kind_or_reads_what_only_one_kind_has():
+    """Outside its folder a kind is reached through the registry (``ema.kinds``): no shared module imports a kind's
+    module (the registry imports each at its call), reads a signal only one kind's window carries, or a field only
+    one kind's document has (its section, the rotary's airframe and sensors' noise). The modules that declare them (the
+    documents' classes, the windows' signals and their bounds) are the exception."""
+    from ema.model.actuator import ActuatorDocument, RotaryActuator
+
+    kinds_modules = tuple(f"ema.kinds.{name}" for name in facts.KINDS)
+    counts: dict[str, int] = {}
+    for kind in facts.KINDS.values():
+        for name in kind.all_signals:
+            counts[name] = counts.get(name, 0) + 1
+    one_kinds_signals = {name for name, n in counts.items() if n == 1}
+    own_fields = {kind.section for kind in facts.KINDS.values()}
+    own_fields |= set(RotaryActuator.model_fields) - set(ActuatorDocument.model_fields)
+    declared_in = {PACKAGE / "model" / "actuator.py", PACKAGE / "model" / "window.py"}
+    found = []
+    for path in _shared_modules():
+        at = path.relative_to(PACKAGE.parent)
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.ImportFrom) and (node.module or "").startswith(kinds_modules):
+                # the registry alone: each kind's object (its package) on load, the kind's modules at their call
+                registry = path == PACKAGE / "kinds" / "__init__.py"
+                if not registry or (node.col_offset == 0 and node.module not in kinds_modules):
+                    found.append(f"{at}:{node.lineno} imports {node.module}")
+            if path in declared_in:
+                continue
+            key = node.slice if isinstance(node, ast.Subscript) else None
+            if isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute) and node.func.attr == "get":
+                key = node.args[0] if node.args else None
+            if isinstance(key, ast.Constant) and key.value in one_kinds_signals:
+                found.append(f"{at}:{node.lineno} reads {key.value}")
+            if isinstance(node, ast.Attribute) and node.attr in own_fields and isinstance(node.ctx, ast.Load):
+                found.append(f"{at}:{node.lineno} reads .{node.attr}")
     assert found == []
 
 
