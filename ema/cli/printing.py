@@ -118,10 +118,12 @@ def print_simulate(result: dict[str, Any]) -> None:
 
 
 def print_calibration(report: dict[str, Any]) -> None:
-    """The ``ema-calibration/1`` report as a person reads it (a linear actuator's drive and changes included)."""
-    if report.get("drive"):
-        _print_drive(report["drive"])
-    elif report["noise_floor"]["copies"]:
+    """The ``ema-calibration/1`` report as a person reads it: what every kind's holds, then its kind's own parts as
+    the kind prints them (``ema.kinds.report_lines``: a ball screw's drive and changes, a servo's constants as
+    simulated, a geared servo's runs per load)."""
+    from ema.kinds import report_lines
+
+    if report["noise_floor"]["copies"]:
         click.echo(
             f"noise floor: the base model's residual is {report['noise_floor']['equation_error_ratio']:.2f}x "
             f"what noise alone leaves ({report['noise_floor']['copies']} copies)"
@@ -141,25 +143,10 @@ def print_calibration(report: dict[str, Any]) -> None:
     if report.get("ambiguity"):
         ambiguity = report["ambiguity"]
         click.echo(f"ambiguous: {' / '.join(ambiguity['effects'])}; to tell them apart: {ambiguity['tell_apart']}")
-    for change in report.get("changes", []):
-        click.echo(
-            f"{change['parameter']}: {change['said']} ({change['value']:.4g} ± {change['std']:.2g} against "
-            f"nominal {change['nominal']:.4g})"
-        )
     click.echo(f"held out: {report['held_out']['note']}")
-    learned = {entry["name"]: entry for entry in report.get("learned", [])}
-    units = {"FDJ": " " + learned["FDJ"]["unit"] if "FDJ" in learned else " N·m", "eta_O": ""}
-    for name in ("FDJ", "eta_O"):
-        if name not in report["estimates_after"]:
-            continue
-        was = report["estimates_before"].get(name)
-        line = f"{name}: {'—' if was is None else f'{was:.5g}{units[name]}'} -> {report['estimates_after'][name]:.5g}"
-        line += units[name]
-        if report.get("error_pct_before"):
-            line += f"   error {report['error_pct_before'][name]:.2f} % -> {report['error_pct_after'][name]:.2f} %"
+    _print_estimates(report)
+    for line in report_lines(report):
         click.echo(line)
-    if learned and not report.get("drive"):
-        _print_learned(learned, {entry["name"]: entry["value"] for entry in report.get("as_simulated", [])})
     for when in ("before", "after", "document"):
         errors = report.get(f"model_error_pct_{when}")
         if errors:
@@ -172,39 +159,20 @@ def print_calibration(report: dict[str, Any]) -> None:
 ERROR_WORDS = {"drive_force_n": "force, inverse model", "drive_force_n_closed_loop": "force, closed loop"}
 
 
-def _print_learned(learned: dict[str, Any], simulated: dict[str, float]) -> None:
-    """The learned constants (the solution's, with its std), and where the report gives them, as the simulator takes
-    them: what the completed document keeps."""
-    if not simulated:
-        click.echo("learned (one model):")
-    else:
-        click.echo("learned (one model): the solution's, and as the simulator takes them (what the document keeps)")
-    for entry in learned.values():
-        kept = simulated.get(entry["name"], entry["value"])
-        beside = f"{kept:>12.5g}  " if simulated else ""
-        click.echo(f"  {entry['name']:<24}{entry['value']:>12.5g} ± {entry['std']:<10.2g}{beside}{entry['unit']}")
-
-
-def _print_drive(drive: dict[str, Any]) -> None:
-    loads = ", ".join(f"{n:.0f} N" for n in drive["loads_n"])
-    click.echo(f"learned from {drive['runs']} healthy run(s) at {loads}:")
-    click.echo(
-        f"  current per N·m (c)     {drive['current_per_nm_a']:.4f} ± {drive['current_per_nm_std_a']:.4f} A/(N·m)"
-    )
-    click.echo(
-        f"  current at zero torque  {drive['current_at_zero_torque_a']:.4f} ± "
-        f"{drive['current_at_zero_torque_std_a']:.4f} A (the runs' spread)"
-    )
-    if drive["fdj_nm"] is not None:
-        click.echo(f"  nominal FDJ             {drive['fdj_nm']:.4f} ± {drive['fdj_std_nm']:.4f} N·m")
-        click.echo(f"  nominal η_O             {drive['eta_o']:.3f} ± {drive['eta_o_std']:.3f}")
-    if drive.get("run_to_run_nm") is not None:
-        click.echo(f"  a healthy run's FDJ     scatters by {drive['run_to_run_nm']:.4f} N·m within a set (one load)")
-        click.echo(f"  a healthy set's mean    sits within {drive['healthy_set_nm']:.4f} N·m of the nominal")
-    else:
-        click.echo(f"  repeatability of FDJ    {drive['repeatability_nm']:.4f} N·m beyond each run's own noise")
-    for unread in drive["not_separable"]:
-        click.echo(f"  not separable: {unread}")
+def _print_estimates(report: dict[str, Any]) -> None:
+    """FDJ and η_O before and after, in FDJ's unit as the learned constants give it, with the errors against a truth
+    where one was given."""
+    learned = {entry["name"]: entry for entry in report.get("learned", [])}
+    units = {"FDJ": " " + learned["FDJ"]["unit"] if "FDJ" in learned else " N·m", "eta_O": ""}
+    for name in ("FDJ", "eta_O"):
+        if name not in report["estimates_after"]:
+            continue
+        was = report["estimates_before"].get(name)
+        line = f"{name}: {'—' if was is None else f'{was:.5g}{units[name]}'} -> {report['estimates_after'][name]:.5g}"
+        line += units[name]
+        if report.get("error_pct_before"):
+            line += f"   error {report['error_pct_before'][name]:.2f} % -> {report['error_pct_after'][name]:.2f} %"
+        click.echo(line)
 
 
 TIME_UNITS = {

@@ -57,6 +57,7 @@ __all__ = [
     "load_methods",
     "other_windows_lent",
     "readings_of_results",
+    "report_lines",
     "synthesize",
     "thesis_kernel_cached",
     "thesis_kernel_seconds",
@@ -223,6 +224,14 @@ def synthesize(actuator: ActuatorDocument, flags: Mapping[str, Any]) -> dict[str
     """``ema simulate``: windows of ``actuator`` drawn by its kind's simulator, as ``flags`` ask (``Kind.synthesize``);
     InputError naming ``--actuator`` for a kind that draws none."""
     return kind_of(actuator).synthesize(actuator, flags)
+
+
+def report_lines(report: Mapping[str, Any]) -> list[str]:
+    """The lines of a calibration report's own parts, as its kind prints them (``Kind.report_lines``); a report
+    written before reports named their kind is told by its parts (``kind_written``)."""
+    from ema.calibration.documents import kind_written
+
+    return REGISTRY[report.get("kind") or kind_written(dict(report))].report_lines(report)
 
 
 def estimate_thesis_window(window: Window, config: PipelineConfig) -> Estimate:

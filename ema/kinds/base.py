@@ -81,6 +81,19 @@ def read_quasi_statically(window: Window, request: Request, reading: QuasiStatic
     )
 
 
+def learned_lines(learned: Sequence[Mapping[str, Any]], simulated: Mapping[str, float] | None = None) -> list[str]:
+    """A report's learned constants for a person: each with its std and unit, and where ``simulated`` gives them, as
+    the simulator takes them (what the completed document keeps)."""
+    if not learned:
+        return []
+    beside = ": the solution's, and as the simulator takes them (what the document keeps)" if simulated else ""
+    lines = [f"learned (one model){beside}:"]
+    for entry in learned:
+        kept = f"{simulated.get(entry['name'], entry['value']):>12.5g}  " if simulated else ""
+        lines.append(f"  {entry['name']:<24}{entry['value']:>12.5g} ± {entry['std']:<10.2g}{kept}{entry['unit']}")
+    return lines
+
+
 def not_drawn(facts: KindFacts) -> InputError:
     """The refusal of a kind without a simulator of its own windows (``ema simulate``), naming the flag."""
     drawn = ", ".join(kinds_with("simulated"))
@@ -98,3 +111,5 @@ class Kind(Protocol):
     def warm_up(self) -> None: ...  # what its first window would load, loaded now (a service before it answers)
     # ``ema simulate``: its windows drawn by its simulator as the flags ask; ``not_drawn`` where it has none
     def synthesize(self, actuator: ActuatorDocument, flags: Mapping[str, Any]) -> dict[str, Any]: ...
+    # its own parts of an ``ema-calibration/1`` report (as JSON), as a person reads them
+    def report_lines(self, report: Mapping[str, Any]) -> list[str]: ...

@@ -10,7 +10,8 @@ the document's repeatability; each load's median against the nominal says whethe
 from __future__ import annotations
 
 from collections import defaultdict
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
+from typing import Any
 
 import numpy as np
 
@@ -190,3 +191,19 @@ def calibrate_geared(
     read = read_runs(windows, document)
     document = repeatable(document, read)
     return report(model, runs, document, by_load(windows, read, document)), document
+
+
+def report_lines(report: Mapping[str, Any]) -> list[str]:
+    """The runs' mean position error before and after (in sample and held out), and each load's runs read with the
+    completed document: their median health and its z against the nominal's std."""
+    errors = report.get("position_error_rad", {})
+    lines = []
+    if errors:
+        lines.append(
+            f"position error: {errors['before']:.4f} -> {errors['after']:.4f} rad on average "
+            f"(held out: {errors['held_out_before']:.4f} -> {errors['held_out_after']:.4f} rad)"
+        )
+    for load in report.get("by_load", []):
+        said = ", ".join(f"{name} {value:.4g} (z {load['z'][name]:+.1f})" for name, value in load["median"].items())
+        lines.append(f"{load['load']}: {load['runs']} run(s), median {said}")
+    return lines

@@ -45,6 +45,12 @@ class Linear:
     def synthesize(self, actuator: ActuatorDocument, flags: Mapping[str, Any]) -> dict[str, Any]:
         raise not_drawn(self.facts)
 
+    def report_lines(self, report: Mapping[str, Any]) -> list[str]:
+        """What its healthy runs taught of its drive, or what its faulted runs changed."""
+        from ema.kinds.linear.calibration_report import report_lines
+
+        return report_lines(report)
+
     def warm_up(self) -> None:
         """Nothing: a stepper's window is read quasi-statically in NumPy, milliseconds from the first."""
 

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Mapping, Sequence
+from typing import Any
 
 import numpy as np
 
@@ -246,3 +247,34 @@ def _report(
         estimates_after=after,
         timings_s={"total": time.perf_counter() - started},
     )
+
+
+def report_lines(report: Mapping[str, Any]) -> list[str]:
+    """The drive its healthy runs taught (``drive``), or what its faulted runs changed (``changes``), for a person."""
+    lines = [] if report.get("drive") is None else drive_lines(report["drive"])
+    for change in report.get("changes", []):
+        lines.append(
+            f"{change['parameter']}: {change['said']} ({change['value']:.4g} ± {change['std']:.2g} against "
+            f"nominal {change['nominal']:.4g})"
+        )
+    return lines
+
+
+def drive_lines(drive: Mapping[str, Any]) -> list[str]:
+    """The learned drive: c and I₀ with the runs' spread, the nominal FDJ and η_O, their repeatability."""
+    loads = ", ".join(f"{n:.0f} N" for n in drive["loads_n"])
+    lines = [
+        f"learned from {drive['runs']} healthy run(s) at {loads}:",
+        f"  current per N·m (c)     {drive['current_per_nm_a']:.4f} ± {drive['current_per_nm_std_a']:.4f} A/(N·m)",
+        f"  current at zero torque  {drive['current_at_zero_torque_a']:.4f} ± "
+        f"{drive['current_at_zero_torque_std_a']:.4f} A (the runs' spread)",
+    ]
+    if drive["fdj_nm"] is not None:
+        lines.append(f"  nominal FDJ             {drive['fdj_nm']:.4f} ± {drive['fdj_std_nm']:.4f} N·m")
+        lines.append(f"  nominal η_O             {drive['eta_o']:.3f} ± {drive['eta_o_std']:.3f}")
+    if drive.get("run_to_run_nm") is not None:
+        lines.append(f"  a healthy run's FDJ     scatters by {drive['run_to_run_nm']:.4f} N·m within a set (one load)")
+        lines.append(f"  a healthy set's mean    sits within {drive['healthy_set_nm']:.4f} N·m of the nominal")
+    else:
+        lines.append(f"  repeatability of FDJ    {drive['repeatability_nm']:.4f} N·m beyond each run's own noise")
+    return lines + [f"  not separable: {unread}" for unread in drive["not_separable"]]

@@ -20,7 +20,7 @@ from ema.calibration.plot import ResidualPlot, Series
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import STAGES, Estimate
 from ema.estimate.quasistatic.slow_window import QUASI_STATIC_STAGES
-from ema.kinds.base import WARM_UP, Calibrated, CalibrationRequest, Cost, Request, read_quasi_statically
+from ema.kinds.base import WARM_UP, Calibrated, CalibrationRequest, Cost, Request, learned_lines, read_quasi_statically
 from ema.kinds.rotary.motor_reading import MOTOR_READING
 from ema.kinds.rotary.synthetic import synthetic_window
 from ema.model.actuator import THESIS, ActuatorDocument, RotaryActuator, as_kind
@@ -96,6 +96,9 @@ class Rotary:
         from ema.kinds.rotary.synthesis import Draw, synthesize
 
         return synthesize(Draw(**flags), as_kind(actuator, RotaryActuator))
+
+    def report_lines(self, report: Mapping[str, Any]) -> list[str]:
+        return learned_lines(report.get("learned", []))
 
     def warm_up(self) -> None:
         """A tiny pipeline run: simulation kernels, residual, network and the physics solution all exercised once

@@ -17,7 +17,7 @@ import numpy as np
 
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import STAGES, Estimate
-from ema.kinds.base import WARM_UP, Calibrated, CalibrationRequest, Cost, Request, not_drawn
+from ema.kinds.base import WARM_UP, Calibrated, CalibrationRequest, Cost, Request, learned_lines, not_drawn
 from ema.kinds.servo.calibration import CLOSED_LOOPS, calibrate_servo
 from ema.kinds.servo.closed_loop import SUBSTEPS, ServoLoop, simulate_servo
 from ema.model.actuator import ActuatorDocument, ServoActuator, actuator_from_dict, as_kind
@@ -61,6 +61,11 @@ class Servo:
 
     def synthesize(self, actuator: ActuatorDocument, flags: Mapping[str, Any]) -> dict[str, Any]:
         raise not_drawn(self.facts)
+
+    def report_lines(self, report: Mapping[str, Any]) -> list[str]:
+        """What it learned, beside it as the simulator takes it (``as_simulated``)."""
+        simulated = {entry["name"]: entry["value"] for entry in report.get("as_simulated", [])}
+        return learned_lines(report.get("learned", []), simulated)
 
     def warm_up(self) -> None:
         """A tiny servo's window (``WARM_UP_SERVO``) simulated and estimated: its filters, its simulator and its
