@@ -28,9 +28,10 @@ from ema.kinds.rotary.physics.features import features
 from ema.kinds.rotary.physics.friction import solve_window
 from ema.kinds.rotary.physics.scenario import Scenario
 from ema.kinds.rotary.simulator.commands import random_command_knots
+from ema.kinds.rotary.simulator.loads import GroundLoad
 from ema.kinds.rotary.simulator.sensor_noise import add_sensor_noise
 from ema.kinds.rotary.synthetic import synthetic_window
-from ema.model.aircraft import FlightCondition, GroundLoad
+from ema.model.aircraft import FlightCondition
 from ema.model.noise import NO_NOISE, SensorNoise
 from ema.model.params import DEFAULT_RANGES, IRREVERSIBLE_RANGES, HealthParams, HealthRanges
 

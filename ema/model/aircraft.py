@@ -61,15 +61,3 @@ class FlightCondition:
     def dynamic_pressure_pa(self) -> float:
         """q̄ = ½ρV²."""
         return 0.5 * self.density_kgpm3 * self.airspeed_mps**2
-
-
-@dataclass(frozen=True)
-class GroundLoad:
-    """On-ground routine (Case 1A): the aircraft replaced by a prescribed hinge moment."""
-
-    constant_nm: float = -100.0  # H_e at t = 0 [N·m] on the elevator (negative: pulls towards −δ)
-    ramp_nmps: float = 0.0  # dH_e/dt [N·m/s]
-
-    def __post_init__(self) -> None:
-        in_range("ground_load.constant_nm", self.constant_nm, -800.0, 800.0, "N·m")
-        in_range("ground_load.ramp_nmps", self.ramp_nmps, -2000.0, 2000.0, "N·m/s")

@@ -12,10 +12,11 @@ from typing import Any
 import numpy as np
 
 from ema.kinds.rotary.simulator.effects import EFFECTS, EffectSet
+from ema.kinds.rotary.simulator.loads import GroundLoad
 from ema.kinds.rotary.simulator.residual import residual_torque_nm
 from ema.kinds.rotary.synthetic import synthetic_window
 from ema.model.actuator import RotaryActuator
-from ema.model.aircraft import FlightCondition, GroundLoad
+from ema.model.aircraft import FlightCondition
 from ema.model.checks import InputError
 from ema.model.noise import NO_NOISE, SensorNoise
 from ema.model.params import HealthParams

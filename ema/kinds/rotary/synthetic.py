@@ -9,9 +9,10 @@ import numpy as np
 from ema.kinds.rotary.simulator.batch import InitialState, simulate_batch
 from ema.kinds.rotary.simulator.commands import family_knots
 from ema.kinds.rotary.simulator.effects import EffectSet
+from ema.kinds.rotary.simulator.loads import GroundLoad
 from ema.kinds.rotary.simulator.sensor_noise import add_sensor_noise
 from ema.model.actuator import THESIS, RotaryActuator
-from ema.model.aircraft import FlightCondition, GroundLoad
+from ema.model.aircraft import FlightCondition
 from ema.model.bounds import (
     DEFAULT_SAMPLE_RATE_HZ,
     DURATION_RANGE_S,

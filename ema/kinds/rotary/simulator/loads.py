@@ -14,8 +14,8 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ema.model.aircraft import SEA_LEVEL_DENSITY_KGPM3, FlightCondition, GroundLoad, HingeGeometry
-from ema.model.checks import InputError
+from ema.model.aircraft import SEA_LEVEL_DENSITY_KGPM3, FlightCondition, HingeGeometry
+from ema.model.checks import InputError, in_range
 from ema.model.envelope import DEFAULT_AIRSPEED_MPS
 
 # Linearization at the default condition, x = (ΔV [m/s], Δα [rad], Δθ [rad], Δq [rad/s]), u = Δδe [rad].
@@ -40,6 +40,18 @@ TRIM_TABLE = np.array(
         [700.0, 0.382, -0.900],
     ]
 )
+
+
+@dataclass(frozen=True)
+class GroundLoad:
+    """On-ground routine (Case 1A): the aircraft replaced by a prescribed hinge moment."""
+
+    constant_nm: float = -100.0  # H_e at t = 0 [N·m] on the elevator (negative: pulls towards −δ)
+    ramp_nmps: float = 0.0  # dH_e/dt [N·m/s]
+
+    def __post_init__(self) -> None:
+        in_range("ground_load.constant_nm", self.constant_nm, -800.0, 800.0, "N·m")
+        in_range("ground_load.ramp_nmps", self.ramp_nmps, -2000.0, 2000.0, "N·m/s")
 
 
 class LoadModel(NamedTuple):

@@ -5,10 +5,10 @@ import pytest
 
 from ema.kinds.rotary.physics.friction import SolveSettings, solve_friction, solve_window
 from ema.kinds.rotary.simulator.batch import simulate_batch
+from ema.kinds.rotary.simulator.loads import GroundLoad
 from ema.kinds.rotary.simulator.sensor_noise import add_sensor_noise
 from ema.kinds.rotary.synthetic import synthetic_window
 from ema.model.actuator import THESIS
-from ema.model.aircraft import GroundLoad
 from ema.model.checks import InputError
 from ema.model.noise import NO_NOISE, SensorNoise
 from ema.model.params import DriveConstants, HealthParams

@@ -7,9 +7,9 @@ from ema.kinds.rotary.physics.features import as_read
 from ema.kinds.rotary.physics.static_friction import read_static_friction
 from ema.kinds.rotary.prepare.conditioning import prepare
 from ema.kinds.rotary.simulator.batch import simulate_batch
+from ema.kinds.rotary.simulator.loads import GroundLoad
 from ema.kinds.rotary.simulator.sensor_noise import add_sensor_noise
 from ema.model.actuator import THESIS
-from ema.model.aircraft import GroundLoad
 from ema.model.noise import SensorNoise
 from ema.model.params import DriveConstants, HealthParams
 from ema.model.window import window_from_dict

@@ -16,12 +16,12 @@ from ema.kinds.rotary.simulator.batch import (
 )
 from ema.kinds.rotary.simulator.commands import random_command_knots
 from ema.kinds.rotary.simulator.effects import EffectSet
-from ema.kinds.rotary.simulator.loads import LoggedLoad, load_model
+from ema.kinds.rotary.simulator.loads import GroundLoad, LoggedLoad, load_model
 from ema.kinds.rotary.simulator.reference import simulate_numpy
 from ema.kinds.rotary.simulator.residual import residual_torque_nm
 from ema.model import runtime
 from ema.model.actuator import THESIS
-from ema.model.aircraft import FlightCondition, GroundLoad
+from ema.model.aircraft import FlightCondition
 from ema.model.checks import InputError
 from ema.model.params import DEFAULT_RANGES, DriveConstants, HealthParams, eta_a_from_eta_o
 from tests.kinds.rotary.simulator.conftest import ramp_knots

@@ -5,8 +5,8 @@ import pytest
 
 from ema.kinds.rotary.simulator.batch import simulate_batch
 from ema.kinds.rotary.simulator.effects import EFFECTS, EffectSet, FrictionTable
+from ema.kinds.rotary.simulator.loads import GroundLoad
 from ema.model.actuator import THESIS
-from ema.model.aircraft import GroundLoad
 from ema.model.checks import InputError
 from ema.model.params import HealthParams
 from tests.kinds.rotary.simulator.conftest import ramp_knots

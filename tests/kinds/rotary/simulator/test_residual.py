@@ -3,6 +3,7 @@ import pytest
 
 from ema.kinds.rotary.simulator.batch import simulate_batch
 from ema.kinds.rotary.simulator.commands import random_command_knots
+from ema.kinds.rotary.simulator.loads import GroundLoad
 from ema.kinds.rotary.simulator.residual import (
     above_throughout,
     derivative_weights,
@@ -14,7 +15,6 @@ from ema.kinds.rotary.simulator.residual import (
 )
 from ema.kinds.rotary.simulator.sensor_noise import add_sensor_noise
 from ema.model.actuator import THESIS
-from ema.model.aircraft import GroundLoad
 from ema.model.checks import InputError
 from ema.model.noise import SensorNoise
 from ema.model.params import HealthParams

@@ -4,13 +4,14 @@ import pytest
 from ema.kinds.rotary.simulator.loads import (
     A_DEFAULT,
     B_DEFAULT,
+    GroundLoad,
     discretize,
     expm,
     flight_load_model,
     state_space,
     trim,
 )
-from ema.model.aircraft import FlightCondition, GroundLoad, HingeGeometry
+from ema.model.aircraft import FlightCondition, HingeGeometry
 from ema.model.checks import InputError
 
 
