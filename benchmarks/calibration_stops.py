@@ -19,7 +19,7 @@ from ema.cli.benchmark_docs import write_section
 from ema.estimate import thread_budget
 from ema.kinds.rotary.calibration import Calibrator
 from ema.model.actuator import THESIS
-from ema.model.window import window_from_dict
+from ema.model.window import RotaryWindow, as_window, window_from_dict
 from tests.foreign.physics import Effects, Flight
 from tests.foreign.windows import draw
 
@@ -39,7 +39,11 @@ MECHANICAL = {"backlash", "position_friction", "stribeck", "viscous", "cogging"}
 
 def one(case: str, seed: int) -> dict[str, object]:
     drawn = draw(seed, "stops", effects=CASES[case], duration_s=1.5, flight=LOW_Q)
-    report = Calibrator(seed=seed, actuator=THESIS).fit([window_from_dict(drawn.document)], drawn.truth).report_
+    report = (
+        Calibrator(seed=seed, actuator=THESIS)
+        .fit([as_window(window_from_dict(drawn.document), RotaryWindow)], drawn.truth)
+        .report_
+    )
     assert report.error_pct_before is not None and report.error_pct_after is not None
     before = (report.error_pct_before["FDJ"] + report.error_pct_before["eta_O"]) / 100
     after = (report.error_pct_after["FDJ"] + report.error_pct_after["eta_O"]) / 100

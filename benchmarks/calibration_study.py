@@ -31,7 +31,7 @@ from ema.kinds.rotary.calibration import Calibrator, combined
 from ema.kinds.rotary.pipeline import estimate_window
 from ema.model.actuator import THESIS
 from ema.model.checks import InputError
-from ema.model.window import window_from_dict
+from ema.model.window import RotaryWindow, as_window, window_from_dict
 from tests.foreign.effects import CASES
 from tests.foreign.windows import draw
 
@@ -59,7 +59,9 @@ def one(case: str, scale: float, seed: int, figure: Path | None) -> dict[str, An
     effects = CASES[case](np.random.default_rng(seed), scale)
     drawn = draw(seed, "thesis", effects=effects)
     started = time.perf_counter()
-    calibrator = Calibrator(seed=seed, actuator=THESIS).fit([window_from_dict(drawn.document)], drawn.truth)
+    calibrator = Calibrator(seed=seed, actuator=THESIS).fit(
+        [as_window(window_from_dict(drawn.document), RotaryWindow)], drawn.truth
+    )
     seconds = time.perf_counter() - started
     report = calibrator.report_
     if figure is not None:

@@ -42,7 +42,7 @@ from ema.kinds.servo.log_reading import completed, followed_loop, log_loop, prep
 from ema.kinds.servo.stages import physics_of
 from ema.model.actuator import ActuatorDocument, ServoActuator, as_kind, read_actuator
 from ema.model.logmap import read_logmap, read_mapped
-from ema.model.window import Window, window_from_dict
+from ema.model.window import ServoWindow, as_window, window_from_dict
 from tests.foreign import servo as foreign
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -68,16 +68,16 @@ PUBLISHED_ERROR_PCT = 4.08
 NAMES = {"mass_kg": "mass", "viscous_ns_per_m": "viscous", "fdj_n": "FDJ", "offset_n": "offset"}
 
 
-def read(path: Path, mapping: Path) -> Window:
-    return window_from_dict(read_mapped(path, read_logmap(mapping)))
+def read(path: Path, mapping: Path) -> ServoWindow:
+    return as_window(window_from_dict(read_mapped(path, read_logmap(mapping))), ServoWindow)
 
 
-def estimation_run() -> Window:
+def estimation_run() -> ServoWindow:
     """The benchmark's estimation run, as the bundled log map reads it."""
     return read(EMPS / "DATA_EMPS.mat", EMPS / "log-map.json")
 
 
-def calibrations(window: Window, times: int) -> list[ActuatorDocument]:
+def calibrations(window: ServoWindow, times: int) -> list[ActuatorDocument]:
     """The bundled document, then each document ``ema calibrate`` completes on ``window`` from the one before:
     ``times`` + 1 documents."""
     documents = [read_actuator(EMPS / "actuator.json")]
@@ -116,7 +116,7 @@ def identification_table(learned: dict, base: dict, simulated: dict[str, float])
     return "\n".join(rows)
 
 
-def errors_on(window: Window, document: ServoActuator, completed: ServoActuator) -> dict[str, dict[str, float]]:
+def errors_on(window: ServoWindow, document: ServoActuator, completed: ServoActuator) -> dict[str, dict[str, float]]:
     """Each model's error on ``window``, its constants fixed: ema's learned, the published symmetric and asymmetric."""
     prepared = [prepare_servo(window, document)]
     servo = completed.servo
@@ -226,7 +226,7 @@ def main() -> None:
 WRONG_KP = (0.5, 30.0)  # the log's recorded kp times these: a log whose recorded gain is not its loop's
 
 
-def recorded_gain_line(window: Window, document: ServoActuator, answer: dict) -> str:
+def recorded_gain_line(window: ServoWindow, document: ServoActuator, answer: dict) -> str:
     """The log read with its recorded kp altered: the gains its command follows (``log_loop``), and FDJ read."""
     kp = window.constants["position_gain_per_s"]
     read = []
@@ -279,7 +279,7 @@ def network_line(name: str, answer: dict) -> str:
     return f"- {name}: physics / network {'; '.join(read)}: {said}."
 
 
-def _base_model(window: Window, document: ServoActuator) -> dict[str, dict]:
+def _base_model(window: ServoWindow, document: ServoActuator) -> dict[str, dict]:
     """The symmetric model's constants as ema's physics stage reads them (Newey–West stds)."""
     solution = physics_of(prepare_servo(window, document))
     return {NAMES[n]: {"value": solution.values[n], "std": solution.stds[n], "unit": UNITS[n]} for n in NAMES}
@@ -297,7 +297,7 @@ PULSED_SAID = (
 )
 
 
-def pulsed_copy(window: Window, pulses: tuple[int, int, float]) -> Window:
+def pulsed_copy(window: ServoWindow, pulses: tuple[int, int, float]) -> ServoWindow:
     """The estimation run with an excitation (``PULSES``' form) added to its command and felt: the foreign servo's
     response to it (its run with the excitation less its run without, over the log's set point) added to the logged
     position and force, the force saturated where the sum passes the drive's limit."""
@@ -331,7 +331,7 @@ class Checked:
     disagrees: list[str]  # the constants the network disagrees with physics on
 
 
-def checked(window: Window, document: ServoActuator, first: dict) -> Checked:
+def checked(window: ServoWindow, document: ServoActuator, first: dict) -> Checked:
     """``window`` estimated with ``document``, against ``first`` (the estimation run's answer with it, as JSON)."""
     answer = estimate(window, actuator=document)
     fdj, before = answer.estimates.FDJ, first["estimates"]["FDJ"]
@@ -343,7 +343,7 @@ def checked(window: Window, document: ServoActuator, first: dict) -> Checked:
     )
 
 
-def sweep_lines(window: Window, runs: dict[str, tuple[ServoActuator, dict]]) -> list[str]:
+def sweep_lines(window: ServoWindow, runs: dict[str, tuple[ServoActuator, dict]]) -> list[str]:
     """Stand-ins of other excitations (``SWEEP``), each read with both documents: the lab's three checks on each."""
     lines = [
         "Stand-ins of other excitations, each read with the bundled / the calibrated document: the closed loop's force "
@@ -368,7 +368,7 @@ def sweep_lines(window: Window, runs: dict[str, tuple[ServoActuator, dict]]) -> 
     return lines
 
 
-def _added_share(window: Window, document: ServoActuator) -> str:
+def _added_share(window: ServoWindow, document: ServoActuator) -> str:
     """The command added to the loop's that the log shows, as a share of the logged command's RMS."""
     servo = completed(document, window)
     added = followed_loop(servo, window).added
@@ -379,7 +379,7 @@ def _added_share(window: Window, document: ServoActuator) -> str:
 
 
 def held_out_lines(
-    window: Window, runs: dict[str, tuple[ServoActuator, dict]], name: str = "held-out run"
+    window: ServoWindow, runs: dict[str, tuple[ServoActuator, dict]], name: str = "held-out run"
 ) -> list[str]:
     """The held-out run read with each document (``runs``: the document and the estimation run's answer with it):
     both runs' FDJ against 2 std of their difference, the held-out run's closed-loop check and whether the network

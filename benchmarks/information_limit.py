@@ -45,7 +45,7 @@ from ema.kinds.rotary.simulator.hinge import HINGE_SMOOTHING_S, local_line
 from ema.kinds.rotary.simulator.residual import kernel_samples
 from ema.model.actuator import THESIS
 from ema.model.params import DriveConstants, eta_a_from_eta_o
-from ema.model.window import Window, window_from_dict
+from ema.model.window import RotaryWindow, Window, as_window, window_from_dict
 
 GROUPS = ("short window (0.1 s, gust)", "low log rate (1-2 kHz)")  # the groups with errors past 10 % of range
 SENSORS = ("current_a", "motor_speed_radps", "hinge_moment_nm", "position_deg")
@@ -57,8 +57,9 @@ def twins(group: str, i: int) -> tuple[Window, Window, dict[str, float]]:
     them), and its truth."""
     make, seed = groups()[group], group_seed(group, i)
     logged, clean = make(seed), make(seed, noise_level=0.0)
-    as_logged = prepare(window_from_dict(logged.document), actuator=THESIS).window
-    return as_logged, prepare(window_from_dict(clean.document), actuator=THESIS).window, logged.truth
+    as_logged = prepare(as_window(window_from_dict(logged.document), RotaryWindow), actuator=THESIS).window
+    clean_window = as_window(window_from_dict(clean.document), RotaryWindow)
+    return as_logged, prepare(clean_window, actuator=THESIS).window, logged.truth
 
 
 def noise_levels(logged: Mapping[str, Any], clean: Mapping[str, np.ndarray]) -> dict[str, float]:

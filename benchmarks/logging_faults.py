@@ -18,7 +18,7 @@ from ema.cli.benchmark_docs import typed_command, write_section
 from ema.estimate import thread_budget
 from ema.kinds.rotary.prepare.stale import stale_runs
 from ema.model.actuator import THESIS
-from ema.model.window import window_from_dict
+from ema.model.window import RotaryWindow, as_window, window_from_dict
 from tests.foreign.faults import FAULTS, with_fault
 
 FIRST_SEED = 1_000_000  # apart from every other benchmark's (foreign_history's reach ~610 000) and the tests'
@@ -74,7 +74,8 @@ def main() -> None:
         for label, fault in FAULTS.items():
             logged = replace(drawn, document=with_fault(drawn.document, fault, seed))
             found[label] += any(
-                run.signal == fault.signal for run in stale_runs(window_from_dict(logged.document), drive=THESIS.params)
+                run.signal == fault.signal
+                for run in stale_runs(as_window(window_from_dict(logged.document), RotaryWindow), drive=THESIS.params)
             )
             rows[label].append(run_one(logged))
         print(i, name, flush=True)

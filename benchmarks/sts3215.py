@@ -39,7 +39,7 @@ from ema.estimate.config import PipelineConfig
 from ema.kinds import CalibrationRequest, calibrate, estimate
 from ema.model.actuator import GearedActuator, as_kind, read_actuator
 from ema.model.logmap import read_logmap, read_mapped
-from ema.model.window import Window, window_from_dict
+from ema.model.window import GearedWindow, as_window, window_from_dict
 
 ROOT = Path(__file__).resolve().parents[1]
 RUNS = ROOT.parent / "shared" / "data" / "sts3215" / "runs"
@@ -77,7 +77,7 @@ class Split:
     name: str
     says: str
 
-    def held(self, window: Window, later: bool) -> bool:
+    def held(self, window: GearedWindow, later: bool) -> bool:
         c = window.constants
         if self.name == "repeat":
             return later
@@ -93,12 +93,12 @@ SPLITS = (
 )
 
 
-def read_runs(folder: Path, every: int) -> tuple[list[Window], list[bool], list[str]]:
+def read_runs(folder: Path, every: int) -> tuple[list[GearedWindow], list[bool], list[str]]:
     """The runs as ``ema`` reads them (the example's log map), whether each is its condition's later run, and each
     one's set point's name (the recorder's header)."""
     log_map = read_logmap(EXAMPLE / "log-map.json")
     files = sorted(folder.glob("*.json"))[::every]
-    windows = [window_from_dict(read_mapped(path, log_map)) for path in files]
+    windows = [as_window(window_from_dict(read_mapped(path, log_map)), GearedWindow) for path in files]
     shapes = [json.loads(path.read_text())["trajectory"] for path in files]
     seen: dict[tuple, int] = defaultdict(int)
     later = []
@@ -109,7 +109,7 @@ def read_runs(folder: Path, every: int) -> tuple[list[Window], list[bool], list[
     return windows, later, shapes
 
 
-def reference_positions(windows: list[Window], law: dict[str, float], bam: bool) -> list[np.ndarray]:
+def reference_positions(windows: list[GearedWindow], law: dict[str, float], bam: bool) -> list[np.ndarray]:
     """Each window simulated from its set point by the reference simulator (module docstring): ``law`` is a
     document's constants (ema's equations) or BAM's M6 parameters (``bam``)."""
     out = []
@@ -187,13 +187,13 @@ def document_law(document: GearedActuator) -> dict[str, float]:
     }
 
 
-def mean_error(windows: list[Window], positions: list[np.ndarray]) -> float:
+def mean_error(windows: list[GearedWindow], positions: list[np.ndarray]) -> float:
     return float(
         np.mean([np.mean(np.abs(w.signals["position_rad"] - q)) for w, q in zip(windows, positions, strict=True)])
     )
 
 
-def split_lines(split: Split, windows: list[Window], later: list[bool], config: PipelineConfig) -> list[str]:
+def split_lines(split: Split, windows: list[GearedWindow], later: list[bool], config: PipelineConfig) -> list[str]:
     """One split: the calibration on the rest, the held-out runs read and predicted."""
     seen = [w for w, late in zip(windows, later, strict=True) if not split.held(w, late)]
     held = [w for w, late in zip(windows, later, strict=True) if split.held(w, late)]
@@ -224,7 +224,7 @@ def split_lines(split: Split, windows: list[Window], later: list[bool], config: 
     return [*lines, ""]
 
 
-def load_lines(held: list[Window], estimates: list, document: GearedActuator) -> list[str]:  # type: ignore[type-arg]
+def load_lines(held: list[GearedWindow], estimates: list, document: GearedActuator) -> list[str]:  # type: ignore[type-arg]
     """Per load, the held-out runs' median health against the nominal, in the nominal's stds."""
     groups: dict[str, list[int]] = defaultdict(list)
     for i, w in enumerate(held):
@@ -257,7 +257,7 @@ def network_lines(estimates: list) -> list[str]:  # type: ignore[type-arg]
     return lines
 
 
-def gain_lines(windows: list[Window], delay_s: float) -> list[str]:
+def gain_lines(windows: list[GearedWindow], delay_s: float) -> list[str]:
     """The loop's gain read off the logged duty per kp, with no delay and at the one the calibration names."""
     from ema.kinds.geared.calibration import logged_runs
     from ema.kinds.geared.duty_gain import gain_at

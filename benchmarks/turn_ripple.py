@@ -28,7 +28,7 @@ from ema.kinds.servo.inverse import InverseSolution, inverse_columns, load_motio
 from ema.kinds.servo.log_reading import prepare_servo
 from ema.kinds.servo.stages import physics_of
 from ema.model.actuator import ServoActuator, actuator_from_dict, as_kind
-from ema.model.window import Window, window_from_dict
+from ema.model.window import ServoWindow, as_window, window_from_dict
 from tests.foreign import servo as foreign
 
 TITLE = "What else EMPS holds: a force once per turn of the motor"
@@ -46,7 +46,7 @@ document names the pre-sliding and a friction along the stroke, the table above)
 force it is never named; with one it is named on every seed, and kept near its truth."""
 
 
-def solution(window: Window, period_m: float | None) -> InverseSolution:
+def solution(window: ServoWindow, period_m: float | None) -> InverseSolution:
     """Eq. 5.1 with ``MODEL``, and the force once per ``period_m`` where given."""
     s = window.signals
     motion = load_motion(s["position_m"], window.sample_rate_hz, BANDWIDTH_HZ, STEP_M)
@@ -54,7 +54,7 @@ def solution(window: Window, period_m: float | None) -> InverseSolution:
     return solve_inverse(s["drive_force_n"][motion.samples], inverse_columns(motion, effects), motion)
 
 
-def period_lines(window: Window) -> list[str]:
+def period_lines(window: ServoWindow) -> list[str]:
     """The error over a wide grid of periods and around the turn."""
     base = solution(window, None).error_pct
     wide = np.geomspace(0.5e-3, 50e-3, 241)
@@ -75,9 +75,10 @@ def period_lines(window: Window) -> list[str]:
     ]
 
 
-def part_rows(window: Window) -> list[str]:
+def part_rows(window: ServoWindow) -> list[str]:
     rows = []
     for name, part in parts(window):
+        part = as_window(part, ServoWindow)
         before, after = solution(part, None), solution(part, TURN_M)
         a, b = after.values["turn_ripple_sin_n"], after.values["turn_ripple_cos_n"]
         rows.append(
@@ -96,7 +97,7 @@ def foreign_rows(seeds: int) -> list[str]:
     rows = []
     for seed in range(seeds):
         for turn in ((0.0, 0.0), (0.8, -0.6)):
-            window = window_from_dict(foreign.draw(seed, foreign.Load(turn_n=turn)))
+            window = as_window(window_from_dict(foreign.draw(seed, foreign.Load(turn_n=turn))), ServoWindow)
             report = calibrate([window], CalibrationRequest(PipelineConfig(), document)).report
             assert isinstance(report, ServoCalibration), "a servo's calibration answers a servo's report"
             kept = {e.name: e.value for e in report.as_simulated}
@@ -110,7 +111,7 @@ def foreign_rows(seeds: int) -> list[str]:
     return rows
 
 
-def chain_rows(window: Window) -> list[str]:
+def chain_rows(window: ServoWindow) -> list[str]:
     """The bundled document, then ``ema calibrate`` on the log twice, each document's model read on it by an
     estimate: its effects, the inverse error, the Eq. 5.1 residual over its simulations', the closed loop's error."""
     rows = []

@@ -45,7 +45,7 @@ from ema.kinds.rotary.physics.scenario import scenario_from_window
 from ema.kinds.rotary.prepare.conditioning import prepare
 from ema.model.actuator import THESIS
 from ema.model.params import HealthParams
-from ema.model.window import Window, window_from_dict
+from ema.model.window import RotaryWindow, as_window, window_from_dict
 from tests.foreign.physics import Effects
 from tests.foreign.windows import Draw
 
@@ -77,9 +77,10 @@ def sensitivities(window: Draw, levels: dict[str, float]) -> np.ndarray:
     return np.stack(columns, axis=1)
 
 
-def _as_window(window: Draw, signals: dict[str, np.ndarray]) -> Window:
+def _as_window(window: Draw, signals: dict[str, np.ndarray]) -> RotaryWindow:
     """``window``'s document with these signals, through the public contract."""
-    return window_from_dict({**window.document, "signals": {name: values.tolist() for name, values in signals.items()}})
+    document = {**window.document, "signals": {name: values.tolist() for name, values in signals.items()}}
+    return as_window(window_from_dict(document), RotaryWindow)
 
 
 def our_simulator_bias(window: Draw, clean: dict[str, np.ndarray], levels: dict[str, float]) -> np.ndarray:

@@ -14,7 +14,7 @@ import hashlib
 import json
 from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
-from typing import Annotated, Any, ClassVar, Literal
+from typing import Annotated, Any, ClassVar, Literal, TypeVar
 
 import numpy as np
 from pydantic import (
@@ -277,8 +277,11 @@ class Resampling:
 
 @dataclass(frozen=True)
 class Window:
-    """A logged window as arrays: five uniformly sampled signals from t = 0 and where the aircraft flew (None:
-    on the ground)."""
+    """A logged window as arrays: its kind's signals, uniformly sampled from t = 0, and where the aircraft flew (None:
+    on the ground). Built as ``Window(signals, ...)`` it is its kind's class (``RotaryWindow``, ``LinearWindow``,
+    ``ServoWindow``, ``GearedWindow``, told by its signals once): a kind's code takes its own, and says so."""
+
+    KIND: ClassVar[str | None] = None  # each kind's class: its name
 
     signals: dict[str, np.ndarray]
     sample_rate_hz: float = DEFAULT_SAMPLE_RATE_HZ
@@ -291,7 +294,17 @@ class Window:
     constants: dict[str, float] = field(default_factory=dict)  # what the log recorded beside its signals
     resampled: Resampling | None = None  # a log of uneven time steps, resampled to sample_rate_hz
 
+    def __new__(cls, *args: Any, **kwargs: Any) -> Window:
+        """The window as its kind's class where built as ``Window``: the kind its signals are (no one kind's: the
+        shared class, whose ``kind`` says why)."""
+        signals = args[0] if args else kwargs.get("signals")
+        if cls is Window and signals is not None and (found := kind_of_signals(signals)) is not None:
+            cls = WINDOW_CLASSES[found.name]
+        return super().__new__(cls)
+
     def __post_init__(self) -> None:
+        if self.KIND is not None and kind_of_signals(self.signals) is not KINDS[self.KIND]:
+            raise InputError("signals", f"{', '.join(self.signals)} are not a {self.KIND} actuator's signals")
         lengths = {name: len(self.signals[name]) for name in self.signal_names}
         if len(set(lengths.values())) != 1:
             raise InputError("signals", f"signals differ in length: {lengths}")
@@ -299,10 +312,9 @@ class Window:
     @property
     def kind(self) -> str:
         """The kind whose signals these are (``ema.model.kinds``)."""
-        found = kind_of_signals(self.signals)
-        if found is None:
-            raise InputError("signals", f"{', '.join(self.signals)} are no one kind's signals")
-        return found.name
+        if self.KIND is not None:
+            return self.KIND
+        raise InputError("signals", f"{', '.join(self.signals)} are no one kind's signals")
 
     @property
     def signal_names(self) -> tuple[str, ...]:
@@ -337,6 +349,48 @@ class Window:
     @property
     def on_ground(self) -> bool:
         return self.flight_condition is None
+
+
+@dataclass(frozen=True)
+class RotaryWindow(Window):
+    """A rotary actuator's window: command, deflection, motor speed, current and hinge moment."""
+
+    KIND: ClassVar[str | None] = "rotary"
+
+
+@dataclass(frozen=True)
+class LinearWindow(Window):
+    """A ball screw's window: its set point, position, current and load."""
+
+    KIND: ClassVar[str | None] = "linear"
+
+
+@dataclass(frozen=True)
+class ServoWindow(Window):
+    """A servo's window on the load side: its set point, position, drive force (and load)."""
+
+    KIND: ClassVar[str | None] = "servo"
+
+
+@dataclass(frozen=True)
+class GearedWindow(Window):
+    """A geared servo's window at its output: set point, position, duty and supply (and the motor's on flag)."""
+
+    KIND: ClassVar[str | None] = "geared"
+
+
+WINDOW_CLASSES: dict[str, type[Window]] = {
+    cls.KIND: cls for cls in (RotaryWindow, LinearWindow, ServoWindow, GearedWindow) if cls.KIND
+}
+KindWindow = TypeVar("KindWindow", bound=Window)
+
+
+def as_window(window: Window, kind: type[KindWindow]) -> KindWindow:
+    """``window`` as ``kind``'s class (a kind's method reading its own signals); InputError naming the signals where
+    the window is another kind's."""
+    if not isinstance(window, kind):
+        raise InputError("signals", f"are a {window.kind} actuator's: this reads a {kind.KIND} actuator's window")
+    return window
 
 
 def window_from_dict(document: Any) -> Window:

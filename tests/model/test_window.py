@@ -93,3 +93,26 @@ def test_a_null_signal_of_another_kind_is_absent_as_in_the_earlier_document(docu
     padded = copy.deepcopy(document)
     padded["signals"].update(command_mm=None, position_mm=None, load_n=None, set_point_m=None)
     assert window_from_dict(padded).signals.keys() == window_from_dict(document).signals.keys()
+
+
+def test_a_window_is_its_kinds_class_told_once_by_its_signals():
+    """``Window(...)`` is its kind's class, kept through a copy and a pickle (a fleet's workers); a kind's code that
+    takes its own class refuses another kind's window naming the signals, and a kind's class another's signals."""
+    import dataclasses
+    import pickle
+
+    from ema.model.window import GearedWindow, RotaryWindow, ServoWindow, Window, as_window
+
+    n = 4
+    servo = Window({"set_point_m": np.zeros(n), "position_m": np.zeros(n), "drive_force_n": np.ones(n)}, 1000.0)
+    assert type(servo) is ServoWindow and servo.kind == "servo"
+    assert type(dataclasses.replace(servo, window_id="b")) is ServoWindow
+    assert type(pickle.loads(pickle.dumps(servo))) is ServoWindow
+    assert as_window(servo, ServoWindow) is servo
+    with pytest.raises(InputError, match="are a servo actuator's: this reads a rotary") as refused:
+        as_window(servo, RotaryWindow)
+    assert refused.value.field == "signals"
+    with pytest.raises(InputError, match="not a geared actuator's signals"):
+        GearedWindow(servo.signals, 1000.0)
+    with pytest.raises(InputError, match="no one kind's signals"):
+        Window({"speed": np.zeros(n)}, 1000.0)

@@ -23,7 +23,7 @@ from ema.kinds.base import WARM_UP, Calibrated, CalibrationRequest, Cost, Reques
 from ema.model.actuator import ActuatorDocument, GearedActuator, actuator_from_dict, as_kind
 from ema.model.kinds import KINDS, KindFacts
 from ema.model.params import DriveConstants
-from ema.model.window import Window
+from ema.model.window import GearedWindow, Window, as_window
 
 ROTARY_STEP_S = DriveConstants().step_s  # what a service's simulation limit counts in
 SOLVE_RUNS = 200  # closed-loop runs of the window a reading's solves take, about (physics and its held-out twins)
@@ -42,14 +42,20 @@ class Geared:
 
         actuator = as_kind(request.actuator, GearedActuator)
         return estimate_geared(
-            window, request.config, actuator=actuator, read_with=request.read_with, on_stage=request.on_stage
+            as_window(window, GearedWindow),
+            request.config,
+            actuator=actuator,
+            read_with=request.read_with,
+            on_stage=request.on_stage,
         )
 
     def calibrate(self, windows: Sequence[Window], request: CalibrationRequest) -> Calibrated:
         from ema.kinds.geared.calibration_report import calibrate_geared
 
         actuator = as_kind(request.actuator, GearedActuator)
-        report, completed = calibrate_geared(windows, actuator, request.on_stage or (lambda _: None))
+        report, completed = calibrate_geared(
+            [as_window(w, GearedWindow) for w in windows], actuator, request.on_stage or (lambda _: None)
+        )
         return Calibrated(report.model_copy(update={"completed_actuator": completed}), completed)
 
     def cost(self, window: Window, config: PipelineConfig) -> Cost:

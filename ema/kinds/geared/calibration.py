@@ -40,7 +40,7 @@ from ema.kinds.geared.stacked_fit import (
     solve,
 )
 from ema.model.geared import Geared
-from ema.model.window import Window
+from ema.model.window import GearedWindow
 
 COPY_SEED = 20_250_317  # the copies' encoder phases: their own stream, the same on every rerun
 
@@ -55,7 +55,7 @@ class Trial:
     start: dict[str, float]
 
 
-def logged_runs(windows: Sequence[Window], geared: Geared) -> list[LoggedRun]:
+def logged_runs(windows: Sequence[GearedWindow], geared: Geared) -> list[LoggedRun]:
     """Each window as its calibration reads it: what its simulation takes, and its logged position."""
     runs = []
     for window in windows:
@@ -207,7 +207,7 @@ class LearnedModel:
 
 
 def learned_model(
-    windows: Sequence[Window], geared: Geared, on_stage: Callable[[str], None]
+    windows: Sequence[GearedWindow], geared: Geared, on_stage: Callable[[str], None]
 ) -> tuple[LearnedModel, list[LoggedRun]]:
     """The selection and the final solve (steps 1 to 3 of the module docstring)."""
     runs = logged_runs(windows, geared)

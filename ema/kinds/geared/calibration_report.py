@@ -23,7 +23,7 @@ from ema.kinds.geared.log_reading import HEALTH, log_constants, prepare_geared
 from ema.kinds.geared.output_error import read_health
 from ema.kinds.geared.stacked_fit import LoggedRun, RunSet
 from ema.model.actuator import GearedActuator, Nominal
-from ema.model.window import Window
+from ema.model.window import GearedWindow
 
 UNITS = {"torque_constant_nm_per_a": "N·m/A", "resistance_ohm": "Ω", "inertia_kg_m2": "kg·m²",
          "error_gain_per_rad": "1/rad", "duty_limit": "1", "viscous_nm_s_per_rad": "N·m·s/rad",
@@ -84,7 +84,7 @@ def completed_document(actuator: GearedActuator, model: Model) -> GearedActuator
     return actuator.model_copy(update={"geared": section, "nominal": nominal})
 
 
-def read_runs(windows: Sequence[Window], document: GearedActuator) -> dict[str, np.ndarray]:
+def read_runs(windows: Sequence[GearedWindow], document: GearedActuator) -> dict[str, np.ndarray]:
     """(R,) each run's FDJ, η_O and η_A read with ``document``, and (R,) their stds (``<name>_std``)."""
     read: dict[str, list[float]] = defaultdict(list)
     for window in windows:
@@ -109,7 +109,9 @@ def repeatable(document: GearedActuator, read: dict[str, np.ndarray]) -> GearedA
     return document.model_copy(update={"geared": section.completed(repeatability=repeatability, stds=stds)})
 
 
-def by_load(windows: Sequence[Window], read: dict[str, np.ndarray], document: GearedActuator) -> list[LoadReading]:
+def by_load(
+    windows: Sequence[GearedWindow], read: dict[str, np.ndarray], document: GearedActuator
+) -> list[LoadReading]:
     """Each load's (mass × arm) runs: their median health against the nominal, in the nominal's stds."""
     groups: dict[tuple[float, float], list[int]] = defaultdict(list)
     for i, window in enumerate(windows):
@@ -182,7 +184,7 @@ def report(
 
 
 def calibrate_geared(
-    windows: Sequence[Window], actuator: GearedActuator, on_stage: Callable[[str], None]
+    windows: Sequence[GearedWindow], actuator: GearedActuator, on_stage: Callable[[str], None]
 ) -> tuple[GearedCalibration, GearedActuator]:
     """The report and the completed document of a geared servo's runs (module docstring)."""
     model, runs = learned_model(windows, actuator.geared, on_stage)

@@ -24,7 +24,7 @@ from ema.model.actuator import GearedActuator
 from ema.model.checks import InputError
 from ema.model.geared import GEARED_CONSTANTS, Geared
 from ema.model.params import HealthRanges
-from ema.model.window import Window
+from ema.model.window import GearedWindow
 
 SUPPLY_BAND = 0.25  # a supply sample more than this share off the log's median is a glitch of its reading
 HEALTH = ("fdj_nm", "eta_o", "eta_a")  # what a window reads: the thesis's health, at the output shaft
@@ -32,7 +32,7 @@ HEALTH = ("fdj_nm", "eta_o", "eta_a")  # what a window reads: the thesis's healt
 
 @dataclass(frozen=True)
 class GearedPrepared:
-    window: Window
+    window: GearedWindow
     geared: Geared
     run: Run  # what the simulator takes: the supply repaired
     resolution_rad: float  # the position's step
@@ -73,7 +73,7 @@ def lane_of(geared: Geared, health: dict[str, float]) -> np.ndarray:
     return np.array([lane[name] for name in LANE_PARAMETERS])
 
 
-def log_constants(window: Window) -> dict[str, float]:
+def log_constants(window: GearedWindow) -> dict[str, float]:
     """The loop's gain and the load, as the log recorded them; InputError naming the first it lacks."""
     missing = [name for name in GEARED_CONSTANTS if name not in window.constants]
     if missing:
@@ -102,7 +102,7 @@ def completed_section(actuator: GearedActuator) -> Geared:
     return geared
 
 
-def load_run(window: Window, geared: Geared, supply_v: np.ndarray) -> Run:
+def load_run(window: GearedWindow, geared: Geared, supply_v: np.ndarray) -> Run:
     """What the simulator takes of ``window`` (``Run``): its load's gravity moment and inertia from the log's mass
     and arm and the document's arm."""
     constants = log_constants(window)
@@ -156,7 +156,7 @@ def position_step(position_rad: np.ndarray, geared: Geared) -> float:
     return float(np.min(moves)) if len(moves) else 0.0
 
 
-def _notes(window: Window, run: Run, resolution: float) -> list[doc.Note]:
+def _notes(window: GearedWindow, run: Run, resolution: float) -> list[doc.Note]:
     notes = []
     if window.resampled is not None:
         steps = window.resampled
@@ -188,7 +188,7 @@ def _notes(window: Window, run: Run, resolution: float) -> list[doc.Note]:
     return notes
 
 
-def prepare_geared(window: Window, actuator: GearedActuator) -> GearedPrepared:
+def prepare_geared(window: GearedWindow, actuator: GearedActuator) -> GearedPrepared:
     """The window ready to simulate (module docstring); InputError where its log or its document lacks a constant."""
     geared = completed_section(actuator)
     supply, glitches = repaired_supply(window.signals["supply_v"])

@@ -34,7 +34,7 @@ from ema.kinds.geared.log_reading import HEALTH, GearedPrepared, prepare_geared
 from ema.kinds.geared.loop import simulate_lanes
 from ema.kinds.geared.output_error import HealthReading, read_health
 from ema.model.actuator import GearedActuator
-from ema.model.window import Window
+from ema.model.window import GearedWindow
 
 REPORTED = {"fdj_nm": "FDJ", "eta_o": "eta_O", "eta_a": "eta_A"}
 UNITS = {"fdj_nm": "N·m", "eta_o": doc.DIMENSIONLESS, "eta_a": doc.DIMENSIONLESS}
@@ -203,7 +203,7 @@ def _report(
 
 
 def estimate_geared(
-    window: Window,
+    window: GearedWindow,
     config: PipelineConfig,
     *,
     actuator: GearedActuator,

@@ -19,7 +19,7 @@ from ema.kinds.linear.calibration_report import calibrate_linear
 from ema.kinds.linear.stepper_reading import STEPPER_READING
 from ema.model.actuator import ActuatorDocument, LinearActuator, as_kind
 from ema.model.kinds import KINDS, KindFacts
-from ema.model.window import Window
+from ema.model.window import LinearWindow, Window, as_window
 
 
 @dataclass(frozen=True)
@@ -33,7 +33,9 @@ class Linear:
         return read_quasi_statically(window, request, STEPPER_READING)
 
     def calibrate(self, windows: Sequence[Window], request: CalibrationRequest) -> Calibrated:
-        report, completed, plot = calibrate_linear(windows, as_kind(request.actuator, LinearActuator), request.truth)
+        report, completed, plot = calibrate_linear(
+            [as_window(w, LinearWindow) for w in windows], as_kind(request.actuator, LinearActuator), request.truth
+        )
         return Calibrated(report.model_copy(update={"completed_actuator": completed}), completed, plot)
 
     def cost(self, window: Window, config: PipelineConfig) -> Cost:

@@ -31,7 +31,7 @@ from ema.kinds.linear.changes import baseline, compared
 from ema.kinds.linear.drive_calibration import CalibratedDrive, Run, calibrate_drive, read_run
 from ema.model.actuator import LinearActuator, Nominal
 from ema.model.params import load_factors
-from ema.model.window import Window
+from ema.model.window import LinearWindow
 
 ANCHOR = (
     "the current at zero torque and FDJ: at constant speed one number (I0 + c·FDJ); read against the runs' "
@@ -40,7 +40,7 @@ ANCHOR = (
 
 
 def calibrate_linear(
-    windows: Sequence[Window], actuator: LinearActuator, truth: Mapping[str, float] | None = None
+    windows: Sequence[LinearWindow], actuator: LinearActuator, truth: Mapping[str, float] | None = None
 ) -> tuple[LinearCalibration, LinearActuator | None, ResidualPlot]:
     """The report, the completed document where the runs taught the drive (None when comparing), and its figure."""
     started = time.perf_counter()

@@ -27,7 +27,7 @@ from ema.estimate.quasistatic.stretches import solve_stretches
 from ema.kinds.linear.drive_calibration import Run, profile_change, run_load_n
 from ema.kinds.linear.stepper_reading import FELL, ROSE, STEPPER_READING
 from ema.model.actuator import LinearActuator
-from ema.model.window import Window
+from ema.model.window import LinearWindow
 
 
 def fdj_changes(runs: list[Run], results: list[Estimate], actuator: LinearActuator) -> list[Change]:
@@ -163,7 +163,7 @@ def baseline(actuator: LinearActuator) -> tuple[np.ndarray, np.ndarray]:
     return np.array(screw.stroke_profile_a, dtype=float), np.array(screw.stroke_profile_std_a, dtype=float)
 
 
-def compared(windows: Sequence[Window], runs: list[Run], actuator: LinearActuator) -> LinearCalibration:
+def compared(windows: Sequence[LinearWindow], runs: list[Run], actuator: LinearActuator) -> LinearCalibration:
     """The runs against the calibrated document (module docstring)."""
     started = time.perf_counter()
     read_with = ActuatorRead(name=actuator.name)

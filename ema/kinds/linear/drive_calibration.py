@@ -38,7 +38,7 @@ from ema.kinds.linear.stepper_reading import set_point_motion
 from ema.model.actuator import LinearActuator
 from ema.model.checks import InputError
 from ema.model.params import load_factors
-from ema.model.window import Window
+from ema.model.window import LinearWindow
 
 PROFILE_BINS = 8  # the current along each stroke, in this many bins, against the healthy runs'
 
@@ -54,7 +54,7 @@ class Run:
     profile: np.ndarray  # (2, PROFILE_BINS): current along each direction's stroke, less its stroke's mean
 
 
-def read_run(window: Window, actuator: LinearActuator) -> Run:
+def read_run(window: LinearWindow, actuator: LinearActuator) -> Run:
     """A run's stretches and rest; InputError naming the window where it has no stretch or never rests."""
     speed, load = set_point_motion(window, actuator.gear_ratio)
     found, rest = stretches(speed, window.signals["current_a"], load, window.sample_rate_hz)
@@ -64,7 +64,7 @@ def read_run(window: Window, actuator: LinearActuator) -> Run:
     return Run(window.window_id, found, rest.current_a, rest.current_std_a, stroke_profile(window, found))
 
 
-def stroke_profile(window: Window, found: list[Stretch]) -> np.ndarray:
+def stroke_profile(window: LinearWindow, found: list[Stretch]) -> np.ndarray:
     """(2, PROFILE_BINS): the current along each direction's first stretch (0: positive, 1: negative), binned by
     position and less that stretch's mean; NaN where a direction has none."""
     current, out = window.signals["current_a"], np.full((2, PROFILE_BINS), np.nan)

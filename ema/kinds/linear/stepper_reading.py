@@ -10,13 +10,13 @@ from ema.estimate.quasistatic.drive_torque import HealthyRuns, QuasiStaticReadin
 from ema.estimate.quasistatic.stretches import Repeatability, Rest, TorqueReading
 from ema.model.actuator import ActuatorDocument, LinearActuator, as_kind
 from ema.model.checks import InputError
-from ema.model.window import Window
+from ema.model.window import LinearWindow, Window, as_window
 
 
 def set_point_motion(window: Window, gear_ratio: float) -> tuple[np.ndarray, np.ndarray]:
     """A linear window's motion by its set point's speed (exact where a potentiometer's is noise) and its load
     torque at the motor in the positive direction (F·lead/2π = F/n)."""
-    s = window.signals
+    s = as_window(window, LinearWindow).signals
     return np.gradient(s["command_mm"]) * window.sample_rate_hz, s["load_n"] / gear_ratio
 
 

@@ -28,7 +28,7 @@ from ema.model.bounds import HIGH_RATE_HZ
 from ema.model.checks import InputError
 from ema.model.kinds import KINDS, KindFacts
 from ema.model.params import HealthParams
-from ema.model.window import Window
+from ema.model.window import RotaryWindow, Window, as_window
 
 if TYPE_CHECKING:
     from ema.kinds.rotary.calibration import Calibrator
@@ -79,7 +79,12 @@ class Rotary:
         config = request.config
         actuator = as_kind(request.actuator, RotaryActuator)
         calibrator = Calibrator(config, copies=request.copies, seed=config.seed, actuator=actuator)
-        calibrator.fit(windows, request.truth, on_stage=request.on_stage, checkpoint=request.checkpoint)
+        calibrator.fit(
+            [as_window(w, RotaryWindow) for w in windows],
+            request.truth,
+            on_stage=request.on_stage,
+            checkpoint=request.checkpoint,
+        )
         return Calibrated(calibrator.report_, None, residual_plot(calibrator))
 
     def cost(self, window: Window, config: PipelineConfig) -> Cost:

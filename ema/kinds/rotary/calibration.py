@@ -49,7 +49,7 @@ from ema.model.bounds import DEFAULT_SAMPLE_RATE_HZ, NOISE_COPIES
 from ema.model.checks import InputError
 from ema.model.noise import SensorNoise
 from ema.model.params import HealthRanges
-from ema.model.window import Window
+from ema.model.window import RotaryWindow
 
 # A std past this share of the healthy range does not place the actuator in it: a reading's move is judged on
 # no wider a std (a base model a sensor fault defeats carried 3 N·m on FDJ, and then nothing counted as a move).
@@ -79,7 +79,7 @@ class Context:
 
     measured: Equations
     copies: Sequence[Equations]
-    windows: Sequence[Window]
+    windows: Sequence[RotaryWindow]
     before: Mapping[str, float]
     stds: Mapping[str, float]
     noise: Sequence[SensorNoise]
@@ -126,7 +126,7 @@ class Calibrator:
         self.copies = copies
         self.seed = seed
 
-    def _check(self, windows: Sequence[Window]) -> list[Window]:
+    def _check(self, windows: Sequence[RotaryWindow]) -> list[RotaryWindow]:
         if not 1 <= self.max_effects <= 4:
             raise InputError("max_effects", f"must be in [1, 4], got {self.max_effects}")
         if not 8 <= self.copies <= 500:
@@ -143,7 +143,7 @@ class Calibrator:
 
     def fit(
         self,
-        windows: Sequence[Window],
+        windows: Sequence[RotaryWindow],
         truth: Mapping[str, float] | None = None,
         on_stage: Callable[[str], None] | None = None,
         checkpoint: Callable[[], None] | None = None,

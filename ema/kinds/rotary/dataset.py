@@ -19,7 +19,7 @@ from ema.kinds.rotary.simulator.sensor_noise import add_seeded_noise
 from ema.model.actuator import RotaryActuator
 from ema.model.noise import SensorNoise
 from ema.model.params import DriveConstants, HealthParams
-from ema.model.window import Window
+from ema.model.window import RotaryWindow
 
 # All the estimators read, and so all drawn with the window's noise (position too: the hinge
 # moment is read along it, ema.kinds.rotary.simulator.hinge, and b·0.01° ≈ 0.1 N·m).
@@ -40,7 +40,7 @@ class Simulated:
 
 
 def simulate_noisy(
-    scenario: Scenario, health: HealthParams, window: Window, reference: HealthParams, seed: int, clean_last: int
+    scenario: Scenario, health: HealthParams, window: RotaryWindow, reference: HealthParams, seed: int, clean_last: int
 ) -> Simulated:
     """Simulate ``health``, add the window's own noise to what the estimators read, read it as the window
     is read (``as_read``) and reconstruct T_R (and without noise for the last ``clean_last`` simulations).
@@ -82,8 +82,8 @@ class Data:
 
 
 def simulate_dataset(
-    window: Window,
-    seen: Window,
+    window: RotaryWindow,
+    seen: RotaryWindow,
     physics: FrictionSolution,
     config: PipelineConfig,
     *,

@@ -8,12 +8,12 @@ from ema.estimate.documents import Note
 from ema.estimate.quasistatic.drive_torque import QuasiStaticReading
 from ema.estimate.quasistatic.stretches import Rest, TorqueReading
 from ema.model.actuator import ActuatorDocument, RotaryActuator, as_kind
-from ema.model.window import Window
+from ema.model.window import RotaryWindow, Window, as_window
 
 
 def logged_motion(window: Window, gear_ratio: float) -> tuple[np.ndarray, np.ndarray]:
     """A rotary window's motion by its logged motor speed, and its hinge moment at the motor (H/n)."""
-    s = window.signals
+    s = as_window(window, RotaryWindow).signals
     return s["motor_speed_radps"], s["hinge_moment_nm"] / gear_ratio
 
 

@@ -23,11 +23,11 @@ from ema.model.actuator import RotaryActuator
 from ema.model.bounds import NOISE_COPIES
 from ema.model.noise import SensorNoise
 from ema.model.params import DriveConstants
-from ema.model.window import Window
+from ema.model.window import RotaryWindow
 
 
 def clean_replicas(
-    windows: Sequence[Window], estimates: Mapping[str, float], actuator: RotaryActuator
+    windows: Sequence[RotaryWindow], estimates: Mapping[str, float], actuator: RotaryActuator
 ) -> list[dict[str, np.ndarray]]:
     """Each window simulated at ``estimates`` (FSJ at twice FDJ), without noise."""
     health = inside(estimates["FDJ"], estimates["eta_O"], actuator.health.fdj)

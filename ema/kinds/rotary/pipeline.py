@@ -40,7 +40,7 @@ from ema.kinds.rotary.prepare.conditioning import Prepared, prepare, widened
 from ema.kinds.rotary.report import estimate_document
 from ema.kinds.rotary.reproduction import output_error_ratios
 from ema.model.actuator import THESIS, RotaryActuator
-from ema.model.window import Window
+from ema.model.window import RotaryWindow, Window, as_window
 
 # On a few dozen noisy simulations the network stops improving within a few epochs, and the physics solution
 # carries most of the answer (ema.estimate.assess.weighing): the thesis's 12 failures and 1000 epochs made its time
@@ -54,7 +54,7 @@ def learned(data: Data, config: PipelineConfig) -> NetworkEstimator:
 
 
 def candidates(
-    window: Window, physics: FrictionSolution, data: Data, network: NetworkEstimator, n: int
+    window: RotaryWindow, physics: FrictionSolution, data: Data, network: NetworkEstimator, n: int
 ) -> tuple[Candidates, FrictionSolution]:
     """Physics and network on the window and on the held-out simulations (and the physics solution of those)."""
     held = {name: values[n:] for name, values in data.sims.signals.items()}
@@ -81,7 +81,7 @@ def candidates(
 
 
 def checked(
-    window: Window,
+    window: RotaryWindow,
     data: Data,
     answer: Assessed,
     physics: FrictionSolution,
@@ -130,7 +130,13 @@ def checked(
 
 
 def assessed(
-    window: Window, physics: FrictionSolution, data: Data, network: NetworkEstimator, *, prepared: Prepared, n: int
+    window: RotaryWindow,
+    physics: FrictionSolution,
+    data: Data,
+    network: NetworkEstimator,
+    *,
+    prepared: Prepared,
+    n: int,
 ) -> tuple[Assessed, float, float]:
     """The assessed answer (its stds widened by what prepare left undecided), the window's equation error over
     its held-out simulations' median, and the misfit limit that ratio is held to."""
@@ -161,8 +167,9 @@ def estimate_window(
     version; ``on_stage`` hears each stage as it starts (and may raise to stop the job there);
     ``spec_only`` reads the window with the document's model alone, no departures taken off (calibration's
     base); ``history``: what other windows of the actuator lend this one (``ema.kinds.rotary.other_windows``). Raises
-    InputError naming the field for a window that cannot be read.
+    InputError naming the field for a window that cannot be read, or of another kind.
     """
+    window = as_window(window, RotaryWindow)
     watch = Stopwatch(on_stage)
     read_with = ActuatorRead(name=actuator.name, version=version, default=actuator is THESIS)
     with watch("prepare", "preparing the window"):

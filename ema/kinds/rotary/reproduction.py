@@ -22,11 +22,11 @@ from ema.kinds.rotary.physics.scenario import SETTLE_S, Scenario
 from ema.kinds.rotary.simulator.residual import residual_torque_nm
 from ema.model.noise import SensorNoise
 from ema.model.params import DriveConstants, HealthParams
-from ema.model.window import Window
+from ema.model.window import RotaryWindow
 
 
 def output_error_ratios(
-    window: Window,
+    window: RotaryWindow,
     scenario: Scenario,
     health: HealthParams,
     *,

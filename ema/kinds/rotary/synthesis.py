@@ -20,7 +20,7 @@ from ema.model.aircraft import FlightCondition
 from ema.model.checks import InputError
 from ema.model.noise import NO_NOISE, SensorNoise
 from ema.model.params import HealthParams
-from ema.model.window import Window, write_window
+from ema.model.window import RotaryWindow, write_window
 
 
 def parse_effect(text: str) -> tuple[str, dict[str, float]]:
@@ -41,7 +41,7 @@ def parse_effect(text: str) -> tuple[str, dict[str, float]]:
     return name, parameters
 
 
-def summary(window: Window, actuator: RotaryActuator) -> dict[str, Any]:
+def summary(window: RotaryWindow, actuator: RotaryActuator) -> dict[str, Any]:
     """Ranges of the signals and of the reconstructed residual torque, for a human or a script."""
     s = window.signals
     residual = residual_torque_nm(
@@ -125,7 +125,7 @@ def _window(
     *,
     noise: SensorNoise,
     effects: EffectSet,
-) -> Window:
+) -> RotaryWindow:
     """The ``index``-th window of ``draw`` at ``health`` (FDJ, η_O, FSJ), stamped ``index`` steps of
     ``every_hours`` on from ``flight_hours`` and ``recorded_at`` where a series or a time was asked for."""
     window = synthetic_window(

@@ -23,7 +23,7 @@ from ema.model.bounds import (
 from ema.model.checks import InputError, in_range
 from ema.model.noise import SensorNoise
 from ema.model.params import HealthParams
-from ema.model.window import Window
+from ema.model.window import RotaryWindow
 
 
 def synthetic_window(
@@ -39,7 +39,7 @@ def synthetic_window(
     window_id: str | None = None,
     command: str = "thesis",
     actuator: RotaryActuator = THESIS,
-) -> Window:
+) -> RotaryWindow:
     """One window logged from the model of ``actuator``: a command of ``command``'s family
     (``simulator.commands.COMMAND_FAMILIES``), the actuator at rest where the command starts, sensor noise; in flight at
     ``condition``, or on the ground under a load cell's ``GroundLoad`` (the window then names no flight
@@ -59,7 +59,7 @@ def synthetic_window(
     )
     signals = add_sensor_noise(result.simulation(0), noise, rng)
     flight = condition if isinstance(condition, FlightCondition) else None
-    window = Window(signals, sample_rate_hz, flight, actuator_id, window_id or "synthetic")
+    window = RotaryWindow(signals, sample_rate_hz, flight, actuator_id, window_id or "synthetic")
     return window if window_id else replace(window, window_id=f"synthetic-{window.content_sha256()[:16]}")
 
 

@@ -24,7 +24,7 @@ from ema.kinds.rotary.selection import NAME_MARGIN, Evidence
 from ema.kinds.rotary.simulator.effects import EffectSet
 from ema.model.actuator import RotaryActuator
 from ema.model.noise import SensorNoise
-from ema.model.window import Window
+from ema.model.window import RotaryWindow
 
 # Look-alikes, each with the others of its group. An inertia ΔJ leaves ΔJ·dω/dt, which a gain of k_T·I
 # (mostly the load and J_M·dω/dt) nearly matches; only its simulation moves the speed otherwise. A current
@@ -35,7 +35,7 @@ TWINS = {name: tuple(other for other in group if other != name) for group in GRO
 
 
 def output_error(
-    windows: Sequence[Window],
+    windows: Sequence[RotaryWindow],
     estimates: Mapping[str, float],
     option: Evidence | None,
     noise: Sequence[SensorNoise],
@@ -63,7 +63,7 @@ def simulated_effects(options: Sequence[Evidence]) -> EffectSet | None:
 
 
 def tell_apart(
-    windows: Sequence[Window],
+    windows: Sequence[RotaryWindow],
     readings: Mapping[str, Mapping[str, float]],
     options: Sequence[Evidence],
     noise: Sequence[SensorNoise],

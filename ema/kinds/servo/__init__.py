@@ -23,7 +23,7 @@ from ema.kinds.servo.closed_loop import SUBSTEPS, ServoLoop, simulate_servo
 from ema.model.actuator import ActuatorDocument, ServoActuator, actuator_from_dict, as_kind
 from ema.model.kinds import KINDS, KindFacts
 from ema.model.params import DriveConstants
-from ema.model.window import Window
+from ema.model.window import ServoWindow, Window, as_window
 
 ROTARY_STEP_S = DriveConstants().step_s  # what a service's simulation limit counts in
 
@@ -42,11 +42,17 @@ class Servo:
 
         actuator = as_kind(request.actuator, ServoActuator)
         return estimate_servo(
-            window, request.config, actuator=actuator, read_with=request.read_with, on_stage=request.on_stage
+            as_window(window, ServoWindow),
+            request.config,
+            actuator=actuator,
+            read_with=request.read_with,
+            on_stage=request.on_stage,
         )
 
     def calibrate(self, windows: Sequence[Window], request: CalibrationRequest) -> Calibrated:
-        report, completed, plot = calibrate_servo(windows, as_kind(request.actuator, ServoActuator))
+        report, completed, plot = calibrate_servo(
+            [as_window(w, ServoWindow) for w in windows], as_kind(request.actuator, ServoActuator)
+        )
         return Calibrated(report.model_copy(update={"completed_actuator": completed}), completed, plot)
 
     def cost(self, window: Window, config: PipelineConfig) -> Cost:

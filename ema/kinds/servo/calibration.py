@@ -67,7 +67,7 @@ from ema.kinds.servo.stacked_solve import (
 )
 from ema.model.actuator import Nominal, ServoActuator
 from ema.model.checks import InputError
-from ema.model.window import Window
+from ema.model.window import ServoWindow
 
 CLOSED_LOOPS = COPIES + 2 * FRAME_PHASES + 2  # per window: noise copies, twins before and after, the errors
 FORCES_ALONG_TRAVEL = ("position_force", "turn_ripple")  # effects that follow the position, not the speed
@@ -239,7 +239,7 @@ def _own_controller(prepared: ServoPrepared) -> ServoPrepared:
 
 
 def calibrate_servo(
-    windows: Sequence[Window], actuator: ServoActuator
+    windows: Sequence[ServoWindow], actuator: ServoActuator
 ) -> tuple[ServoCalibration, ServoActuator, ResidualPlot]:
     """The report (module docstring), the document completed with what the windows taught, and the figure."""
     started = time.perf_counter()

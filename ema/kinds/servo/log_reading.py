@@ -40,7 +40,7 @@ from ema.kinds.servo.inverse import Motion, inverse_columns, load_motion, refuse
 from ema.model.actuator import ServoActuator
 from ema.model.checks import InputError
 from ema.model.servo import Servo
-from ema.model.window import Window
+from ema.model.window import ServoWindow
 
 RATE_TOLERANCE = 0.01
 CONTROLLER_TOLERANCE = 0.02
@@ -59,7 +59,7 @@ POSITIVE = ("mass_kg", "fdj_n", "viscous_ns_per_m", "viscous_up_ns_per_m", "visc
 
 @dataclass(frozen=True)
 class ServoPrepared:
-    window: Window
+    window: ServoWindow
     servo: Servo  # the document's section completed by the log
     loop: ServoLoop
     motion: Motion
@@ -87,7 +87,7 @@ class ServoPrepared:
         )
 
 
-def completed(actuator: ServoActuator, window: Window) -> Servo:
+def completed(actuator: ServoActuator, window: ServoWindow) -> Servo:
     """The document's servo section with the log's constants; InputError naming what neither gives."""
     assert actuator.servo is not None  # the kind's own section (ema.kinds)
     servo = actuator.servo.with_constants(window.constants, "window.constants")
@@ -148,13 +148,13 @@ def _loop_law(
     return gains.speed_gain_per_mps * (gains.position_gain_per_s * (set_point_m - position_m) - speed)
 
 
-def _logged_command(servo: Servo, window: Window) -> np.ndarray:
+def _logged_command(servo: Servo, window: ServoWindow) -> np.ndarray:
     """The command [its unit] the log recorded: its drive force over the drive's gain."""
     assert servo.drive_gain_n_per_unit is not None  # completed
     return window.signals["drive_force_n"] / servo.drive_gain_n_per_unit
 
 
-def document_loop(servo: Servo, window: Window) -> LoopGains:
+def document_loop(servo: Servo, window: ServoWindow) -> LoopGains:
     """The document's gains, and how far the logged command is from what they give; past the filter's and the
     difference's start (as many samples as taps), which read positions from before the window: a log cut from a
     longer one starts in motion."""
@@ -165,7 +165,7 @@ def document_loop(servo: Servo, window: Window) -> LoopGains:
     return LoopGains(servo.position_gain_per_s, servo.speed_gain_per_mps, float(off / max(rms(logged), 1e-300)))
 
 
-def log_loop(servo: Servo, window: Window, among: np.ndarray | None = None) -> LoopGains | None:
+def log_loop(servo: Servo, window: ServoWindow, among: np.ndarray | None = None) -> LoopGains | None:
     """The gains the logged command follows through the document's speed filter: the command is linear in
     kv·kp and kv, so least squares over the samples the limit does not clip (past the filter's start; of those
     ``among`` (N,) marks, where given) reads them. None where it reads no stable loop (gains not both positive,
@@ -186,7 +186,7 @@ def log_loop(servo: Servo, window: Window, among: np.ndarray | None = None) -> L
     return LoopGains(float(stiffness / kv), float(kv), float(off / max(rms(logged[free]), 1e-300)))
 
 
-def _loop_columns(servo: Servo, window: Window) -> np.ndarray:
+def _loop_columns(servo: Servo, window: ServoWindow) -> np.ndarray:
     """(N − taps, 2) the loop's own terms past the speed filter's start: the position error and the filtered speed
     negated, of which the command is kv·kp times the first plus kv times the second."""
     s, start = window.signals, len(servo.speed_filter)
@@ -194,7 +194,7 @@ def _loop_columns(servo: Servo, window: Window) -> np.ndarray:
     return np.column_stack([(s["set_point_m"] - s["position_m"])[start:], -speed])
 
 
-def departure(servo: Servo, window: Window, gains: LoopGains) -> np.ndarray:
+def departure(servo: Servo, window: ServoWindow, gains: LoopGains) -> np.ndarray:
     """(N,) the logged command less the loop's with ``gains``: what the loop does not give. 0 where both sit at the
     same limit (the loop gives it), and before the speed filter's start (it reads positions from before the log)."""
     s, limit = window.signals, _command_limit(servo)
@@ -212,7 +212,7 @@ def loops_own(values: np.ndarray) -> np.ndarray:
     return np.abs(values - np.median(values)) <= ADDED_MADS * spread + 1e-12 * float(np.max(np.abs(values)))
 
 
-def trimmed_loop(servo: Servo, window: Window) -> LoopGains | None:
+def trimmed_loop(servo: Servo, window: ServoWindow) -> LoopGains | None:
     """The gains most of the logged command follows: ``log_loop`` solved ``TRIMMED_SOLVES`` times more, each without
     the samples the last solution's gains leave beyond ``ADDED_MADS`` robust stds (an added command's)."""
     gains = log_loop(servo, window)
@@ -231,7 +231,7 @@ class AddedCommand:
     values: np.ndarray  # (N,) [the command's unit]
 
 
-def loop_share(servo: Servo, window: Window, values: np.ndarray) -> float:
+def loop_share(servo: Servo, window: ServoWindow, values: np.ndarray) -> float:
     """The share of ``values``' energy (N,) that the loop's own terms (the position error and the filtered speed,
     at any gains) explain by least squares: near 1 where ``values`` is a gain's, the sign's or the filter's error."""
     columns, target = _loop_columns(servo, window), values[len(servo.speed_filter) :]
@@ -240,7 +240,7 @@ def loop_share(servo: Servo, window: Window, values: np.ndarray) -> float:
     return 1.0 - left / max(float(np.sum(target**2)), 1e-300)
 
 
-def added_command(servo: Servo, window: Window, gains: LoopGains | None) -> AddedCommand | None:
+def added_command(servo: Servo, window: ServoWindow, gains: LoopGains | None) -> AddedCommand | None:
     """The log's command as the loop with ``gains`` plus an added one, the departure (``departure``), where the loop's
     own terms explain at most ``MAX_LOOP_SHARE`` of it (else it is the loop's error, not a command added to it) and
     the logged command stays within the document's limit (no command added before the limit passes it); else
@@ -263,7 +263,7 @@ class FollowedLoop:
     note: Note | None = None
 
 
-def followed_loop(servo: Servo, window: Window) -> FollowedLoop:
+def followed_loop(servo: Servo, window: ServoWindow) -> FollowedLoop:
     """The loop the log follows: the document's gains where the log follows them within ``CONTROLLER_TOLERANCE``,
     else those its command follows (``log_loop``) where they do, else one of them plus a command added to it
     (``added_command``: the document's first); and the note (``controller_mismatch``, ``added_command``) where the
@@ -293,7 +293,7 @@ def followed_loop(servo: Servo, window: Window) -> FollowedLoop:
     return FollowedLoop(document, note=Note(code="controller_mismatch", parameter="drive_force_n", text=text))
 
 
-def _added_note(servo: Servo, window: Window, added: AddedCommand, document: LoopGains) -> Note:
+def _added_note(servo: Servo, window: ServoWindow, added: AddedCommand, document: LoopGains) -> Note:
     """``added_command``: the added command's size, and whose loop it is added to."""
     logged, values = _logged_command(servo, window), added.values
     gains = added.gains
@@ -347,7 +347,7 @@ def _window_motion(position_m: np.ndarray, rate_hz: float, bandwidth_hz: float, 
     return motion
 
 
-def prepare_servo(window: Window, actuator: ServoActuator) -> ServoPrepared:
+def prepare_servo(window: ServoWindow, actuator: ServoActuator) -> ServoPrepared:
     """The window ready for its physics (module docstring); InputError naming what cannot be read."""
     servo = completed(actuator, window)
     rate = servo.controller_rate_hz or window.sample_rate_hz

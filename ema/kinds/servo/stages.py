@@ -43,7 +43,7 @@ from ema.kinds.servo.inverse import (
 from ema.kinds.servo.log_reading import ServoPrepared, prepare_servo, refuse_reversed_signs
 from ema.kinds.servo.loop_dataset import ServoData, carrying, lane_parameters, simulate_servo_dataset, window_misfit
 from ema.model.actuator import ServoActuator
-from ema.model.window import Window
+from ema.model.window import ServoWindow
 
 MISFIT_SEED_OFFSET = 7919  # the misfit's shifts and signs draw from the window's seed plus this: a stream of their own
 CHECK_PHASES = (0.0, 0.5)  # the position sensor's phases of its step the check simulates: the answer's, its twin's
@@ -292,7 +292,7 @@ def _report(
 
 
 def estimate_servo(
-    window: Window,
+    window: ServoWindow,
     config: PipelineConfig,
     *,
     actuator: ServoActuator,

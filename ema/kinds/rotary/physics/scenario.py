@@ -22,7 +22,7 @@ from ema.model.aircraft import FlightCondition, HingeGeometry
 from ema.model.bounds import DEFAULT_SAMPLE_RATE_HZ
 from ema.model.noise import SensorNoise
 from ema.model.params import DriveConstants, HealthParams
-from ema.model.window import Window
+from ema.model.window import RotaryWindow
 
 INITIAL_SOLVE_SAMPLES = 8
 SETTLE_S = 0.02  # the simulation settles from an estimated first state: compared after this
@@ -58,7 +58,7 @@ class Scenario:
         )
 
 
-def initial_state(window: Window, drive: DriveConstants) -> InitialState:
+def initial_state(window: RotaryWindow, drive: DriveConstants) -> InitialState:
     """The state at t = 0: a parabola through the first samples (at their interval centres), taken at 0.
 
     Not the first sample: the solution averages the sensor noise down, and a parabola follows the motor,
@@ -78,7 +78,7 @@ def initial_state(window: Window, drive: DriveConstants) -> InitialState:
     )
 
 
-def logged_load(window: Window, hinge: HingeGeometry | None, sensor_bias_nm: float = 0.0) -> LoggedLoad:
+def logged_load(window: RotaryWindow, hinge: HingeGeometry | None, sensor_bias_nm: float = 0.0) -> LoggedLoad:
     """The window's own hinge moment (smoothed of sensor noise) as the load its simulations feel, less the
     sensor's bias where one is supposed (the drive feels the moment, the sensor adds its bias to it); with
     the airframe's ``hinge`` model in flight, corrected for the simulation's own deflection."""
@@ -92,7 +92,7 @@ def logged_load(window: Window, hinge: HingeGeometry | None, sensor_bias_nm: flo
 
 
 def scenario_from_window(
-    window: Window, drive: DriveConstants, hinge: HingeGeometry | None, effects: EffectSet = EffectSet()
+    window: RotaryWindow, drive: DriveConstants, hinge: HingeGeometry | None, effects: EffectSet = EffectSet()
 ) -> Scenario:
     """Case 1B for a logged window: its actuator, its command, its logged load, its first state."""
     return Scenario(
@@ -113,7 +113,7 @@ def inside(fdj_nm: float, eta_o: float, nominal_fdj_nm: float, fsd: float = 2.0)
     return HealthParams.single(fsd * fdj, fdj, float(np.clip(eta_o, *limits.eta_o)))
 
 
-def following_error(scenario: Scenario, window: Window, health: HealthParams, noise: SensorNoise) -> float:
+def following_error(scenario: Scenario, window: RotaryWindow, health: HealthParams, noise: SensorNoise) -> float:
     """RMS(speed)/σ_speed + RMS(current)/σ_current of ``window`` simulated clean at ``health`` in ``scenario``
     (after ``SETTLE_S``): how closely a model with its effects follows the drive itself."""
     simulated = scenario.simulate(health, lanes=1).simulation(0)

@@ -26,7 +26,7 @@ from ema.kinds.rotary.physics.friction import SolveSettings
 from ema.kinds.rotary.physics.shifts import advanced, shifted_solutions
 from ema.kinds.rotary.prepare.hinge_lag import hinge_lag
 from ema.model.params import DriveConstants
-from ema.model.window import Window
+from ema.model.window import RotaryWindow
 
 MAX_LAG_S = 1e-3
 HALF_STEP = 0.5  # samples: the finest grid searched
@@ -77,7 +77,7 @@ class Lags:
     hinge_weight: float = 0.0  # how likely the moment is late at all (not only its noise filtered)
 
 
-def aligned(window: Window, drive: DriveConstants) -> tuple[Window, Lags]:
+def aligned(window: RotaryWindow, drive: DriveConstants) -> tuple[RotaryWindow, Lags]:
     """``window`` with the later of its current and speed advanced onto the other and its hinge moment
     advanced by its lag's posterior mean (``ema.kinds.rotary.prepare.hinge_lag``), and those lags."""
     rate, signals = window.sample_rate_hz, dict(window.signals)

@@ -53,7 +53,7 @@ from ema.model.actuator import RotaryActuator
 from ema.model.bounds import DEFAULT_SAMPLE_RATE_HZ
 from ema.model.noise import NOISY_SIGNALS
 from ema.model.params import DriveConstants
-from ema.model.window import Window
+from ema.model.window import RotaryWindow
 
 MAX_RATE_HZ = DEFAULT_SAMPLE_RATE_HZ
 RESAMPLED_MAX_SAMPLES = int(10.0 * KERNEL_FREE_RATE_HZ)  # a 10 s window (0.1–10 s are answered) at the unbiased rate
@@ -79,7 +79,7 @@ class Prepared:
     stale: Stale = field(default_factory=Stale)  # sensors that repeated one value while the shaft slid: cut out
 
     @property
-    def window(self) -> Window:
+    def window(self) -> RotaryWindow:
         """What the pipeline processes: averaged, aligned, corrected for its departures."""
         return self.departures.window
 
@@ -124,7 +124,7 @@ def glitch_starts(values: np.ndarray, run: int, floor: float) -> np.ndarray:
     return np.array(starts, dtype=np.int64)
 
 
-def repaired(window: Window) -> tuple[Window, dict[str, int]]:
+def repaired(window: RotaryWindow) -> tuple[RotaryWindow, dict[str, int]]:
     """``window`` with each sensor's glitches (runs of up to ``MAX_GLITCH_RUN`` samples and
     ``MAX_GLITCH_S``, but single samples at any rate) replaced by the line between their flanks, and
     how many samples were."""
@@ -142,7 +142,9 @@ def repaired(window: Window) -> tuple[Window, dict[str, int]]:
     return (replace(window, signals=signals) if counts else window), counts
 
 
-def prepare(window: Window, actuator: RotaryActuator, spec_only: bool = False, known: Known | None = None) -> Prepared:
+def prepare(
+    window: RotaryWindow, actuator: RotaryActuator, spec_only: bool = False, known: Known | None = None
+) -> Prepared:
     """Cut ``window`` to a stretch its sensors kept updating in (``ema.kinds.rotary.prepare.stale``), repair its
     glitches, average it down to the pipeline's sizes, check its signals agree
     (``ema.kinds.rotary.prepare.consistency``: InputError naming the field), put its sensors on one clock

@@ -47,7 +47,7 @@ from ema.kinds.rotary.physics.shifts import shifted_solutions
 from ema.kinds.rotary.prepare.departures.zero_offset import OFFSET_SOLVE
 from ema.kinds.rotary.simulator.dead_band import dead_band_paths
 from ema.model.params import DriveConstants
-from ema.model.window import Window
+from ema.model.window import RotaryWindow
 
 BAND_GRID = 40  # dead band widths tried: 0, then geometric from 5 % of the document's to the whole travel
 MIN_EXPLAINED = 0.9  # share of the position's variance the speed's travel must explain for g to be judged
@@ -103,7 +103,7 @@ def _best_band(travel: np.ndarray, y: np.ndarray, halves: np.ndarray) -> tuple[f
     return float(explained[best]), float(slope), best % len(halves)
 
 
-def travel_gain(window: Window, drive: DriveConstants) -> float | None:
+def travel_gain(window: RotaryWindow, drive: DriveConstants) -> float | None:
     """The drive's kinematic gain g: the least-squares slope (with an intercept) of the position (rad) on
     the speed's integral / n carried through a dead band (``simulator.dead_band``) whose width (any the travel
     shows: a worn band too; a coarse grid, then a fine one about the best) and start the least squares
@@ -130,7 +130,7 @@ def reaction_s(drive: DriveConstants) -> float:
     return REACTION_MARGIN * turn
 
 
-def following(window: Window, drive: DriveConstants) -> float | None:
+def following(window: RotaryWindow, drive: DriveConstants) -> float | None:
     """The share of ``FOLLOW_STEP_S`` steps, begun over ``FOLLOW_GAP_DEG`` from the command (clipped to the
     end stops) on the side it has stood for the drive's reaction time (``reaction_s``) and moving, that move
     toward it; None where they
@@ -147,7 +147,7 @@ def following(window: Window, drive: DriveConstants) -> float | None:
     return float(np.mean(np.sign(step[judged]) == side[judged]))
 
 
-def better_reading(window: Window, drive: DriveConstants) -> tuple[str, float] | None:
+def better_reading(window: RotaryWindow, drive: DriveConstants) -> tuple[str, float] | None:
     """The reading of ``READINGS`` that follows Eq. 5.1 best, with how many times its equation error is below
     the window's as logged, if by ``MIN_BETTER``; one batched solution of the window and its readings."""
     signals, rate = window.signals, window.sample_rate_hz
@@ -165,13 +165,13 @@ def better_reading(window: Window, drive: DriveConstants) -> tuple[str, float] |
     return list(READINGS)[best], float(gains[best])
 
 
-def step_lags(window: Window) -> np.ndarray:
+def step_lags(window: RotaryWindow) -> np.ndarray:
     """``STEP_LAGS_S`` in samples of ``window``, those under a quarter of it (the rest must overlap)."""
     lags = STEP_LAGS_S * window.sample_rate_hz
     return lags[np.abs(lags) < window.n_samples / 4]
 
 
-def out_of_step(window: Window, drive: DriveConstants) -> tuple[str, float, float] | None:
+def out_of_step(window: RotaryWindow, drive: DriveConstants) -> tuple[str, float, float] | None:
     """The channel (current or hinge moment), its lag [s] and how many times better Eq. 5.1 explains with it,
     where a lag of ``STEP_LAGS_S`` explains it ``MIN_BETTER`` times better than none; else None."""
     signals, rate, lags = window.signals, window.sample_rate_hz, step_lags(window)
@@ -186,6 +186,6 @@ def out_of_step(window: Window, drive: DriveConstants) -> tuple[str, float, floa
     return None
 
 
-def consistency(window: Window, drive: DriveConstants) -> Consistency:
+def consistency(window: RotaryWindow, drive: DriveConstants) -> Consistency:
     """The three relations of the module docstring, read off ``window``."""
     return Consistency(travel_gain(window, drive), following(window, drive), better_reading(window, drive))

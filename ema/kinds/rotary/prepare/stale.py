@@ -45,7 +45,7 @@ from ema.kinds.rotary.simulator.residual import DERIVATIVE_SPAN_S, kernel_sample
 from ema.model.checks import InputError
 from ema.model.noise import NOISY_SIGNALS
 from ema.model.params import DriveConstants
-from ema.model.window import Window
+from ema.model.window import RotaryWindow
 
 MIN_STALE_SAMPLES = 4  # equal samples: fewer is the glitch repair's (3 at most)
 STALE_CHANCE = 1e-6  # expected number of such runs in a working sensor of this signal's repeat rate
@@ -132,7 +132,7 @@ def stands_off(values: np.ndarray, run: StaleRun, jump: float) -> bool:
     return bool(min(abs(values[run.start - 1] - run.value), abs(values[run.stop] - run.value)) > jump)
 
 
-def slides_during(window: Window, drive: DriveConstants, run: StaleRun) -> bool:
+def slides_during(window: RotaryWindow, drive: DriveConstants, run: StaleRun) -> bool:
     """Whether the shaft slides during ``run`` of a motion sensor by the other one (module docstring, 3): the
     speed past the sliding speed (``SolveSettings.sliding_speed_radps``) for the position; for the speed, its
     frozen value past it, or the position
@@ -154,7 +154,7 @@ def slides_during(window: Window, drive: DriveConstants, run: StaleRun) -> bool:
     return travel_deg > TRAVEL_STDS * white_noise_std(position) / math.sqrt(width) and mean_speed > sliding_radps
 
 
-def stale_runs(window: Window, drive: DriveConstants) -> tuple[StaleRun, ...]:
+def stale_runs(window: RotaryWindow, drive: DriveConstants) -> tuple[StaleRun, ...]:
     """Every sensor's stale runs (module docstring), in the order of the samples."""
     n, found = window.n_samples, []
     for name in NOISY_SIGNALS:
@@ -173,7 +173,7 @@ def stale_runs(window: Window, drive: DriveConstants) -> tuple[StaleRun, ...]:
     return tuple(sorted(found, key=lambda r: r.start))
 
 
-def best_stretch(window: Window, runs: tuple[StaleRun, ...], drive: DriveConstants) -> tuple[int, int, int]:
+def best_stretch(window: RotaryWindow, runs: tuple[StaleRun, ...], drive: DriveConstants) -> tuple[int, int, int]:
     """(start, stop, sliding samples) of the stretch free of ``runs`` with the most sliding samples by the
     speed (the longest of equals)."""
     free = np.ones(window.n_samples, dtype=bool)
@@ -188,7 +188,7 @@ def best_stretch(window: Window, runs: tuple[StaleRun, ...], drive: DriveConstan
     return int(starts[best]), int(stops[best]), int(sliding[stops[best]] - sliding[starts[best]])
 
 
-def without_stale(window: Window, drive: DriveConstants) -> tuple[Window, Stale]:
+def without_stale(window: RotaryWindow, drive: DriveConstants) -> tuple[RotaryWindow, Stale]:
     """``window`` with its short stale runs bridged and cut to its best stretch free of the long ones, and
     what was found; InputError naming the sensor where too little sliding motion is left (module docstring)."""
     rate, n = window.sample_rate_hz, window.n_samples

@@ -38,7 +38,7 @@ from ema.kinds.rotary.physics.shifts import shifted_solutions
 from ema.kinds.rotary.prepare.consistency import step_lags
 from ema.kinds.rotary.prepare.hinge_lag import band_log_likelihood
 from ema.model.params import DriveConstants
-from ema.model.window import Window
+from ema.model.window import RotaryWindow
 
 # the prior odds of "out of step" against "in step", and the weight from which a note says so
 PRIOR_LOG_ODDS, NOTE_WEIGHT = UNDECIDED_PRIOR_LOG_ODDS, UNDECIDED_NOTE_WEIGHT
@@ -54,7 +54,7 @@ class StepLag:
     spread: dict[str, float] = field(default_factory=dict)  # per target, the std the story adds
 
 
-def step_lag(window: Window, drive: DriveConstants) -> StepLag:
+def step_lag(window: RotaryWindow, drive: DriveConstants) -> StepLag:
     """The hinge moment's out-of-step story on ``window`` (its departures taken off, ``drive`` as read)."""
     rate, lags = window.sample_rate_hz, np.concatenate([[0.0], step_lags(window)])
     if len(lags) == 1:

@@ -22,7 +22,7 @@ from ema.kinds.rotary.prepare.consistency import (
 )
 from ema.model.checks import InputError
 from ema.model.params import DriveConstants
-from ema.model.window import Window
+from ema.model.window import RotaryWindow
 
 TRAVEL_GAIN = (0.9, 1.1)  # g accepted
 NOTED_GAIN = (0.98, 1.02)  # g accepted without a note: a working drive's position and speed agree within it
@@ -39,7 +39,7 @@ RATE_SLIP_TOLERANCE = 0.02
 AGAINST_THE_MOTION = ("current sign", "torque signs")  # readings that say the motor's motion runs backwards
 
 
-def check_logged(window: Window) -> None:
+def check_logged(window: RotaryWindow) -> None:
     """An InputError naming the first sensor with fewer than three distinct values over ``window``
     (``ema.estimate.information.too_few_levels``, the rule every kind's channels are held to), its load's too."""
     for name in ("position_deg", "motor_speed_radps", "current_a", "hinge_moment_nm"):
@@ -62,7 +62,7 @@ def kinematics_note(found: Consistency) -> list[Note]:
 
 
 def _travel_error(
-    gain: float, reading: tuple[str, float] | None, loop: str, window: Window, drive: DriveConstants
+    gain: float, reading: tuple[str, float] | None, loop: str, window: RotaryWindow, drive: DriveConstants
 ) -> InputError:
     """The error for a travel gain outside ``TRAVEL_GAIN``, naming the field it points to: for a sign, the
     speed where Eq. 5.1 reads the torques against the motion (24–940x better flipped), else the position
@@ -104,7 +104,7 @@ def _travel_error(
     )
 
 
-def check_consistency(window: Window, drive: DriveConstants) -> Consistency:
+def check_consistency(window: RotaryWindow, drive: DriveConstants) -> Consistency:
     """``window``'s relations, or an InputError naming the field the failing ones point to."""
     check_logged(window)
     found = consistency(window, drive)

@@ -51,7 +51,7 @@ from ema.model.actuator import Airframe
 from ema.model.aircraft import HingeGeometry
 from ema.model.checks import InputError
 from ema.model.params import DriveConstants
-from ema.model.window import Window
+from ema.model.window import RotaryWindow
 
 TOLERANCE = Airframe.model_fields["tolerance"].default  # how far the airframe's C_hδ may be off: the document's default
 DEPART_STDS = 2.0  # stds beyond the tolerance by which a ratio departs: the gauge is off by it
@@ -94,7 +94,7 @@ class AircraftCheck:
         """Beyond the tolerance by ``SUSPECT_STDS`` but not divided out (module docstring, 3)."""
         return self.factor == 1.0 and self.beyond(SUSPECT_STDS)
 
-    def corrected(self, window: Window) -> Window:
+    def corrected(self, window: RotaryWindow) -> RotaryWindow:
         """``window`` with its hinge moment divided by ``factor``."""
         return divided_hinge(window, self.factor)
 
@@ -130,7 +130,9 @@ def slope(
     return value, max(white, jackknife) if np.isfinite(jackknife) else math.inf, correlation
 
 
-def check_against_aircraft(window: Window, hinge: HingeGeometry | None, tolerance: float = TOLERANCE) -> AircraftCheck:
+def check_against_aircraft(
+    window: RotaryWindow, hinge: HingeGeometry | None, tolerance: float = TOLERANCE
+) -> AircraftCheck:
     """The ratio of ``window``'s moment to the aircraft's, or an InputError naming the moment where it
     was exported out of step or lies outside ``GROSS`` (module docstring, 1 and 2); ``tolerance``: how far
     the airframe's C_hδ may be off. Skipped on the ground (the logged moment is the load) and without the
@@ -203,7 +205,7 @@ def divided_out(read: AircraftCheck) -> AircraftCheck:
     return replace(read, factor=read.ratio) if read.decisive and read.beyond(DEPART_STDS) else read
 
 
-def banded(read: AircraftCheck, window: Window, gain: float, drive: DriveConstants) -> AircraftCheck:
+def banded(read: AircraftCheck, window: RotaryWindow, gain: float, drive: DriveConstants) -> AircraftCheck:
     """``read`` with the stds it adds to FDJ and η_O of ``window`` (its ratio divided out already, where
     it departs) where the window's own loads read no ``gain``
     (``ema.kinds.rotary.prepare.departures.hinge_gain``); as it is otherwise. Divided out: half of what the ends of
@@ -221,7 +223,7 @@ def banded(read: AircraftCheck, window: Window, gain: float, drive: DriveConstan
     return replace(read, spread=_moved(window, drive, 1.0 - band, 1.0 + band, 0.5))
 
 
-def _moved(window: Window, drive: DriveConstants, first: float, second: float, share: float) -> dict[str, float]:
+def _moved(window: RotaryWindow, drive: DriveConstants, first: float, second: float, share: float) -> dict[str, float]:
     """``share`` of how far FDJ and η_O of Eq. 5.1's solution move between the hinge moment divided by
     ``first`` and by ``second``."""
     ends = [solve_as_read(divided_hinge(window, g).signals, window.sample_rate_hz, drive) for g in (first, second)]

@@ -38,7 +38,7 @@ from ema.kinds.rotary.physics.friction import FrictionSolution, SolveSettings
 from ema.kinds.rotary.prepare.departures.zero_offset import equation_z, log_likelihood_ratio
 from ema.model.checks import InputError
 from ema.model.params import DriveConstants
-from ema.model.window import Window
+from ema.model.window import RotaryWindow
 
 ITERATIONS = 3  # solves of the corrected window at most: each settles what the peak torque's cut left
 SETTLED = 0.01  # of the constant's std: what a solve may leave
@@ -97,18 +97,18 @@ class DriveReading:
         scale = self.torque_factor * (1.0 + float(left.term("torque_scale")[0])) - 1.0
         return replace(self, torque_scale=scale, inertia_kgm2=self.inertia_kgm2 + float(left.term("inertia")[0]))
 
-    def corrected(self, window: Window) -> Window:
+    def corrected(self, window: RotaryWindow) -> RotaryWindow:
         """``window`` with its current on the document's k_T: I' = (1 + γ)·I."""
         if not self.torque_scale:
             return window
         return replace(window, signals=dict(window.signals, current_a=self.torque_factor * window.signals["current_a"]))
 
 
-def _solve(window: Window, drive: DriveConstants, settings: SolveSettings) -> FrictionSolution:
+def _solve(window: RotaryWindow, drive: DriveConstants, settings: SolveSettings) -> FrictionSolution:
     return solve_as_read(window.signals, window.sample_rate_hz, drive, settings)
 
 
-def read_drive_constants(window: Window, drive: DriveConstants) -> DriveReading:
+def read_drive_constants(window: RotaryWindow, drive: DriveConstants) -> DriveReading:
     """γ or ΔJ where it stands out (module docstring), with FDJ's and η_O's change across it ± its std. Where
     both do, the likelier if the window decides (``DECISIVE``); else γ, with ΔJ beside it as the
     ``alternative`` (``ema.kinds.rotary.prepare.departures.read`` replays both, or widens the stds by their gap)."""
@@ -126,7 +126,7 @@ def read_drive_constants(window: Window, drive: DriveConstants) -> DriveReading:
 
 
 def _read_constants(
-    window: Window, drive: DriveConstants, plain: FrictionSolution, alone: dict[str, FrictionSolution]
+    window: RotaryWindow, drive: DriveConstants, plain: FrictionSolution, alone: dict[str, FrictionSolution]
 ) -> DriveReading:
     rate = window.sample_rate_hz
     found = [name for name in FIELDS if _stands_out(plain, alone[name], name, rate, drive)]
@@ -196,7 +196,7 @@ def _stands_out(plain: FrictionSolution, alone: FrictionSolution, name: str, rat
 
 
 def _reading(
-    window: Window, drive: DriveConstants, name: str, first: FrictionSolution
+    window: RotaryWindow, drive: DriveConstants, name: str, first: FrictionSolution
 ) -> tuple[DriveReading, FrictionSolution]:
     """Constant ``name``, solved again on the corrected window until nothing is left, its std ΔJ's with the
     kernel's (``kernel_inertia_std``); and the last solution (its likelihood)."""
@@ -216,12 +216,12 @@ def kernel_inertia_std(rate_hz: float, spec: DriveConstants) -> float:
     return KERNEL_INERTIA_SHARE * (1_000.0 / rate_hz) ** 2 * spec.inertia_kgm2
 
 
-def _plain(window: Window, read: DriveReading) -> dict[str, float]:
+def _plain(window: RotaryWindow, read: DriveReading) -> dict[str, float]:
     solved = _solve(read.corrected(window), read.drive_as_read, SolveSettings())
     return {name: float(value) for name, value in solved.values().items()}
 
 
-def _with_spread(window: Window, read: DriveReading) -> DriveReading:
+def _with_spread(window: RotaryWindow, read: DriveReading) -> DriveReading:
     """``read`` with, per target, half the change of the plain solution across each read constant ± its std, in
     quadrature."""
     spread = {"FDJ": 0.0, "eta_O": 0.0}

@@ -36,7 +36,7 @@ from ema.kinds.rotary.physics.friction import MIN_SLIDING_KERNELS, SolveSettings
 from ema.kinds.rotary.prepare.departures.drive_constants import BESIDE, FIELDS
 from ema.kinds.rotary.simulator.residual import DERIVATIVE_SPAN_S, kernel_samples
 from ema.model.params import DriveConstants
-from ema.model.window import Window
+from ema.model.window import RotaryWindow
 
 GAIN_PLAUSIBLE = (0.7, 1.35)  # lbf·ft for N·m is 0.74; outside, no sensor's: not taken
 GAIN_MIN_CHANGE = 0.01  # a gain nearer 1 than this changes nothing worth a note
@@ -51,12 +51,12 @@ class HingeGain:
     gain_std: float = 0.0
     spread: dict[str, float] = field(default_factory=dict)  # per target, the std g's uncertainty adds
 
-    def corrected(self, window: Window) -> Window:
+    def corrected(self, window: RotaryWindow) -> RotaryWindow:
         """``window`` with its hinge moment divided by the gain."""
         return divided_hinge(window, self.gain)
 
 
-def divided_hinge(window: Window, gain: float) -> Window:
+def divided_hinge(window: RotaryWindow, gain: float) -> RotaryWindow:
     """``window`` with its hinge moment divided by ``gain`` (itself where the gain is 1)."""
     if gain == 1.0:
         return window
@@ -74,7 +74,7 @@ def eta_o_from_product(product: np.ndarray, gear: float) -> np.ndarray:
 
 
 def free_load_solution(
-    window: Window, drive: DriveConstants, beside: SolveSettings = SolveSettings()
+    window: RotaryWindow, drive: DriveConstants, beside: SolveSettings = SolveSettings()
 ) -> tuple[np.ndarray, float, int] | None:
     """The least squares of t on (1, a, o) and ``beside``'s nuisance columns over the sliding samples: g
     from the whole window and from each jackknife block left out ((B + 1,), the whole first), the RMS
@@ -96,7 +96,9 @@ def free_load_solution(
     return 1.0 / ((1 + betas[:, 2]) * eta_o), misfit, used
 
 
-def _margin(window: Window, drive: DriveConstants, free_rms: float, used: int, rivals: list[SolveSettings]) -> float:
+def _margin(
+    window: RotaryWindow, drive: DriveConstants, free_rms: float, used: int, rivals: list[SolveSettings]
+) -> float:
     """ln LR by which the free load solution explains ``window`` better than the best of Eq. 5.1's solutions with
     g = 1 and ``rivals``' terms (−inf where one cannot be compared)."""
     rate = window.sample_rate_hz
@@ -107,7 +109,7 @@ def _margin(window: Window, drive: DriveConstants, free_rms: float, used: int, r
     return rms_log_likelihood_ratio(best, free_rms, used, rate, resolution_nm=float(solutions[0].resolution_nm[0]))
 
 
-def read_hinge_gain(window: Window, drive: DriveConstants, leading: bool = False) -> HingeGain:
+def read_hinge_gain(window: RotaryWindow, drive: DriveConstants, leading: bool = False) -> HingeGain:
     """g where it stands out and is plausible (module docstring), with FDJ's and η_O's change across g ± its
     std; ``leading``: only where it also explains the window ``GAIN_DECISIVE`` (ln LR) better than γ or ΔJ alone,
     each beside an offset and ΔC, to be read before them (which would each take a part of it)."""

@@ -36,7 +36,7 @@ from ema.model.actuator import RotaryActuator
 from ema.model.checks import InputError
 from ema.model.noise import SensorNoise
 from ema.model.params import DriveConstants
-from ema.model.window import Window
+from ema.model.window import RotaryWindow
 
 # A reading agrees with the J_M an actuator's history holds where it lies within this many stds of it.
 AGREES_Z = 3.0
@@ -54,7 +54,7 @@ class Known:
 
 @dataclass(frozen=True)
 class Departures:
-    window: Window  # zeroed, its current on the document's k_T
+    window: RotaryWindow  # zeroed, its current on the document's k_T
     drive: DriveReading  # γ and ΔJ, and the drive's constants they were read against
     offset: ZeroOffset = field(default_factory=ZeroOffset)
     viscosity: Viscosity = field(default_factory=Viscosity)
@@ -75,7 +75,7 @@ class Departures:
 
 
 def read_departures(
-    window: Window,
+    window: RotaryWindow,
     actuator: RotaryActuator,
     aircraft: AircraftCheck = AircraftCheck(),
     known: Known = Known(),
@@ -109,7 +109,7 @@ def _doubted(read: Departures, divided: Departures) -> Departures:
     return replace(read, aircraft=replace(read.aircraft, spread=spread))
 
 
-def _read(window: Window, actuator: RotaryActuator, aircraft: AircraftCheck, known: Known) -> Departures:
+def _read(window: RotaryWindow, actuator: RotaryActuator, aircraft: AircraftCheck, known: Known) -> Departures:
     """``read_departures`` with ``aircraft``'s factor as decided."""
     zero, spec = known.zero, actuator.params
     window = aircraft.corrected(window)
@@ -134,7 +134,9 @@ def _read(window: Window, actuator: RotaryActuator, aircraft: AircraftCheck, kno
 NOISELESS_SPEED = 1e-6  # a speed's white-noise std under this share of its range: logged without noise
 
 
-def _told_apart(window: Window, scale: Departures, inertia: Departures, actuator: RotaryActuator) -> Departures | None:
+def _told_apart(
+    window: RotaryWindow, scale: Departures, inertia: Departures, actuator: RotaryActuator
+) -> Departures | None:
     """The reading whose simulation follows the window's motor speed and current clearly better
     (``CLEAR_MARGIN``), or None: γ as a torque constant or as a current sensor's gain, whichever
     follows better, against ΔJ; each at its own answer, with the viscous coefficient it read. Only
@@ -184,7 +186,7 @@ def _by_history(scale: Departures, inertia: Departures, known: Known) -> Departu
 
 
 def _along(
-    window: Window,
+    window: RotaryWindow,
     offset: ZeroOffset,
     drive: DriveReading,
     hinge: HingeGain,

@@ -35,7 +35,7 @@ from ema.kinds.rotary.physics.friction import SolveSettings, solve_friction
 from ema.kinds.rotary.prepare.departures.drive_constants import UNDECIDED_SHARE
 from ema.kinds.rotary.simulator.effects import EffectSet
 from ema.model.params import DriveConstants
-from ema.model.window import Window
+from ema.model.window import RotaryWindow
 
 MIN_CHANGE = 0.1  # of the document's C
 # A floor of C's std, of the document's C: the reconstruction's bias follows the speed a little, beyond what the
@@ -91,7 +91,7 @@ class Viscosity:
         return EffectSet({"viscous": {"coefficient_nms": self.change_nms}}) if self.change_nms else EffectSet()
 
 
-def read_viscosity(window: Window, spec: DriveConstants) -> Viscosity:
+def read_viscosity(window: RotaryWindow, spec: DriveConstants) -> Viscosity:
     """ΔC where it stands out, with FDJ's and η_O's change across C ± its std; elsewhere the document's C,
     with what the change the window leans to would move them, by its weight (module docstring)."""
     rate = window.sample_rate_hz

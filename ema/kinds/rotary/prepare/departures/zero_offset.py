@@ -38,7 +38,7 @@ from ema.kinds.rotary.evidence import rms_log_likelihood_ratio
 from ema.kinds.rotary.physics.features import solve_as_read
 from ema.kinds.rotary.physics.friction import FrictionSolution, SolveSettings
 from ema.model.params import DriveConstants
-from ema.model.window import Window
+from ema.model.window import RotaryWindow
 
 # A flight's zero holds on a window where, taken off it, the constant left lies within this many stds of none: a
 # sensor that drifted (or a power-on between) shows, and the window's own reading is taken.
@@ -115,7 +115,7 @@ def second_weight(first: FrictionSolution, second: FrictionSolution, rate: float
     return odds_weight(log_likelihood_ratio(first, second, rate))
 
 
-def read_zero_offset(window: Window, drive: DriveConstants, carried: ZeroOffset | None = None) -> ZeroOffset:
+def read_zero_offset(window: RotaryWindow, drive: DriveConstants, carried: ZeroOffset | None = None) -> ZeroOffset:
     """The window's constant torque beyond friction, where the solution with it explains the window ``DECISIVE_Z``
     stds better, and the two readings of it (module docstring) weighed; the zero ``carried`` from a window
     of the same flight where it is the more precise and holds here (``flight_zero``); where the motion goes
@@ -172,7 +172,7 @@ def flight_zero(
     return replace(carried, spread={"FDJ": carried.zero_std_nm})
 
 
-def zeroed(window: Window, offset: ZeroOffset) -> Window:
+def zeroed(window: RotaryWindow, offset: ZeroOffset) -> RotaryWindow:
     """``window`` with the offset taken off its sensors."""
     if not offset.hinge_nm and not offset.current_a:
         return window
