@@ -57,14 +57,18 @@ class _Readings:
     zeros: dict[tuple[str, str | None], list[Any]] = field(default_factory=dict)
     inertias: dict[str, list[Any]] = field(default_factory=dict)
 
-    def add(self, window: Window, answer: dict[str, Any]) -> None:
+    def add(self, window: Window, answer: dict[str, Any]) -> bool:
+        """Keep what ``answer`` lends; whether the window waits for the run's others (``waits_for_the_run``)."""
         from ema.estimate.documents.window_facts import WindowInfo
+        from ema.kinds import lent_by, waits_for_the_run
 
         info = WindowInfo.model_validate(answer["window"])
-        if info.sensor_zero is not None and window.flight_id is not None:
-            self.zeros.setdefault((window.actuator_id, window.flight_id), []).append(info.sensor_zero)
-        if info.inertia_read is not None:
-            self.inertias.setdefault(window.actuator_id, []).append(info.inertia_read)
+        zero, inertia = lent_by(info)
+        if zero is not None and window.flight_id is not None:
+            self.zeros.setdefault((window.actuator_id, window.flight_id), []).append(zero)
+        if inertia is not None:
+            self.inertias.setdefault(window.actuator_id, []).append(inertia)
+        return waits_for_the_run(info)
 
     def lacked(self, window: Window, answer: dict[str, Any]) -> dict[str, Any] | None:
         """What the run's other windows lend this one that it lacks (``ema.kinds.lacking``), as
@@ -107,8 +111,7 @@ def _with_history(
         if "error" in answer:
             yield window, answer
             continue
-        readings.add(window, answer)
-        (at_end if answer["window"].get("inertia_undecided") else held).append((window, answer))
+        (at_end if readings.add(window, answer) else held).append((window, answer))
         waiting: list[Answer] = []
         for w, a in held:
             if w.flight_id is not None and unanswered[(w.actuator_id, w.flight_id)] > 0:

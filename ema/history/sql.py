@@ -25,7 +25,7 @@ from ema.history.connection import now
 from ema.history.refusals import ConflictError, WithdrawnError
 from ema.history.tables import actuators, calibrations, estimates, summaries, withdrawals
 from ema.history.versions import VersionedDocuments
-from ema.kinds import other_windows_lent
+from ema.kinds import lent_by, other_windows_lent
 from ema.prognosis.documents import Stored, Withdrawal
 
 
@@ -36,6 +36,7 @@ class SqlHistory(VersionedDocuments):
         """Store one result; where its (actuator_id, window_id) is stored already from the same content, that row,
         marked as a replay (ConflictError where from other content; WithdrawnError where it was withdrawn)."""
         stored_at, document, info = now(), result.model_dump_json(by_alias=True), result.window
+        zero, inertia = lent_by(info)  # kept in their own columns: what the actuator's other windows borrow
         row = {
             "actuator_id": result.actuator_id,
             "window_id": result.window_id,
@@ -43,8 +44,8 @@ class SqlHistory(VersionedDocuments):
             "result": document,
             "content_sha256": info.content_sha256,
             "flight_id": info.flight_id,
-            "sensor_zero": None if info.sensor_zero is None else info.sensor_zero.model_dump_json(),
-            "inertia_read": None if info.inertia_read is None else info.inertia_read.model_dump_json(),
+            "sensor_zero": None if zero is None else zero.model_dump_json(),
+            "inertia_read": None if inertia is None else inertia.model_dump_json(),
         }
         statement = self._insert(estimates).values(**row).on_conflict_do_nothing().returning(estimates.c.id)
         with self._writing() as connection:

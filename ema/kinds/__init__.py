@@ -28,7 +28,7 @@ from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import Estimate, Note
 from ema.estimate.documents.window_facts import HistoryReadings, InertiaReading, SensorZero, WindowInfo
 from ema.estimate.information import out_of_bounds, refuse_empty_channels
-from ema.kinds.base import Calibrated, CalibrationRequest, Cost, Kind, Request
+from ema.kinds.base import Calibrated, CalibrationRequest, Cost, Kind, Request, SensorGain
 from ema.kinds.geared import GEARED
 from ema.kinds.linear import LINEAR
 from ema.kinds.rotary import ROTARY
@@ -51,17 +51,21 @@ __all__ = [
     "estimate",
     "estimate_thesis_window",
     "inertia_change_note",
+    "inertia_of",
     "kind_of",
     "lacking",
     "learns",
+    "lent_by",
     "load_methods",
     "other_windows_lent",
     "readings_of_results",
     "report_lines",
+    "sensor_gains",
     "synthesize",
     "thesis_kernel_cached",
     "thesis_kernel_seconds",
     "thesis_window",
+    "waits_for_the_run",
     "warm_up",
 ]
 
@@ -169,6 +173,33 @@ def other_windows_lent(zeros: Sequence[SensorZero], inertias: Sequence[InertiaRe
     from ema.kinds.rotary.other_windows import lent
 
     return lent(zeros, inertias)
+
+
+def lent_by(info: WindowInfo) -> tuple[SensorZero | None, InertiaReading | None]:
+    """What a window's answer lends the other windows of its actuator: a sensor zero to its flight's, a J_M to all
+    (``ema.kinds.rotary.other_windows.lent_by``; other kinds lend nothing, and their answers hold neither)."""
+    from ema.kinds.rotary.other_windows import lent_by as lent
+
+    return lent(info)
+
+
+def waits_for_the_run(info: WindowInfo) -> bool:
+    """Whether a window answered alone is answered again once its run's other windows are (``lacking``)."""
+    from ema.kinds.rotary.other_windows import waits_for_the_run as waits
+
+    return waits(info)
+
+
+def sensor_gains() -> tuple[SensorGain, ...]:
+    """Every kind's sensors' gains against a model, as their windows read them (``Kind.sensor_gains``)."""
+    return tuple(gain for kind in REGISTRY.values() for gain in kind.sensor_gains)
+
+
+def inertia_of(infos: Sequence[WindowInfo]) -> tuple[InertiaReading | None, Note | None]:
+    """An actuator's J_M as its windows (oldest first) read it since it last changed, and a note where it changed
+    along them or scatters beyond their stds (``combined_inertia``, ``inertia_change_note``)."""
+    readings = [inertia for info in infos if (inertia := lent_by(info)[1]) is not None]
+    return combined_inertia(readings), inertia_change_note(readings)
 
 
 def readings_of_results(windows: Sequence[WindowInfo], flight_id: str | None) -> HistoryReadings:

@@ -10,7 +10,7 @@ from ema.calibration.documents import CalibrationReport
 from ema.calibration.plot import ResidualPlot
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import ActuatorRead, Estimate
-from ema.estimate.documents.window_facts import HistoryReadings
+from ema.estimate.documents.window_facts import HistoryReadings, WindowInfo
 from ema.estimate.quasistatic.drive_torque import QuasiStaticReading
 from ema.estimate.quasistatic.slow_window import estimate_low_rate
 from ema.model.actuator import THESIS, ActuatorDocument
@@ -81,6 +81,19 @@ def read_quasi_statically(window: Window, request: Request, reading: QuasiStatic
     )
 
 
+@dataclass(frozen=True)
+class SensorGain:
+    """A sensor's gain against a model of what it measures, as each window of a kind reads it: what the prognosis
+    trends over an actuator's windows, and says where it stands off 1 or drifts."""
+
+    name: str  # the trend's name, the window part's field
+    signal: str  # the signal the sensor logs
+    sensor: str  # for a person: "the hinge moment's strain gauge"
+    model: str  # for a person: "the aircraft model"
+    remedy: str  # what to do where it stands off the model
+    read: Callable[[WindowInfo], tuple[float, float | None] | None]  # (gain, its std) a window read, or None
+
+
 def learned_lines(learned: Sequence[Mapping[str, Any]], simulated: Mapping[str, float] | None = None) -> list[str]:
     """A report's learned constants for a person: each with its std and unit, and where ``simulated`` gives them, as
     the simulator takes them (what the completed document keeps)."""
@@ -111,5 +124,8 @@ class Kind(Protocol):
     def warm_up(self) -> None: ...  # what its first window would load, loaded now (a service before it answers)
     # ``ema simulate``: its windows drawn by its simulator as the flags ask; ``not_drawn`` where it has none
     def synthesize(self, actuator: ActuatorDocument, flags: Mapping[str, Any]) -> dict[str, Any]: ...
+    # the sensors' gains its windows read against a model, for the prognosis to trend (none: its windows read none)
+    @property
+    def sensor_gains(self) -> tuple[SensorGain, ...]: ...
     # its own parts of an ``ema-calibration/1`` report (as JSON), as a person reads them
     def report_lines(self, report: Mapping[str, Any]) -> list[str]: ...

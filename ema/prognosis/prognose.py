@@ -10,7 +10,8 @@ from dataclasses import replace
 import numpy as np
 
 from ema.estimate.documents import Note
-from ema.kinds import combined_inertia, inertia_change_note
+from ema.kinds import inertia_of, sensor_gains
+from ema.kinds.base import SensorGain
 from ema.model.actuator import ActuatorDocument
 from ema.prognosis.backtest import backtest
 from ema.prognosis.documents import MIN_SPAN, PARAMETERS, Prognosis, RemainingLife, Stored, TimeUnit, Trend
@@ -64,18 +65,18 @@ def prognose(
         if (seen := _outlook(name, stored, times, actuator, unit, backtested)) is not None
     }
     sensors, said = sensor_trends(stored, times, unit, actuator.load_model_tolerance)
-    inertias = [s.window.inertia_read for s in stored if s.window.inertia_read is not None]
+    inertia, inertia_note = inertia_of([s.window for s in stored])
     faster = [speeding_note(name) for name, seen in outlooks.items() if seen.life.speeding_up]
     away = [away_note(name, seen, actuator, unit) for name, seen in outlooks.items()]
     levelless = [no_level_note(name, actuator) for name in PARAMETERS if _read(name, stored) and name not in outlooks]
-    notes = [n for n in (note, *faster, *away, *levelless, *said, inertia_change_note(inertias)) if n]
+    notes = [n for n in (note, *faster, *away, *levelless, *said, inertia_note) if n]
     return Prognosis(
         actuator_id=actuator_id,
         time_unit=unit,
         trends={n: o.trend for n, o in outlooks.items()},
         remaining_life={n: o.life for n, o in outlooks.items()},
         sensors=sensors,
-        inertia=combined_inertia(inertias),
+        inertia=inertia,
         notes=notes,
         backtest={n: o.backtest for n, o in outlooks.items()},
     )
@@ -173,41 +174,41 @@ def away_note(name: str, seen: Outlook, actuator: ActuatorDocument, unit: TimeUn
 def sensor_trends(
     stored: Sequence[Stored], times: np.ndarray, unit: str, tolerance: float
 ) -> tuple[dict[str, Trend], list[Note]]:
-    """The trend of the strain gauge's gain against the aircraft model over the windows that read it (two
-    at least), and notes where its level stands off 1 beyond the airframe model's ``tolerance`` or it drifts
+    """The trend of each sensor's gain against its model (``ema.kinds.sensor_gains``) over the windows that read
+    it (two at least), and notes where its level stands off 1 beyond the model's ``tolerance`` or it drifts
     (``SENSOR_STDS`` stds)."""
-    read = [
-        (t, s.window.hinge_aircraft_ratio, s.window.hinge_aircraft_ratio_std, s.window_id)
-        for t, s in zip(times, stored, strict=True)
-        if s.window.hinge_aircraft_ratio is not None
-    ]
-    if len(read) < 2:
-        return {}, []
-    t, values, stds, ids = zip(*read, strict=True)
-    trend = trend_of(
-        Series("hinge_aircraft_ratio", np.array(t), np.array(values), np.array(stds, dtype=float), list(ids))
-    )
+    trends: dict[str, Trend] = {}
+    notes: list[Note] = []
+    for gain in sensor_gains():
+        read = [(t, *r, s.window_id) for t, s in zip(times, stored, strict=True) if (r := gain.read(s.window))]
+        if len(read) < 2:
+            continue
+        t, values, stds, ids = zip(*read, strict=True)
+        trend = trend_of(Series(gain.name, np.array(t), np.array(values), np.array(stds, dtype=float), list(ids)))
+        trends[gain.name] = trend
+        notes += _gain_notes(gain, trend, tolerance, unit)
+    return trends, notes
+
+
+def _gain_notes(gain: SensorGain, trend: Trend, tolerance: float, unit: str) -> list[Note]:
+    """Where a sensor's gain stands off its model beyond ``tolerance``, or drifts, each by ``SENSOR_STDS`` stds."""
     notes = []
     if abs(trend.level - 1.0) > tolerance + SENSOR_STDS * trend.level_std:
         notes.append(
             Note(
                 code="gauge_off_model",
-                parameter="hinge_moment_nm",
-                text=f"the hinge moment's strain gauge reads {trend.level:.3f} ± {trend.level_std:.3f}x the aircraft "
-                f"model over "
-                f"{trend.n} windows, beyond the model's {100 * tolerance:.0f} % tolerance: recalibrate the gauge, or "
-                f"the "
-                "airframe's C_hδ is off (each estimate divides the gauge's gain out where its window is long enough)",
+                parameter=gain.signal,
+                text=f"{gain.sensor} reads {trend.level:.3f} ± {trend.level_std:.3f}x {gain.model} over {trend.n} "
+                f"windows, beyond the model's {100 * tolerance:.0f} % tolerance: {gain.remedy}",
             )
         )
     if trend.slope_std is not None and abs(trend.slope_per_unit) > SENSOR_STDS * trend.slope_std:
         notes.append(
             Note(
                 code="gauge_drift",
-                parameter="hinge_moment_nm",
-                text=f"the hinge moment's strain gauge drifts against the aircraft model by "
-                f"{trend.slope_per_unit:+.2g} "
+                parameter=gain.signal,
+                text=f"{gain.sensor} drifts against {gain.model} by {trend.slope_per_unit:+.2g} "
                 f"± {trend.slope_std:.2g} per {_one(unit)}",
             )
         )
-    return {"hinge_aircraft_ratio": trend}, notes
+    return notes

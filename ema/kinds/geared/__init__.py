@@ -19,7 +19,7 @@ import numpy as np
 
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import STAGES, Estimate
-from ema.kinds.base import WARM_UP, Calibrated, CalibrationRequest, Cost, Request, learned_lines, not_drawn
+from ema.kinds.base import WARM_UP, Calibrated, CalibrationRequest, Cost, Request, SensorGain, learned_lines, not_drawn
 from ema.model.actuator import ActuatorDocument, GearedActuator, actuator_from_dict, as_kind
 from ema.model.kinds import KINDS, KindFacts
 from ema.model.params import DriveConstants
@@ -70,6 +70,8 @@ class Geared:
 
     def synthesize(self, actuator: ActuatorDocument, flags: Mapping[str, Any]) -> dict[str, Any]:
         raise not_drawn(self.facts)
+
+    sensor_gains: tuple[SensorGain, ...] = ()
 
     def report_lines(self, report: Mapping[str, Any]) -> list[str]:
         """What it learned, its runs' position error before and after, and each load's runs against the nominal."""

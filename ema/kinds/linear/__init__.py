@@ -14,7 +14,7 @@ from typing import Any
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import Estimate
 from ema.estimate.quasistatic.slow_window import QUASI_STATIC_STAGES
-from ema.kinds.base import Calibrated, CalibrationRequest, Cost, Request, not_drawn, read_quasi_statically
+from ema.kinds.base import Calibrated, CalibrationRequest, Cost, Request, SensorGain, not_drawn, read_quasi_statically
 from ema.kinds.linear.calibration_report import calibrate_linear
 from ema.kinds.linear.stepper_reading import STEPPER_READING
 from ema.model.actuator import ActuatorDocument, LinearActuator, as_kind
@@ -46,6 +46,8 @@ class Linear:
 
     def synthesize(self, actuator: ActuatorDocument, flags: Mapping[str, Any]) -> dict[str, Any]:
         raise not_drawn(self.facts)
+
+    sensor_gains: tuple[SensorGain, ...] = ()
 
     def report_lines(self, report: Mapping[str, Any]) -> list[str]:
         """What its healthy runs taught of its drive, or what its faulted runs changed."""

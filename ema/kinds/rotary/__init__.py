@@ -19,8 +19,18 @@ import numpy as np
 from ema.calibration.plot import ResidualPlot, Series
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import STAGES, Estimate
+from ema.estimate.documents.window_facts import WindowInfo
 from ema.estimate.quasistatic.slow_window import QUASI_STATIC_STAGES
-from ema.kinds.base import WARM_UP, Calibrated, CalibrationRequest, Cost, Request, learned_lines, read_quasi_statically
+from ema.kinds.base import (
+    WARM_UP,
+    Calibrated,
+    CalibrationRequest,
+    Cost,
+    Request,
+    SensorGain,
+    learned_lines,
+    read_quasi_statically,
+)
 from ema.kinds.rotary.motor_reading import MOTOR_READING
 from ema.kinds.rotary.synthetic import synthetic_window
 from ema.model.actuator import THESIS, ActuatorDocument, RotaryActuator, as_kind
@@ -102,6 +112,10 @@ class Rotary:
 
         return synthesize(Draw(**flags), as_kind(actuator, RotaryActuator))
 
+    @property
+    def sensor_gains(self) -> tuple[SensorGain, ...]:
+        return (HINGE_GAUGE,)
+
     def report_lines(self, report: Mapping[str, Any]) -> list[str]:
         return learned_lines(report.get("learned", []))
 
@@ -139,4 +153,17 @@ def residual_plot(calibrator: Calibrator) -> ResidualPlot:
     )
 
 
+def _hinge_gauge_read(info: WindowInfo) -> tuple[float, float | None] | None:
+    return None if info.hinge_aircraft_ratio is None else (info.hinge_aircraft_ratio, info.hinge_aircraft_ratio_std)
+
+
+HINGE_GAUGE = SensorGain(
+    name="hinge_aircraft_ratio",
+    signal="hinge_moment_nm",
+    sensor="the hinge moment's strain gauge",
+    model="the aircraft model",
+    remedy="recalibrate the gauge, or the airframe's C_hδ is off (each estimate divides the gauge's gain out where "
+    "its window is long enough)",
+    read=_hinge_gauge_read,
+)
 ROTARY = Rotary()

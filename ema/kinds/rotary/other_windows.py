@@ -31,6 +31,17 @@ def lent(zeros: Iterable[SensorZero], inertias: Sequence[InertiaReading]) -> His
     return HistoryReadings(sensor_zero=best_zero(zeros), inertia=combined_inertia(inertias))
 
 
+def lent_by(info: WindowInfo) -> tuple[SensorZero | None, InertiaReading | None]:
+    """What a window's answer lends the others of its actuator: its sensors' zero (to its flight's windows) and
+    the J_M it read (to every window), each None where it read none."""
+    return info.sensor_zero, info.inertia_read
+
+
+def waits_for_the_run(info: WindowInfo) -> bool:
+    """Whether a window answered alone could not tell J_M: it is answered again once the run's windows have read it."""
+    return info.inertia_undecided
+
+
 def readings_of(windows: Iterable[WindowInfo], flight_id: str | None) -> HistoryReadings:
     """What the results of other windows of an actuator (their ``window`` parts, oldest first) lend a window
     of ``flight_id`` (``lent``)."""

@@ -17,7 +17,7 @@ import numpy as np
 
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import STAGES, Estimate
-from ema.kinds.base import WARM_UP, Calibrated, CalibrationRequest, Cost, Request, learned_lines, not_drawn
+from ema.kinds.base import WARM_UP, Calibrated, CalibrationRequest, Cost, Request, SensorGain, learned_lines, not_drawn
 from ema.kinds.servo.calibration import CLOSED_LOOPS, calibrate_servo
 from ema.kinds.servo.closed_loop import SUBSTEPS, ServoLoop, simulate_servo
 from ema.model.actuator import ActuatorDocument, ServoActuator, actuator_from_dict, as_kind
@@ -67,6 +67,8 @@ class Servo:
 
     def synthesize(self, actuator: ActuatorDocument, flags: Mapping[str, Any]) -> dict[str, Any]:
         raise not_drawn(self.facts)
+
+    sensor_gains: tuple[SensorGain, ...] = ()
 
     def report_lines(self, report: Mapping[str, Any]) -> list[str]:
         """What it learned, beside it as the simulator takes it (``as_simulated``)."""
