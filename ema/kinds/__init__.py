@@ -33,7 +33,7 @@ from ema.kinds.geared import GEARED
 from ema.kinds.linear import LINEAR
 from ema.kinds.rotary import ROTARY
 from ema.kinds.servo import SERVO
-from ema.model.actuator import THESIS, ActuatorDocument, Nominal
+from ema.model.actuator import THESIS, ActuatorDocument
 from ema.model.checks import InputError
 from ema.model.params import HealthParams
 from ema.model.window import Window
@@ -126,7 +126,7 @@ def held_to_document(answer: Estimate, actuator: ActuatorDocument) -> None:
         if entry is not None:
             values[field] = entry.value
     values |= {name: entry.value for name, entry in answer.estimates.constants.items()}
-    out_of_bounds(values, (Nominal, type(actuator.section)), "estimates")
+    out_of_bounds(values, (actuator.nominal_class, type(actuator.section)), "estimates")
 
 
 def calibrate(windows: Sequence[Window], request: CalibrationRequest) -> Calibrated:

@@ -55,9 +55,6 @@ class Nominal(Document):
     fdj_n: Number | None = Field(
         None, ge=1e-6, le=1e6, description="FDJ, dynamic friction on the load [N] (a kind logged on the load side)"
     )
-    fsj_nm: Number | None = Field(
-        None, gt=0, le=100, description="FSJ, static (break-away) friction at the motor shaft (a rotary actuator's)"
-    )
     eta_o: Number | None = Field(
         None, gt=0, lt=1, description="η_O, efficiency under opposing load (null: never shown, as without a load)"
     )
@@ -69,15 +66,29 @@ class Nominal(Document):
         "gear ratio)",
     )
 
+    @model_validator(mode="before")
+    @classmethod
+    def _no_null_static_friction(cls, values: Any) -> Any:
+        """The input without a null ``fsj_nm`` where the kind reads none (documents were first written with it)."""
+        if (
+            isinstance(values, dict)
+            and "fsj_nm" in values
+            and values["fsj_nm"] is None
+            and "fsj_nm" not in cls.model_fields
+        ):
+            return {k: v for k, v in values.items() if k != "fsj_nm"}
+        return values
+
     @model_validator(mode="after")
     def _one_friction(self) -> Nominal:
         if (self.fdj_nm is None) == (self.fdj_n is None):
             raise ValueError("fdj_nm: give the nominal FDJ once, at the motor shaft (fdj_nm) or on the load (fdj_n)")
-        if self.fsj_nm is not None and self.fdj_nm is not None and self.fsj_nm < self.fdj_nm:
-            raise ValueError(
-                f"fsj_nm: {self.fsj_nm:g} is below fdj_nm {self.fdj_nm:g}: static friction is never below dynamic"
-            )
         return self
+
+    @property
+    def fsj(self) -> float | None:
+        """The nominal FSJ where the kind reads a static friction (``RotaryNominal``), else None."""
+        return None
 
     @property
     def fdj(self) -> float:
@@ -92,6 +103,26 @@ class Nominal(Document):
         if self.eta_o is None:
             raise InputError("actuator.nominal.eta_o", "is not known: no run with a load has shown it")
         return self.eta_o
+
+
+class RotaryNominal(Nominal):
+    """A rotary actuator's health new: beside its FDJ and η_O, its static (break-away) friction FSJ."""
+
+    fsj_nm: Number | None = Field(
+        None, gt=0, le=100, description="FSJ, static (break-away) friction at the motor shaft (a rotary actuator's)"
+    )
+
+    @model_validator(mode="after")
+    def _static_above_dynamic(self) -> RotaryNominal:
+        if self.fsj_nm is not None and self.fdj_nm is not None and self.fsj_nm < self.fdj_nm:
+            raise ValueError(
+                f"fsj_nm: {self.fsj_nm:g} is below fdj_nm {self.fdj_nm:g}: static friction is never below dynamic"
+            )
+        return self
+
+    @property
+    def fsj(self) -> float | None:
+        return self.fsj_nm
 
 
 class Thresholds(Document):
@@ -175,7 +206,7 @@ class ActuatorDocument(Document):
     @model_validator(mode="after")
     def _nominal_in_its_unit(self) -> ActuatorDocument:
         if self.facts.nominal_given and (
-            self.nominal is None or self.nominal.fsj_nm is None or self.nominal.eta_o is None
+            self.nominal is None or self.nominal.fsj is None or self.nominal.eta_o is None
         ):
             raise ValueError(f"nominal.fsj_nm: a {self.kind} actuator's document gives its nominal FDJ, FSJ and η_O")
         unit_field = self.facts.friction_field("fdj")
@@ -199,6 +230,11 @@ class ActuatorDocument(Document):
     def facts(self) -> KindFacts:
         """What this document's kind is (``ema.model.kinds``)."""
         return KINDS[self.kind]
+
+    @property
+    def nominal_class(self) -> type[Nominal]:
+        """The class of this kind's nominal health (``RotaryNominal`` beside a static friction)."""
+        return Nominal
 
     @property
     def section(self) -> Drive | Screw | Servo | Geared:
@@ -232,7 +268,7 @@ class ActuatorDocument(Document):
         """The healthy range around the nominal health: ``HEALTHY_SPAN`` either way, η_O capped below 1 (the thesis's
         nominal where the document has none)."""
         n, span = self.health, HEALTHY_SPAN
-        fsj = n.fsj_nm if n.fsj_nm is not None else n.fdj
+        fsj = n.fsj if n.fsj is not None else n.fdj
         eta_o = n.eta_o if n.eta_o is not None else THESIS_ETA_O
         eta = (eta_o * (1 - span), min(eta_o * (1 + span), max(MAX_HEALTHY_ETA_O, eta_o)))
         return HealthRanges(
@@ -288,12 +324,17 @@ class RotaryActuator(ActuatorDocument):
 
     kind: Literal["rotary"] = Field("rotary", description=_KIND_DESCRIPTION)
     drive: Drive = Field(description="the drive and its gear train")
+    nominal: RotaryNominal | None = Field(None, description="the health new: FDJ, FSJ and η_O")
     sensor_noise: SensorNoiseDocument | None = Field(None, description="null: the thesis's levels")
     airframe: Airframe | None = Field(None, description="null: the hinge moment is not checked against an aircraft")
 
     @property
     def section(self) -> Drive:
         return self.drive
+
+    @property
+    def nominal_class(self) -> type[Nominal]:
+        return RotaryNominal
 
     @property
     def params(self) -> DriveConstants:
@@ -374,7 +415,7 @@ def _thesis() -> RotaryActuator:
     return RotaryActuator(
         name="thesis elevator EMA (Table 3.1)",
         drive=Drive(**drive),
-        nominal=Nominal(fdj_nm=0.05, fsj_nm=0.10, eta_o=0.85),
+        nominal=RotaryNominal(fdj_nm=0.05, fsj_nm=0.10, eta_o=0.85),
         thresholds=Thresholds(fdj_above_nm=0.075, eta_o_below=0.70),
         airframe=Airframe(**{name: getattr(hinge, name) for name in Airframe.model_fields if name != "tolerance"}),
     )

@@ -371,6 +371,7 @@ def test_a_window_refused_under_a_document_since_changed_is_read_again(tmp_path,
     (folder / "a.json").write_text(json.dumps({**bench.document, "actuator_id": "small-1", "window_id": "b"}))
     wrong = {**document("smaller"), "kind": "linear", "screw": {"lead_mm": 5.0}}
     wrong.pop("drive", None)
+    wrong["nominal"] = {k: v for k, v in wrong["nominal"].items() if k != "fsj_nm"}  # a ball screw reads no FSJ
     (folder / "actuators.json").write_text(json.dumps({"small-1": wrong}))
     out = tmp_path / "r.csv"
     run = ["fleet", str(folder), "--out", str(out), "--workers", "1", *SIZES, "--json"]

@@ -71,7 +71,7 @@ def _estimates(
         eta_A=eta_a if loaded else None,
         FSJ=None
         if fsj.value_nm is None
-        else parameter(fsj.value_nm, fsj.std_nm, nominal.fsj_nm or fsj.value_nm, unit=friction),
+        else parameter(fsj.value_nm, fsj.std_nm, nominal.fsj or fsj.value_nm, unit=friction),
         FSD=ratio,
     )
 

@@ -72,9 +72,9 @@ def _healths(
     ``end`` (FDJ, η_O; no change where None) over ``series`` windows, FSJ never below FDJ (static friction
     never below dynamic)."""
     nominal_health = actuator.nominal
-    if not isinstance(actuator, RotaryActuator) or nominal_health is None or nominal_health.fsj_nm is None:
+    if nominal_health is None or nominal_health.fsj is None:
         raise InputError("--actuator", f"a {actuator.kind} actuator's drive is not simulated: give a rotary one")
-    nominal = (nominal_health.fdj, nominal_health.efficiency, nominal_health.fsj_nm)
+    nominal = (nominal_health.fdj, nominal_health.efficiency, nominal_health.fsj)
     first = {
         name: default if given is None else given
         for name, given, default in zip(("FDJ", "eta_O", "FSJ"), start, nominal, strict=True)
