@@ -150,7 +150,6 @@ class CalibrationReport(Document):
     selected_parameters: dict[str, float] | None
     effects: dict = Field(description="what the simulator adds: named effects' parameters and a friction table")
     selection_steps: list[Step]
-    unexplained: Unexplained | None
     held_out: HeldOut
     estimates_before: dict[str, float]
     estimates_after: dict[str, float]
@@ -159,9 +158,6 @@ class CalibrationReport(Document):
     )
     stds_after: dict[str, float] | None = Field(
         None, description="of the estimates after: the base ones, widened where an ambiguity keeps two readings open"
-    )
-    ambiguity: Ambiguity | None = Field(
-        None, description="effects the windows cannot choose between whose estimates differ (null: none)"
     )
     learned: list[Learned] = Field(
         default_factory=list,
@@ -174,15 +170,6 @@ class CalibrationReport(Document):
         "benchmarks' error) with the base model",
     )
     model_error_pct_after: dict[str, float] | None = Field(None, description="the same with the effects in")
-    model_error_pct_document: dict[str, float] | None = Field(
-        None,
-        description="the same for the document's model as it stands, its constants fixed (null where it holds none): "
-        "how well what was learned before reads these windows",
-    )
-    error_before: dict[str, float] | None = None
-    error_after: dict[str, float] | None = None
-    error_pct_before: dict[str, float] | None = None
-    error_pct_after: dict[str, float] | None = None
     completed_actuator: AnyActuator | None = Field(
         None,
         description="the actuator's ema-actuator/1 document completed with what the windows taught (a linear "
@@ -210,9 +197,18 @@ _KIND_DESCRIPTION = "the kind of actuator the windows are of (reports first writ
 
 
 class RotaryCalibration(CalibrationReport):
-    """A rotary actuator's report: the shared parts only."""
+    """A rotary actuator's report: what no named effect explains, effects its windows cannot tell apart, and its
+    errors against a known truth (synthetic windows)."""
 
     kind: Literal["rotary"] = Field("rotary", description=_KIND_DESCRIPTION)
+    unexplained: Unexplained | None
+    ambiguity: Ambiguity | None = Field(
+        None, description="effects the windows cannot choose between whose estimates differ (null: none)"
+    )
+    error_before: dict[str, float] | None = None
+    error_after: dict[str, float] | None = None
+    error_pct_before: dict[str, float] | None = None
+    error_pct_after: dict[str, float] | None = None
 
 
 class LinearCalibration(CalibrationReport):
@@ -229,6 +225,11 @@ class ServoCalibration(CalibrationReport):
     """A servo's report: its learned constants also as the simulator takes them."""
 
     kind: Literal["servo"] = Field("servo", description=_KIND_DESCRIPTION)
+    model_error_pct_document: dict[str, float] | None = Field(
+        None,
+        description="the same for the document's model as it stands, its constants fixed (null where it holds none): "
+        "how well what was learned before reads these windows",
+    )
     as_simulated: list[Learned] = Field(
         default_factory=list,
         description="its learned constants as the simulator takes them, what the completed document keeps: "

@@ -119,8 +119,8 @@ def print_simulate(result: dict[str, Any]) -> None:
 
 def print_calibration(report: dict[str, Any]) -> None:
     """The ``ema-calibration/1`` report as a person reads it: what every kind's holds, then its kind's own parts as
-    the kind prints them (``ema.kinds.report_lines``: a ball screw's drive and changes, a servo's constants as
-    simulated, a geared servo's runs per load)."""
+    the kind prints them (``ema.kinds.report_lines``: the rotary's unexplained residual, ambiguity and errors against
+    a truth, a ball screw's drive and changes, a servo's constants as simulated, a geared servo's runs per load)."""
     from ema.kinds import report_lines
 
     if report["noise_floor"]["copies"]:
@@ -138,11 +138,6 @@ def print_calibration(report: dict[str, Any]) -> None:
             f"named {step['selected']}" if step["selected"] else "nothing named" if i == 0 else "nothing further named"
         )
         click.echo(f"{said}: {step['reason']}")
-    if report["unexplained"]:
-        click.echo(f"unexplained: {report['unexplained']['description']}")
-    if report.get("ambiguity"):
-        ambiguity = report["ambiguity"]
-        click.echo(f"ambiguous: {' / '.join(ambiguity['effects'])}; to tell them apart: {ambiguity['tell_apart']}")
     click.echo(f"held out: {report['held_out']['note']}")
     _print_estimates(report)
     for line in report_lines(report):
@@ -160,8 +155,7 @@ ERROR_WORDS = {"drive_force_n": "force, inverse model", "drive_force_n_closed_lo
 
 
 def _print_estimates(report: dict[str, Any]) -> None:
-    """FDJ and η_O before and after, in FDJ's unit as the learned constants give it, with the errors against a truth
-    where one was given."""
+    """FDJ and η_O before and after, in FDJ's unit as the learned constants give it."""
     learned = {entry["name"]: entry for entry in report.get("learned", [])}
     units = {"FDJ": " " + learned["FDJ"]["unit"] if "FDJ" in learned else " N·m", "eta_O": ""}
     for name in ("FDJ", "eta_O"):
@@ -169,10 +163,7 @@ def _print_estimates(report: dict[str, Any]) -> None:
             continue
         was = report["estimates_before"].get(name)
         line = f"{name}: {'—' if was is None else f'{was:.5g}{units[name]}'} -> {report['estimates_after'][name]:.5g}"
-        line += units[name]
-        if report.get("error_pct_before"):
-            line += f"   error {report['error_pct_before'][name]:.2f} % -> {report['error_pct_after'][name]:.2f} %"
-        click.echo(line)
+        click.echo(line + units[name])
 
 
 TIME_UNITS = {

@@ -164,7 +164,6 @@ def report(
         selected_parameters={name: after[name] for name in CONSTANTS if name not in ("torque_per_volt", "back_emf")},
         effects={name: 1.0 for name in model.final.effects},
         selection_steps=model.steps,
-        unexplained=None,
         held_out=model.held,
         estimates_before={"FDJ": before["fdj_nm"]},
         estimates_after={REPORTED[name]: v for name, (v, _) in health.items()},

@@ -241,7 +241,6 @@ def _report(
         selected_parameters=None,
         effects={},
         selection_steps=steps,
-        unexplained=None,
         held_out=held,
         estimates_before=before,
         estimates_after=after,

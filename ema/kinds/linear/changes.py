@@ -186,7 +186,6 @@ def compared(windows: Sequence[LinearWindow], runs: list[Run], actuator: LinearA
         selected_parameters=None,
         effects={},
         selection_steps=[step],
-        unexplained=None,
         held_out=HeldOut(rss_before=0.0, rss_after=0.0, adopted=False, note="runs read with the document"),
         estimates_before={"FDJ": actuator.health.fdj},
         estimates_after={"FDJ": fdj},

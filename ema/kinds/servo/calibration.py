@@ -277,7 +277,6 @@ def calibrate_servo(
         selected_parameters={k: v for k, v in after.values.items() if k not in base.values} or None,
         effects={name: model[name] for name in adopted},
         selection_steps=steps,
-        unexplained=None,
         held_out=HeldOut(
             rss_before=float(base.held_out_rss.sum()),
             rss_after=float(after.held_out_rss.sum()),
