@@ -235,11 +235,12 @@ def history(
             ) from None
         raise ServiceError(f"HTTP {error.code} from {url}") from None
     prognosis = Prognosis.model_validate(request(f"{base}/prognosis", key, timeout=60))
-    read = {"FDJ", "eta_O", "eta_A", *prognosis.trends}
+    read = {"FDJ", "eta_O", "eta_A", *prognosis.trends, *prognosis.constants}
     read |= {name for entry in stored.estimates for name in entry.estimates.constants}
     if plot is not None and parameter not in read:
         raise InputError("--parameter", f"{parameter!r} is not one of this actuator's: {', '.join(sorted(read))}")
-    drawn = plot if plot is not None and parameter in prognosis.trends else None
+    trended = parameter in prognosis.trends or parameter in prognosis.constants
+    drawn = plot if plot is not None and trended else None
     if drawn is not None:
         prognosis_figure(prognosis, parameter, drawn, unit=value_units(stored).get(parameter, "").strip())
     elif plot is not None:

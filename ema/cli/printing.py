@@ -183,11 +183,11 @@ def _slope(trend: Any, unit: str, value_unit: str = "") -> str:
 
 def value_units(stored: Any) -> dict[str, str]:
     """Each parameter's unit as its latest stored estimate gives it, with a leading space (none for an efficiency,
-    or where no estimate says): N·m at the motor shaft, N on the load."""
+    or where no estimate says): N·m at the motor shaft, N on the load, a constant's own (kg, N·s/m)."""
     units: dict[str, str] = {}
     for entry in reversed(stored.estimates):
-        for name in ("FDJ", "eta_O", "eta_A"):
-            estimate = getattr(entry.estimates, name)
+        read = {name: getattr(entry.estimates, name) for name in ("FDJ", "eta_O", "eta_A")} | entry.estimates.constants
+        for name, estimate in read.items():
             if name not in units and estimate is not None and estimate.unit not in (None, "1"):
                 units[name] = f" {estimate.unit}"
     return units
@@ -226,7 +226,7 @@ def print_prognosis(stored: Any, prognosis: Any, plot: Path | None) -> None:
                 f"       backtest at {point.time:.4g} {many} ({point.windows} windows; times from the first window): "
                 f"{said}; of the {point.later_windows} later windows {inside} inside its 90 % band"
             )
-    for name, trend in prognosis.sensors.items():
+    for name, trend in {**prognosis.sensors, **prognosis.constants}.items():
         click.echo(f"{name} now {trend.level:.4g} ± {trend.level_std:.2g}, {_slope(trend, one)} ({trend.n} windows)")
     if prognosis.inertia is not None:
         inertia = prognosis.inertia

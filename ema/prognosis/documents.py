@@ -182,6 +182,12 @@ class Prognosis(Document):
         "against the aircraft model (1 where they agree; a level off 1 in every window is the gauge's calibration or "
         "the airframe's C_hδ, a slope the gauge drifting)",
     )
+    constants: dict[str, Trend] = Field(
+        default_factory=dict,
+        description="trends of the other constants the windows read beside the health (a servo's mass, its viscous "
+        "friction, a geared servo's loop gain), each over the windows that read it: no failure level, no remaining "
+        "life, a change to see",
+    )
     inertia: InertiaReading | None = Field(
         None,
         description="the actuator's J_M as its windows that told a heavier rotor from a weaker motor read it: "

@@ -65,6 +65,7 @@ def prognose(
         if (seen := _outlook(name, stored, times, actuator, unit, backtested)) is not None
     }
     sensors, said = sensor_trends(stored, times, unit, actuator.load_model_tolerance)
+    constants = constant_trends(stored, times)
     inertia, inertia_note = inertia_of([s.window for s in stored])
     faster = [speeding_note(name) for name, seen in outlooks.items() if seen.life.speeding_up]
     away = [away_note(name, seen, actuator, unit) for name, seen in outlooks.items()]
@@ -76,6 +77,7 @@ def prognose(
         trends={n: o.trend for n, o in outlooks.items()},
         remaining_life={n: o.life for n, o in outlooks.items()},
         sensors=sensors,
+        constants=constants,
         inertia=inertia,
         notes=notes,
         backtest={n: o.backtest for n, o in outlooks.items()},
@@ -169,6 +171,24 @@ def away_note(name: str, seen: Outlook, actuator: ActuatorDocument, unit: TimeUn
         f"{_one(unit)} over {trend.n} windows: a change all the same, which the remaining "
         f"life to its level {life.direction} ({life.threshold:.4g}{units}) cannot call a degradation{hint}",
     )
+
+
+def constant_trends(stored: Sequence[Stored], times: np.ndarray) -> dict[str, Trend]:
+    """The trend of each constant the windows read beside the health (``Estimates.constants``) over the windows
+    that read it (two at least), each judged on its repeatability std as the health is."""
+    names = dict.fromkeys(name for s in stored for name in s.estimates.constants)
+    trends = {}
+    for name in names:
+        read = [
+            (t, e, s.window_id) for t, s in zip(times, stored, strict=True) if (e := s.estimates.constants.get(name))
+        ]
+        if len(read) < 2:
+            continue
+        stds = [np.nan if (std := e.repeatability_std or e.std) is None else std for _, e, _ in read]
+        values = np.array([e.value for _, e, _ in read])
+        t, ids = np.array([t for t, _, _ in read]), [i for _, _, i in read]
+        trends[name] = trend_of(Series(name, t, values, np.array(stds, dtype=float), ids))
+    return trends
 
 
 def sensor_trends(

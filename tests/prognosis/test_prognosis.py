@@ -132,6 +132,28 @@ def test_a_strain_gauge_drifting_against_the_aircraft_is_trended_and_said(one_es
     assert not any(n.code.startswith("gauge") for n in prognosis.notes)
 
 
+def test_a_constant_read_beside_the_health_is_trended_and_drawn(one_estimate, tmp_path):
+    """A servo's mass, read window after window, is trended as the health is (no failure level, no life) and
+    ``ema history --plot`` draws it."""
+    from ema.cli.figures import prognosis_figure
+    from ema.estimate.documents import ParameterEstimate
+    from ema.prognosis.prognose import prognose
+
+    rng = np.random.default_rng(8)
+    hours = np.sort(rng.uniform(0, 100, 30))
+    masses = 90.0 + 0.05 * hours + 0.2 * rng.normal(size=30)  # a load gaining 5 kg over 100 h
+    history = _history(one_estimate, [None] * 30, [None] * 30, hours)
+    for stored, mass in zip(history[:-1], masses, strict=False):  # the last window read no mass
+        entry = ParameterEstimate(value=float(mass), std=0.2, nominal=90.0, drift_pct=None, unit="kg")
+        stored.estimates.constants["mass_kg"] = entry
+    prognosis = prognose("axis-1", history, actuator=THESIS)
+    trend = prognosis.constants["mass_kg"]
+    assert trend.n == 29 and trend.slope_per_unit == pytest.approx(0.05, rel=0.2)
+    assert "mass_kg" not in prognosis.remaining_life
+    pytest.importorskip("matplotlib")
+    assert prognosis_figure(prognosis, "mass_kg", tmp_path / "mass.png", unit="kg").stat().st_size > 0
+
+
 def test_the_actuators_j_m_is_its_windows_readings_and_a_replaced_part_is_said(one_estimate):
     from ema.estimate.documents.window_facts import InertiaReading
     from ema.prognosis.prognose import prognose
