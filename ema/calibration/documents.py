@@ -141,7 +141,10 @@ class CalibrationReport(Document):
     schema_: Literal["ema-calibration/1"] = Field("ema-calibration/1", alias="schema")
     kind: str  # each kind's class narrows it to its name
     n_windows: int
-    noise_floor: NoiseFloor
+    noise_floor: NoiseFloor | None = Field(
+        description="the base model's residual against what noise-only copies of the windows leave (null: the kind "
+        "draws no copies, as a ball screw's drive calibration, which reads its runs' spread instead)"
+    )
     residual_rms_before: dict[str, float]
     residual_rms_after: dict[str, float]
     candidates: list[Candidate]

@@ -123,10 +123,11 @@ def print_calibration(report: dict[str, Any]) -> None:
     a truth, a ball screw's drive and changes, a servo's constants as simulated, a geared servo's runs per load)."""
     from ema.kinds import report_lines
 
-    if report["noise_floor"]["copies"]:
+    floor = report["noise_floor"]
+    if floor and floor["copies"]:
         click.echo(
-            f"noise floor: the base model's residual is {report['noise_floor']['equation_error_ratio']:.2f}x "
-            f"what noise alone leaves ({report['noise_floor']['copies']} copies)"
+            f"noise floor: the base model's residual is {floor['equation_error_ratio']:.2f}x what noise alone leaves "
+            f"({floor['copies']} copies)"
         )
     if report["candidates"]:
         click.echo(f"{'candidate':<28}{'z':>9}{'held-out drop':>15}  parameters")

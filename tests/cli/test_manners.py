@@ -175,7 +175,7 @@ def test_a_second_step_naming_nothing_does_not_contradict_the_first(capsys):
 
     step = {"selected": "current_sensor_offset", "reason": "it explains the windows"}
     report = {
-        "noise_floor": {"copies": 0, "equation_error_ratio": 1.0},
+        "noise_floor": None,
         "candidates": [],
         "selection_steps": [step, {"selected": None, "reason": "nothing beyond it"}],
         "unexplained": None,

@@ -22,7 +22,6 @@ from ema.calibration.documents import (
     HeldOut,
     Learned,
     LinearCalibration,
-    NoiseFloor,
     Step,
 )
 from ema.calibration.plot import ResidualPlot, Series
@@ -232,7 +231,7 @@ def _report(
 ) -> LinearCalibration:
     return LinearCalibration(
         n_windows=n,
-        noise_floor=NoiseFloor(copies=0, equation_error_ratio=1.0),
+        noise_floor=None,
         residual_rms_before={"current_a": before_a},
         residual_rms_after={"current_a": after_a},
         candidates=candidates or [],

@@ -17,7 +17,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ema.calibration.documents import Candidate, Change, HeldOut, LinearCalibration, NoiseFloor, Step
+from ema.calibration.documents import Candidate, Change, HeldOut, LinearCalibration, Step
 from ema.calibration.limits import NAME_Z
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import DIMENSIONLESS, ActuatorRead, Estimate
@@ -177,7 +177,7 @@ def compared(windows: Sequence[LinearWindow], runs: list[Run], actuator: LinearA
     fdj = float(np.mean([r.estimates.FDJ.value for r in results]))
     return LinearCalibration(
         n_windows=len(runs),
-        noise_floor=NoiseFloor(copies=0, equation_error_ratio=1.0),
+        noise_floor=None,
         residual_rms_before={"current_a": 0.0},
         residual_rms_after={"current_a": 0.0},
         candidates=[candidate],
