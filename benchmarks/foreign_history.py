@@ -23,6 +23,7 @@ from benchmarks.tails import BOUND
 from benchmarks.wearing_fleet import KINDS_OF_WEAR, Thresholds, Wear, flights, logged_window, wear
 from ema.cli.benchmark_docs import write_section
 from ema.estimate import thread_budget
+from ema.estimate.documents.window_facts import RotaryWindowInfo
 from ema.estimate.report import share_of_range
 from ema.kinds.rotary.other_windows import readings_of
 from ema.kinds.rotary.pipeline import estimate_window
@@ -85,8 +86,10 @@ def history(
         fdj = result.estimates.FDJ
         past = abs(share_of_range("FDJ", fdj.value - drawn.truth["FDJ"], ranges=THESIS.ranges)) > BOUND
         weak, over, unsaid = weak + fdj.weakly_determined, over + past, unsaid + (past and not fdj.weakly_determined)
-        undecided, decided = undecided + result.window.inertia_undecided, decided + bool(result.window.inertia_from)
-        zeroed += result.window.sensor_zero_from is not None
+        read = result.window
+        assert isinstance(read, RotaryWindowInfo)  # a rotary window at 10 kHz: its prepare stage ran
+        undecided, decided = undecided + read.inertia_undecided, decided + bool(read.inertia_from)
+        zeroed += read.sensor_zero_from is not None
         stored.append(Stored(**result.model_dump(), id=j, stored_at="2026-01-01T00:00:00+00:00"))
     fared = {
         "weak": weak,

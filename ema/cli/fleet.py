@@ -59,10 +59,10 @@ class _Readings:
 
     def add(self, window: Window, answer: dict[str, Any]) -> bool:
         """Keep what ``answer`` lends; whether the window waits for the run's others (``waits_for_the_run``)."""
-        from ema.estimate.documents.window_facts import WindowInfo
+        from ema.estimate.documents.window_facts import window_info_from
         from ema.kinds import lent_by, waits_for_the_run
 
-        info = WindowInfo.model_validate(answer["window"])
+        info = window_info_from(answer["window"])
         zero, inertia = lent_by(info)
         if zero is not None and window.flight_id is not None:
             self.zeros.setdefault((window.actuator_id, window.flight_id), []).append(zero)
@@ -73,13 +73,13 @@ class _Readings:
     def lacked(self, window: Window, answer: dict[str, Any]) -> dict[str, Any] | None:
         """What the run's other windows lend this one that it lacks (``ema.kinds.lacking``), as
         JSON; or None."""
-        from ema.estimate.documents.window_facts import WindowInfo
+        from ema.estimate.documents.window_facts import window_info_from
         from ema.kinds import lacking, other_windows_lent
 
         flight = self.zeros.get((window.actuator_id, window.flight_id), [])
         own = [zero for zero in flight if zero.window_id != window.window_id]
         others = other_windows_lent(own, self.inertias.get(window.actuator_id, []))
-        lacked = lacking(WindowInfo.model_validate(answer["window"]), others)
+        lacked = lacking(window_info_from(answer["window"]), others)
         return None if lacked is None else lacked.model_dump()
 
 

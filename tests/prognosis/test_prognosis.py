@@ -94,6 +94,10 @@ def one_estimate():
     return estimate_window(synthetic_window(HealthParams.single(), seed=1, duration_s=0.1), small, actuator=THESIS)
 
 
+def _float(value):
+    return None if value is None else float(value)  # a document holds Python's floats (model_copy validates nothing)
+
+
 def _history(estimate, ratios, stds, hours):
     from ema.prognosis.documents import Stored
 
@@ -103,7 +107,11 @@ def _history(estimate, ratios, stds, hours):
                 update={
                     "window_id": f"w{i}",
                     "window": estimate.window.model_copy(
-                        update={"flight_hours": float(h), "hinge_aircraft_ratio": r, "hinge_aircraft_ratio_std": s}
+                        update={
+                            "flight_hours": float(h),
+                            "hinge_aircraft_ratio": _float(r),
+                            "hinge_aircraft_ratio_std": _float(s),
+                        }
                     ),
                 }
             ).model_dump(),

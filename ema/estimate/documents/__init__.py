@@ -14,7 +14,7 @@ from pydantic import Field, model_validator
 from ema.estimate.config import EarlierCheckWindows, PipelineConfig
 from ema.estimate.documents.notes import AnyNote, Notes, OptionalNote
 from ema.estimate.documents.notes import Note as Note  # every stage's notes, imported from here
-from ema.estimate.documents.window_facts import WindowInfo
+from ema.estimate.documents.window_facts import RotaryWindowInfo, WindowInfo
 from ema.model.document import Document
 
 TARGETS = ("FDJ", "eta_O")  # what the estimators read; η_A follows by Eq. 3.4, FSD from FSJ
@@ -211,7 +211,9 @@ class Estimate(Document):
     methods: dict[str, MethodReport]
     check: Check = Field(description="the window simulated at the answer, against the log (the check stage)")
     fit_check: Check | None = Field(None, description="deprecated alias of check (ema-estimate/1 as first published)")
-    window: WindowInfo
+    window: WindowInfo | RotaryWindowInfo = Field(
+        description="what the reading did with the window: every kind's facts, and a rotary window's prepare stage"
+    )
     config: PipelineConfig
 
     @model_validator(mode="before")

@@ -5,7 +5,9 @@ the estimate document (``ema.estimate.documents``).
 
 from __future__ import annotations
 
-from pydantic import Field
+from typing import Self
+
+from pydantic import Field, TypeAdapter
 
 from ema.model.document import Document
 from ema.model.window import Window
@@ -41,6 +43,9 @@ class HistoryReadings(Document):
 
 
 class WindowInfo(Document):
+    """What every kind's estimate says of its window: its content, length and rates, its times and flight, what the
+    reading used of it. A rotary window's reading adds what its prepare stage did (``RotaryWindowInfo``)."""
+
     content_sha256: str | None = Field(
         default=None,
         description="SHA-256 of the window as posted, but its actuator_id and window_id (ema.model.window): another "
@@ -51,6 +56,34 @@ class WindowInfo(Document):
     sample_rate_hz: float
     processed_rate_hz: float = Field(description="after averaging adjacent samples (exact for interval means)")
     command_clipped_fraction: float = Field(description="share of command samples past the end stops, saturating")
+    sliding_fraction: float = Field(description="share of samples the friction solution could use")
+    recorded_at: str | None = None
+    flight_hours: float | None = None
+    flight_id: str | None = None
+
+    @classmethod
+    def logged(cls, window: Window, digest: str, **read: object) -> Self:
+        """The window's own facts (its rate, length, times and flight) and what reading it did (``read``: the
+        processed rate, the sliding share, and whatever else a kind's reading reports)."""
+        return cls.model_validate(
+            {
+                "content_sha256": digest,
+                "n_samples": window.n_samples,
+                "duration_s": window.duration_s,
+                "sample_rate_hz": window.sample_rate_hz,
+                "recorded_at": window.recorded_at,
+                "flight_hours": window.flight_hours,
+                "flight_id": window.flight_id,
+                **read,
+            }
+        )
+
+
+class RotaryWindowInfo(WindowInfo):
+    """What a rotary window's reading did to it beside what every kind's says: its sensors' repairs, clocks and
+    departures from the document (the prepare stage), the sensors' zero and J_M it read for its actuator's other
+    windows, and the strain gauge's gain against the aircraft."""
+
     glitches_repaired: dict[str, int] = Field(
         default_factory=dict,
         description="per sensor, samples of glitches (short runs far off both flanks, which agree), "
@@ -102,10 +135,6 @@ class WindowInfo(Document):
         description="the position's travel over the speed's integral / gear ratio through the dead band (1 in a "
         "consistent log; 0.9-1.1 accepted; null: too little motion to tell)",
     )
-    sliding_fraction: float = Field(description="share of samples the friction solution could use")
-    recorded_at: str | None = None
-    flight_hours: float | None = None
-    flight_id: str | None = None
     sensor_zero: SensorZero | None = Field(
         default=None,
         description="the sensors' zero as this window read it, for the windows of its flight that move one way "
@@ -130,19 +159,11 @@ class WindowInfo(Document):
         description="it could not tell a heavier rotor from a weaker motor: the windows whose J_M (history) decided",
     )
 
-    @classmethod
-    def logged(cls, window: Window, digest: str, **read: object) -> WindowInfo:
-        """The window's own facts (its rate, length, times and flight) and what reading it did (``read``: the
-        processed rate, the sliding share, and whatever else a kind's reading reports)."""
-        return cls.model_validate(
-            {
-                "content_sha256": digest,
-                "n_samples": window.n_samples,
-                "duration_s": window.duration_s,
-                "sample_rate_hz": window.sample_rate_hz,
-                "recorded_at": window.recorded_at,
-                "flight_hours": window.flight_hours,
-                "flight_id": window.flight_id,
-                **read,
-            }
-        )
+
+def window_info_from(value: object) -> WindowInfo:
+    """An estimate's ``window`` part (a dict, as JSON gives it) as its class: a rotary window's prepare stage's
+    facts read as ``RotaryWindowInfo``, every other window's as ``WindowInfo``."""
+    return _WINDOW_INFO.validate_python(value)
+
+
+_WINDOW_INFO: TypeAdapter[WindowInfo] = TypeAdapter(WindowInfo | RotaryWindowInfo)  # type: ignore[arg-type]

@@ -19,7 +19,7 @@ import numpy as np
 from ema.calibration.plot import ResidualPlot, Series
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import STAGES, Estimate
-from ema.estimate.documents.window_facts import WindowInfo
+from ema.estimate.documents.window_facts import RotaryWindowInfo, WindowInfo
 from ema.estimate.quasistatic.slow_window import QUASI_STATIC_STAGES
 from ema.kinds.base import (
     WARM_UP,
@@ -166,7 +166,9 @@ def residual_plot(calibrator: Calibrator) -> ResidualPlot:
 
 
 def _hinge_gauge_read(info: WindowInfo) -> tuple[float, float | None] | None:
-    return None if info.hinge_aircraft_ratio is None else (info.hinge_aircraft_ratio, info.hinge_aircraft_ratio_std)
+    if not isinstance(info, RotaryWindowInfo) or info.hinge_aircraft_ratio is None:
+        return None
+    return info.hinge_aircraft_ratio, info.hinge_aircraft_ratio_std
 
 
 HINGE_GAUGE = SensorGain(

@@ -13,7 +13,13 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
 
-from ema.estimate.documents.window_facts import HistoryReadings, InertiaReading, SensorZero, WindowInfo
+from ema.estimate.documents.window_facts import (
+    HistoryReadings,
+    InertiaReading,
+    RotaryWindowInfo,
+    SensorZero,
+    WindowInfo,
+)
 from ema.kinds.rotary.inertia import combined_inertia
 from ema.kinds.rotary.prepare.departures.read import Known
 from ema.kinds.rotary.prepare.departures.zero_offset import ZeroOffset
@@ -34,12 +40,14 @@ def lent(zeros: Iterable[SensorZero], inertias: Sequence[InertiaReading]) -> His
 def lent_by(info: WindowInfo) -> tuple[SensorZero | None, InertiaReading | None]:
     """What a window's answer lends the others of its actuator: its sensors' zero (to its flight's windows) and
     the J_M it read (to every window), each None where it read none."""
+    if not isinstance(info, RotaryWindowInfo):
+        return None, None  # a window read without the rotary's prepare stage (logged slowly) lends nothing
     return info.sensor_zero, info.inertia_read
 
 
 def waits_for_the_run(info: WindowInfo) -> bool:
     """Whether a window answered alone could not tell J_M: it is answered again once the run's windows have read it."""
-    return info.inertia_undecided
+    return isinstance(info, RotaryWindowInfo) and info.inertia_undecided
 
 
 def readings_of(windows: Iterable[WindowInfo], flight_id: str | None) -> HistoryReadings:
@@ -47,10 +55,11 @@ def readings_of(windows: Iterable[WindowInfo], flight_id: str | None) -> History
     of ``flight_id`` (``lent``)."""
     zeros, inertias = [], []
     for info in windows:
-        if info.sensor_zero is not None and flight_id is not None and info.flight_id == flight_id:
-            zeros.append(info.sensor_zero)
-        if info.inertia_read is not None:
-            inertias.append(info.inertia_read)
+        zero, inertia = lent_by(info)
+        if zero is not None and flight_id is not None and info.flight_id == flight_id:
+            zeros.append(zero)
+        if inertia is not None:
+            inertias.append(inertia)
     return lent(zeros, inertias)
 
 
@@ -59,9 +68,9 @@ def wanted(read: WindowInfo, others: HistoryReadings) -> HistoryReadings | None:
     read none or a less precise one (conditioning takes it where it holds), J_M where it could not tell a
     heavier rotor from a weaker motor; None where the others lend it nothing it lacks."""
     zero = others.sensor_zero
-    own = read.sensor_zero
+    own = lent_by(read)[0]
     takes_zero = zero is not None and (own is None or zero.torque_std_nm < own.torque_std_nm)
-    inertia = others.inertia if read.inertia_undecided else None
+    inertia = others.inertia if waits_for_the_run(read) else None
     if not takes_zero and inertia is None:
         return None
     return HistoryReadings(sensor_zero=zero if takes_zero else None, inertia=inertia)

@@ -23,7 +23,7 @@ from ema.estimate.documents import (
     Timings,
     parameter,
 )
-from ema.estimate.documents.window_facts import InertiaReading, SensorZero, WindowInfo
+from ema.estimate.documents.window_facts import InertiaReading, RotaryWindowInfo, SensorZero
 from ema.estimate.report import learned_info, share_of_range, weakly_determined
 from ema.estimate.stats import rms
 from ema.kinds.rotary.dataset import Data
@@ -147,7 +147,7 @@ def carries_load(prepared: Prepared) -> bool:
     return bool(term >= NO_LOAD_SHARE * document.health.fdj)
 
 
-def _window_info(prepared: Prepared, data: Data, digest: str) -> WindowInfo:
+def _window_info(prepared: Prepared, data: Data, digest: str) -> RotaryWindowInfo:
     """The window as logged, and what conditioning did to it."""
     w, offset, drive = prepared.window, prepared.departures.offset, prepared.departures.drive
     zero = SensorZero(
@@ -161,7 +161,7 @@ def _window_info(prepared: Prepared, data: Data, digest: str) -> WindowInfo:
     if drive.inertia_kgm2 and not prepared.departures.inertia_from and not offset.one_way and unbiased:
         std = drive.stds["inertia_kgm2"] / drive.spec.inertia_kgm2
         inertia = InertiaReading(factor=drive.inertia_factor, std=std, window_ids=[w.window_id])
-    return WindowInfo.logged(
+    return RotaryWindowInfo.logged(
         w,
         digest,
         n_samples=prepared.original_samples,  # as logged, before averaging
