@@ -45,7 +45,7 @@ def say_kinds() -> None:
 
     for name, command in ema.commands.items():
         fact = SERVES_ONLY.get(name, "all")
-        if fact is None:
+        if fact is None or "\n\nKinds:\n" in (command.help or ""):  # none served, or said already (in one process)
             continue
         served = (DEFAULT_KIND,) if fact == "default" else tuple(KINDS) if fact == "all" else kinds_with(fact)
         said = "\n".join(f"  {kind}: {KINDS[kind].summary}" for kind in served)

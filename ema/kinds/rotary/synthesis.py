@@ -73,7 +73,7 @@ def _healths(
     never below dynamic)."""
     nominal_health = actuator.nominal
     if nominal_health is None or nominal_health.fsj is None:
-        raise InputError("--actuator", f"a {actuator.kind} actuator's drive is not simulated: give a rotary one")
+        raise InputError("--actuator", "gives no nominal FDJ, FSJ and η_O to draw its windows at")
     nominal = (nominal_health.fdj, nominal_health.efficiency, nominal_health.fsj)
     first = {
         name: default if given is None else given
