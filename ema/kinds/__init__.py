@@ -46,11 +46,9 @@ __all__ = [
     "Request",
     "calibrate",
     "calibration_cost",
-    "combined_inertia",
     "cost",
     "estimate",
     "estimate_thesis_window",
-    "inertia_change_note",
     "inertia_of",
     "kind_of",
     "lacking",
@@ -164,8 +162,9 @@ def calibration_cost(windows: Sequence[Window], config: PipelineConfig) -> Cost:
 
 # What the layers above reach of one kind's own, through the registry rather than the kind's modules: what an
 # actuator's other windows lend one of its windows (a rotary drive's sensor zero, kept for a power-on, and its J_M,
-# kept with the build: other kinds borrow nothing), and the thesis's own windows (``ema simulate`` and the latency
-# benchmark draw and read them). Each imports the kind's module at its call: the registry stays light.
+# kept with the build: other kinds borrow nothing), the sensors' gains the prognosis trends, a report's own lines,
+# ema simulate's windows, and the thesis's own windows and kernel (the latency benchmark draws, reads and times
+# them). Each imports the kind's module at its call: the registry stays light.
 
 
 def other_windows_lent(zeros: Sequence[SensorZero], inertias: Sequence[InertiaReading]) -> HistoryReadings:
@@ -198,6 +197,8 @@ def sensor_gains() -> tuple[SensorGain, ...]:
 def inertia_of(infos: Sequence[WindowInfo]) -> tuple[InertiaReading | None, Note | None]:
     """An actuator's J_M as its windows (oldest first) read it since it last changed, and a note where it changed
     along them or scatters beyond their stds (``combined_inertia``, ``inertia_change_note``)."""
+    from ema.kinds.rotary.inertia import combined_inertia, inertia_change_note
+
     readings = [inertia for info in infos if (inertia := lent_by(info)[1]) is not None]
     return combined_inertia(readings), inertia_change_note(readings)
 
@@ -214,20 +215,6 @@ def lacking(read: WindowInfo, others: HistoryReadings) -> HistoryReadings | None
     from ema.kinds.rotary.other_windows import wanted
 
     return wanted(read, others)
-
-
-def combined_inertia(readings: Sequence[InertiaReading]) -> InertiaReading | None:
-    """An actuator's J_M as its windows read it since it last changed (``ema.kinds.rotary.inertia``)."""
-    from ema.kinds.rotary.inertia import combined_inertia as combined
-
-    return combined(readings)
-
-
-def inertia_change_note(readings: Sequence[InertiaReading]) -> Note | None:
-    """A note where an actuator's J_M changed along its windows, or scatters beyond their stds."""
-    from ema.kinds.rotary.inertia import inertia_change_note as note
-
-    return note(readings)
 
 
 def thesis_window(health: HealthParams, **drawn: Any) -> Window:
