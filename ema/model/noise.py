@@ -48,6 +48,11 @@ class SensorNoise:
         tau_s = getattr(self, f"{name}_corr_s", 0.0)
         return float(np.exp(-1.0 / (tau_s * sample_rate_hz))) if tau_s > 0 else 0.0
 
+    def mean_inflation(self, name: str, n_samples: int, sample_rate_hz: float) -> float:
+        """How many times more the mean of ``n_samples`` consecutive samples of ``name``'s noise scatters than white
+        noise's of the same per-sample std: √(n · Var(mean of unit AR(1)))."""
+        return float(np.sqrt(n_samples * ar1_mean_variance(self.correlation(name, sample_rate_hz), n_samples)))
+
     def mean_std(self, name: str, n_samples: int, sample_rate_hz: float) -> float:
         """The std of the mean of ``n_samples`` consecutive samples of ``name``'s noise."""
         variance = ar1_mean_variance(self.correlation(name, sample_rate_hz), n_samples)

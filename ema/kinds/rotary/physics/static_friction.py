@@ -32,7 +32,7 @@ import numpy as np
 from ema.estimate.documents import Note
 from ema.estimate.stats import white_noise_std
 from ema.kinds.rotary.simulator.residual import END_STOP_MARGIN_DEG, smoothed
-from ema.model.noise import NO_NOISE, SensorNoise, ar1_mean_variance
+from ema.model.noise import NO_NOISE, SensorNoise
 from ema.model.params import DriveConstants, load_factors
 
 REST_SPEED_RADPS = 0.5  # at rest: the smoothed speed below this (the sensor noise alone exceeds a creep of 1 rad/s)
@@ -135,7 +135,7 @@ def _traces(signals: Mapping[str, np.ndarray], rate: float, drive: DriveConstant
     rho_speed = noise.correlation("motor_speed_radps", rate)
     return _Traces(
         drive_nm=np.abs(np.convolve(torque, np.ones(3) / 3, mode="same")),
-        drive_noise_nm=drive_noise * float(np.sqrt(3 * ar1_mean_variance(noise.correlation("current_a", rate), 3))),
+        drive_noise_nm=drive_noise * noise.mean_inflation("current_a", 3, rate),
         speed_radps=speed,
         speed_noise_radps=speed_noise * float(np.sqrt((1 + rho_speed) / (1 - rho_speed))),  # of long means
         position_deg=signals["position_deg"],
