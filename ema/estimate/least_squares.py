@@ -62,9 +62,10 @@ def newey_west_lags(n: int) -> int:
     return int(4.0 * (n / 100.0) ** (2.0 / 9.0))
 
 
-def newey_west_std(x: np.ndarray, residual: np.ndarray, lags: int) -> np.ndarray:
+def newey_west_std(x: np.ndarray, residual: np.ndarray, lags: int | None = None) -> np.ndarray:
     """Each coefficient's std from the sandwich (XᵀX)⁻¹·S·(XᵀX)⁻¹, S the residual's long-run covariance with
-    Bartlett weights 1 − k/(lags + 1)."""
+    Bartlett weights 1 − k/(lags + 1); ``lags`` None: Newey and West's plug-in for the residual's length."""
+    lags = newey_west_lags(len(residual)) if lags is None else lags
     inverse = np.linalg.pinv(x.T @ x)
     scores = x * residual[:, None]
     s = scores.T @ scores

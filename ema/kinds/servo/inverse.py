@@ -34,7 +34,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ema.estimate.least_squares import MIN_OFFSET_BALANCE, coefficients, newey_west_lags, newey_west_std
+from ema.estimate.least_squares import MIN_OFFSET_BALANCE, coefficients, newey_west_std
 from ema.estimate.stats import rms, robust_variance, white_noise_std
 from ema.kinds.servo.zero_phase import butter_lowpass, cheby1_lowpass, filtfilt
 from ema.model.checks import InputError
@@ -262,7 +262,7 @@ def solve_inverse(
         )
     beta = coefficients(x, y)
     residual = y - x @ beta
-    stds = newey_west_std(x, residual, newey_west_lags(len(y)))
+    stds = newey_west_std(x, residual)
     by_row = np.full(len(motion.sliding), np.nan)
     by_row[motion.sliding if left_out is None else motion.sliding & ~left_out] = residual
     return InverseSolution(

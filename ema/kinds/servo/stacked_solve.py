@@ -14,7 +14,7 @@ import numpy as np
 
 from ema.calibration.held_out import score
 from ema.calibration.limits import FOLDS
-from ema.estimate.least_squares import coefficients, newey_west_lags, newey_west_std
+from ema.estimate.least_squares import coefficients, newey_west_std
 from ema.estimate.stats import rms
 from ema.kinds.servo.inverse import (
     decimated_problem,
@@ -75,7 +75,7 @@ def solved(p: Problem) -> Solved:
     x = p.design(names)
     beta = coefficients(x, p.y)
     residual = p.y - x @ beta
-    stds = newey_west_std(x, residual, newey_west_lags(len(p.y)))
+    stds = newey_west_std(x, residual)
     return Solved(
         dict(zip(names, beta.tolist(), strict=True)),
         dict(zip(names, stds.tolist(), strict=True)),
