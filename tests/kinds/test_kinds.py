@@ -112,7 +112,9 @@ def test_no_shared_module_imports_a_kind_or_reads_what_only_one_kind_has():
 
 
 def test_every_kind_of_the_documents_has_its_method():
-    assert set(REGISTRY) == set(facts.KINDS)
+    from ema.model.window import WINDOW_CLASSES
+
+    assert set(REGISTRY) == set(facts.KINDS) == set(WINDOW_CLASSES)  # its method, and its window's class
     assert all(kind.facts is facts.KINDS[name] for name, kind in REGISTRY.items())
 
 
