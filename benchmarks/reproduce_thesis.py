@@ -239,9 +239,8 @@ def write_results(results: list[dict], comparison: list[str], command: str) -> N
         "after a pilot's step the drive jumps past the static level within one log interval. FSJ is",
         "read only at quasi-static break-aways (`ema/kinds/rotary/physics/static_friction.py`); otherwise the product",
         "reports `FSJ: null` with the reason. On the ground with a slowly rising load the shaft rests",
-        "and breaks away: FSJ is read within 2 % there, within its ±2 std under sensor noise; a shaft",
-        "held and then stepped away shows only a lower bound, not read",
-        "(tests/kinds/rotary/physics/test_static_friction.py).",
+        "and breaks away: FSJ is read within 2 % there, within its ±2 std under sensor noise; a shaft held",
+        "and then stepped away shows only a lower bound (tests/kinds/rotary/physics/test_static_friction.py).",
     ]
     write_section("Thesis chapter 6, reproduced", command, "\n".join(lines), DOCS / "results.md")
 
