@@ -195,7 +195,8 @@ class ActuatorDocument(Document):
         if kind is None:
             return values
         own = KINDS[kind].section
-        values = {k: v for k, v in values.items() if v is not None or k == own or k in cls.model_fields}
+        kinds_fields = {name for kind in ActuatorDocument.__subclasses__() for name in kind.model_fields}
+        values = {k: v for k, v in values.items() if v is not None or k in cls.model_fields or k not in kinds_fields}
         for other in SECTIONS:
             if other != own and other in values:
                 raise ValueError(f"{other}: a {kind} actuator has no {other} (kind: {kind})")

@@ -115,6 +115,9 @@ def test_the_rotarys_own_fields_are_its_own_and_a_null_one_in_another_kinds_docu
     with pytest.raises(InputError, match="Extra inputs") as refused:
         actuator_from_dict({**servo, "sensor_noise": THESIS.model_dump()["drive"]})
     assert refused.value.field == "sensor_noise"
+    with pytest.raises(InputError, match="Extra inputs") as refused:  # a null field no kind has: a typo, named
+        actuator_from_dict({**servo, "airfram": None})
+    assert refused.value.field == "airfram"
     assert THESIS.load_model_tolerance == THESIS.airframe.tolerance and read.load_model_tolerance == 0.1
     nominal = {"fdj_n": 20.0, "eta_o": None}  # FSJ is the rotary's: null as once written, else refused
     assert actuator_from_dict({**servo, "nominal": {**nominal, "fsj_nm": None}}).nominal.fsj is None
