@@ -290,6 +290,11 @@ def test_a_servo_log_is_refused_until_its_document_is_stored_then_stored_once(tm
         assert main(history) == EXIT_OK and not plot.exists()
         captured = capsys.readouterr()
         assert "no figure written" in captured.err and "[no_threshold]" in captured.out
+        assert main([*history, "--parameter", "stiffness"]) == EXIT_BAD_INPUT  # not one of the servo's: named
+        refused = capsys.readouterr().err
+        assert "--parameter: 'stiffness' is not one of this actuator's" in refused and "mass_kg" in refused
+        assert main([*history, "--parameter", "mass_kg"]) == EXIT_OK  # its own constant: one window, no trend yet
+        assert "no figure written" in capsys.readouterr().err and not plot.exists()
         assert main(history[:4]) == EXIT_BAD_INPUT and "--api-key-file" in capsys.readouterr().err
     finally:
         server.terminate()
