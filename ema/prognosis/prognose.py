@@ -9,7 +9,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from ema.estimate.documents import Note
+from ema.estimate.documents import Note, ParameterEstimate
 from ema.kinds import inertia_of, sensor_gains
 from ema.kinds.base import SensorGain
 from ema.model.actuator import ActuatorDocument
@@ -89,17 +89,11 @@ def _outlook(
 ) -> Outlook | None:
     """``name``'s outlook over the windows that read it, or None where none did: against the level it crosses first
     where the document gives two (FDJ above and below), its changes judged on each window's repeatability std."""
-    read = [(t, e, s.window_id) for t, s in zip(times, stored, strict=True) if (e := getattr(s.estimates, name))]
-    if not read:
-        return None
-    values = np.array([e.value for _, e, _ in read])
-    stds = np.array([np.nan if (std := e.repeatability_std or e.std) is None else std for _, e, _ in read])
-    times_read, ids = np.array([t for t, _, _ in read]), [i for _, _, i in read]
+    series = _series(name, stored, times, [getattr(s.estimates, name) for s in stored])
     limits = actuator.limits(name)
-    if not limits:
+    if series is None or not limits:
         return None
     span = MIN_SPAN[unit]
-    series = Series(name, times_read, values, stds, ids)
     each = {(level, way): outlook(series, threshold=level, direction=way, min_span=span) for level, way in limits}
     (threshold, direction), seen = min(each.items(), key=lambda item: _urgency(item[1].life))
     if not backtested:
@@ -179,16 +173,23 @@ def constant_trends(stored: Sequence[Stored], times: np.ndarray) -> dict[str, Tr
     names = dict.fromkeys(name for s in stored for name in s.estimates.constants)
     trends = {}
     for name in names:
-        read = [
-            (t, e, s.window_id) for t, s in zip(times, stored, strict=True) if (e := s.estimates.constants.get(name))
-        ]
-        if len(read) < 2:
-            continue
-        stds = [np.nan if (std := e.repeatability_std or e.std) is None else std for _, e, _ in read]
-        values = np.array([e.value for _, e, _ in read])
-        t, ids = np.array([t for t, _, _ in read]), [i for _, _, i in read]
-        trends[name] = trend_of(Series(name, t, values, np.array(stds, dtype=float), ids))
+        series = _series(name, stored, times, [s.estimates.constants.get(name) for s in stored])
+        if series is not None and len(series.values) >= 2:
+            trends[name] = trend_of(series)
     return trends
+
+
+def _series(
+    name: str, stored: Sequence[Stored], times: np.ndarray, entries: Sequence[ParameterEstimate | None]
+) -> Series | None:
+    """``name``'s readings over the windows whose entry (``entries``, one per window) holds one (None: none does),
+    each with its repeatability std (its whole std where it gives none; NaN where neither is known)."""
+    read = [(t, e, s.window_id) for t, s, e in zip(times, stored, entries, strict=True) if e is not None]
+    if not read:
+        return None
+    values = np.array([e.value for _, e, _ in read])
+    stds = np.array([np.nan if (std := e.repeatability_std or e.std) is None else std for _, e, _ in read])
+    return Series(name, np.array([t for t, _, _ in read]), values, stds, [i for _, _, i in read])
 
 
 def sensor_trends(
