@@ -23,7 +23,7 @@ import numpy as np
 from ema.cli.benchmark_docs import write_section
 from ema.estimate import thread_budget
 from ema.estimate.learn.network import LearnConfig, learn_network, predict
-from ema.estimate.simulate.design import Box
+from ema.kinds.rotary.box import Box
 from ema.kinds.rotary.physics.features import features
 from ema.kinds.rotary.physics.friction import solve_window
 from ema.kinds.rotary.physics.scenario import Scenario

@@ -1,9 +1,9 @@
-"""Networks trained on a dataset, as an estimator of FDJ and η_O (η_A derived).
+"""A window's networks, as an estimator every kind trains on its simulations.
 
-With several members (independently seeded, each with its own split) the prediction is their
-mean. Targets are FDJ and η_O in the units of the dataset's box (``ema.estimate.simulate.design``): 0 and 1
-at its edges. Predictions are returned unclipped in those units too, so that the caller sees
-when the network leaves the region it was trained on.
+With several members (independently seeded, each with its own split) the prediction is their mean. Targets are in
+the units of the kind's dataset box, 0 and 1 at its edges (the rotary's FDJ and η_O, a servo's constants).
+Predictions are returned unclipped in those units too, so that the caller sees when the network leaves the region
+it was trained on.
 """
 
 from __future__ import annotations

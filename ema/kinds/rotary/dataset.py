@@ -8,7 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ema.estimate.config import PipelineConfig
-from ema.estimate.simulate import design
+from ema.kinds.rotary.box import Box, box_around, centre, draw
 from ema.kinds.rotary.physics.features import as_read, sliding_features
 from ema.kinds.rotary.physics.friction import FrictionSolution, SolveSettings, regressors
 from ema.kinds.rotary.physics.noise_reading import excess_noise
@@ -72,7 +72,7 @@ class Data:
     """Everything simulated for one window."""
 
     scenario: Scenario
-    box: design.Box
+    box: Box
     noise: SensorNoise
     sims: Simulated  # n_simulations for training, then check_simulations held out
     sliding: np.ndarray  # (n_samples,) the window's Eq. 5.1 samples
@@ -96,10 +96,10 @@ def simulate_dataset(
     features of both (the window read as ``seen``: through ``as_read``, its T_R with ``drive``, the
     document's drive with J_M and C as the window shows them)."""
     fdj, eta_o = physics.fdj_nm[0], physics.eta_o[0]
-    box = design.box_around(fdj, physics.fdj_std_nm[0], eta_o, physics.eta_o_std[0], document.health.fdj)
+    box = box_around(fdj, physics.fdj_std_nm[0], eta_o, physics.eta_o_std[0], document.health.fdj)
     scenario = scenario_from_window(seen, document.params, document.hinge, effects)
-    health = design.draw(box, config.total_simulations, config.seed)
-    sims = simulate_noisy(scenario, health, window, design.centre(box), config.seed + 1, config.check_simulations)
+    health = draw(box, config.total_simulations, config.seed)
+    sims = simulate_noisy(scenario, health, window, centre(box), config.seed + 1, config.check_simulations)
     rate = window.sample_rate_hz
     residual = residual_torque_nm(
         seen.signals["current_a"], seen.signals["motor_speed_radps"], seen.signals["hinge_moment_nm"], rate, drive

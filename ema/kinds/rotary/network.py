@@ -6,7 +6,7 @@ import numpy as np
 
 from ema.estimate.config import PipelineConfig
 from ema.estimate.learn.estimator import trained
-from ema.estimate.simulate.design import Box
+from ema.kinds.rotary.box import Box
 
 
 class NetworkEstimator:

@@ -6,7 +6,7 @@ The thesis's §6.3 proposal, made to hold on data our simulator did not draw:
    (``ema.kinds.rotary.prepare.conditioning``);
 2. **physics**: solve Eq. 5.1 by least squares (``ema.kinds.rotary.physics.friction``), a block-jackknife std beside;
 3. **simulate**: a Case-1B dataset of the window's own command, logged load and first state, its
-   health drawn in a box around the physics estimate (``ema.estimate.simulate.design``: no fixed range, so no
+   health drawn in a box around the physics estimate (``ema.kinds.rotary.box``: no fixed range, so no
    cap on a worn actuator), with the window's own sensor noise;
 4. **learn**: the shallow network on the residual torque of the sliding samples (``learned``);
 5. **assess**: both estimators scored on held-out simulations and blended per parameter, checked against the

@@ -11,8 +11,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ema.estimate.simulate.design import physical
 from ema.estimate.stats import rms
+from ema.kinds.rotary.box import physical
 from ema.kinds.rotary.simulator.batch import BatchResult, InitialState, simulate_batch
 from ema.kinds.rotary.simulator.commands import knots_from_samples
 from ema.kinds.rotary.simulator.effects import EffectSet
