@@ -15,6 +15,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from ema.calibration.truth import with_truth_errors
 from ema.cli.benchmark_docs import write_section
 from ema.estimate import thread_budget
 from ema.kinds.rotary.calibration import Calibrator
@@ -39,11 +40,9 @@ MECHANICAL = {"backlash", "position_friction", "stribeck", "viscous", "cogging"}
 
 def one(case: str, seed: int) -> dict[str, object]:
     drawn = draw(seed, "stops", effects=CASES[case], duration_s=1.5, flight=LOW_Q)
-    report = (
-        Calibrator(seed=seed, actuator=THESIS)
-        .fit([as_window(window_from_dict(drawn.document), RotaryWindow)], drawn.truth)
-        .report_
-    )
+    calibrator = Calibrator(seed=seed, actuator=THESIS)
+    calibrator.fit([as_window(window_from_dict(drawn.document), RotaryWindow)], drawn.truth)
+    report = with_truth_errors(calibrator.report_, drawn.truth)  # as every kind's calibration reports it
     assert report.error_pct_before is not None and report.error_pct_after is not None
     before = (report.error_pct_before["FDJ"] + report.error_pct_before["eta_O"]) / 100
     after = (report.error_pct_after["FDJ"] + report.error_pct_after["eta_O"]) / 100

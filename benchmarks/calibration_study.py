@@ -22,6 +22,7 @@ from typing import Any
 
 import numpy as np
 
+from ema.calibration.truth import with_truth_errors
 from ema.cli.benchmark_docs import write_section
 from ema.cli.figures import residual_figure
 from ema.estimate import thread_budget
@@ -63,7 +64,7 @@ def one(case: str, scale: float, seed: int, figure: Path | None) -> dict[str, An
         [as_window(window_from_dict(drawn.document), RotaryWindow)], drawn.truth
     )
     seconds = time.perf_counter() - started
-    report = calibrator.report_
+    report = with_truth_errors(calibrator.report_, drawn.truth)  # as every kind's calibration reports it
     if figure is not None:
         residual_figure(residual_plot(calibrator), figure)
 

@@ -173,6 +173,14 @@ class CalibrationReport(Document):
         "benchmarks' error) with the base model",
     )
     model_error_pct_after: dict[str, float] | None = Field(None, description="the same with the effects in")
+    error_before: dict[str, float] | None = Field(
+        None,
+        description="against a known truth (synthetic windows): |value − truth| of each constant the truth names that "
+        "the report carries, with the document's model (null: no truth given, or the constant has no value before)",
+    )
+    error_after: dict[str, float] | None = Field(None, description="the same with what the windows taught")
+    error_pct_before: dict[str, float] | None = Field(None, description="error_before over |truth|, in %")
+    error_pct_after: dict[str, float] | None = Field(None, description="error_after over |truth|, in %")
     completed_actuator: AnyActuator | None = Field(
         None,
         description="the actuator's ema-actuator/1 document completed with what the windows taught (a linear "
@@ -200,18 +208,13 @@ _KIND_DESCRIPTION = "the kind of actuator the windows are of (reports first writ
 
 
 class RotaryCalibration(CalibrationReport):
-    """A rotary actuator's report: what no named effect explains, effects its windows cannot tell apart, and its
-    errors against a known truth (synthetic windows)."""
+    """A rotary actuator's report: what no named effect explains, and effects its windows cannot tell apart."""
 
     kind: Literal["rotary"] = Field("rotary", description=_KIND_DESCRIPTION)
     unexplained: Unexplained | None
     ambiguity: Ambiguity | None = Field(
         None, description="effects the windows cannot choose between whose estimates differ (null: none)"
     )
-    error_before: dict[str, float] | None = None
-    error_after: dict[str, float] | None = None
-    error_pct_before: dict[str, float] | None = None
-    error_pct_after: dict[str, float] | None = None
 
 
 class LinearCalibration(CalibrationReport):

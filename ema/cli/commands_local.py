@@ -203,8 +203,8 @@ def simulate(as_json: bool, **options: Any) -> None:
 @click.option(
     "--truth",
     type=EXISTING,
-    help='JSON of what synthetic windows were drawn at, by name ({"FDJ": ..., "eta_O": ...} for a rotary EMA): '
-    "the report states its errors against it",
+    help='JSON of what synthetic windows were drawn at, by name ({"FDJ": 0.05, "eta_O": 0.85}, a servo\'s '
+    '{"mass": 95}): the report states its error against each constant it reports',
 )
 @click.option("--figure", type=FIGURE_FILE, help="also write a PNG of the residual before and after (needs [plots])")
 @click.option(
@@ -255,10 +255,9 @@ def calibrate(
     mapping = log_map_document(log_map_file)
     loaded = [read_one(path, mapping) for path in windows]
     kind_given(loaded, actuator_file)
-    request = kinds.CalibrationRequest(
-        config, document, read_truth(truth, document.facts), copies=copies, on_stage=progress
-    )
-    calibrated = kinds.calibrate(loaded, request)
+    request = kinds.CalibrationRequest(config, document, read_truth(truth), copies=copies, on_stage=progress)
+    with flags_named({"truth": "--truth"}):
+        calibrated = kinds.calibrate(loaded, request)
     written: dict[str, str | None] = {"figure": None, "actuator_written": None}
     if out_actuator is not None:
         if calibrated.completed is None:

@@ -9,21 +9,28 @@ from typing import Any
 import click
 
 from ema.model.checks import InputError
-from ema.model.kinds import KindFacts
 
 
-def read_truth(path: Path | None, facts: KindFacts) -> dict[str, float] | None:
-    """What ``facts``' kind's calibration report compares with a truth, read from ``path`` (``{"FDJ": 0.05, "eta_O":
-    0.85}`` for a rotary EMA; other keys ignored); errors name the file, or --truth for a kind that compares none."""
+def read_truth(path: Path | None) -> dict[str, float] | None:
+    """A truth file's numbers by name (``{"FDJ": 0.05, "eta_O": 0.85}``, a servo's ``{"mass": 95.0}``): what the
+    calibration compares with what it reports (``ema.calibration.truth``); entries that are not numbers (``ema
+    simulate``'s ``flight_hours`` of null) are not a truth. Errors name the file."""
     if path is None:
         return None
-    if not facts.truth:
-        raise InputError("--truth", f"a {facts.name} actuator's calibration compares no truth: leave it out")
     try:
         truth = json.loads(Path(path).read_text())
-        return {key: float(truth[key]) for key in facts.truth}
-    except (OSError, ValueError, KeyError, TypeError) as exc:
-        raise InputError(str(path), f"is not a truth file with {' and '.join(facts.truth)} ({exc!r})") from None
+    except (OSError, ValueError) as exc:
+        raise InputError(str(path), f"is not a truth file ({exc!r})") from None
+    if not isinstance(truth, dict):
+        raise InputError(str(path), "is not a truth file: a JSON object of true values by name")
+    numbers = {
+        name: float(value)
+        for name, value in truth.items()
+        if isinstance(value, int | float) and not isinstance(value, bool)
+    }
+    if not numbers:
+        raise InputError(str(path), "holds no true value: a JSON object of numbers by name")
+    return numbers
 
 
 def _std(std: float | None) -> str:
@@ -143,6 +150,8 @@ def print_calibration(report: dict[str, Any]) -> None:
     _print_estimates(report)
     for line in report_lines(report):
         click.echo(line)
+    for line in _truth_lines(report):
+        click.echo(line)
     for when in ("before", "after", "document"):
         errors = report.get(f"model_error_pct_{when}")
         if errors:
@@ -150,6 +159,18 @@ def print_calibration(report: dict[str, Any]) -> None:
             click.echo(f"model error {when}: {said}  (100·‖y − ŷ‖/‖y‖)")
     if report.get("figure"):
         click.echo(f"figure: {report['figure']}")
+
+
+def _truth_lines(report: dict[str, Any]) -> list[str]:
+    """Each constant's error against a known truth, before -> after (relative where the truth is not 0)."""
+    after = report.get("error_pct_after") or report.get("error_after") or {}
+    relative = bool(report.get("error_pct_after"))
+    before = (report.get("error_pct_before") if relative else report.get("error_before")) or {}
+    said = "{:.2f} %".format if relative else "{:.3g}".format
+    return [
+        f"{name} error against the truth: {said(before[name]) if name in before else '—'} -> {said(after[name])}"
+        for name in after
+    ]
 
 
 ERROR_WORDS = {"drive_force_n": "force, inverse model", "drive_force_n_closed_loop": "force, closed loop"}

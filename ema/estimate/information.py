@@ -17,6 +17,7 @@ positions declared in µm is refused naming the bound, never stored.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
@@ -102,11 +103,20 @@ def bounds_of(model: type, name: str) -> tuple[float | None, bool, float | None,
     return None if low is None and high is None else (low, low_in, high, high_in)
 
 
-def out_of_bounds(values: dict[str, float], models: tuple[Any, ...], field: str) -> None:
+def out_of_bounds(
+    values: Mapping[str, float],
+    models: tuple[Any, ...],
+    field: str,
+    *,
+    fields: Mapping[str, str] | None = None,
+    why: str = "not a reading (a channel scaled into another unit, or mapped wrong?)",
+) -> None:
     """InputError naming the first of ``values`` outside its document field's bounds (the first of ``models``, the
-    document's classes, that has a field of its name)."""
+    document's classes, that has a field of its name, or of the name ``fields`` gives it: an answer's ``FDJ`` is a
+    document's ``fdj_nm``)."""
     for name, value in values.items():
-        bounds = next((b for model in models if (b := bounds_of(model, name)) is not None), None)
+        document_field = name if fields is None else fields.get(name, name)
+        bounds = next((b for model in models if (b := bounds_of(model, document_field)) is not None), None)
         if bounds is None:
             continue
         low, low_in, high, high_in = bounds
@@ -116,6 +126,5 @@ def out_of_bounds(values: dict[str, float], models: tuple[Any, ...], field: str)
             limit = f"{'≥' if low_in else '>'} {low:g}" if below else f"{'≤' if high_in else '<'} {high:g}"
             raise InputError(
                 f"{field}.{name}",
-                f"reads {value:.4g}, where the actuator's document allows {limit}: not a reading (a channel scaled "
-                "into another unit, or mapped wrong?)",
+                f"reads {value:.4g}, where the actuator's document allows {limit}: {why}",
             )

@@ -22,8 +22,10 @@ fourth kind is a folder here, a row of ``ema.model.kinds`` and a line in ``REGIS
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
+from dataclasses import replace
 from typing import Any
 
+from ema.calibration.truth import refuse_truth, with_truth_errors
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import Estimate, Note
 from ema.estimate.documents.window_facts import HistoryReadings, InertiaReading, SensorZero, WindowInfo
@@ -117,14 +119,13 @@ def estimate(
 def held_to_document(answer: Estimate, actuator: ActuatorDocument) -> None:
     """InputError naming the first value of ``answer`` outside the bounds its document's field allows
     (``ema.estimate.information.out_of_bounds``): an answer outside them is never a reading."""
-    e = actuator.facts
-    values = {e.friction_field("fdj"): answer.estimates.FDJ.value}
-    for name, field in (("eta_O", "eta_o"), ("eta_A", "eta_a"), ("FSJ", "fsj_nm")):
-        entry = getattr(answer.estimates, name)
-        if entry is not None:
-            values[field] = entry.value
+    values = {
+        actuator.facts.document_field(name): entry.value
+        for name in ("FDJ", "eta_O", "eta_A", "FSJ")
+        if (entry := getattr(answer.estimates, name)) is not None
+    }
     values |= {name: entry.value for name, entry in answer.estimates.constants.items()}
-    out_of_bounds(values, (actuator.nominal_class, type(actuator.section)), "estimates")
+    out_of_bounds(values, actuator.bounding_classes, "estimates")
 
 
 def calibrate(windows: Sequence[Window], request: CalibrationRequest) -> Calibrated:
@@ -141,7 +142,10 @@ def calibrate(windows: Sequence[Window], request: CalibrationRequest) -> Calibra
                 f"is {window.actuator_id!r}; a calibration reads the windows of one actuator "
                 f"({windows[0].actuator_id!r})",
             )
-    return kind_of(request.actuator).calibrate(windows, request)
+    if request.truth is not None:
+        refuse_truth(request.truth, request.actuator)
+    calibrated = kind_of(request.actuator).calibrate(windows, request)
+    return replace(calibrated, report=with_truth_errors(calibrated.report, request.truth))
 
 
 def learns(window: Window) -> bool:

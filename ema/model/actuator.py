@@ -243,6 +243,11 @@ class ActuatorDocument(Document):
         raise NotImplementedError  # each kind's class
 
     @property
+    def bounding_classes(self) -> tuple[type, ...]:
+        """The classes whose fields bound a value read of this actuator: its nominal health's, then its section's."""
+        return self.nominal_class, type(self.section)
+
+    @property
     def params(self) -> DriveConstants:
         """The drive's constants as the simulator takes them (a rotary actuator's)."""
         raise InputError("actuator.kind", f"a {self.kind} actuator has no rotary drive to simulate")

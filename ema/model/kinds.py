@@ -56,7 +56,6 @@ class KindFacts:
     recorded: tuple[str, ...] = ()  # the section's fields a log may record beside its signals (``constants``)
     measured: tuple[str, ...] = ()  # the signals its answer is read from: a dead one refuses a window
     simulated: bool = False  # ema simulate draws its windows (its simulator runs from a document alone)
-    truth: tuple[str, ...] = ()  # what its calibration report compares with a known truth (``ema calibrate --truth``)
     # How long the windows a recording of this kind is cut into unless told (the thesis's windows: a few commands of
     # the elevator each); None: a log is one window (a rig's run, a controller's log).
     cut_s: float | None = None
@@ -87,6 +86,11 @@ class KindFacts:
     def all_signals(self) -> tuple[str, ...]:
         return self.signals + self.optional_signals
 
+    def document_field(self, name: str) -> str:
+        """The actuator document's field an answer's value ``name`` is held to (``FDJ`` -> ``fdj_nm`` or ``fdj_n``,
+        ``eta_O`` -> ``eta_o``); a constant is its own field's name."""
+        return {"FDJ": self.friction_field("fdj"), "eta_O": "eta_o", "eta_A": "eta_a", "FSJ": "fsj_nm"}.get(name, name)
+
     def friction_field(self, prefix: str) -> str:
         """The document's field of a friction value in this kind's unit (``fdj`` -> ``fdj_nm`` or ``fdj_n``)."""
         return f"{prefix}_{FRICTION_SUFFIX[self.friction_unit]}"
@@ -110,7 +114,6 @@ _ROTARY = KindFacts(
     static_friction=True,
     measured=("position_deg", "motor_speed_radps", "current_a"),
     simulated=True,
-    truth=("FDJ", "eta_O"),
 )
 _LINEAR = KindFacts(
     name="linear",

@@ -5,7 +5,7 @@
 
 from __future__ import annotations
 
-from typing import Any, Literal
+from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, FiniteFloat
 
@@ -26,13 +26,15 @@ class BusyOut(BaseModel):
     detail: str
 
 
-class Truth(BaseModel):
-    """The true parameters of synthetic windows, to report the estimation error."""
-
-    model_config = ConfigDict(extra="forbid")
-    FDJ: FiniteFloat = Field(gt=0, le=10)
-    eta_O: FiniteFloat = Field(gt=0, le=1)
-    FSJ: FiniteFloat | None = Field(None, gt=0, le=10)
+Truth = Annotated[
+    dict[str, FiniteFloat],
+    Field(
+        min_length=1,
+        description="the true values of synthetic windows by name (FDJ and eta_O of a rotary EMA, a servo's mass): "
+        "the report states its error against each constant it reports; each held to its document field's bounds",
+        examples=[{"FDJ": 0.05, "eta_O": 0.85}],
+    ),
+]
 
 
 class CalibrateIn(BaseModel):

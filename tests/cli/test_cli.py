@@ -368,8 +368,39 @@ def test_another_kind_s_log_without_its_document_or_with_a_flag_it_has_not_is_na
     assert main(["simulate", "--out", str(out), "--actuator", str(EMPS / "actuator.json")]) == EXIT_BAD_INPUT
     assert "is a servo actuator's document: ema simulate draws rotary windows only" in capsys.readouterr().err
     assert not out.exists()
+
+
+def test_a_servo_s_calibration_states_its_error_against_any_constant_it_reports(tmp_path, capsys):
+    """EMPS's servo: its mass and FDJ compared with a truth (here the values its published identification reads,
+    ~95 kg and ~20 N), a name it does not report refused naming the flag, never silently compared with nothing."""
     truth = tmp_path / "truth.json"
-    truth.write_text('{"FDJ": 1.0, "eta_O": 0.9}')
-    calibrate = ["calibrate", *log, "--actuator", str(EMPS / "actuator.json"), "--truth", str(truth)]
-    assert main(calibrate) == EXIT_BAD_INPUT  # a servo's report compares no truth: never silently ignored
-    assert "--truth: a servo actuator's calibration compares no truth" in capsys.readouterr().err
+    calibrate = [
+        "calibrate",
+        str(EMPS / "DATA_EMPS.mat"),
+        "--log-map",
+        str(EMPS / "log-map.json"),
+        "--actuator",
+        str(EMPS / "actuator.json"),
+        "--truth",
+        str(truth),
+    ]
+    truth.write_text('{"mass": 95.0, "FDJ": 20.0, "flight_hours": null}')
+    assert main([*calibrate, "--json"]) == EXIT_OK
+    report = json.loads(capsys.readouterr().out)
+    learned = {entry["name"]: entry["value"] for entry in report["learned"]}
+    assert report["error_after"] == pytest.approx(
+        {"mass": abs(learned["mass"] - 95.0), "FDJ": abs(learned["FDJ"] - 20)}
+    )
+    assert set(report["error_before"]) == {"FDJ"}  # the mass has no value before: the document holds none
+    assert report["error_pct_after"]["mass"] == pytest.approx(100 * report["error_after"]["mass"] / 95.0)
+    assert main(calibrate) == EXIT_OK
+    assert "mass error against the truth: — -> " in capsys.readouterr().out
+    truth.write_text('{"massa": 95.0}')
+    assert main(calibrate) == EXIT_BAD_INPUT
+    said = capsys.readouterr().err
+    assert "--truth: names massa; this calibration reports" in said and "mass" in said
+    truth.write_text('{"FDJ": -20.0}')
+    assert main(calibrate) == EXIT_BAD_INPUT
+    assert (
+        "--truth FDJ: reads -20, where the actuator's document allows ≥ 1e-06: no actuator" in capsys.readouterr().err
+    )

@@ -34,7 +34,7 @@ class Linear:
 
     def calibrate(self, windows: Sequence[Window], request: CalibrationRequest) -> Calibrated:
         report, completed, plot = calibrate_linear(
-            [as_window(w, LinearWindow) for w in windows], as_kind(request.actuator, LinearActuator), request.truth
+            [as_window(w, LinearWindow) for w in windows], as_kind(request.actuator, LinearActuator)
         )
         return Calibrated(report.model_copy(update={"completed_actuator": completed}), completed, plot)
 

@@ -39,7 +39,7 @@ ANCHOR = (
 
 
 def calibrate_linear(
-    windows: Sequence[LinearWindow], actuator: LinearActuator, truth: Mapping[str, float] | None = None
+    windows: Sequence[LinearWindow], actuator: LinearActuator
 ) -> tuple[LinearCalibration, LinearActuator | None, ResidualPlot]:
     """The report, the completed document where the runs taught the drive (None when comparing), and its figure."""
     started = time.perf_counter()

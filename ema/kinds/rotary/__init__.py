@@ -117,8 +117,7 @@ class Rotary:
         return (HINGE_GAUGE,)
 
     def report_lines(self, report: Mapping[str, Any]) -> list[str]:
-        """What no named effect explains, effects its windows cannot tell apart, FDJ's and η_O's errors against a
-        known truth, and what it learned."""
+        """What no named effect explains, effects its windows cannot tell apart, and what it learned."""
         lines = []
         if report.get("unexplained"):
             lines.append(f"unexplained: {report['unexplained']['description']}")
@@ -127,8 +126,6 @@ class Rotary:
             lines.append(
                 f"ambiguous: {' / '.join(ambiguity['effects'])}; to tell them apart: {ambiguity['tell_apart']}"
             )
-        before, after = report.get("error_pct_before") or {}, report.get("error_pct_after") or {}
-        lines += [f"{name} error against the truth: {before[name]:.2f} % -> {after[name]:.2f} %" for name in before]
         return lines + learned_lines(report.get("learned", []))
 
     def warm_up(self) -> None:

@@ -85,11 +85,11 @@ def adopted_effects(found: Found) -> EffectSet:
     return effects
 
 
-def _errors(values: Mapping[str, float], truth: Mapping[str, float] | None) -> tuple[dict, dict] | tuple[None, None]:
+def _errors(values: Mapping[str, float], truth: Mapping[str, float] | None) -> dict[str, float] | None:
+    """|value − truth| of FDJ and η_O, those the truth names (None: it names neither, or no truth)."""
     if truth is None:
-        return None, None
-    absolute = {k: abs(values[k] - float(truth[k])) for k in TARGETS}
-    return absolute, {k: 100 * absolute[k] / abs(float(truth[k])) for k in TARGETS}
+        return None
+    return {k: abs(values[k] - float(truth[k])) for k in TARGETS if k in truth} or None
 
 
 def scatter(copies: Sequence[Equations], with_it: Sequence[Chosen]) -> np.ndarray:
@@ -169,7 +169,7 @@ def unexplained(found: Found, bias: Mapping[str, float], truth: Mapping[str, flo
         estimates_if_added=estimates,
         estimates_withheld=reason,
         residual_rms_if_added=residual_rms(found.measured, with_it),
-        error_if_added=None if estimates is None else _errors(estimates, truth)[0],
+        error_if_added=None if estimates is None else _errors(estimates, truth),
     )
 
 
@@ -187,8 +187,6 @@ def assemble(
     effects = adopted_effects(found)
     names = [c.family.name for c in found.chosen] + (["backlash"] if found.backlash.significant else [])
     first = next((e for e in found.evidence if found.chosen and e.family.name == found.chosen[0].family.name), None)
-    errors_before, pct_before = _errors(before, truth)
-    errors_after, pct_after = _errors(after, truth)
     return RotaryCalibration(
         n_windows=int(found.measured.window.max()) + 1,
         noise_floor=NoiseFloor(copies=len(found.copies), equation_error_ratio=residual_rms(found.measured, []) / floor),
@@ -204,9 +202,5 @@ def assemble(
         held_out=HeldOut(rss_before=held.rss_before, rss_after=held.rss_after, adopted=held.adopted, note=held.note),
         estimates_before=dict(before),
         estimates_after=dict(after),
-        error_before=errors_before,
-        error_after=errors_after,
-        error_pct_before=pct_before,
-        error_pct_after=pct_after,
         timings_s={"total": seconds},
     )

@@ -5,6 +5,7 @@ from starlette.concurrency import run_in_threadpool
 
 from ema import kinds
 from ema.calibration.documents import AnyCalibration, CalibrationReport
+from ema.calibration.truth import refuse_truth
 from ema.model.window import Window
 from ema.service.deps import RunnerDep, SettingsDep, StoreDep, actuator_of, stopper, stored_kind
 from ema.service.parsing import check_calibration_budget, read_body
@@ -14,8 +15,7 @@ router = APIRouter(tags=["calibrate"])
 
 
 def _windows_and_truth(body: CalibrateIn) -> tuple[list[Window], dict[str, float] | None]:
-    truth = None if body.truth is None else body.truth.model_dump(exclude_none=True)
-    return [document.to_window() for document in body.windows], truth
+    return [document.to_window() for document in body.windows], body.truth
 
 
 @router.post(
@@ -34,6 +34,8 @@ async def calibrate(request: Request, settings: SettingsDep, store: StoreDep, ru
         check_calibration_budget(windows, settings.pipeline, settings)
         actuator, version = await actuator_of(store, windows[0].actuator_id)
         stored_kind(windows, actuator, version, listed=True)
+        if truth is not None:
+            refuse_truth(truth, actuator)  # before the run is queued, as its windows are
         stop = stopper(ticket.cancel)
         asked = kinds.CalibrationRequest(settings.pipeline, actuator, truth, on_stage=stop, checkpoint=lambda: stop(""))
         report = await runner.run(ticket, request.is_disconnected, lambda: kinds.calibrate(windows, asked).report)

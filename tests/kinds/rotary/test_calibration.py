@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 from ema.calibration.documents import CalibrationReport
+from ema.calibration.truth import with_truth_errors
 from ema.estimate.config import PipelineConfig
 from ema.kinds.rotary.calibration import Calibrator
 from ema.model.actuator import THESIS
@@ -17,10 +18,16 @@ SMALL = PipelineConfig(n_simulations=32, check_simulations=16, n_timesteps=100, 
 STOPS_FLIGHT = Flight(airspeed_mps=100.0, altitude_m=5000.0)  # a low q̄: the motor holds the stop against it
 
 
+def reported(drawn, calibrator: Calibrator | None = None) -> CalibrationReport:
+    """The report as ``ema calibrate`` gives it: the calibrator's, with its errors against the drawn truth."""
+    calibrator = calibrator or Calibrator(SMALL, copies=16, actuator=THESIS)
+    return with_truth_errors(calibrator.fit([window_from_dict(drawn.document)], drawn.truth).report_, drawn.truth)
+
+
 def calibrate(case: str, seed: int, scale: float = 1.0) -> tuple[CalibrationReport, dict]:
     effects = CASES[case](np.random.default_rng(seed), scale)
     drawn = draw(seed, "thesis", effects=effects)
-    report = Calibrator(SMALL, copies=16, actuator=THESIS).fit([window_from_dict(drawn.document)], drawn.truth).report_
+    report = reported(drawn)
     return report, drawn.truth
 
 
@@ -49,7 +56,7 @@ def test_a_drive_whose_loop_departs_from_the_spec_is_no_effect():
         loop_noise_seed=5,
     )
     drawn = draw(903, "doublet", effects=loop)
-    report = Calibrator(SMALL, copies=16, actuator=THESIS).fit([window_from_dict(drawn.document)], drawn.truth).report_
+    report = reported(drawn)
     assert report.selected_effect is None and report.unexplained is None
     assert report.estimates_after == report.estimates_before
 
@@ -59,7 +66,7 @@ def test_sensors_behind_filters_are_no_effect(seed, family):
     # Correlated sensor noise (moving averages of 2–40 samples) is noise: drawn white into the noise
     # floor's copies, it was described as an unexplained effect on 5 of 6 such windows.
     drawn = draw(seed, family, filter_samples=filter_widths(seed))
-    report = Calibrator(SMALL, copies=16, actuator=THESIS).fit([window_from_dict(drawn.document)], drawn.truth).report_
+    report = reported(drawn)
     assert report.selected_effect is None and report.unexplained is None
 
 
@@ -260,7 +267,7 @@ def test_a_tanh_stribeck_decay_is_followed_by_an_exponent_between_the_classic_on
 
 def _into_the_stops(seed: int, effects: Effects) -> tuple[CalibrationReport, dict]:
     drawn = draw(seed, "stops", effects=effects, duration_s=1.5, flight=STOPS_FLIGHT)
-    report = Calibrator(SMALL, copies=16, actuator=THESIS).fit([window_from_dict(drawn.document)], drawn.truth).report_
+    report = reported(drawn)
     return report, drawn.truth
 
 
@@ -270,7 +277,7 @@ def test_a_light_rotor_into_the_stops_is_not_read_as_a_stribeck_decay():
     simulation beat the base model's, but put FDJ at 2.2x the truth (adopted, 0.069 -> 1.15). Whatever is read
     now, no decay is adopted and the estimates are no worse."""
     drawn = draw(3, "stops", effects=Effects(inertia_factor=0.8), duration_s=1.5, flight=STOPS_FLIGHT)
-    report = Calibrator(seed=3, actuator=THESIS).fit([window_from_dict(drawn.document)], drawn.truth).report_
+    report = reported(drawn, Calibrator(seed=3, actuator=THESIS))
     assert combined_error(report, "after") <= combined_error(report, "before") + 1e-4
     assert "stribeck" not in report.selected_effects
 
