@@ -25,7 +25,8 @@ from ema.cli.benchmark_docs import write_section
 from ema.estimate import thread_budget
 from ema.estimate.documents.window_facts import RotaryWindowInfo
 from ema.estimate.report import share_of_range
-from ema.kinds.rotary.other_windows import readings_of
+from ema.kinds import readings_of_results
+from ema.kinds.rotary.other_windows import as_readings
 from ema.kinds.rotary.pipeline import estimate_window
 from ema.model.actuator import THESIS
 from ema.model.checks import InputError
@@ -76,7 +77,9 @@ def history(
         drawn = logged_window(actuator, j, float(h), truth, thresholds, float(offsets[j]))
         if flight_id is not None:
             drawn.document["flight_id"] = flight_id
-        known = None if alone else readings_of([s.window for s in stored], flight_id)  # as the service reads it
+        known = (
+            None if alone else as_readings(readings_of_results(THESIS, [s.window for s in stored], flight_id))
+        )  # as the service reads it
         try:
             result = estimate_window(window_from_dict(drawn.document), history=known, actuator=THESIS)
         except InputError as exc:

@@ -15,7 +15,8 @@ from benchmarks.foreign_accuracy import RESULTS_MD, run_one, summarize, table
 from benchmarks.foreign_groups import FAMILIES, drive_off, off_zero, viscous
 from ema.cli.benchmark_docs import typed_command, write_section
 from ema.estimate import thread_budget
-from ema.kinds.rotary.other_windows import readings_of
+from ema.kinds import readings_of_results
+from ema.kinds.rotary.other_windows import as_readings
 from ema.kinds.rotary.pipeline import estimate_window
 from ema.model.actuator import THESIS
 from ema.model.window import window_from_dict
@@ -63,7 +64,7 @@ def _after_another(make: Callable[[int], Draw], seed: int, family: str, duration
     for document in (drawn.document, other.document):
         document["flight_id"] = f"flight-{seed}"
     read = estimate_window(window_from_dict(other.document), actuator=THESIS).window
-    return run_one(drawn, readings_of([read], f"flight-{seed}"))
+    return run_one(drawn, as_readings(readings_of_results(THESIS, [read], f"flight-{seed}")))
 
 
 GROUPS: dict[str, Callable[[int], Draw]] = {

@@ -56,9 +56,9 @@ SIMULATE_FLAGS = {
 }
 
 
-def history_of(window: Any, paths: tuple[Path, ...]) -> Any:
-    """What the ema-estimate/1 results in ``paths``, of other windows of ``window``'s actuator, read that it may
-    not (``ema.kinds.readings_of_results``); InputError naming --history."""
+def history_of(window: Any, paths: tuple[Path, ...], actuator: Any) -> Any:
+    """What the ema-estimate/1 results in ``paths``, of other windows of ``window``'s actuator, lend it, as its kind
+    reads them (``ema.kinds.readings_of_results``); InputError naming --history."""
     from pydantic import ValidationError
 
     from ema.estimate.documents import Estimate
@@ -80,7 +80,7 @@ def history_of(window: Any, paths: tuple[Path, ...]) -> Any:
                 "--history", f"{path} is of actuator {result.actuator_id}, the window of {window.actuator_id}"
             )
         results.append(result)
-    return readings_of_results([result.window for result in results], window.flight_id)
+    return readings_of_results(actuator, [result.window for result in results], window.flight_id)
 
 
 @click.command()
@@ -122,7 +122,7 @@ def estimate(
     read = read_one(window, log_map_document(log_map_file))
     kind_given([read], actuator_file)
     say_if_compiling([read])
-    known = history_of(read, history) if history else None
+    known = history_of(read, history, document) if history else None
     thread_budget.configure(threads)
     with about_file(window):
         result = estimate_one(read, config, actuator=document, on_stage=progress, history=known)

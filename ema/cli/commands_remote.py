@@ -219,7 +219,7 @@ def history(
     from ema.cli.printing import print_prognosis, value_units
     from ema.cli.replay import ServiceError, key_refused, refusal_text, request
     from ema.model.checks import InputError
-    from ema.prognosis.documents import EstimateHistory, Prognosis
+    from ema.prognosis.documents import PROGNOSIS, EstimateHistory
 
     key = api_key(api_key_file)
     check_service(url, key)
@@ -234,7 +234,7 @@ def history(
                 "ACTUATOR_ID", f"{actuator_id!r}: {refusal_text(error.code, error.read().decode())}"
             ) from None
         raise ServiceError(f"HTTP {error.code} from {url}") from None
-    prognosis = Prognosis.model_validate(request(f"{base}/prognosis", key, timeout=60))
+    prognosis = PROGNOSIS.validate_python(request(f"{base}/prognosis", key, timeout=60))
     read = {"FDJ", "eta_O", "eta_A", *prognosis.trends, *prognosis.constants}
     read |= {name for entry in stored.estimates for name in entry.estimates.constants}
     if plot is not None and parameter not in read:

@@ -51,11 +51,12 @@ class Progress:
 
 @dataclass
 class _Readings:
-    """What the run's windows read that others may lack (``ema.kinds.rotary.other_windows``): sensor zeros by (actuator,
-    flight), J_M readings by actuator, in the order answered; indexed so that each lookup reads one flight."""
+    """What the run's windows lent others (``ema.kinds.lent_by``): by (actuator, flight) what each lent its flight's
+    windows, with its window_id; by actuator what each lent every window; in the order answered, indexed so that each
+    lookup reads one flight."""
 
-    zeros: dict[tuple[str, str | None], list[Any]] = field(default_factory=dict)
-    inertias: dict[str, list[Any]] = field(default_factory=dict)
+    to_flights: dict[tuple[str, str | None], list[tuple[str, str]]] = field(default_factory=dict)
+    to_actuators: dict[str, list[str]] = field(default_factory=dict)
 
     def add(self, window: Window, answer: dict[str, Any]) -> bool:
         """Keep what ``answer`` lends; whether the window waits for the run's others (``waits_for_the_run``)."""
@@ -63,23 +64,28 @@ class _Readings:
         from ema.kinds import lent_by, waits_for_the_run
 
         info = window_info_from(answer["window"])
-        zero, inertia = lent_by(info)
-        if zero is not None and window.flight_id is not None:
-            self.zeros.setdefault((window.actuator_id, window.flight_id), []).append(zero)
-        if inertia is not None:
-            self.inertias.setdefault(window.actuator_id, []).append(inertia)
+        lent = lent_by(info)
+        if lent.to_flight is not None and window.flight_id is not None:
+            flight = self.to_flights.setdefault((window.actuator_id, window.flight_id), [])
+            flight.append((window.window_id, lent.to_flight))
+        if lent.to_actuator is not None:
+            self.to_actuators.setdefault(window.actuator_id, []).append(lent.to_actuator)
         return waits_for_the_run(info)
 
-    def lacked(self, window: Window, answer: dict[str, Any]) -> dict[str, Any] | None:
-        """What the run's other windows lend this one that it lacks (``ema.kinds.lacking``), as
-        JSON; or None."""
+    def lacked(self, window: Window, answer: dict[str, Any], actuator: Any) -> dict[str, Any] | None:
+        """What the run's other windows lend this one, read with ``actuator``'s document, that it lacks
+        (``ema.kinds.lacking``), as JSON; or None."""
         from ema.estimate.documents.window_facts import window_info_from
-        from ema.kinds import lacking, other_windows_lent
+        from ema.kinds import Borrowed, lacking, other_windows_lent
+        from ema.model.actuator import THESIS
 
-        flight = self.zeros.get((window.actuator_id, window.flight_id), [])
-        own = [zero for zero in flight if zero.window_id != window.window_id]
-        others = other_windows_lent(own, self.inertias.get(window.actuator_id, []))
-        lacked = lacking(window_info_from(answer["window"]), others)
+        flight = self.to_flights.get((window.actuator_id, window.flight_id), [])
+        kept = Borrowed(
+            from_flight=tuple(lent for window_id, lent in flight if window_id != window.window_id),
+            from_actuator=tuple(self.to_actuators.get(window.actuator_id, [])),
+        )
+        others = other_windows_lent(actuator or THESIS, kept)  # None: the run reads it with the thesis's
+        lacked = lacking(window, window_info_from(answer["window"]), others)
         return None if lacked is None else lacked.model_dump()
 
 
@@ -87,6 +93,7 @@ def _with_history(
     windows: list[Window],
     first: Iterator[Answer],
     again: Callable[[list[Job]], Iterator[Answer]],
+    documents: Documents,
 ) -> Iterator[Answer]:
     """The answers of ``first`` (one per window of ``windows``), each given out once what other windows of its
     actuator read is known: a window of a named flight once its flight's windows are answered (a recording's
@@ -100,7 +107,7 @@ def _with_history(
     jobs: list[Job] = []
 
     def settled(window: Window, answer: dict) -> Iterator[Answer]:
-        history = readings.lacked(window, answer)
+        history = readings.lacked(window, answer, documents.of(window.actuator_id))
         if history is None:
             yield window, answer
         else:
@@ -163,7 +170,7 @@ def run_fleet(
         return on_ray(jobs, config, workers, threads, address, documents)
 
     try:
-        answers = _with_history(todo, engine([(w, None) for w in todo]), engine)
+        answers = _with_history(todo, engine([(w, None) for w in todo]), engine, documents)
         writing = _written(answers, out, store, progress, documents)
     finally:
         if pool is not None:

@@ -230,6 +230,8 @@ def _life(life: Any, unit: str, status: str) -> str:
 
 def print_prognosis(stored: Any, prognosis: Any, plot: Path | None) -> None:
     """An actuator's outlook per parameter, the laws it weighs, its backtest, its sensors' trends and notes."""
+    from ema.kinds import prognosis_lines
+
     one, many = TIME_UNITS[prognosis.time_unit]
     units = value_units(stored)
     click.echo(f"{prognosis.actuator_id}: {len(stored.estimates)} window(s), time in {many}")
@@ -250,11 +252,8 @@ def print_prognosis(stored: Any, prognosis: Any, plot: Path | None) -> None:
             )
     for name, trend in {**prognosis.sensors, **prognosis.constants}.items():
         click.echo(f"{name} now {trend.level:.4g} ± {trend.level_std:.2g}, {_slope(trend, one)} ({trend.n} windows)")
-    if prognosis.inertia is not None:
-        inertia = prognosis.inertia
-        click.echo(
-            f"J_M {inertia.factor:.4f} ± {inertia.std:.2g}x the document's, as windows that could tell it read it"
-        )
+    for line in prognosis_lines(prognosis.model_dump(mode="json")):  # its kind's own parts (a rotary's J_M)
+        click.echo(line)
     for note in prognosis.notes:
         click.echo(f"note [{note.code}]: {note.text}")
     if plot is not None:

@@ -17,14 +17,13 @@ def schemas() -> dict[str, dict[str, Any]]:
     from ema.model.actuator import actuator_schema
     from ema.model.logmap import logmap_schema
     from ema.model.window import WindowDocument
-    from ema.prognosis.documents import ActuatorSummary, EstimateHistory, Prognosis, StoredActuator, Withdrawal
+    from ema.prognosis.documents import ActuatorSummary, EstimateHistory, StoredActuator, Withdrawal, prognosis_schema
 
     models: dict[str, type[BaseModel]] = {
         "stored-actuator": StoredActuator,
         "ema-window-1": WindowDocument,
         "ema-estimate-1": Estimate,
         "history": EstimateHistory,
-        "prognosis": Prognosis,
         "actuator-summary": ActuatorSummary,
         "withdrawal": Withdrawal,
     }
@@ -33,6 +32,7 @@ def schemas() -> dict[str, dict[str, Any]]:
         "ema-actuator-1": actuator_schema(),
         "ema-logmap-1": logmap_schema(),
         "ema-calibration-1": calibration_schema(),
+        "prognosis": prognosis_schema(),
         **exported,
     }
 

@@ -20,7 +20,7 @@ from ema.cli.pool import IN_FLIGHT_PER_WORKER, NODE_LOSSES
 from ema.estimate.config import PipelineConfig
 from ema.model.window import Window, window_to_dict
 
-Job = tuple[Window, dict[str, Any] | None]  # a window and what other windows of its actuator read (HistoryReadings)
+Job = tuple[Window, dict[str, Any] | None]  # a window, and what its actuator's other windows lend it as JSON
 Answer = tuple[Window, dict]  # a window and its ema-estimate/1 document (or {"error": ...})
 
 

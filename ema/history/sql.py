@@ -20,12 +20,11 @@ from pydantic import ValidationError
 
 from ema.calibration.documents import CALIBRATION_REPORT, CalibrationReport
 from ema.estimate.documents import Estimate
-from ema.estimate.documents.window_facts import HistoryReadings, InertiaReading, SensorZero
 from ema.history.connection import now
 from ema.history.refusals import ConflictError, WithdrawnError
 from ema.history.tables import actuators, calibrations, estimates, summaries, withdrawals
 from ema.history.versions import VersionedDocuments
-from ema.kinds import lent_by, other_windows_lent
+from ema.kinds import Borrowed, lent_by
 from ema.prognosis.documents import Stored, Withdrawal
 
 
@@ -36,7 +35,7 @@ class SqlHistory(VersionedDocuments):
         """Store one result; where its (actuator_id, window_id) is stored already from the same content, that row,
         marked as a replay (ConflictError where from other content; WithdrawnError where it was withdrawn)."""
         stored_at, document, info = now(), result.model_dump_json(by_alias=True), result.window
-        zero, inertia = lent_by(info)  # kept in their own columns: what the actuator's other windows borrow
+        lent = lent_by(info)  # kept in their own columns: what the actuator's other windows borrow
         row = {
             "actuator_id": result.actuator_id,
             "window_id": result.window_id,
@@ -44,8 +43,8 @@ class SqlHistory(VersionedDocuments):
             "result": document,
             "content_sha256": info.content_sha256,
             "flight_id": info.flight_id,
-            "sensor_zero": None if zero is None else zero.model_dump_json(),
-            "inertia_read": None if inertia is None else inertia.model_dump_json(),
+            "lent_to_flight": lent.to_flight,
+            "lent_to_actuator": lent.to_actuator,
         }
         statement = self._insert(estimates).values(**row).on_conflict_do_nothing().returning(estimates.c.id)
         with self._writing() as connection:
@@ -178,25 +177,32 @@ class SqlHistory(VersionedDocuments):
             found[stored.actuator_id] = stored
         return found
 
-    def readings(self, actuator_id: str, flight_id: str | None) -> HistoryReadings:
-        """What the stored windows of this actuator lend a window of ``flight_id``
-        (``ema.kinds.other_windows_lent``)."""
+    def lent_to(self, actuator_id: str, flight_id: str | None) -> Borrowed:
+        """What the stored windows of this actuator lent a window of ``flight_id``, oldest first: those of its flight
+        to their flight's windows, and every one to the actuator's (its kind reads them: ``other_windows_lent``)."""
         mine = estimates.c.actuator_id == actuator_id
         with self._reading() as connection:
-            zeros: list[SensorZero] = []
+            from_flight: Sequence[str] = []
             if flight_id is not None:
-                found = connection.execute(
-                    sa.select(estimates.c.sensor_zero)
-                    .where(mine, estimates.c.flight_id == flight_id, estimates.c.sensor_zero.is_not(None))
+                from_flight = (
+                    connection.execute(
+                        sa.select(estimates.c.lent_to_flight)
+                        .where(mine, estimates.c.flight_id == flight_id, estimates.c.lent_to_flight.is_not(None))
+                        .order_by(estimates.c.id)
+                    )
+                    .scalars()
+                    .all()
+                )
+            from_actuator = (
+                connection.execute(
+                    sa.select(estimates.c.lent_to_actuator)
+                    .where(mine, estimates.c.lent_to_actuator.is_not(None))
                     .order_by(estimates.c.id)
-                ).scalars()
-                zeros = [SensorZero.model_validate_json(zero) for zero in found]
-            inertias = connection.execute(
-                sa.select(estimates.c.inertia_read)
-                .where(mine, estimates.c.inertia_read.is_not(None))
-                .order_by(estimates.c.id)
-            ).scalars()
-            return other_windows_lent(zeros, [InertiaReading.model_validate_json(reading) for reading in inertias])
+                )
+                .scalars()
+                .all()
+            )
+            return Borrowed(from_flight=tuple(from_flight), from_actuator=tuple(from_actuator))
 
     def history(self, actuator_id: str) -> tuple[list[Stored], list[dict[str, Any]]]:
         """Every stored result of one actuator, oldest first; rows of an earlier format apart, as stored."""

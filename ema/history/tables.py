@@ -1,7 +1,8 @@
 """The history's tables, defined once for every database (SQLAlchemy Core); migrations build them.
 
 What a lookup before every estimate needs is a column of its own, extracted when the row is written
-(``flight_id``, ``sensor_zero``, ``inertia_read``), so that no query parses stored JSON.
+(``flight_id``, and what the window lends its flight's and its actuator's other windows: ``lent_to_flight``,
+``lent_to_actuator``, each its kind's JSON), so that no query parses stored JSON.
 """
 
 from __future__ import annotations
@@ -37,11 +38,11 @@ estimates = _per_actuator(
     _required("result"),
     Column("content_sha256", Text),
     Column("flight_id", Text),
-    Column("sensor_zero", Text),
-    Column("inertia_read", Text),
+    Column("lent_to_flight", Text),
+    Column("lent_to_actuator", Text),
     UniqueConstraint("actuator_id", "window_id", name="estimates_actuator_window"),
 )
-Index("estimates_by_flight", estimates.c.actuator_id, estimates.c.flight_id)  # a flight's sensor zero, lent
+Index("estimates_by_flight", estimates.c.actuator_id, estimates.c.flight_id)  # what a flight's windows lend
 calibrations = _per_actuator("calibrations", _required("stored_at"), _required("report"))
 withdrawals = _per_actuator(
     "withdrawals",

@@ -28,36 +28,41 @@ from typing import Any
 from ema.calibration.truth import refuse_truth, with_truth_errors
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import Estimate, Note
-from ema.estimate.documents.window_facts import HistoryReadings, InertiaReading, SensorZero, WindowInfo
+from ema.estimate.documents.window_facts import WindowInfo
 from ema.estimate.information import out_of_bounds, refuse_empty_channels
-from ema.kinds.base import Calibrated, CalibrationRequest, Cost, Kind, Request, SensorGain
+from ema.kinds.base import NOTHING_LENT, Borrowed, Calibrated, CalibrationRequest, Cost, Kind, Lent, Request, SensorGain
 from ema.kinds.geared import GEARED
 from ema.kinds.linear import LINEAR
 from ema.kinds.rotary import ROTARY
 from ema.kinds.servo import SERVO
 from ema.model.actuator import THESIS, ActuatorDocument
 from ema.model.checks import InputError
+from ema.model.document import Document
 from ema.model.params import HealthParams
 from ema.model.window import Window
 
 __all__ = [
     "REGISTRY",
+    "Borrowed",
     "Calibrated",
     "CalibrationRequest",
     "Cost",
+    "Lent",
     "Request",
+    "borrowed_document",
     "calibrate",
     "calibration_cost",
     "cost",
     "estimate",
     "estimate_thesis_window",
-    "inertia_of",
     "kind_of",
     "lacking",
     "learns",
     "lent_by",
     "load_methods",
     "other_windows_lent",
+    "prognosis_lines",
+    "prognosis_parts",
     "readings_of_results",
     "report_lines",
     "sensor_gains",
@@ -104,7 +109,7 @@ def estimate(
     actuator: ActuatorDocument,
     version: int | None = None,
     on_stage: Callable[[str], None] | None = None,
-    history: HistoryReadings | None = None,
+    history: Document | None = None,
     spec_only: bool = False,
 ) -> Estimate:
     """The ``ema-estimate/1`` result for ``window``, read by its actuator's kind; InputError where the window's
@@ -165,32 +170,55 @@ def calibration_cost(windows: Sequence[Window], config: PipelineConfig) -> Cost:
 
 
 # What the layers above reach of one kind's own, through the registry rather than the kind's modules: what an
-# actuator's other windows lend one of its windows (a rotary drive's sensor zero, kept for a power-on, and its J_M,
-# kept with the build: other kinds borrow nothing), the sensors' gains the prognosis trends, a report's own lines,
-# ema simulate's windows, and the thesis's own windows and kernel (the latency benchmark draws, reads and times
-# them). Each imports the kind's module at its call: the registry stays light.
+# actuator's other windows lend one of its windows (``Kind.lent_by``, ``Kind.borrowed``: a rotary drive's sensor zero,
+# kept for a power-on, and its J_M, kept with the build), a prognosis's and a report's own parts, the sensors' gains
+# the prognosis trends, ema simulate's windows, and the thesis's own windows and kernel (the latency benchmark draws,
+# reads and times them). Each kind imports its modules at their call: the registry stays light.
 
 
-def other_windows_lent(zeros: Sequence[SensorZero], inertias: Sequence[InertiaReading]) -> HistoryReadings:
-    """What an actuator's stored windows lend another (``ema.kinds.rotary.other_windows.lent``)."""
-    from ema.kinds.rotary.other_windows import lent
-
-    return lent(zeros, inertias)
-
-
-def lent_by(info: WindowInfo) -> tuple[SensorZero | None, InertiaReading | None]:
-    """What a window's answer lends the other windows of its actuator: a sensor zero to its flight's, a J_M to all
-    (``ema.kinds.rotary.other_windows.lent_by``; other kinds lend nothing, and their answers hold neither)."""
-    from ema.kinds.rotary.other_windows import lent_by as lent
-
-    return lent(info)
+def lent_by(info: WindowInfo) -> Lent:
+    """What a window's answer (its ``window`` part) lends the other windows of its actuator, as JSON: its kind's
+    (each kind knows its answers' part by its class; one that lends nothing says ``NOTHING_LENT``)."""
+    return next((lent for kind in REGISTRY.values() if (lent := kind.lent_by(info)) != NOTHING_LENT), NOTHING_LENT)
 
 
 def waits_for_the_run(info: WindowInfo) -> bool:
     """Whether a window answered alone is answered again once its run's other windows are (``lacking``)."""
-    from ema.kinds.rotary.other_windows import waits_for_the_run as waits
+    return any(kind.waits_for_the_run(info) for kind in REGISTRY.values())
 
-    return waits(info)
+
+def other_windows_lent(actuator: ActuatorDocument, kept: Borrowed) -> Document | None:
+    """What the kept loans of ``actuator``'s other windows lend one of its windows, as its kind reads them (None:
+    its kind borrows nothing)."""
+    return kind_of(actuator).borrowed(kept)
+
+
+def borrowed_document(actuator: ActuatorDocument, data: Mapping[str, Any]) -> Document | None:
+    """What a window borrows, as JSON (a fleet's worker is sent it), read as ``actuator``'s kind's class; None where
+    its kind borrows nothing."""
+    borrowing = kind_of(actuator).borrowing
+    return None if borrowing is None else borrowing.model_validate(data)
+
+
+def readings_of_results(
+    actuator: ActuatorDocument, windows: Sequence[WindowInfo], flight_id: str | None
+) -> Document | None:
+    """What the results of other windows of an actuator (their ``window`` parts, oldest first) lend a window of
+    ``flight_id``: to it, what those of its flight lent their flight, and what every one lent the actuator."""
+    lent = [(info.flight_id, lent_by(info)) for info in windows]
+    return other_windows_lent(
+        actuator,
+        Borrowed(
+            from_flight=tuple(s.to_flight for f, s in lent if s.to_flight and flight_id is not None and f == flight_id),
+            from_actuator=tuple(s.to_actuator for _, s in lent if s.to_actuator),
+        ),
+    )
+
+
+def lacking(window: Window, read: WindowInfo, others: Document | None) -> Document | None:
+    """What ``window``, answered alone (``read``), would be answered again with, of what the others lend (None:
+    nothing it lacks)."""
+    return REGISTRY[window.kind].lacking(read, others)
 
 
 def sensor_gains() -> tuple[SensorGain, ...]:
@@ -198,27 +226,15 @@ def sensor_gains() -> tuple[SensorGain, ...]:
     return tuple(gain for kind in REGISTRY.values() for gain in kind.sensor_gains)
 
 
-def inertia_of(infos: Sequence[WindowInfo]) -> tuple[InertiaReading | None, Note | None]:
-    """An actuator's J_M as its windows (oldest first) read it since it last changed, and a note where it changed
-    along them or scatters beyond their stds (``combined_inertia``, ``inertia_change_note``)."""
-    from ema.kinds.rotary.inertia import combined_inertia, inertia_change_note
-
-    readings = [inertia for info in infos if (inertia := lent_by(info)[1]) is not None]
-    return combined_inertia(readings), inertia_change_note(readings)
+def prognosis_parts(actuator: ActuatorDocument, infos: Sequence[WindowInfo]) -> tuple[dict[str, Any], list[Note]]:
+    """``actuator``'s kind's own parts of a prognosis over its windows (oldest first), and notes beside them."""
+    return kind_of(actuator).prognosis_parts(infos)
 
 
-def readings_of_results(windows: Sequence[WindowInfo], flight_id: str | None) -> HistoryReadings:
-    """What the results of other windows of an actuator lend a window of ``flight_id``."""
-    from ema.kinds.rotary.other_windows import readings_of
-
-    return readings_of(windows, flight_id)
-
-
-def lacking(read: WindowInfo, others: HistoryReadings) -> HistoryReadings | None:
-    """What a window answered alone would be answered again with, of what the others lend (None: nothing)."""
-    from ema.kinds.rotary.other_windows import wanted
-
-    return wanted(read, others)
+def prognosis_lines(prognosis: Mapping[str, Any]) -> list[str]:
+    """The lines of a prognosis's own parts (as JSON), as the kind whose parts they are prints them (each kind prints
+    its own and none of another's)."""
+    return [line for kind in REGISTRY.values() for line in kind.prognosis_lines(prognosis)]
 
 
 def thesis_window(health: HealthParams, **drawn: Any) -> Window:

@@ -9,13 +9,14 @@ from typing import Any, Protocol
 from ema.calibration.documents import CalibrationReport
 from ema.calibration.plot import ResidualPlot
 from ema.estimate.config import PipelineConfig
-from ema.estimate.documents import ActuatorRead, Estimate
-from ema.estimate.documents.window_facts import HistoryReadings, WindowInfo
+from ema.estimate.documents import ActuatorRead, Estimate, Note
+from ema.estimate.documents.window_facts import WindowInfo
 from ema.estimate.quasistatic.drive_torque import QuasiStaticReading
 from ema.estimate.quasistatic.slow_window import estimate_low_rate
 from ema.model.actuator import THESIS, ActuatorDocument
 from ema.model.bounds import NOISE_COPIES
 from ema.model.checks import InputError
+from ema.model.document import Document
 from ema.model.kinds import KindFacts, kinds_with
 from ema.model.window import Window
 
@@ -30,7 +31,7 @@ class Request:
     actuator: ActuatorDocument
     version: int | None = None
     on_stage: Callable[[str], None] | None = None
-    history: HistoryReadings | None = None
+    history: Document | None = None  # what its actuator's other windows lend it, as its kind reads it (Kind.borrowed)
     spec_only: bool = False
 
     @property
@@ -94,6 +95,53 @@ class SensorGain:
     read: Callable[[WindowInfo], tuple[float, float | None] | None]  # (gain, its std) a window read, or None
 
 
+@dataclass(frozen=True)
+class Lent:
+    """What one window's answer lends its actuator's other windows, as JSON of its kind's own documents: to the
+    windows of its flight (a rotary drive's sensor zero, kept for a power-on) and to every window of the actuator (its
+    J_M, kept with the build); None where it lends nothing. The history keeps each in a column of its own."""
+
+    to_flight: str | None = None
+    to_actuator: str | None = None
+
+
+NOTHING_LENT = Lent()
+
+
+@dataclass(frozen=True)
+class Borrowed:
+    """What an actuator's other windows lent one of its windows, as kept (``Lent``'s JSON, oldest first): those of
+    its flight's windows, and those every window of the actuator takes."""
+
+    from_flight: tuple[str, ...] = ()
+    from_actuator: tuple[str, ...] = ()
+
+
+class LendsNothing:
+    """The ``Kind`` methods of a kind whose windows read alone all they are read with: they lend nothing, borrow
+    nothing, wait for no other, and its prognosis holds the shared parts alone."""
+
+    borrowing: type[Document] | None = None
+
+    def lent_by(self, info: WindowInfo) -> Lent:
+        return NOTHING_LENT
+
+    def borrowed(self, lent: Borrowed) -> Document | None:
+        return None
+
+    def waits_for_the_run(self, info: WindowInfo) -> bool:
+        return False
+
+    def lacking(self, read: WindowInfo, others: Document | None) -> Document | None:
+        return None
+
+    def prognosis_parts(self, infos: Sequence[WindowInfo]) -> tuple[dict[str, Any], list[Note]]:
+        return {}, []
+
+    def prognosis_lines(self, prognosis: Mapping[str, Any]) -> list[str]:
+        return []
+
+
 def learned_lines(learned: Sequence[Mapping[str, Any]], simulated: Mapping[str, float] | None = None) -> list[str]:
     """A report's learned constants for a person: each with its std and unit, and where ``simulated`` gives them, as
     the simulator takes them (what the completed document keeps)."""
@@ -129,3 +177,16 @@ class Kind(Protocol):
     def sensor_gains(self) -> tuple[SensorGain, ...]: ...
     # its own parts of an ``ema-calibration/1`` report (as JSON), as a person reads them
     def report_lines(self, report: Mapping[str, Any]) -> list[str]: ...
+    # What its windows lend each other (``LendsNothing``: nothing). The class of what a window borrows (None: none),
+    # what a window's answer lends, what the kept loans lend one window, whether a window answered alone is answered
+    # again once its run's others are, and what it would be answered again with (None: nothing it lacks).
+    @property
+    def borrowing(self) -> type[Document] | None: ...
+    def lent_by(self, info: WindowInfo) -> Lent: ...
+    def borrowed(self, lent: Borrowed) -> Document | None: ...
+    def waits_for_the_run(self, info: WindowInfo) -> bool: ...
+    def lacking(self, read: WindowInfo, others: Document | None) -> Document | None: ...
+    # its own parts of a prognosis over its windows (their ``window`` parts, oldest first) and notes beside them, and
+    # those parts (as JSON) as a person reads them
+    def prognosis_parts(self, infos: Sequence[WindowInfo]) -> tuple[dict[str, Any], list[Note]]: ...
+    def prognosis_lines(self, prognosis: Mapping[str, Any]) -> list[str]: ...

@@ -16,10 +16,10 @@ from typing import Any
 from ema.estimate import thread_budget
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import Estimate
-from ema.estimate.documents.window_facts import HistoryReadings
-from ema.kinds import estimate, warm_up
+from ema.kinds import borrowed_document, estimate, warm_up
 from ema.model.actuator import THESIS, ActuatorDocument, actuator_from_dict
 from ema.model.checks import InputError
+from ema.model.document import Document
 from ema.model.window import Window, window_from_dict, window_to_dict
 
 
@@ -35,9 +35,9 @@ def estimate_json(
     ``history``: what other windows of the actuator read, ``document``: its ema-actuator/1 document and
     ``version`` (none: the default, ``ema.model.actuator.THESIS``; ``ema.kinds.estimate``)."""
     thread_budget.configure(threads)
-    known = None if history is None else HistoryReadings.model_validate(history)
     try:
         actuator = THESIS if document is None else actuator_from_dict(document)
+        known = None if history is None else borrowed_document(actuator, history)
         result = estimate(
             window_from_dict(window), PipelineConfig(**config), actuator=actuator, version=version, history=known
         )
@@ -78,7 +78,7 @@ def estimate_on_ray(
     window: Window,
     config: PipelineConfig,
     threads: int,
-    history: HistoryReadings | None = None,
+    history: Document | None = None,
     actuator: ActuatorDocument = THESIS,
     version: int | None = None,
 ) -> Estimate:

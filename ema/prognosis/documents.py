@@ -7,10 +7,11 @@ Schemas.
 
 from __future__ import annotations
 
-from typing import Any, Literal
+from collections.abc import Mapping
+from typing import Annotated, Any, Literal
 
 import numpy as np
-from pydantic import Field
+from pydantic import Field, TypeAdapter
 
 from ema.estimate.documents import Estimate, Notes
 from ema.estimate.documents.window_facts import InertiaReading
@@ -188,11 +189,6 @@ class Prognosis(Document):
         "friction, a geared servo's loop gain), each over the windows that read it: no failure level, no remaining "
         "life, a change to see",
     )
-    inertia: InertiaReading | None = Field(
-        None,
-        description="the actuator's J_M as its windows that told a heavier rotor from a weaker motor read it: "
-        "what a window that cannot is read with (null: none read one)",
-    )
     notes: Notes = Field(default_factory=list)
     backtest: dict[str, list[BacktestPoint]] = Field(
         default_factory=dict,
@@ -206,6 +202,39 @@ class Prognosis(Document):
         if not any(n.code == "moving_away" and n.parameter == parameter for n in self.notes):
             return life.status
         return f"{life.status} towards the level {life.direction}; moving away from it: a change"
+
+
+class RotaryPrognosis(Prognosis):
+    """A rotary actuator's prognosis: beside its trends, J_M as its windows read it (kept with the build)."""
+
+    inertia: InertiaReading | None = Field(
+        None,
+        description="the actuator's J_M as its windows that told a heavier rotor from a weaker motor read it: "
+        "what a window that cannot is read with (null: none read one)",
+    )
+
+
+KINDS_PROGNOSES: tuple[type[Prognosis], ...] = (RotaryPrognosis,)  # each a kind's own parts beside the shared
+AnyPrognosis = Annotated[Prognosis | RotaryPrognosis, Field(union_mode="left_to_right")]  # the shared, else its own
+PROGNOSIS: TypeAdapter[Prognosis] = TypeAdapter(AnyPrognosis)  # what parses and exports a prognosis
+
+
+def own_parts(cls: type[Prognosis]) -> set[str]:
+    """The fields a kind's prognosis class adds to the shared ones."""
+    return set(cls.model_fields) - set(Prognosis.model_fields)
+
+
+def prognosis_class(parts: Mapping[str, Any]) -> type[Prognosis]:
+    """The class of a prognosis whose kind adds ``parts`` (``ema.kinds.prognosis_parts``): the shared one where it
+    adds none, else the one whose own fields they are."""
+    if not parts:
+        return Prognosis
+    return next(cls for cls in KINDS_PROGNOSES if own_parts(cls) == set(parts))
+
+
+def prognosis_schema() -> dict[str, Any]:
+    """The JSON Schema of a prognosis: the shared document, or a kind's with its own parts."""
+    return {"title": "Prognosis", **PROGNOSIS.json_schema(by_alias=True)}
 
 
 class EstimateHistory(Document):

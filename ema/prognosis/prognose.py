@@ -10,11 +10,20 @@ from dataclasses import replace
 import numpy as np
 
 from ema.estimate.documents import Note, ParameterEstimate
-from ema.kinds import inertia_of, sensor_gains
+from ema.kinds import prognosis_parts, sensor_gains
 from ema.kinds.base import SensorGain
 from ema.model.actuator import ActuatorDocument
 from ema.prognosis.backtest import backtest
-from ema.prognosis.documents import MIN_SPAN, PARAMETERS, Prognosis, RemainingLife, Stored, TimeUnit, Trend
+from ema.prognosis.documents import (
+    MIN_SPAN,
+    PARAMETERS,
+    Prognosis,
+    RemainingLife,
+    Stored,
+    TimeUnit,
+    Trend,
+    prognosis_class,
+)
 from ema.prognosis.outlook import Outlook, outlook
 from ema.prognosis.trend import Series, trend_of
 
@@ -51,12 +60,14 @@ def prognose(
     """Trends and remaining lives of FDJ, η_O and η_A over ``stored`` (any order), to ``actuator``'s
     thresholds; a parameter a window did not read (η_O without a load) is left out of its trend."""
     if not stored:
-        return Prognosis(
+        own, _ = prognosis_parts(actuator, [])
+        return prognosis_class(own)(
             actuator_id=actuator_id,
             time_unit="windows",
             trends={},
             remaining_life={},
             notes=[Note(code="no_estimates", text="no estimates stored for this actuator")],
+            **own,
         )
     times, unit, note = _times(stored)
     outlooks = {
@@ -66,19 +77,19 @@ def prognose(
     }
     sensors, said = sensor_trends(stored, times, unit, actuator.load_model_tolerance)
     constants = constant_trends(stored, times)
-    inertia, inertia_note = inertia_of([s.window for s in stored])
+    own, own_notes = prognosis_parts(actuator, [s.window for s in stored])  # its kind's parts (a rotary's J_M)
     faster = [speeding_note(name) for name, seen in outlooks.items() if seen.life.speeding_up]
     away = [away_note(name, seen, actuator, unit) for name, seen in outlooks.items()]
     levelless = [no_level_note(name, actuator) for name in PARAMETERS if _read(name, stored) and name not in outlooks]
-    notes = [n for n in (note, *faster, *away, *levelless, *said, inertia_note) if n]
-    return Prognosis(
+    notes = [n for n in (note, *faster, *away, *levelless, *said, *own_notes) if n]
+    return prognosis_class(own)(
         actuator_id=actuator_id,
         time_unit=unit,
         trends={n: o.trend for n, o in outlooks.items()},
         remaining_life={n: o.life for n, o in outlooks.items()},
         sensors=sensors,
         constants=constants,
-        inertia=inertia,
+        **own,
         notes=notes,
         backtest={n: o.backtest for n, o in outlooks.items()},
     )

@@ -65,9 +65,10 @@ async def _job(
     settings: Settings, store: History, window: Window, config: PipelineConfig, cancel: threading.Event
 ) -> Callable[[], Estimate]:
     """The pipeline run for ``window``: in this process or on Ray, with what the history lends it."""
-    history = await run_in_threadpool(store.readings, window.actuator_id, window.flight_id)
+    lent = await run_in_threadpool(store.lent_to, window.actuator_id, window.flight_id)
     actuator, version = await actuator_of(store, window.actuator_id)
     stored_kind([window], actuator, version, listed=False)
+    history = kinds.other_windows_lent(actuator, lent)
     if settings.backend == "ray":
         from ema.kinds.remote import estimate_on_ray
 

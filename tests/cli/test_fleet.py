@@ -6,6 +6,7 @@ import json
 import pytest
 
 from ema.cli.main import EXIT_BAD_INPUT, EXIT_OK, main
+from ema.cli.workers import Documents
 from ema.kinds.rotary.synthetic import synthetic_window
 from ema.model.actuator import THESIS
 from ema.model.params import HealthParams
@@ -243,7 +244,7 @@ def test_a_flights_windows_are_given_out_once_the_flight_is_answered_not_at_the_
     from ema.cli import fleet
 
     monkeypatch.setattr(fleet._Readings, "add", lambda self, window, answer: None)
-    monkeypatch.setattr(fleet._Readings, "lacked", lambda self, window, answer: None)
+    monkeypatch.setattr(fleet._Readings, "lacked", lambda self, window, answer, actuator: None)
     base = synthetic_window(HealthParams.single(), seed=1, duration_s=0.05)
     flights = [("f-1", "a"), ("f-1", "b"), (None, "c"), ("f-2", "d"), ("f-2", "e")]
     windows = [replace(base, flight_id=flight, window_id=name) for flight, name in flights]
@@ -254,7 +255,8 @@ def test_a_flights_windows_are_given_out_once_the_flight_is_answered_not_at_the_
             consumed.append(window.window_id)
             yield window, {"window": {}}
 
-    given = [(w.window_id, list(consumed)) for w, _ in fleet._with_history(windows, first(), lambda jobs: iter(()))]
+    answers = fleet._with_history(windows, first(), lambda jobs: iter(()), Documents())
+    given = [(w.window_id, list(consumed)) for w, _ in answers]
     assert given == [
         ("a", ["a", "b"]),
         ("b", ["a", "b"]),

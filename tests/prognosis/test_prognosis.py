@@ -1,5 +1,7 @@
 """Trend and remaining life on synthetic actuator histories with a known truth."""
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -200,3 +202,22 @@ def test_windows_at_one_time_are_a_level_with_no_slope(times):
     status = outlook(series, threshold=THRESHOLD, direction="above").life.status
     assert status == ("too few windows" if n < MIN_TREND_WINDOWS else "span too short")  # enough, at one time
     trend.model_dump_json()  # finite: JSON carries it
+
+
+def test_a_prognosis_holds_its_kinds_own_parts_and_reads_back_as_its_class(one_estimate):
+    """The rotary's J_M is its prognosis's own part (``RotaryPrognosis``); a ball screw's prognosis holds the shared
+    parts alone, and each reads back as its class, as does one an earlier ema wrote with ``inertia`` in every kind's."""
+    from ema.model.actuator import actuator_from_json
+    from ema.prognosis.documents import PROGNOSIS, Prognosis, RotaryPrognosis
+    from ema.prognosis.prognose import prognose
+
+    history = _history(one_estimate, [1.0] * 6, [0.01] * 6, np.arange(6, dtype=float))
+    rotary = prognose("tail-9", history, actuator=THESIS)
+    screw = actuator_from_json((Path(__file__).parents[2] / "examples" / "ballscrew-rig" / "actuator.json").read_text())
+    linear = prognose("rig", history, actuator=screw)
+    assert type(rotary) is RotaryPrognosis and type(linear) is Prognosis and "inertia" not in linear.model_dump()
+    for prognosis in (rotary, linear):
+        assert PROGNOSIS.validate_json(prognosis.model_dump_json()) == prognosis
+    earlier = {**linear.model_dump(mode="json"), "inertia": None}
+    assert PROGNOSIS.validate_python(earlier) == RotaryPrognosis(**earlier)
+    assert type(prognose("tail-9", [], actuator=THESIS)) is RotaryPrognosis  # its kind's, with no window yet

@@ -16,6 +16,13 @@ from ema.model.params import HealthParams
 from tests.service.conftest import SMALL
 
 
+def _lent(history, actuator_id, flight_id):
+    """What the stored windows lend a window of the thesis's actuator of ``flight_id``, as its kind reads them."""
+    from ema.kinds import other_windows_lent
+
+    return other_windows_lent(THESIS, history.lent_to(actuator_id, flight_id))
+
+
 @pytest.fixture(scope="module")
 def result():
     return estimate_window(synthetic_window(HealthParams.single(), seed=1, duration_s=0.1), SMALL, actuator=THESIS)
@@ -104,7 +111,7 @@ def test_the_sensor_zero_is_the_most_precise_of_the_actuators_flight(tmp_path, r
         ("a", "w6", None, 1e-6),
     ]:
         stored(*args)
-    assert store.readings("a", "f").sensor_zero.window_id == "w2"
-    assert store.readings("a", "g").sensor_zero.window_id == "w4"
-    assert store.readings("a", "h").sensor_zero is None and store.readings("c", "f").sensor_zero is None
-    assert store.readings("a", None).sensor_zero is None
+    assert _lent(store, "a", "f").sensor_zero.window_id == "w2"
+    assert _lent(store, "a", "g").sensor_zero.window_id == "w4"
+    assert _lent(store, "a", "h").sensor_zero is None and _lent(store, "c", "f").sensor_zero is None
+    assert _lent(store, "a", None).sensor_zero is None

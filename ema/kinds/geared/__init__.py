@@ -19,7 +19,17 @@ import numpy as np
 
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import STAGES, Estimate
-from ema.kinds.base import WARM_UP, Calibrated, CalibrationRequest, Cost, Request, SensorGain, learned_lines, not_drawn
+from ema.kinds.base import (
+    WARM_UP,
+    Calibrated,
+    CalibrationRequest,
+    Cost,
+    LendsNothing,
+    Request,
+    SensorGain,
+    learned_lines,
+    not_drawn,
+)
 from ema.model.actuator import ActuatorDocument, GearedActuator, actuator_from_dict, as_kind
 from ema.model.kinds import KINDS, KindFacts
 from ema.model.params import DriveConstants
@@ -31,7 +41,7 @@ CALIBRATION_RUNS = 3_000  # closed-loop runs of each window a calibration's solv
 
 
 @dataclass(frozen=True)
-class Geared:
+class Geared(LendsNothing):
     facts: KindFacts = KINDS["geared"]
 
     def stages(self, window: Window) -> tuple[str, ...]:

@@ -14,7 +14,16 @@ from typing import Any
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import Estimate
 from ema.estimate.quasistatic.slow_window import QUASI_STATIC_STAGES
-from ema.kinds.base import Calibrated, CalibrationRequest, Cost, Request, SensorGain, not_drawn, read_quasi_statically
+from ema.kinds.base import (
+    Calibrated,
+    CalibrationRequest,
+    Cost,
+    LendsNothing,
+    Request,
+    SensorGain,
+    not_drawn,
+    read_quasi_statically,
+)
 from ema.kinds.linear.calibration_report import calibrate_linear
 from ema.kinds.linear.stepper_reading import STEPPER_READING
 from ema.model.actuator import ActuatorDocument, LinearActuator, as_kind
@@ -23,7 +32,7 @@ from ema.model.window import LinearWindow, Window, as_window
 
 
 @dataclass(frozen=True)
-class Linear:
+class Linear(LendsNothing):
     facts: KindFacts = KINDS["linear"]
 
     def stages(self, window: Window) -> tuple[str, ...]:

@@ -18,14 +18,16 @@ import numpy as np
 
 from ema.calibration.plot import ResidualPlot, Series
 from ema.estimate.config import PipelineConfig
-from ema.estimate.documents import STAGES, Estimate
-from ema.estimate.documents.window_facts import RotaryWindowInfo, WindowInfo
+from ema.estimate.documents import STAGES, Estimate, Note
+from ema.estimate.documents.window_facts import HistoryReadings, RotaryWindowInfo, WindowInfo
 from ema.estimate.quasistatic.slow_window import QUASI_STATIC_STAGES
 from ema.kinds.base import (
     WARM_UP,
+    Borrowed,
     Calibrated,
     CalibrationRequest,
     Cost,
+    Lent,
     Request,
     SensorGain,
     learned_lines,
@@ -36,6 +38,7 @@ from ema.kinds.rotary.synthetic import synthetic_window
 from ema.model.actuator import THESIS, ActuatorDocument, RotaryActuator, as_kind
 from ema.model.bounds import HIGH_RATE_HZ
 from ema.model.checks import InputError
+from ema.model.document import Document
 from ema.model.kinds import KINDS, KindFacts
 from ema.model.params import HealthParams
 from ema.model.window import RotaryWindow, Window, as_window
@@ -64,6 +67,7 @@ class Rotary:
     def estimate(self, window: Window, request: Request) -> Estimate:
         if not window.high_rate:
             return read_quasi_statically(window, request, MOTOR_READING)
+        from ema.kinds.rotary.other_windows import as_readings
         from ema.kinds.rotary.pipeline import estimate_window  # the network's (module docstring)
 
         return estimate_window(
@@ -73,7 +77,7 @@ class Rotary:
             version=request.version,
             on_stage=request.on_stage,
             spec_only=request.spec_only,
-            history=request.history,
+            history=as_readings(request.history),
         )
 
     def calibrate(self, windows: Sequence[Window], request: CalibrationRequest) -> Calibrated:
@@ -127,6 +131,46 @@ class Rotary:
                 f"ambiguous: {' / '.join(ambiguity['effects'])}; to tell them apart: {ambiguity['tell_apart']}"
             )
         return lines + learned_lines(report.get("learned", []))
+
+    # What its windows lend each other: a flight's sensor zero, the build's J_M (``ema.kinds.rotary.other_windows``)
+    borrowing = HistoryReadings
+
+    def lent_by(self, info: WindowInfo) -> Lent:
+        from ema.kinds.rotary.other_windows import lent_by
+
+        return lent_by(info)
+
+    def borrowed(self, lent: Borrowed) -> HistoryReadings:
+        from ema.kinds.rotary.other_windows import borrowed
+
+        return borrowed(lent)
+
+    def waits_for_the_run(self, info: WindowInfo) -> bool:
+        from ema.kinds.rotary.other_windows import waits_for_the_run
+
+        return waits_for_the_run(info)
+
+    def lacking(self, read: WindowInfo, others: Document | None) -> HistoryReadings | None:
+        from ema.kinds.rotary.other_windows import wanted
+
+        return wanted(read, others)
+
+    def prognosis_parts(self, infos: Sequence[WindowInfo]) -> tuple[dict[str, Any], list[Note]]:
+        """J_M as the windows read it since it last changed, and a note where it changed along them or scatters
+        beyond their stds (``ema.kinds.rotary.inertia``)."""
+        from ema.kinds.rotary.inertia import combined_inertia, inertia_change_note
+        from ema.kinds.rotary.other_windows import inertia_readings
+
+        readings = inertia_readings(infos)
+        note = inertia_change_note(readings)
+        return {"inertia": combined_inertia(readings)}, [] if note is None else [note]
+
+    def prognosis_lines(self, prognosis: Mapping[str, Any]) -> list[str]:
+        inertia = prognosis.get("inertia")
+        if not inertia:
+            return []
+        said = f"J_M {inertia['factor']:.4f} ± {inertia['std']:.2g}x the document's"
+        return [f"{said}, as windows that could tell it read it"]
 
     def warm_up(self) -> None:
         """A tiny pipeline run: simulation kernels, residual, network and the physics solution all exercised once

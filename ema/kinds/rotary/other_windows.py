@@ -20,9 +20,11 @@ from ema.estimate.documents.window_facts import (
     SensorZero,
     WindowInfo,
 )
+from ema.kinds.base import NOTHING_LENT, Borrowed, Lent
 from ema.kinds.rotary.inertia import combined_inertia
 from ema.kinds.rotary.prepare.departures.read import Known
 from ema.kinds.rotary.prepare.departures.zero_offset import ZeroOffset
+from ema.model.document import Document
 
 
 def best_zero(zeros: Iterable[SensorZero]) -> SensorZero | None:
@@ -37,12 +39,27 @@ def lent(zeros: Iterable[SensorZero], inertias: Sequence[InertiaReading]) -> His
     return HistoryReadings(sensor_zero=best_zero(zeros), inertia=combined_inertia(inertias))
 
 
-def lent_by(info: WindowInfo) -> tuple[SensorZero | None, InertiaReading | None]:
+def lent_by(info: WindowInfo) -> Lent:
     """What a window's answer lends the others of its actuator: its sensors' zero (to its flight's windows) and
     the J_M it read (to every window), each None where it read none."""
     if not isinstance(info, RotaryWindowInfo):
-        return None, None  # a window read without the rotary's prepare stage (logged slowly) lends nothing
-    return info.sensor_zero, info.inertia_read
+        return NOTHING_LENT  # a window read without the rotary's prepare stage (logged slowly) lends nothing
+    zero, inertia = info.sensor_zero, info.inertia_read
+    return Lent(
+        to_flight=None if zero is None else zero.model_dump_json(),
+        to_actuator=None if inertia is None else inertia.model_dump_json(),
+    )
+
+
+def borrowed(kept: Borrowed) -> HistoryReadings:
+    """What the kept loans of an actuator's other windows (``lent_by``'s JSON, oldest first) lend one window."""
+    zeros = [SensorZero.model_validate_json(text) for text in kept.from_flight]
+    return lent(zeros, [InertiaReading.model_validate_json(text) for text in kept.from_actuator])
+
+
+def inertia_readings(infos: Iterable[WindowInfo]) -> list[InertiaReading]:
+    """The J_M each of ``infos`` read, in their order (those that read one)."""
+    return [info.inertia_read for info in infos if isinstance(info, RotaryWindowInfo) and info.inertia_read]
 
 
 def waits_for_the_run(info: WindowInfo) -> bool:
@@ -50,34 +67,31 @@ def waits_for_the_run(info: WindowInfo) -> bool:
     return isinstance(info, RotaryWindowInfo) and info.inertia_undecided
 
 
-def readings_of(windows: Iterable[WindowInfo], flight_id: str | None) -> HistoryReadings:
-    """What the results of other windows of an actuator (their ``window`` parts, oldest first) lend a window
-    of ``flight_id`` (``lent``)."""
-    zeros, inertias = [], []
-    for info in windows:
-        zero, inertia = lent_by(info)
-        if zero is not None and flight_id is not None and info.flight_id == flight_id:
-            zeros.append(zero)
-        if inertia is not None:
-            inertias.append(inertia)
-    return lent(zeros, inertias)
+def as_readings(history: Document | None) -> HistoryReadings | None:
+    """``history`` as what the rotary's windows borrow (what the registry hands a kind is its own class)."""
+    assert history is None or isinstance(history, HistoryReadings), type(history)
+    return history
 
 
-def wanted(read: WindowInfo, others: HistoryReadings) -> HistoryReadings | None:
+def wanted(read: WindowInfo, others: Document | None) -> HistoryReadings | None:
     """What a window answered alone (``read``) would be answered again with: its flight's sensor zero where it
     read none or a less precise one (conditioning takes it where it holds), J_M where it could not tell a
     heavier rotor from a weaker motor; None where the others lend it nothing it lacks."""
-    zero = others.sensor_zero
-    own = lent_by(read)[0]
+    lending = as_readings(others)
+    if lending is None:
+        return None
+    zero = lending.sensor_zero
+    own = read.sensor_zero if isinstance(read, RotaryWindowInfo) else None
     takes_zero = zero is not None and (own is None or zero.torque_std_nm < own.torque_std_nm)
-    inertia = others.inertia if waits_for_the_run(read) else None
+    inertia = lending.inertia if waits_for_the_run(read) else None
     if not takes_zero and inertia is None:
         return None
     return HistoryReadings(sensor_zero=zero if takes_zero else None, inertia=inertia)
 
 
-def known_from(history: HistoryReadings | None) -> Known:
+def known_from(history: Document | None) -> Known:
     """A flight's sensor zero and an actuator's J_M as conditioning takes them."""
+    history = as_readings(history)
     if history is None:
         return Known()
     zero, inertia, carried = history.sensor_zero, history.inertia, None

@@ -17,7 +17,17 @@ import numpy as np
 
 from ema.estimate.config import PipelineConfig
 from ema.estimate.documents import STAGES, Estimate
-from ema.kinds.base import WARM_UP, Calibrated, CalibrationRequest, Cost, Request, SensorGain, learned_lines, not_drawn
+from ema.kinds.base import (
+    WARM_UP,
+    Calibrated,
+    CalibrationRequest,
+    Cost,
+    LendsNothing,
+    Request,
+    SensorGain,
+    learned_lines,
+    not_drawn,
+)
 from ema.kinds.servo.calibration import CLOSED_LOOPS, calibrate_servo
 from ema.kinds.servo.closed_loop import SUBSTEPS, ServoLoop, simulate_servo
 from ema.model.actuator import ActuatorDocument, ServoActuator, actuator_from_dict, as_kind
@@ -29,7 +39,7 @@ ROTARY_STEP_S = DriveConstants().step_s  # what a service's simulation limit cou
 
 
 @dataclass(frozen=True)
-class Servo:
+class Servo(LendsNothing):
     facts: KindFacts = KINDS["servo"]
 
     def stages(self, window: Window) -> tuple[str, ...]:

@@ -9,7 +9,14 @@ from fastapi import APIRouter, Query, Request
 from starlette.concurrency import run_in_threadpool
 
 from ema.model.actuator import ACTUATOR_DOCUMENT, ActuatorDocument
-from ema.prognosis.documents import ActuatorSummary, EstimateHistory, Prognosis, StoredActuator, Withdrawal
+from ema.prognosis.documents import (
+    ActuatorSummary,
+    AnyPrognosis,
+    EstimateHistory,
+    Prognosis,
+    StoredActuator,
+    Withdrawal,
+)
 from ema.service.deps import ActuatorId, RunnerDep, StoreDep, is_stored, prognosis_now
 from ema.service.errors import NotStoredError
 from ema.service.parsing import read_body
@@ -63,7 +70,7 @@ async def withdraw(
     return found
 
 
-@router.get("/{actuator_id:path}/prognosis", response_model=Prognosis, responses=responses(401, 404, 422, 503))
+@router.get("/{actuator_id:path}/prognosis", response_model=AnyPrognosis, responses=responses(401, 404, 422, 503))
 async def prognosis(actuator_id: ActuatorId, request: Request, store: StoreDep, runner: RunnerDep) -> Prognosis:
     """Trend of FDJ, η_O and η_A and the remaining useful life to the thresholds of the actuator's document
     (the default actuator's where it has none), with its backtest; computed as a job of the queue."""

@@ -4,8 +4,9 @@ import numpy as np
 import pytest
 
 from ema.estimate.documents.window_facts import HistoryReadings, InertiaReading, SensorZero
+from ema.kinds import readings_of_results
 from ema.kinds.rotary.inertia import NAMED_WINDOWS, combined_inertia, since_change
-from ema.kinds.rotary.other_windows import best_zero, known_from, readings_of
+from ema.kinds.rotary.other_windows import best_zero, known_from
 from ema.kinds.rotary.pipeline import estimate_window
 from ema.kinds.rotary.synthetic import synthetic_window
 from ema.model.actuator import THESIS
@@ -45,9 +46,11 @@ def test_the_zero_is_the_flights_most_precise_and_j_m_the_actuators():
         return base.model_copy(update={"flight_id": flight_id, "sensor_zero": zero, "inertia_read": inertia})
 
     windows = [info("f", 2e-4), info("f", 1e-4), info("g", 1e-6, _reading(1.06, 0.001, "x")), info(None, 1e-7)]
-    assert readings_of(windows, "f").sensor_zero.window_id == "f-0.0001"
-    assert readings_of(windows, "f").inertia.factor == 1.06  # J_M from any flight: it stays with the build
-    assert readings_of(windows, None).sensor_zero is None and readings_of([], "f") == HistoryReadings()
+    flight_f = readings_of_results(THESIS, windows, "f")
+    assert flight_f.sensor_zero.window_id == "f-0.0001"
+    assert flight_f.inertia.factor == 1.06  # J_M from any flight: it stays with the build
+    assert readings_of_results(THESIS, windows, None).sensor_zero is None
+    assert readings_of_results(THESIS, [], "f") == HistoryReadings()
     assert best_zero([]) is None
 
 
@@ -67,3 +70,11 @@ def test_j_m_is_read_since_it_last_changed_where_two_readings_say_so():
     assert combined_inertia([*before, *after]).factor == pytest.approx(1.0)
     alone = [*before, _reading(1.0, 0.002, "a0")]  # one reading against five: replaced, or gone wrong
     assert since_change(alone) == alone and combined_inertia(alone).std > 0.01
+
+
+def test_a_prognosis_prints_the_actuators_j_m_where_its_windows_read_one():
+    from ema.kinds import prognosis_lines
+
+    read = {"inertia": {"factor": 1.06, "std": 0.002, "window_ids": ["w1"]}}
+    assert prognosis_lines(read) == ["J_M 1.0600 ± 0.002x the document's, as windows that could tell it read it"]
+    assert prognosis_lines({"inertia": None}) == prognosis_lines({"trends": {}}) == []
