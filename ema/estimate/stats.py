@@ -48,3 +48,30 @@ def white_noise_std(values: np.ndarray) -> float:
     the median ignores the few samples where the motion itself turns sharply.
     """
     return float(np.sqrt(robust_variance(np.diff(values, n=2)) / 6.0))
+
+
+def between_runs_std(values: np.ndarray, stds: np.ndarray, centre: float | None = None) -> float:
+    """τ ≥ 0, how far readings of one quantity scatter beyond their stated ``stds``: Paule and Mandel's root of
+    Σ (v − m)² / (σ² + τ²) = n − 1 about their inverse-variance mean m, or = n about a known ``centre`` (a nominal the
+    readings are judged against, so that their offset from it is part of their scatter); 0 where the stds explain it.
+
+    Each reading is weighed by its own std, so a precise reading that lies off counts as such: the spread less the
+    mean stated variance lets a few imprecise readings hide the precise ones' scatter."""
+    n = len(values)
+    if n < (1 if centre is not None else 3):
+        return 0.0
+
+    def excess(tau2: float) -> float:
+        weights = 1.0 / np.maximum(stds**2 + tau2, 1e-300)
+        mean = float(np.sum(weights * values) / np.sum(weights)) if centre is None else centre
+        return float(np.sum(weights * (values - mean) ** 2)) - (n - 1 if centre is None else n)
+
+    if excess(0.0) <= 0:
+        return 0.0
+    # where the excess is ≤ 0 (every term under 1 about a known centre), bisected
+    high = float(np.var(values)) * 10 if centre is None else float(np.max((values - centre) ** 2))
+    low, high = 0.0, high + 1e-18
+    for _ in range(60):
+        mid = 0.5 * (low + high)
+        low, high = (mid, high) if excess(mid) > 0 else (low, mid)
+    return float(np.sqrt(0.5 * (low + high)))

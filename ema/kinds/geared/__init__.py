@@ -64,7 +64,10 @@ class Geared(LendsNothing):
 
         actuator = as_kind(request.actuator, GearedActuator)
         report, completed = calibrate_geared(
-            [as_window(w, GearedWindow) for w in windows], actuator, request.on_stage or (lambda _: None)
+            [as_window(w, GearedWindow) for w in windows],
+            actuator,
+            request.config,
+            request.on_stage or (lambda _: None),
         )
         return Calibrated(report.model_copy(update={"completed_actuator": completed}), completed)
 
@@ -75,8 +78,10 @@ class Geared(LendsNothing):
         return Cost(simulated_s=steps * ROTARY_STEP_S, window_s=window.duration_s)
 
     def calibration_cost(self, windows: Sequence[Window], config: PipelineConfig) -> Cost:
+        """The solves' runs of every window, and each window answered again with the completed document (``cost``)."""
         steps = sum(window.n_samples for window in windows) * CALIBRATION_RUNS
-        return Cost(simulated_s=steps * ROTARY_STEP_S, window_s=sum(window.duration_s for window in windows))
+        answered = sum(self.cost(window, config).simulated_s for window in windows)
+        return Cost(simulated_s=steps * ROTARY_STEP_S + answered, window_s=sum(window.duration_s for window in windows))
 
     def synthesize(self, actuator: ActuatorDocument, flags: Mapping[str, Any]) -> dict[str, Any]:
         raise not_drawn(self.facts)

@@ -11,8 +11,9 @@ effects, the error before and after, and the completed document.
    ``ema.calibration.limits``).
 3. **The constants** of the model with its named effects are solved on every run; each std is the larger of the
    Gauss–Newton one and the spread of the five fold solutions (the runs' own scatter).
-4. **Every run read** with the completed document (``ema.kinds.geared.output_error``): how far one run's FDJ, η_O
-   and η_A scatter beyond their own stds (the document's repeatability), and per load (mass × arm) their medians.
+4. **Every run answered** with the completed document, as ``ema estimate`` answers it: how far one run's FDJ, η_O
+   and η_A scatter about the nominal beyond their own stds (the document's repeatability), and per load (mass ×
+   arm) their medians (``ema.kinds.geared.calibration_report``).
 """
 
 from __future__ import annotations

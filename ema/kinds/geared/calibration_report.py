@@ -1,10 +1,11 @@
 """A geared servo's calibration as its report and its completed document (``ema.kinds.geared.calibration`` learns).
 
 The completed document holds every constant in SI at the output shaft, each with its std, the named effects, the
-nominal health (FDJ, η_O, η_A) and what a healthy run's reading of it scatters by: every run is read again with the
-completed document (``ema.kinds.geared.output_error``), and the scatter of those readings beyond their own stds is
-the document's repeatability; each load's median against the nominal says whether a load's share was misplaced
-(FDJ would then rise with the mass).
+nominal health (FDJ, η_O, η_A) and what a healthy run's answer scatters by: every run is answered again with the
+completed document, as ``ema estimate`` answers it (its physics reading blended with its network's), and the scatter
+of those answers about the nominal beyond their own stds is the document's repeatability (``between_runs_std``);
+each load's median against the nominal says whether a load's share was misplaced (FDJ would then rise with the
+mass).
 """
 
 from __future__ import annotations
@@ -16,11 +17,12 @@ from typing import Any
 import numpy as np
 
 from ema.calibration.documents import GearedCalibration, Learned, LoadReading
+from ema.estimate.config import PipelineConfig
+from ema.estimate.stats import between_runs_std
 from ema.kinds.geared.calibration import LearnedModel as Model
 from ema.kinds.geared.calibration import learned_model
 from ema.kinds.geared.effects import CONSTANTS
-from ema.kinds.geared.log_reading import HEALTH, log_constants, prepare_geared
-from ema.kinds.geared.output_error import read_health
+from ema.kinds.geared.log_reading import HEALTH, log_constants
 from ema.kinds.geared.stacked_fit import LoggedRun, RunSet
 from ema.model.actuator import GearedActuator, Nominal
 from ema.model.window import GearedWindow
@@ -84,27 +86,37 @@ def completed_document(actuator: GearedActuator, model: Model) -> GearedActuator
     return actuator.model_copy(update={"geared": section, "nominal": nominal})
 
 
-def read_runs(windows: Sequence[GearedWindow], document: GearedActuator) -> dict[str, np.ndarray]:
-    """(R,) each run's FDJ, η_O and η_A read with ``document``, and (R,) their stds (``<name>_std``)."""
+def read_runs(
+    windows: Sequence[GearedWindow], document: GearedActuator, config: PipelineConfig
+) -> dict[str, np.ndarray]:
+    """(R,) each run's FDJ, η_O and η_A as ``ema estimate`` answers it with ``document``, and (R,) their stds before
+    any repeatability (``<name>_std``: the document read with none): what a run's answer scatters by is measured on the
+    answers themselves, their physics reading blended with the network's, not on the physics reading alone."""
+    from ema.estimate.documents import ActuatorRead
+    from ema.kinds.geared.stages import estimate_geared  # the network's
+
+    bare = document.model_copy(update={"geared": document.geared.completed(repeatability={})})
+    read_with = ActuatorRead(name=document.name, version=None, default=False)
     read: dict[str, list[float]] = defaultdict(list)
     for window in windows:
-        reading = read_health(prepare_geared(window, document))
+        estimates = estimate_geared(window, config, actuator=bare, read_with=read_with).estimates
         for name in HEALTH:
-            read[name].append(reading.values[name])
-            read[f"{name}_std"].append(reading.stds[name])
+            entry = getattr(estimates, REPORTED[name])
+            read[name].append(entry.value)
+            read[f"{name}_std"].append(entry.std)
     return {name: np.array(values) for name, values in read.items()}
 
 
 def repeatable(document: GearedActuator, read: dict[str, np.ndarray]) -> GearedActuator:
-    """The document with its repeatability (the runs' scatter beyond their own stds: a set point the model reads
-    off counts, as it will in service) and its nominal health's stds widened by it: what a healthy run's reading
-    scatters about the nominal."""
-    section = document.geared
+    """The document with its repeatability (``between_runs_std`` of the runs' answers about the nominal: an answer is
+    judged against it, so the runs' offset from it counts, as a set point the model reads off does in service) and
+    its nominal health's stds widened by it: what a healthy run's answer scatters by about the nominal."""
+    section, nominal = document.geared, health_nominal(document)
     repeatability, stds = {}, dict(section.stds)
     for name in HEALTH:
         values, own = read[name], read[f"{name}_std"]
-        spread = float(np.std(values, ddof=1)) if len(values) > 1 else 0.0  # every run's: a shape read off counts
-        repeatability[name] = float(np.sqrt(max(spread**2 - float(np.mean(own**2)), 0.0)))
+        centre = nominal.get(name, float(np.median(values)) if len(values) else 0.0)
+        repeatability[name] = between_runs_std(values, own, centre)
         stds[name] = float(np.hypot(stds.get(name, 0.0), repeatability[name]))
     return document.model_copy(update={"geared": section.completed(repeatability=repeatability, stds=stds)})
 
@@ -183,13 +195,16 @@ def report(
 
 
 def calibrate_geared(
-    windows: Sequence[GearedWindow], actuator: GearedActuator, on_stage: Callable[[str], None]
+    windows: Sequence[GearedWindow],
+    actuator: GearedActuator,
+    config: PipelineConfig,
+    on_stage: Callable[[str], None],
 ) -> tuple[GearedCalibration, GearedActuator]:
     """The report and the completed document of a geared servo's runs (module docstring)."""
     model, runs = learned_model(windows, actuator.geared, on_stage)
     document = completed_document(actuator, model)
-    on_stage(f"reading each of the {len(windows)} runs with the completed document")
-    read = read_runs(windows, document)
+    on_stage(f"answering each of the {len(windows)} runs with the completed document")
+    read = read_runs(windows, document, config)
     document = repeatable(document, read)
     return report(model, runs, document, by_load(windows, read, document)), document
 

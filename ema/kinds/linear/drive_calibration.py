@@ -33,7 +33,7 @@ import numpy as np
 from ema.estimate.least_squares import weighted
 from ema.estimate.profile import ETA_GRID, profile_std
 from ema.estimate.quasistatic.stretches import Stretch, stretches
-from ema.estimate.stats import below_zero, rms
+from ema.estimate.stats import below_zero, between_runs_std, rms
 from ema.kinds.linear.stepper_reading import set_point_motion
 from ema.model.actuator import LinearActuator
 from ema.model.checks import InputError
@@ -165,7 +165,7 @@ def calibrate_drive(runs: list[Run], actuator: LinearActuator) -> CalibratedDriv
     fdj = c_fdj / c
     eta_std = profile_std(ETA_GRID, chi2, rise=birge**2)
     per_run = [_run_fdj(run, c, float(ETA_GRID[best]), actuator) for run in runs]
-    repeat = _excess_std(np.array([f for f, _ in per_run]), np.array([s for _, s in per_run]))
+    repeat = between_runs_std(np.array([f for f, _ in per_run]), np.array([s for _, s in per_run]))
     anchored = [_run_fdj(run, c, float(ETA_GRID[best]), actuator, float(rests.mean())) for run in runs]
     return CalibratedDrive(
         current_per_nm_a=float(c),
@@ -237,25 +237,6 @@ def healthy_spread(runs: list[Run], per_run: list[tuple[float, float]], nominal_
     sets = rms(np.array([np.mean(v) - nominal_fdj_nm for v in groups.values()]))
     noise = float(np.median([std for _, std in per_run]))
     return HealthySpread(run_to_run_nm=run_to_run, run_noise_nm=noise, set_nm=max(sets, run_to_run))
-
-
-def _excess_std(values: np.ndarray, stds: np.ndarray) -> float:
-    """τ ≥ 0 with Σ (v − m)²/(σ² + τ²) = n − 1: the scatter beyond the stated stds (0 where they explain it)."""
-    if len(values) < 3:
-        return 0.0
-
-    def excess(tau2: float) -> float:
-        weights = 1.0 / (stds**2 + tau2)
-        mean = np.sum(weights * values) / np.sum(weights)
-        return float(np.sum(weights * (values - mean) ** 2) - (len(values) - 1))
-
-    if excess(0.0) <= 0:
-        return 0.0
-    low, high = 0.0, float(np.var(values)) * 10 + 1e-18
-    for _ in range(60):
-        mid = 0.5 * (low + high)
-        low, high = (mid, high) if excess(mid) > 0 else (low, mid)
-    return float(np.sqrt(0.5 * (low + high)))
 
 
 def _predicted_before(runs: list[Run], actuator: LinearActuator) -> np.ndarray:
