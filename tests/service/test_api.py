@@ -175,6 +175,7 @@ def test_history_survives_a_restart(tmp_path, document):
     assert [h["id"] for h in history["estimates"]] == [first["id"], second["id"]]  # oldest first
     assert prognosis["trends"]["FDJ"]["n"] == 2
     assert prognosis["remaining_life"]["FDJ"]["status"] == "too few windows"
+    assert "inertia" in prognosis  # a rotary actuator's prognosis answers its own part (RotaryPrognosis), null or not
 
 
 def test_the_first_prognosis_of_a_new_actuator_is_a_level_with_no_slope(client, document):
