@@ -293,3 +293,39 @@ def test_a_calibration_stored_before_reports_named_their_kind_comes_back_as_its_
         connection.execute(row)
     [(when, read)] = history.calibrations("rig")
     assert when == "then" and isinstance(read, LinearCalibration) and read == report
+
+
+def test_the_lending_columns_renamed_go_back_and_forth_with_what_they_hold(setting, result):
+    """Round 7's migration renames round 4's sensor_zero and inertia_read in place: down to r4 the loans sit in the
+    old columns, up again in the new ones, nothing lost either way."""
+    import sqlalchemy as sa
+    from alembic import command
+    from alembic.config import Config
+
+    from ema.history.schema import MIGRATIONS
+
+    zero = SensorZero(window_id="w1", hinge_nm=0.0, current_a=2e-4, torque_std_nm=2e-4)
+    store = open_history(setting)
+    try:
+        store.add(_as(result, "a", "w1", flight_id="f", sensor_zero=zero))
+    finally:
+        store.close()
+    address = setting if "://" in setting else f"sqlite:///{setting}"
+    engine = sa.create_engine(address.replace("postgresql://", "postgresql+psycopg://", 1))
+    try:
+        with engine.connect() as connection:
+            config = Config()
+            config.set_main_option("script_location", str(MIGRATIONS))
+            config.attributes["connection"] = connection
+            command.downgrade(config, "r4")
+            kept = connection.execute(sa.text("SELECT sensor_zero FROM estimates")).scalar_one()
+            assert SensorZero.model_validate_json(kept) == zero
+            command.upgrade(config, "head")
+            connection.commit()
+    finally:
+        engine.dispose()
+    store = open_history(setting)
+    try:
+        assert _lent(store, "a", "f").sensor_zero == zero
+    finally:
+        store.close()
