@@ -258,6 +258,9 @@ def calibrate(
     request = kinds.CalibrationRequest(config, document, read_truth(truth), copies=copies, on_stage=progress)
     with flags_named({"truth": "--truth"}):
         calibrated = kinds.calibrate(loaded, request)
+    uncompared = [name for name in request.truth or {} if name not in (calibrated.report.error_after or {})]
+    if uncompared:  # a truth file of ema simulate holds FSJ and eta_A: said, never silently passed over
+        print(f"ema: --truth: not compared, the report carries no {', '.join(uncompared)}", file=sys.stderr)
     written: dict[str, str | None] = {"figure": None, "actuator_written": None}
     if out_actuator is not None:
         if calibrated.completed is None:

@@ -394,7 +394,11 @@ def test_a_servo_s_calibration_states_its_error_against_any_constant_it_reports(
     assert set(report["error_before"]) == {"FDJ"}  # the mass has no value before: the document holds none
     assert report["error_pct_after"]["mass"] == pytest.approx(100 * report["error_after"]["mass"] / 95.0)
     assert main(calibrate) == EXIT_OK
-    assert "mass error against the truth: — -> " in capsys.readouterr().out
+    said = capsys.readouterr()
+    assert "mass error against the truth: — -> " in said.out and "--truth: not compared" not in said.err
+    truth.write_text('{"mass": 95.0, "eta_A": 0.9}')
+    assert main(calibrate) == EXIT_OK
+    assert "ema: --truth: not compared, the report carries no eta_A" in capsys.readouterr().err
     truth.write_text('{"massa": 95.0}')
     assert main(calibrate) == EXIT_BAD_INPUT
     said = capsys.readouterr().err
