@@ -1,6 +1,6 @@
-"""What an estimate says of its window (``ema-estimate/1``'s ``window``), and what windows of one actuator lend each
-other: a flight's sensor zero, the actuator's J_M (``ema.kinds.rotary.other_windows``). Part of the one definition of
-the estimate document (``ema.estimate.documents``).
+"""What an estimate says of its window (``ema-estimate/1``'s ``window``): what every kind's says, and what a rotary
+window's reading adds, with what its windows lend each other (a flight's sensor zero, the actuator's J_M:
+``ema.kinds.rotary.other_windows``). Part of the one definition of the estimate document (``ema.estimate.documents``).
 """
 
 from __future__ import annotations
@@ -14,9 +14,8 @@ from ema.model.window import Window
 
 
 class SensorZero(Document):
-    """The sensors' zero as a window moving both ways read it (``ema.kinds.rotary.prepare.departures.zero_offset``):
-    what a window of
-    the same flight that moves one way, and so cannot read it, is read with."""
+    """The sensors' zero as a rotary window moving both ways read it (``ema.kinds.rotary.prepare.departures
+    .zero_offset``): what a window of the same flight that moves one way, and so cannot read it, is read with."""
 
     window_id: str = Field(description="the window that read it")
     hinge_nm: float = Field(description="taken off the logged hinge moment")
@@ -35,8 +34,9 @@ class InertiaReading(Document):
 
 
 class HistoryReadings(Document):
-    """What other windows of an actuator read that one window may not: the sensor zero of its flight
-    (``flight_id``) and the actuator's J_M. The service takes them from its history."""
+    """What a rotary actuator's other windows lend one of its windows that it may not read itself: the sensor zero of
+    its flight (``flight_id``) and the actuator's J_M (``Rotary.borrowing``: the service, the fleet and ``ema estimate
+    --history`` read it from what the windows lent, ``ema.kinds.rotary.other_windows``)."""
 
     sensor_zero: SensorZero | None = None
     inertia: InertiaReading | None = None
