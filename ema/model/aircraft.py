@@ -58,6 +58,11 @@ class FlightCondition:
         return SEA_LEVEL_DENSITY_KGPM3 * (1.0 - 2.2558e-5 * self.altitude_m) ** 4.2559
 
     @property
+    def density_ratio(self) -> float:
+        """ρ(h)/ρ0: what the sea-level linearization and trim table are scaled by."""
+        return self.density_kgpm3 / SEA_LEVEL_DENSITY_KGPM3
+
+    @property
     def dynamic_pressure_pa(self) -> float:
         """q̄ = ½ρV²."""
         return 0.5 * self.density_kgpm3 * self.airspeed_mps**2

@@ -14,7 +14,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ema.model.aircraft import SEA_LEVEL_DENSITY_KGPM3, FlightCondition, HingeGeometry
+from ema.model.aircraft import FlightCondition, HingeGeometry
 from ema.model.checks import InputError, in_range
 from ema.model.envelope import DEFAULT_AIRSPEED_MPS
 
@@ -76,7 +76,7 @@ class LoadModel(NamedTuple):
 
 def state_space(condition: FlightCondition) -> tuple[np.ndarray, np.ndarray]:
     """(A, B) at ``condition``, scaled from the default linearization as ``docs/model.md`` sets out."""
-    k_rho = condition.density_kgpm3 / SEA_LEVEL_DENSITY_KGPM3
+    k_rho = condition.density_ratio
     k_v = k_rho * condition.airspeed_mps / DEFAULT_AIRSPEED_MPS
     k_q = k_rho * (condition.airspeed_mps / DEFAULT_AIRSPEED_MPS) ** 2
     a, b = A_DEFAULT.copy(), B_DEFAULT.copy()
@@ -98,7 +98,7 @@ def trim(condition: FlightCondition) -> tuple[float, float]:
     equivalent airspeed V·sqrt(ρ/ρ0) carries the sea-level table to altitude. Outside the table's
     300–700 ft/s the end rows hold (the linear model is not valid beyond them anyway).
     """
-    eas_ftps = condition.airspeed_mps * np.sqrt(condition.density_kgpm3 / SEA_LEVEL_DENSITY_KGPM3) / FT_TO_M
+    eas_ftps = condition.airspeed_mps * np.sqrt(condition.density_ratio) / FT_TO_M
     alpha_deg = np.interp(eas_ftps, TRIM_TABLE[:, 0], TRIM_TABLE[:, 1])
     delta_deg = np.interp(eas_ftps, TRIM_TABLE[:, 0], TRIM_TABLE[:, 2])
     return float(np.radians(alpha_deg)), float(np.radians(delta_deg))
