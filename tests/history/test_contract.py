@@ -1,6 +1,7 @@
 """One contract for every history: SQLite and PostgreSQL pass the same tests (``setting`` runs each on both)."""
 
 import concurrent.futures
+import contextlib
 import json
 
 import pytest
@@ -237,37 +238,48 @@ def test_calibrations_come_back_whole_latest_first(history):
     assert all(when for when, _ in stored)
 
 
+@contextlib.contextmanager
+def _migrating(setting):
+    """A connection to the history at ``setting`` and an Alembic configuration of ema's migrations on it, committed
+    when the block ends."""
+    import sqlalchemy as sa
+    from alembic.config import Config
+
+    from ema.history.schema import MIGRATIONS
+
+    address = setting if "://" in setting else f"sqlite:///{setting}"
+    engine = sa.create_engine(address.replace("postgresql://", "postgresql+psycopg://", 1))
+    try:
+        with engine.connect() as connection:
+            config = Config()
+            config.set_main_option("script_location", str(MIGRATIONS))
+            config.attributes["connection"] = connection
+            yield connection, config
+            connection.commit()
+    finally:
+        engine.dispose()
+
+
 def test_a_round_three_history_upgraded_keeps_every_window_and_fills_its_lookups(setting, result):
     """A history round 3 left (its tables, windows stored as JSON only) opened by this ema: every window comes back
     as stored, and the lookups round 4 added (a flight's sensor zero) read from their JSON, more than the batch of
     rows the migration fills at once."""
     import sqlalchemy as sa
     from alembic import command
-    from alembic.config import Config
 
     from ema.history.migrations.versions import r4_lookups_withdrawals_summaries as r4
-    from ema.history.schema import MIGRATIONS
 
-    address = setting if "://" in setting else f"sqlite:///{setting}"
-    engine = sa.create_engine(address.replace("postgresql://", "postgresql+psycopg://", 1))
     n = r4.BATCH + 3
     zero = SensorZero(window_id="last", hinge_nm=0.0, current_a=1e-4, torque_std_nm=1e-4)  # in the second batch
     rows = [_as(result, "a", f"w{i}", flight_id="f", sensor_zero=zero if i == n - 1 else None) for i in range(n)]
-    try:
-        with engine.connect() as connection:
-            config = Config()
-            config.set_main_option("script_location", str(MIGRATIONS))
-            config.attributes["connection"] = connection
-            command.upgrade(config, "r3")
-            table = sa.table("estimates", *(sa.column(c) for c in ("actuator_id", "window_id", "stored_at", "result")))
-            connection.execute(
-                table.insert(),
-                [{"actuator_id": "a", "window_id": r.window_id, "stored_at": "2026-01-01T00:00:00Z",
-                  "result": r.model_dump_json(by_alias=True)} for r in rows],
-            )  # fmt: skip
-            connection.commit()
-    finally:
-        engine.dispose()
+    with _migrating(setting) as (connection, config):
+        command.upgrade(config, "r3")
+        table = sa.table("estimates", *(sa.column(c) for c in ("actuator_id", "window_id", "stored_at", "result")))
+        connection.execute(
+            table.insert(),
+            [{"actuator_id": "a", "window_id": r.window_id, "stored_at": "2026-01-01T00:00:00Z",
+              "result": r.model_dump_json(by_alias=True)} for r in rows],
+        )  # fmt: skip
     store = open_history(setting)
     try:
         current, legacy = store.history("a")
@@ -300,9 +312,6 @@ def test_the_lending_columns_renamed_go_back_and_forth_with_what_they_hold(setti
     old columns, up again in the new ones, nothing lost either way."""
     import sqlalchemy as sa
     from alembic import command
-    from alembic.config import Config
-
-    from ema.history.schema import MIGRATIONS
 
     zero = SensorZero(window_id="w1", hinge_nm=0.0, current_a=2e-4, torque_std_nm=2e-4)
     store = open_history(setting)
@@ -310,20 +319,11 @@ def test_the_lending_columns_renamed_go_back_and_forth_with_what_they_hold(setti
         store.add(_as(result, "a", "w1", flight_id="f", sensor_zero=zero))
     finally:
         store.close()
-    address = setting if "://" in setting else f"sqlite:///{setting}"
-    engine = sa.create_engine(address.replace("postgresql://", "postgresql+psycopg://", 1))
-    try:
-        with engine.connect() as connection:
-            config = Config()
-            config.set_main_option("script_location", str(MIGRATIONS))
-            config.attributes["connection"] = connection
-            command.downgrade(config, "r4")
-            kept = connection.execute(sa.text("SELECT sensor_zero FROM estimates")).scalar_one()
-            assert SensorZero.model_validate_json(kept) == zero
-            command.upgrade(config, "head")
-            connection.commit()
-    finally:
-        engine.dispose()
+    with _migrating(setting) as (connection, config):
+        command.downgrade(config, "r4")
+        kept = connection.execute(sa.text("SELECT sensor_zero FROM estimates")).scalar_one()
+        assert SensorZero.model_validate_json(kept) == zero
+        command.upgrade(config, "head")
     store = open_history(setting)
     try:
         assert _lent(store, "a", "f").sensor_zero == zero
